@@ -1,0 +1,367 @@
+#include "config/scene_file.h"
+
+#include <toml++/toml.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <set>
+#include <sstream>
+#include <vector>
+
+#include "world/counter_random.h"
+
+namespace nephele {
+namespace {
+
+struct SceneError {
+  std::string message;
+};
+
+std::string formatNumber(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+std::string joinKeys(const std::vector<std::string>& keys) {
+  std::string out;
+  for (const auto& k : keys) out += (out.empty() ? "" : ", ") + k;
+  return out;
+}
+
+// Reads one TOML table; every key must be consumed by exactly one typed getter, and
+// finish() reports whatever is left as unknown.
+class TableReader {
+ public:
+  TableReader(const toml::table& table, std::string path, const std::string& file)
+      : table_(table), path_(std::move(path)), file_(file) {}
+
+  bool has(std::string_view key) const { return table_.contains(key); }
+
+  void number(std::string_view key, double& out, double lo, double hi) {
+    const toml::node* node = take(key);
+    if (!node) return;
+    out = toNumber(*node, key, lo, hi);
+  }
+
+  void integer(std::string_view key, int& out, int lo, int hi) {
+    const toml::node* node = take(key);
+    if (!node) return;
+    out = int(toInteger(*node, key, lo, hi));
+  }
+
+  void seed(std::string_view key, std::uint64_t& out) {
+    const toml::node* node = take(key);
+    if (!node) return;
+    out = std::uint64_t(toInteger(*node, key, 0, std::numeric_limits<std::int64_t>::max()));
+  }
+
+  void boolean(std::string_view key, bool& out) {
+    const toml::node* node = take(key);
+    if (!node) return;
+    if (!node->is_boolean()) fail(*node, key, "must be true or false");
+    out = node->value<bool>().value();
+  }
+
+  // A string that must be one of `allowed`; returns its index.
+  int choice(std::string_view key, const std::vector<std::string>& allowed, int current) {
+    const toml::node* node = take(key);
+    if (!node) return current;
+    if (!node->is_string())
+      fail(*node, key, "must be a string (one of: " + joinKeys(allowed) + ")");
+    const std::string value = node->value<std::string>().value();
+    for (std::size_t i = 0; i < allowed.size(); ++i)
+      if (allowed[i] == value) return int(i);
+    fail(*node, key, "\"" + value + "\" is not allowed (one of: " + joinKeys(allowed) + ")");
+  }
+
+  void string(std::string_view key, std::string& out) {
+    const toml::node* node = take(key);
+    if (!node) return;
+    if (!node->is_string()) fail(*node, key, "must be a string");
+    out = node->value<std::string>().value();
+  }
+
+  template <int N>
+  void vector(std::string_view key, glm::vec<N, double>& out, double lo, double hi) {
+    const toml::node* node = take(key);
+    if (!node) return;
+    const toml::array* array = node->as_array();
+    if (!array || array->size() != std::size_t(N))
+      fail(*node, key, "must be an array of " + std::to_string(N) + " numbers");
+    for (int i = 0; i < N; ++i) out[i] = toNumber(*array->get(std::size_t(i)), key, lo, hi);
+  }
+
+  // A sub-table (absent: null). Its reader must be finished by the caller.
+  std::optional<TableReader> table(std::string_view key) {
+    const toml::node* node = take(key);
+    if (!node) return std::nullopt;
+    if (!node->is_table()) fail(*node, key, "must be a table");
+    return TableReader(*node->as_table(), qualified(key), file_);
+  }
+
+  // An array of tables ([[key]]).
+  std::vector<TableReader> tables(std::string_view key) {
+    std::vector<TableReader> out;
+    const toml::node* node = take(key);
+    if (!node) return out;
+    const toml::array* array = node->as_array();
+    if (!array || !array->is_array_of_tables())
+      fail(*node, key, "must be an array of tables, written [[" + std::string(key) + "]]");
+    for (std::size_t i = 0; i < array->size(); ++i)
+      out.emplace_back(*array->get(i)->as_table(), qualified(key) + "[" + std::to_string(i) + "]",
+                       file_);
+    return out;
+  }
+
+  // Rejects a key that is present but does not apply here.
+  void forbid(std::string_view key, const std::string& why) {
+    if (const toml::node* node = table_.get(key)) fail(*node, key, why);
+  }
+
+  void finish() const {
+    for (auto&& [key, node] : table_) {
+      if (taken_.count(std::string(key.str()))) continue;
+      fail(node, key.str(), "unknown key (allowed here: " + joinKeys(allowed_) + ")");
+    }
+  }
+
+  // Declares the keys this table accepts, for the unknown-key message.
+  void allow(std::vector<std::string> keys) { allowed_ = std::move(keys); }
+
+  [[noreturn]] void failAt(std::string_view key, const std::string& what) const {
+    fail(*table_.get(key), key, what);
+  }
+
+  [[noreturn]] void fail(const toml::node& node, std::string_view key,
+                         const std::string& what) const {
+    throw SceneError{file_ + ":" + std::to_string(node.source().begin.line) + ": " +
+                     qualified(key) + ": " + what};
+  }
+
+ private:
+  const toml::node* take(std::string_view key) {
+    taken_.insert(std::string(key));
+    return table_.get(key);
+  }
+
+  std::string qualified(std::string_view key) const {
+    return path_.empty() ? std::string(key) : path_ + "." + std::string(key);
+  }
+
+  double toNumber(const toml::node& node, std::string_view key, double lo, double hi) const {
+    if (!node.is_number()) fail(node, key, "must be a number");
+    const double v = node.value<double>().value();
+    if (!std::isfinite(v))
+      fail(node, key,
+           formatNumber(v) + " is not a finite number (allowed: " + formatNumber(lo) + " to " +
+               formatNumber(hi) + ")");
+    if (v < lo || v > hi)
+      fail(node, key,
+           formatNumber(v) + " is out of range (allowed: " + formatNumber(lo) + " to " +
+               formatNumber(hi) + ")");
+    return v;
+  }
+
+  std::int64_t toInteger(const toml::node& node, std::string_view key, std::int64_t lo,
+                         std::int64_t hi) const {
+    if (!node.is_integer()) fail(node, key, "must be an integer");
+    const std::int64_t v = node.value<std::int64_t>().value();
+    if (v < lo || v > hi)
+      fail(node, key,
+           std::to_string(v) + " is out of range (allowed: " + std::to_string(lo) + " to " +
+               std::to_string(hi) + ")");
+    return v;
+  }
+
+  const toml::table& table_;
+  std::string path_;
+  const std::string& file_;
+  std::set<std::string> taken_;
+  std::vector<std::string> allowed_;
+};
+
+constexpr double kMaxColour = 100.0;  // linear RGB; above 1 is allowed for bright HDR suns
+
+void readImage(TableReader& t, Camera& camera) {
+  t.allow({"width", "height"});
+  t.integer("width", camera.width, 1, Limits::kMaxImageSide);
+  t.integer("height", camera.height, 1, Limits::kMaxImageSide);
+  t.finish();
+}
+
+void readCamera(TableReader& t, Camera& camera) {
+  t.allow({"position", "heading", "pitch", "roll", "vfov"});
+  t.vector("position", camera.position, -Limits::kMaxCoordinate, Limits::kMaxCoordinate);
+  if (camera.position.z < 0.0)
+    t.failAt("position",
+             "z = " + formatNumber(camera.position.z) + " is below the ground (allowed: z >= 0)");
+  t.number("heading", camera.orientation.heading_deg, -360.0, 360.0);
+  t.number("pitch", camera.orientation.pitch_deg, -90.0, 90.0);
+  t.number("roll", camera.orientation.roll_deg, -180.0, 180.0);
+  t.number("vfov", camera.vfov_deg, Limits::kMinVfov, Limits::kMaxVfov);
+  t.finish();
+}
+
+void readSun(TableReader& t, Sun& sun) {
+  t.allow({"azimuth", "elevation", "colour"});
+  t.number("azimuth", sun.azimuth_deg, -360.0, 360.0);
+  t.number("elevation", sun.elevation_deg, -90.0, 90.0);
+  t.vector("colour", sun.colour, 0.0, kMaxColour);
+  t.finish();
+}
+
+void readSky(TableReader& t, Sky& sky) {
+  t.allow({"model", "zenith", "horizon", "ground"});
+  t.choice("model", {"gradient"}, 0);
+  t.vector("zenith", sky.zenith, 0.0, kMaxColour);
+  t.vector("horizon", sky.horizon, 0.0, kMaxColour);
+  t.vector("ground", sky.ground, 0.0, kMaxColour);
+  t.finish();
+}
+
+void readFog(TableReader& t, Fog& fog) {
+  t.allow({"top", "visibility", "colour"});
+  t.number("top", fog.top_m, 0.0, Limits::kMaxAltitude);
+  t.number("visibility", fog.visibility_m, 1.0, 1.0e7);
+  t.vector("colour", fog.colour, 0.0, kMaxColour);
+  t.finish();
+}
+
+void readRender(TableReader& t, SceneFile& out) {
+  t.allow({"texture", "term_filter", "bake_texels_per_cycle", "reference_samples"});
+  out.render.texture_evaluation = TextureEvaluation(
+      t.choice("texture", {"baked", "procedural"}, int(out.render.texture_evaluation)));
+  out.render.term_filter =
+      TermFilter(t.choice("term_filter", {"fade", "cut", "none"}, int(out.render.term_filter)));
+  t.integer("bake_texels_per_cycle", out.render.bake_texels_per_cycle, 2, 64);
+  t.integer("reference_samples", out.reference.samples_per_axis, 1, 16);
+  t.finish();
+}
+
+void readTexture(TableReader& t, LayerTextureSpec& texture) {
+  t.allow({"source", "terms", "fx1", "fy1", "t0", "phases", "tile_size", "size_log2", "roughness",
+           "cells", "octaves", "persistence"});
+  texture.source = TextureSource(
+      t.choice("source", {"gardner", "perlin", "diamond-square"}, int(texture.source)));
+  const std::string source(textureSourceName(texture.source));
+  const bool gardner = texture.source == TextureSource::kGardner;
+  const bool perlin = texture.source == TextureSource::kPerlin;
+  for (const char* key : {"terms", "fx1", "fy1", "t0", "phases"})
+    if (!gardner) t.forbid(key, "applies to source \"gardner\" only, not \"" + source + "\"");
+  for (const char* key : {"tile_size", "size_log2"})
+    if (gardner) t.forbid(key, "applies to sources \"perlin\" and \"diamond-square\" only");
+  for (const char* key : {"cells", "octaves", "persistence"})
+    if (!perlin) t.forbid(key, "applies to source \"perlin\" only, not \"" + source + "\"");
+  if (texture.source != TextureSource::kDiamondSquare)
+    t.forbid("roughness", "applies to source \"diamond-square\" only, not \"" + source + "\"");
+
+  GardnerTextureParams& g = texture.gardner;
+  t.integer("terms", g.terms, 1, GardnerTextureParams::kMaxTerms);
+  t.number("fx1", g.fx1, 1.0e-7, 10.0);
+  t.number("fy1", g.fy1, 1.0e-7, 10.0);
+  t.number("t0", g.t0, 0.0, 10.0);
+  t.boolean("phases", g.seeded_phases);
+  NoiseTableParams& n = texture.table;
+  t.vector("tile_size", n.tile_size_m, 1.0, 1.0e7);
+  t.integer("size_log2", n.size_log2, 4, 12);
+  t.number("roughness", n.roughness, 0.0, 4.0);
+  t.integer("cells", n.cells, 1, 64);
+  t.integer("octaves", n.octaves, 1, 12);
+  t.number("persistence", n.persistence, 0.0, 1.0);
+  t.finish();
+}
+
+void readLayer(TableReader& t, CloudLayer& layer) {
+  t.allow({"name", "altitude", "colour", "threshold", "transition", "ambient", "texture_fraction",
+           "specular", "shininess", "drift", "seed", "texture"});
+  t.string("name", layer.name);
+  t.number("altitude", layer.altitude_m, 0.0, Limits::kMaxAltitude);
+  t.vector("colour", layer.colour, 0.0, kMaxColour);
+  t.number("threshold", layer.threshold, 0.0, 1.0);
+  t.number("transition", layer.transition, 0.0, 10.0);
+  t.number("ambient", layer.shading.ambient, 0.0, 1.0);
+  t.number("texture_fraction", layer.shading.texture_fraction, 0.0, 1.0);
+  t.number("specular", layer.shading.specular, 0.0, 1.0);
+  t.number("shininess", layer.shading.shininess, 1.0, 1000.0);
+  t.vector("drift", layer.texture.drift_velocity, -300.0, 300.0);
+  t.seed("seed", layer.texture.seed);
+  if (auto texture = t.table("texture")) readTexture(*texture, layer.texture);
+  t.finish();
+}
+
+void readScene(const toml::table& root, const std::string& file, SceneFile& out) {
+  TableReader t(root, "", file);
+  t.allow({"seed", "time", "image", "camera", "sun", "sky", "fog", "render", "layer"});
+  Scene& scene = out.scene;
+  t.seed("seed", scene.seed);
+  t.number("time", scene.time_s, 0.0, 1.0e9);
+  if (auto image = t.table("image")) readImage(*image, scene.camera);
+  if (auto camera = t.table("camera")) readCamera(*camera, scene.camera);
+  if (auto sun = t.table("sun")) readSun(*sun, scene.sun);
+  if (auto sky = t.table("sky")) readSky(*sky, scene.sky);
+  if (auto fog = t.table("fog")) readFog(*fog, scene.fog.emplace());
+  if (auto render = t.table("render")) readRender(*render, out);
+  std::vector<TableReader> layers = t.tables("layer");
+  for (std::size_t i = 0; i < layers.size(); ++i) {
+    CloudLayer& layer = scene.layers.emplace_back();
+    layer.texture.seed = hashCounters(scene.seed, 0x4c61796572ull, i);  // unless given
+    readLayer(layers[i], layer);
+    if (layer.name.empty()) layer.name = "layer" + std::to_string(i);
+  }
+  t.finish();
+}
+
+}  // namespace
+
+std::string parseSceneText(std::string_view text, const std::string& source_name, SceneFile& out) {
+  SceneFile parsed;
+  try {
+    const toml::table root = toml::parse(text, source_name);
+    readScene(root, source_name, parsed);
+  } catch (const toml::parse_error& e) {
+    return source_name + ":" + std::to_string(e.source().begin.line) +
+           ": not valid TOML: " + std::string(e.description());
+  } catch (const SceneError& e) {
+    return e.message;
+  }
+  out = std::move(parsed);
+  return "";
+}
+
+std::string loadSceneFile(const std::string& path, SceneFile& out) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return "cannot read scene file '" + path + "': " + std::strerror(errno);
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) return "cannot read scene file '" + path + "': " + std::strerror(errno);
+  return parseSceneText(text.str(), path, out);
+}
+
+std::string validateCamera(const Camera& c) {
+  if (c.width < 1 || c.width > Limits::kMaxImageSide || c.height < 1 ||
+      c.height > Limits::kMaxImageSide)
+    return ("image size " + std::to_string(c.width) + "x" + std::to_string(c.height) +
+            " is out of range (allowed: 1 to " + std::to_string(Limits::kMaxImageSide) +
+            " per side)");
+  for (int i = 0; i < 3; ++i)
+    if (!std::isfinite(c.position[i]) || std::abs(c.position[i]) > Limits::kMaxCoordinate)
+      return ("camera position is out of range (allowed: |x|, |y|, |z| <= " +
+              formatNumber(Limits::kMaxCoordinate) + " m)");
+  if (c.position.z < 0.0) return ("camera z is below the ground (allowed: z >= 0)");
+  if (!(c.vfov_deg >= Limits::kMinVfov && c.vfov_deg <= Limits::kMaxVfov))
+    return ("vfov " + formatNumber(c.vfov_deg) + " is out of range (allowed: " +
+            formatNumber(Limits::kMinVfov) + " to " + formatNumber(Limits::kMaxVfov) + ")");
+  const Orientation& o = c.orientation;
+  if (!(std::abs(o.heading_deg) <= 360.0) || !(std::abs(o.pitch_deg) <= 90.0) ||
+      !(std::abs(o.roll_deg) <= 180.0))
+    return (
+        "camera orientation is out of range (allowed: heading -360 to 360, pitch -90 to "
+        "90, roll -180 to 180)");
+  return "";
+}
+
+}  // namespace nephele

@@ -1,0 +1,34 @@
+#pragma once
+// Scene files (TOML) to typed settings, validated once here. Every error names the file, the
+// line, the key and what is allowed; on error nothing is returned.
+#include <string>
+#include <string_view>
+
+#include "renderer/render_settings.h"
+#include "world/scene.h"
+
+namespace nephele {
+
+struct SceneFile {
+  Scene scene;
+  RenderSettings render;
+  ReferenceSettings reference;
+};
+
+// Allowed ranges shared by scene files and command-line overrides.
+struct Limits {
+  static constexpr int kMaxImageSide = 16384;      // GL_MAX_RENDERBUFFER_SIZE on llvmpipe
+  static constexpr double kMaxCoordinate = 1.0e8;  // metres from the origin
+  static constexpr double kMaxAltitude = 1.0e5;
+  static constexpr double kMinVfov = 0.01, kMaxVfov = 179.0;
+};
+
+// Reads `path`. Returns an empty string on success, else the error.
+std::string loadSceneFile(const std::string& path, SceneFile& out);
+// Parses TOML text; `source_name` is the file name used in messages.
+std::string parseSceneText(std::string_view text, const std::string& source_name, SceneFile& out);
+
+// Checks a camera after command-line overrides; empty string when valid.
+std::string validateCamera(const Camera& camera);
+
+}  // namespace nephele

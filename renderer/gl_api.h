@@ -1,0 +1,90 @@
+#pragma once
+// The OpenGL 4.5 core entry points Nephele uses, loaded per context through the platform's
+// own GetProcAddress. Nothing links libGL: with EGL and OSMesa in one process, a link-time
+// glClear would bind every call to whichever library came first.
+#include <GL/glcorearb.h>
+
+namespace nephele {
+
+// GL 1.1 entry points: glcorearb.h skips their typedefs when gl.h came first (osmesa.h).
+using GlDeleteTexturesProc = void(APIENTRYP)(GLsizei n, const GLuint* textures);
+using GlDrawArraysProc = void(APIENTRYP)(GLenum mode, GLint first, GLsizei count);
+
+#define NEPHELE_GL_FUNCTIONS(X)                                          \
+  X(PFNGLGETSTRINGPROC, GetString)                                       \
+  X(PFNGLGETERRORPROC, GetError)                                         \
+  X(PFNGLGETINTEGERVPROC, GetIntegerv)                                   \
+  X(PFNGLCREATESHADERPROC, CreateShader)                                 \
+  X(PFNGLSHADERSOURCEPROC, ShaderSource)                                 \
+  X(PFNGLCOMPILESHADERPROC, CompileShader)                               \
+  X(PFNGLGETSHADERIVPROC, GetShaderiv)                                   \
+  X(PFNGLGETSHADERINFOLOGPROC, GetShaderInfoLog)                         \
+  X(PFNGLDELETESHADERPROC, DeleteShader)                                 \
+  X(PFNGLCREATEPROGRAMPROC, CreateProgram)                               \
+  X(PFNGLATTACHSHADERPROC, AttachShader)                                 \
+  X(PFNGLLINKPROGRAMPROC, LinkProgram)                                   \
+  X(PFNGLGETPROGRAMIVPROC, GetProgramiv)                                 \
+  X(PFNGLGETPROGRAMINFOLOGPROC, GetProgramInfoLog)                       \
+  X(PFNGLDELETEPROGRAMPROC, DeleteProgram)                               \
+  X(PFNGLUSEPROGRAMPROC, UseProgram)                                     \
+  X(PFNGLGETUNIFORMLOCATIONPROC, GetUniformLocation)                     \
+  X(PFNGLPROGRAMUNIFORM1IPROC, ProgramUniform1i)                         \
+  X(PFNGLPROGRAMUNIFORM1FPROC, ProgramUniform1f)                         \
+  X(PFNGLPROGRAMUNIFORM1FVPROC, ProgramUniform1fv)                       \
+  X(PFNGLPROGRAMUNIFORM2FVPROC, ProgramUniform2fv)                       \
+  X(PFNGLPROGRAMUNIFORM3FVPROC, ProgramUniform3fv)                       \
+  X(PFNGLPROGRAMUNIFORM4FVPROC, ProgramUniform4fv)                       \
+  X(PFNGLCREATEVERTEXARRAYSPROC, CreateVertexArrays)                     \
+  X(PFNGLDELETEVERTEXARRAYSPROC, DeleteVertexArrays)                     \
+  X(PFNGLBINDVERTEXARRAYPROC, BindVertexArray)                           \
+  X(PFNGLCREATETEXTURESPROC, CreateTextures)                             \
+  X(GlDeleteTexturesProc, DeleteTextures)                                \
+  X(PFNGLTEXTURESTORAGE2DPROC, TextureStorage2D)                         \
+  X(PFNGLTEXTURESUBIMAGE2DPROC, TextureSubImage2D)                       \
+  X(PFNGLTEXTUREPARAMETERIPROC, TextureParameteri)                       \
+  X(PFNGLGENERATETEXTUREMIPMAPPROC, GenerateTextureMipmap)               \
+  X(PFNGLBINDTEXTUREUNITPROC, BindTextureUnit)                           \
+  X(PFNGLCREATERENDERBUFFERSPROC, CreateRenderbuffers)                   \
+  X(PFNGLDELETERENDERBUFFERSPROC, DeleteRenderbuffers)                   \
+  X(PFNGLNAMEDRENDERBUFFERSTORAGEPROC, NamedRenderbufferStorage)         \
+  X(PFNGLCREATEFRAMEBUFFERSPROC, CreateFramebuffers)                     \
+  X(PFNGLDELETEFRAMEBUFFERSPROC, DeleteFramebuffers)                     \
+  X(PFNGLNAMEDFRAMEBUFFERRENDERBUFFERPROC, NamedFramebufferRenderbuffer) \
+  X(PFNGLCHECKNAMEDFRAMEBUFFERSTATUSPROC, CheckNamedFramebufferStatus)   \
+  X(PFNGLBINDFRAMEBUFFERPROC, BindFramebuffer)                           \
+  X(PFNGLVIEWPORTPROC, Viewport)                                         \
+  X(PFNGLENABLEPROC, Enable)                                             \
+  X(PFNGLDISABLEPROC, Disable)                                           \
+  X(PFNGLBLENDFUNCSEPARATEPROC, BlendFuncSeparate)                       \
+  X(GlDrawArraysProc, DrawArrays)                                        \
+  X(PFNGLPIXELSTOREIPROC, PixelStorei)                                   \
+  X(PFNGLREADPIXELSPROC, ReadPixels)                                     \
+  X(PFNGLFINISHPROC, Finish)
+
+struct GlApi {
+#define NEPHELE_GL_MEMBER(type, name) type name = nullptr;
+  NEPHELE_GL_FUNCTIONS(NEPHELE_GL_MEMBER)
+#undef NEPHELE_GL_MEMBER
+};
+
+}  // namespace nephele
+
+#include <string>
+
+namespace nephele {
+
+// Fills `gl` from `lookup(name)`; on a missing entry point names it in `error`.
+template <typename Lookup>
+bool loadGlApi(GlApi& gl, Lookup lookup, std::string& error) {
+#define NEPHELE_GL_LOAD(type, name)                      \
+  gl.name = reinterpret_cast<type>(lookup("gl" #name));  \
+  if (!gl.name) {                                        \
+    error = "OpenGL entry point gl" #name " is missing"; \
+    return false;                                        \
+  }
+  NEPHELE_GL_FUNCTIONS(NEPHELE_GL_LOAD)
+#undef NEPHELE_GL_LOAD
+  return true;
+}
+
+}  // namespace nephele

@@ -1,0 +1,57 @@
+#pragma once
+// The GL renderer: sky background, then every cloud layer composited back to front into a
+// framebuffer object, then read back.
+#include <map>
+#include <memory>
+#include <string>
+
+#include "renderer/gl_objects.h"
+#include "renderer/gl_platform.h"
+#include "renderer/render_settings.h"
+#include "world/image.h"
+#include "world/scene.h"
+
+namespace nephele {
+
+class LayerTexture;
+
+class GlRenderer {
+ public:
+  // Borrows the platform, whose context must stay current on this thread.
+  explicit GlRenderer(const GlPlatform& platform);
+  ~GlRenderer();
+
+  // Linear float RGB plus coverage (for EXR and for measuring error).
+  FloatImage renderFloat(const Scene& scene, const RenderSettings& settings);
+  // sRGB-encoded bytes, rows bottom-up as GL reads them (PNG, JPEG, TIFF).
+  Srgb8Image renderSrgb8(const Scene& scene, const RenderSettings& settings);
+
+ private:
+  enum class TargetFormat { kFloat, kSrgb8 };
+  // A layer's texture, built once and kept while frames keep using it.
+  struct CachedTexture {
+    std::unique_ptr<LayerTexture> source;
+    GlObject texture;  // made on first use by a pass that samples it
+    bool used = false;
+  };
+
+  void drawFrame(const Scene& scene, const RenderSettings& settings, TargetFormat format);
+  void prepareTarget(int width, int height, TargetFormat format);
+  GLuint program(const std::string& key, const std::string& fragment_source);
+  CachedTexture& cachedTexture(const LayerTextureSpec& spec, const RenderSettings& settings);
+  GLuint gpuTexture(CachedTexture& cached, const RenderSettings& settings);
+  void drawLayer(const Scene& scene, const CloudLayer& layer, const RenderSettings& settings);
+  void setViewUniforms(GLuint program, const Scene& scene);
+
+  const GlApi& gl_;
+  GlObject vertex_array_;
+  GlObject framebuffer_;
+  GlObject colour_buffer_;
+  int target_width_ = 0;
+  int target_height_ = 0;
+  TargetFormat target_format_ = TargetFormat::kFloat;
+  std::map<std::string, GlObject> programs_;
+  std::map<std::string, CachedTexture> textures_;
+};
+
+}  // namespace nephele

@@ -1,0 +1,155 @@
+#include "server/render_command.h"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+
+#include "config/scene_file.h"
+#include "renderer/gl_renderer.h"
+#include "renderer/reference_renderer.h"
+
+namespace nephele {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double millisecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+// Applies command-line overrides to the scene; returns an error for invalid values.
+std::string applyOverrides(const RenderCommandOptions& o, SceneFile& file) {
+  Camera& camera = file.scene.camera;
+  if (o.width) camera.width = *o.width;
+  if (o.height) camera.height = *o.height;
+  if (o.position) camera.position = {(*o.position)[0], (*o.position)[1], (*o.position)[2]};
+  if (o.heading) camera.orientation.heading_deg = *o.heading;
+  if (o.pitch) camera.orientation.pitch_deg = *o.pitch;
+  if (o.roll) camera.orientation.roll_deg = *o.roll;
+  if (o.vfov) camera.vfov_deg = *o.vfov;
+  if (o.time) file.scene.time_s = *o.time;
+  if (o.texture)
+    file.render.texture_evaluation =
+        *o.texture == "procedural" ? TextureEvaluation::kProcedural : TextureEvaluation::kBaked;
+  if (o.term_filter)
+    file.render.term_filter = *o.term_filter == "cut"    ? TermFilter::kCut
+                              : *o.term_filter == "none" ? TermFilter::kNone
+                                                         : TermFilter::kFade;
+  if (o.samples) file.reference.samples_per_axis = *o.samples;
+  std::string error = validateCamera(camera);
+  return error.empty() ? "" : "command line: " + error;
+}
+
+GlBackend backendFromName(const std::string& name) {
+  if (name == "egl") return GlBackend::kEgl;
+  if (name == "osmesa") return GlBackend::kOsmesa;
+  return GlBackend::kAuto;
+}
+
+}  // namespace
+
+void addRenderCommand(CLI::App& app, RenderCommandOptions& o) {
+  CLI::App* cmd = app.add_subcommand("render", "Render one image of a scene file");
+  cmd->add_option("scene", o.scene_path, "Scene file (TOML)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("-o,--output", o.output_path,
+                  "Output image; the extension picks the format: " + std::string(kImageExtensions))
+      ->required();
+  cmd->add_option("--gl", o.gl_backend, "OpenGL back end")
+      ->check(CLI::IsMember({"auto", "egl", "osmesa"}))
+      ->capture_default_str();
+  cmd->add_option("--renderer", o.renderer, "gl, or the CPU reference (slow, exact)")
+      ->check(CLI::IsMember({"gl", "reference"}))
+      ->capture_default_str();
+  cmd->add_option("--width", o.width, "Image width in pixels")
+      ->check(CLI::Range(1, Limits::kMaxImageSide));
+  cmd->add_option("--height", o.height, "Image height in pixels")
+      ->check(CLI::Range(1, Limits::kMaxImageSide));
+  cmd->add_option("--position", o.position, "Camera position X,Y,Z in metres")
+      ->expected(3)
+      ->delimiter(',');
+  cmd->add_option("--heading", o.heading, "Camera heading, degrees clockwise from north")
+      ->check(CLI::Range(-360.0, 360.0));
+  cmd->add_option("--pitch", o.pitch, "Camera pitch, degrees, positive up")
+      ->check(CLI::Range(-90.0, 90.0));
+  cmd->add_option("--roll", o.roll, "Camera roll, degrees, positive right wing down")
+      ->check(CLI::Range(-180.0, 180.0));
+  cmd->add_option("--vfov", o.vfov, "Vertical field of view, degrees")
+      ->check(CLI::Range(Limits::kMinVfov, Limits::kMaxVfov));
+  cmd->add_option("--time", o.time, "Simulation time in seconds (layers drift with it)")
+      ->check(CLI::Range(0.0, 1.0e9));
+  cmd->add_option("--texture", o.texture, "Gardner texture on the GPU: baked or procedural")
+      ->check(CLI::IsMember({"baked", "procedural"}));
+  cmd->add_option("--term-filter", o.term_filter,
+                  "Removal of texture terms above the pixel frequency: fade, cut or none")
+      ->check(CLI::IsMember({"fade", "cut", "none"}));
+  cmd->add_option("--samples", o.samples, "Reference supersampling per pixel axis")
+      ->check(CLI::Range(1, 16));
+  cmd->add_option("--png-compression", o.encode.png_compression, "PNG zlib level")
+      ->check(CLI::Range(0, 9))
+      ->capture_default_str();
+  cmd->add_option("--jpeg-quality", o.encode.jpeg_quality, "JPEG quality")
+      ->check(CLI::Range(1, 100))
+      ->capture_default_str();
+  cmd->add_option("--exr-compression", o.encode.exr_compression, "EXR compression")
+      ->check(CLI::IsMember({"none", "zip", "zips", "piz", "rle", "pxr24", "b44", "dwaa", "dwab"}))
+      ->capture_default_str();
+  cmd->add_flag("!--exr-float", o.encode.exr_half, "Write EXR as 32-bit float instead of half");
+}
+
+int runRenderCommand(const RenderCommandOptions& o) {
+  const auto format = imageFileFormatForPath(o.output_path);
+  if (!format) {
+    spdlog::error("output '{}': unknown image extension (allowed: {})", o.output_path,
+                  kImageExtensions);
+    return 2;
+  }
+  SceneFile file;
+  if (std::string error = loadSceneFile(o.scene_path, file); !error.empty()) {
+    spdlog::error("{}", error);
+    return 2;
+  }
+  if (std::string error = applyOverrides(o, file); !error.empty()) {
+    spdlog::error("{}", error);
+    return 2;
+  }
+  const Scene& scene = file.scene;
+  spdlog::info("scene {}: {}x{}, {} layer(s){}", o.scene_path, scene.camera.width,
+               scene.camera.height, scene.layers.size(), scene.fog ? ", fog" : "");
+
+  std::string error;
+  const auto start = Clock::now();
+  if (o.renderer == "reference") {
+    const FloatImage image = renderReference(scene, file.reference);
+    spdlog::info("reference render: {:.0f} ms ({}x{} samples per pixel)", millisecondsSince(start),
+                 file.reference.samples_per_axis, file.reference.samples_per_axis);
+    error = writeImageFile(o.output_path, image, o.encode);
+  } else {
+    std::string platform_error;
+    const auto platform = createGlPlatform(backendFromName(o.gl_backend), platform_error);
+    if (!platform) {
+      spdlog::error("{}", platform_error);
+      return 1;
+    }
+    spdlog::info("OpenGL: {} ({}), GL_RENDERER {}", platform->backendName(), platform->version(),
+                 platform->renderer());
+    GlRenderer renderer(*platform);
+    const auto render_start = Clock::now();
+    if (isFloatFormat(*format)) {
+      const FloatImage image = renderer.renderFloat(scene, file.render);
+      spdlog::info("render: {:.1f} ms", millisecondsSince(render_start));
+      error = writeImageFile(o.output_path, image, o.encode);
+    } else {
+      const Srgb8Image image = renderer.renderSrgb8(scene, file.render);
+      spdlog::info("render: {:.1f} ms", millisecondsSince(render_start));
+      error = writeImageFile(o.output_path, image, o.encode);
+    }
+  }
+  if (!error.empty()) {
+    spdlog::error("{}", error);
+    return 1;
+  }
+  spdlog::info("wrote {} in {:.0f} ms", o.output_path, millisecondsSince(start));
+  return 0;
+}
+
+}  // namespace nephele

@@ -1,0 +1,31 @@
+#pragma once
+// `nephele render SCENE -o OUT`: one image of a scene file.
+#include <optional>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "protocol/image_encoding.h"
+#include "renderer/gl_platform.h"
+
+namespace nephele {
+
+struct RenderCommandOptions {
+  std::string scene_path;
+  std::string output_path;
+  std::string gl_backend = "auto";
+  std::string renderer = "gl";  // or "reference"
+  std::optional<int> width, height;
+  std::optional<std::vector<double>> position;
+  std::optional<double> heading, pitch, roll, vfov, time;
+  std::optional<std::string> texture, term_filter;
+  std::optional<int> samples;
+  EncodeOptions encode;
+};
+
+void addRenderCommand(CLI::App& app, RenderCommandOptions& options);
+
+// Runs the command; returns the process exit code (0 ok, 2 bad input, 1 failure).
+int runRenderCommand(const RenderCommandOptions& options);
+
+}  // namespace nephele

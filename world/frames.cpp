@@ -1,0 +1,51 @@
+#include "world/frames.h"
+
+#include <cmath>
+#include <numbers>
+
+namespace nephele {
+namespace {
+
+double radians(double degrees) {
+  return degrees * std::numbers::pi / 180.0;
+}
+
+// Rotations by angle a about the world axes (column-major: m[column][row]).
+glm::dmat3 rotationZ(double a) {
+  const double c = std::cos(a), s = std::sin(a);
+  return glm::dmat3(c, s, 0, -s, c, 0, 0, 0, 1);
+}
+glm::dmat3 rotationX(double a) {
+  const double c = std::cos(a), s = std::sin(a);
+  return glm::dmat3(1, 0, 0, 0, c, s, 0, -s, c);
+}
+glm::dmat3 rotationY(double a) {
+  const double c = std::cos(a), s = std::sin(a);
+  return glm::dmat3(c, 0, -s, 0, 1, 0, s, 0, c);
+}
+
+}  // namespace
+
+glm::dmat3 bodyToWorld(const Orientation& o) {
+  return rotationZ(-radians(o.heading_deg)) * rotationX(radians(o.pitch_deg)) *
+         rotationY(radians(o.roll_deg));
+}
+
+ViewBasis viewBasis(const Camera& camera) {
+  const glm::dmat3 r = bodyToWorld(camera.orientation);
+  ViewBasis basis;
+  basis.right = r[0];
+  basis.forward = r[1];
+  basis.up = r[2];
+  basis.tan_half_vfov = std::tan(radians(camera.vfov_deg) * 0.5);
+  basis.aspect = double(camera.width) / double(camera.height);
+  return basis;
+}
+
+glm::dvec3 rayDirection(const ViewBasis& basis, const Camera& camera, double x, double y) {
+  const double u = (2.0 * x / camera.width - 1.0) * basis.tan_half_vfov * basis.aspect;
+  const double v = (1.0 - 2.0 * y / camera.height) * basis.tan_half_vfov;
+  return u * basis.right + v * basis.up + basis.forward;
+}
+
+}  // namespace nephele

@@ -1,0 +1,40 @@
+#pragma once
+// World frame, orientation and camera (SPEC section 1).
+#include <glm/glm.hpp>
+
+namespace nephele {
+
+// Heading clockwise from north (+Y), pitch nose up, roll right wing down; degrees.
+struct Orientation {
+  double heading_deg = 0.0;
+  double pitch_deg = 0.0;
+  double roll_deg = 0.0;
+};
+
+// R = Rz(-h) Rx(p) Ry(r): columns are the world directions of body right, forward and up.
+glm::dmat3 bodyToWorld(const Orientation& orientation);
+
+struct Camera {
+  glm::dvec3 position{0.0, 0.0, 2.0};
+  Orientation orientation;
+  double vfov_deg = 60.0;
+  int width = 640;
+  int height = 480;
+};
+
+// The camera's image-plane basis: a ray through continuous image position (x, y), with x
+// from the left and y from the top in pixels, has direction u * right + v * up + forward.
+struct ViewBasis {
+  glm::dvec3 right;    // world direction of image +u
+  glm::dvec3 up;       // world direction of image +v
+  glm::dvec3 forward;  // world direction of the optical axis
+  double tan_half_vfov = 0.0;
+  double aspect = 1.0;  // width / height
+};
+
+ViewBasis viewBasis(const Camera& camera);
+
+// Unnormalised ray direction through image position (x, y) in pixels (pixel centres at +0.5).
+glm::dvec3 rayDirection(const ViewBasis& basis, const Camera& camera, double x, double y);
+
+}  // namespace nephele

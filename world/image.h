@@ -1,0 +1,38 @@
+#pragma once
+// Image buffers handed from renderers to encoders. Rows run top to bottom unless stated.
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+namespace nephele {
+
+// Linear RGB plus coverage alpha, 4 floats per pixel.
+struct FloatImage {
+  int width = 0;
+  int height = 0;
+  std::vector<float> rgba;
+
+  float* pixel(int x, int y) { return &rgba[(std::size_t(y) * width + x) * 4]; }
+  const float* pixel(int x, int y) const { return &rgba[(std::size_t(y) * width + x) * 4]; }
+};
+
+// sRGB-encoded RGB plus linear coverage alpha, 4 bytes per pixel.
+struct Srgb8Image {
+  int width = 0;
+  int height = 0;
+  bool bottom_up = false;  // rows stored bottom row first (GL readback order)
+  std::vector<std::uint8_t> rgba;
+};
+
+// sRGB transfer function (IEC 61966-2-1), linear [0, 1] to encoded [0, 1].
+inline double srgbEncode(double linear) {
+  if (!(linear > 0.0)) return 0.0;
+  if (linear >= 1.0) return 1.0;
+  return linear <= 0.0031308 ? 12.92 * linear : 1.055 * std::pow(linear, 1.0 / 2.4) - 0.055;
+}
+
+inline std::uint8_t toByte(double unit) {
+  return std::uint8_t(std::lround((unit > 0.0 ? (unit < 1.0 ? unit : 1.0) : 0.0) * 255.0));
+}
+
+}  // namespace nephele

@@ -1,0 +1,38 @@
+#pragma once
+// A scene: everything one rendered image depends on.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "world/frames.h"
+#include "world/layer_texture.h"
+#include "world/shading.h"
+#include "world/sky.h"
+
+namespace nephele {
+
+// A textured sky plane Z = altitude (SPEC section 5), seen from below or above.
+struct CloudLayer {
+  std::string name;
+  double altitude_m = 3000.0;
+  glm::dvec3 colour{1.0, 1.0, 1.0};  // linear RGB
+  double threshold = 0.3;            // T1
+  double transition = 0.3;           // D, >= 0
+  ShadingParams shading;
+  LayerTextureSpec texture;
+};
+
+struct Scene {
+  std::uint64_t seed = 1;
+  double time_s = 0.0;
+  Camera camera;
+  Sun sun;
+  Sky sky;
+  std::optional<Fog> fog;
+  std::vector<CloudLayer> layers;
+};
+
+}  // namespace nephele

@@ -1,0 +1,43 @@
+#include "world/shading.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace nephele {
+namespace {
+
+// clamp(1 - excess / D, 0, 1), with D = 0 meaning a step at excess = 0.
+double translucenceFromExcess(double excess, double transition) {
+  if (transition <= 0.0) return excess <= 0.0 ? 1.0 : 0.0;
+  return std::clamp(1.0 - excess / transition, 0.0, 1.0);
+}
+
+}  // namespace
+
+double gardnerIntensity(const ShadingParams& shading, double texture_value, glm::dvec3 normal,
+                        glm::dvec3 to_sun, glm::dvec3 to_viewer) {
+  glm::dvec3 n = glm::normalize(normal);
+  if (glm::dot(n, to_viewer) < 0.0) n = -n;
+  const double n_dot_l = glm::dot(n, to_sun);
+  const double diffuse = std::max(0.0, n_dot_l);
+  double highlight = 0.0;
+  if (n_dot_l > 0.0 && shading.specular > 0.0) {
+    const glm::dvec3 reflected = 2.0 * n_dot_l * n - to_sun;
+    highlight = std::pow(std::max(0.0, glm::dot(reflected, to_viewer)), shading.shininess);
+  }
+  const double a = shading.ambient, t = shading.texture_fraction, s = shading.specular;
+  return (1.0 - a) * ((1.0 - t) * ((1.0 - s) * diffuse + s * highlight) + t * texture_value) +
+         a;  // Gardner eq. 8
+}
+
+double skyPlaneTranslucence(double texture_value, double threshold, double transition) {
+  return translucenceFromExcess(texture_value - threshold, transition);  // Gardner eq. 9
+}
+
+double ellipsoidTranslucence(double texture_value, double threshold_centre, double threshold_limb,
+                             double limb_g, double transition) {
+  const double threshold = threshold_centre + (threshold_limb - threshold_centre) * (1.0 - limb_g);
+  return translucenceFromExcess(texture_value - threshold, transition);  // Gardner eq. 11
+}
+
+}  // namespace nephele

@@ -1,0 +1,27 @@
+#pragma once
+// Gardner's shading equation (SPEC section 3) and translucence (SPEC section 4).
+#include <glm/glm.hpp>
+
+namespace nephele {
+
+struct ShadingParams {
+  double ambient = 0.4;           // a
+  double texture_fraction = 0.5;  // t
+  double specular = 0.0;          // s
+  double shininess = 8.0;         // e
+};
+
+// Gardner eq. 8. `normal` is any surface normal (it is turned towards the viewer here),
+// `to_sun` and `to_viewer` are unit vectors.
+double gardnerIntensity(const ShadingParams& shading, double texture_value, glm::dvec3 normal,
+                        glm::dvec3 to_sun, glm::dvec3 to_viewer);
+
+// Gardner eq. 9: translucence of a sky plane for texture value It, threshold T1 and
+// transition width D. D = 0 is a hard threshold.
+double skyPlaneTranslucence(double texture_value, double threshold, double transition);
+
+// Gardner eq. 11: the threshold rises from T1 at the centre (g = 1) to T2 at the limb (g = 0).
+double ellipsoidTranslucence(double texture_value, double threshold_centre, double threshold_limb,
+                             double limb_g, double transition);
+
+}  // namespace nephele

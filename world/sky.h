@@ -1,0 +1,40 @@
+#pragma once
+// Sky background, ground, sun (SPEC sections 1 and 5) and ground fog.
+#include <glm/glm.hpp>
+
+namespace nephele {
+
+struct Sky {
+  glm::dvec3 zenith{0.16, 0.32, 0.75};  // linear RGB
+  glm::dvec3 horizon{0.62, 0.74, 0.90};
+  glm::dvec3 ground{0.20, 0.22, 0.18};
+};
+
+// The "gradient" model: horizon + (zenith - horizon) sqrt(d.z) above the horizon, the
+// ground colour below. `direction` need not be normalised.
+glm::dvec3 skyBackground(const Sky& sky, glm::dvec3 direction);
+
+struct Sun {
+  double azimuth_deg = 135.0;   // clockwise from north, like a heading
+  double elevation_deg = 40.0;  // above the horizon
+  glm::dvec3 colour{1.0, 0.98, 0.94};
+};
+
+glm::dvec3 sunDirection(const Sun& sun);  // unit vector towards the sun
+
+// Homogeneous fog filling the slab 0 <= Z <= top (McReynolds and Blythe's ground fog).
+// Extinction follows the meteorological visibility: 2 % contrast left after `visibility_m`,
+// sigma = -ln(0.02) / visibility. Fog is unlit: it adds its own colour.
+struct Fog {
+  double top_m = 100.0;
+  double visibility_m = 1000.0;
+  glm::dvec3 colour{0.75, 0.77, 0.80};
+};
+
+double fogExtinction(const Fog& fog);  // per metre
+
+// Length inside the fog slab of the ray origin + s * direction for 0 <= s <= distance
+// (distance may be +infinity). `direction` must be normalised.
+double fogPathLength(const Fog& fog, glm::dvec3 origin, glm::dvec3 direction, double distance);
+
+}  // namespace nephele
