@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <sstream>
 #include <vector>
@@ -15,10 +16,6 @@ namespace nephele {
 namespace {
 
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
-
-glm::vec3 toFloat(glm::dvec3 v) {
-  return glm::vec3(v);
-}
 
 // The part of the screen square [-1, 1]^2 where a * x + b * y + c >= 0, as a convex polygon
 // (Sutherland-Hodgman against one line). Empty when nothing is left.
@@ -52,11 +49,34 @@ std::string textureKey(const LayerTextureSpec& spec, const RenderSettings& setti
   return key.str();
 }
 
-void uploadLevels(const GlApi& gl, GLuint texture, const std::vector<TextureTable>& levels) {
-  gl.TextureStorage2D(texture, GLsizei(levels.size()), GL_R16, levels[0].width, levels[0].height);
-  for (std::size_t level = 0; level < levels.size(); ++level)
-    gl.TextureSubImage2D(texture, GLint(level), 0, 0, levels[level].width, levels[level].height,
-                         GL_RED, GL_FLOAT, levels[level].values.data());
+// Baked Gardner chain: level l holds the truncations to n - l terms (red) and n - l - 1
+// terms (green) at (texels_per_cycle * 2^n) >> l texels a side.
+void uploadBakedGardner(const GlApi& gl, GLuint texture, const GardnerTexture& gardner,
+                        int texels_per_cycle) {
+  const int base = gardnerBakeSize(gardner.terms(), texels_per_cycle);
+  const int levels = int(std::log2(base)) + 1;
+  gl.TextureStorage2D(texture, levels, GL_RG16, base, base);
+  for (int level = 0; level < levels; ++level) {
+    const int size = base >> level, terms = gardner.terms() - level;
+    const TextureTable more = bakeGardner(gardner, size, terms);
+    const TextureTable fewer = bakeGardner(gardner, size, terms - 1);
+    std::vector<float> rg(more.values.size() * 2);
+    for (std::size_t i = 0; i < more.values.size(); ++i) {
+      rg[2 * i] = more.values[i];
+      rg[2 * i + 1] = fewer.values[i];
+    }
+    gl.TextureSubImage2D(texture, level, 0, 0, size, size, GL_RG, GL_FLOAT, rg.data());
+  }
+  gl.TextureParameteri(texture, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_NEAREST);
+}
+
+void uploadTable(const GlApi& gl, GLuint texture, const TextureTable& table) {
+  const int levels = int(std::log2(std::max(table.width, table.height))) + 1;
+  gl.TextureStorage2D(texture, levels, GL_R16, table.width, table.height);
+  gl.TextureSubImage2D(texture, 0, 0, 0, table.width, table.height, GL_RED, GL_FLOAT,
+                       table.values.data());
+  gl.GenerateTextureMipmap(texture);
+  gl.TextureParameteri(texture, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
 }
 
 }  // namespace
@@ -109,34 +129,14 @@ void GlRenderer::prepareTarget(int width, int height, TargetFormat format) {
   target_format_ = format;
 }
 
-GLuint GlRenderer::program(const std::string& key, const std::string& fragment_source) {
+GLuint GlRenderer::program(const SkyPassLayout& layout) {
+  const std::string key = layout.key();
   auto found = programs_.find(key);
   if (found != programs_.end()) return found->second.get();
   std::string error;
-  GlObject compiled = createProgram(gl_, polygonVertexSource(), fragment_source, error);
+  GlObject compiled = createProgram(gl_, polygonVertexSource(), skyFragmentSource(layout), error);
   NEPHELE_CHECK(compiled, key << ": " << error);
   return programs_.emplace(key, std::move(compiled)).first->second.get();
-}
-
-void GlRenderer::setViewUniforms(GLuint p, const Scene& scene) {
-  const Camera& camera = scene.camera;
-  const ViewBasis basis = viewBasis(camera);
-  auto uniform3 = [&](const char* name, glm::dvec3 v) {
-    const glm::vec3 f = toFloat(v);
-    gl_.ProgramUniform3fv(p, gl_.GetUniformLocation(p, name), 1, &f.x);
-  };
-  uniform3("u_right", basis.right * basis.tan_half_vfov * basis.aspect);
-  uniform3("u_up", basis.up * basis.tan_half_vfov);
-  uniform3("u_forward", basis.forward);
-  const glm::vec2 viewport(camera.width, camera.height);
-  gl_.ProgramUniform2fv(p, gl_.GetUniformLocation(p, "u_viewport"), 1, &viewport.x);
-  gl_.ProgramUniform1f(p, gl_.GetUniformLocation(p, "u_camera_z"), float(camera.position.z));
-  if (scene.fog) {
-    gl_.ProgramUniform1f(p, gl_.GetUniformLocation(p, "u_fog_top"), float(scene.fog->top_m));
-    gl_.ProgramUniform1f(p, gl_.GetUniformLocation(p, "u_fog_sigma"),
-                         float(fogExtinction(*scene.fog)));
-    uniform3("u_fog_colour", scene.fog->colour);
-  }
 }
 
 GlRenderer::CachedTexture& GlRenderer::cachedTexture(const LayerTextureSpec& spec,
@@ -151,66 +151,41 @@ GLuint GlRenderer::gpuTexture(CachedTexture& cached, const RenderSettings& setti
   if (cached.texture) return cached.texture.get();
   cached.texture = createTexture(gl_, GL_TEXTURE_2D);
   const GLuint t = cached.texture.get();
-  if (const GardnerTexture* gardner = cached.source->gardner()) {
-    uploadLevels(gl_, t, bakeGardnerLevels(*gardner, settings.bake_texels_per_cycle));
-  } else {
-    const TextureTable& table = *cached.source->table();
-    const int levels = int(std::log2(std::max(table.width, table.height))) + 1;
-    gl_.TextureStorage2D(t, levels, GL_R16, table.width, table.height);
-    gl_.TextureSubImage2D(t, 0, 0, 0, table.width, table.height, GL_RED, GL_FLOAT,
-                          table.values.data());
-    gl_.GenerateTextureMipmap(t);
-  }
+  if (const GardnerTexture* gardner = cached.source->gardner())
+    uploadBakedGardner(gl_, t, *gardner, settings.bake_texels_per_cycle);
+  else
+    uploadTable(gl_, t, *cached.source->table());
   gl_.TextureParameteri(t, GL_TEXTURE_WRAP_S, GL_REPEAT);
   gl_.TextureParameteri(t, GL_TEXTURE_WRAP_T, GL_REPEAT);
-  gl_.TextureParameteri(t, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
   gl_.TextureParameteri(t, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
   return t;
 }
 
-void GlRenderer::drawLayer(const Scene& scene, const CloudLayer& layer,
-                           const RenderSettings& settings) {
+void GlRenderer::setSlotUniforms(GLuint p, int slot, const LayerSlot& entry, const Scene& scene,
+                                 const RenderSettings& settings) {
+  const CloudLayer& layer = *entry.layer;
+  const LayerTexture& texture = *entry.texture->source;
   const Camera& camera = scene.camera;
-  const double height = layer.altitude_m - camera.position.z;
-  const ViewBasis basis = viewBasis(camera);
-  // Only pixels whose ray climbs towards the plane (or descends to it) can see it: draw the
-  // screen region where sign(height) * ray.z >= 0, widened by two pixels; the shader
-  // discards the rest of the margin.
-  const double side = height > 0.0 ? 1.0 : -1.0;
-  const double a = side * basis.right.z * basis.tan_half_vfov * basis.aspect;
-  const double b = side * basis.up.z * basis.tan_half_vfov;
-  const double margin = std::abs(a) * 4.0 / camera.width + std::abs(b) * 4.0 / camera.height;
-  const std::vector<glm::vec2> polygon =
-      clipScreenToHalfPlane(a, b, side * basis.forward.z + margin);
-  if (polygon.size() < 3) return;
-
-  CachedTexture& cached = cachedTexture(layer.texture, settings);
-  const LayerTexture& texture = *cached.source;
-  LayerShaderVariant variant;
-  variant.fog = scene.fog.has_value();
-  variant.specular = layer.shading.specular > 0.0;
-  variant.term_filter = settings.term_filter;
-  if (!texture.gardner())
-    variant.texture = LayerShaderVariant::Texture::kTable;
-  else if (settings.texture_evaluation == TextureEvaluation::kProcedural)
-    variant.texture = LayerShaderVariant::Texture::kProceduralGardner;
-  const GLuint p = program(variant.key(), layerFragmentSource(variant));
-  gl_.UseProgram(p);
-  setViewUniforms(p, scene);
-
-  auto location = [&](const char* name) { return gl_.GetUniformLocation(p, name); };
-  auto uniform3 = [&](const char* name, glm::dvec3 v) {
-    const glm::vec3 f = toFloat(v);
-    gl_.ProgramUniform3fv(p, location(name), 1, &f.x);
+  auto location = [&](const char* name, int index) {
+    char element[48];
+    std::snprintf(element, sizeof element, "%s[%d]", name, index);
+    return gl_.GetUniformLocation(p, element);
   };
-  gl_.ProgramUniform1f(p, location("u_height"), float(height));
-  uniform3("u_colour", layer.colour * scene.sun.colour);
-  uniform3("u_to_sun", sunDirection(scene.sun));
-  const glm::vec4 shading(layer.shading.ambient, layer.shading.texture_fraction,
-                          layer.shading.specular, layer.shading.shininess);
-  gl_.ProgramUniform4fv(p, location("u_shading"), 1, &shading.x);
-  gl_.ProgramUniform1f(p, location("u_threshold"), float(layer.threshold));
-  gl_.ProgramUniform1f(p, location("u_transition"), float(layer.transition));
+  gl_.ProgramUniform1f(p, location("u_height", slot), float(layer.altitude_m - camera.position.z));
+  const glm::vec3 colour(layer.colour * scene.sun.colour);
+  gl_.ProgramUniform3fv(p, location("u_colour", slot), 1, &colour.x);
+  // Gardner eq. 8, I = (1-a){(1-t)[(1-s) Id + s Is] + t It} + a, regrouped around what
+  // varies per pixel: Id = max(0, N.L) is constant over a plane, It and Is are not.
+  const ShadingParams& sh = layer.shading;
+  const double to_viewer_z = layer.altitude_m > camera.position.z ? -1.0 : 1.0;  // N.z
+  const double diffuse = std::max(0.0, to_viewer_z * sunDirection(scene.sun).z);
+  const glm::vec4 intensity(
+      (1.0 - sh.ambient) * (1.0 - sh.texture_fraction) * (1.0 - sh.specular) * diffuse + sh.ambient,
+      (1.0 - sh.ambient) * sh.texture_fraction,
+      (1.0 - sh.ambient) * (1.0 - sh.texture_fraction) * sh.specular, sh.shininess);
+  gl_.ProgramUniform4fv(p, location("u_intensity", slot), 1, &intensity.x);
+  gl_.ProgramUniform1f(p, location("u_threshold", slot), float(layer.threshold));
+  gl_.ProgramUniform1f(p, location("u_transition", slot), float(layer.transition));
 
   // SPEC precision rule: the texture's local origin is the point under the camera, reduced
   // modulo the period in double; the shader only sees offsets from it.
@@ -218,40 +193,75 @@ void GlRenderer::drawLayer(const Scene& scene, const CloudLayer& layer,
   const glm::dvec2 origin_uv =
       texture.periodicCoordinate({camera.position.x, camera.position.y}, scene.time_s);
   const glm::vec2 origin_f(origin_uv), inv_period(1.0 / period);
-  gl_.ProgramUniform2fv(p, location("u_origin"), 1, &origin_f.x);
-  gl_.ProgramUniform2fv(p, location("u_inv_period"), 1, &inv_period.x);
+  gl_.ProgramUniform2fv(p, location("u_origin", slot), 1, &origin_f.x);
+  gl_.ProgramUniform2fv(p, location("u_inv_period", slot), 1, &inv_period.x);
 
   if (const GardnerTexture* g = texture.gardner()) {
-    gl_.ProgramUniform1f(p, location("u_terms"), float(g->terms()));
-    if (variant.texture == LayerShaderVariant::Texture::kProceduralGardner) {
+    gl_.ProgramUniform1f(p, location("u_terms", slot), float(g->terms()));
+    if (entry.kind == LayerKind::kProceduralGardner) {
       const glm::dvec2 origin = origin_uv * period;  // metres inside one period
-      float fx[8], fy[8], amp[8], phx[8], phy[8], half_x[8], half_y[8];
-      for (int i = 0; i < g->terms(); ++i) {
-        fx[i] = float(g->frequencyX(i));
-        fy[i] = float(g->frequencyY(i));
-        amp[i] = float(g->amplitude(i));
-        phx[i] = float(wrapPeriodic(g->frequencyX(i) * origin.x + g->phaseX(i), kTwoPi));
-        phy[i] = float(wrapPeriodic(g->frequencyY(i) * origin.y + g->phaseY(i), kTwoPi));
-        half_x[i] = float(wrapPeriodic(0.5 * g->frequencyX(i) * origin.x, kTwoPi));
-        half_y[i] = float(wrapPeriodic(0.5 * g->frequencyY(i) * origin.y, kTwoPi));
+      for (int j = 0; j < g->terms(); ++j) {
+        const int k = 8 * slot + j;
+        auto set = [&](const char* name, double v) {
+          gl_.ProgramUniform1f(p, location(name, k), float(v));
+        };
+        set("u_fx", g->frequencyX(j));
+        set("u_fy", g->frequencyY(j));
+        set("u_amplitude", g->amplitude(j));
+        set("u_phase_x", wrapPeriodic(g->frequencyX(j) * origin.x + g->phaseX(j), kTwoPi));
+        set("u_phase_y", wrapPeriodic(g->frequencyY(j) * origin.y + g->phaseY(j), kTwoPi));
+        set("u_half_phase_x", wrapPeriodic(0.5 * g->frequencyX(j) * origin.x, kTwoPi));
+        set("u_half_phase_y", wrapPeriodic(0.5 * g->frequencyY(j) * origin.y, kTwoPi));
       }
-      const GLsizei n = g->terms();
-      gl_.ProgramUniform1fv(p, location("u_fx"), n, fx);
-      gl_.ProgramUniform1fv(p, location("u_fy"), n, fy);
-      gl_.ProgramUniform1fv(p, location("u_amplitude"), n, amp);
-      gl_.ProgramUniform1fv(p, location("u_phase_x"), n, phx);
-      gl_.ProgramUniform1fv(p, location("u_phase_y"), n, phy);
-      gl_.ProgramUniform1fv(p, location("u_half_phase_x"), n, half_x);
-      gl_.ProgramUniform1fv(p, location("u_half_phase_y"), n, half_y);
-      gl_.ProgramUniform1f(p, location("u_t0"), float(g->params().t0));
-      gl_.ProgramUniform1f(p, location("u_k"), float(g->normalisation()));
+      gl_.ProgramUniform1f(p, location("u_t0", slot), float(g->params().t0));
+      gl_.ProgramUniform1f(p, location("u_k", slot), float(g->normalisation()));
     }
   }
-  if (variant.texture != LayerShaderVariant::Texture::kProceduralGardner) {
-    gl_.BindTextureUnit(0, gpuTexture(cached, settings));
-    gl_.ProgramUniform1i(p, location("u_table"), 0);
+  if (entry.kind != LayerKind::kProceduralGardner) {
+    gl_.BindTextureUnit(GLuint(slot), gpuTexture(*entry.texture, settings));
+    const std::string sampler = "u_table" + std::to_string(slot);
+    gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, sampler.c_str()), slot);
   }
-  gl_.ProgramUniform2fv(p, location("u_polygon"), GLsizei(polygon.size()), &polygon[0].x);
+}
+
+void GlRenderer::drawSkyPass(const Scene& scene, const RenderSettings& settings,
+                             const SkyPassLayout& layout, const std::vector<LayerSlot>& slots,
+                             const std::vector<glm::vec2>& polygon) {
+  const GLuint p = program(layout);
+  gl_.UseProgram(p);
+  const Camera& camera = scene.camera;
+  const ViewBasis basis = viewBasis(camera);
+  auto uniform3 = [&](const char* name, glm::dvec3 v) {
+    const glm::vec3 f(v);
+    gl_.ProgramUniform3fv(p, gl_.GetUniformLocation(p, name), 1, &f.x);
+  };
+  uniform3("u_right", basis.right * basis.tan_half_vfov * basis.aspect);
+  uniform3("u_up", basis.up * basis.tan_half_vfov);
+  uniform3("u_forward", basis.forward);
+  const glm::vec2 viewport(camera.width, camera.height);
+  gl_.ProgramUniform2fv(p, gl_.GetUniformLocation(p, "u_viewport"), 1, &viewport.x);
+  gl_.ProgramUniform1f(p, gl_.GetUniformLocation(p, "u_camera_z"), float(camera.position.z));
+  if (scene.fog) {
+    gl_.ProgramUniform1f(p, gl_.GetUniformLocation(p, "u_fog_top"), float(scene.fog->top_m));
+    gl_.ProgramUniform1f(p, gl_.GetUniformLocation(p, "u_fog_sigma"),
+                         float(fogExtinction(*scene.fog)));
+    uniform3("u_fog_colour", scene.fog->colour);
+  }
+  if (layout.background) {
+    uniform3("u_zenith", scene.sky.zenith);
+    uniform3("u_horizon", scene.sky.horizon);
+    uniform3("u_ground", scene.sky.ground);
+    const double slope =
+        std::hypot(basis.right.z * basis.tan_half_vfov * basis.aspect * 2.0 / camera.width,
+                   basis.up.z * basis.tan_half_vfov * 2.0 / camera.height);
+    gl_.ProgramUniform1f(p, gl_.GetUniformLocation(p, "u_horizon_slope"),
+                         float(std::max(slope, 1e-12)));
+  }
+  if (!slots.empty()) uniform3("u_to_sun", sunDirection(scene.sun));
+  for (std::size_t i = 0; i < slots.size(); ++i)
+    setSlotUniforms(p, int(i), slots[i], scene, settings);
+  gl_.ProgramUniform2fv(p, gl_.GetUniformLocation(p, "u_polygon"), GLsizei(polygon.size()),
+                        &polygon[0].x);
   gl_.DrawArrays(GL_TRIANGLE_FAN, 0, GLsizei(polygon.size()));
 }
 
@@ -268,38 +278,65 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
     gl_.Disable(GL_FRAMEBUFFER_SRGB);
   for (auto& [key, cached] : textures_) cached.used = false;
 
-  // Background: sky gradient and ground, coverage 0.
-  gl_.Disable(GL_BLEND);
-  const GLuint bg = program(scene.fog ? "background/fog" : "background",
-                            backgroundFragmentSource(scene.fog.has_value()));
-  gl_.UseProgram(bg);
-  setViewUniforms(bg, scene);
-  auto uniform3 = [&](const char* name, glm::dvec3 v) {
-    const glm::vec3 f = toFloat(v);
-    gl_.ProgramUniform3fv(bg, gl_.GetUniformLocation(bg, name), 1, &f.x);
-  };
-  uniform3("u_zenith", scene.sky.zenith);
-  uniform3("u_horizon", scene.sky.horizon);
-  uniform3("u_ground", scene.sky.ground);
-  const glm::vec2 screen[4] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
-  gl_.ProgramUniform2fv(bg, gl_.GetUniformLocation(bg, "u_polygon"), 4, &screen[0].x);
-  gl_.DrawArrays(GL_TRIANGLE_FAN, 0, 4);
-
-  // Layers back to front: a ray meets only the layers on one side of the camera, farthest
-  // first, so layers above draw from the highest down and layers below from the lowest up.
-  std::vector<const CloudLayer*> order;
-  for (const CloudLayer& layer : scene.layers)
-    if (layer.altitude_m != camera.position.z) order.push_back(&layer);
+  // A ray meets only the layers on one side of the camera: above it from the highest down,
+  // below it from the lowest up. Those orders are back to front.
   const double z = camera.position.z;
-  std::sort(order.begin(), order.end(), [z](const CloudLayer* a, const CloudLayer* b) {
-    return std::abs(a->altitude_m - z) > std::abs(b->altitude_m - z);
+  std::vector<LayerSlot> above, below;
+  for (const CloudLayer& layer : scene.layers) {
+    if (layer.altitude_m == z) continue;  // seen edge-on: covers no pixel
+    CachedTexture& texture = cachedTexture(layer.texture, settings);
+    const LayerKind kind = !texture.source->gardner() ? LayerKind::kTable
+                           : settings.texture_evaluation == TextureEvaluation::kProcedural
+                               ? LayerKind::kProceduralGardner
+                               : LayerKind::kBakedGardner;
+    (layer.altitude_m > z ? above : below).push_back({&layer, &texture, kind});
+  }
+  std::sort(above.begin(), above.end(), [](const LayerSlot& a, const LayerSlot& b) {
+    return a.layer->altitude_m > b.layer->altitude_m;
   });
-  gl_.Enable(GL_BLEND);
-  // Colour: alpha C + (1 - alpha) C_behind; coverage: 1 - product of TR.
-  gl_.BlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
-  for (const CloudLayer* layer : order) drawLayer(scene, *layer, settings);
-  gl_.Disable(GL_BLEND);
+  std::sort(below.begin(), below.end(), [](const LayerSlot& a, const LayerSlot& b) {
+    return a.layer->altitude_m < b.layer->altitude_m;
+  });
 
+  SkyPassLayout base;
+  base.fog = scene.fog.has_value();
+  base.term_filter = settings.term_filter;
+  for (const CloudLayer& layer : scene.layers) base.specular |= layer.shading.specular > 0.0;
+  // One triangle covering the screen: no diagonal edge for the rasteriser to split tiles on.
+  const std::vector<glm::vec2> screen = {{-1, -1}, {3, -1}, {-1, 3}};
+  const bool fused = settings.sky_passes == SkyPasses::kFused &&
+                     int(above.size() + below.size()) <= kMaxLayerSlots;
+
+  // Every pass writes premultiplied colour and coverage; the first overwrites.
+  gl_.Disable(GL_BLEND);
+  gl_.BlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  if (fused) {
+    SkyPassLayout layout = base;
+    std::vector<LayerSlot> slots = above;
+    for (const LayerSlot& s : above) layout.above.push_back(s.kind);
+    for (const LayerSlot& s : below) layout.below.push_back(s.kind), slots.push_back(s);
+    drawSkyPass(scene, settings, layout, slots, screen);
+  } else {
+    drawSkyPass(scene, settings, base, {}, screen);
+    gl_.Enable(GL_BLEND);
+    const ViewBasis basis = viewBasis(camera);
+    for (const auto* side : {&above, &below})
+      for (const LayerSlot& slot : *side) {
+        // Draw only the screen region whose rays meet the plane, plus a two-pixel margin.
+        const double sign = side == &above ? 1.0 : -1.0;
+        const double a = sign * basis.right.z * basis.tan_half_vfov * basis.aspect;
+        const double b = sign * basis.up.z * basis.tan_half_vfov;
+        const double margin = std::abs(a) * 4.0 / camera.width + std::abs(b) * 4.0 / camera.height;
+        const std::vector<glm::vec2> polygon =
+            clipScreenToHalfPlane(a, b, sign * basis.forward.z + margin);
+        if (polygon.size() < 3) continue;
+        SkyPassLayout layout = base;
+        layout.background = false;
+        (side == &above ? layout.above : layout.below).push_back(slot.kind);
+        drawSkyPass(scene, settings, layout, {slot}, polygon);
+      }
+  }
+  gl_.Disable(GL_BLEND);
   std::erase_if(textures_, [](const auto& entry) { return !entry.second.used; });
 }
 

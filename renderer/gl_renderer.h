@@ -1,13 +1,15 @@
 #pragma once
-// The GL renderer: sky background, then every cloud layer composited back to front into a
+// The GL renderer: sky background and cloud layers composited back to front into a
 // framebuffer object, then read back.
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "renderer/gl_objects.h"
 #include "renderer/gl_platform.h"
 #include "renderer/render_settings.h"
+#include "renderer/sky_shaders.h"
 #include "world/image.h"
 #include "world/scene.h"
 
@@ -34,14 +36,21 @@ class GlRenderer {
     GlObject texture;  // made on first use by a pass that samples it
     bool used = false;
   };
+  struct LayerSlot {
+    const CloudLayer* layer;
+    CachedTexture* texture;
+    LayerKind kind;
+  };
 
   void drawFrame(const Scene& scene, const RenderSettings& settings, TargetFormat format);
+  void drawSkyPass(const Scene& scene, const RenderSettings& settings, const SkyPassLayout& layout,
+                   const std::vector<LayerSlot>& slots, const std::vector<glm::vec2>& polygon);
+  void setSlotUniforms(GLuint program, int slot, const LayerSlot& layer, const Scene& scene,
+                       const RenderSettings& settings);
   void prepareTarget(int width, int height, TargetFormat format);
-  GLuint program(const std::string& key, const std::string& fragment_source);
+  GLuint program(const SkyPassLayout& layout);
   CachedTexture& cachedTexture(const LayerTextureSpec& spec, const RenderSettings& settings);
   GLuint gpuTexture(CachedTexture& cached, const RenderSettings& settings);
-  void drawLayer(const Scene& scene, const CloudLayer& layer, const RenderSettings& settings);
-  void setViewUniforms(GLuint program, const Scene& scene);
 
   const GlApi& gl_;
   GlObject vertex_array_;

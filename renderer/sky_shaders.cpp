@@ -3,16 +3,15 @@
 namespace nephele {
 namespace {
 
-// The view (camera-relative: the camera sits at the origin, only its altitude is known to
-// the shader), the output, and fog (SPEC: fog is unlit and applied per surface by its
-// camera distance, which composites exactly under "over").
+// View (camera-relative: the shader knows only the camera's altitude), output, fog. Fog is
+// unlit and applied to each surface by its camera distance, which is exact under "over".
 const char* kCommon = R"(
 uniform vec3 u_right;    // image-plane basis, scaled by tan(vfov/2) * aspect
 uniform vec3 u_up;       // scaled by tan(vfov/2)
 uniform vec3 u_forward;
 uniform vec2 u_viewport;
 uniform float u_camera_z;
-out vec4 o_colour;
+out vec4 o_colour;       // premultiplied colour, coverage
 const float kFar = 1e30;
 
 vec3 viewRay() {
@@ -39,168 +38,195 @@ float fogPathLength(vec3 d, float distance) {
 }
 
 vec3 applyFog(vec3 colour, vec3 d, float distance) {
-  float transmittance = exp(-u_fog_sigma * fogPathLength(d, distance));
-  return mix(u_fog_colour, colour, transmittance);
+  return mix(u_fog_colour, colour, exp(-u_fog_sigma * fogPathLength(d, distance)));
 }
+#else
+vec3 applyFog(vec3 colour, vec3 d, float distance) { return colour; }
 #endif
-)";
 
-const char* kBackground = R"(
+#ifdef BACKGROUND
 uniform vec3 u_zenith;
 uniform vec3 u_horizon;
 uniform vec3 u_ground;
 
-void main() {
-  vec3 d = normalize(viewRay());
-  vec3 colour;
-  float distance;
-  if (d.z < 0.0) {
-    colour = u_ground;
-    distance = u_camera_z / -d.z;
-  } else {
-    colour = u_horizon + (u_zenith - u_horizon) * sqrt(d.z);  // SPEC section 5 gradient
-    distance = kFar;
-  }
+uniform float u_horizon_slope;  // |gradient of r.z| per pixel
+
+vec3 background(vec3 r) {
+  vec3 d = normalize(r);
+  // The ground's share of the pixel: r.z is linear across the image, so the horizon is a
+  // straight edge and its box-filtered coverage is exact.
+  float ground = clamp(0.5 - r.z / u_horizon_slope, 0.0, 1.0);
+  vec3 sky = u_horizon + (u_zenith - u_horizon) * sqrt(max(d.z, 0.0));  // SPEC section 5
 #ifdef FOG
-  colour = applyFog(colour, d, distance);
+  // Each part carries its own fog. The ground seen at the horizon lies behind an infinite
+  // stretch of fog (the fog touches the ground), so there it is the fog colour.
+  vec3 fogged_ground = d.z < 0.0 ? applyFog(u_ground, d, u_camera_z / -d.z) : u_fog_colour;
+  return mix(applyFog(sky, d, kFar), fogged_ground, ground);
+#else
+  return mix(sky, u_ground, ground);
 #endif
-  o_colour = vec4(colour, 0.0);
 }
+#endif
 )";
 
-const char* kLayer = R"(
-uniform float u_height;     // layer altitude minus camera altitude, never 0
-uniform vec3 u_colour;      // layer colour times sun colour
+const char* kLayers = R"(
+const int kSlots = 8;
+uniform float u_height[kSlots];     // layer altitude minus camera altitude, never 0
+uniform vec3 u_colour[kSlots];      // layer colour times sun colour
+// Gardner eq. 8 per slot, with Id constant over a plane: I = base + texture * It
+// + specular * Is (see GlRenderer::setSlotUniforms).
+uniform vec4 u_intensity[kSlots];   // base, texture, specular weight, shininess e
+uniform float u_threshold[kSlots];  // T1
+uniform float u_transition[kSlots]; // D
+uniform vec2 u_origin[kSlots];      // texture coordinate under the camera, periods, in [0, 1)
+uniform vec2 u_inv_period[kSlots];  // periods per metre
+uniform float u_terms[kSlots];      // n
 uniform vec3 u_to_sun;
-uniform vec4 u_shading;     // ambient a, texture fraction t, specular s, shininess e
-uniform float u_threshold;  // T1
-uniform float u_transition; // D
-uniform vec2 u_origin;      // texture coordinate under the camera, in periods, in [0, 1)
-uniform vec2 u_inv_period;  // periods per metre
-uniform float u_terms;      // n
 
-// Number of Gardner terms a pixel resolves; its footprint is in periods (SPEC section 2).
-float termCount(float footprint) {
+struct LayerHit {
+  vec2 p;        // hit point relative to the camera, metres
+  vec2 dpdx;     // its change per pixel step right
+  vec2 dpdy;     // and up
+  float distance;
+};
+
+// Hit of the view ray on slot i's plane; the caller has checked that the ray meets it.
+LayerHit hitLayer(int i, vec3 r) {
+  float h = u_height[i];
+  // Near the horizon keep the hit finite; its footprint is then far too large for any term.
+  float rz = sign(h) * max(abs(r.z), 1e-6 * length(r));
+  LayerHit hit;
+  hit.p = (h / rz) * r.xy;
+  // Exact derivatives of the hit point per pixel (the plane's perspective Jacobian).
+  float scale = h / (rz * rz);
+  hit.dpdx = (u_right.xy * rz - r.xy * u_right.z) * scale * (2.0 / u_viewport.x);
+  hit.dpdy = (u_up.xy * rz - r.xy * u_up.z) * scale * (2.0 / u_viewport.y);
+  hit.distance = (h / rz) * length(r);
+  return hit;
+}
+
+vec2 layerCoordinate(int i, LayerHit hit) { return u_origin[i] + hit.p * u_inv_period[i]; }
+
+// Number of Gardner terms a pixel resolves (SPEC section 2). Term j (1-based) has 2^j
+// cycles per period and resolves while 2^j * footprint <= 1/2.
+float termCount(int i, LayerHit hit) {
 #if defined(FILTER_NONE)
-  return u_terms;
+  return u_terms[i];
 #else
+  float footprint = max(length(hit.dpdx * u_inv_period[i]), length(hit.dpdy * u_inv_period[i]));
   float highest_resolved = log2(0.5 / footprint);
 #if defined(FILTER_CUT)
-  return clamp(floor(highest_resolved), 0.0, u_terms);
+  return clamp(floor(highest_resolved), 0.0, u_terms[i]);
 #else
-  return clamp(highest_resolved - 1.0, 0.0, u_terms);
+  return clamp(highest_resolved - 1.0, 0.0, u_terms[i]);  // fade over the octave below
 #endif
 #endif
 }
 
-#if defined(TEXTURE_BAKED) || defined(TEXTURE_TABLE)
-uniform sampler2D u_table;
-#endif
+// Baked Gardner: level l holds the truncation to n - l terms in red and to n - l - 1 in
+// green, so one bilinear fetch gives both truncations the fade blends.
+float bakedValue(sampler2D table, int i, LayerHit hit) {
+  float lod = u_terms[i] - termCount(i, hit);
+  float level = floor(lod);
+  vec2 t = textureLod(table, layerCoordinate(i, hit), level).rg;
+  return mix(t.r, t.g, lod - level);
+}
 
-#if defined(TEXTURE_PROCEDURAL)
-// Per-term constants; the local origin's phase is reduced modulo 2 pi on the CPU in double.
-uniform float u_fx[8];
-uniform float u_fy[8];
-uniform float u_amplitude[8];
-uniform float u_phase_x[8];       // FX(i) * origin.x + phx(i), mod 2 pi
-uniform float u_phase_y[8];       // FY(i) * origin.y + phy(i), mod 2 pi
-uniform float u_half_phase_x[8];  // 0.5 FX(i) * origin.x, mod 2 pi
-uniform float u_half_phase_y[8];  // 0.5 FY(i) * origin.y, mod 2 pi
-uniform float u_t0;
-uniform float u_k;
+// Tabulated noise: trilinear mipmapping with the exact footprint.
+float tableValue(sampler2D table, int i, LayerHit hit) {
+  return textureGrad(table, layerCoordinate(i, hit), hit.dpdx * u_inv_period[i],
+                     hit.dpdy * u_inv_period[i]).r;
+}
+
+#ifdef PROCEDURAL
+// Per-term constants, slot i's term j at [8 i + j]; the local origin's phases are reduced
+// modulo 2 pi on the CPU in double.
+uniform float u_fx[kSlots * 8];
+uniform float u_fy[kSlots * 8];
+uniform float u_amplitude[kSlots * 8];
+uniform float u_phase_x[kSlots * 8];       // FX(j) * origin.x + phx(j), mod 2 pi
+uniform float u_phase_y[kSlots * 8];       // FY(j) * origin.y + phy(j), mod 2 pi
+uniform float u_half_phase_x[kSlots * 8];  // 0.5 FX(j) * origin.x, mod 2 pi
+uniform float u_half_phase_y[kSlots * 8];  // 0.5 FY(j) * origin.y, mod 2 pi
+uniform float u_t0[kSlots];
+uniform float u_k[kSlots];
 const float kHalfPi = 1.5707963267948966;
 
-void addTerm(int i, vec2 p, inout float sx, inout float sy) {
-  float px = kHalfPi * sin(0.5 * u_fy[i] * p.y + u_half_phase_y[i]);
-  float py = kHalfPi * sin(0.5 * u_fx[i] * p.x + u_half_phase_x[i]);
-  sx += u_amplitude[i] * sin(u_fx[i] * p.x + u_phase_x[i] + px);
-  sy += u_amplitude[i] * sin(u_fy[i] * p.y + u_phase_y[i] + py);
+void addTerm(int j, vec2 p, inout float sx, inout float sy) {
+  float px = kHalfPi * sin(0.5 * u_fy[j] * p.y + u_half_phase_y[j]);
+  float py = kHalfPi * sin(0.5 * u_fx[j] * p.x + u_half_phase_x[j]);
+  sx += u_amplitude[j] * sin(u_fx[j] * p.x + u_phase_x[j] + px);
+  sy += u_amplitude[j] * sin(u_fy[j] * p.y + u_phase_y[j] + py);
 }
 
-float gardner(vec2 p, float count) {
+float proceduralValue(int i, LayerHit hit) {
+  float count = termCount(i, hit);
   int whole = int(count);
-  float sx = u_t0, sy = u_t0;
-  for (int i = 0; i < whole; ++i) addTerm(i, p, sx, sy);
-  float t = u_k * max(sx, 0.0) * max(sy, 0.0);
+  float sx = u_t0[i], sy = u_t0[i];
+  for (int j = 0; j < whole; ++j) addTerm(8 * i + j, hit.p, sx, sy);
+  float t = u_k[i] * max(sx, 0.0) * max(sy, 0.0);
   float fraction = count - float(whole);
   if (fraction > 0.0) {
-    addTerm(whole, p, sx, sy);
-    t = mix(t, u_k * max(sx, 0.0) * max(sy, 0.0), fraction);
+    addTerm(8 * i + whole, hit.p, sx, sy);
+    t = mix(t, u_k[i] * max(sx, 0.0) * max(sy, 0.0), fraction);
   }
   return t;
 }
 #endif
 
-// T at offset p (metres from the camera) with the pixel's footprint derivatives.
-float textureValue(vec2 p, vec2 dpdx, vec2 dpdy) {
-  vec2 gx = dpdx * u_inv_period, gy = dpdy * u_inv_period;
-#if defined(TEXTURE_TABLE)
-  return textureGrad(u_table, u_origin + p * u_inv_period, gx, gy).r;
-#else
-  float count = termCount(max(length(gx), length(gy)));
-#if defined(TEXTURE_BAKED)
-  // Mip level l holds the truncation to n - l terms.
-  return textureLod(u_table, u_origin + p * u_inv_period, u_terms - count).r;
-#else
-  return gardner(p, count);
-#endif
-#endif
-}
-
-float translucence(float excess) {  // Gardner eq. 9, D = 0 a hard threshold
-  if (u_transition <= 0.0) return excess <= 0.0 ? 1.0 : 0.0;
-  return clamp(1.0 - excess / u_transition, 0.0, 1.0);
-}
-
-void main() {
-  vec3 r = viewRay();
-  // Rays that never meet the plane are outside the drawn polygon but for a margin.
-  if (r.z * u_height <= 0.0) discard;
-  // Near the horizon keep the hit finite; its footprint is then far too large for any term.
-  float rz = sign(u_height) * max(abs(r.z), 1e-6 * length(r));
-  float s = u_height / rz;
-  vec2 p = s * r.xy;
-  // Exact derivatives of the hit point per pixel step (the plane's perspective Jacobian).
-  float inv_rz2 = u_height / (rz * rz);
-  vec2 dpdx = (u_right.xy * rz - r.xy * u_right.z) * inv_rz2 * (2.0 / u_viewport.x);
-  vec2 dpdy = (u_up.xy * rz - r.xy * u_up.z) * inv_rz2 * (2.0 / u_viewport.y);
-
-  float it = textureValue(p, dpdx, dpdy);
-  float tr = translucence(it - u_threshold);
-
-  vec3 to_viewer = -normalize(r);
-  vec3 normal = vec3(0.0, 0.0, u_height > 0.0 ? -1.0 : 1.0);  // turned towards the viewer
-  float n_dot_l = dot(normal, u_to_sun);
-  float lit = max(n_dot_l, 0.0);
+// Slot i's surface "over" what lies behind it.
+void composite(int i, vec3 r, LayerHit hit, float it, inout vec3 colour,
+               inout float transmittance) {
+  float excess = it - u_threshold[i];
+  float tr = u_transition[i] <= 0.0 ? (excess <= 0.0 ? 1.0 : 0.0)     // D = 0: hard threshold
+                                    : clamp(1.0 - excess / u_transition[i], 0.0, 1.0);  // eq. 9
+  vec4 weights = u_intensity[i];
+  float intensity = weights.x + weights.y * it;
 #ifdef SPECULAR
-  float highlight = 0.0;
+  vec3 normal = vec3(0.0, 0.0, u_height[i] > 0.0 ? -1.0 : 1.0);  // turned towards the viewer
+  float n_dot_l = dot(normal, u_to_sun);
   if (n_dot_l > 0.0) {
     vec3 reflected = 2.0 * n_dot_l * normal - u_to_sun;
-    highlight = pow(max(dot(reflected, to_viewer), 0.0), u_shading.w);
+    intensity += weights.z * pow(max(dot(reflected, -normalize(r)), 0.0), weights.w);
   }
-  lit = (1.0 - u_shading.z) * lit + u_shading.z * highlight;
 #endif
-  float a = u_shading.x, t = u_shading.y;
-  float intensity = (1.0 - a) * ((1.0 - t) * lit + t * it) + a;  // Gardner eq. 8
-  vec3 colour = intensity * u_colour;
+  vec3 surface = intensity * u_colour[i];
 #ifdef FOG
-  colour = applyFog(colour, -to_viewer, s * length(r));
+  surface = applyFog(surface, normalize(r), hit.distance);
 #endif
-  o_colour = vec4(colour, 1.0 - tr);
+  colour = mix(colour, surface, 1.0 - tr);
+  transmittance *= tr;
 }
 )";
 
-std::string header(bool fog) {
-  std::string s = "#version 450 core\n";
-  if (fog) s += "#define FOG\n";
-  return s;
+std::string slotStatement(int slot, LayerKind kind) {
+  const std::string i = std::to_string(slot);
+  std::string value;
+  switch (kind) {
+    case LayerKind::kBakedGardner:
+      value = "bakedValue(u_table" + i + ", " + i + ", hit)";
+      break;
+    case LayerKind::kTable:
+      value = "tableValue(u_table" + i + ", " + i + ", hit)";
+      break;
+    case LayerKind::kProceduralGardner:
+      value = "proceduralValue(" + i + ", hit)";
+      break;
+  }
+  return "    { LayerHit hit = hitLayer(" + i + ", r); composite(" + i + ", r, hit, " + value +
+         ", colour, transmittance); }\n";
 }
 
 }  // namespace
 
-std::string LayerShaderVariant::key() const {
-  return "layer/" + std::to_string(int(texture)) + "/" + std::to_string(int(term_filter)) + "/" +
-         std::to_string(fog) + std::to_string(specular);
+std::string SkyPassLayout::key() const {
+  std::string k = background ? "bg" : "--";
+  k += "/";
+  for (LayerKind kind : above) k += char('a' + int(kind));
+  k += "/";
+  for (LayerKind kind : below) k += char('a' + int(kind));
+  k += "/" + std::to_string(int(term_filter)) + (fog ? "f" : "-") + (specular ? "s" : "-");
+  return k;
 }
 
 std::string polygonVertexSource() {
@@ -210,27 +236,41 @@ void main() { gl_Position = vec4(u_polygon[gl_VertexID], 0.0, 1.0); }
 )";
 }
 
-std::string backgroundFragmentSource(bool fog) {
-  return header(fog) + kCommon + kBackground;
-}
+std::string skyFragmentSource(const SkyPassLayout& layout) {
+  std::string s = "#version 450 core\n";
+  if (layout.fog) s += "#define FOG\n";
+  if (layout.background) s += "#define BACKGROUND\n";
+  if (layout.specular) s += "#define SPECULAR\n";
+  if (layout.term_filter == TermFilter::kCut) s += "#define FILTER_CUT\n";
+  if (layout.term_filter == TermFilter::kNone) s += "#define FILTER_NONE\n";
+  bool procedural = false, sampled = false;
+  for (const auto* side : {&layout.above, &layout.below})
+    for (LayerKind kind : *side)
+      (kind == LayerKind::kProceduralGardner ? procedural : sampled) = true;
+  if (procedural) s += "#define PROCEDURAL\n";
+  s += kCommon;
+  if (layout.slots() > 0) s += kLayers;
+  // One sampler uniform per slot: llvmpipe samples a sampler-array element far more slowly.
+  if (sampled)
+    for (int i = 0; i < layout.slots(); ++i)
+      s += "uniform sampler2D u_table" + std::to_string(i) + ";\n";
 
-std::string layerFragmentSource(const LayerShaderVariant& variant) {
-  std::string s = header(variant.fog);
-  switch (variant.texture) {
-    case LayerShaderVariant::Texture::kBakedGardner:
-      s += "#define TEXTURE_BAKED\n";
-      break;
-    case LayerShaderVariant::Texture::kProceduralGardner:
-      s += "#define TEXTURE_PROCEDURAL\n";
-      break;
-    case LayerShaderVariant::Texture::kTable:
-      s += "#define TEXTURE_TABLE\n";
-      break;
+  s += "void main() {\n  vec3 r = viewRay();\n";
+  s += layout.background ? "  vec3 colour = background(r);\n" : "  vec3 colour = vec3(0.0);\n";
+  s += "  float transmittance = 1.0;\n";
+  int slot = 0;
+  if (!layout.above.empty()) {
+    s += "  if (r.z > 0.0) {\n";
+    for (LayerKind kind : layout.above) s += slotStatement(slot++, kind);
+    s += "  }\n";
   }
-  if (variant.term_filter == TermFilter::kCut) s += "#define FILTER_CUT\n";
-  if (variant.term_filter == TermFilter::kNone) s += "#define FILTER_NONE\n";
-  if (variant.specular) s += "#define SPECULAR\n";
-  return s + kCommon + kLayer;
+  if (!layout.below.empty()) {
+    s += "  if (r.z < 0.0) {\n";
+    for (LayerKind kind : layout.below) s += slotStatement(slot++, kind);
+    s += "  }\n";
+  }
+  s += "  o_colour = vec4(colour, 1.0 - transmittance);\n}\n";
+  return s;
 }
 
 }  // namespace nephele

@@ -1,23 +1,35 @@
 #pragma once
-// GLSL for the sky passes: the background (sky gradient, ground) and one pass per cloud layer.
+// GLSL for the sky: the background (sky gradient, ground) and textured cloud layers. One
+// generator serves both pass structures: a fused pass (background and every layer composited
+// in registers, written once) and multipass (background, then one blended pass per layer).
+// Every pass writes premultiplied colour and coverage, blended with (ONE, ONE_MINUS_SRC_ALPHA).
 #include <string>
+#include <vector>
 
 #include "renderer/render_settings.h"
 
 namespace nephele {
 
-// What a layer pass must compute; everything a scene does not need is compiled out.
-struct LayerShaderVariant {
-  enum class Texture { kBakedGardner, kProceduralGardner, kTable } texture = Texture::kBakedGardner;
+enum class LayerKind { kBakedGardner, kProceduralGardner, kTable };
+
+inline constexpr int kMaxLayerSlots = 8;
+
+// What one pass computes; everything a scene does not need is compiled out.
+struct SkyPassLayout {
+  bool background = true;
+  // Slots 0..above.size()-1 are layers above the camera, farthest (highest) first; the next
+  // below.size() slots are layers below it, farthest (lowest) first.
+  std::vector<LayerKind> above;
+  std::vector<LayerKind> below;
   TermFilter term_filter = TermFilter::kFade;
   bool fog = false;
   bool specular = false;
 
+  int slots() const { return int(above.size() + below.size()); }
   std::string key() const;
 };
 
 std::string polygonVertexSource();
-std::string backgroundFragmentSource(bool fog);
-std::string layerFragmentSource(const LayerShaderVariant& variant);
+std::string skyFragmentSource(const SkyPassLayout& layout);
 
 }  // namespace nephele

@@ -107,49 +107,47 @@ TextureTable perlinNoise(int size, int cells, int octaves, double persistence, s
   return table;
 }
 
-std::vector<TextureTable> bakeGardnerLevels(const GardnerTexture& texture, int texels_per_cycle) {
-  const int n = texture.terms();
-  while (texels_per_cycle > 2 && (texels_per_cycle << n) > kMaxBakeSize) texels_per_cycle /= 2;
-  const int base = texels_per_cycle << n;
+int gardnerBakeSize(int terms, int texels_per_cycle) {
+  while (texels_per_cycle > 2 && (texels_per_cycle << terms) > kMaxBakeSize) texels_per_cycle /= 2;
+  return texels_per_cycle << terms;
+}
+
+TextureTable bakeGardner(const GardnerTexture& texture, int size, int terms) {
+  const int m = std::clamp(terms, 0, texture.terms());
   const glm::dvec2 period = texture.period();
   const double t0 = texture.params().t0, k = texture.normalisation();
-
-  std::vector<TextureTable> levels;
-  for (int size = base, level = 0; size >= 1; size /= 2, ++level) {
-    const int m = std::max(n - level, 0);
-    // T is a sum of products of a function of X and a function of Y per term, so the sines
-    // are tabulated once per column and row (sin(a + b) = sin a cos b + cos a sin b).
-    std::vector<double> sin_ax(m * size), cos_ax(m * size), sin_py(m * size), cos_py(m * size);
-    std::vector<double> sin_ay(m * size), cos_ay(m * size), sin_px(m * size), cos_px(m * size);
-    for (int i = 0; i < m; ++i)
-      for (int t = 0; t < size; ++t) {
-        const double x = (t + 0.5) / size * period.x, y = (t + 0.5) / size * period.y;
-        const double ax = texture.frequencyX(i) * x + texture.phaseX(i);
-        const double ay = texture.frequencyY(i) * y + texture.phaseY(i);
-        const double py = 0.5 * kPi * std::sin(0.5 * texture.frequencyX(i) * x);  // PY(i) of X
-        const double px = 0.5 * kPi * std::sin(0.5 * texture.frequencyY(i) * y);  // PX(i) of Y
-        const int j = i * size + t;
-        sin_ax[j] = std::sin(ax), cos_ax[j] = std::cos(ax);
-        sin_ay[j] = std::sin(ay), cos_ay[j] = std::cos(ay);
-        sin_py[j] = std::sin(py), cos_py[j] = std::cos(py);
-        sin_px[j] = std::sin(px), cos_px[j] = std::cos(px);
+  // Each term is sin(a(x) + b(y)) along X and sin(a'(y) + b'(x)) along Y, so the sines are
+  // tabulated once per column and row: sin(a + b) = sin a cos b + cos a sin b.
+  const std::size_t cells = std::size_t(m) * size;
+  std::vector<double> sin_ax(cells), cos_ax(cells), sin_py(cells), cos_py(cells);
+  std::vector<double> sin_ay(cells), cos_ay(cells), sin_px(cells), cos_px(cells);
+  for (int i = 0; i < m; ++i)
+    for (int t = 0; t < size; ++t) {
+      const double x = (t + 0.5) / size * period.x, y = (t + 0.5) / size * period.y;
+      const double ax = texture.frequencyX(i) * x + texture.phaseX(i);
+      const double ay = texture.frequencyY(i) * y + texture.phaseY(i);
+      const double py = 0.5 * kPi * std::sin(0.5 * texture.frequencyX(i) * x);  // PY(i) at X
+      const double px = 0.5 * kPi * std::sin(0.5 * texture.frequencyY(i) * y);  // PX(i) at Y
+      const std::size_t j = std::size_t(i) * size + t;
+      sin_ax[j] = std::sin(ax), cos_ax[j] = std::cos(ax);
+      sin_ay[j] = std::sin(ay), cos_ay[j] = std::cos(ay);
+      sin_py[j] = std::sin(py), cos_py[j] = std::cos(py);
+      sin_px[j] = std::sin(px), cos_px[j] = std::cos(px);
+    }
+  TextureTable table{size, size, std::vector<float>(std::size_t(size) * size)};
+  for (int row = 0; row < size; ++row)
+    for (int col = 0; col < size; ++col) {
+      double sx = t0, sy = t0;
+      for (int i = 0; i < m; ++i) {
+        const std::size_t jx = std::size_t(i) * size + col, jy = std::size_t(i) * size + row;
+        const double c = texture.amplitude(i);
+        sx += c * (sin_ax[jx] * cos_px[jy] + cos_ax[jx] * sin_px[jy]);
+        sy += c * (sin_ay[jy] * cos_py[jx] + cos_ay[jy] * sin_py[jx]);
       }
-    TextureTable table{size, size, std::vector<float>(std::size_t(size) * size)};
-    for (int row = 0; row < size; ++row)
-      for (int col = 0; col < size; ++col) {
-        double sx = t0, sy = t0;
-        for (int i = 0; i < m; ++i) {
-          const int jx = i * size + col, jy = i * size + row;
-          const double c = texture.amplitude(i);
-          sx += c * (sin_ax[jx] * cos_px[jy] + cos_ax[jx] * sin_px[jy]);
-          sy += c * (sin_ay[jy] * cos_py[jx] + cos_ay[jy] * sin_py[jx]);
-        }
-        table.values[std::size_t(row) * size + col] =
-            float(k * std::max(sx, 0.0) * std::max(sy, 0.0));
-      }
-    levels.push_back(std::move(table));
-  }
-  return levels;
+      table.values[std::size_t(row) * size + col] =
+          float(k * std::max(sx, 0.0) * std::max(sy, 0.0));
+    }
+  return table;
 }
 
 }  // namespace nephele

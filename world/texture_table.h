@@ -31,12 +31,13 @@ TextureTable diamondSquare(int size_log2, double roughness, std::uint64_t seed);
 // amplitude. Sampled on a size x size grid and normalised to [0, 1].
 TextureTable perlinNoise(int size, int cells, int octaves, double persistence, std::uint64_t seed);
 
-// Gardner's texture over one period, baked as a mip chain: level l has (texels_per_cycle *
-// 2^n) >> l texels a side and holds the truncation to max(n - l, 0) terms, so that each
-// level has exactly `texels_per_cycle` texels per cycle of its highest term. Sampling at
-// level n - c blends the truncations floor(c) and floor(c) + 1, which is the term fade.
-// The base size is capped at kMaxBakeSize by lowering texels_per_cycle.
-inline constexpr int kMaxBakeSize = 4096;
-std::vector<TextureTable> bakeGardnerLevels(const GardnerTexture& texture, int texels_per_cycle);
+// Gardner's texture over one period, truncated to `terms` terms (k as for all n), on a
+// size x size grid of texel centres: what texture hardware samples instead of the sines.
+TextureTable bakeGardner(const GardnerTexture& texture, int size, int terms);
+
+// Base size of a baked Gardner texture: `texels_per_cycle` texels per cycle of the highest
+// term (2^n cycles per period), halved as needed to stay within kMaxBakeSize.
+inline constexpr int kMaxBakeSize = 2048;
+int gardnerBakeSize(int terms, int texels_per_cycle);
 
 }  // namespace nephele

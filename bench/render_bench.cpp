@@ -1,0 +1,150 @@
+// Sky-layer renderer benchmark: milliseconds per frame (median) and error against the CPU
+// reference for every preset, size and quality knob. A program that prints figures, not a
+// test: these machines are shared and noisy.
+//
+//   render_bench [--presets DIR] [--repeats N] [--samples N] [--sizes 640x480,1280x1024]
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "config/scene_file.h"
+#include "renderer/gl_renderer.h"
+#include "renderer/image_metrics.h"
+#include "renderer/reference_renderer.h"
+
+namespace {
+
+using namespace nephele;
+using Clock = std::chrono::steady_clock;
+
+struct Knob {
+  const char* name;
+  RenderSettings settings;
+};
+
+std::vector<Knob> knobs() {
+  std::vector<Knob> k;
+  k.push_back({"baked/fade (default)", {}});
+  RenderSettings s;
+  s.term_filter = TermFilter::kCut;
+  k.push_back({"baked/cut", s});
+  s = {};
+  s.bake_texels_per_cycle = 8;
+  k.push_back({"baked/fade tpc=8", s});
+  s = {};
+  s.bake_texels_per_cycle = 16;
+  k.push_back({"baked/fade tpc=16", s});
+  s = {};
+  s.bake_texels_per_cycle = 2;
+  k.push_back({"baked/fade tpc=2", s});
+  s = {};
+  s.bake_texels_per_cycle = 32;
+  k.push_back({"baked/fade tpc=32", s});
+  s = {};
+  s.sky_passes = SkyPasses::kMultipass;
+  k.push_back({"baked/fade multipass", s});
+  s = {};
+  s.texture_evaluation = TextureEvaluation::kProcedural;
+  k.push_back({"procedural/fade", s});
+  s.term_filter = TermFilter::kNone;
+  k.push_back({"procedural/none", s});
+  return k;
+}
+
+double medianMilliseconds(GlRenderer& renderer, const Scene& scene, const RenderSettings& s,
+                          int repeats, bool float_target) {
+  // Each frame includes glReadPixels, so it is finished when timed.
+  auto frame = [&] {
+    if (float_target)
+      renderer.renderFloat(scene, s);
+    else
+      renderer.renderSrgb8(scene, s);
+  };
+  frame();  // warm-up: shader compile, texture bake
+  std::vector<double> ms;
+  for (int i = 0; i < repeats; ++i) {
+    const auto start = Clock::now();
+    frame();
+    ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
+  }
+  std::sort(ms.begin(), ms.end());
+  return ms[ms.size() / 2];
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app("Nephele sky-layer benchmark");
+  std::string presets = NEPHELE_SOURCE_DIR "/config/scenes";
+  int repeats = 9, samples = 4;
+  std::string target = "srgb8";
+  std::vector<std::string> sizes{"640x480", "1280x1024"};
+  app.add_option("--presets", presets, "Directory of scene files")->capture_default_str();
+  app.add_option("--repeats", repeats, "Timed frames per case (median reported)")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  app.add_option("--samples", samples, "Reference supersampling per axis")
+      ->check(CLI::Range(1, 16))
+      ->capture_default_str();
+  app.add_option("--sizes", sizes, "Image sizes WxH")->delimiter(',');
+  app.add_option("--target", target, "Render target timed: srgb8 (PNG/JPEG/TIFF) or float (EXR)")
+      ->check(CLI::IsMember({"srgb8", "float"}))
+      ->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+
+  std::string error;
+  auto platform = createGlPlatform(GlBackend::kAuto, error);
+  if (!platform) {
+    std::fprintf(stderr, "%s\n", error.c_str());
+    return 1;
+  }
+  std::printf("GL: %s, %s\n", std::string(platform->backendName()).c_str(),
+              platform->renderer().c_str());
+  std::printf("timed: %s target, render + readback\n", target.c_str());
+  std::printf("error: sRGB RGB against the CPU reference (%dx%d samples, every term)\n\n", samples,
+              samples);
+  std::printf("%-12s %-10s %-22s %9s %9s %9s\n", "preset", "size", "knob", "ms/frame", "PSNR dB",
+              "max err");
+  GlRenderer renderer(*platform);
+
+  std::vector<std::filesystem::path> files;
+  for (const auto& entry : std::filesystem::directory_iterator(presets))
+    if (entry.path().extension() == ".toml") files.push_back(entry.path());
+  std::sort(files.begin(), files.end());
+
+  for (const auto& path : files) {
+    SceneFile file;
+    if (std::string e = loadSceneFile(path.string(), file); !e.empty()) {
+      std::fprintf(stderr, "%s\n", e.c_str());
+      return 1;
+    }
+    for (const std::string& size : sizes) {
+      Scene scene = file.scene;
+      if (std::sscanf(size.c_str(), "%dx%d", &scene.camera.width, &scene.camera.height) != 2) {
+        std::fprintf(stderr, "bad size '%s' (expected WxH)\n", size.c_str());
+        return 2;
+      }
+      const auto ref_start = Clock::now();
+      const FloatImage reference = renderReference(scene, {samples, 0});
+      const double ref_ms =
+          std::chrono::duration<double, std::milli>(Clock::now() - ref_start).count();
+      for (const Knob& knob : knobs()) {
+        const double ms =
+            medianMilliseconds(renderer, scene, knob.settings, repeats, target == "float");
+        const ImageError err = compareImages(renderer.renderFloat(scene, knob.settings), reference);
+        std::printf("%-12s %-10s %-22s %9.2f %9.2f %9.4f%s\n", path.stem().c_str(), size.c_str(),
+                    knob.name, ms, err.psnr_db, err.max_abs,
+                    err.non_finite ? "  NON-FINITE PIXELS" : "");
+        std::fflush(stdout);
+      }
+      std::printf("%-12s %-10s %-22s %9.0f\n", path.stem().c_str(), size.c_str(), "(CPU reference)",
+                  ref_ms);
+    }
+  }
+  return 0;
+}
