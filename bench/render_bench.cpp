@@ -34,8 +34,8 @@ std::vector<Knob> knobs() {
   s.term_filter = TermFilter::kCut;
   k.push_back({"baked/cut", s});
   s = {};
-  s.bake_texels_per_cycle = 8;
-  k.push_back({"baked/fade tpc=8", s});
+  s.bake_texels_per_cycle = 4;
+  k.push_back({"baked/fade tpc=4", s});
   s = {};
   s.bake_texels_per_cycle = 16;
   k.push_back({"baked/fade tpc=16", s});

@@ -232,11 +232,13 @@ void readFog(TableReader& t, Fog& fog) {
 }
 
 void readRender(TableReader& t, SceneFile& out) {
-  t.allow({"texture", "term_filter", "bake_texels_per_cycle", "reference_samples"});
+  t.allow({"texture", "term_filter", "sky_passes", "bake_texels_per_cycle", "reference_samples"});
   out.render.texture_evaluation = TextureEvaluation(
       t.choice("texture", {"baked", "procedural"}, int(out.render.texture_evaluation)));
   out.render.term_filter =
       TermFilter(t.choice("term_filter", {"fade", "cut", "none"}, int(out.render.term_filter)));
+  out.render.sky_passes =
+      SkyPasses(t.choice("sky_passes", {"fused", "multipass"}, int(out.render.sky_passes)));
   t.integer("bake_texels_per_cycle", out.render.bake_texels_per_cycle, 2, 64);
   t.integer("reference_samples", out.reference.samples_per_axis, 1, 16);
   t.finish();

@@ -1,0 +1,60 @@
+#include "world/frames.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace nephele {
+namespace {
+
+void expectNear(glm::dvec3 actual, glm::dvec3 expected) {
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(actual[i], expected[i], 1e-12) << "component " << i;
+}
+
+TEST(Frames, IdentityLooksNorthWithZUp) {
+  const glm::dmat3 r = bodyToWorld({});
+  expectNear(r[0], {1, 0, 0});
+  expectNear(r[1], {0, 1, 0});
+  expectNear(r[2], {0, 0, 1});
+}
+
+TEST(Frames, HeadingNinetyLooksEast) {
+  expectNear(bodyToWorld({90, 0, 0})[1], {1, 0, 0});
+}
+
+TEST(Frames, PitchNinetyLooksUp) {
+  expectNear(bodyToWorld({0, 90, 0})[1], {0, 0, 1});
+}
+
+TEST(Frames, RollNinetyTurnsImageUpToEast) {
+  const glm::dmat3 r = bodyToWorld({0, 0, 90});
+  expectNear(r[2], {1, 0, 0});
+  expectNear(r[0], {0, 0, -1});  // right wing down
+}
+
+TEST(Frames, RotationIsOrthonormal) {
+  const glm::dmat3 r = bodyToWorld({37, -21, 123});
+  const glm::dmat3 identity = glm::transpose(r) * r;
+  for (int c = 0; c < 3; ++c)
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(identity[c][k], c == k ? 1.0 : 0.0, 1e-12);
+  EXPECT_NEAR(glm::determinant(r), 1.0, 1e-12);
+}
+
+TEST(Frames, PixelRaysFollowSpecImagePlane) {
+  Camera camera;
+  camera.width = 200;
+  camera.height = 100;
+  camera.vfov_deg = 90.0;  // tan(45) = 1
+  const ViewBasis basis = viewBasis(camera);
+  // Image centre: the optical axis.
+  expectNear(rayDirection(basis, camera, 100, 50), {0, 1, 0});
+  // Top-left corner: u = -aspect, v = +1.
+  expectNear(rayDirection(basis, camera, 0, 0), {-2, 1, 1});
+  // Pixel (i, j) centre: u = (2 (i + 0.5) / W - 1) tan W/H.
+  const glm::dvec3 d = rayDirection(basis, camera, 10 + 0.5, 20 + 0.5);
+  EXPECT_NEAR(d.x, (2.0 * 10.5 / 200 - 1.0) * 2.0, 1e-12);
+  EXPECT_NEAR(d.z, 1.0 - 2.0 * 20.5 / 100, 1e-12);
+}
+
+}  // namespace
+}  // namespace nephele

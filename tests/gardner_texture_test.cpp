@@ -1,0 +1,183 @@
+#include "world/gardner_texture.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <random>
+
+#include "world/layer_texture.h"
+
+namespace nephele {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+// SPEC section 2 written out independently: m of n terms, k for all n terms.
+double specTexture(const GardnerTexture& g, glm::dvec3 p, int m, bool solid) {
+  const GardnerTextureParams& params = g.params();
+  double c = 1.0, sum_c = 0.0, sx = params.t0, sy = params.t0;
+  double fx = params.fx1, fy = params.fy1;
+  for (int i = 0; i < params.terms; ++i) {
+    sum_c += c;
+    if (i < m) {
+      double px = kPi / 2 * std::sin(0.5 * fy * p.y), py = kPi / 2 * std::sin(0.5 * fx * p.x);
+      if (solid) {
+        px += kPi * std::sin(0.5 * fx * p.z);
+        py += kPi * std::sin(0.5 * fx * p.z);
+      }
+      sx += c * std::sin(fx * p.x + px + g.phaseX(i));
+      sy += c * std::sin(fy * p.y + py + g.phaseY(i));
+    }
+    fx *= 2.0, fy *= 2.0, c *= 0.707;
+  }
+  const double k = 1.0 / ((sum_c + params.t0) * (sum_c + params.t0));
+  return k * std::max(sx, 0.0) * std::max(sy, 0.0);
+}
+
+GardnerTextureParams params(int terms, double t0, std::uint64_t seed = 9) {
+  GardnerTextureParams p;
+  p.terms = terms;
+  p.fx1 = 1.3e-3;
+  p.fy1 = 0.7e-3;
+  p.t0 = t0;
+  p.seed = seed;
+  return p;
+}
+
+TEST(GardnerTexture, StaysWithinZeroAndOne) {
+  std::mt19937_64 rng(1);
+  std::uniform_real_distribution<double> coordinate(-1e6, 1e6);
+  for (int n = 1; n <= 8; ++n)
+    for (double t0 : {0.0, 0.5, 3.0}) {
+      const GardnerTexture g(params(n, t0));
+      double highest = 0.0;
+      for (int i = 0; i < 2000; ++i) {
+        const double t = g.planar({coordinate(rng), coordinate(rng)});
+        ASSERT_GE(t, 0.0);
+        ASSERT_LE(t, 1.0);
+        highest = std::max(highest, t);
+      }
+      EXPECT_GT(highest, 0.0) << "n=" << n << " t0=" << t0;
+    }
+}
+
+TEST(GardnerTexture, FrequencyAndAmplitudeRelations) {
+  const GardnerTexture g(params(8, 0.4));
+  double sum = 0.0;
+  for (int i = 0; i < 8; ++i) {
+    sum += g.amplitude(i);
+    if (i == 0) {
+      EXPECT_EQ(g.amplitude(0), 1.0);
+      EXPECT_EQ(g.frequencyX(0), 1.3e-3);
+      continue;
+    }
+    EXPECT_DOUBLE_EQ(g.frequencyX(i), 2.0 * g.frequencyX(i - 1));
+    EXPECT_DOUBLE_EQ(g.frequencyY(i), 2.0 * g.frequencyY(i - 1));
+    EXPECT_DOUBLE_EQ(g.amplitude(i), 0.707 * g.amplitude(i - 1));
+  }
+  EXPECT_DOUBLE_EQ(g.normalisation(), 1.0 / ((sum + 0.4) * (sum + 0.4)));
+}
+
+TEST(GardnerTexture, MatchesSpecFormulaWithPhaseShifts) {
+  const GardnerTexture g(params(6, 0.3));
+  std::mt19937_64 rng(2);
+  std::uniform_real_distribution<double> coordinate(-5e4, 5e4);
+  for (int i = 0; i < 500; ++i) {
+    const glm::dvec3 p(coordinate(rng), coordinate(rng), coordinate(rng));
+    ASSERT_NEAR(g.planar({p.x, p.y}), specTexture(g, {p.x, p.y, 0.0}, 6, false), 1e-12);
+    ASSERT_NEAR(g.solid(p, 6), specTexture(g, p, 6, true), 1e-12);
+  }
+}
+
+TEST(GardnerTexture, SeededPhasesAreDeterministicAndPerSeed) {
+  const GardnerTexture a(params(5, 0.0, 7)), b(params(5, 0.0, 7)), c(params(5, 0.0, 8));
+  GardnerTextureParams unseeded = params(5, 0.0, 7);
+  unseeded.seeded_phases = false;
+  const GardnerTexture none(unseeded);
+  int differing = 0;
+  for (int i = 0; i < 5; ++i) {
+    EXPECT_EQ(a.phaseX(i), b.phaseX(i));
+    EXPECT_GE(a.phaseX(i), 0.0);
+    EXPECT_LT(a.phaseX(i), 2 * kPi);
+    EXPECT_EQ(none.phaseX(i), 0.0);
+    EXPECT_EQ(none.phaseY(i), 0.0);
+    differing += a.phaseX(i) != c.phaseX(i);
+  }
+  EXPECT_EQ(differing, 5);
+  EXPECT_NE(a.planar({1234.0, 567.0}), none.planar({1234.0, 567.0}));
+}
+
+TEST(GardnerTexture, RepeatsWithItsPeriod) {
+  const GardnerTexture g(params(7, 0.2));
+  const glm::dvec2 period = g.period();
+  EXPECT_DOUBLE_EQ(period.x, 4 * kPi / 1.3e-3);
+  for (double x : {0.0, 1234.5, -9876.0})
+    for (double y : {0.0, 345.25}) {
+      EXPECT_NEAR(g.planar({x + period.x, y}), g.planar({x, y}), 1e-10);
+      EXPECT_NEAR(g.planar({x, y - 3 * period.y}), g.planar({x, y}), 1e-10);
+    }
+}
+
+TEST(GardnerTexture, TruncationKeepsExactlyTheLowTerms) {
+  const GardnerTexture g(params(6, 0.5));
+  const glm::dvec2 p(8123.0, -2231.0);
+  for (int m = 0; m <= 6; ++m)
+    EXPECT_NEAR(g.planar(p, m), specTexture(g, {p.x, p.y, 0.0}, m, false), 1e-12) << m;
+  // A fractional count blends the neighbouring truncations.
+  EXPECT_NEAR(g.planar(p, 2.25), 0.75 * g.planar(p, 2) + 0.25 * g.planar(p, 3), 1e-12);
+  // With no terms only the offset is left: k T0^2.
+  EXPECT_NEAR(g.planar(p, 0), g.normalisation() * 0.25, 1e-15);
+}
+
+TEST(GardnerTexture, TermCountFollowsSamplingFrequency) {
+  const GardnerTexture g(params(6, 0.0));
+  // Term i (1-based) has 2^i cycles per period and resolves while 2^i * footprint <= 1/2.
+  for (int i = 1; i <= 6; ++i) {
+    const double at_limit = 0.5 / std::ldexp(1.0, i);
+    EXPECT_EQ(g.termCountForFootprint(at_limit, TermFilter::kCut), i);
+    EXPECT_EQ(g.termCountForFootprint(at_limit * 1.01, TermFilter::kCut), i - 1);
+    // Fading: the term at its limit has weight 0 and full weight an octave below.
+    EXPECT_NEAR(g.termCountForFootprint(at_limit, TermFilter::kFade), i - 1, 1e-12);
+    EXPECT_NEAR(g.termCountForFootprint(at_limit / std::sqrt(2.0), TermFilter::kFade), i - 0.5,
+                1e-12);
+  }
+  EXPECT_EQ(g.termCountForFootprint(1e-9, TermFilter::kFade), 6);
+  EXPECT_EQ(g.termCountForFootprint(10.0, TermFilter::kFade), 0);
+  EXPECT_EQ(g.termCountForFootprint(std::numeric_limits<double>::infinity(), TermFilter::kCut), 0);
+  EXPECT_EQ(g.termCountForFootprint(10.0, TermFilter::kNone), 6);
+}
+
+LayerTextureSpec driftingSpec(glm::dvec2 velocity) {
+  LayerTextureSpec spec;
+  spec.gardner = params(5, 0.2);
+  spec.seed = 4;
+  spec.drift_velocity = velocity;
+  return spec;
+}
+
+TEST(LayerTextureDrift, WrappedOffsetEqualsUnwrappedMotion) {
+  const LayerTexture moving(driftingSpec({13.7, -4.1}));
+  const LayerTexture still(driftingSpec({0.0, 0.0}));
+  for (double t : {0.0, 1.0, 3600.0, 4.0 * 3600.0}) {
+    const glm::dvec2 offset = moving.driftOffset(t);
+    EXPECT_GE(offset.x, 0.0);
+    EXPECT_LT(offset.x, moving.period().x);
+    EXPECT_GE(offset.y, 0.0);
+    EXPECT_LT(offset.y, moving.period().y);
+    const glm::dvec2 p(523.0, 1711.0);
+    EXPECT_NEAR(moving.value(p, t), still.value(p - glm::dvec2(13.7, -4.1) * t, 0.0), 1e-9)
+        << "t=" << t;
+  }
+}
+
+TEST(LayerTextureDrift, HoursOfDriftKeepFullPrecision) {
+  const LayerTexture moving(driftingSpec({25.0, 0.0}));
+  const double period = moving.period().x;
+  const double t = 10.0 * 3600.0 + 0.125;
+  const long double exact = std::fmod(25.0L * (long double)t, (long double)period);
+  EXPECT_NEAR(moving.driftOffset(t).x, double(exact), 1e-9);
+}
+
+}  // namespace
+}  // namespace nephele

@@ -1,0 +1,112 @@
+#include "protocol/image_encoding.h"
+
+#include <OpenImageIO/imageio.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+namespace nephele {
+namespace {
+
+FloatImage gradientImage(int w, int h) {
+  FloatImage image{w, h, std::vector<float>(std::size_t(w) * h * 4)};
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      float* p = image.pixel(x, y);
+      p[0] = float(x) / w;
+      p[1] = float(y) / h;
+      p[2] = 0.25f;
+      p[3] = float(x + y) / (w + h);
+    }
+  return image;
+}
+
+class ImageEncodingTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ =
+        std::filesystem::temp_directory_path() / ("nephele_encoding_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+
+  std::filesystem::path dir_;
+};
+
+TEST_F(ImageEncodingTest, FormatFollowsExtension) {
+  EXPECT_EQ(imageFileFormatForPath("a.PNG"), ImageFileFormat::kPng);
+  EXPECT_EQ(imageFileFormatForPath("a.jpeg"), ImageFileFormat::kJpeg);
+  EXPECT_EQ(imageFileFormatForPath("dir.x/a.tif"), ImageFileFormat::kTiff);
+  EXPECT_EQ(imageFileFormatForPath("a.exr"), ImageFileFormat::kExr);
+  EXPECT_EQ(imageFileFormatForPath("a.bmp"), std::nullopt);
+  EXPECT_EQ(imageFileFormatForPath("noextension"), std::nullopt);
+}
+
+TEST_F(ImageEncodingTest, PngHoldsSrgbBytesTopRowFirst) {
+  const FloatImage image = gradientImage(16, 8);
+  ASSERT_EQ(writeImageFile(path("a.png"), image), "");
+  auto in = OIIO::ImageInput::open(path("a.png"));
+  ASSERT_TRUE(in);
+  EXPECT_EQ(in->spec().nchannels, 3);
+  EXPECT_EQ(in->spec().format, OIIO::TypeDesc::UINT8);
+  std::vector<std::uint8_t> bytes(16 * 8 * 3);
+  ASSERT_TRUE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, bytes.data()));
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 16; ++x)
+      for (int c = 0; c < 3; ++c)
+        ASSERT_EQ(bytes[(y * 16 + x) * 3 + c], toByte(srgbEncode(image.pixel(x, y)[c])));
+}
+
+TEST_F(ImageEncodingTest, BottomUpRowsAreWrittenTopDown) {
+  Srgb8Image image{2, 2, true, {10, 0, 0, 255, 20, 0, 0, 255, 30, 0, 0, 255, 40, 0, 0, 255}};
+  ASSERT_EQ(writeImageFile(path("b.png"), image), "");
+  auto in = OIIO::ImageInput::open(path("b.png"));
+  ASSERT_TRUE(in);
+  std::vector<std::uint8_t> bytes(2 * 2 * 3);
+  ASSERT_TRUE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, bytes.data()));
+  EXPECT_EQ(bytes[0], 30);  // the stored last row is the top row
+  EXPECT_EQ(bytes[6], 10);
+}
+
+TEST_F(ImageEncodingTest, ExrHoldsLinearRgbAndCoverage) {
+  const FloatImage image = gradientImage(12, 10);
+  for (bool half : {true, false}) {
+    EncodeOptions options;
+    options.exr_half = half;
+    options.exr_compression = half ? "piz" : "none";
+    ASSERT_EQ(writeImageFile(path("a.exr"), image, options), "");
+    auto in = OIIO::ImageInput::open(path("a.exr"));
+    ASSERT_TRUE(in);
+    EXPECT_EQ(in->spec().nchannels, 4);
+    EXPECT_EQ(in->spec().alpha_channel, 3);
+    EXPECT_EQ(in->spec().format, half ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT);
+    std::vector<float> values(image.rgba.size());
+    ASSERT_TRUE(in->read_image(0, 0, 0, 4, OIIO::TypeDesc::FLOAT, values.data()));
+    for (std::size_t i = 0; i < values.size(); ++i)
+      ASSERT_NEAR(values[i], image.rgba[i], half ? 1e-3 : 0.0);
+  }
+}
+
+TEST_F(ImageEncodingTest, JpegAndTiffAreWritten) {
+  const FloatImage image = gradientImage(32, 16);
+  for (const char* name : {"a.jpg", "a.tiff"}) {
+    ASSERT_EQ(writeImageFile(path(name), image), "");
+    auto in = OIIO::ImageInput::open(path(name));
+    ASSERT_TRUE(in) << name;
+    EXPECT_EQ(in->spec().width, 32);
+    EXPECT_EQ(in->spec().nchannels, 3);
+  }
+}
+
+TEST_F(ImageEncodingTest, FailuresLeaveNoFile) {
+  const FloatImage image = gradientImage(4, 4);
+  EXPECT_NE(writeImageFile(path("a.bmp"), image).find("allowed: .png"), std::string::npos);
+  EXPECT_NE(writeImageFile(path("missing/dir/a.png"), image), "");
+  Srgb8Image bytes{1, 1, false, {0, 0, 0, 0}};
+  EXPECT_NE(writeImageFile(path("a.exr"), bytes).find("float"), std::string::npos);
+  EXPECT_TRUE(std::filesystem::is_empty(dir_));
+}
+
+}  // namespace
+}  // namespace nephele

@@ -1,0 +1,88 @@
+// The `nephele render` command as a user runs it: exit codes, messages, files.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace {
+
+using ::testing::HasSubstr;
+
+struct CommandResult {
+  int exit_code;
+  std::string output;
+};
+
+CommandResult runNephele(const std::string& arguments) {
+  const std::string command = std::string(NEPHELE_BINARY) + " " + arguments + " 2>&1";
+  CommandResult run{-1, ""};
+  FILE* pipe = popen(command.c_str(), "r");
+  if (!pipe) return run;
+  char buffer[512];
+  while (fgets(buffer, sizeof buffer, pipe)) run.output += buffer;
+  const int status = pclose(pipe);
+  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return run;
+}
+
+class RenderCommandTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() / ("nephele_cli_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  std::string writeScene(const std::string& text) {
+    std::ofstream(path("scene.toml")) << text;
+    return path("scene.toml");
+  }
+  std::filesystem::path dir_;
+};
+
+TEST_F(RenderCommandTest, RendersAPresetWithOverrides) {
+  const CommandResult run =
+      runNephele("render " NEPHELE_SOURCE_DIR "/config/scenes/cirrus.toml -o " + path("out.png") +
+                 " --width 64 --height 40 --pitch 45 --gl osmesa");
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_THAT(run.output, HasSubstr("osmesa"));
+  EXPECT_THAT(run.output, HasSubstr("GL_RENDERER"));
+  EXPECT_TRUE(std::filesystem::exists(path("out.png")));
+}
+
+TEST_F(RenderCommandTest, BadSceneFailsWithMessageAndWritesNothing) {
+  const std::string scene = writeScene("[[layer]]\naltitude = 1000\nthreshold = 7\n");
+  const CommandResult run = runNephele("render " + scene + " -o " + path("out.png"));
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_THAT(run.output, HasSubstr("scene.toml:3: layer[0].threshold: 7 is out of range"));
+  EXPECT_FALSE(std::filesystem::exists(path("out.png")));
+}
+
+TEST_F(RenderCommandTest, BadFlagsAreRejected) {
+  const std::string preset = NEPHELE_SOURCE_DIR "/config/scenes/cirrus.toml";
+  CommandResult run = runNephele("render " + preset + " -o " + path("out.bmp"));
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_THAT(run.output, HasSubstr("allowed: .png"));
+  run = runNephele("render " + preset + " -o " + path("out.png") + " --width 0");
+  EXPECT_NE(run.exit_code, 0);
+  run = runNephele("render " + preset + " -o " + path("out.png") + " --gl vulkan");
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_THAT(run.output, HasSubstr("vulkan"));
+  run = runNephele("render " + preset + " -o " + path("out.png") + " --position 1,2,-5");
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_THAT(run.output, HasSubstr("below the ground"));
+  EXPECT_TRUE(std::filesystem::is_empty(dir_));
+}
+
+TEST_F(RenderCommandTest, ReferenceRendererWritesExr) {
+  const CommandResult run =
+      runNephele("render " NEPHELE_SOURCE_DIR "/config/scenes/stratus.toml -o " + path("ref.exr") +
+                 " --renderer reference --width 32 --height 24 --samples 2");
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_TRUE(std::filesystem::exists(path("ref.exr")));
+}
+
+}  // namespace

@@ -1,0 +1,185 @@
+#include "config/scene_file.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+namespace nephele {
+namespace {
+
+using ::testing::HasSubstr;
+
+std::string parseError(const std::string& text, SceneFile& out) {
+  return parseSceneText(text, "test.toml", out);
+}
+
+std::string parseError(const std::string& text) {
+  SceneFile out;
+  return parseError(text, out);
+}
+
+TEST(SceneFile, EveryPresetLoads) {
+  int count = 0;
+  for (const auto& entry :
+       std::filesystem::directory_iterator(NEPHELE_SOURCE_DIR "/config/scenes")) {
+    if (entry.path().extension() != ".toml") continue;
+    SceneFile file;
+    EXPECT_EQ(loadSceneFile(entry.path().string(), file), "") << entry.path();
+    EXPECT_FALSE(file.scene.layers.empty()) << entry.path();
+    ++count;
+  }
+  EXPECT_GE(count, 4);
+}
+
+TEST(SceneFile, ReadsEveryField) {
+  SceneFile f;
+  ASSERT_EQ(parseError(R"(
+seed = 4
+time = 12.5
+[image]
+width = 320
+height = 200
+[camera]
+position = [1.0, 2, 3.5]
+heading = 10
+pitch = -5
+roll = 2
+vfov = 45
+[sun]
+azimuth = 100
+elevation = 20
+colour = [1, 0.5, 0.25]
+[fog]
+top = 50
+visibility = 800
+[render]
+texture = "procedural"
+term_filter = "cut"
+sky_passes = "multipass"
+bake_texels_per_cycle = 8
+reference_samples = 3
+[[layer]]
+altitude = 900
+threshold = 0.1
+transition = 0
+drift = [3, -1]
+seed = 77
+[layer.texture]
+source = "gardner"
+terms = 8
+fx1 = 0.01
+fy1 = 0.005
+t0 = 1.5
+phases = false
+[[layer]]
+[layer.texture]
+source = "diamond-square"
+tile_size = [1000, 2000]
+roughness = 0.5
+)",
+                       f),
+            "");
+  EXPECT_EQ(f.scene.seed, 4u);
+  EXPECT_EQ(f.scene.time_s, 12.5);
+  EXPECT_EQ(f.scene.camera.width, 320);
+  EXPECT_EQ(f.scene.camera.position, glm::dvec3(1, 2, 3.5));
+  EXPECT_EQ(f.scene.camera.orientation.pitch_deg, -5);
+  EXPECT_EQ(f.scene.sun.colour, glm::dvec3(1, 0.5, 0.25));
+  ASSERT_TRUE(f.scene.fog);
+  EXPECT_EQ(f.scene.fog->visibility_m, 800);
+  EXPECT_EQ(f.render.texture_evaluation, TextureEvaluation::kProcedural);
+  EXPECT_EQ(f.render.term_filter, TermFilter::kCut);
+  EXPECT_EQ(f.render.sky_passes, SkyPasses::kMultipass);
+  EXPECT_EQ(f.render.bake_texels_per_cycle, 8);
+  EXPECT_EQ(f.reference.samples_per_axis, 3);
+  ASSERT_EQ(f.scene.layers.size(), 2u);
+  const CloudLayer& a = f.scene.layers[0];
+  EXPECT_EQ(a.transition, 0.0);
+  EXPECT_EQ(a.texture.seed, 77u);
+  EXPECT_EQ(a.texture.gardner.terms, 8);
+  EXPECT_FALSE(a.texture.gardner.seeded_phases);
+  EXPECT_EQ(a.texture.drift_velocity, glm::dvec2(3, -1));
+  const CloudLayer& b = f.scene.layers[1];
+  EXPECT_EQ(b.texture.source, TextureSource::kDiamondSquare);
+  EXPECT_EQ(b.texture.table.tile_size_m, glm::dvec2(1000, 2000));
+  EXPECT_NE(b.texture.seed, 0u);  // derived from the scene seed
+}
+
+TEST(SceneFile, UnknownKeyNamesLineKeyAndAllowedKeys) {
+  const std::string e = parseError("[camera]\nheading = 1\nheadng = 2\n");
+  EXPECT_THAT(e, HasSubstr("test.toml:3:"));
+  EXPECT_THAT(e, HasSubstr("camera.headng"));
+  EXPECT_THAT(e, HasSubstr("unknown key"));
+  EXPECT_THAT(e, HasSubstr("heading, pitch"));
+}
+
+TEST(SceneFile, WrongTypeIsRejected) {
+  EXPECT_THAT(parseError("[image]\nwidth = \"wide\"\n"),
+              HasSubstr("test.toml:2: image.width: must be an integer"));
+  EXPECT_THAT(parseError("[[layer]]\naltitude = true\n"),
+              HasSubstr("layer[0].altitude: must be a number"));
+  EXPECT_THAT(parseError("[camera]\nposition = [1, 2]\n"),
+              HasSubstr("must be an array of 3 numbers"));
+  EXPECT_THAT(parseError("camera = 3\n"), HasSubstr("camera: must be a table"));
+}
+
+TEST(SceneFile, OutOfRangeNamesTheAllowedRange) {
+  const std::string e = parseError("[[layer]]\n\nthreshold = 1.5\n");
+  EXPECT_THAT(e,
+              HasSubstr("test.toml:3: layer[0].threshold: 1.5 is out of range (allowed: 0 to 1)"));
+  EXPECT_THAT(parseError("[image]\nwidth = 0\n"), HasSubstr("allowed: 1 to 16384"));
+  EXPECT_THAT(parseError("[[layer]]\n[layer.texture]\nterms = 9\n"), HasSubstr("allowed: 1 to 8"));
+  EXPECT_THAT(parseError("[camera]\nposition = [0, 0, -1]\n"), HasSubstr("below the ground"));
+}
+
+TEST(SceneFile, NanAndInfinityAreRejected) {
+  EXPECT_THAT(parseError("[camera]\nvfov = nan\n"),
+              HasSubstr("camera.vfov: nan is not a finite number"));
+  EXPECT_THAT(parseError("[sun]\nelevation = inf\n"), HasSubstr("not a finite number"));
+  EXPECT_THAT(parseError("[camera]\nposition = [0, nan, 0]\n"), HasSubstr("camera.position"));
+}
+
+TEST(SceneFile, KeysOfAnotherTextureSourceAreRejected) {
+  EXPECT_THAT(parseError("[[layer]]\n[layer.texture]\nsource = \"perlin\"\nterms = 3\n"),
+              HasSubstr("applies to source \"gardner\" only"));
+  EXPECT_THAT(parseError("[[layer]]\n[layer.texture]\ntile_size = [1, 1]\n"),
+              HasSubstr("perlin\" and \"diamond-square\" only"));
+  EXPECT_THAT(parseError("[[layer]]\n[layer.texture]\nsource = \"cumulus\"\n"),
+              HasSubstr("one of: gardner, perlin, diamond-square"));
+}
+
+TEST(SceneFile, SyntaxErrorNamesTheLine) {
+  EXPECT_THAT(parseError("seed = 1\n[camera\n"), HasSubstr("test.toml:2: not valid TOML"));
+}
+
+TEST(SceneFile, UnreadableFileIsAnError) {
+  SceneFile f;
+  EXPECT_THAT(loadSceneFile("/nonexistent/scene.toml", f),
+              HasSubstr("cannot read scene file '/nonexistent/scene.toml'"));
+}
+
+TEST(SceneFile, ErrorLeavesTheOutputUntouched) {
+  SceneFile f;
+  f.scene.seed = 1234;
+  f.scene.camera.width = 77;
+  ASSERT_NE(parseError("seed = 5\n[image]\nwidth = 100\nheight = -1\n", f), "");
+  EXPECT_EQ(f.scene.seed, 1234u);
+  EXPECT_EQ(f.scene.camera.width, 77);
+}
+
+TEST(SceneFile, ValidateCameraChecksOverrides) {
+  Camera c;
+  EXPECT_EQ(validateCamera(c), "");
+  c.vfov_deg = 180.0;
+  EXPECT_THAT(validateCamera(c), HasSubstr("vfov 180 is out of range"));
+  c = {};
+  c.position.x = std::nan("");
+  EXPECT_THAT(validateCamera(c), HasSubstr("camera position"));
+  c = {};
+  c.position.z = -3;
+  EXPECT_THAT(validateCamera(c), HasSubstr("below the ground"));
+}
+
+}  // namespace
+}  // namespace nephele
