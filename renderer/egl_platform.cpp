@@ -24,7 +24,8 @@ class EglPlatform final : public GlPlatform {
     if (display_ == EGL_NO_DISPLAY) return;
     eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     if (context_ != EGL_NO_CONTEXT) eglDestroyContext(display_, context_);
-    eglTerminate(display_);
+    // The display stays initialised: it is a per-process singleton, and eglTerminate would
+    // unload the driver only for the next platform to load it again.
   }
   std::string_view backendName() const override { return name_; }
 
