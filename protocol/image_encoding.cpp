@@ -45,6 +45,11 @@ std::string writeWithOiio(const std::string& path, oiio::ImageSpec spec, oiio::T
   return "";
 }
 
+std::string unknownExtension(const std::string& path) {
+  return "unknown image extension in '" + path + "' (allowed: " + std::string(kImageExtensions) +
+         ")";
+}
+
 }  // namespace
 
 std::optional<ImageFileFormat> imageFileFormatForPath(std::string_view path) {
@@ -68,9 +73,7 @@ Srgb8Image toSrgb8(const FloatImage& image) {
 std::string writeImageFile(const std::string& path, const Srgb8Image& image,
                            const EncodeOptions& options) {
   const auto format = imageFileFormatForPath(path);
-  if (!format)
-    return "unknown image extension in '" + path + "' (allowed: " + std::string(kImageExtensions) +
-           ")";
+  if (!format) return unknownExtension(path);
   if (isFloatFormat(*format)) return "'" + path + "' is a float format; it needs a float image";
   // 8-bit files are for viewing: RGB only (coverage goes to EXR, where it is the alpha).
   oiio::ImageSpec spec(image.width, image.height, 3, oiio::TypeDesc::UINT8);
@@ -90,9 +93,7 @@ std::string writeImageFile(const std::string& path, const Srgb8Image& image,
 std::string writeImageFile(const std::string& path, const FloatImage& image,
                            const EncodeOptions& options) {
   const auto format = imageFileFormatForPath(path);
-  if (!format)
-    return "unknown image extension in '" + path + "' (allowed: " + std::string(kImageExtensions) +
-           ")";
+  if (!format) return unknownExtension(path);
   if (!isFloatFormat(*format)) return writeImageFile(path, toSrgb8(image), options);
   oiio::ImageSpec spec(image.width, image.height, 4,
                        options.exr_half ? oiio::TypeDesc::HALF : oiio::TypeDesc::FLOAT);

@@ -220,12 +220,14 @@ std::string slotStatement(int slot, LayerKind kind) {
 }  // namespace
 
 std::string SkyPassLayout::key() const {
-  std::string k = background ? "bg" : "--";
-  k += "/";
+  std::string k = background ? "bg/" : "--/";
   for (LayerKind kind : above) k += char('a' + int(kind));
-  k += "/";
+  k += '/';
   for (LayerKind kind : below) k += char('a' + int(kind));
-  k += "/" + std::to_string(int(term_filter)) + (fog ? "f" : "-") + (specular ? "s" : "-");
+  k += '/';
+  k += char('0' + int(term_filter));
+  k += fog ? 'f' : '-';
+  k += specular ? 's' : '-';
   return k;
 }
 
