@@ -302,33 +302,43 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
   base.fog = scene.fog.has_value();
   base.term_filter = settings.term_filter;
   for (const CloudLayer& layer : scene.layers) base.specular |= layer.shading.specular > 0.0;
-  // One triangle covering the screen: no diagonal edge for the rasteriser to split tiles on.
-  const std::vector<glm::vec2> screen = {{-1, -1}, {3, -1}, {-1, 3}};
   const bool fused = settings.sky_passes == SkyPasses::kFused &&
-                     int(above.size() + below.size()) <= kMaxLayerSlots;
+                     int(std::max(above.size(), below.size())) <= kMaxLayerSlots;
+
+  // The screen region whose rays climb (sign = 1) or descend (sign = -1), widened by
+  // `margin_pixels`: ray.z is linear across the image, so the horizon is a straight line.
+  const ViewBasis basis = viewBasis(camera);
+  auto sideOfHorizon = [&](double sign, double margin_pixels) {
+    const double a = sign * basis.right.z * basis.tan_half_vfov * basis.aspect;
+    const double b = sign * basis.up.z * basis.tan_half_vfov;
+    const double margin =
+        margin_pixels * (std::abs(a) * 2.0 / camera.width + std::abs(b) * 2.0 / camera.height);
+    return clipScreenToHalfPlane(a, b, sign * basis.forward.z + margin);
+  };
 
   // Every pass writes premultiplied colour and coverage; the first overwrites.
   gl_.Disable(GL_BLEND);
   gl_.BlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
   if (fused) {
-    SkyPassLayout layout = base;
-    std::vector<LayerSlot> slots = above;
-    for (const LayerSlot& s : above) layout.above.push_back(s.kind);
-    for (const LayerSlot& s : below) layout.below.push_back(s.kind), slots.push_back(s);
-    drawSkyPass(scene, settings, layout, slots, screen);
+    // One pass per side of the horizon, each with the background and that side's layers:
+    // pixels below the horizon never run the code of layers above the camera. The two
+    // polygons share their edge exactly, so every pixel is drawn once.
+    for (const auto* side : {&above, &below}) {
+      const std::vector<glm::vec2> polygon = sideOfHorizon(side == &above ? 1.0 : -1.0, 0.0);
+      if (polygon.size() < 3) continue;
+      SkyPassLayout layout = base;
+      for (const LayerSlot& slot : *side)
+        (side == &above ? layout.above : layout.below).push_back(slot.kind);
+      drawSkyPass(scene, settings, layout, *side, polygon);
+    }
   } else {
-    drawSkyPass(scene, settings, base, {}, screen);
+    // One triangle covering the screen: no diagonal edge for the rasteriser to split tiles on.
+    drawSkyPass(scene, settings, base, {}, {{-1, -1}, {3, -1}, {-1, 3}});
     gl_.Enable(GL_BLEND);
-    const ViewBasis basis = viewBasis(camera);
     for (const auto* side : {&above, &below})
       for (const LayerSlot& slot : *side) {
-        // Draw only the screen region whose rays meet the plane, plus a two-pixel margin.
-        const double sign = side == &above ? 1.0 : -1.0;
-        const double a = sign * basis.right.z * basis.tan_half_vfov * basis.aspect;
-        const double b = sign * basis.up.z * basis.tan_half_vfov;
-        const double margin = std::abs(a) * 4.0 / camera.width + std::abs(b) * 4.0 / camera.height;
-        const std::vector<glm::vec2> polygon =
-            clipScreenToHalfPlane(a, b, sign * basis.forward.z + margin);
+        // Only where rays meet the plane, plus two pixels the shader leaves untouched.
+        const std::vector<glm::vec2> polygon = sideOfHorizon(side == &above ? 1.0 : -1.0, 2.0);
         if (polygon.size() < 3) continue;
         SkyPassLayout layout = base;
         layout.background = false;
