@@ -74,7 +74,8 @@ class ReferenceTracer {
 
 }  // namespace
 
-FloatImage renderReference(const Scene& scene, const ReferenceSettings& settings) {
+FloatImage renderReference(const Scene& scene, const ReferenceSettings& settings,
+                           const std::function<void(double)>& progress) {
   const Camera& camera = scene.camera;
   FloatImage image{camera.width, camera.height,
                    std::vector<float>(std::size_t(camera.width) * camera.height * 4)};
@@ -83,9 +84,14 @@ FloatImage renderReference(const Scene& scene, const ReferenceSettings& settings
   const int n = std::max(1, settings.samples_per_axis);
 
   std::atomic<int> next_row{0};
-  auto work = [&] {
+  auto work = [&](bool report) {
     std::vector<LayerHit> hits;
+    int reported_tenths = 0;
     for (int y; (y = next_row.fetch_add(1)) < camera.height;) {
+      if (report && progress && y * 10 / camera.height > reported_tenths) {
+        reported_tenths = y * 10 / camera.height;
+        progress(double(y) / camera.height);
+      }
       for (int x = 0; x < camera.width; ++x) {
         glm::dvec4 sum(0.0);
         for (int sy = 0; sy < n; ++sy)
@@ -103,8 +109,8 @@ FloatImage renderReference(const Scene& scene, const ReferenceSettings& settings
   const int threads = settings.threads > 0 ? settings.threads
                                            : std::max(1, int(std::thread::hardware_concurrency()));
   std::vector<std::jthread> pool;
-  for (int i = 1; i < threads; ++i) pool.emplace_back(work);
-  work();
+  for (int i = 1; i < threads; ++i) pool.emplace_back(work, false);
+  work(true);
   pool.clear();  // join before the image is handed out
   return image;
 }

@@ -1,12 +1,17 @@
 #pragma once
 // The CPU reference renderer (SPEC section 7): double precision, exact ray-plane hits, every
 // texture term, per-pixel depth order, supersampled. Slow and simple enough to trust.
+#include <functional>
+
 #include "renderer/render_settings.h"
 #include "world/image.h"
 #include "world/scene.h"
 
 namespace nephele {
 
-FloatImage renderReference(const Scene& scene, const ReferenceSettings& settings = {});
+// `progress`, if given, is called on the calling thread with the fraction of rows started,
+// about every tenth of the image.
+FloatImage renderReference(const Scene& scene, const ReferenceSettings& settings = {},
+                           const std::function<void(double)>& progress = {});
 
 }  // namespace nephele

@@ -119,7 +119,11 @@ int runRenderCommand(const RenderCommandOptions& o) {
   std::string error;
   const auto start = Clock::now();
   if (o.renderer == "reference") {
-    const FloatImage image = renderReference(scene, file.reference);
+    const FloatImage image = renderReference(scene, file.reference, [&](double done) {
+      const double seconds = millisecondsSince(start) / 1000.0;
+      if (seconds >= 2.0)  // only long renders need a progress line
+        spdlog::info("reference render: {:.0f} % after {:.1f} s", 100.0 * done, seconds);
+    });
     spdlog::info("reference render: {:.0f} ms ({}x{} samples per pixel)", millisecondsSince(start),
                  file.reference.samples_per_axis, file.reference.samples_per_axis);
     error = writeImageFile(o.output_path, image, o.encode);
