@@ -28,32 +28,27 @@ struct Knob {
 };
 
 std::vector<Knob> knobs() {
-  std::vector<Knob> k;
-  k.push_back({"baked/fade (default)", {}});
-  RenderSettings s;
-  s.term_filter = TermFilter::kCut;
-  k.push_back({"baked/cut", s});
-  s = {};
-  s.bake_texels_per_cycle = 4;
-  k.push_back({"baked/fade tpc=4", s});
-  s = {};
-  s.bake_texels_per_cycle = 16;
-  k.push_back({"baked/fade tpc=16", s});
-  s = {};
-  s.bake_texels_per_cycle = 2;
-  k.push_back({"baked/fade tpc=2", s});
-  s = {};
-  s.bake_texels_per_cycle = 32;
-  k.push_back({"baked/fade tpc=32", s});
-  s = {};
-  s.sky_passes = SkyPasses::kMultipass;
-  k.push_back({"baked/fade multipass", s});
-  s = {};
-  s.texture_evaluation = TextureEvaluation::kProcedural;
-  k.push_back({"procedural/fade", s});
-  s.term_filter = TermFilter::kNone;
-  k.push_back({"procedural/none", s});
-  return k;
+  auto knob = [](const char* name, auto edit) {
+    Knob k{name, {}};
+    edit(k.settings);
+    return k;
+  };
+  return {
+      knob("baked/fade (default)", [](RenderSettings&) {}),
+      knob("baked/cut", [](RenderSettings& s) { s.term_filter = TermFilter::kCut; }),
+      knob("baked/fade tpc=4", [](RenderSettings& s) { s.bake_texels_per_cycle = 4; }),
+      knob("baked/fade tpc=16", [](RenderSettings& s) { s.bake_texels_per_cycle = 16; }),
+      knob("baked/fade tpc=2", [](RenderSettings& s) { s.bake_texels_per_cycle = 2; }),
+      knob("baked/fade tpc=32", [](RenderSettings& s) { s.bake_texels_per_cycle = 32; }),
+      knob("baked/fade multipass", [](RenderSettings& s) { s.sky_passes = SkyPasses::kMultipass; }),
+      knob("procedural/fade",
+           [](RenderSettings& s) { s.texture_evaluation = TextureEvaluation::kProcedural; }),
+      knob("procedural/none",
+           [](RenderSettings& s) {
+             s.texture_evaluation = TextureEvaluation::kProcedural;
+             s.term_filter = TermFilter::kNone;
+           }),
+  };
 }
 
 double medianMilliseconds(GlRenderer& renderer, const Scene& scene, const RenderSettings& s,

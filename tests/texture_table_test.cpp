@@ -25,15 +25,20 @@ void expectUnitRange(const TextureTable& t) {
   EXPECT_FLOAT_EQ(*hi, 1.0f);
 }
 
-TEST(DiamondSquare, NormalisedSeededAndPeriodic) {
-  const TextureTable a = diamondSquare(7, 1.0, 42), b = diamondSquare(7, 1.0, 42);
-  const TextureTable c = diamondSquare(7, 1.0, 43);
-  ASSERT_EQ(a.width, 128);
+// `a` and `same_seed` come from one seed, `other_seed` from another.
+void expectSeededPeriodicTable(const TextureTable& a, const TextureTable& same_seed,
+                               const TextureTable& other_seed) {
   expectUnitRange(a);
-  EXPECT_EQ(a.values, b.values);
-  EXPECT_NE(a.values, c.values);
+  EXPECT_EQ(a.values, same_seed.values);
+  EXPECT_NE(a.values, other_seed.values);
   const auto [seam, interior] = seamAndInteriorSteps(a);
   EXPECT_LT(seam, 2.0 * interior);
+}
+
+TEST(DiamondSquare, NormalisedSeededAndPeriodic) {
+  const TextureTable a = diamondSquare(7, 1.0, 42);
+  ASSERT_EQ(a.width, 128);
+  expectSeededPeriodicTable(a, diamondSquare(7, 1.0, 42), diamondSquare(7, 1.0, 43));
 }
 
 TEST(DiamondSquare, RoughnessControlsHighFrequencies) {
@@ -43,13 +48,8 @@ TEST(DiamondSquare, RoughnessControlsHighFrequencies) {
 }
 
 TEST(PerlinNoise, NormalisedSeededAndPeriodic) {
-  const TextureTable a = perlinNoise(128, 4, 5, 0.5, 3), b = perlinNoise(128, 4, 5, 0.5, 3);
-  const TextureTable c = perlinNoise(128, 4, 5, 0.5, 4);
-  expectUnitRange(a);
-  EXPECT_EQ(a.values, b.values);
-  EXPECT_NE(a.values, c.values);
-  const auto [seam, interior] = seamAndInteriorSteps(a);
-  EXPECT_LT(seam, 2.0 * interior);
+  expectSeededPeriodicTable(perlinNoise(128, 4, 5, 0.5, 3), perlinNoise(128, 4, 5, 0.5, 3),
+                            perlinNoise(128, 4, 5, 0.5, 4));
 }
 
 TEST(TextureTable, BilinearSampleHitsTexelCentresAndWraps) {
