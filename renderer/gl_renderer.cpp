@@ -58,12 +58,11 @@ void uploadBakedGardner(const GlApi& gl, GLuint texture, const GardnerTexture& g
   gl.TextureStorage2D(texture, levels, GL_RG16, base, base);
   for (int level = 0; level < levels; ++level) {
     const int size = base >> level, terms = gardner.terms() - level;
-    const TextureTable more = bakeGardner(gardner, size, terms);
-    const TextureTable fewer = bakeGardner(gardner, size, terms - 1);
-    std::vector<float> rg(more.values.size() * 2);
-    for (std::size_t i = 0; i < more.values.size(); ++i) {
-      rg[2 * i] = more.values[i];
-      rg[2 * i + 1] = fewer.values[i];
+    const GardnerTruncations baked = bakeGardner(gardner, size, terms);
+    std::vector<float> rg(baked.with_terms.values.size() * 2);
+    for (std::size_t i = 0; i < baked.with_terms.values.size(); ++i) {
+      rg[2 * i] = baked.with_terms.values[i];
+      rg[2 * i + 1] = baked.one_fewer.values[i];
     }
     gl.TextureSubImage2D(texture, level, 0, 0, size, size, GL_RG, GL_FLOAT, rg.data());
   }

@@ -75,12 +75,14 @@ TEST(BakedGardner, TexelsEqualTheTruncatedTexture) {
   const GardnerTexture g(params);
   const int size = gardnerBakeSize(5, 4);
   EXPECT_EQ(size, 128);
-  for (int terms : {5, 3, 0}) {
-    const TextureTable t = bakeGardner(g, size, terms);
+  for (int terms : {5, 3, 1, 0}) {
+    const GardnerTruncations t = bakeGardner(g, size, terms);
     for (int y = 0; y < size; y += 7)
       for (int x = 0; x < size; x += 11) {
         const glm::dvec2 p((x + 0.5) / size * g.period().x, (y + 0.5) / size * g.period().y);
-        ASSERT_NEAR(t.at(x, y), g.planar(p, terms), 1e-6) << x << "," << y << " m=" << terms;
+        ASSERT_NEAR(t.with_terms.at(x, y), g.planar(p, terms), 1e-6) << x << "," << y;
+        ASSERT_NEAR(t.one_fewer.at(x, y), g.planar(p, std::max(terms - 1, 0)), 1e-6)
+            << x << "," << y << " m=" << terms;
       }
   }
 }

@@ -112,7 +112,7 @@ int gardnerBakeSize(int terms, int texels_per_cycle) {
   return texels_per_cycle << terms;
 }
 
-TextureTable bakeGardner(const GardnerTexture& texture, int size, int terms) {
+GardnerTruncations bakeGardner(const GardnerTexture& texture, int size, int terms) {
   const int m = std::clamp(terms, 0, texture.terms());
   const glm::dvec2 period = texture.period();
   const double t0 = texture.params().t0, k = texture.normalisation();
@@ -134,20 +134,27 @@ TextureTable bakeGardner(const GardnerTexture& texture, int size, int terms) {
       sin_py[j] = std::sin(py), cos_py[j] = std::cos(py);
       sin_px[j] = std::sin(px), cos_px[j] = std::cos(px);
     }
-  TextureTable table{size, size, std::vector<float>(std::size_t(size) * size)};
+  const std::size_t texels = std::size_t(size) * size;
+  GardnerTruncations out{{size, size, std::vector<float>(texels)},
+                         {size, size, std::vector<float>(texels)}};
+  auto texture_value = [k](double sx, double sy) {
+    return float(k * std::max(sx, 0.0) * std::max(sy, 0.0));
+  };
   for (int row = 0; row < size; ++row)
     for (int col = 0; col < size; ++col) {
       double sx = t0, sy = t0;
+      const std::size_t texel = std::size_t(row) * size + col;
+      out.one_fewer.values[texel] = texture_value(sx, sy);
       for (int i = 0; i < m; ++i) {
         const std::size_t jx = std::size_t(i) * size + col, jy = std::size_t(i) * size + row;
         const double c = texture.amplitude(i);
         sx += c * (sin_ax[jx] * cos_px[jy] + cos_ax[jx] * sin_px[jy]);
         sy += c * (sin_ay[jy] * cos_py[jx] + cos_ay[jy] * sin_py[jx]);
+        if (i == m - 2) out.one_fewer.values[texel] = texture_value(sx, sy);
       }
-      table.values[std::size_t(row) * size + col] =
-          float(k * std::max(sx, 0.0) * std::max(sy, 0.0));
+      out.with_terms.values[texel] = texture_value(sx, sy);
     }
-  return table;
+  return out;
 }
 
 }  // namespace nephele

@@ -31,9 +31,14 @@ TextureTable diamondSquare(int size_log2, double roughness, std::uint64_t seed);
 // amplitude. Sampled on a size x size grid and normalised to [0, 1].
 TextureTable perlinNoise(int size, int cells, int octaves, double persistence, std::uint64_t seed);
 
-// Gardner's texture over one period, truncated to `terms` terms (k as for all n), on a
-// size x size grid of texel centres: what texture hardware samples instead of the sines.
-TextureTable bakeGardner(const GardnerTexture& texture, int size, int terms);
+// Gardner's texture over one period on a size x size grid of texel centres (what texture
+// hardware samples instead of the sines), truncated to `terms` terms and, from the same
+// partial sums, to one term fewer (at least 0); k stays as for all n terms.
+struct GardnerTruncations {
+  TextureTable with_terms;
+  TextureTable one_fewer;
+};
+GardnerTruncations bakeGardner(const GardnerTexture& texture, int size, int terms);
 
 // Base size of a baked Gardner texture: `texels_per_cycle` texels per cycle of the highest
 // term (2^n cycles per period), halved as needed to stay within kMaxBakeSize.
