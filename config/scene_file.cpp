@@ -73,8 +73,7 @@ class TableReader {
     if (!node->is_string())
       fail(*node, key, "must be a string (one of: " + joinKeys(allowed) + ")");
     const std::string value = node->value<std::string>().value();
-    for (std::size_t i = 0; i < allowed.size(); ++i)
-      if (allowed[i] == value) return int(i);
+    if (const int index = nameIndex(allowed, value); index >= 0) return index;
     fail(*node, key, "\"" + value + "\" is not allowed (one of: " + joinKeys(allowed) + ")");
   }
 
@@ -199,17 +198,17 @@ void readCamera(TableReader& t, Camera& camera) {
   if (camera.position.z < 0.0)
     t.failAt("position",
              "z = " + formatNumber(camera.position.z) + " is below the ground (allowed: z >= 0)");
-  t.number("heading", camera.orientation.heading_deg, -360.0, 360.0);
-  t.number("pitch", camera.orientation.pitch_deg, -90.0, 90.0);
-  t.number("roll", camera.orientation.roll_deg, -180.0, 180.0);
+  t.number("heading", camera.orientation.heading_deg, -Limits::kMaxHeading, Limits::kMaxHeading);
+  t.number("pitch", camera.orientation.pitch_deg, -Limits::kMaxPitch, Limits::kMaxPitch);
+  t.number("roll", camera.orientation.roll_deg, -Limits::kMaxRoll, Limits::kMaxRoll);
   t.number("vfov", camera.vfov_deg, Limits::kMinVfov, Limits::kMaxVfov);
   t.finish();
 }
 
 void readSun(TableReader& t, Sun& sun) {
   t.allow({"azimuth", "elevation", "colour"});
-  t.number("azimuth", sun.azimuth_deg, -360.0, 360.0);
-  t.number("elevation", sun.elevation_deg, -90.0, 90.0);
+  t.number("azimuth", sun.azimuth_deg, -Limits::kMaxHeading, Limits::kMaxHeading);
+  t.number("elevation", sun.elevation_deg, -Limits::kMaxPitch, Limits::kMaxPitch);
   t.vector("colour", sun.colour, 0.0, kMaxColour);
   t.finish();
 }
@@ -234,11 +233,11 @@ void readFog(TableReader& t, Fog& fog) {
 void readRender(TableReader& t, SceneFile& out) {
   t.allow({"texture", "term_filter", "sky_passes", "bake_texels_per_cycle", "reference_samples"});
   out.render.texture_evaluation = TextureEvaluation(
-      t.choice("texture", {"baked", "procedural"}, int(out.render.texture_evaluation)));
+      t.choice("texture", kTextureEvaluationNames, int(out.render.texture_evaluation)));
   out.render.term_filter =
-      TermFilter(t.choice("term_filter", {"fade", "cut", "none"}, int(out.render.term_filter)));
+      TermFilter(t.choice("term_filter", kTermFilterNames, int(out.render.term_filter)));
   out.render.sky_passes =
-      SkyPasses(t.choice("sky_passes", {"fused", "multipass"}, int(out.render.sky_passes)));
+      SkyPasses(t.choice("sky_passes", kSkyPassesNames, int(out.render.sky_passes)));
   t.integer("bake_texels_per_cycle", out.render.bake_texels_per_cycle, 2, 64);
   t.integer("reference_samples", out.reference.samples_per_axis, 1, 16);
   t.finish();
@@ -300,7 +299,7 @@ void readScene(const toml::table& root, const std::string& file, SceneFile& out)
   t.allow({"seed", "time", "image", "camera", "sun", "sky", "fog", "render", "layer"});
   Scene& scene = out.scene;
   t.seed("seed", scene.seed);
-  t.number("time", scene.time_s, 0.0, 1.0e9);
+  t.number("time", scene.time_s, 0.0, Limits::kMaxTime);
   if (auto image = t.table("image")) readImage(*image, scene.camera);
   if (auto camera = t.table("camera")) readCamera(*camera, scene.camera);
   if (auto sun = t.table("sun")) readSun(*sun, scene.sun);
@@ -318,6 +317,12 @@ void readScene(const toml::table& root, const std::string& file, SceneFile& out)
 }
 
 }  // namespace
+
+int nameIndex(const std::vector<std::string>& names, std::string_view name) {
+  for (std::size_t i = 0; i < names.size(); ++i)
+    if (names[i] == name) return int(i);
+  return -1;
+}
 
 std::string parseSceneText(std::string_view text, const std::string& source_name, SceneFile& out) {
   SceneFile parsed;
@@ -358,11 +363,11 @@ std::string validateCamera(const Camera& c) {
     return ("vfov " + formatNumber(c.vfov_deg) + " is out of range (allowed: " +
             formatNumber(Limits::kMinVfov) + " to " + formatNumber(Limits::kMaxVfov) + ")");
   const Orientation& o = c.orientation;
-  if (!(std::abs(o.heading_deg) <= 360.0) || !(std::abs(o.pitch_deg) <= 90.0) ||
-      !(std::abs(o.roll_deg) <= 180.0))
-    return (
-        "camera orientation is out of range (allowed: heading -360 to 360, pitch -90 to "
-        "90, roll -180 to 180)");
+  if (!(std::abs(o.heading_deg) <= Limits::kMaxHeading) ||
+      !(std::abs(o.pitch_deg) <= Limits::kMaxPitch) || !(std::abs(o.roll_deg) <= Limits::kMaxRoll))
+    return "camera orientation is out of range (allowed: heading, pitch, roll within +-" +
+           formatNumber(Limits::kMaxHeading) + ", +-" + formatNumber(Limits::kMaxPitch) + ", +-" +
+           formatNumber(Limits::kMaxRoll) + " degrees)";
   return "";
 }
 

@@ -3,6 +3,7 @@
 // line, the key and what is allowed; on error nothing is returned.
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "renderer/render_settings.h"
 #include "world/scene.h"
@@ -21,7 +22,19 @@ struct Limits {
   static constexpr double kMaxCoordinate = 1.0e8;  // metres from the origin
   static constexpr double kMaxAltitude = 1.0e5;
   static constexpr double kMinVfov = 0.01, kMaxVfov = 179.0;
+  // Angles in degrees, each allowed from -max to +max; sun azimuth and elevation follow
+  // heading and pitch.
+  static constexpr double kMaxHeading = 360.0, kMaxPitch = 90.0, kMaxRoll = 180.0;
+  static constexpr double kMaxTime = 1.0e9;  // seconds of simulation time
 };
+
+// Names of the render knobs in enum order, shared by scene files and the command line.
+inline const std::vector<std::string> kTextureEvaluationNames{"baked", "procedural"};
+inline const std::vector<std::string> kTermFilterNames{"fade", "cut", "none"};
+inline const std::vector<std::string> kSkyPassesNames{"fused", "multipass"};
+
+// Position of `name` in `names`, or -1.
+int nameIndex(const std::vector<std::string>& names, std::string_view name);
 
 // Reads `path`. Returns an empty string on success, else the error.
 std::string loadSceneFile(const std::string& path, SceneFile& out);

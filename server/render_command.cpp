@@ -28,13 +28,13 @@ std::string applyOverrides(const RenderCommandOptions& o, SceneFile& file) {
   if (o.roll) camera.orientation.roll_deg = *o.roll;
   if (o.vfov) camera.vfov_deg = *o.vfov;
   if (o.time) file.scene.time_s = *o.time;
+  // The names were checked against the same lists when the flags were parsed.
   if (o.texture)
     file.render.texture_evaluation =
-        *o.texture == "procedural" ? TextureEvaluation::kProcedural : TextureEvaluation::kBaked;
+        TextureEvaluation(nameIndex(kTextureEvaluationNames, *o.texture));
   if (o.term_filter)
-    file.render.term_filter = *o.term_filter == "cut"    ? TermFilter::kCut
-                              : *o.term_filter == "none" ? TermFilter::kNone
-                                                         : TermFilter::kFade;
+    file.render.term_filter = TermFilter(nameIndex(kTermFilterNames, *o.term_filter));
+  if (o.sky_passes) file.render.sky_passes = SkyPasses(nameIndex(kSkyPassesNames, *o.sky_passes));
   if (o.samples) file.reference.samples_per_axis = *o.samples;
   std::string error = validateCamera(camera);
   return error.empty() ? "" : "command line: " + error;
@@ -68,20 +68,22 @@ void addRenderCommand(CLI::App& app, RenderCommandOptions& o) {
       ->expected(3)
       ->delimiter(',');
   cmd->add_option("--heading", o.heading, "Camera heading, degrees clockwise from north")
-      ->check(CLI::Range(-360.0, 360.0));
+      ->check(CLI::Range(-Limits::kMaxHeading, Limits::kMaxHeading));
   cmd->add_option("--pitch", o.pitch, "Camera pitch, degrees, positive up")
-      ->check(CLI::Range(-90.0, 90.0));
+      ->check(CLI::Range(-Limits::kMaxPitch, Limits::kMaxPitch));
   cmd->add_option("--roll", o.roll, "Camera roll, degrees, positive right wing down")
-      ->check(CLI::Range(-180.0, 180.0));
+      ->check(CLI::Range(-Limits::kMaxRoll, Limits::kMaxRoll));
   cmd->add_option("--vfov", o.vfov, "Vertical field of view, degrees")
       ->check(CLI::Range(Limits::kMinVfov, Limits::kMaxVfov));
   cmd->add_option("--time", o.time, "Simulation time in seconds (layers drift with it)")
-      ->check(CLI::Range(0.0, 1.0e9));
+      ->check(CLI::Range(0.0, Limits::kMaxTime));
   cmd->add_option("--texture", o.texture, "Gardner texture on the GPU: baked or procedural")
-      ->check(CLI::IsMember({"baked", "procedural"}));
+      ->check(CLI::IsMember(kTextureEvaluationNames));
   cmd->add_option("--term-filter", o.term_filter,
                   "Removal of texture terms above the pixel frequency: fade, cut or none")
-      ->check(CLI::IsMember({"fade", "cut", "none"}));
+      ->check(CLI::IsMember(kTermFilterNames));
+  cmd->add_option("--sky-passes", o.sky_passes, "fused, or multipass (one pass per layer)")
+      ->check(CLI::IsMember(kSkyPassesNames));
   cmd->add_option("--samples", o.samples, "Reference supersampling per pixel axis")
       ->check(CLI::Range(1, 16));
   cmd->add_option("--png-compression", o.encode.png_compression, "PNG zlib level")

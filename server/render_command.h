@@ -18,7 +18,7 @@ struct RenderCommandOptions {
   std::optional<int> width, height;
   std::optional<std::vector<double>> position;
   std::optional<double> heading, pitch, roll, vfov, time;
-  std::optional<std::string> texture, term_filter;
+  std::optional<std::string> texture, term_filter, sky_passes;
   std::optional<int> samples;
   EncodeOptions encode;
 };

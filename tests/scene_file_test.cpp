@@ -179,6 +179,9 @@ TEST(SceneFile, ValidateCameraChecksOverrides) {
   c = {};
   c.position.z = -3;
   EXPECT_THAT(validateCamera(c), HasSubstr("below the ground"));
+  c = {};
+  c.orientation.pitch_deg = 91.0;
+  EXPECT_THAT(validateCamera(c), HasSubstr("+-90"));
 }
 
 }  // namespace
