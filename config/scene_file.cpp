@@ -5,12 +5,14 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <set>
 #include <sstream>
 #include <vector>
 
+#include "config/obj_mesh.h"
 #include "world/counter_random.h"
 
 namespace nephele {
@@ -135,6 +137,12 @@ class TableReader {
     fail(*table_.get(key), key, what);
   }
 
+  // An error about the table as a whole (a missing key, a missing part).
+  [[noreturn]] void failHere(const std::string& what) const {
+    throw SceneError{file_ + ":" + std::to_string(table_.source().begin.line) + ": " +
+                     (path_.empty() ? std::string("scene") : path_) + ": " + what};
+  }
+
   [[noreturn]] void fail(const toml::node& node, std::string_view key,
                          const std::string& what) const {
     throw SceneError{file_ + ":" + std::to_string(node.source().begin.line) + ": " +
@@ -231,7 +239,9 @@ void readFog(TableReader& t, Fog& fog) {
 }
 
 void readRender(TableReader& t, SceneFile& out) {
-  t.allow({"texture", "term_filter", "sky_passes", "bake_texels_per_cycle", "reference_samples"});
+  t.allow({"texture", "term_filter", "sky_passes", "bake_texels_per_cycle", "reference_samples",
+           "ellipsoid_passes", "ellipsoid_order", "limb", "tile_resolution", "tile_format",
+           "tessellation", "impostor_tolerance"});
   out.render.texture_evaluation = TextureEvaluation(
       t.choice("texture", kTextureEvaluationNames, int(out.render.texture_evaluation)));
   out.render.term_filter =
@@ -240,6 +250,24 @@ void readRender(TableReader& t, SceneFile& out) {
       SkyPasses(t.choice("sky_passes", kSkyPassesNames, int(out.render.sky_passes)));
   t.integer("bake_texels_per_cycle", out.render.bake_texels_per_cycle, 2, 64);
   t.integer("reference_samples", out.reference.samples_per_axis, 1, 16);
+  RenderSettings& r = out.render;
+  r.ellipsoid_passes =
+      EllipsoidPasses(t.choice("ellipsoid_passes", kEllipsoidPassesNames, int(r.ellipsoid_passes)));
+  r.ellipsoid_order =
+      EllipsoidOrder(t.choice("ellipsoid_order", kEllipsoidOrderNames, int(r.ellipsoid_order)));
+  r.limb = LimbEvaluation(t.choice("limb", kLimbNames, int(r.limb)));
+  r.tile_format = TileFormat(t.choice("tile_format", kTileFormatNames, int(r.tile_format)));
+  t.integer("tile_resolution", r.tile_resolution, 0, 1024);
+  if (r.tile_resolution != 0 &&
+      (r.tile_resolution < 8 || (r.tile_resolution & (r.tile_resolution - 1)) != 0))
+    t.failAt("tile_resolution", std::to_string(r.tile_resolution) +
+                                    " is not allowed (allowed: 0 for adaptive, or a power of "
+                                    "two from 8 to 1024)");
+  t.integer("tessellation", r.tessellation, 0, 256);
+  if (r.tessellation != 0 && r.tessellation < 3)
+    t.failAt("tessellation", std::to_string(r.tessellation) +
+                                 " is not allowed (allowed: 0 for adaptive, or 3 to 256)");
+  t.number("impostor_tolerance", r.impostor_tolerance_px, 0.0, 100.0);
   t.finish();
 }
 
@@ -294,9 +322,118 @@ void readLayer(TableReader& t, CloudLayer& layer) {
   t.finish();
 }
 
+void readSolidTexture(TableReader& t, SolidTextureSpec& texture) {
+  t.allow({"source", "terms", "fx1", "fy1", "t0", "phases", "period", "size_log2", "cells",
+           "octaves", "persistence"});
+  texture.source =
+      SolidTextureSource(t.choice("source", {"gardner", "perlin"}, int(texture.source)));
+  const bool gardner = texture.source == SolidTextureSource::kGardner;
+  for (const char* key : {"terms", "fx1", "fy1", "t0", "phases"})
+    if (!gardner) t.forbid(key, "applies to source \"gardner\" only, not \"perlin\"");
+  for (const char* key : {"period", "size_log2", "cells", "octaves", "persistence"})
+    if (gardner) t.forbid(key, "applies to source \"perlin\" only, not \"gardner\"");
+  GardnerTextureParams& g = texture.gardner;
+  t.integer("terms", g.terms, 1, GardnerTextureParams::kMaxTerms);
+  t.number("fx1", g.fx1, 1.0e-6, 10.0);
+  t.number("fy1", g.fy1, 1.0e-6, 10.0);
+  t.number("t0", g.t0, 0.0, 10.0);
+  t.boolean("phases", g.seeded_phases);
+  t.number("period", texture.perlin_period_m, 1.0, 1.0e6);
+  t.integer("size_log2", texture.perlin_size_log2, 3, 8);
+  t.integer("cells", texture.perlin_cells, 1, 32);
+  t.integer("octaves", texture.perlin_octaves, 1, 8);
+  t.number("persistence", texture.perlin_persistence, 0.0, 1.0);
+  t.finish();
+}
+
+void readOrientation(TableReader& t, Orientation& o) {
+  t.number("heading", o.heading_deg, -Limits::kMaxHeading, Limits::kMaxHeading);
+  t.number("pitch", o.pitch_deg, -Limits::kMaxPitch, Limits::kMaxPitch);
+  t.number("roll", o.roll_deg, -Limits::kMaxRoll, Limits::kMaxRoll);
+}
+
+void readEllipsoid(TableReader& t, Ellipsoid& e) {
+  t.allow({"radii", "centre", "heading", "pitch", "roll"});
+  if (!t.has("radii")) t.failHere("missing key radii (three semi-axes in metres)");
+  t.vector("radii", e.radii, Limits::kMinRadius, Limits::kMaxRadius);
+  t.vector("centre", e.centre, -Limits::kMaxCoordinate, Limits::kMaxCoordinate);
+  readOrientation(t, e.orientation);
+  t.finish();
+}
+
+void readCumulus(TableReader& t, std::uint64_t seed, std::vector<Ellipsoid>& out) {
+  t.allow({"count", "base", "width", "seed"});
+  int count = 27;
+  glm::dvec3 base{0.0, 0.0, 1000.0};
+  double width = 1500.0;
+  t.integer("count", count, 1, Limits::kMaxEllipsoidsPerCloud);
+  t.vector("base", base, -Limits::kMaxCoordinate, Limits::kMaxCoordinate);
+  t.number("width", width, 1.0, 1.0e5);
+  t.seed("seed", seed);
+  t.finish();
+  out = cumulusEllipsoids(count, base, width, seed);
+}
+
+void readCloud(TableReader& t, std::uint64_t seed, EllipsoidCloud& cloud) {
+  t.allow({"name", "colour", "threshold", "limb_threshold", "transition", "ambient",
+           "texture_fraction", "specular", "shininess", "seed", "texture", "cumulus",
+           "ellipsoid"});
+  t.string("name", cloud.name);
+  t.vector("colour", cloud.colour, 0.0, kMaxColour);
+  t.number("threshold", cloud.threshold_centre, 0.0, 1.0);
+  t.number("limb_threshold", cloud.threshold_limb, 0.0, 2.0);
+  t.number("transition", cloud.transition, 0.0, 10.0);
+  t.number("ambient", cloud.shading.ambient, 0.0, 1.0);
+  t.number("texture_fraction", cloud.shading.texture_fraction, 0.0, 1.0);
+  t.number("specular", cloud.shading.specular, 0.0, 1.0);
+  t.number("shininess", cloud.shading.shininess, 1.0, 1000.0);
+  cloud.texture.seed = seed;
+  t.seed("seed", cloud.texture.seed);
+  if (auto texture = t.table("texture")) readSolidTexture(*texture, cloud.texture);
+  if (auto cumulus = t.table("cumulus")) readCumulus(*cumulus, cloud.texture.seed, cloud.ellipsoids);
+  std::vector<TableReader> ellipsoids = t.tables("ellipsoid");
+  if (cloud.ellipsoids.size() + ellipsoids.size() > std::size_t(Limits::kMaxEllipsoidsPerCloud))
+    t.failAt("ellipsoid", "more than " + std::to_string(Limits::kMaxEllipsoidsPerCloud) +
+                              " ellipsoids in one cloud");
+  for (TableReader& e : ellipsoids) readEllipsoid(e, cloud.ellipsoids.emplace_back());
+  if (cloud.ellipsoids.empty())
+    t.failHere("has no ellipsoids (add [[cloud.ellipsoid]] tables or a [cloud.cumulus] table)");
+  t.finish();
+}
+
+void readTarget(TableReader& t, const std::string& scene_path, Target& target) {
+  t.allow({"name", "shape", "centre", "heading", "pitch", "roll", "size", "colour", "mesh"});
+  t.string("name", target.name);
+  target.shape =
+      TargetShape(t.choice("shape", {"box", "ellipsoid", "mesh"}, int(target.shape)));
+  t.vector("centre", target.centre, -Limits::kMaxCoordinate, Limits::kMaxCoordinate);
+  readOrientation(t, target.orientation);
+  if (target.shape == TargetShape::kMesh) target.size = glm::dvec3(1.0);
+  t.vector("size", target.size, Limits::kMinRadius, Limits::kMaxRadius);
+  t.vector("colour", target.colour, 0.0, kMaxColour);
+  std::string mesh_path;
+  t.string("mesh", mesh_path);
+  if (target.shape == TargetShape::kMesh) {
+    if (mesh_path.empty()) t.failAt("shape", "shape \"mesh\" needs a mesh = \"file.obj\" key");
+    // Relative paths are relative to the scene file.
+    const std::filesystem::path resolved =
+        std::filesystem::path(mesh_path).is_absolute()
+            ? std::filesystem::path(mesh_path)
+            : std::filesystem::path(scene_path).parent_path() / mesh_path;
+    auto mesh = std::make_shared<TriangleMesh>();
+    if (std::string error = loadObjMesh(resolved.string(), *mesh); !error.empty())
+      t.failAt("mesh", error);
+    target.mesh = std::move(mesh);
+  } else if (!mesh_path.empty()) {
+    t.failAt("mesh", "applies to shape \"mesh\" only");
+  }
+  t.finish();
+}
+
 void readScene(const toml::table& root, const std::string& file, SceneFile& out) {
   TableReader t(root, "", file);
-  t.allow({"seed", "time", "image", "camera", "sun", "sky", "fog", "render", "layer"});
+  t.allow({"seed", "time", "image", "camera", "sun", "sky", "fog", "render", "layer", "cloud",
+           "target"});
   Scene& scene = out.scene;
   t.seed("seed", scene.seed);
   t.number("time", scene.time_s, 0.0, Limits::kMaxTime);
@@ -312,6 +449,18 @@ void readScene(const toml::table& root, const std::string& file, SceneFile& out)
     layer.texture.seed = hashCounters(scene.seed, 0x4c61796572ull, i);  // unless given
     readLayer(layers[i], layer);
     if (layer.name.empty()) layer.name = "layer" + std::to_string(i);
+  }
+  std::vector<TableReader> clouds = t.tables("cloud");
+  for (std::size_t i = 0; i < clouds.size(); ++i) {
+    EllipsoidCloud& cloud = scene.clouds.emplace_back();
+    readCloud(clouds[i], hashCounters(scene.seed, 0x436c6f7564ull, i), cloud);
+    if (cloud.name.empty()) cloud.name = "cloud" + std::to_string(i);
+  }
+  std::vector<TableReader> targets = t.tables("target");
+  for (std::size_t i = 0; i < targets.size(); ++i) {
+    Target& target = scene.targets.emplace_back();
+    readTarget(targets[i], file, target);
+    if (target.name.empty()) target.name = "target" + std::to_string(i);
   }
   t.finish();
 }

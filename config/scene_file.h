@@ -26,12 +26,19 @@ struct Limits {
   // heading and pitch.
   static constexpr double kMaxHeading = 360.0, kMaxPitch = 90.0, kMaxRoll = 180.0;
   static constexpr double kMaxTime = 1.0e9;  // seconds of simulation time
+  // Ellipsoid semi-axes and target sizes, metres: zero, negative and NaN are rejected.
+  static constexpr double kMinRadius = 1.0e-3, kMaxRadius = 1.0e5;
+  static constexpr int kMaxEllipsoidsPerCloud = 4096;
 };
 
 // Names of the render knobs in enum order, shared by scene files and the command line.
 inline const std::vector<std::string> kTextureEvaluationNames{"baked", "procedural"};
 inline const std::vector<std::string> kTermFilterNames{"fade", "cut", "none"};
 inline const std::vector<std::string> kSkyPassesNames{"fused", "multipass"};
+inline const std::vector<std::string> kEllipsoidPassesNames{"fused", "multipass"};
+inline const std::vector<std::string> kEllipsoidOrderNames{"centre", "per-pixel"};
+inline const std::vector<std::string> kLimbNames{"exact", "spotlight"};
+inline const std::vector<std::string> kTileFormatNames{"rgba8", "float"};
 
 // Position of `name` in `names`, or -1.
 int nameIndex(const std::vector<std::string>& names, std::string_view name);

@@ -9,6 +9,12 @@ namespace nephele {
 // GL 1.1 entry points: glcorearb.h skips their typedefs when gl.h came first (osmesa.h).
 using GlDeleteTexturesProc = void(APIENTRYP)(GLsizei n, const GLuint* textures);
 using GlDrawArraysProc = void(APIENTRYP)(GLenum mode, GLint first, GLsizei count);
+using GlDrawElementsProc = void(APIENTRYP)(GLenum mode, GLsizei count, GLenum type,
+                                           const void* indices);
+using GlColorMaskProc = void(APIENTRYP)(GLboolean r, GLboolean g, GLboolean b, GLboolean a);
+using GlEnumProc = void(APIENTRYP)(GLenum value);  // glCullFace, glFrontFace, glDepthFunc
+using GlScissorProc = void(APIENTRYP)(GLint x, GLint y, GLsizei width, GLsizei height);
+using GlDepthMaskProc = void(APIENTRYP)(GLboolean flag);
 
 #define NEPHELE_GL_FUNCTIONS(X)                                          \
   X(PFNGLGETSTRINGPROC, GetString)                                       \
@@ -59,7 +65,33 @@ using GlDrawArraysProc = void(APIENTRYP)(GLenum mode, GLint first, GLsizei count
   X(GlDrawArraysProc, DrawArrays)                                        \
   X(PFNGLPIXELSTOREIPROC, PixelStorei)                                   \
   X(PFNGLREADPIXELSPROC, ReadPixels)                                     \
-  X(PFNGLFINISHPROC, Finish)
+  X(PFNGLFINISHPROC, Finish)                                             \
+  X(GlDrawElementsProc, DrawElements)                                    \
+  X(GlColorMaskProc, ColorMask)                                          \
+  X(GlEnumProc, CullFace)                                                \
+  X(GlEnumProc, FrontFace)                                               \
+  X(GlEnumProc, DepthFunc)                                               \
+  X(GlDepthMaskProc, DepthMask)                                          \
+  X(GlScissorProc, Scissor)                                              \
+  X(PFNGLTEXTURESTORAGE3DPROC, TextureStorage3D)                         \
+  X(PFNGLTEXTURESUBIMAGE3DPROC, TextureSubImage3D)                       \
+  X(PFNGLCLIPCONTROLPROC, ClipControl)                                   \
+  X(PFNGLCLEARNAMEDFRAMEBUFFERFVPROC, ClearNamedFramebufferfv)           \
+  X(PFNGLNAMEDFRAMEBUFFERTEXTUREPROC, NamedFramebufferTexture)           \
+  X(PFNGLNAMEDFRAMEBUFFERDRAWBUFFERSPROC, NamedFramebufferDrawBuffers)   \
+  X(PFNGLCREATEBUFFERSPROC, CreateBuffers)                               \
+  X(PFNGLDELETEBUFFERSPROC, DeleteBuffers)                               \
+  X(PFNGLNAMEDBUFFERDATAPROC, NamedBufferData)                           \
+  X(PFNGLBINDBUFFERBASEPROC, BindBufferBase)                             \
+  X(PFNGLVERTEXARRAYVERTEXBUFFERPROC, VertexArrayVertexBuffer)           \
+  X(PFNGLVERTEXARRAYATTRIBFORMATPROC, VertexArrayAttribFormat)           \
+  X(PFNGLVERTEXARRAYATTRIBBINDINGPROC, VertexArrayAttribBinding)         \
+  X(PFNGLENABLEVERTEXARRAYATTRIBPROC, EnableVertexArrayAttrib)           \
+  X(PFNGLVERTEXARRAYELEMENTBUFFERPROC, VertexArrayElementBuffer)         \
+  X(PFNGLDRAWARRAYSINSTANCEDPROC, DrawArraysInstanced)                   \
+  X(PFNGLBLENDEQUATIONSEPARATEPROC, BlendEquationSeparate)               \
+  X(PFNGLPROGRAMUNIFORMMATRIX3FVPROC, ProgramUniformMatrix3fv)           \
+  X(PFNGLPROGRAMUNIFORMMATRIX4FVPROC, ProgramUniformMatrix4fv)
 
 struct GlApi {
 #define NEPHELE_GL_MEMBER(type, name) type name = nullptr;

@@ -25,6 +25,9 @@ void GlObject::reset() {
     case Kind::kShader:
       gl_->DeleteShader(name_);
       break;
+    case Kind::kBuffer:
+      gl_->DeleteBuffers(1, &name_);
+      break;
   }
   name_ = 0;
 }
@@ -51,6 +54,12 @@ GlObject createVertexArray(const GlApi& gl) {
   GLuint name = 0;
   gl.CreateVertexArrays(1, &name);
   return {gl, GlObject::Kind::kVertexArray, name};
+}
+
+GlObject createBuffer(const GlApi& gl) {
+  GLuint name = 0;
+  gl.CreateBuffers(1, &name);
+  return {gl, GlObject::Kind::kBuffer, name};
 }
 
 namespace {

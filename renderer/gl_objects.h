@@ -10,7 +10,7 @@ namespace nephele {
 
 class GlObject {
  public:
-  enum class Kind { kTexture, kFramebuffer, kRenderbuffer, kVertexArray, kProgram, kShader };
+  enum class Kind { kTexture, kFramebuffer, kRenderbuffer, kVertexArray, kProgram, kShader, kBuffer };
 
   GlObject() = default;
   GlObject(const GlApi& gl, Kind kind, GLuint name) : gl_(&gl), kind_(kind), name_(name) {}
@@ -42,6 +42,7 @@ GlObject createTexture(const GlApi& gl, GLenum target);
 GlObject createFramebuffer(const GlApi& gl);
 GlObject createRenderbuffer(const GlApi& gl);
 GlObject createVertexArray(const GlApi& gl);
+GlObject createBuffer(const GlApi& gl);
 
 // Compiles and links a vertex + fragment program. On failure returns an empty object and
 // puts the driver's log in `error`.

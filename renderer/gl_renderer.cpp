@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "renderer/sky_shaders.h"
+#include "renderer/view_uniforms.h"
 #include "world/check.h"
 #include "world/layer_texture.h"
 #include "world/texture_table.h"
@@ -83,7 +84,9 @@ void uploadTable(const GlApi& gl, GLuint texture, const TextureTable& table) {
 GlRenderer::GlRenderer(const GlPlatform& platform)
     : gl_(platform.gl()),
       vertex_array_(createVertexArray(gl_)),
-      framebuffer_(createFramebuffer(gl_)) {}
+      framebuffer_(createFramebuffer(gl_)),
+      ellipsoids_(gl_),
+      targets_(gl_) {}
 
 GlRenderer::~GlRenderer() = default;
 
@@ -230,22 +233,8 @@ void GlRenderer::drawSkyPass(const Scene& scene, const RenderSettings& settings,
   gl_.UseProgram(p);
   const Camera& camera = scene.camera;
   const ViewBasis basis = viewBasis(camera);
-  auto uniform3 = [&](const char* name, glm::dvec3 v) {
-    const glm::vec3 f(v);
-    gl_.ProgramUniform3fv(p, gl_.GetUniformLocation(p, name), 1, &f.x);
-  };
-  uniform3("u_right", basis.right * basis.tan_half_vfov * basis.aspect);
-  uniform3("u_up", basis.up * basis.tan_half_vfov);
-  uniform3("u_forward", basis.forward);
-  const glm::vec2 viewport(camera.width, camera.height);
-  gl_.ProgramUniform2fv(p, gl_.GetUniformLocation(p, "u_viewport"), 1, &viewport.x);
-  gl_.ProgramUniform1f(p, gl_.GetUniformLocation(p, "u_camera_z"), float(camera.position.z));
-  if (scene.fog) {
-    gl_.ProgramUniform1f(p, gl_.GetUniformLocation(p, "u_fog_top"), float(scene.fog->top_m));
-    gl_.ProgramUniform1f(p, gl_.GetUniformLocation(p, "u_fog_sigma"),
-                         float(fogExtinction(*scene.fog)));
-    uniform3("u_fog_colour", scene.fog->colour);
-  }
+  auto uniform3 = [&](const char* name, glm::dvec3 v) { setUniform3(gl_, p, name, v); };
+  setViewUniforms(gl_, p, camera, scene.fog);
   if (layout.background) {
     uniform3("u_zenith", scene.sky.zenith);
     uniform3("u_horizon", scene.sky.horizon);
@@ -264,10 +253,74 @@ void GlRenderer::drawSkyPass(const Scene& scene, const RenderSettings& settings,
   gl_.DrawArrays(GL_TRIANGLE_FAN, 0, GLsizei(polygon.size()));
 }
 
+void GlRenderer::drawSkyGroup(const Scene& scene, const RenderSettings& settings,
+                              const std::vector<LayerSlot>& above,
+                              const std::vector<LayerSlot>& below, bool background,
+                              bool targets) {
+  const Camera& camera = scene.camera;
+  SkyPassLayout base;
+  base.fog = scene.fog.has_value();
+  base.term_filter = settings.term_filter;
+  base.targets = targets;
+  for (const CloudLayer& layer : scene.layers) base.specular |= layer.shading.specular > 0.0;
+  const bool fused = settings.sky_passes == SkyPasses::kFused &&
+                     int(std::max(above.size(), below.size())) <= kMaxLayerSlots;
+
+  // The screen region whose rays climb (sign = 1) or descend (sign = -1), widened by
+  // `margin_pixels`: ray.z is linear across the image, so the horizon is a straight line.
+  const ViewBasis basis = viewBasis(camera);
+  auto sideOfHorizon = [&](double sign, double margin_pixels) {
+    const double a = sign * basis.right.z * basis.tan_half_vfov * basis.aspect;
+    const double b = sign * basis.up.z * basis.tan_half_vfov;
+    const double margin =
+        margin_pixels * (std::abs(a) * 2.0 / camera.width + std::abs(b) * 2.0 / camera.height);
+    return clipScreenToHalfPlane(a, b, sign * basis.forward.z + margin);
+  };
+
+  // Every pass writes premultiplied colour and coverage; a pass with the background
+  // overwrites, the others blend "over".
+  gl_.BlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  if (background) gl_.Disable(GL_BLEND);
+  else gl_.Enable(GL_BLEND);
+  if (fused) {
+    // One pass per side of the horizon, each with the background and that side's layers:
+    // pixels below the horizon never run the code of layers above the camera. The two
+    // polygons share their edge exactly, so every pixel is drawn once.
+    for (const auto* side : {&above, &below}) {
+      if (!background && side->empty()) continue;
+      const std::vector<glm::vec2> polygon = sideOfHorizon(side == &above ? 1.0 : -1.0, 0.0);
+      if (polygon.size() < 3) continue;
+      SkyPassLayout layout = base;
+      layout.background = background;
+      for (const LayerSlot& slot : *side)
+        (side == &above ? layout.above : layout.below).push_back(slot.kind);
+      drawSkyPass(scene, settings, layout, *side, polygon);
+    }
+    return;
+  }
+  if (background) {
+    // One triangle covering the screen: no diagonal edge for the rasteriser to split tiles on.
+    drawSkyPass(scene, settings, base, {}, {{-1, -1}, {3, -1}, {-1, 3}});
+    gl_.Enable(GL_BLEND);
+  }
+  for (const auto* side : {&above, &below})
+    for (const LayerSlot& slot : *side) {
+      // Only where rays meet the plane, plus two pixels the shader leaves untouched.
+      const std::vector<glm::vec2> polygon = sideOfHorizon(side == &above ? 1.0 : -1.0, 2.0);
+      if (polygon.size() < 3) continue;
+      SkyPassLayout layout = base;
+      layout.background = false;
+      (side == &above ? layout.above : layout.below).push_back(slot.kind);
+      drawSkyPass(scene, settings, layout, {slot}, polygon);
+    }
+}
+
 void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
                            TargetFormat format) {
   const Camera& camera = scene.camera;
   prepareTarget(camera.width, camera.height, format);
+  // Opaque targets first, into their own colour and distance textures.
+  const bool targets = targets_.draw(scene);
   gl_.BindFramebuffer(GL_FRAMEBUFFER, framebuffer_.get());
   gl_.Viewport(0, 0, camera.width, camera.height);
   gl_.BindVertexArray(vertex_array_.get());
@@ -276,6 +329,7 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
   else
     gl_.Disable(GL_FRAMEBUFFER_SRGB);
   for (auto& [key, cached] : textures_) cached.used = false;
+  ellipsoids_.beginFrame();
 
   // A ray meets only the layers on one side of the camera: above it from the highest down,
   // below it from the lowest up. Those orders are back to front.
@@ -297,55 +351,58 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
     return a.layer->altitude_m < b.layer->altitude_m;
   });
 
-  SkyPassLayout base;
-  base.fog = scene.fog.has_value();
-  base.term_filter = settings.term_filter;
-  for (const CloudLayer& layer : scene.layers) base.specular |= layer.shading.specular > 0.0;
-  const bool fused = settings.sky_passes == SkyPasses::kFused &&
-                     int(std::max(above.size(), below.size())) <= kMaxLayerSlots;
-
-  // The screen region whose rays climb (sign = 1) or descend (sign = -1), widened by
-  // `margin_pixels`: ray.z is linear across the image, so the horizon is a straight line.
-  const ViewBasis basis = viewBasis(camera);
-  auto sideOfHorizon = [&](double sign, double margin_pixels) {
-    const double a = sign * basis.right.z * basis.tan_half_vfov * basis.aspect;
-    const double b = sign * basis.up.z * basis.tan_half_vfov;
-    const double margin =
-        margin_pixels * (std::abs(a) * 2.0 / camera.width + std::abs(b) * 2.0 / camera.height);
-    return clipScreenToHalfPlane(a, b, sign * basis.forward.z + margin);
+  // Interleave ellipsoid clouds with the layers. A cloud lies in band b when b layers on its
+  // side of the camera lie between the camera and the cloud's altitude: it is drawn after
+  // the layers beyond it and before the b layers in front of it. Clouds in one band go
+  // back to front by distance.
+  struct CloudEntry {
+    std::size_t index;
+    int band;
+    double distance;
   };
-
-  // Every pass writes premultiplied colour and coverage; the first overwrites.
-  gl_.Disable(GL_BLEND);
-  gl_.BlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
-  if (fused) {
-    // One pass per side of the horizon, each with the background and that side's layers:
-    // pixels below the horizon never run the code of layers above the camera. The two
-    // polygons share their edge exactly, so every pixel is drawn once.
-    for (const auto* side : {&above, &below}) {
-      const std::vector<glm::vec2> polygon = sideOfHorizon(side == &above ? 1.0 : -1.0, 0.0);
-      if (polygon.size() < 3) continue;
-      SkyPassLayout layout = base;
-      for (const LayerSlot& slot : *side)
-        (side == &above ? layout.above : layout.below).push_back(slot.kind);
-      drawSkyPass(scene, settings, layout, *side, polygon);
-    }
-  } else {
-    // One triangle covering the screen: no diagonal edge for the rasteriser to split tiles on.
-    drawSkyPass(scene, settings, base, {}, {{-1, -1}, {3, -1}, {-1, 3}});
-    gl_.Enable(GL_BLEND);
-    for (const auto* side : {&above, &below})
-      for (const LayerSlot& slot : *side) {
-        // Only where rays meet the plane, plus two pixels the shader leaves untouched.
-        const std::vector<glm::vec2> polygon = sideOfHorizon(side == &above ? 1.0 : -1.0, 2.0);
-        if (polygon.size() < 3) continue;
-        SkyPassLayout layout = base;
-        layout.background = false;
-        (side == &above ? layout.above : layout.below).push_back(slot.kind);
-        drawSkyPass(scene, settings, layout, {slot}, polygon);
-      }
+  std::vector<CloudEntry> clouds;
+  for (std::size_t i = 0; i < scene.clouds.size(); ++i) {
+    const double altitude = cloudAltitude(scene.clouds[i]);
+    int band = 0;
+    for (const CloudLayer& layer : scene.layers)
+      band += (altitude > z) ? (layer.altitude_m > z && layer.altitude_m < altitude)
+                             : (layer.altitude_m < z && layer.altitude_m > altitude);
+    glm::dvec3 centre(0.0);
+    for (const Ellipsoid& e : scene.clouds[i].ellipsoids) centre += e.centre;
+    centre /= double(scene.clouds[i].ellipsoids.size());
+    clouds.push_back({i, band, glm::length(centre - camera.position)});
   }
+  std::sort(clouds.begin(), clouds.end(), [](const CloudEntry& a, const CloudEntry& b) {
+    return a.band != b.band ? a.band > b.band : a.distance > b.distance;
+  });
+
+  std::vector<LayerSlot> pending_above, pending_below;
+  bool background_pending = true;
+  auto flushSky = [&] {
+    if (!background_pending && pending_above.empty() && pending_below.empty()) return;
+    drawSkyGroup(scene, settings, pending_above, pending_below, background_pending, targets);
+    background_pending = false;
+    pending_above.clear();
+    pending_below.clear();
+  };
+  const FrameTarget frame{framebuffer_.get(), camera.width, camera.height};
+  const int top_band = int(std::max({above.size(), below.size(),
+                                     clouds.empty() ? std::size_t(0) : std::size_t(clouds[0].band)}));
+  auto next_cloud = clouds.begin();
+  for (int band = top_band; band >= 0; --band) {
+    if (next_cloud != clouds.end() && next_cloud->band == band) flushSky();
+    for (; next_cloud != clouds.end() && next_cloud->band == band; ++next_cloud)
+      ellipsoids_.drawCloud(scene, next_cloud->index, settings, frame, targets);
+    // Then the layers of rank band - 1 (rank 0 is nearest the camera) on both sides.
+    if (band >= 1) {
+      if (std::size_t(band) <= above.size()) pending_above.push_back(above[above.size() - band]);
+      if (std::size_t(band) <= below.size()) pending_below.push_back(below[below.size() - band]);
+    }
+  }
+  flushSky();
+  ellipsoids_.drawVeil(scene, settings);
   gl_.Disable(GL_BLEND);
+  ellipsoids_.endFrame();
   std::erase_if(textures_, [](const auto& entry) { return !entry.second.used; });
 }
 

@@ -1,15 +1,17 @@
 #pragma once
-// The GL renderer: sky background and cloud layers composited back to front into a
-// framebuffer object, then read back.
+// The GL renderer: opaque targets, then the sky background, cloud layers and ellipsoid
+// clouds composited back to front into a framebuffer object, then read back.
 #include <map>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "renderer/ellipsoid_renderer.h"
 #include "renderer/gl_objects.h"
 #include "renderer/gl_platform.h"
 #include "renderer/render_settings.h"
 #include "renderer/sky_shaders.h"
+#include "renderer/target_renderer.h"
 #include "world/image.h"
 #include "world/scene.h"
 
@@ -43,6 +45,10 @@ class GlRenderer {
   };
 
   void drawFrame(const Scene& scene, const RenderSettings& settings, TargetFormat format);
+  // Background (if asked) and the given layers, fused or one pass per layer.
+  void drawSkyGroup(const Scene& scene, const RenderSettings& settings,
+                    const std::vector<LayerSlot>& above, const std::vector<LayerSlot>& below,
+                    bool background, bool targets);
   void drawSkyPass(const Scene& scene, const RenderSettings& settings, const SkyPassLayout& layout,
                    const std::vector<LayerSlot>& slots, const std::vector<glm::vec2>& polygon);
   void setSlotUniforms(GLuint program, int slot, const LayerSlot& layer, const Scene& scene,
@@ -61,6 +67,8 @@ class GlRenderer {
   TargetFormat target_format_ = TargetFormat::kFloat;
   std::map<std::string, GlObject> programs_;
   std::map<std::string, CachedTexture> textures_;
+  EllipsoidRenderer ellipsoids_;
+  TargetRenderer targets_;
 };
 
 }  // namespace nephele

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "world/frames.h"
+#include "world/ellipsoid.h"
 #include "world/layer_texture.h"
 
 namespace nephele {
@@ -15,10 +16,17 @@ namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
-struct LayerHit {
+// One translucent surface on a ray, already shaded and fogged.
+struct Surface {
   double distance;
-  const CloudLayer* layer;
-  const LayerTexture* texture;
+  glm::dvec3 colour;
+  double alpha;  // 1 - TR
+};
+
+struct EllipsoidEntry {
+  EllipsoidView view;
+  std::size_t cloud;
+  double fade;  // in-cloud model: the surface fades as the eye nears it
 };
 
 class ReferenceTracer {
@@ -26,40 +34,80 @@ class ReferenceTracer {
   explicit ReferenceTracer(const Scene& scene) : scene_(scene), sun_(sunDirection(scene.sun)) {
     textures_.reserve(scene.layers.size());
     for (const CloudLayer& layer : scene.layers) textures_.emplace_back(layer.texture);
+    solid_textures_.reserve(scene.clouds.size());
+    std::vector<const SolidTexture*> solid_pointers;
+    for (std::size_t c = 0; c < scene.clouds.size(); ++c) {
+      solid_pointers.push_back(&solid_textures_.emplace_back(scene.clouds[c].texture));
+      for (const Ellipsoid& e : scene.clouds[c].ellipsoids) {
+        EllipsoidView view(e, scene.camera.position);
+        if (view.eyeInside()) continue;  // SPEC section 4: no surface to show
+        const double fade = surfaceFade(view.eyeRadius());
+        if (fade > 0.0) ellipsoids_.push_back({view, c, fade});
+      }
+    }
+    veil_ = inCloudVeil(scene.clouds, solid_pointers, scene.camera.position, scene.sun);
   }
 
   // Colour and coverage along one ray (unit direction).
-  glm::dvec4 trace(glm::dvec3 direction, std::vector<LayerHit>& hits) const {
+  glm::dvec4 trace(glm::dvec3 direction, std::vector<Surface>& surfaces) const {
     const glm::dvec3 eye = scene_.camera.position;
-    const double ground = direction.z < 0.0 ? eye.z / -direction.z : kInfinity;
-    glm::dvec3 colour = withFog(skyBackground(scene_.sky, direction), direction, ground);
+    double nearest_opaque = direction.z < 0.0 ? eye.z / -direction.z : kInfinity;
+    glm::dvec3 colour = skyBackground(scene_.sky, direction);
+    for (const Target& target : scene_.targets) {
+      const auto hit = intersectTarget(target, eye, direction);
+      if (!hit || hit->distance >= nearest_opaque) continue;
+      nearest_opaque = hit->distance;
+      colour = targetRadiance(target, hit->normal, sun_, -direction, scene_.sun);
+    }
+    colour = withFog(colour, direction, nearest_opaque);
 
-    hits.clear();
+    surfaces.clear();
     for (std::size_t i = 0; i < scene_.layers.size(); ++i) {
       const double s = (scene_.layers[i].altitude_m - eye.z) / direction.z;
-      if (s > 0.0 && s <= ground && std::isfinite(s))
-        hits.push_back({s, &scene_.layers[i], &textures_[i]});
+      if (s > 0.0 && s <= nearest_opaque && std::isfinite(s))
+        surfaces.push_back(layerSurface(scene_.layers[i], textures_[i], direction, s));
     }
-    std::sort(hits.begin(), hits.end(),
-              [](const LayerHit& a, const LayerHit& b) { return a.distance > b.distance; });
+    for (const EllipsoidEntry& entry : ellipsoids_) {
+      const auto span = entry.view.intersect(direction);
+      if (span && span->near > 0.0 && span->near <= nearest_opaque)
+        surfaces.push_back(ellipsoidSurface(entry, direction, span->near));
+    }
+    std::sort(surfaces.begin(), surfaces.end(),
+              [](const Surface& a, const Surface& b) { return a.distance > b.distance; });
 
     double translucence_product = 1.0;
-    for (const LayerHit& hit : hits) {  // back to front
-      const glm::dvec3 p = eye + hit.distance * direction;
-      const double t = hit.texture->value({p.x, p.y}, scene_.time_s);
-      const CloudLayer& layer = *hit.layer;
-      const double tr = skyPlaneTranslucence(t, layer.threshold, layer.transition);
-      const double intensity =
-          gardnerIntensity(layer.shading, t, {0.0, 0.0, 1.0}, sun_, -direction);
-      const glm::dvec3 surface =
-          withFog(intensity * layer.colour * scene_.sun.colour, direction, hit.distance);
-      colour = (1.0 - tr) * surface + tr * colour;  // "over", alpha = 1 - TR
-      translucence_product *= tr;
+    for (const Surface& surface : surfaces) {  // back to front
+      colour = surface.alpha * surface.colour + (1.0 - surface.alpha) * colour;  // "over"
+      translucence_product *= 1.0 - surface.alpha;
     }
+    // The in-cloud veil sits at the eye, in front of everything.
+    colour = veil_.opacity * veil_.colour + (1.0 - veil_.opacity) * colour;
+    translucence_product *= 1.0 - veil_.opacity;
     return {colour, 1.0 - translucence_product};
   }
 
  private:
+  Surface layerSurface(const CloudLayer& layer, const LayerTexture& texture,
+                       glm::dvec3 direction, double s) const {
+    const glm::dvec3 p = scene_.camera.position + s * direction;
+    const double t = texture.value({p.x, p.y}, scene_.time_s);
+    const double tr = skyPlaneTranslucence(t, layer.threshold, layer.transition);
+    const double intensity = gardnerIntensity(layer.shading, t, {0.0, 0.0, 1.0}, sun_, -direction);
+    return {s, withFog(intensity * layer.colour * scene_.sun.colour, direction, s), 1.0 - tr};
+  }
+
+  Surface ellipsoidSurface(const EllipsoidEntry& entry, glm::dvec3 direction, double s) const {
+    const EllipsoidCloud& cloud = scene_.clouds[entry.cloud];
+    const glm::dvec3 p = scene_.camera.position + s * direction;
+    const double t = solid_textures_[entry.cloud].value(p);
+    const double tr = ellipsoidTranslucence(t, cloud.threshold_centre, cloud.threshold_limb,
+                                            entry.view.limb(direction), cloud.transition);
+    const double intensity =
+        gardnerIntensity(cloud.shading, t, entry.view.normalAt(direction, s), sun_, -direction);
+    return {s, withFog(intensity * cloud.colour * scene_.sun.colour, direction, s),
+            (1.0 - tr) * entry.fade};
+  }
+
   glm::dvec3 withFog(glm::dvec3 colour, glm::dvec3 direction, double distance) const {
     if (!scene_.fog) return colour;
     const double length = fogPathLength(*scene_.fog, scene_.camera.position, direction, distance);
@@ -70,6 +118,9 @@ class ReferenceTracer {
   const Scene& scene_;
   glm::dvec3 sun_;
   std::vector<LayerTexture> textures_;
+  std::vector<SolidTexture> solid_textures_;
+  std::vector<EllipsoidEntry> ellipsoids_;
+  Veil veil_;
 };
 
 }  // namespace
@@ -85,7 +136,7 @@ FloatImage renderReference(const Scene& scene, const ReferenceSettings& settings
 
   std::atomic<int> next_row{0};
   auto work = [&](bool report) {
-    std::vector<LayerHit> hits;
+    std::vector<Surface> hits;
     int reported_tenths = 0;
     for (int y; (y = next_row.fetch_add(1)) < camera.height;) {
       if (report && progress && y * 10 / camera.height > reported_tenths) {

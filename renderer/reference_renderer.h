@@ -1,6 +1,7 @@
 #pragma once
 // The CPU reference renderer (SPEC section 7): double precision, exact ray-plane hits, every
-// texture term, per-pixel depth order, supersampled. Slow and simple enough to trust.
+// texture term, exact ray-ellipsoid hits and limb function, per-pixel depth order,
+// supersampled. Slow and simple enough to trust.
 #include <functional>
 
 #include "renderer/render_settings.h"

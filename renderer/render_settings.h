@@ -15,6 +15,26 @@ enum class SkyPasses {
   kMultipass,  // a background pass, then one blended pass per layer (Elinas-style)
 };
 
+// Ellipsoid clouds (Gardner; Elinas and Stuerzlinger).
+enum class EllipsoidPasses {
+  kFused,      // one pass per ellipsoid straight to the screen: exact ray-quadric hit per
+               // fragment over its screen rectangle, every term of eq. 8 and 11 at once
+  kMultipass,  // Elinas: per-ellipsoid tiles in an atlas (threshold, limb, colour passes on a
+               // tessellated ellipsoid), a shader pass applying 1/D, then tiles composited
+};
+
+enum class EllipsoidOrder {
+  kCentre,    // back to front by distance to each ellipsoid's centre (Elinas)
+  kPerPixel,  // each pixel composites the cloud's ellipsoids by the depth of their hits
+};
+
+enum class LimbEvaluation {
+  kExact,      // g from the discriminant form per fragment (SPEC section 4)
+  kSpotlight,  // Elinas: a radial 1 - rho^2 texture projected from the eye along the cone
+};
+
+enum class TileFormat { kRgba8, kFloat };
+
 struct RenderSettings {
   SkyPasses sky_passes = SkyPasses::kFused;
   TextureEvaluation texture_evaluation = TextureEvaluation::kBaked;
@@ -23,6 +43,20 @@ struct RenderSettings {
   // 1/tpc^2 (mean 0.0075, 0.0020, 0.0005 for 4, 8, 16 on a close deck); cost rises with it
   // through texture cache traffic (18.3, 19.3, 23.6 ms for cirrus at 1280x1024).
   int bake_texels_per_cycle = 8;
+
+  EllipsoidPasses ellipsoid_passes = EllipsoidPasses::kFused;
+  EllipsoidOrder ellipsoid_order = EllipsoidOrder::kPerPixel;
+  LimbEvaluation limb = LimbEvaluation::kExact;
+  // Multipass tiles: 0 sizes each tile to its screen rectangle rounded up to a power of two;
+  // a power of two from 8 to 1024 fixes every tile at that size.
+  int tile_resolution = 0;
+  TileFormat tile_format = TileFormat::kFloat;
+  // Multipass meshes: 0 adapts the slices to keep the silhouette within half a pixel;
+  // otherwise N slices by N stacks (Elinas used 10 x 10).
+  int tessellation = 0;
+  // Far clouds drawn from an impostor rendered once and reused while the view of the cloud
+  // changes by less than impostor_tolerance_px pixels; 0 turns impostors off.
+  double impostor_tolerance_px = 0.0;
 };
 
 // The CPU reference (SPEC section 7).

@@ -11,7 +11,7 @@ uniform vec3 u_up;       // scaled by tan(vfov/2)
 uniform vec3 u_forward;
 uniform vec2 u_viewport;
 uniform float u_camera_z;
-out vec4 o_colour;       // premultiplied colour, coverage
+layout(location = 0) out vec4 o_colour;  // premultiplied colour, coverage
 const float kFar = 1e30;
 
 vec3 viewRay() {
@@ -42,6 +42,15 @@ vec3 applyFog(vec3 colour, vec3 d, float distance) {
 }
 #else
 vec3 applyFog(vec3 colour, vec3 d, float distance) { return colour; }
+#endif
+
+#ifdef TARGETS
+// Opaque targets drawn first: their fogged colour and their distance along the unit ray
+// (1e30 where there is none), read at this pixel.
+layout(binding = 14) uniform sampler2D u_target_colour;
+layout(binding = 15) uniform sampler2D u_target_distance;
+float targetDistance() { return texelFetch(u_target_distance, ivec2(gl_FragCoord.xy), 0).r; }
+vec3 targetColour() { return texelFetch(u_target_colour, ivec2(gl_FragCoord.xy), 0).rgb; }
 #endif
 
 #ifdef BACKGROUND
@@ -213,8 +222,8 @@ std::string slotStatement(int slot, LayerKind kind) {
       value = "proceduralValue(" + i + ", hit)";
       break;
   }
-  return "    { LayerHit hit = hitLayer(" + i + ", r); composite(" + i + ", r, hit, " + value +
-         ", colour, transmittance); }\n";
+  return "    { LayerHit hit = hitLayer(" + i + ", r); if (inFront(hit.distance)) composite(" + i +
+         ", r, hit, " + value + ", colour, transmittance); }\n";
 }
 
 }  // namespace
@@ -228,7 +237,12 @@ std::string SkyPassLayout::key() const {
   k += char('0' + int(term_filter));
   k += fog ? 'f' : '-';
   k += specular ? 's' : '-';
+  k += targets ? 't' : '-';
   return k;
+}
+
+std::string viewShaderSource() {
+  return kCommon;
 }
 
 std::string polygonVertexSource() {
@@ -243,6 +257,7 @@ std::string skyFragmentSource(const SkyPassLayout& layout) {
   if (layout.fog) s += "#define FOG\n";
   if (layout.background) s += "#define BACKGROUND\n";
   if (layout.specular) s += "#define SPECULAR\n";
+  if (layout.targets) s += "#define TARGETS\n";
   if (layout.term_filter == TermFilter::kCut) s += "#define FILTER_CUT\n";
   if (layout.term_filter == TermFilter::kNone) s += "#define FILTER_NONE\n";
   bool procedural = false, sampled = false;
@@ -259,6 +274,14 @@ std::string skyFragmentSource(const SkyPassLayout& layout) {
 
   s += "void main() {\n  vec3 r = viewRay();\n";
   s += layout.background ? "  vec3 colour = background(r);\n" : "  vec3 colour = vec3(0.0);\n";
+  if (layout.targets) {
+    // Layers behind a target are hidden; the target replaces the background.
+    s += "  float target_distance = targetDistance();\n";
+    if (layout.background) s += "  if (target_distance < kFar) colour = targetColour();\n";
+    s += "#define inFront(d) ((d) < target_distance)\n";
+  } else {
+    s += "#define inFront(d) true\n";
+  }
   s += "  float transmittance = 1.0;\n";
   int slot = 0;
   if (!layout.above.empty()) {

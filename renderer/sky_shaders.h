@@ -24,11 +24,15 @@ struct SkyPassLayout {
   TermFilter term_filter = TermFilter::kFade;
   bool fog = false;
   bool specular = false;
+  bool targets = false;  // opaque targets were drawn first (their colour and distance)
 
   int slots() const { return int(above.size() + below.size()); }
   std::string key() const;
 };
 
+// The view chunk every screen-space pass shares: the view ray, fog, the background and the
+// targets' colour and distance, each behind its #define.
+std::string viewShaderSource();
 std::string polygonVertexSource();
 std::string skyFragmentSource(const SkyPassLayout& layout);
 

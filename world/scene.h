@@ -7,10 +7,12 @@
 
 #include <glm/glm.hpp>
 
+#include "world/ellipsoid_cloud.h"
 #include "world/frames.h"
 #include "world/layer_texture.h"
 #include "world/shading.h"
 #include "world/sky.h"
+#include "world/target.h"
 
 namespace nephele {
 
@@ -33,6 +35,8 @@ struct Scene {
   Sky sky;
   std::optional<Fog> fog;
   std::vector<CloudLayer> layers;
+  std::vector<EllipsoidCloud> clouds;
+  std::vector<Target> targets;
 };
 
 }  // namespace nephele

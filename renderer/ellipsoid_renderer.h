@@ -1,0 +1,102 @@
+#pragma once
+// Ellipsoid clouds on the GL: visible ellipsoids culled and ordered on the CPU in double,
+// then drawn either fused (exact per-fragment hits) or with Elinas and Stuerzlinger's tiles.
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "renderer/ellipsoid_shaders.h"
+#include "renderer/gl_objects.h"
+#include "renderer/render_settings.h"
+#include "world/scene.h"
+
+namespace nephele {
+
+// Where a pass draws: the framebuffer and its size.
+struct FrameTarget {
+  GLuint framebuffer = 0;
+  int width = 0;
+  int height = 0;
+};
+
+// One ellipsoid as the shaders see it (EllipsoidRecord in ellipsoid_shaders.cpp).
+struct EllipsoidRecord {
+  glm::vec4 v[kEllipsoidRecordVec4s];
+};
+
+// Everything the GPU needs for one ellipsoid seen from `camera`; false when it cannot show
+// (behind the eye, off screen, the eye inside it, or faded out by the in-cloud model).
+// `centre_distance` is the back-to-front sort key.
+bool makeEllipsoidRecord(const Ellipsoid& ellipsoid, const Camera& camera, EllipsoidRecord& out,
+                         double& centre_distance);
+
+// The altitude at which a cloud is interleaved with sky layers: the middle of the vertical
+// extent of its ellipsoids.
+double cloudAltitude(const EllipsoidCloud& cloud);
+
+class EllipsoidRenderer {
+ public:
+  explicit EllipsoidRenderer(const GlApi& gl);
+  ~EllipsoidRenderer();
+
+  // Starts a frame: marks cached textures unused until a cloud asks for them again.
+  void beginFrame();
+  void endFrame();
+
+  // Draws cloud `index` of the scene "over" what `target` holds, blending premultiplied.
+  // `targets_drawn`: the target colour and distance textures are bound.
+  void drawCloud(const Scene& scene, std::size_t index, const RenderSettings& settings,
+                 const FrameTarget& target, bool targets_drawn);
+
+  // The in-cloud veil over the whole frame, if the eye is in or near any ellipsoid.
+  void drawVeil(const Scene& scene, const RenderSettings& settings);
+
+ private:
+  struct CachedTexture {
+    std::unique_ptr<SolidTexture> source;
+    GlObject texture;
+    bool used = false;
+  };
+  struct SphereMesh {
+    GlObject vertex_array, vertices, indices;
+    GLsizei index_count = 0;
+  };
+  struct Tile {
+    int record;  // index into the batch's records
+    int width, height;
+    int x = 0, y = 0;
+  };
+
+  GLuint program(const EllipsoidPassLayout& layout);
+  CachedTexture& cachedTexture(const SolidTextureSpec& spec, const RenderSettings& settings);
+  GLuint gpuTexture(CachedTexture& cached);
+  const SphereMesh& sphereMesh(int slices);
+  GLuint spotlightTexture();
+  void setCloudUniforms(GLuint program, const Scene& scene, const EllipsoidCloud& cloud,
+                        const CachedTexture& texture, SolidTextureKind kind);
+  void uploadRecords(const std::vector<EllipsoidRecord>& records);
+  void drawTiles(const Scene& scene, const EllipsoidCloud& cloud, CachedTexture& texture,
+                 const EllipsoidPassLayout& base, const RenderSettings& settings,
+                 std::vector<EllipsoidRecord>& records, const FrameTarget& target);
+  void renderAtlasBatch(const Scene& scene, const EllipsoidCloud& cloud,
+                        const CachedTexture& texture, const EllipsoidPassLayout& base,
+                        const RenderSettings& settings, std::vector<EllipsoidRecord>& records,
+                        std::vector<Tile>& tiles, const FrameTarget& target);
+  void prepareAtlas(TileFormat format);
+
+  const GlApi& gl_;
+  GlObject vertex_array_;  // empty: attribute-less draws
+  GlObject records_buffer_;
+  GlObject spotlight_;
+  GlObject atlas_;
+  GlObject atlas_framebuffer_;
+  TileFormat atlas_format_ = TileFormat::kFloat;
+  std::map<std::string, GlObject> programs_;
+  std::map<std::string, CachedTexture> textures_;
+  std::map<int, SphereMesh> meshes_;
+};
+
+}  // namespace nephele

@@ -1,0 +1,56 @@
+#pragma once
+// Opaque objects for sensor simulation (targets): a box, an ellipsoid or a triangle mesh,
+// placed and oriented like every body (SPEC section 1). Clouds hide them and they hide
+// clouds, per pixel.
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "world/frames.h"
+#include "world/sky.h"
+
+namespace nephele {
+
+// Vertices in body coordinates (x right, y forward, z up), metres before scaling.
+struct TriangleMesh {
+  std::vector<glm::dvec3> vertices;
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+};
+
+enum class TargetShape { kBox, kEllipsoid, kMesh };
+
+struct Target {
+  std::string name;
+  TargetShape shape = TargetShape::kBox;
+  glm::dvec3 centre{0.0, 0.0, 1000.0};
+  Orientation orientation;
+  // Box: half-extents; ellipsoid: semi-axes; mesh: scale per body axis.
+  glm::dvec3 size{10.0, 10.0, 3.0};
+  glm::dvec3 colour{0.35, 0.35, 0.38};  // linear RGB albedo
+  std::shared_ptr<const TriangleMesh> mesh;  // for kMesh
+};
+
+// Targets are Lambertian with a fixed ambient share: colour * sun * (a + (1 - a) max(0, N.L)),
+// N turned towards the viewer.
+inline constexpr double kTargetAmbient = 0.3;
+glm::dvec3 targetRadiance(const Target& target, glm::dvec3 normal, glm::dvec3 to_sun,
+                          glm::dvec3 to_viewer, const Sun& sun);
+
+struct TargetHit {
+  double distance;    // along the unit ray
+  glm::dvec3 normal;  // world, unit, not yet turned
+};
+
+// Nearest hit in front of `eye` along the unit `direction`.
+std::optional<TargetHit> intersectTarget(const Target& target, glm::dvec3 eye,
+                                         glm::dvec3 direction);
+
+// The mesh's triangles in body coordinates after scaling (box and ellipsoid are analytic).
+std::vector<glm::dvec3> scaledMeshVertices(const Target& target);
+
+}  // namespace nephele
