@@ -258,15 +258,9 @@ void readRender(TableReader& t, SceneFile& out) {
   r.limb = LimbEvaluation(t.choice("limb", kLimbNames, int(r.limb)));
   r.tile_format = TileFormat(t.choice("tile_format", kTileFormatNames, int(r.tile_format)));
   t.integer("tile_resolution", r.tile_resolution, 0, 1024);
-  if (r.tile_resolution != 0 &&
-      (r.tile_resolution < 8 || (r.tile_resolution & (r.tile_resolution - 1)) != 0))
-    t.failAt("tile_resolution", std::to_string(r.tile_resolution) +
-                                    " is not allowed (allowed: 0 for adaptive, or a power of "
-                                    "two from 8 to 1024)");
   t.integer("tessellation", r.tessellation, 0, 256);
-  if (r.tessellation != 0 && r.tessellation < 3)
-    t.failAt("tessellation", std::to_string(r.tessellation) +
-                                 " is not allowed (allowed: 0 for adaptive, or 3 to 256)");
+  if (std::string error = validateRenderSettings(r); !error.empty())
+    t.failAt(error.substr(0, error.find(':')), error.substr(error.find(':') + 2));
   t.number("impostor_tolerance", r.impostor_tolerance_px, 0.0, 100.0);
   t.finish();
 }
@@ -495,6 +489,21 @@ std::string loadSceneFile(const std::string& path, SceneFile& out) {
   text << in.rdbuf();
   if (in.bad()) return "cannot read scene file '" + path + "': " + std::strerror(errno);
   return parseSceneText(text.str(), path, out);
+}
+
+std::string validateRenderSettings(const RenderSettings& r) {
+  if (r.tile_resolution != 0 &&
+      (r.tile_resolution < 8 || r.tile_resolution > 1024 ||
+       (r.tile_resolution & (r.tile_resolution - 1)) != 0))
+    return "tile_resolution: " + std::to_string(r.tile_resolution) +
+           " is not allowed (allowed: 0 for adaptive, or a power of two from 8 to 1024)";
+  if (r.tessellation != 0 && (r.tessellation < 3 || r.tessellation > 256))
+    return "tessellation: " + std::to_string(r.tessellation) +
+           " is not allowed (allowed: 0 for adaptive, or 3 to 256)";
+  if (!(r.impostor_tolerance_px >= 0.0 && r.impostor_tolerance_px <= 100.0))
+    return "impostor_tolerance: " + formatNumber(r.impostor_tolerance_px) +
+           " is out of range (allowed: 0 to 100 pixels)";
+  return "";
 }
 
 std::string validateCamera(const Camera& c) {

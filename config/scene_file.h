@@ -48,6 +48,10 @@ std::string loadSceneFile(const std::string& path, SceneFile& out);
 // Parses TOML text; `source_name` is the file name used in messages.
 std::string parseSceneText(std::string_view text, const std::string& source_name, SceneFile& out);
 
+// Checks the render knobs whose allowed values are not a plain range: "key: what is wrong
+// (allowed: ...)", or empty when valid.
+std::string validateRenderSettings(const RenderSettings& settings);
+
 // Checks a camera after command-line overrides; empty string when valid.
 std::string validateCamera(const Camera& camera);
 

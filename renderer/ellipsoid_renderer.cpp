@@ -167,7 +167,11 @@ double cloudAltitude(const EllipsoidCloud& cloud) {
 }
 
 EllipsoidRenderer::EllipsoidRenderer(const GlApi& gl)
-    : gl_(gl), vertex_array_(createVertexArray(gl)), records_buffer_(createBuffer(gl)) {}
+    : gl_(gl),
+      vertex_array_(createVertexArray(gl)),
+      records_buffer_(createBuffer(gl)),
+      bins_buffer_(createBuffer(gl)),
+      bin_items_buffer_(createBuffer(gl)) {}
 
 EllipsoidRenderer::~EllipsoidRenderer() = default;
 
@@ -369,22 +373,50 @@ void EllipsoidRenderer::drawCloud(const Scene& scene, std::size_t index,
     gl_.DrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(records.size()));
     return;
   }
-  // Per pixel: one rectangle around the whole cloud.
+  // Per pixel: screen bins, each listing the ellipsoids that overlap it, in one draw.
   EllipsoidPassLayout layout = base;
   layout.program = EllipsoidProgram::kFusedPerPixel;
   const GLuint p = program(layout);
   gl_.UseProgram(p);
   setCloudUniforms(p, scene, cloud, texture, layout.texture);
-  glm::vec4 bounds(1e30f, 1e30f, -1e30f, -1e30f);
-  for (const EllipsoidRecord& r : records)
-    bounds = {std::min(bounds.x, r.v[10].x), std::min(bounds.y, r.v[10].y),
-              std::max(bounds.z, r.v[10].z), std::max(bounds.w, r.v[10].w)};
-  const glm::vec2 polygon[4] = {{bounds.x, bounds.y}, {bounds.z, bounds.y}, {bounds.z, bounds.w},
-                                {bounds.x, bounds.w}};
-  gl_.ProgramUniform2fv(p, gl_.GetUniformLocation(p, "u_polygon"), 4, &polygon[0].x);
-  gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_first"), 0);
-  gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_count"), GLint(records.size()));
-  gl_.DrawArrays(GL_TRIANGLE_FAN, 0, 4);
+  const int bins_x = (target.width + kPerPixelBinSize - 1) / kPerPixelBinSize;
+  const int bins_y = (target.height + kPerPixelBinSize - 1) / kPerPixelBinSize;
+  std::vector<std::vector<GLint>> lists(std::size_t(bins_x) * bins_y);
+  auto pixel = [](float ndc, int size) { return (double(ndc) + 1.0) * 0.5 * size; };
+  for (int i = 0; i < int(records.size()); ++i) {
+    const glm::vec4 rect = records[i].v[10];
+    const int x0 = std::clamp(int(pixel(rect.x, target.width)) / kPerPixelBinSize, 0, bins_x - 1);
+    const int x1 = std::clamp(int(pixel(rect.z, target.width)) / kPerPixelBinSize, 0, bins_x - 1);
+    const int y0 = std::clamp(int(pixel(rect.y, target.height)) / kPerPixelBinSize, 0, bins_y - 1);
+    const int y1 = std::clamp(int(pixel(rect.w, target.height)) / kPerPixelBinSize, 0, bins_y - 1);
+    for (int y = y0; y <= y1; ++y)
+      for (int x = x0; x <= x1; ++x) lists[std::size_t(y) * bins_x + x].push_back(i);
+  }
+  struct Bin {
+    glm::vec4 rect;
+    glm::ivec4 items;  // first, count
+  };
+  std::vector<Bin> bins;
+  std::vector<GLint> items;
+  auto ndc = [](int p, int size) { return float(2.0 * std::min(p, size) / size - 1.0); };
+  for (int y = 0; y < bins_y; ++y)
+    for (int x = 0; x < bins_x; ++x) {
+      const std::vector<GLint>& list = lists[std::size_t(y) * bins_x + x];
+      if (list.empty()) continue;
+      const int px = x * kPerPixelBinSize, py = y * kPerPixelBinSize;
+      bins.push_back({{ndc(px, target.width), ndc(py, target.height),
+                       ndc(px + kPerPixelBinSize, target.width),
+                       ndc(py + kPerPixelBinSize, target.height)},
+                      {GLint(items.size()), GLint(list.size()), 0, 0}});
+      items.insert(items.end(), list.begin(), list.end());
+    }
+  gl_.NamedBufferData(bins_buffer_.get(), GLsizeiptr(bins.size() * sizeof(Bin)), bins.data(),
+                      GL_STREAM_DRAW);
+  gl_.NamedBufferData(bin_items_buffer_.get(), GLsizeiptr(items.size() * sizeof(GLint)),
+                      items.data(), GL_STREAM_DRAW);
+  gl_.BindBufferBase(GL_SHADER_STORAGE_BUFFER, kBinBufferBinding, bins_buffer_.get());
+  gl_.BindBufferBase(GL_SHADER_STORAGE_BUFFER, kBinItemBufferBinding, bin_items_buffer_.get());
+  gl_.DrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(bins.size()));
 }
 
 void EllipsoidRenderer::prepareAtlas(TileFormat format) {

@@ -90,6 +90,8 @@ class EllipsoidRenderer {
   const GlApi& gl_;
   GlObject vertex_array_;  // empty: attribute-less draws
   GlObject records_buffer_;
+  GlObject bins_buffer_;
+  GlObject bin_items_buffer_;
   GlObject spotlight_;
   GlObject atlas_;
   GlObject atlas_framebuffer_;

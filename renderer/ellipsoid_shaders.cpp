@@ -184,8 +184,9 @@ void main() {
 )";
 
 const char* kFusedPerPixel = R"(
-uniform int u_first;
-uniform int u_count;
+layout(std430, binding = 2) readonly buffer BinItems { int u_items[]; };
+flat in int v_first;  // this screen bin's ellipsoids: u_items[v_first .. v_first + v_count)
+flat in int v_count;
 const int kMaxHits = 8;
 void main() {
   vec3 r = viewRay();
@@ -199,8 +200,8 @@ void main() {
   float depth[kMaxHits];
   int index[kMaxHits];
   int n = 0;
-  for (int k = 0; k < u_count; ++k) {
-    int i = u_first + k;
+  for (int k = 0; k < v_count; ++k) {
+    int i = u_items[v_first + k];
     vec4 rect = u_e[i].rect;
     if (any(lessThan(ndc, rect.xy)) || any(greaterThan(ndc, rect.zw))) continue;
     float s = hitEllipsoid(i, r);
@@ -216,11 +217,11 @@ void main() {
     index[j] = i;
   }
   if (n == 0) discard;
+  // "Over", accumulated front to back (the same sum), so that hits behind an opaque one are
+  // never shaded; what they could add is below 1/1024.
   vec4 result = vec4(0.0);
-  for (int j = n - 1; j >= 0; --j) {  // back to front, "over"
-    vec4 surface = ellipsoidSurface(index[j], r, depth[j]);
-    result = surface + (1.0 - surface.a) * result;
-  }
+  for (int j = 0; j < n && result.a < 1.0 - 1.0 / 1024.0; ++j)
+    result += (1.0 - result.a) * ellipsoidSurface(index[j], r, depth[j]);
   o_colour = result;
 }
 )";
@@ -299,6 +300,26 @@ void main() {
   vec4 rect = u_e[v_index].rect;
   vec2 corner = vec2(gl_VertexID & 1, gl_VertexID >> 1);  // triangle strip
   gl_Position = vec4(mix(rect.xy, rect.zw, corner), 0.0, 1.0);
+}
+)";
+      return s;
+    case EllipsoidProgram::kFusedPerPixel:
+      s += R"(
+// Screen bins (Gardner sorted per scan-line region; here per square of pixels): each lists
+// the ellipsoids whose rectangles overlap it.
+struct Bin {
+  vec4 rect;    // NDC x0, y0, x1, y1
+  ivec4 items;  // first, count
+};
+layout(std430, binding = 1) readonly buffer Bins { Bin u_bins[]; };
+flat out int v_first;
+flat out int v_count;
+void main() {
+  Bin bin = u_bins[gl_InstanceID];
+  v_first = bin.items.x;
+  v_count = bin.items.y;
+  vec2 corner = vec2(gl_VertexID & 1, gl_VertexID >> 1);  // triangle strip
+  gl_Position = vec4(mix(bin.rect.xy, bin.rect.zw, corner), 0.0, 1.0);
 }
 )";
       return s;

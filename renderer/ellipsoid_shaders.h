@@ -37,6 +37,10 @@ inline constexpr int kEllipsoidRecordVec4s = 16;
 inline constexpr int kMaxPerPixelHits = 8;
 // Storage-buffer and texture binding points.
 inline constexpr int kEllipsoidBufferBinding = 0;
+inline constexpr int kBinBufferBinding = 1;
+inline constexpr int kBinItemBufferBinding = 2;
+// Side of the square screen bins of the per-pixel pass, pixels.
+inline constexpr int kPerPixelBinSize = 16;
 inline constexpr int kVolumeTextureUnit = 9;
 inline constexpr int kSpotlightTextureUnit = 10;
 inline constexpr int kAtlasTextureUnit = 11;

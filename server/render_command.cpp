@@ -35,8 +35,19 @@ std::string applyOverrides(const RenderCommandOptions& o, SceneFile& file) {
   if (o.term_filter)
     file.render.term_filter = TermFilter(nameIndex(kTermFilterNames, *o.term_filter));
   if (o.sky_passes) file.render.sky_passes = SkyPasses(nameIndex(kSkyPassesNames, *o.sky_passes));
+  RenderSettings& r = file.render;
+  if (o.ellipsoid_passes)
+    r.ellipsoid_passes = EllipsoidPasses(nameIndex(kEllipsoidPassesNames, *o.ellipsoid_passes));
+  if (o.ellipsoid_order)
+    r.ellipsoid_order = EllipsoidOrder(nameIndex(kEllipsoidOrderNames, *o.ellipsoid_order));
+  if (o.limb) r.limb = LimbEvaluation(nameIndex(kLimbNames, *o.limb));
+  if (o.tile_format) r.tile_format = TileFormat(nameIndex(kTileFormatNames, *o.tile_format));
+  if (o.tile_resolution) r.tile_resolution = *o.tile_resolution;
+  if (o.tessellation) r.tessellation = *o.tessellation;
+  if (o.impostor_tolerance) r.impostor_tolerance_px = *o.impostor_tolerance;
   if (o.samples) file.reference.samples_per_axis = *o.samples;
   std::string error = validateCamera(camera);
+  if (error.empty()) error = validateRenderSettings(r);
   return error.empty() ? "" : "command line: " + error;
 }
 
@@ -84,6 +95,22 @@ void addRenderCommand(CLI::App& app, RenderCommandOptions& o) {
       ->check(CLI::IsMember(kTermFilterNames));
   cmd->add_option("--sky-passes", o.sky_passes, "fused, or multipass (one pass per layer)")
       ->check(CLI::IsMember(kSkyPassesNames));
+  cmd->add_option("--ellipsoid-passes", o.ellipsoid_passes,
+                  "Ellipsoids: fused (exact hit per fragment) or multipass (Elinas tiles)")
+      ->check(CLI::IsMember(kEllipsoidPassesNames));
+  cmd->add_option("--ellipsoid-order", o.ellipsoid_order,
+                  "Fused ellipsoids: per-pixel depth order, or centre (by ellipsoid centre)")
+      ->check(CLI::IsMember(kEllipsoidOrderNames));
+  cmd->add_option("--limb", o.limb, "Limb function g: exact, or spotlight (Elinas' texture)")
+      ->check(CLI::IsMember(kLimbNames));
+  cmd->add_option("--tile-resolution", o.tile_resolution,
+                  "Multipass tile size: 0 adaptive, or a power of two 8..1024");
+  cmd->add_option("--tile-format", o.tile_format, "Multipass tiles: float or rgba8")
+      ->check(CLI::IsMember(kTileFormatNames));
+  cmd->add_option("--tessellation", o.tessellation,
+                  "Multipass ellipsoid mesh: 0 adaptive, or N slices by N stacks (3..256)");
+  cmd->add_option("--impostor-tolerance", o.impostor_tolerance,
+                  "Reuse far-cloud impostors while they move less than this many pixels (0 off)");
   cmd->add_option("--samples", o.samples, "Reference supersampling per pixel axis")
       ->check(CLI::Range(1, 16));
   cmd->add_option("--png-compression", o.encode.png_compression, "PNG zlib level")
@@ -115,8 +142,11 @@ int runRenderCommand(const RenderCommandOptions& o) {
     return 2;
   }
   const Scene& scene = file.scene;
-  spdlog::info("scene {}: {}x{}, {} layer(s){}", o.scene_path, scene.camera.width,
-               scene.camera.height, scene.layers.size(), scene.fog ? ", fog" : "");
+  std::size_t ellipsoids = 0;
+  for (const EllipsoidCloud& cloud : scene.clouds) ellipsoids += cloud.ellipsoids.size();
+  spdlog::info("scene {}: {}x{}, {} layer(s), {} cloud(s) of {} ellipsoid(s), {} target(s){}",
+               o.scene_path, scene.camera.width, scene.camera.height, scene.layers.size(),
+               scene.clouds.size(), ellipsoids, scene.targets.size(), scene.fog ? ", fog" : "");
 
   std::string error;
   const auto start = Clock::now();

@@ -19,6 +19,9 @@ struct RenderCommandOptions {
   std::optional<std::vector<double>> position;
   std::optional<double> heading, pitch, roll, vfov, time;
   std::optional<std::string> texture, term_filter, sky_passes;
+  std::optional<std::string> ellipsoid_passes, ellipsoid_order, limb, tile_format;
+  std::optional<int> tile_resolution, tessellation;
+  std::optional<double> impostor_tolerance;
   std::optional<int> samples;
   EncodeOptions encode;
 };
