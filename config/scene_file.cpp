@@ -374,8 +374,8 @@ void readCloud(TableReader& t, std::uint64_t seed, EllipsoidCloud& cloud) {
            "ellipsoid"});
   t.string("name", cloud.name);
   t.vector("colour", cloud.colour, 0.0, kMaxColour);
-  t.number("threshold", cloud.threshold_centre, 0.0, 1.0);
-  t.number("limb_threshold", cloud.threshold_limb, 0.0, 2.0);
+  t.number("threshold", cloud.threshold_centre, -2.0, 2.0);
+  t.number("limb_threshold", cloud.threshold_limb, -2.0, 2.0);
   t.number("transition", cloud.transition, 0.0, 10.0);
   t.number("ambient", cloud.shading.ambient, 0.0, 1.0);
   t.number("texture_fraction", cloud.shading.texture_fraction, 0.0, 1.0);

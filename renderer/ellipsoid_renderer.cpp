@@ -167,16 +167,22 @@ double cloudAltitude(const EllipsoidCloud& cloud) {
 }
 
 EllipsoidRenderer::EllipsoidRenderer(const GlApi& gl)
-    : gl_(gl),
-      vertex_array_(createVertexArray(gl)),
-      records_buffer_(createBuffer(gl)),
-      bins_buffer_(createBuffer(gl)),
-      bin_items_buffer_(createBuffer(gl)) {}
+    : gl_(gl), vertex_array_(createVertexArray(gl)) {}
 
 EllipsoidRenderer::~EllipsoidRenderer() = default;
 
 void EllipsoidRenderer::beginFrame() {
   for (auto& [key, cached] : textures_) cached.used = false;
+  next_buffer_ = 0;
+}
+
+GLuint EllipsoidRenderer::frameBuffer(const void* data, std::size_t bytes) {
+  // A fresh buffer for every upload in a frame: llvmpipe may still be drawing from the last
+  // one (it defers rasterisation), and rewriting it in place would change earlier draws.
+  if (next_buffer_ == buffer_pool_.size()) buffer_pool_.push_back(createBuffer(gl_));
+  const GLuint buffer = buffer_pool_[next_buffer_++].get();
+  gl_.NamedBufferData(buffer, GLsizeiptr(std::max<std::size_t>(bytes, 16)), data, GL_STREAM_DRAW);
+  return buffer;
 }
 
 void EllipsoidRenderer::endFrame() {
@@ -317,9 +323,8 @@ void EllipsoidRenderer::setCloudUniforms(GLuint p, const Scene& scene,
 }
 
 void EllipsoidRenderer::uploadRecords(const std::vector<EllipsoidRecord>& records) {
-  gl_.NamedBufferData(records_buffer_.get(), GLsizeiptr(records.size() * sizeof(EllipsoidRecord)),
-                      records.data(), GL_STREAM_DRAW);
-  gl_.BindBufferBase(GL_SHADER_STORAGE_BUFFER, kEllipsoidBufferBinding, records_buffer_.get());
+  gl_.BindBufferBase(GL_SHADER_STORAGE_BUFFER, kEllipsoidBufferBinding,
+                     frameBuffer(records.data(), records.size() * sizeof(EllipsoidRecord)));
 }
 
 void EllipsoidRenderer::drawCloud(const Scene& scene, std::size_t index,
@@ -410,12 +415,10 @@ void EllipsoidRenderer::drawCloud(const Scene& scene, std::size_t index,
                       {GLint(items.size()), GLint(list.size()), 0, 0}});
       items.insert(items.end(), list.begin(), list.end());
     }
-  gl_.NamedBufferData(bins_buffer_.get(), GLsizeiptr(bins.size() * sizeof(Bin)), bins.data(),
-                      GL_STREAM_DRAW);
-  gl_.NamedBufferData(bin_items_buffer_.get(), GLsizeiptr(items.size() * sizeof(GLint)),
-                      items.data(), GL_STREAM_DRAW);
-  gl_.BindBufferBase(GL_SHADER_STORAGE_BUFFER, kBinBufferBinding, bins_buffer_.get());
-  gl_.BindBufferBase(GL_SHADER_STORAGE_BUFFER, kBinItemBufferBinding, bin_items_buffer_.get());
+  gl_.BindBufferBase(GL_SHADER_STORAGE_BUFFER, kBinBufferBinding,
+                     frameBuffer(bins.data(), bins.size() * sizeof(Bin)));
+  gl_.BindBufferBase(GL_SHADER_STORAGE_BUFFER, kBinItemBufferBinding,
+                     frameBuffer(items.data(), items.size() * sizeof(GLint)));
   gl_.DrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(bins.size()));
 }
 

@@ -77,6 +77,7 @@ class EllipsoidRenderer {
   GLuint spotlightTexture();
   void setCloudUniforms(GLuint program, const Scene& scene, const EllipsoidCloud& cloud,
                         const CachedTexture& texture, SolidTextureKind kind);
+  GLuint frameBuffer(const void* data, std::size_t bytes);
   void uploadRecords(const std::vector<EllipsoidRecord>& records);
   void drawTiles(const Scene& scene, const EllipsoidCloud& cloud, CachedTexture& texture,
                  const EllipsoidPassLayout& base, const RenderSettings& settings,
@@ -89,9 +90,8 @@ class EllipsoidRenderer {
 
   const GlApi& gl_;
   GlObject vertex_array_;  // empty: attribute-less draws
-  GlObject records_buffer_;
-  GlObject bins_buffer_;
-  GlObject bin_items_buffer_;
+  std::vector<GlObject> buffer_pool_;  // storage buffers, one per upload in a frame
+  std::size_t next_buffer_ = 0;
   GlObject spotlight_;
   GlObject atlas_;
   GlObject atlas_framebuffer_;

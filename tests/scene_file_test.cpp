@@ -26,10 +26,10 @@ TEST(SceneFile, EveryPresetLoads) {
     if (entry.path().extension() != ".toml") continue;
     SceneFile file;
     EXPECT_EQ(loadSceneFile(entry.path().string(), file), "") << entry.path();
-    EXPECT_FALSE(file.scene.layers.empty()) << entry.path();
+    EXPECT_FALSE(file.scene.layers.empty() && file.scene.clouds.empty()) << entry.path();
     ++count;
   }
-  EXPECT_GE(count, 4);
+  EXPECT_GE(count, 9);
 }
 
 TEST(SceneFile, ReadsEveryField) {
@@ -182,6 +182,106 @@ TEST(SceneFile, ValidateCameraChecksOverrides) {
   c = {};
   c.orientation.pitch_deg = 91.0;
   EXPECT_THAT(validateCamera(c), HasSubstr("+-90"));
+}
+
+TEST(SceneFile, ReadsCloudsAndTargets) {
+  SceneFile f;
+  ASSERT_EQ(parseError(R"(
+[[cloud]]
+name = "pair"
+threshold = 0.1
+limb_threshold = 0.4
+transition = 0.05
+[cloud.texture]
+source = "perlin"
+period = 900.0
+[[cloud.ellipsoid]]
+radii = [300.0, 200.0, 100.0]
+centre = [1.0, 2.0, 1500.0]
+heading = 45.0
+[[cloud.ellipsoid]]
+radii = [250.0, 250.0, 250.0]
+centre = [300.0, 0.0, 1500.0]
+[[cloud]]
+[cloud.cumulus]
+count = 6
+width = 800.0
+[[target]]
+shape = "ellipsoid"
+centre = [0.0, 500.0, 900.0]
+size = [20.0, 5.0, 3.0]
+[render]
+ellipsoid_passes = "multipass"
+ellipsoid_order = "centre"
+limb = "spotlight"
+tile_resolution = 64
+tile_format = "rgba8"
+tessellation = 10
+)",
+                       f),
+            "");
+  ASSERT_EQ(f.scene.clouds.size(), 2u);
+  const EllipsoidCloud& pair = f.scene.clouds[0];
+  EXPECT_EQ(pair.name, "pair");
+  EXPECT_EQ(pair.threshold_limb, 0.4);
+  EXPECT_EQ(pair.texture.source, SolidTextureSource::kPerlin);
+  ASSERT_EQ(pair.ellipsoids.size(), 2u);
+  EXPECT_EQ(pair.ellipsoids[0].orientation.heading_deg, 45.0);
+  EXPECT_EQ(f.scene.clouds[1].ellipsoids.size(), 6u);
+  ASSERT_EQ(f.scene.targets.size(), 1u);
+  EXPECT_EQ(f.scene.targets[0].shape, TargetShape::kEllipsoid);
+  EXPECT_EQ(f.render.ellipsoid_passes, EllipsoidPasses::kMultipass);
+  EXPECT_EQ(f.render.ellipsoid_order, EllipsoidOrder::kCentre);
+  EXPECT_EQ(f.render.limb, LimbEvaluation::kSpotlight);
+  EXPECT_EQ(f.render.tile_resolution, 64);
+  EXPECT_EQ(f.render.tile_format, TileFormat::kRgba8);
+  EXPECT_EQ(f.render.tessellation, 10);
+}
+
+TEST(SceneFile, InvalidEllipsoidsAreRejected) {
+  auto cloud = [](const std::string& radii) {
+    return "[[cloud]]\n[[cloud.ellipsoid]]\nradii = " + radii + "\ncentre = [0.0, 0.0, 1000.0]\n";
+  };
+  EXPECT_THAT(parseError(cloud("[0.0, 1.0, 1.0]")),
+              AllOf(HasSubstr("test.toml:3: cloud[0].ellipsoid[0].radii"),
+                    HasSubstr("out of range (allowed: 0.001 to 100000)")));
+  EXPECT_THAT(parseError(cloud("[10.0, -1.0, 1.0]")), HasSubstr("-1 is out of range"));
+  EXPECT_THAT(parseError(cloud("[10.0, nan, 1.0]")), HasSubstr("not a finite number"));
+  EXPECT_THAT(parseError(cloud("[10.0, 1.0]")), HasSubstr("must be an array of 3 numbers"));
+  EXPECT_THAT(parseError("[[cloud]]\n[[cloud.ellipsoid]]\ncentre = [0.0, 0.0, 1.0]\n"),
+              HasSubstr("missing key radii"));
+  EXPECT_THAT(parseError("[[cloud]]\nname = \"empty\"\n"),
+              AllOf(HasSubstr("cloud[0]: has no ellipsoids"), HasSubstr("[cloud.cumulus]")));
+  EXPECT_THAT(parseError(cloud("[1.0, 1.0, 1.0]") + "size = 3\n"),
+              HasSubstr("unknown key (allowed here: radii, centre, heading, pitch, roll)"));
+  EXPECT_THAT(parseError("[[cloud]]\n[cloud.texture]\nsource = \"perlin\"\nterms = 3\n"),
+              HasSubstr("applies to source \"gardner\" only"));
+}
+
+TEST(SceneFile, BadTargetsAndKnobsAreRejected) {
+  EXPECT_THAT(parseError("[[target]]\nshape = \"mesh\"\n"), HasSubstr("needs a mesh"));
+  EXPECT_THAT(parseError("[[target]]\nshape = \"mesh\"\nmesh = \"missing.obj\"\n"),
+              AllOf(HasSubstr("target[0].mesh"), HasSubstr("cannot read mesh file")));
+  EXPECT_THAT(parseError("[[target]]\nmesh = \"a.obj\"\n"),
+              HasSubstr("applies to shape \"mesh\" only"));
+  EXPECT_THAT(parseError("[[target]]\nshape = \"cone\"\n"),
+              HasSubstr("(one of: box, ellipsoid, mesh)"));
+  EXPECT_THAT(parseError("[render]\ntile_resolution = 100\n"),
+              HasSubstr("render.tile_resolution: 100 is not allowed (allowed: 0 for adaptive, or a "
+                        "power of two from 8 to 1024)"));
+  EXPECT_THAT(parseError("[render]\ntessellation = 2\n"), HasSubstr("allowed: 0 for adaptive"));
+  EXPECT_THAT(parseError("[render]\nellipsoid_order = \"random\"\n"),
+              HasSubstr("(one of: centre, per-pixel)"));
+}
+
+TEST(SceneFile, MeshTargetsLoadRelativeToTheScene) {
+  SceneFile f;
+  ASSERT_EQ(loadSceneFile(NEPHELE_SOURCE_DIR "/config/scenes/cumulus_target.toml", f), "");
+  ASSERT_FALSE(f.scene.targets.empty());
+  bool has_mesh = false;
+  for (const Target& t : f.scene.targets)
+    if (t.shape == TargetShape::kMesh) has_mesh = t.mesh && !t.mesh->triangles.empty();
+  EXPECT_TRUE(has_mesh);
 }
 
 }  // namespace

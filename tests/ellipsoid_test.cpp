@@ -1,0 +1,292 @@
+// The ellipsoid primitive (SPEC sections 4 and 5): quadric, ray hits, the limb function g
+// against SPEC's definition restated here, the silhouette conic, the eye-space box, solid
+// textures, the in-cloud model and targets.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "world/ellipsoid.h"
+#include "world/ellipsoid_cloud.h"
+#include "world/solid_texture.h"
+#include "world/target.h"
+
+namespace nephele {
+namespace {
+
+Ellipsoid tilted() {
+  return {{500.0, 300.0, 120.0}, {200.0, 900.0, 1500.0}, {30.0, 20.0, -15.0}};
+}
+
+// SPEC section 4, restated: Q(X) = (X - C)^T M (X - C) - 1 with M from the nine parameters,
+// the ray quadratic a s^2 + b s + c and its discriminant.
+struct Quadratic {
+  double a, b, c;
+};
+Quadratic rayQuadratic(const Ellipsoid& e, glm::dvec3 eye, glm::dvec3 d) {
+  const glm::dmat3 r = bodyToWorld(e.orientation);
+  const glm::dmat3 inv_s2(1.0 / (e.radii.x * e.radii.x), 0, 0, 0, 1.0 / (e.radii.y * e.radii.y), 0,
+                          0, 0, 1.0 / (e.radii.z * e.radii.z));
+  const glm::dmat3 m = r * inv_s2 * glm::transpose(r);
+  const glm::dvec3 o = eye - e.centre;
+  return {glm::dot(d, m * d), 2.0 * glm::dot(d, m * o), glm::dot(o, m * o) - 1.0};
+}
+
+glm::dvec3 randomUnit(std::mt19937_64& rng) {
+  std::normal_distribution<double> n;
+  return glm::normalize(glm::dvec3(n(rng), n(rng), n(rng)));
+}
+
+TEST(Ellipsoid, SymmetricEigenReconstructs) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-10.0, 10.0);
+  for (int trial = 0; trial < 50; ++trial) {
+    glm::dmat3 m;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j <= i; ++j) m[i][j] = m[j][i] = u(rng);
+    const SymmetricEigen e = symmetricEigen(m);
+    EXPECT_LE(e.values[0], e.values[1]);
+    EXPECT_LE(e.values[1], e.values[2]);
+    for (int k = 0; k < 3; ++k) {
+      const glm::dvec3 residual = m * e.vectors[k] - e.values[k] * e.vectors[k];
+      EXPECT_LT(glm::length(residual), 1e-9);
+      EXPECT_NEAR(glm::length(e.vectors[k]), 1.0, 1e-12);
+    }
+  }
+}
+
+TEST(Ellipsoid, RayHitsLieOnTheQuadric) {
+  const Ellipsoid e = tilted();
+  const glm::dvec3 eye(-3000.0, -2000.0, 400.0);
+  const EllipsoidView view(e, eye);
+  std::mt19937_64 rng(7);
+  int hits = 0;
+  for (int i = 0; i < 2000; ++i) {
+    // Directions around the one to the centre, some hitting, some missing.
+    const glm::dvec3 d = glm::normalize(e.centre - eye) + 0.08 * randomUnit(rng);
+    const Quadratic q = rayQuadratic(e, eye, d);
+    const auto span = view.intersect(d);
+    ASSERT_EQ(span.has_value(), q.b * q.b - 4 * q.a * q.c > 0.0) << i;
+    if (!span) continue;
+    ++hits;
+    EXPECT_NEAR(quadricValue(e, eye + span->near * d), 0.0, 1e-9);
+    EXPECT_NEAR(quadricValue(e, eye + span->far * d), 0.0, 1e-9);
+    EXPECT_LE(span->near, span->far);
+  }
+  EXPECT_GT(hits, 200);
+  EXPECT_LT(hits, 1800);
+}
+
+// 100 km from the origin the hit is as exact, relative to the ellipsoid, as at the origin.
+TEST(Ellipsoid, FarFromTheOriginStaysExact) {
+  Ellipsoid near = tilted(), far = tilted();
+  const glm::dvec3 shift(1.0e5, -1.0e5, 0.0);
+  far.centre += shift;
+  const glm::dvec3 eye(-3000.0, -2000.0, 400.0), d = glm::normalize(near.centre - eye);
+  const auto a = EllipsoidView(near, eye).intersect(d), b = EllipsoidView(far, eye + shift).intersect(d);
+  ASSERT_TRUE(a && b);
+  EXPECT_NEAR(a->near, b->near, 1e-7);
+  EXPECT_NEAR(EllipsoidView(near, eye).limb(d), EllipsoidView(far, eye + shift).limb(d), 1e-9);
+}
+
+TEST(Ellipsoid, LimbFunctionFollowsTheSpec) {
+  const Ellipsoid e = tilted();
+  const glm::dvec3 eye(-2500.0, -1500.0, 300.0);
+  const EllipsoidView view(e, eye);
+  const glm::dmat3& k = view.discriminantForm();
+  const double lambda = view.limbEigenvalue();
+  const glm::dvec3 axis = view.limbAxis();
+  // K's eigenpair: K a = lam a, the one positive eigenvalue; a points at the ellipsoid.
+  EXPECT_LT(glm::length(k * axis - lambda * axis), 1e-9 * lambda);
+  const SymmetricEigen eigen = symmetricEigen(k);
+  EXPECT_LT(eigen.values[1], 0.0);
+  EXPECT_GT(eigen.values[2], 0.0);
+  EXPECT_GT(glm::dot(axis, e.centre - eye), 0.0);
+  EXPECT_NEAR(view.limb(axis), 1.0, 1e-12);
+
+  std::mt19937_64 rng(11);
+  for (int i = 0; i < 2000; ++i) {
+    const glm::dvec3 d = (glm::normalize(e.centre - eye) + 0.2 * randomUnit(rng)) * 3.7;
+    const Quadratic q = rayQuadratic(e, eye, d);
+    const double delta = q.b * q.b - 4.0 * q.a * q.c;
+    EXPECT_NEAR(glm::dot(d, k * d), delta, 1e-9 * std::abs(q.b * q.b));
+    const double expected =
+        std::clamp(delta / (lambda * glm::dot(d, axis) * glm::dot(d, axis)), 0.0, 1.0);
+    EXPECT_NEAR(view.limb(d), expected, 1e-9) << i;
+  }
+}
+
+// Rays on the silhouette (found by bisection between a hit and a miss) have g = 0 and lie on
+// the silhouette conic.
+TEST(Ellipsoid, SilhouetteConicAndLimbAgree) {
+  const Ellipsoid e = tilted();
+  Camera camera;
+  camera.position = {-2500.0, -1500.0, 300.0};
+  camera.orientation = {60.0, 15.0, 10.0};
+  const ViewBasis basis = viewBasis(camera);
+  const EllipsoidView view(e, camera.position);
+  const glm::dmat3 conic = silhouetteConic(view, basis);
+  const glm::dvec3 to_centre = e.centre - camera.position;
+  const glm::dvec2 centre_uv(glm::dot(to_centre, basis.right) / glm::dot(to_centre, basis.forward),
+                             glm::dot(to_centre, basis.up) / glm::dot(to_centre, basis.forward));
+  for (int k = 0; k < 16; ++k) {
+    const double angle = 2.0 * 3.141592653589793 * k / 16;
+    const glm::dvec2 step(std::cos(angle), std::sin(angle));
+    double lo = 0.0, hi = 1.0;  // in image-plane units from the centre's image
+    auto dir = [&](double t) {
+      const glm::dvec2 uv = centre_uv + t * step;
+      return uv.x * basis.right + uv.y * basis.up + basis.forward;
+    };
+    ASSERT_TRUE(view.intersect(dir(lo)).has_value());
+    ASSERT_FALSE(view.intersect(dir(hi)).has_value());
+    for (int i = 0; i < 60; ++i) (view.intersect(dir(0.5 * (lo + hi))) ? lo : hi) = 0.5 * (lo + hi);
+    const glm::dvec2 uv = centre_uv + lo * step;
+    const glm::dvec3 h(uv, 1.0);
+    EXPECT_NEAR(glm::dot(h, conic * h) / glm::dot(h, h), 0.0, 1e-6 * view.limbEigenvalue());
+    EXPECT_NEAR(view.limb(dir(lo)), 0.0, 1e-6);
+  }
+}
+
+TEST(Ellipsoid, EyeBoxContainsTheSurface) {
+  const Ellipsoid e = tilted();
+  Camera camera;
+  camera.position = {-2500.0, -1500.0, 300.0};
+  camera.orientation = {60.0, 15.0, 10.0};
+  const ViewBasis basis = viewBasis(camera);
+  const EyeBox box = eyeSpaceBox(e, camera.position, basis);
+  std::mt19937_64 rng(3);
+  glm::dvec3 reached(0.0);
+  const glm::dmat3 body = bodyToWorld(e.orientation);
+  for (int i = 0; i < 20000; ++i) {
+    const glm::dvec3 u = randomUnit(rng);
+    const glm::dvec3 p = e.centre + body * (u * e.radii) - camera.position;
+    const glm::dvec3 eye_p(glm::dot(p, basis.right), glm::dot(p, basis.up), glm::dot(p, basis.forward));
+    const glm::dvec3 offset = glm::abs(eye_p - box.centre);
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_LE(offset[a], box.half_extent[a] * (1.0 + 1e-12));
+      reached[a] = std::max(reached[a], offset[a] / box.half_extent[a]);
+    }
+  }
+  for (int a = 0; a < 3; ++a) EXPECT_GT(reached[a], 0.99);  // tight, not just large
+}
+
+TEST(Ellipsoid, InvalidParametersAreNamed) {
+  Ellipsoid e = tilted();
+  EXPECT_EQ(ellipsoidError(e), "");
+  e.radii.y = 0.0;
+  EXPECT_NE(ellipsoidError(e).find("radius y"), std::string::npos);
+  e.radii.y = -1.0;
+  EXPECT_NE(ellipsoidError(e).find("> 0"), std::string::npos);
+  e.radii.y = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(ellipsoidError(e), "");
+  e = tilted();
+  e.centre.x = std::numeric_limits<double>::infinity();
+  EXPECT_NE(ellipsoidError(e).find("centre"), std::string::npos);
+}
+
+TEST(Ellipsoid, EyeInsideHasNoSurface) {
+  const Ellipsoid e = tilted();
+  const EllipsoidView view(e, e.centre + glm::dvec3(10.0, 0.0, 0.0));
+  EXPECT_TRUE(view.eyeInside());
+  EXPECT_EQ(view.limb({1.0, 0.0, 0.0}), 0.0);
+  EXPECT_LT(view.eyeRadius(), 1.0);
+}
+
+TEST(SolidTexture, BakedVolumeEqualsTheSolidTexture) {
+  GardnerTextureParams params{4, 0.01, 0.013, 0.2, true, 9};
+  const GardnerTexture gardner(params);
+  const int size = 16;
+  const VolumeTable baked = bakeGardnerSolid(gardner, size, 3);
+  const glm::dvec2 period = gardner.period();
+  for (int z = 0; z < size; z += 3)
+    for (int y = 0; y < size; y += 5)
+      for (int x = 0; x < size; ++x) {
+        const glm::dvec3 p((x + 0.5) / size * period.x, (y + 0.5) / size * period.y,
+                           (z + 0.5) / size * period.x);
+        EXPECT_NEAR(baked.at(x, y, z), gardner.solid(p, 3), 1e-6);
+      }
+}
+
+TEST(SolidTexture, PeriodicInEveryAxisAndFarAway) {
+  SolidTextureSpec spec;
+  spec.seed = 4;
+  const SolidTexture texture(spec);
+  const glm::dvec3 period = texture.period();
+  const glm::dvec3 p(123.0, 456.0, 789.0);
+  for (int axis = 0; axis < 3; ++axis) {
+    glm::dvec3 q = p;
+    q[axis] += 80.0 * period[axis];
+    EXPECT_NEAR(texture.value(p), texture.value(q), 1e-9);
+  }
+  spec.source = SolidTextureSource::kPerlin;
+  spec.perlin_size_log2 = 4;
+  const SolidTexture perlin(spec);
+  double lo = 1.0, hi = 0.0;
+  for (float v : perlin.volume()->values) lo = std::min(lo, double(v)), hi = std::max(hi, double(v));
+  EXPECT_EQ(lo, 0.0);
+  EXPECT_EQ(hi, 1.0);
+  EXPECT_NEAR(perlin.value(p), perlin.value(p + perlin.period()), 1e-9);
+}
+
+TEST(InCloudModel, ContinuousAcrossTheSurface) {
+  EXPECT_EQ(surfaceFade(1.0), 0.0);
+  EXPECT_EQ(surfaceFade(1.0 + kInCloudBand), 1.0);
+  EXPECT_EQ(veilOpacity(1.0 + kInCloudBand), 0.0);
+  EXPECT_NEAR(veilOpacity(1.0), 0.5, 1e-12);
+  EXPECT_EQ(veilOpacity(1.0 - kInCloudBand), 1.0);
+  for (double rho = 0.5; rho < 1.5; rho += 1e-3) {
+    EXPECT_LT(std::abs(surfaceFade(rho + 1e-4) - surfaceFade(rho)), 2e-3);
+    EXPECT_LT(std::abs(veilOpacity(rho + 1e-4) - veilOpacity(rho)), 2e-3);
+  }
+  EllipsoidCloud cloud;
+  cloud.ellipsoids = {tilted()};
+  const SolidTexture texture(cloud.texture);
+  const Sun sun;
+  const Veil far = inCloudVeil({cloud}, {&texture}, {0.0, 0.0, 0.0}, sun);
+  EXPECT_EQ(far.opacity, 0.0);
+  const Veil inside = inCloudVeil({cloud}, {&texture}, tilted().centre, sun);
+  EXPECT_EQ(inside.opacity, 1.0);
+  EXPECT_GT(inside.colour.x, 0.0);
+}
+
+TEST(Targets, BoxAndMeshHits) {
+  Target box;
+  box.centre = {0.0, 100.0, 50.0};
+  box.size = {5.0, 10.0, 2.0};
+  const auto hit = intersectTarget(box, {0.0, 0.0, 50.0}, {0.0, 1.0, 0.0});
+  ASSERT_TRUE(hit);
+  EXPECT_NEAR(hit->distance, 90.0, 1e-9);
+  EXPECT_NEAR(hit->normal.y, -1.0, 1e-12);
+  EXPECT_FALSE(intersectTarget(box, {0.0, 0.0, 50.0}, {0.0, -1.0, 0.0}));
+
+  // A mesh of the same box's front face (a square of two triangles), scaled by `size`.
+  auto square = std::make_shared<TriangleMesh>();
+  square->vertices = {{-1, -1, -1}, {1, -1, -1}, {1, -1, 1}, {-1, -1, 1}};
+  square->triangles = {{0, 1, 2}, {0, 2, 3}};
+  Target mesh = box;
+  mesh.shape = TargetShape::kMesh;
+  mesh.mesh = square;
+  for (double x : {-4.9, 0.0, 3.0}) {
+    const auto a = intersectTarget(box, {x, 0.0, 51.0}, {0.0, 1.0, 0.0});
+    const auto b = intersectTarget(mesh, {x, 0.0, 51.0}, {0.0, 1.0, 0.0});
+    ASSERT_TRUE(a && b);
+    EXPECT_NEAR(a->distance, b->distance, 1e-9);
+  }
+  EXPECT_FALSE(intersectTarget(mesh, {5.1, 0.0, 50.0}, {0.0, 1.0, 0.0}));
+}
+
+TEST(Cumulus, DeterministicAndValid) {
+  const auto a = cumulusEllipsoids(27, {0.0, 0.0, 800.0}, 2000.0, 5);
+  const auto b = cumulusEllipsoids(27, {0.0, 0.0, 800.0}, 2000.0, 5);
+  ASSERT_EQ(a.size(), 27u);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].centre, b[i].centre);
+    EXPECT_EQ(ellipsoidError(a[i]), "");
+    EXPECT_GT(a[i].centre.z - a[i].radii.z, 700.0);  // nothing far below the base
+  }
+  EXPECT_EQ(cumulusEllipsoids(1, {0, 0, 0}, 100.0, 1).size(), 1u);
+}
+
+}  // namespace
+}  // namespace nephele
