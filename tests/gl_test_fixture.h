@@ -1,0 +1,60 @@
+#pragma once
+// Shared fixture of the GL image tests: one platform and renderer per suite, presets at test
+// size, and an image comparison that writes the actual, expected and 8x difference images to
+// NEPHELE_TEST_OUTPUT when it fails.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+
+#include "config/scene_file.h"
+#include "protocol/image_encoding.h"
+#include "renderer/gl_renderer.h"
+#include "renderer/image_metrics.h"
+#include "renderer/reference_renderer.h"
+
+namespace nephele {
+
+class GlRenderTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    std::string error;
+    platform_ = createGlPlatform(GlBackend::kAuto, error).release();
+    ASSERT_NE(platform_, nullptr) << error;
+    renderer_ = new GlRenderer(*platform_);
+  }
+  static void TearDownTestSuite() {
+    delete renderer_;
+    delete platform_;
+  }
+
+  static SceneFile preset(const std::string& name, int width = 160, int height = 120) {
+    SceneFile file;
+    const std::string path = NEPHELE_SOURCE_DIR "/config/scenes/" + name + ".toml";
+    EXPECT_EQ(loadSceneFile(path, file), "");
+    file.scene.camera.width = width;
+    file.scene.camera.height = height;
+    return file;
+  }
+
+  static void expectClose(const FloatImage& actual, const FloatImage& expected, double min_psnr,
+                          double max_abs, const std::string& name) {
+    const ImageError e = compareImages(actual, expected);
+    EXPECT_EQ(e.non_finite, 0) << name;
+    EXPECT_GE(e.psnr_db, min_psnr) << name;
+    EXPECT_LE(e.max_abs, max_abs) << name;
+    if (e.non_finite == 0 && e.psnr_db >= min_psnr && e.max_abs <= max_abs) return;
+    const std::filesystem::path dir(NEPHELE_TEST_OUTPUT);
+    std::filesystem::create_directories(dir);
+    writeImageFile((dir / (name + "_actual.png")).string(), actual);
+    writeImageFile((dir / (name + "_expected.png")).string(), expected);
+    writeImageFile((dir / (name + "_diff.png")).string(), differenceImage(actual, expected, 8.0f));
+    ADD_FAILURE() << name << ": images written to " << dir;
+  }
+
+  static inline GlPlatform* platform_ = nullptr;
+  static inline GlRenderer* renderer_ = nullptr;
+};
+
+
+}  // namespace nephele
