@@ -187,6 +187,8 @@ GLuint EllipsoidRenderer::frameBuffer(const void* data, std::size_t bytes) {
 
 void EllipsoidRenderer::endFrame() {
   std::erase_if(textures_, [](const auto& entry) { return !entry.second.used; });
+  std::erase_if(impostors_, [](const auto& entry) { return !entry.second.used; });
+  for (auto& [index, impostor] : impostors_) impostor.used = false;
 }
 
 GLuint EllipsoidRenderer::program(const EllipsoidPassLayout& layout) {
@@ -330,6 +332,148 @@ void EllipsoidRenderer::uploadRecords(const std::vector<EllipsoidRecord>& record
 void EllipsoidRenderer::drawCloud(const Scene& scene, std::size_t index,
                                   const RenderSettings& settings, const FrameTarget& target,
                                   bool targets_drawn) {
+  if (settings.impostor_tolerance_px > 0.0 &&
+      drawImpostor(scene, index, settings, target, targets_drawn))
+    return;
+  drawCloudDirect(scene, index, settings, target, targets_drawn);
+}
+
+namespace {
+
+// The bounding sphere of a cloud: the centre of its ellipsoids' bounding box, and the
+// largest distance from it to a centre plus that ellipsoid's longest semi-axis.
+void boundingSphere(const EllipsoidCloud& cloud, glm::dvec3& centre, double& radius) {
+  glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-lo);
+  for (const Ellipsoid& e : cloud.ellipsoids) {
+    const double r = std::max({e.radii.x, e.radii.y, e.radii.z});
+    lo = glm::min(lo, e.centre - r);
+    hi = glm::max(hi, e.centre + r);
+  }
+  centre = 0.5 * (lo + hi);
+  radius = 0.0;
+  for (const Ellipsoid& e : cloud.ellipsoids)
+    radius = std::max(radius, glm::length(e.centre - centre) +
+                                  std::max({e.radii.x, e.radii.y, e.radii.z}));
+}
+
+// Everything an impostor's picture depends on besides the eye.
+std::string impostorKey(const Scene& scene, const EllipsoidCloud& cloud,
+                        const RenderSettings& settings) {
+  std::ostringstream key;
+  key.precision(17);
+  key << cloud.colour.x << cloud.colour.y << cloud.colour.z << '/' << cloud.threshold_centre << '/'
+      << cloud.threshold_limb << '/' << cloud.transition << '/' << cloud.shading.ambient << '/'
+      << cloud.shading.texture_fraction << '/' << cloud.shading.specular << '/'
+      << cloud.shading.shininess << '/' << textureKey(cloud.texture, settings) << '/'
+      << int(settings.ellipsoid_passes) << int(settings.ellipsoid_order) << int(settings.limb)
+      << int(settings.term_filter) << '/' << scene.sun.azimuth_deg << '/'
+      << scene.sun.elevation_deg << '/' << scene.sun.colour.x << scene.sun.colour.y
+      << scene.sun.colour.z << '/' << scene.fog.has_value();
+  if (scene.fog) key << scene.fog->top_m << '/' << scene.fog->visibility_m;
+  for (const Ellipsoid& e : cloud.ellipsoids)
+    key << '|' << e.radii.x << ',' << e.radii.y << ',' << e.radii.z << ',' << e.centre.x << ','
+        << e.centre.y << ',' << e.centre.z << ',' << e.orientation.heading_deg << ','
+        << e.orientation.pitch_deg << ',' << e.orientation.roll_deg;
+  return key.str();
+}
+
+}  // namespace
+
+bool EllipsoidRenderer::drawImpostor(const Scene& scene, std::size_t index,
+                                     const RenderSettings& settings, const FrameTarget& target,
+                                     bool targets_drawn) {
+  const EllipsoidCloud& cloud = scene.clouds[index];
+  const Camera& camera = scene.camera;
+  glm::dvec3 centre;
+  double radius;
+  boundingSphere(cloud, centre, radius);
+  const double distance = glm::length(centre - camera.position);
+  // Only far clouds: the sphere well away from the eye and small on screen.
+  const double pixels_per_radian = camera.height / glm::radians(camera.vfov_deg);
+  const double diameter_px = 2.0 * radius / distance * pixels_per_radian;
+  if (distance < 4.0 * radius || diameter_px > 512.0) return false;
+  const int size = std::clamp(nextPowerOfTwo(diameter_px), 16, 512);
+
+  Impostor& impostor = impostors_[index];
+  impostor.used = true;
+  const std::string key = impostorKey(scene, cloud, settings);
+  // Reuse while the billboard's parallax, about R theta / distance in pixels for a change
+  // theta in the direction to the centre, stays within the tolerance.
+  const double theta =
+      std::acos(std::clamp(glm::dot(glm::normalize(centre - impostor.eye),
+                                    glm::normalize(centre - camera.position)),
+                           -1.0, 1.0));
+  const double parallax_px =
+      pixels_per_radian * radius *
+      (theta + std::abs(glm::length(centre - impostor.eye) - distance) / distance) / distance;
+  const bool fresh = impostor.key == key && glm::distance(impostor.centre, centre) == 0.0 &&
+                     impostor.size >= size && parallax_px <= settings.impostor_tolerance_px;
+  if (!fresh) {
+    // Render the cloud alone from here, looking at its centre, into a square texture.
+    Scene view = scene;
+    const glm::dvec3 d = glm::normalize(centre - camera.position);
+    view.camera.position = camera.position;
+    view.camera.orientation = {glm::degrees(std::atan2(d.x, d.y)),
+                               glm::degrees(std::asin(std::clamp(d.z, -1.0, 1.0))), 0.0};
+    const double half_angle = std::asin(std::min(1.0, radius / distance)) * 1.02;
+    view.camera.vfov_deg = glm::degrees(2.0 * half_angle);
+    view.camera.width = view.camera.height = size;
+    if (impostor.size != size || !impostor.texture) {
+      impostor.texture = createTexture(gl_, GL_TEXTURE_2D);
+      gl_.TextureStorage2D(impostor.texture.get(), 1, GL_RGBA16F, size, size);
+      gl_.TextureParameteri(impostor.texture.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+      gl_.TextureParameteri(impostor.texture.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+      gl_.TextureParameteri(impostor.texture.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+      gl_.TextureParameteri(impostor.texture.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+      impostor.framebuffer = createFramebuffer(gl_);
+      gl_.NamedFramebufferTexture(impostor.framebuffer.get(), GL_COLOR_ATTACHMENT0,
+                                  impostor.texture.get(), 0);
+    }
+    const float clear[4] = {0, 0, 0, 0};
+    gl_.ClearNamedFramebufferfv(impostor.framebuffer.get(), GL_COLOR, 0, clear);
+    gl_.BindFramebuffer(GL_FRAMEBUFFER, impostor.framebuffer.get());
+    gl_.Viewport(0, 0, size, size);
+    const FrameTarget impostor_target{impostor.framebuffer.get(), size, size};
+    drawCloudDirect(view, index, settings, impostor_target, false);
+    gl_.BindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
+    gl_.Viewport(0, 0, target.width, target.height);
+    const ViewBasis basis = viewBasis(view.camera);
+    impostor.key = key;
+    impostor.eye = camera.position;
+    impostor.centre = centre;
+    impostor.right = basis.right;
+    impostor.up = basis.up;
+    impostor.half_size = distance * std::tan(half_angle);
+    impostor.size = size;
+    ++impostor_renders_;
+  }
+
+  EllipsoidPassLayout layout;
+  layout.program = EllipsoidProgram::kImpostor;
+  layout.targets = targets_drawn;
+  const GLuint p = program(layout);
+  gl_.UseProgram(p);
+  const ViewBasis basis = viewBasis(camera);
+  setUniform3(gl_, p, "u_clip_x", basis.right / (basis.tan_half_vfov * basis.aspect));
+  setUniform3(gl_, p, "u_clip_y", basis.up / basis.tan_half_vfov);
+  setUniform3(gl_, p, "u_clip_w", basis.forward);
+  glm::vec3 corners[4];
+  for (int k = 0; k < 4; ++k)
+    corners[k] = glm::vec3(centre - camera.position +
+                           impostor.half_size * ((k & 1 ? 1.0 : -1.0) * impostor.right +
+                                                 (k & 2 ? 1.0 : -1.0) * impostor.up));
+  gl_.ProgramUniform3fv(p, gl_.GetUniformLocation(p, "u_corner"), 4, &corners[0].x);
+  gl_.BindTextureUnit(kImpostorTextureUnit, impostor.texture.get());
+  gl_.Enable(GL_BLEND);
+  gl_.BlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  gl_.BindVertexArray(vertex_array_.get());
+  gl_.DrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+  return true;
+}
+
+void EllipsoidRenderer::drawCloudDirect(const Scene& scene, std::size_t index,
+                                        const RenderSettings& settings,
+                                        const FrameTarget& target, bool targets_drawn) {
   const EllipsoidCloud& cloud = scene.clouds[index];
   // Visible ellipsoids, back to front by centre distance.
   std::vector<std::pair<double, EllipsoidRecord>> visible;

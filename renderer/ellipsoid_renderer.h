@@ -47,9 +47,13 @@ class EllipsoidRenderer {
   void endFrame();
 
   // Draws cloud `index` of the scene "over" what `target` holds, blending premultiplied.
-  // `targets_drawn`: the target colour and distance textures are bound.
+  // `targets_drawn`: the target colour and distance textures are bound. A far cloud may be
+  // drawn from its impostor (RenderSettings::impostor_tolerance_px).
   void drawCloud(const Scene& scene, std::size_t index, const RenderSettings& settings,
                  const FrameTarget& target, bool targets_drawn);
+
+  // Impostors rendered so far (for measurement and tests).
+  int impostorRenders() const { return impostor_renders_; }
 
   // The in-cloud veil over the whole frame, if the eye is in or near any ellipsoid.
   void drawVeil(const Scene& scene, const RenderSettings& settings);
@@ -70,6 +74,22 @@ class EllipsoidRenderer {
     int x = 0, y = 0;
   };
 
+  // A far cloud rendered once from `eye` into a texture and shown as a billboard through
+  // its bounding sphere's centre, facing that eye.
+  struct Impostor {
+    std::string key;  // everything the picture depends on besides the eye
+    glm::dvec3 eye{0.0}, centre{0.0}, right{0.0}, up{0.0};
+    double half_size = 0.0;  // billboard half-extent, metres
+    int size = 0;            // texels a side
+    GlObject texture, framebuffer;
+    bool used = false;
+  };
+
+  void drawCloudDirect(const Scene& scene, std::size_t index, const RenderSettings& settings,
+                       const FrameTarget& target, bool targets_drawn);
+  // False when the cloud is too near for an impostor; then the caller draws it directly.
+  bool drawImpostor(const Scene& scene, std::size_t index, const RenderSettings& settings,
+                    const FrameTarget& target, bool targets_drawn);
   GLuint program(const EllipsoidPassLayout& layout);
   CachedTexture& cachedTexture(const SolidTextureSpec& spec, const RenderSettings& settings);
   GLuint gpuTexture(CachedTexture& cached);
@@ -99,6 +119,8 @@ class EllipsoidRenderer {
   std::map<std::string, GlObject> programs_;
   std::map<std::string, CachedTexture> textures_;
   std::map<int, SphereMesh> meshes_;
+  std::map<std::size_t, Impostor> impostors_;  // by cloud index
+  int impostor_renders_ = 0;
 };
 
 }  // namespace nephele

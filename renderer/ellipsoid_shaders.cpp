@@ -268,6 +268,18 @@ void main() {
 }
 )";
 
+const char* kImpostor = R"(
+layout(binding = 12) uniform sampler2D u_impostor;  // premultiplied colour, coverage
+in vec2 v_uv;
+in vec3 v_position;  // camera-relative point on the billboard
+void main() {
+#ifdef TARGETS
+  if (length(v_position) >= targetDistance()) discard;
+#endif
+  o_colour = texture(u_impostor, v_uv);
+}
+)";
+
 const char* kVeil = R"(
 uniform vec4 u_veil;  // premultiplied colour, opacity
 void main() { o_colour = u_veil; }
@@ -341,6 +353,21 @@ void main() {
 }
 )";
       return s;
+    case EllipsoidProgram::kImpostor:
+      return s + R"(
+uniform vec3 u_corner[4];  // camera-relative billboard corners, in triangle-strip order
+uniform vec3 u_clip_x;     // right / (tan(vfov/2) aspect)
+uniform vec3 u_clip_y;     // up / tan(vfov/2)
+uniform vec3 u_clip_w;     // forward
+out vec2 v_uv;
+out vec3 v_position;
+void main() {
+  vec3 p = u_corner[gl_VertexID];
+  v_position = p;
+  v_uv = vec2(gl_VertexID & 1, gl_VertexID >> 1);
+  gl_Position = vec4(dot(p, u_clip_x), dot(p, u_clip_y), 0.0, dot(p, u_clip_w));
+}
+)";
     default:
       return polygonVertexSource();
   }
@@ -370,6 +397,7 @@ std::string ellipsoidFragmentSource(const EllipsoidPassLayout& layout) {
   }
   s += viewShaderSource();
   if (layout.program == EllipsoidProgram::kVeil) return s + kVeil;
+  if (layout.program == EllipsoidProgram::kImpostor) return s + kImpostor;
   s += kRecords;
   s += kCloud;
   switch (layout.program) {

@@ -15,6 +15,7 @@ enum class EllipsoidProgram {
   kTileColour,      // Elinas colour pass: Gardner eq. 8, fogged
   kTileComposite,   // 1/D into alpha, tile drawn as a screen rectangle
   kVeil,            // in-cloud fog over the whole view
+  kImpostor,        // a far cloud's impostor drawn as a billboard
 };
 
 enum class SolidTextureKind { kProcedural, kBakedGardner, kTable };
@@ -44,6 +45,7 @@ inline constexpr int kPerPixelBinSize = 16;
 inline constexpr int kVolumeTextureUnit = 9;
 inline constexpr int kSpotlightTextureUnit = 10;
 inline constexpr int kAtlasTextureUnit = 11;
+inline constexpr int kImpostorTextureUnit = 12;
 inline constexpr int kTargetColourUnit = 14;  // matches the view chunk's bindings
 inline constexpr int kTargetDistanceUnit = 15;
 

@@ -30,6 +30,9 @@ class GlRenderer {
   // sRGB-encoded bytes, rows bottom-up as GL reads them (PNG, JPEG, TIFF).
   Srgb8Image renderSrgb8(const Scene& scene, const RenderSettings& settings);
 
+  // Far-cloud impostors rendered since construction (each reuse saves one).
+  int impostorRenders() const { return ellipsoids_.impostorRenders(); }
+
  private:
   enum class TargetFormat { kFloat, kSrgb8 };
   // A layer's texture, built once and kept while frames keep using it.

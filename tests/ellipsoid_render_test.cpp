@@ -301,5 +301,31 @@ TEST_F(EllipsoidRenderTest, ExtremeCasesStayFinite) {
     EXPECT_TRUE(allFinite(renderReference(scenes[i], {1, 0}))) << i;
 }
 
+// Far clouds from impostors: close to drawing them directly and to the reference, rendered
+// once and reused while the camera moves a little, rendered again when it moves a lot.
+TEST_F(EllipsoidRenderTest, ImpostorsAreCloseAndReused) {
+  SceneFile file = preset("far_cumuli", 320, 240);
+  ASSERT_GT(file.render.impostor_tolerance_px, 0.0);
+  RenderSettings direct = file.render;
+  direct.impostor_tolerance_px = 0.0;
+  const int before = renderer_->impostorRenders();
+  const FloatImage with_impostors = renderer_->renderFloat(file.scene, file.render);
+  EXPECT_EQ(renderer_->impostorRenders() - before, int(file.scene.clouds.size()));
+  Scene moved = file.scene;
+  moved.camera.position.x += 2.0;  // a fraction of a pixel of parallax
+  moved.camera.orientation.heading_deg += 3.0;  // turning never invalidates them
+  const int reused = renderer_->impostorRenders();
+  renderer_->renderFloat(moved, file.render);
+  EXPECT_EQ(renderer_->impostorRenders(), reused);
+  moved.camera.position.x += 2000.0;
+  renderer_->renderFloat(moved, file.render);
+  EXPECT_GT(renderer_->impostorRenders(), reused);
+
+  expectClose(with_impostors, renderer_->renderFloat(file.scene, direct), 38.0, 0.3,
+              "impostor_vs_direct");
+  expectClose(with_impostors, renderReference(file.scene, {2, 0}), 33.0, 0.4,
+              "impostor_vs_reference");
+}
+
 }  // namespace
 }  // namespace nephele
