@@ -105,7 +105,8 @@ int main(int argc, char** argv) {
   app.add_option("--presets", presets, "Directory of scene files")->capture_default_str();
   app.add_option("--repeats", repeats, "Timed frames per case (median reported)")
       ->check(CLI::Range(1, 1000));
-  app.add_option("--samples", samples, "Reference supersampling per axis")->check(CLI::Range(1, 16));
+  app.add_option("--samples", samples, "Reference supersampling per axis")
+      ->check(CLI::Range(1, 16));
   app.add_option("--counts", counts, "Ellipsoid counts for the scaling table")->delimiter(',');
   app.add_option("--sizes", sizes, "Image sizes WxH for the scaling table")->delimiter(',');
   app.add_flag("--no-knobs", skip_knobs, "Print only the scaling table");

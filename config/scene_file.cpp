@@ -370,8 +370,7 @@ void readCumulus(TableReader& t, std::uint64_t seed, std::vector<Ellipsoid>& out
 
 void readCloud(TableReader& t, std::uint64_t seed, EllipsoidCloud& cloud) {
   t.allow({"name", "colour", "threshold", "limb_threshold", "transition", "ambient",
-           "texture_fraction", "specular", "shininess", "seed", "texture", "cumulus",
-           "ellipsoid"});
+           "texture_fraction", "specular", "shininess", "seed", "texture", "cumulus", "ellipsoid"});
   t.string("name", cloud.name);
   t.vector("colour", cloud.colour, 0.0, kMaxColour);
   t.number("threshold", cloud.threshold_centre, -2.0, 2.0);
@@ -384,7 +383,8 @@ void readCloud(TableReader& t, std::uint64_t seed, EllipsoidCloud& cloud) {
   cloud.texture.seed = seed;
   t.seed("seed", cloud.texture.seed);
   if (auto texture = t.table("texture")) readSolidTexture(*texture, cloud.texture);
-  if (auto cumulus = t.table("cumulus")) readCumulus(*cumulus, cloud.texture.seed, cloud.ellipsoids);
+  if (auto cumulus = t.table("cumulus"))
+    readCumulus(*cumulus, cloud.texture.seed, cloud.ellipsoids);
   std::vector<TableReader> ellipsoids = t.tables("ellipsoid");
   if (cloud.ellipsoids.size() + ellipsoids.size() > std::size_t(Limits::kMaxEllipsoidsPerCloud))
     t.failAt("ellipsoid", "more than " + std::to_string(Limits::kMaxEllipsoidsPerCloud) +
@@ -398,8 +398,7 @@ void readCloud(TableReader& t, std::uint64_t seed, EllipsoidCloud& cloud) {
 void readTarget(TableReader& t, const std::string& scene_path, Target& target) {
   t.allow({"name", "shape", "centre", "heading", "pitch", "roll", "size", "colour", "mesh"});
   t.string("name", target.name);
-  target.shape =
-      TargetShape(t.choice("shape", {"box", "ellipsoid", "mesh"}, int(target.shape)));
+  target.shape = TargetShape(t.choice("shape", {"box", "ellipsoid", "mesh"}, int(target.shape)));
   t.vector("centre", target.centre, -Limits::kMaxCoordinate, Limits::kMaxCoordinate);
   readOrientation(t, target.orientation);
   if (target.shape == TargetShape::kMesh) target.size = glm::dvec3(1.0);
@@ -492,9 +491,8 @@ std::string loadSceneFile(const std::string& path, SceneFile& out) {
 }
 
 std::string validateRenderSettings(const RenderSettings& r) {
-  if (r.tile_resolution != 0 &&
-      (r.tile_resolution < 8 || r.tile_resolution > 1024 ||
-       (r.tile_resolution & (r.tile_resolution - 1)) != 0))
+  if (r.tile_resolution != 0 && (r.tile_resolution < 8 || r.tile_resolution > 1024 ||
+                                 (r.tile_resolution & (r.tile_resolution - 1)) != 0))
     return "tile_resolution: " + std::to_string(r.tile_resolution) +
            " is not allowed (allowed: 0 for adaptive, or a power of two from 8 to 1024)";
   if (r.tessellation != 0 && (r.tessellation < 3 || r.tessellation > 256))

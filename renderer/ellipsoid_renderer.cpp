@@ -158,8 +158,8 @@ double cloudAltitude(const EllipsoidCloud& cloud) {
   for (const Ellipsoid& e : cloud.ellipsoids) {
     // Vertical half-extent: |row z of R S|.
     const glm::dmat3 body = bodyToWorld(e.orientation);
-    const double half = glm::length(glm::dvec3(body[0].z * e.radii.x, body[1].z * e.radii.y,
-                                               body[2].z * e.radii.z));
+    const double half = glm::length(
+        glm::dvec3(body[0].z * e.radii.x, body[1].z * e.radii.y, body[2].z * e.radii.z));
     lo = std::min(lo, e.centre.z - half);
     hi = std::max(hi, e.centre.z + half);
   }
@@ -181,7 +181,13 @@ GLuint EllipsoidRenderer::frameBuffer(const void* data, std::size_t bytes) {
   // one (it defers rasterisation), and rewriting it in place would change earlier draws.
   if (next_buffer_ == buffer_pool_.size()) buffer_pool_.push_back(createBuffer(gl_));
   const GLuint buffer = buffer_pool_[next_buffer_++].get();
-  gl_.NamedBufferData(buffer, GLsizeiptr(std::max<std::size_t>(bytes, 16)), data, GL_STREAM_DRAW);
+  if (bytes >= 16) {
+    gl_.NamedBufferData(buffer, GLsizeiptr(bytes), data, GL_STREAM_DRAW);
+  } else {  // never bind an empty store
+    const std::uint8_t zeros[16] = {};
+    gl_.NamedBufferData(buffer, 16, zeros, GL_STREAM_DRAW);
+    if (bytes > 0) gl_.NamedBufferSubData(buffer, 0, GLsizeiptr(bytes), data);
+  }
   return buffer;
 }
 
@@ -196,14 +202,14 @@ GLuint EllipsoidRenderer::program(const EllipsoidPassLayout& layout) {
   auto found = programs_.find(key);
   if (found != programs_.end()) return found->second.get();
   std::string error;
-  GlObject compiled = createProgram(gl_, ellipsoidVertexSource(layout),
-                                    ellipsoidFragmentSource(layout), error);
+  GlObject compiled =
+      createProgram(gl_, ellipsoidVertexSource(layout), ellipsoidFragmentSource(layout), error);
   NEPHELE_CHECK(compiled, key << ": " << error);
   return programs_.emplace(key, std::move(compiled)).first->second.get();
 }
 
-EllipsoidRenderer::CachedTexture& EllipsoidRenderer::cachedTexture(
-    const SolidTextureSpec& spec, const RenderSettings& settings) {
+EllipsoidRenderer::CachedTexture& EllipsoidRenderer::cachedTexture(const SolidTextureSpec& spec,
+                                                                   const RenderSettings& settings) {
   auto [entry, inserted] = textures_.try_emplace(textureKey(spec, settings));
   if (inserted) entry->second.source = std::make_unique<SolidTexture>(spec);
   entry->second.used = true;
@@ -246,46 +252,16 @@ GLuint EllipsoidRenderer::spotlightTexture() {
   return t;
 }
 
-const EllipsoidRenderer::SphereMesh& EllipsoidRenderer::sphereMesh(int slices) {
+const IndexedMesh& EllipsoidRenderer::sphereMesh(int slices) {
   auto found = meshes_.find(slices);
   if (found != meshes_.end()) return found->second;
-  // Unit sphere, `slices` around and `slices` pole to pole, counter-clockwise from outside.
-  const int stacks = slices;
   std::vector<glm::vec3> vertices;
-  for (int j = 0; j <= stacks; ++j) {
-    const double theta = std::numbers::pi * j / stacks;
-    for (int i = 0; i <= slices; ++i) {
-      const double phi = kTwoPi * i / slices;
-      vertices.emplace_back(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
-                            std::cos(theta));
-    }
-  }
   std::vector<GLuint> indices;
-  for (int j = 0; j < stacks; ++j)
-    for (int i = 0; i < slices; ++i) {
-      const GLuint a = j * (slices + 1) + i, b = a + 1, c = a + slices + 1, d = c + 1;
-      indices.insert(indices.end(), {a, c, b, b, c, d});
-    }
-  SphereMesh mesh;
-  mesh.vertex_array = createVertexArray(gl_);
-  mesh.vertices = createBuffer(gl_);
-  mesh.indices = createBuffer(gl_);
-  gl_.NamedBufferData(mesh.vertices.get(), GLsizeiptr(vertices.size() * sizeof(glm::vec3)),
-                      vertices.data(), GL_STATIC_DRAW);
-  gl_.NamedBufferData(mesh.indices.get(), GLsizeiptr(indices.size() * sizeof(GLuint)),
-                      indices.data(), GL_STATIC_DRAW);
-  const GLuint vao = mesh.vertex_array.get();
-  gl_.VertexArrayVertexBuffer(vao, 0, mesh.vertices.get(), 0, sizeof(glm::vec3));
-  gl_.VertexArrayAttribFormat(vao, 0, 3, GL_FLOAT, GL_FALSE, 0);
-  gl_.VertexArrayAttribBinding(vao, 0, 0);
-  gl_.EnableVertexArrayAttrib(vao, 0);
-  gl_.VertexArrayElementBuffer(vao, mesh.indices.get());
-  mesh.index_count = GLsizei(indices.size());
-  return meshes_.emplace(slices, std::move(mesh)).first->second;
+  unitSphere(slices, vertices, indices);
+  return meshes_.emplace(slices, uploadMesh(gl_, vertices, indices)).first->second;
 }
 
-void EllipsoidRenderer::setCloudUniforms(GLuint p, const Scene& scene,
-                                         const EllipsoidCloud& cloud,
+void EllipsoidRenderer::setCloudUniforms(GLuint p, const Scene& scene, const EllipsoidCloud& cloud,
                                          const CachedTexture& cached, SolidTextureKind kind) {
   setViewUniforms(gl_, p, scene.camera, scene.fog);
   setUniform3(gl_, p, "u_cloud_colour", cloud.colour * scene.sun.colour);
@@ -352,8 +328,8 @@ void boundingSphere(const EllipsoidCloud& cloud, glm::dvec3& centre, double& rad
   centre = 0.5 * (lo + hi);
   radius = 0.0;
   for (const Ellipsoid& e : cloud.ellipsoids)
-    radius = std::max(radius, glm::length(e.centre - centre) +
-                                  std::max({e.radii.x, e.radii.y, e.radii.z}));
+    radius = std::max(radius,
+                      glm::length(e.centre - centre) + std::max({e.radii.x, e.radii.y, e.radii.z}));
 }
 
 // Everything an impostor's picture depends on besides the eye.
@@ -366,9 +342,9 @@ std::string impostorKey(const Scene& scene, const EllipsoidCloud& cloud,
       << cloud.shading.texture_fraction << '/' << cloud.shading.specular << '/'
       << cloud.shading.shininess << '/' << textureKey(cloud.texture, settings) << '/'
       << int(settings.ellipsoid_passes) << int(settings.ellipsoid_order) << int(settings.limb)
-      << int(settings.term_filter) << '/' << scene.sun.azimuth_deg << '/'
-      << scene.sun.elevation_deg << '/' << scene.sun.colour.x << scene.sun.colour.y
-      << scene.sun.colour.z << '/' << scene.fog.has_value();
+      << int(settings.term_filter) << '/' << scene.sun.azimuth_deg << '/' << scene.sun.elevation_deg
+      << '/' << scene.sun.colour.x << scene.sun.colour.y << scene.sun.colour.z << '/'
+      << scene.fog.has_value();
   if (scene.fog) key << scene.fog->top_m << '/' << scene.fog->visibility_m;
   for (const Ellipsoid& e : cloud.ellipsoids)
     key << '|' << e.radii.x << ',' << e.radii.y << ',' << e.radii.z << ',' << e.centre.x << ','
@@ -399,10 +375,9 @@ bool EllipsoidRenderer::drawImpostor(const Scene& scene, std::size_t index,
   const std::string key = impostorKey(scene, cloud, settings);
   // Reuse while the billboard's parallax, about R theta / distance in pixels for a change
   // theta in the direction to the centre, stays within the tolerance.
-  const double theta =
-      std::acos(std::clamp(glm::dot(glm::normalize(centre - impostor.eye),
-                                    glm::normalize(centre - camera.position)),
-                           -1.0, 1.0));
+  const double theta = std::acos(std::clamp(
+      glm::dot(glm::normalize(centre - impostor.eye), glm::normalize(centre - camera.position)),
+      -1.0, 1.0));
   const double parallax_px =
       pixels_per_radian * radius *
       (theta + std::abs(glm::length(centre - impostor.eye) - distance) / distance) / distance;
@@ -472,15 +447,16 @@ bool EllipsoidRenderer::drawImpostor(const Scene& scene, std::size_t index,
 }
 
 void EllipsoidRenderer::drawCloudDirect(const Scene& scene, std::size_t index,
-                                        const RenderSettings& settings,
-                                        const FrameTarget& target, bool targets_drawn) {
+                                        const RenderSettings& settings, const FrameTarget& target,
+                                        bool targets_drawn) {
   const EllipsoidCloud& cloud = scene.clouds[index];
   // Visible ellipsoids, back to front by centre distance.
   std::vector<std::pair<double, EllipsoidRecord>> visible;
   for (const Ellipsoid& e : cloud.ellipsoids) {
     EllipsoidRecord record;
     double distance = 0.0;
-    if (makeEllipsoidRecord(e, scene.camera, record, distance)) visible.push_back({distance, record});
+    if (makeEllipsoidRecord(e, scene.camera, record, distance))
+      visible.push_back({distance, record});
   }
   if (visible.empty()) return;
   std::stable_sort(visible.begin(), visible.end(),
@@ -553,10 +529,10 @@ void EllipsoidRenderer::drawCloudDirect(const Scene& scene, std::size_t index,
       const std::vector<GLint>& list = lists[std::size_t(y) * bins_x + x];
       if (list.empty()) continue;
       const int px = x * kPerPixelBinSize, py = y * kPerPixelBinSize;
-      bins.push_back({{ndc(px, target.width), ndc(py, target.height),
-                       ndc(px + kPerPixelBinSize, target.width),
-                       ndc(py + kPerPixelBinSize, target.height)},
-                      {GLint(items.size()), GLint(list.size()), 0, 0}});
+      bins.push_back(
+          {{ndc(px, target.width), ndc(py, target.height), ndc(px + kPerPixelBinSize, target.width),
+            ndc(py + kPerPixelBinSize, target.height)},
+           {GLint(items.size()), GLint(list.size()), 0, 0}});
       items.insert(items.end(), list.begin(), list.end());
     }
   gl_.BindBufferBase(GL_SHADER_STORAGE_BUFFER, kBinBufferBinding,
@@ -684,7 +660,7 @@ void EllipsoidRenderer::renderAtlasBatch(const Scene& scene, const EllipsoidClou
       gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_index"), t.record);
       const double radius_px = 0.25 * std::max((r.v[10].z - r.v[10].x) * target.width,
                                                (r.v[10].w - r.v[10].y) * target.height);
-      const SphereMesh& mesh =
+      const IndexedMesh& mesh =
           sphereMesh(settings.tessellation > 0 ? settings.tessellation : adaptiveSlices(radius_px));
       gl_.BindVertexArray(mesh.vertex_array.get());
       gl_.DrawElements(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr);
@@ -713,8 +689,8 @@ void EllipsoidRenderer::renderAtlasBatch(const Scene& scene, const EllipsoidClou
   std::sort(order.begin(), order.end());
   for (int i : order) {
     const glm::vec4 rect = records[i].v[10];
-    const glm::vec2 polygon[4] = {{rect.x, rect.y}, {rect.z, rect.y}, {rect.z, rect.w},
-                                  {rect.x, rect.w}};
+    const glm::vec2 polygon[4] = {
+        {rect.x, rect.y}, {rect.z, rect.y}, {rect.z, rect.w}, {rect.x, rect.w}};
     gl_.ProgramUniform2fv(p, gl_.GetUniformLocation(p, "u_polygon"), 4, &polygon[0].x);
     gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_index"), i);
     gl_.DrawArrays(GL_TRIANGLE_FAN, 0, 4);

@@ -64,10 +64,6 @@ class EllipsoidRenderer {
     GlObject texture;
     bool used = false;
   };
-  struct SphereMesh {
-    GlObject vertex_array, vertices, indices;
-    GLsizei index_count = 0;
-  };
   struct Tile {
     int record;  // index into the batch's records
     int width, height;
@@ -93,7 +89,7 @@ class EllipsoidRenderer {
   GLuint program(const EllipsoidPassLayout& layout);
   CachedTexture& cachedTexture(const SolidTextureSpec& spec, const RenderSettings& settings);
   GLuint gpuTexture(CachedTexture& cached);
-  const SphereMesh& sphereMesh(int slices);
+  const IndexedMesh& sphereMesh(int slices);  // cached per tessellation
   GLuint spotlightTexture();
   void setCloudUniforms(GLuint program, const Scene& scene, const EllipsoidCloud& cloud,
                         const CachedTexture& texture, SolidTextureKind kind);
@@ -109,7 +105,7 @@ class EllipsoidRenderer {
   void prepareAtlas(TileFormat format);
 
   const GlApi& gl_;
-  GlObject vertex_array_;  // empty: attribute-less draws
+  GlObject vertex_array_;              // empty: attribute-less draws
   std::vector<GlObject> buffer_pool_;  // storage buffers, one per upload in a frame
   std::size_t next_buffer_ = 0;
   GlObject spotlight_;
@@ -118,7 +114,7 @@ class EllipsoidRenderer {
   TileFormat atlas_format_ = TileFormat::kFloat;
   std::map<std::string, GlObject> programs_;
   std::map<std::string, CachedTexture> textures_;
-  std::map<int, SphereMesh> meshes_;
+  std::map<int, IndexedMesh> meshes_;
   std::map<std::size_t, Impostor> impostors_;  // by cloud index
   int impostor_renders_ = 0;
 };

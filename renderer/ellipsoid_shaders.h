@@ -8,14 +8,14 @@
 namespace nephele {
 
 enum class EllipsoidProgram {
-  kFusedCentre,     // instanced screen rectangles, one per ellipsoid, back to front
-  kFusedPerPixel,   // one rectangle per cloud; each pixel sorts the cloud's hits by depth
-  kTileThreshold,   // Elinas pass 1: alpha = It - T1
-  kTileLimb,        // Elinas pass 2: alpha -= (T2 - T1)(1 - g)
-  kTileColour,      // Elinas colour pass: Gardner eq. 8, fogged
-  kTileComposite,   // 1/D into alpha, tile drawn as a screen rectangle
-  kVeil,            // in-cloud fog over the whole view
-  kImpostor,        // a far cloud's impostor drawn as a billboard
+  kFusedCentre,    // instanced screen rectangles, one per ellipsoid, back to front
+  kFusedPerPixel,  // one rectangle per cloud; each pixel sorts the cloud's hits by depth
+  kTileThreshold,  // Elinas pass 1: alpha = It - T1
+  kTileLimb,       // Elinas pass 2: alpha -= (T2 - T1)(1 - g)
+  kTileColour,     // Elinas colour pass: Gardner eq. 8, fogged
+  kTileComposite,  // 1/D into alpha, tile drawn as a screen rectangle
+  kVeil,           // in-cloud fog over the whole view
+  kImpostor,       // a far cloud's impostor drawn as a billboard
 };
 
 enum class SolidTextureKind { kProcedural, kBakedGardner, kTable };

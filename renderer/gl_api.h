@@ -82,6 +82,7 @@ using GlDepthMaskProc = void(APIENTRYP)(GLboolean flag);
   X(PFNGLCREATEBUFFERSPROC, CreateBuffers)                               \
   X(PFNGLDELETEBUFFERSPROC, DeleteBuffers)                               \
   X(PFNGLNAMEDBUFFERDATAPROC, NamedBufferData)                           \
+  X(PFNGLNAMEDBUFFERSUBDATAPROC, NamedBufferSubData)                     \
   X(PFNGLBINDBUFFERBASEPROC, BindBufferBase)                             \
   X(PFNGLVERTEXARRAYVERTEXBUFFERPROC, VertexArrayVertexBuffer)           \
   X(PFNGLVERTEXARRAYATTRIBFORMATPROC, VertexArrayAttribFormat)           \

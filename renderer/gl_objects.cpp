@@ -1,5 +1,7 @@
 #include "renderer/gl_objects.h"
 
+#include <cmath>
+
 #include <vector>
 
 namespace nephele {
@@ -60,6 +62,43 @@ GlObject createBuffer(const GlApi& gl) {
   GLuint name = 0;
   gl.CreateBuffers(1, &name);
   return {gl, GlObject::Kind::kBuffer, name};
+}
+
+IndexedMesh uploadMesh(const GlApi& gl, const std::vector<glm::vec3>& vertices,
+                       const std::vector<GLuint>& indices) {
+  IndexedMesh mesh;
+  mesh.vertex_array = createVertexArray(gl);
+  mesh.vertices = createBuffer(gl);
+  mesh.indices = createBuffer(gl);
+  gl.NamedBufferData(mesh.vertices.get(), GLsizeiptr(vertices.size() * sizeof(glm::vec3)),
+                     vertices.data(), GL_STATIC_DRAW);
+  gl.NamedBufferData(mesh.indices.get(), GLsizeiptr(indices.size() * sizeof(GLuint)),
+                     indices.data(), GL_STATIC_DRAW);
+  const GLuint vao = mesh.vertex_array.get();
+  gl.VertexArrayVertexBuffer(vao, 0, mesh.vertices.get(), 0, sizeof(glm::vec3));
+  gl.VertexArrayAttribFormat(vao, 0, 3, GL_FLOAT, GL_FALSE, 0);
+  gl.VertexArrayAttribBinding(vao, 0, 0);
+  gl.EnableVertexArrayAttrib(vao, 0);
+  gl.VertexArrayElementBuffer(vao, mesh.indices.get());
+  mesh.index_count = GLsizei(indices.size());
+  return mesh;
+}
+
+void unitSphere(int slices, std::vector<glm::vec3>& vertices, std::vector<GLuint>& indices) {
+  const double pi = 3.14159265358979323846;
+  for (int j = 0; j <= slices; ++j) {
+    const double theta = pi * j / slices;
+    for (int i = 0; i <= slices; ++i) {
+      const double phi = 2.0 * pi * i / slices;
+      vertices.emplace_back(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
+                            std::cos(theta));
+    }
+  }
+  for (int j = 0; j < slices; ++j)
+    for (int i = 0; i < slices; ++i) {
+      const GLuint a = j * (slices + 1) + i, b = a + 1, c = a + slices + 1, d = c + 1;
+      indices.insert(indices.end(), {a, c, b, b, c, d});
+    }
 }
 
 namespace {

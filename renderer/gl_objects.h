@@ -3,6 +3,9 @@
 // it; the context must outlive its objects.
 #include <string>
 #include <utility>
+#include <vector>
+
+#include <glm/glm.hpp>
 
 #include "renderer/gl_api.h"
 
@@ -10,7 +13,15 @@ namespace nephele {
 
 class GlObject {
  public:
-  enum class Kind { kTexture, kFramebuffer, kRenderbuffer, kVertexArray, kProgram, kShader, kBuffer };
+  enum class Kind {
+    kTexture,
+    kFramebuffer,
+    kRenderbuffer,
+    kVertexArray,
+    kProgram,
+    kShader,
+    kBuffer
+  };
 
   GlObject() = default;
   GlObject(const GlApi& gl, Kind kind, GLuint name) : gl_(&gl), kind_(kind), name_(name) {}
@@ -43,6 +54,18 @@ GlObject createFramebuffer(const GlApi& gl);
 GlObject createRenderbuffer(const GlApi& gl);
 GlObject createVertexArray(const GlApi& gl);
 GlObject createBuffer(const GlApi& gl);
+
+// A triangle mesh on the GPU: positions (attribute 0, vec3) and 32-bit indices.
+struct IndexedMesh {
+  GlObject vertex_array, vertices, indices;
+  GLsizei index_count = 0;
+};
+IndexedMesh uploadMesh(const GlApi& gl, const std::vector<glm::vec3>& vertices,
+                       const std::vector<GLuint>& indices);
+
+// The unit sphere, `slices` around and `slices` from pole to pole, counter-clockwise seen
+// from outside.
+void unitSphere(int slices, std::vector<glm::vec3>& vertices, std::vector<GLuint>& indices);
 
 // Compiles and links a vertex + fragment program. On failure returns an empty object and
 // puts the driver's log in `error`.

@@ -255,8 +255,7 @@ void GlRenderer::drawSkyPass(const Scene& scene, const RenderSettings& settings,
 
 void GlRenderer::drawSkyGroup(const Scene& scene, const RenderSettings& settings,
                               const std::vector<LayerSlot>& above,
-                              const std::vector<LayerSlot>& below, bool background,
-                              bool targets) {
+                              const std::vector<LayerSlot>& below, bool background, bool targets) {
   const Camera& camera = scene.camera;
   SkyPassLayout base;
   base.fog = scene.fog.has_value();
@@ -280,8 +279,10 @@ void GlRenderer::drawSkyGroup(const Scene& scene, const RenderSettings& settings
   // Every pass writes premultiplied colour and coverage; a pass with the background
   // overwrites, the others blend "over".
   gl_.BlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
-  if (background) gl_.Disable(GL_BLEND);
-  else gl_.Enable(GL_BLEND);
+  if (background)
+    gl_.Disable(GL_BLEND);
+  else
+    gl_.Enable(GL_BLEND);
   if (fused) {
     // One pass per side of the horizon, each with the background and that side's layers:
     // pixels below the horizon never run the code of layers above the camera. The two
@@ -386,8 +387,8 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
     pending_below.clear();
   };
   const FrameTarget frame{framebuffer_.get(), camera.width, camera.height};
-  const int top_band = int(std::max({above.size(), below.size(),
-                                     clouds.empty() ? std::size_t(0) : std::size_t(clouds[0].band)}));
+  const int top_band = int(std::max(
+      {above.size(), below.size(), clouds.empty() ? std::size_t(0) : std::size_t(clouds[0].band)}));
   auto next_cloud = clouds.begin();
   for (int band = top_band; band >= 0; --band) {
     if (next_cloud != clouds.end() && next_cloud->band == band) flushSky();

@@ -7,8 +7,8 @@
 #include <thread>
 #include <vector>
 
-#include "world/frames.h"
 #include "world/ellipsoid.h"
+#include "world/frames.h"
 #include "world/layer_texture.h"
 
 namespace nephele {
@@ -76,7 +76,7 @@ class ReferenceTracer {
               [](const Surface& a, const Surface& b) { return a.distance > b.distance; });
 
     double translucence_product = 1.0;
-    for (const Surface& surface : surfaces) {  // back to front
+    for (const Surface& surface : surfaces) {                                    // back to front
       colour = surface.alpha * surface.colour + (1.0 - surface.alpha) * colour;  // "over"
       translucence_product *= 1.0 - surface.alpha;
     }
@@ -87,8 +87,8 @@ class ReferenceTracer {
   }
 
  private:
-  Surface layerSurface(const CloudLayer& layer, const LayerTexture& texture,
-                       glm::dvec3 direction, double s) const {
+  Surface layerSurface(const CloudLayer& layer, const LayerTexture& texture, glm::dvec3 direction,
+                       double s) const {
     const glm::dvec3 p = scene_.camera.position + s * direction;
     const double t = texture.value({p.x, p.y}, scene_.time_s);
     const double tr = skyPlaneTranslucence(t, layer.threshold, layer.transition);

@@ -62,8 +62,8 @@ TargetRenderer::~TargetRenderer() = default;
 GLuint TargetRenderer::program() {
   if (program_) return program_.get();
   std::string error;
-  program_ = createProgram(gl_, kVertex, "#version 450 core\n#define FOG\n" + viewShaderSource() +
-                                             kFragment, error);
+  program_ = createProgram(
+      gl_, kVertex, "#version 450 core\n#define FOG\n" + viewShaderSource() + kFragment, error);
   NEPHELE_CHECK(program_, "target program: " << error);
   return program_.get();
 }
@@ -93,7 +93,7 @@ void TargetRenderer::prepare(int width, int height) {
   height_ = height;
 }
 
-const TargetRenderer::Mesh& TargetRenderer::mesh(const Target& target) {
+const IndexedMesh& TargetRenderer::mesh(const Target& target) {
   const void* key = target.mesh.get();
   if (target.shape == TargetShape::kBox) key = &kBoxTag;
   if (target.shape == TargetShape::kEllipsoid) key = &kSphereTag;
@@ -107,38 +107,12 @@ const TargetRenderer::Mesh& TargetRenderer::mesh(const Target& target) {
     indices = {0, 1, 3, 0, 3, 2, 4, 6, 7, 4, 7, 5, 0, 4, 5, 0, 5, 1,
                2, 3, 7, 2, 7, 6, 0, 2, 6, 0, 6, 4, 1, 5, 7, 1, 7, 3};
   } else if (target.shape == TargetShape::kEllipsoid) {
-    const int n = kTargetSphereSlices;
-    for (int j = 0; j <= n; ++j)
-      for (int i = 0; i <= n; ++i) {
-        const double theta = std::numbers::pi * j / n, phi = 2.0 * std::numbers::pi * i / n;
-        vertices.emplace_back(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
-                              std::cos(theta));
-      }
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i) {
-        const GLuint a = j * (n + 1) + i, b = a + 1, c = a + n + 1, d = c + 1;
-        indices.insert(indices.end(), {a, c, b, b, c, d});
-      }
+    unitSphere(kTargetSphereSlices, vertices, indices);
   } else {
     for (const glm::dvec3& v : target.mesh->vertices) vertices.emplace_back(v);
     for (const auto& t : target.mesh->triangles) indices.insert(indices.end(), t.begin(), t.end());
   }
-  Mesh m;
-  m.vertex_array = createVertexArray(gl_);
-  m.vertices = createBuffer(gl_);
-  m.indices = createBuffer(gl_);
-  gl_.NamedBufferData(m.vertices.get(), GLsizeiptr(vertices.size() * sizeof(glm::vec3)),
-                      vertices.data(), GL_STATIC_DRAW);
-  gl_.NamedBufferData(m.indices.get(), GLsizeiptr(indices.size() * sizeof(GLuint)),
-                      indices.data(), GL_STATIC_DRAW);
-  const GLuint vao = m.vertex_array.get();
-  gl_.VertexArrayVertexBuffer(vao, 0, m.vertices.get(), 0, sizeof(glm::vec3));
-  gl_.VertexArrayAttribFormat(vao, 0, 3, GL_FLOAT, GL_FALSE, 0);
-  gl_.VertexArrayAttribBinding(vao, 0, 0);
-  gl_.EnableVertexArrayAttrib(vao, 0);
-  gl_.VertexArrayElementBuffer(vao, m.indices.get());
-  m.index_count = GLsizei(indices.size());
-  return meshes_.emplace(key, std::move(m)).first->second;
+  return meshes_.emplace(key, uploadMesh(gl_, vertices, indices)).first->second;
 }
 
 bool TargetRenderer::draw(const Scene& scene) {
@@ -169,8 +143,8 @@ bool TargetRenderer::draw(const Scene& scene) {
   for (const Target& target : scene.targets) {
     if (target.shape == TargetShape::kMesh && !target.mesh) continue;
     const glm::dmat3 rotation = bodyToWorld(target.orientation);
-    const glm::mat3 model(rotation * glm::dmat3(target.size.x, 0, 0, 0, target.size.y, 0, 0, 0,
-                                                target.size.z));
+    const glm::mat3 model(
+        rotation * glm::dmat3(target.size.x, 0, 0, 0, target.size.y, 0, 0, 0, target.size.z));
     const glm::mat3 normal_matrix(rotation * glm::dmat3(1.0 / target.size.x, 0, 0, 0,
                                                         1.0 / target.size.y, 0, 0, 0,
                                                         1.0 / target.size.z));
@@ -181,7 +155,7 @@ bool TargetRenderer::draw(const Scene& scene) {
     setUniform3(gl_, p, "u_albedo", target.colour * scene.sun.colour);
     gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_smooth"),
                          target.shape == TargetShape::kEllipsoid ? 1 : 0);
-    const Mesh& m = mesh(target);
+    const IndexedMesh& m = mesh(target);
     gl_.BindVertexArray(m.vertex_array.get());
     gl_.DrawElements(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr);
   }

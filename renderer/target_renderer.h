@@ -20,19 +20,15 @@ class TargetRenderer {
   bool draw(const Scene& scene);
 
  private:
-  struct Mesh {
-    GlObject vertex_array, vertices, indices;
-    GLsizei index_count = 0;
-  };
   void prepare(int width, int height);
-  const Mesh& mesh(const Target& target);
+  const IndexedMesh& mesh(const Target& target);
   GLuint program();
 
   const GlApi& gl_;
   GlObject framebuffer_, colour_, distance_, depth_;
   int width_ = 0, height_ = 0;
   GlObject program_;
-  std::map<const void*, Mesh> meshes_;  // by shape tag or TriangleMesh
+  std::map<const void*, IndexedMesh> meshes_;  // by shape tag or TriangleMesh
 };
 
 }  // namespace nephele

@@ -161,8 +161,8 @@ TEST_F(EllipsoidRenderTest, HundredKilometresFromTheOrigin) {
   for (TextureEvaluation evaluation : {TextureEvaluation::kBaked, TextureEvaluation::kProcedural}) {
     RenderSettings settings = file.render;
     settings.texture_evaluation = evaluation;
-    expectClose(renderer_->renderFloat(far, settings),
-                renderer_->renderFloat(file.scene, settings), 50.0, 0.05,
+    expectClose(renderer_->renderFloat(far, settings), renderer_->renderFloat(file.scene, settings),
+                50.0, 0.05,
                 evaluation == TextureEvaluation::kBaked ? "far_baked" : "far_procedural");
   }
 }
@@ -200,9 +200,9 @@ TEST_F(EllipsoidRenderTest, LinkedEllipsoidsDoNotPop) {
   const glm::dvec3 c2 = file.scene.clouds[0].ellipsoids[1].centre;
   // On the line y = -2600, z = 1250, |E - c1| = |E - c2| at x = crossing.
   const double y = -2600.0, z = 1250.0;
-  const double crossing = (glm::dot(c2, c2) - glm::dot(c1, c1) - 2.0 * y * (c2.y - c1.y) -
-                           2.0 * z * (c2.z - c1.z)) /
-                          (2.0 * (c2.x - c1.x));
+  const double crossing =
+      (glm::dot(c2, c2) - glm::dot(c1, c1) - 2.0 * y * (c2.y - c1.y) - 2.0 * z * (c2.z - c1.z)) /
+      (2.0 * (c2.x - c1.x));
   const float kStep = 0.05f;  // a visible change of a channel between 1 m steps
   auto worstStep = [&](EllipsoidOrder order) {
     RenderSettings settings = file.render;
@@ -254,7 +254,8 @@ TEST_F(EllipsoidRenderTest, TargetsAndCloudsHideEachOther) {
   const FloatImage gl = renderer_->renderFloat(in_front, {});
   expectClose(gl, renderReference(in_front, {4, 0}), 33.0, 0.45, "target_in_front");
   const float* centre = gl.pixel(80 + 4, 60 + 2);
-  const float* expected = renderReference(in_front, {1, 0}).pixel(84, 62);
+  const FloatImage point_sampled = renderReference(in_front, {1, 0});
+  const float* expected = point_sampled.pixel(84, 62);
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(centre[c], expected[c], 0.01) << c;
 }
 
@@ -267,7 +268,7 @@ TEST_F(EllipsoidRenderTest, ExtremeCasesStayFinite) {
     scenes.push_back(scene);
   };
   add(cloudScene({lobe}, lookingNorth({0.0, -2000.0, 1200.0})),
-      [](Scene& s) { s.clouds[0].transition = 0.0; });  // D = 0
+      [](Scene& s) { s.clouds[0].transition = 0.0; });                          // D = 0
   add(cloudScene({lobe}, lookingNorth({0.0, -400.0, 1200.0})), [](Scene&) {});  // on the surface
   add(cloudScene({lobe}, lookingNorth({0.0, 0.0, 1200.0})), [](Scene&) {});     // at the centre
   add(cloudScene({{{1.0e5, 1.0e5, 1.0e4}, {0.0, 0.0, 2.0e4}, {}}}, lookingNorth({0, 0, 1000}, 30)),
@@ -312,7 +313,7 @@ TEST_F(EllipsoidRenderTest, ImpostorsAreCloseAndReused) {
   const FloatImage with_impostors = renderer_->renderFloat(file.scene, file.render);
   EXPECT_EQ(renderer_->impostorRenders() - before, int(file.scene.clouds.size()));
   Scene moved = file.scene;
-  moved.camera.position.x += 2.0;  // a fraction of a pixel of parallax
+  moved.camera.position.x += 2.0;               // a fraction of a pixel of parallax
   moved.camera.orientation.heading_deg += 3.0;  // turning never invalidates them
   const int reused = renderer_->impostorRenders();
   renderer_->renderFloat(moved, file.render);

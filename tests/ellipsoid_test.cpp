@@ -84,7 +84,8 @@ TEST(Ellipsoid, FarFromTheOriginStaysExact) {
   const glm::dvec3 shift(1.0e5, -1.0e5, 0.0);
   far.centre += shift;
   const glm::dvec3 eye(-3000.0, -2000.0, 400.0), d = glm::normalize(near.centre - eye);
-  const auto a = EllipsoidView(near, eye).intersect(d), b = EllipsoidView(far, eye + shift).intersect(d);
+  const auto a = EllipsoidView(near, eye).intersect(d),
+             b = EllipsoidView(far, eye + shift).intersect(d);
   ASSERT_TRUE(a && b);
   EXPECT_NEAR(a->near, b->near, 1e-7);
   EXPECT_NEAR(EllipsoidView(near, eye).limb(d), EllipsoidView(far, eye + shift).limb(d), 1e-9);
@@ -161,7 +162,8 @@ TEST(Ellipsoid, EyeBoxContainsTheSurface) {
   for (int i = 0; i < 20000; ++i) {
     const glm::dvec3 u = randomUnit(rng);
     const glm::dvec3 p = e.centre + body * (u * e.radii) - camera.position;
-    const glm::dvec3 eye_p(glm::dot(p, basis.right), glm::dot(p, basis.up), glm::dot(p, basis.forward));
+    const glm::dvec3 eye_p(glm::dot(p, basis.right), glm::dot(p, basis.up),
+                           glm::dot(p, basis.forward));
     const glm::dvec3 offset = glm::abs(eye_p - box.centre);
     for (int a = 0; a < 3; ++a) {
       EXPECT_LE(offset[a], box.half_extent[a] * (1.0 + 1e-12));
@@ -223,7 +225,8 @@ TEST(SolidTexture, PeriodicInEveryAxisAndFarAway) {
   spec.perlin_size_log2 = 4;
   const SolidTexture perlin(spec);
   double lo = 1.0, hi = 0.0;
-  for (float v : perlin.volume()->values) lo = std::min(lo, double(v)), hi = std::max(hi, double(v));
+  for (float v : perlin.volume()->values)
+    lo = std::min(lo, double(v)), hi = std::max(hi, double(v));
   EXPECT_EQ(lo, 0.0);
   EXPECT_EQ(hi, 1.0);
   EXPECT_NEAR(perlin.value(p), perlin.value(p + perlin.period()), 1e-9);

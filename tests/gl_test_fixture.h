@@ -56,5 +56,4 @@ class GlRenderTest : public ::testing::Test {
   static inline GlRenderer* renderer_ = nullptr;
 };
 
-
 }  // namespace nephele

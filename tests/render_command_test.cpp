@@ -74,7 +74,22 @@ TEST_F(RenderCommandTest, BadFlagsAreRejected) {
   run = runNephele("render " + preset + " -o " + path("out.png") + " --position 1,2,-5");
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_THAT(run.output, HasSubstr("below the ground"));
+  run = runNephele("render " + preset + " -o " + path("out.png") + " --tile-resolution 12");
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_THAT(run.output, HasSubstr("tile_resolution: 12 is not allowed (allowed: 0 for adaptive"));
+  run = runNephele("render " + preset + " -o " + path("out.png") + " --ellipsoid-order random");
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_THAT(run.output, HasSubstr("random"));
   EXPECT_TRUE(std::filesystem::is_empty(dir_));
+}
+
+TEST_F(RenderCommandTest, RendersACloudWithATargetFromItsMesh) {
+  const CommandResult run =
+      runNephele("render " NEPHELE_SOURCE_DIR "/config/scenes/cumulus_target.toml -o " +
+                 path("target.png") + " --width 80 --height 60 --ellipsoid-passes multipass");
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_THAT(run.output, HasSubstr("1 cloud(s) of 27 ellipsoid(s), 2 target(s)"));
+  EXPECT_TRUE(std::filesystem::exists(path("target.png")));
 }
 
 TEST_F(RenderCommandTest, ReferenceRendererWritesExr) {

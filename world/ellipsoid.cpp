@@ -11,8 +11,8 @@ std::string ellipsoidError(const Ellipsoid& e) {
   std::ostringstream out;
   for (int i = 0; i < 3; ++i)
     if (!(std::isfinite(e.radii[i]) && e.radii[i] > 0.0)) {
-      out << "radius " << "xyz"[i] << " = " << e.radii[i]
-          << " is not allowed (allowed: a finite number > 0)";
+      out << "radius "
+          << "xyz"[i] << " = " << e.radii[i] << " is not allowed (allowed: a finite number > 0)";
       return out.str();
     }
   for (int i = 0; i < 3; ++i)
@@ -127,9 +127,8 @@ glm::dmat3 silhouetteConic(const EllipsoidView& view, const ViewBasis& basis) {
 EyeBox eyeSpaceBox(const Ellipsoid& e, glm::dvec3 eye, const ViewBasis& basis) {
   const glm::dvec3 rel = e.centre - eye;
   // Half-extent along unit axis n is |S R^T n| (the support function of the ellipsoid).
-  const glm::dmat3 scaled_body =
-      glm::dmat3(e.radii.x, 0, 0, 0, e.radii.y, 0, 0, 0, e.radii.z) *
-      glm::transpose(bodyToWorld(e.orientation));
+  const glm::dmat3 scaled_body = glm::dmat3(e.radii.x, 0, 0, 0, e.radii.y, 0, 0, 0, e.radii.z) *
+                                 glm::transpose(bodyToWorld(e.orientation));
   EyeBox box;
   box.centre = {glm::dot(rel, basis.right), glm::dot(rel, basis.up), glm::dot(rel, basis.forward)};
   box.half_extent = {glm::length(scaled_body * basis.right), glm::length(scaled_body * basis.up),

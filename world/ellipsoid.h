@@ -75,10 +75,10 @@ class EllipsoidView {
   glm::dvec3 normalAt(glm::dvec3 direction, double s) const;
 
  private:
-  glm::dmat3 to_unit_;    // W
-  glm::dvec3 eye_unit_;   // o
-  double c_ = 0.0;        // |o|^2 - 1
-  glm::dmat3 k_{0.0};     // K
+  glm::dmat3 to_unit_;   // W
+  glm::dvec3 eye_unit_;  // o
+  double c_ = 0.0;       // |o|^2 - 1
+  glm::dmat3 k_{0.0};    // K
   double lambda_ = 0.0;
   glm::dvec3 axis_{0.0};
   glm::dmat3 limb_form_{0.0};

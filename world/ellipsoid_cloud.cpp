@@ -17,14 +17,16 @@ double smoothstep(double edge0, double edge1, double x) {
 std::vector<Ellipsoid> cumulusEllipsoids(int count, glm::dvec3 base_centre, double width_m,
                                          std::uint64_t seed) {
   auto random = [&](int i, int purpose) {
-    return unitFromBits(hashCounters(seed, 0x43756d75ull, std::uint64_t(i), std::uint64_t(purpose)));
+    return unitFromBits(
+        hashCounters(seed, 0x43756d75ull, std::uint64_t(i), std::uint64_t(purpose)));
   };
   // Three tiers, as fractions of the width: lobe radius, flatness (z / horizontal), radius of
   // the disc the lobes spread over, and height of their centres above the base.
   struct Tier {
     double radius, flatness, spread, height;
   };
-  const Tier tiers[3] = {{0.24, 0.5, 0.30, 0.12}, {0.19, 0.75, 0.20, 0.30}, {0.14, 0.9, 0.11, 0.46}};
+  const Tier tiers[3] = {
+      {0.24, 0.5, 0.30, 0.12}, {0.19, 0.75, 0.20, 0.30}, {0.14, 0.9, 0.11, 0.46}};
   const int base_count = std::max(1, (count + 2) / 3);
   const int middle_count = std::max(0, std::min(count - base_count, count / 3));
   const int tier_counts[3] = {base_count, middle_count, count - base_count - middle_count};
@@ -34,8 +36,8 @@ std::vector<Ellipsoid> cumulusEllipsoids(int count, glm::dvec3 base_centre, doub
     for (int k = 0; k < tier_counts[tier]; ++k, ++i) {
       const Tier& t = tiers[tier];
       const double angle = kGoldenAngle * k + 0.5 * random(i, 0);
-      const double distance =
-          width_m * t.spread * std::sqrt((k + 0.5) / tier_counts[tier]) * (0.8 + 0.4 * random(i, 1));
+      const double distance = width_m * t.spread * std::sqrt((k + 0.5) / tier_counts[tier]) *
+                              (0.8 + 0.4 * random(i, 1));
       const double size = width_m * t.radius * (0.85 + 0.3 * random(i, 2));
       Ellipsoid e;
       e.radii = {size * (0.9 + 0.25 * random(i, 3)), size * (0.9 + 0.25 * random(i, 4)),
@@ -72,9 +74,8 @@ Veil inCloudVeil(const std::vector<EllipsoidCloud>& clouds,
     const ShadingParams& sh = cloud.shading;
     const double it = textures[c]->value(eye);
     const double intensity =
-        (1.0 - sh.ambient) *
-            ((1.0 - sh.texture_fraction) * (1.0 - sh.specular) * lit_from_above +
-             sh.texture_fraction * it) +
+        (1.0 - sh.ambient) * ((1.0 - sh.texture_fraction) * (1.0 - sh.specular) * lit_from_above +
+                              sh.texture_fraction * it) +
         sh.ambient;
     const double opacity = 1.0 - cloud_transmittance;
     weighted += opacity * intensity * cloud.colour * sun.colour;

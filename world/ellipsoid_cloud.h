@@ -10,8 +10,8 @@
 
 #include "world/ellipsoid.h"
 #include "world/shading.h"
-#include "world/solid_texture.h"
 #include "world/sky.h"
+#include "world/solid_texture.h"
 
 namespace nephele {
 

@@ -23,8 +23,7 @@ double smootherstep(double t) {
 glm::dvec3 latticeGradient(std::uint64_t seed, int octave, int x, int y, int z) {
   const std::uint64_t cell = (std::uint64_t(std::uint32_t(x)) << 32) | std::uint32_t(y);
   const double u = unitFromBits(hashCounters(seed, 0x50336430ull + octave, cell, std::uint32_t(z)));
-  const double v =
-      unitFromBits(hashCounters(seed, 0x50336431ull + octave, cell, std::uint32_t(z)));
+  const double v = unitFromBits(hashCounters(seed, 0x50336431ull + octave, cell, std::uint32_t(z)));
   const double cos_theta = 2.0 * u - 1.0, sin_theta = std::sqrt(1.0 - cos_theta * cos_theta);
   const double phi = 2.0 * kPi * v;
   return {sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta};
@@ -96,8 +95,7 @@ VolumeTable bakeGardnerSolid(const GardnerTexture& texture, int size, int terms)
   return out;
 }
 
-VolumeTable perlinVolume(int size, int cells, int octaves, double persistence,
-                         std::uint64_t seed) {
+VolumeTable perlinVolume(int size, int cells, int octaves, double persistence, std::uint64_t seed) {
   const std::size_t n = std::size_t(size);
   VolumeTable table{size, std::vector<float>(n * n * n, 0.0f)};
   double amplitude = 1.0;

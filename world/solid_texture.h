@@ -56,7 +56,7 @@ class SolidTexture {
   double value(glm::dvec3 world) const;
 
   const GardnerTexture* gardner() const { return gardner_.get(); }  // null for Perlin
-  const VolumeTable* volume() const { return volume_.get(); }        // null for Gardner
+  const VolumeTable* volume() const { return volume_.get(); }       // null for Gardner
 
  private:
   SolidTextureSpec spec_;

@@ -31,7 +31,7 @@ struct Target {
   Orientation orientation;
   // Box: half-extents; ellipsoid: semi-axes; mesh: scale per body axis.
   glm::dvec3 size{10.0, 10.0, 3.0};
-  glm::dvec3 colour{0.35, 0.35, 0.38};  // linear RGB albedo
+  glm::dvec3 colour{0.35, 0.35, 0.38};       // linear RGB albedo
   std::shared_ptr<const TriangleMesh> mesh;  // for kMesh
 };
 
