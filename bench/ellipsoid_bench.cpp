@@ -12,6 +12,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "bench/bench_common.h"
 #include "config/scene_file.h"
 #include "renderer/gl_renderer.h"
 #include "renderer/image_metrics.h"
@@ -20,19 +21,10 @@
 namespace {
 
 using namespace nephele;
-using Clock = std::chrono::steady_clock;
-
-struct Knob {
-  const char* name;
-  RenderSettings settings;
-};
+using bench::Knob;
+using bench::knob;
 
 std::vector<Knob> knobs() {
-  auto knob = [](const char* name, auto edit) {
-    Knob k{name, {}};
-    edit(k.settings);
-    return k;
-  };
   auto multipass = [](RenderSettings& s) { s.ellipsoid_passes = EllipsoidPasses::kMultipass; };
   return {
       knob("fused per-pixel (default)", [](RenderSettings&) {}),
@@ -74,19 +66,6 @@ std::vector<Knob> knobs() {
            }),
       knob("impostors 0.5 px", [](RenderSettings& s) { s.impostor_tolerance_px = 0.5; }),
   };
-}
-
-double medianMilliseconds(GlRenderer& renderer, const Scene& scene, const RenderSettings& s,
-                          int repeats) {
-  renderer.renderSrgb8(scene, s);  // warm-up: shader compile, texture bake
-  std::vector<double> ms;
-  for (int i = 0; i < repeats; ++i) {
-    const auto start = Clock::now();
-    renderer.renderSrgb8(scene, s);
-    ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
-  }
-  std::sort(ms.begin(), ms.end());
-  return ms[ms.size() / 2];
 }
 
 bool parseSize(const std::string& size, Camera& camera) {
@@ -138,8 +117,9 @@ int main(int argc, char** argv) {
       if (!parseSize(size, scene.camera)) return 2;
       RenderSettings multipass;
       multipass.ellipsoid_passes = EllipsoidPasses::kMultipass;
-      const double fused_ms = medianMilliseconds(renderer, scene, {}, repeats);
-      const double multipass_ms = medianMilliseconds(renderer, scene, multipass, repeats);
+      const double fused_ms = bench::medianFrameMilliseconds(renderer, scene, {}, repeats, false);
+      const double multipass_ms =
+          bench::medianFrameMilliseconds(renderer, scene, multipass, repeats, false);
       std::printf("%-10d %-10s %12.2f %14.2f\n", count, size.c_str(), fused_ms, multipass_ms);
       std::fflush(stdout);
     }
@@ -162,7 +142,8 @@ int main(int argc, char** argv) {
     const Scene& scene = file.scene;
     const FloatImage reference = renderReference(scene, {samples, 0});
     for (const Knob& knob : knobs()) {
-      const double ms = medianMilliseconds(renderer, scene, knob.settings, repeats);
+      const double ms =
+          bench::medianFrameMilliseconds(renderer, scene, knob.settings, repeats, false);
       const ImageError err = compareImages(renderer.renderFloat(scene, knob.settings), reference);
       std::printf("%-18s %-26s %9.2f %9.2f %9.4f%s\n", path.stem().c_str(), knob.name, ms,
                   err.psnr_db, err.max_abs, err.non_finite ? "  NON-FINITE PIXELS" : "");

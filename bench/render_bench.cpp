@@ -12,6 +12,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "bench/bench_common.h"
 #include "config/scene_file.h"
 #include "renderer/gl_renderer.h"
 #include "renderer/image_metrics.h"
@@ -20,19 +21,11 @@
 namespace {
 
 using namespace nephele;
+using bench::Knob;
+using bench::knob;
 using Clock = std::chrono::steady_clock;
 
-struct Knob {
-  const char* name;
-  RenderSettings settings;
-};
-
 std::vector<Knob> knobs() {
-  auto knob = [](const char* name, auto edit) {
-    Knob k{name, {}};
-    edit(k.settings);
-    return k;
-  };
   return {
       knob("baked/fade (default)", [](RenderSettings&) {}),
       knob("baked/cut", [](RenderSettings& s) { s.term_filter = TermFilter::kCut; }),
@@ -49,26 +42,6 @@ std::vector<Knob> knobs() {
              s.term_filter = TermFilter::kNone;
            }),
   };
-}
-
-double medianMilliseconds(GlRenderer& renderer, const Scene& scene, const RenderSettings& s,
-                          int repeats, bool float_target) {
-  // Each frame includes glReadPixels, so it is finished when timed.
-  auto frame = [&] {
-    if (float_target)
-      renderer.renderFloat(scene, s);
-    else
-      renderer.renderSrgb8(scene, s);
-  };
-  frame();  // warm-up: shader compile, texture bake
-  std::vector<double> ms;
-  for (int i = 0; i < repeats; ++i) {
-    const auto start = Clock::now();
-    frame();
-    ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
-  }
-  std::sort(ms.begin(), ms.end());
-  return ms[ms.size() / 2];
 }
 
 }  // namespace
@@ -129,8 +102,8 @@ int main(int argc, char** argv) {
       const double ref_ms =
           std::chrono::duration<double, std::milli>(Clock::now() - ref_start).count();
       for (const Knob& knob : knobs()) {
-        const double ms =
-            medianMilliseconds(renderer, scene, knob.settings, repeats, target == "float");
+        const double ms = bench::medianFrameMilliseconds(renderer, scene, knob.settings, repeats,
+                                                         target == "float");
         const ImageError err = compareImages(renderer.renderFloat(scene, knob.settings), reference);
         std::printf("%-12s %-10s %-22s %9.2f %9.2f %9.4f%s\n", path.stem().c_str(), size.c_str(),
                     knob.name, ms, err.psnr_db, err.max_abs,

@@ -1,0 +1,47 @@
+#pragma once
+// Pieces both benchmark programs share: a named knob setting and the timed frame.
+#include <algorithm>
+#include <chrono>
+#include <vector>
+
+#include "renderer/gl_renderer.h"
+
+namespace nephele::bench {
+
+struct Knob {
+  const char* name;
+  RenderSettings settings;
+};
+
+// A knob from a name and an edit of the default settings.
+template <typename Edit>
+Knob knob(const char* name, Edit edit) {
+  Knob k{name, {}};
+  edit(k.settings);
+  return k;
+}
+
+// Median milliseconds of `repeats` frames after one warm-up (shader compile, texture bake).
+// Each frame includes glReadPixels, so it has finished when timed.
+inline double medianFrameMilliseconds(GlRenderer& renderer, const Scene& scene,
+                                      const RenderSettings& settings, int repeats,
+                                      bool float_target) {
+  auto frame = [&] {
+    if (float_target)
+      renderer.renderFloat(scene, settings);
+    else
+      renderer.renderSrgb8(scene, settings);
+  };
+  frame();
+  std::vector<double> ms;
+  for (int i = 0; i < repeats; ++i) {
+    const auto start = std::chrono::steady_clock::now();
+    frame();
+    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                     .count());
+  }
+  std::sort(ms.begin(), ms.end());
+  return ms[ms.size() / 2];
+}
+
+}  // namespace nephele::bench
