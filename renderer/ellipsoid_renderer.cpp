@@ -488,7 +488,8 @@ void EllipsoidRenderer::drawCloudDirect(const Scene& scene, std::size_t index,
   }
   uploadRecords(records);
   gl_.BindVertexArray(vertex_array_.get());
-  if (settings.ellipsoid_order == EllipsoidOrder::kCentre) {
+  // One ellipsoid needs no per-pixel sorting: the centre pass draws the same image, faster.
+  if (settings.ellipsoid_order == EllipsoidOrder::kCentre || records.size() == 1) {
     EllipsoidPassLayout layout = base;
     layout.program = EllipsoidProgram::kFusedCentre;
     const GLuint p = program(layout);
