@@ -2,6 +2,8 @@
 // Pieces both benchmark programs share: a named knob setting and the timed frame.
 #include <algorithm>
 #include <chrono>
+#include <filesystem>
+#include <string>
 #include <vector>
 
 #include "renderer/gl_renderer.h"
@@ -42,6 +44,15 @@ inline double medianFrameMilliseconds(GlRenderer& renderer, const Scene& scene,
   }
   std::sort(ms.begin(), ms.end());
   return ms[ms.size() / 2];
+}
+
+// The scene files (*.toml) in `directory`, sorted by name.
+inline std::vector<std::filesystem::path> presetFiles(const std::string& directory) {
+  std::vector<std::filesystem::path> files;
+  for (const auto& entry : std::filesystem::directory_iterator(directory))
+    if (entry.path().extension() == ".toml") files.push_back(entry.path());
+  std::sort(files.begin(), files.end());
+  return files;
 }
 
 }  // namespace nephele::bench

@@ -128,10 +128,7 @@ int main(int argc, char** argv) {
   std::printf("\nknobs (error: sRGB RGB against the CPU reference, %dx%d samples, every term)\n",
               samples, samples);
   std::printf("%-18s %-26s %9s %9s %9s\n", "preset", "knob", "ms/frame", "PSNR dB", "max err");
-  std::vector<std::filesystem::path> files;
-  for (const auto& entry : std::filesystem::directory_iterator(presets))
-    if (entry.path().extension() == ".toml") files.push_back(entry.path());
-  std::sort(files.begin(), files.end());
+  const std::vector<std::filesystem::path> files = bench::presetFiles(presets);
   for (const auto& path : files) {
     SceneFile file;
     if (std::string e = loadSceneFile(path.string(), file); !e.empty()) {

@@ -80,10 +80,7 @@ int main(int argc, char** argv) {
               "max err");
   GlRenderer renderer(*platform);
 
-  std::vector<std::filesystem::path> files;
-  for (const auto& entry : std::filesystem::directory_iterator(presets))
-    if (entry.path().extension() == ".toml") files.push_back(entry.path());
-  std::sort(files.begin(), files.end());
+  const std::vector<std::filesystem::path> files = bench::presetFiles(presets);
 
   for (const auto& path : files) {
     SceneFile file;

@@ -5,19 +5,11 @@
 #include <numbers>
 
 #include "world/counter_random.h"
+#include "world/texture_table.h"
 
 namespace nephele {
 namespace {
 constexpr double kPi = std::numbers::pi;
-
-int wrapIndex(int i, int n) {
-  const int r = i % n;
-  return r < 0 ? r + n : r;
-}
-
-double smootherstep(double t) {
-  return t * t * t * (t * (t * 6.0 - 15.0) + 10.0);
-}
 
 // Unit gradient for a lattice point: uniform on the sphere from two counter-based draws.
 glm::dvec3 latticeGradient(std::uint64_t seed, int octave, int x, int y, int z) {
@@ -123,9 +115,7 @@ VolumeTable perlinVolume(int size, int cells, int octaves, double persistence, s
           table.values[(z * n + y) * n + x] += float(amplitude * v);
         }
   }
-  const auto [lo, hi] = std::minmax_element(table.values.begin(), table.values.end());
-  const float low = *lo, range = *hi - *lo;
-  for (float& v : table.values) v = range > 0.0f ? (v - low) / range : 0.5f;
+  normaliseToUnit(table.values);
   return table;
 }
 

@@ -10,9 +10,20 @@ namespace nephele {
 namespace {
 constexpr double kPi = std::numbers::pi;
 
+// Signed uniform in [-1, 1) keyed by seed, position and purpose.
+double signedRandom(std::uint64_t seed, int x, int y, std::uint64_t purpose) {
+  return 2.0 * unitFromBits(hashCounters(seed, purpose, std::uint32_t(x), std::uint32_t(y))) - 1.0;
+}
+
+}  // namespace
+
 int wrapIndex(int i, int n) {
   const int r = i % n;
   return r < 0 ? r + n : r;
+}
+
+double smootherstep(double t) {
+  return t * t * t * (t * (t * 6.0 - 15.0) + 10.0);
 }
 
 void normaliseToUnit(std::vector<float>& values) {
@@ -20,17 +31,6 @@ void normaliseToUnit(std::vector<float>& values) {
   const float low = *lo, range = *hi - *lo;
   for (float& v : values) v = range > 0.0f ? (v - low) / range : 0.5f;
 }
-
-// Signed uniform in [-1, 1) keyed by seed, position and purpose.
-double signedRandom(std::uint64_t seed, int x, int y, std::uint64_t purpose) {
-  return 2.0 * unitFromBits(hashCounters(seed, purpose, std::uint32_t(x), std::uint32_t(y))) - 1.0;
-}
-
-double smootherstep(double t) {
-  return t * t * t * (t * (t * 6.0 - 15.0) + 10.0);
-}
-
-}  // namespace
 
 float TextureTable::at(int x, int y) const {
   return values[std::size_t(wrapIndex(y, height)) * width + wrapIndex(x, width)];

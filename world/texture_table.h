@@ -10,6 +10,13 @@
 
 namespace nephele {
 
+// Index i wrapped into [0, n).
+int wrapIndex(int i, int n);
+// Perlin's quintic fade, 6t^5 - 15t^4 + 10t^3.
+double smootherstep(double t);
+// Rescales values linearly onto [0, 1] (all 0.5 when they are all equal).
+void normaliseToUnit(std::vector<float>& values);
+
 // A width x height grid of values in [0, 1] that repeats in both directions.
 struct TextureTable {
   int width = 0;
