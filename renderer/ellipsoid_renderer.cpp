@@ -274,7 +274,7 @@ void EllipsoidRenderer::setCloudUniforms(GLuint p, const Scene& scene, const Ell
   // SPEC precision rule: the texture's local origin is the eye, reduced modulo the period
   // in double; shaders see camera-relative offsets only.
   const SolidTexture& texture = *cached.source;
-  const glm::dvec3 origin_uvw = texture.periodicCoordinate(scene.camera.position);
+  const glm::dvec3 origin_uvw = texture.periodicCoordinate(scene.camera.position - cloud.drift_m);
   setUniform3(gl_, p, "u_tex_origin", origin_uvw);
   setUniform3(gl_, p, "u_inv_period", 1.0 / texture.period());
   if (kind != SolidTextureKind::kProcedural) return;

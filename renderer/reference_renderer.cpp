@@ -99,7 +99,7 @@ class ReferenceTracer {
   Surface ellipsoidSurface(const EllipsoidEntry& entry, glm::dvec3 direction, double s) const {
     const EllipsoidCloud& cloud = scene_.clouds[entry.cloud];
     const glm::dvec3 p = scene_.camera.position + s * direction;
-    const double t = solid_textures_[entry.cloud].value(p);
+    const double t = solid_textures_[entry.cloud].value(p - scene_.clouds[entry.cloud].drift_m);
     const double tr = ellipsoidTranslucence(t, cloud.threshold_centre, cloud.threshold_limb,
                                             entry.view.limb(direction), cloud.transition);
     const double intensity =

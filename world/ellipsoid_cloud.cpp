@@ -72,7 +72,7 @@ Veil inCloudVeil(const std::vector<EllipsoidCloud>& clouds,
     }
     if (cloud_transmittance == 1.0) continue;
     const ShadingParams& sh = cloud.shading;
-    const double it = textures[c]->value(eye);
+    const double it = textures[c]->value(eye - clouds[c].drift_m);
     const double intensity =
         (1.0 - sh.ambient) * ((1.0 - sh.texture_fraction) * (1.0 - sh.specular) * lit_from_above +
                               sh.texture_fraction * it) +

@@ -24,6 +24,9 @@ struct EllipsoidCloud {
   ShadingParams shading{0.35, 0.5, 0.0, 8.0};
   SolidTextureSpec texture;
   std::vector<Ellipsoid> ellipsoids;
+  // How far the cloud has drifted since time 0. Its ellipsoid centres already include it; the
+  // texture is looked up at (X - drift) so that it moves with the cloud.
+  glm::dvec3 drift_m{0.0};
 };
 
 // A cumulus heap of `count` ellipsoids over a base at `base_centre` (the middle of its flat

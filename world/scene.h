@@ -7,6 +7,7 @@
 
 #include <glm/glm.hpp>
 
+#include "world/automaton_cloud.h"
 #include "world/ellipsoid_cloud.h"
 #include "world/frames.h"
 #include "world/layer_texture.h"
@@ -37,6 +38,8 @@ struct Scene {
   std::vector<CloudLayer> layers;
   std::vector<EllipsoidCloud> clouds;
   std::vector<Target> targets;
+  // Automaton clouds as the World hands them to a render (scene files alone hold none).
+  std::vector<AutomatonCloudView> automata;
 };
 
 }  // namespace nephele

@@ -1,0 +1,202 @@
+#include "world/world.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+namespace nephele {
+namespace {
+
+// A small world with every kind of cloud, wind shear and development schedules.
+std::pair<Scene, WorldDynamics> smallWorld() {
+  Scene scene;
+  scene.layers.push_back({});
+  scene.layers[0].altitude_m = 4000.0;
+  scene.clouds.push_back({});
+  scene.clouds[0].ellipsoids.push_back({});
+  WorldDynamics d;
+  d.wind.samples = {{0.0, {2.0, 0.0}}, {3000.0, {12.0, -4.0}}};
+  d.layers.push_back({});
+  d.layers[0].threshold = {{0.0, 1200.0}, {0.9, 0.1}};
+  d.clouds.push_back({});
+  d.clouds[0].transition = {{0.0, 60.0}, {0.3, 0.1}};
+  AutomatonCloudSpec a;
+  a.name = "test";
+  a.cells = {12, 10, 8};
+  a.cell_size_m = 50.0;
+  a.step_interval_s = 1.5;
+  a.warmup_steps = 15;
+  a.position = {0.0, 0.0, 1000.0};
+  d.automata.push_back(a);
+  return {scene, d};
+}
+
+World makeWorld(int threads = 1) {
+  auto [scene, dynamics] = smallWorld();
+  return World(scene, dynamics, threads);
+}
+
+TEST(World, OneLongAdvanceEqualsManyShortOnes) {
+  World once = makeWorld(), split = makeWorld(), irregular = makeWorld();
+  ASSERT_EQ(once.advance(10.0), "");
+  for (int i = 0; i < 100; ++i) ASSERT_EQ(split.advance(0.1), "");
+  for (double dt : {0.0, 1e-9, 3.3, 0.7 - 1e-9, 6.0}) ASSERT_EQ(irregular.advance(dt), "");
+  EXPECT_EQ(once.timeNs(), 10'000'000'000);
+  EXPECT_EQ(once.hash(), split.hash());
+  EXPECT_EQ(once.hash(), irregular.hash());
+  EXPECT_GT(once.automatonStepsRun(), 0u);
+  const Scene a = once.scene(), b = split.scene();
+  EXPECT_EQ(a.clouds[0].ellipsoids[0].centre, b.clouds[0].ellipsoids[0].centre);
+  EXPECT_EQ(a.automata[0].corner, b.automata[0].corner);
+  EXPECT_EQ(a.automata[0].blend, b.automata[0].blend);
+}
+
+TEST(World, RunsAreIdenticalWhateverTheThreadCount) {
+  World one = makeWorld(1), two = makeWorld(2);
+  ASSERT_EQ(one.advance(30.0), "");
+  ASSERT_EQ(two.advance(30.0), "");
+  EXPECT_EQ(one.hash(), two.hash());
+}
+
+TEST(World, TinyZeroAndHourLongStepsStayFinite) {
+  World w = makeWorld();
+  const std::uint64_t start = w.hash();
+  ASSERT_EQ(w.advance(0.0), "");
+  EXPECT_EQ(w.hash(), start);
+  ASSERT_EQ(w.advance(1e-9), "");
+  EXPECT_EQ(w.timeNs(), 1);
+  ASSERT_EQ(w.advance(3600.0), "");
+  const Scene s = w.scene();
+  ASSERT_EQ(s.automata.size(), 1u);
+  const AutomatonCloudView& v = s.automata[0];
+  for (float rho : v.to->lattice.density) ASSERT_TRUE(std::isfinite(rho) && rho >= 0.0f);
+  for (float t : v.to->lattice.sunlight) ASSERT_TRUE(t >= 0.0f && t <= 1.0f);
+  EXPECT_TRUE(v.blend >= 0.0 && v.blend <= 1.0);
+  // After an hour the grid has drifted with the wind at its middle (1200 m: 6 m/s east).
+  EXPECT_NEAR(v.corner.x - (-300.0), 3600.0 * (2.0 + 10.0 * 1200.0 / 3000.0), 1e-6);
+}
+
+TEST(World, RejectsBadStepsAndChangesNothing) {
+  World w = makeWorld();
+  const std::uint64_t start = w.hash();
+  EXPECT_NE(w.advance(-1.0).find("dt"), std::string::npos);
+  EXPECT_NE(w.advance(std::nan("")), "");
+  EXPECT_NE(w.advance(INFINITY), "");
+  EXPECT_EQ(w.hash(), start);
+}
+
+TEST(World, DevelopmentSchedulesAndDriftFollowTime) {
+  World w = makeWorld();
+  ASSERT_EQ(w.advance(600.0), "");
+  const Scene s = w.scene();
+  EXPECT_NEAR(s.layers[0].threshold, 0.5, 1e-12);  // halfway from 0.9 to 0.1
+  EXPECT_NEAR(s.clouds[0].transition, 0.1, 1e-12);  // held after its last keyframe
+  // The layer at 4000 m drifts with the wind held above 3000 m.
+  EXPECT_EQ(s.layers[0].texture.drift_velocity, glm::dvec2(12.0, -4.0));
+  // The ellipsoid (centre at 1500 m) moves with the wind there and carries its texture along.
+  const glm::dvec2 wind(2.0 + 10.0 * 0.5, -4.0 * 0.5);
+  EXPECT_NEAR(s.clouds[0].drift_m.x, 600.0 * wind.x, 1e-9);
+  EXPECT_NEAR(s.clouds[0].ellipsoids[0].centre.y, 600.0 * wind.y, 1e-9);
+}
+
+TEST(World, DensityChangesSmoothlyBetweenAutomatonSteps) {
+  World w = makeWorld();
+  ASSERT_EQ(w.advance(3.0), "");  // exactly on a step boundary (1.5 s interval)
+  auto densityAt = [&](const World& world) {
+    const AutomatonCloudView v = world.scene().automata[0];
+    return v.exactDensity(v.corner + glm::dvec3(300.0, 250.0, 200.0));
+  };
+  double previous = densityAt(w);
+  double largest_jump = 0.0, total_change = 0.0;
+  for (int i = 0; i < 60; ++i) {  // 6 s in 0.1 s ticks: four automaton steps
+    ASSERT_EQ(w.advance(0.1), "");
+    const double now = densityAt(w);
+    largest_jump = std::max(largest_jump, std::abs(now - previous));
+    total_change += std::abs(now - previous);
+    previous = now;
+  }
+  // Linear blending spreads each step's change over 15 ticks.
+  EXPECT_GT(total_change, 0.0);
+  EXPECT_LE(largest_jump, total_change / 4.0 + 1e-12);
+}
+
+TEST(World, LightIsRecomputedOnlyWhenTheSunMoves) {
+  World w = makeWorld();
+  const auto before = w.scene().automata[0].to;
+  Sun sun = w.base().sun;
+  w.setSun(sun);
+  EXPECT_EQ(w.scene().automata[0].to, before);  // same keyframe object: no relighting
+  sun.elevation_deg = 10.0;
+  w.setSun(sun);
+  const auto after = w.scene().automata[0].to;
+  EXPECT_NE(after, before);
+  EXPECT_EQ(after->lattice.density, before->lattice.density);
+  EXPECT_NE(after->lattice.sunlight, before->lattice.sunlight);
+}
+
+TEST(World, WithoutAutomatonCloudsNoAutomatonWorkIsDone) {
+  auto [scene, dynamics] = smallWorld();
+  dynamics.automata.clear();
+  World w(scene, dynamics);
+  ASSERT_EQ(w.advance(100.0), "");
+  EXPECT_EQ(w.automatonStepsRun(), 0u);
+  EXPECT_TRUE(w.scene().automata.empty());
+}
+
+TEST(World, SnapshotRestoresBitExactlyAndContinuesIdentically) {
+  World original = makeWorld();
+  ASSERT_EQ(original.advance(12.3), "");
+  const std::filesystem::path path =
+      std::filesystem::temp_directory_path() / "nephele_world_test.snapshot";
+  ASSERT_EQ(original.saveSnapshot(path.string()), "");
+  // Restore into a world built from a different scene.
+  World restored(Scene{}, WorldDynamics{});
+  ASSERT_EQ(restored.restoreSnapshot(path.string()), "");
+  EXPECT_EQ(restored.hash(), original.hash());
+  EXPECT_EQ(restored.timeNs(), original.timeNs());
+  EXPECT_EQ(restored.scene().automata[0].to->lattice.sunlight,
+            original.scene().automata[0].to->lattice.sunlight);
+  ASSERT_EQ(original.advance(20.0), "");
+  ASSERT_EQ(restored.advance(20.0), "");
+  EXPECT_EQ(restored.hash(), original.hash());
+  std::filesystem::remove(path);
+}
+
+TEST(World, CorruptOrTruncatedSnapshotsAreRefusedAndLeaveTheWorldAsItWas) {
+  World source = makeWorld();
+  ASSERT_EQ(source.advance(5.0), "");
+  const std::vector<std::uint8_t> good = source.snapshot();
+  World target = makeWorld();
+  const std::uint64_t before = target.hash();
+  auto refused = [&](std::vector<std::uint8_t> bytes, const std::string& expected) {
+    const std::string error = target.restore(bytes);
+    EXPECT_NE(error.find(expected), std::string::npos) << error;
+    EXPECT_EQ(target.hash(), before);
+  };
+  std::vector<std::uint8_t> flipped = good;
+  flipped[flipped.size() / 2] ^= 0x10;
+  refused(flipped, "corrupt");
+  refused({good.begin(), good.end() - 100}, "truncated");
+  refused({good.begin(), good.begin() + 10}, "not a Nephele snapshot");
+  std::vector<std::uint8_t> version = good;
+  version[8] = 99;
+  refused(version, "format version");
+  refused({}, "not a Nephele snapshot");
+  EXPECT_NE(target.restoreSnapshot("/nonexistent/dir/x.snapshot").find("cannot read"),
+            std::string::npos);
+  EXPECT_EQ(target.hash(), before);
+  ASSERT_EQ(target.restore(good), "");
+  EXPECT_EQ(target.hash(), source.hash());
+}
+
+TEST(World, HashesDifferWhenTheWorldDiffers) {
+  World a = makeWorld(), b = makeWorld();
+  EXPECT_EQ(a.hash(), b.hash());
+  ASSERT_EQ(b.advance(1e-9), "");
+  EXPECT_NE(a.hash(), b.hash());
+}
+
+}  // namespace
+}  // namespace nephele

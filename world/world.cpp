@@ -1,0 +1,130 @@
+#include "world/world.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "world/check.h"
+
+namespace nephele {
+namespace {
+
+double meanAltitude(const EllipsoidCloud& cloud) {
+  double z = 0.0;
+  for (const Ellipsoid& e : cloud.ellipsoids) z += e.centre.z;
+  return cloud.ellipsoids.empty() ? 0.0 : z / double(cloud.ellipsoids.size());
+}
+
+// Development changes T0 in steps of 1/256 so that a developing layer rebakes its texture
+// a bounded number of times rather than every frame.
+double quantisedT0(double t0) { return std::round(t0 * 256.0) / 256.0; }
+
+}  // namespace
+
+std::string worldDynamicsError(const Scene& scene, const WorldDynamics& d) {
+  std::ostringstream out;
+  if (!d.layers.empty() && d.layers.size() != scene.layers.size())
+    out << "development: " << d.layers.size() << " layer schedules for " << scene.layers.size()
+        << " layers";
+  if (!d.clouds.empty() && d.clouds.size() != scene.clouds.size())
+    out << "development: " << d.clouds.size() << " cloud schedules for " << scene.clouds.size()
+        << " clouds";
+  for (std::size_t i = 0; i < d.wind.samples.size() && out.tellp() == 0; ++i) {
+    const WindSample& w = d.wind.samples[i];
+    if (!std::isfinite(w.altitude_m) || !(glm::length(w.velocity) <= 200.0))
+      out << "wind: sample " << i << " needs a finite altitude and a speed of at most 200 m/s";
+    else if (i > 0 && !(w.altitude_m > d.wind.samples[i - 1].altitude_m))
+      out << "wind: altitudes must increase strictly";
+  }
+  auto check = [&](const char* what, const Schedule& s, double lo, double hi) {
+    if (out.tellp() != 0) return;
+    if (std::string e = scheduleError(s, lo, hi); !e.empty()) out << what << ": " << e;
+  };
+  for (const LayerDevelopment& l : d.layers) {
+    check("threshold", l.threshold, -10.0, 10.0);
+    check("transition", l.transition, 0.0, 10.0);
+    check("t0", l.t0, 0.0, 100.0);
+  }
+  for (const CloudDevelopment& c : d.clouds) {
+    check("threshold_centre", c.threshold_centre, -10.0, 10.0);
+    check("threshold_limb", c.threshold_limb, -10.0, 10.0);
+    check("transition", c.transition, 0.0, 10.0);
+  }
+  for (const AutomatonCloudSpec& a : d.automata)
+    if (out.tellp() == 0)
+      if (std::string e = automatonCloudError(a); !e.empty()) out << "automaton " << a.name << ": " << e;
+  return out.str();
+}
+
+World::World(const Scene& scene, const WorldDynamics& dynamics, int threads)
+    : World(scene, dynamics, threads, true) {}
+
+World::World(const Scene& scene, const WorldDynamics& dynamics, int threads, bool warm_up)
+    : base_(scene), dynamics_(dynamics), threads_(std::max(1, threads)) {
+  NEPHELE_CHECK(worldDynamicsError(scene, dynamics).empty(), worldDynamicsError(scene, dynamics));
+  base_.time_s = 0.0;
+  base_.automata.clear();
+  // With a wind profile, layers drift with the wind at their altitude.
+  if (!dynamics_.wind.empty())
+    for (CloudLayer& layer : base_.layers)
+      layer.texture.drift_velocity = dynamics_.wind.at(layer.altitude_m);
+  const glm::dvec3 to_sun = sunDirection(base_.sun);
+  for (const AutomatonCloudSpec& spec : dynamics_.automata)
+    automata_.emplace_back(spec, dynamics_.wind, to_sun, warm_up);
+}
+
+World::~World() = default;
+World::World(World&&) noexcept = default;
+World& World::operator=(World&&) noexcept = default;
+
+std::string World::advance(double dt_s) {
+  if (!std::isfinite(dt_s) || dt_s < 0.0 || dt_s > kMaxAdvanceS) {
+    std::ostringstream out;
+    out << "dt: " << dt_s << " (allowed: 0 to " << kMaxAdvanceS << " seconds)";
+    return out.str();
+  }
+  const std::int64_t dt_ns = std::llround(dt_s / kTimeResolutionS);
+  if (dt_ns == 0) return {};
+  time_ns_ += dt_ns;
+  refreshAutomata();
+  return {};
+}
+
+void World::refreshAutomata() {
+  for (AutomatonCloud& cloud : automata_) steps_run_ += cloud.advanceTo(time_ns_, threads_);
+}
+
+void World::setSun(const Sun& sun) {
+  base_.sun = sun;
+  const glm::dvec3 to_sun = sunDirection(sun);
+  for (AutomatonCloud& cloud : automata_) cloud.setSun(to_sun);
+}
+
+Scene World::scene() const {
+  Scene s = base_;
+  const double t = timeSeconds();
+  s.time_s = t;
+  for (std::size_t i = 0; i < dynamics_.layers.size(); ++i) {
+    const LayerDevelopment& d = dynamics_.layers[i];
+    CloudLayer& layer = s.layers[i];
+    layer.threshold = d.threshold.at(t, layer.threshold);
+    layer.transition = d.transition.at(t, layer.transition);
+    if (!d.t0.empty()) layer.texture.gardner.t0 = quantisedT0(d.t0.at(t, 0.0));
+  }
+  for (std::size_t i = 0; i < dynamics_.clouds.size(); ++i) {
+    const CloudDevelopment& d = dynamics_.clouds[i];
+    EllipsoidCloud& cloud = s.clouds[i];
+    cloud.threshold_centre = d.threshold_centre.at(t, cloud.threshold_centre);
+    cloud.threshold_limb = d.threshold_limb.at(t, cloud.threshold_limb);
+    cloud.transition = d.transition.at(t, cloud.transition);
+  }
+  if (!dynamics_.wind.empty())
+    for (EllipsoidCloud& cloud : s.clouds) {
+      const glm::dvec3 drift(dynamics_.wind.at(meanAltitude(cloud)) * t, 0.0);
+      for (Ellipsoid& e : cloud.ellipsoids) e.centre += drift;
+      cloud.drift_m += drift;
+    }
+  for (const AutomatonCloud& cloud : automata_) s.automata.push_back(cloud.view(time_ns_));
+  return s;
+}
+
+}  // namespace nephele

@@ -1,0 +1,91 @@
+#pragma once
+// The World: every cloud (layers, ellipsoid clouds, automaton clouds), the sun, wind by
+// altitude and simulation time. advance(dt) moves it on; scene() is what a render sees now.
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "world/automaton_cloud.h"
+#include "world/scene.h"
+#include "world/schedule.h"
+
+namespace nephele {
+
+// How a layer develops over time (clear to overcast): thresholds and contrast offset.
+struct LayerDevelopment {
+  Schedule threshold;   // T1
+  Schedule transition;  // D
+  Schedule t0;          // Gardner's contrast offset (rebakes the texture when it changes)
+};
+
+struct CloudDevelopment {
+  Schedule threshold_centre;  // T1
+  Schedule threshold_limb;    // T2
+  Schedule transition;        // D
+};
+
+// Everything about a world that changes with time, beside the scene at time 0.
+struct WorldDynamics {
+  WindProfile wind;  // drifts layers, ellipsoid clouds and automaton grids; shears automata
+  std::vector<LayerDevelopment> layers;  // empty, or one per scene layer
+  std::vector<CloudDevelopment> clouds;  // empty, or one per ellipsoid cloud
+  std::vector<AutomatonCloudSpec> automata;
+};
+
+// Empty when `dynamics` fits `scene` and is usable, else what is wrong.
+std::string worldDynamicsError(const Scene& scene, const WorldDynamics& dynamics);
+
+class World {
+ public:
+  // Simulation time is kept in whole nanoseconds, so that split advances add up exactly.
+  static constexpr double kTimeResolutionS = 1e-9;
+  static constexpr double kMaxAdvanceS = 1e7;
+
+  // `scene` is the world at time 0 (its time_s is ignored); `threads` runs the automaton.
+  World(const Scene& scene, const WorldDynamics& dynamics, int threads = 1);
+  ~World();
+  World(World&&) noexcept;
+  World& operator=(World&&) noexcept;
+
+  // Moves time on by dt seconds (rounded to the nanosecond): drift, development schedules and
+  // automaton steps at their fixed interval. Returns an error (and changes nothing) for a
+  // negative, non-finite or too large dt.
+  std::string advance(double dt_s);
+  std::int64_t timeNs() const { return time_ns_; }
+  double timeSeconds() const { return double(time_ns_) * kTimeResolutionS; }
+  // Automaton steps run since construction or restore, summed over clouds.
+  std::uint64_t automatonStepsRun() const { return steps_run_; }
+
+  // Relights automaton clouds only if the sun's direction changed.
+  void setSun(const Sun& sun);
+  void setCamera(const Camera& camera) { base_.camera = camera; }
+
+  // The render's view of the world now.
+  Scene scene() const;
+  const Scene& base() const { return base_; }
+  const WorldDynamics& dynamics() const { return dynamics_; }
+  const std::vector<AutomatonCloud>& automata() const { return automata_; }
+
+  // A hash of the whole state (XXH3 of the snapshot): equal worlds give equal hashes.
+  std::uint64_t hash() const;
+  // Snapshots restore bit-exactly. Errors name what is wrong; on error the world is unchanged.
+  std::vector<std::uint8_t> snapshot() const;
+  std::string restore(std::span<const std::uint8_t> bytes);
+  std::string saveSnapshot(const std::string& path) const;
+  std::string restoreSnapshot(const std::string& path);
+
+ private:
+  World(const Scene& scene, const WorldDynamics& dynamics, int threads, bool warm_up);
+  void refreshAutomata();
+
+  Scene base_;
+  WorldDynamics dynamics_;
+  int threads_ = 1;
+  std::int64_t time_ns_ = 0;
+  std::uint64_t steps_run_ = 0;
+  std::vector<AutomatonCloud> automata_;
+};
+
+}  // namespace nephele

@@ -1,0 +1,357 @@
+// World snapshots: a header (magic, format version, payload length, XXH3 of the payload)
+// and a payload holding the scene at time 0, the dynamics, the time and each automaton's last
+// two states. Numbers are stored as their little-endian bytes (bit-exact doubles).
+#include <bit>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <type_traits>
+
+#include <xxhash.h>
+
+#include "world/world.h"
+
+namespace nephele {
+namespace {
+
+static_assert(std::endian::native == std::endian::little, "snapshots assume a little-endian host");
+
+constexpr char kMagic[8] = {'N', 'E', 'P', 'H', 'S', 'N', 'A', 'P'};
+constexpr std::uint32_t kFormatVersion = 1;
+constexpr std::size_t kHeaderBytes = sizeof kMagic + 4 + 8 + 8;
+
+class Writer {
+ public:
+  std::vector<std::uint8_t> bytes;
+  bool ok() const { return true; }
+  template <class T>
+  void raw(T& v) {
+    const auto* p = reinterpret_cast<const std::uint8_t*>(&v);
+    bytes.insert(bytes.end(), p, p + sizeof(T));
+  }
+  // Writes the count; the caller then visits `count` elements.
+  std::size_t count(std::size_t n, std::size_t /*min_bytes*/) {
+    std::uint64_t v = n;
+    raw(v);
+    return n;
+  }
+  void fail(const std::string&) {}
+  static constexpr bool kReading = false;
+};
+
+class Reader {
+ public:
+  explicit Reader(std::span<const std::uint8_t> data) : data_(data) {}
+  bool ok() const { return error_.empty(); }
+  const std::string& error() const { return error_; }
+  std::size_t remaining() const { return data_.size() - pos_; }
+  template <class T>
+  void raw(T& v) {
+    if (!ok()) return;
+    if (remaining() < sizeof(T)) return fail("payload ends early");
+    std::memcpy(&v, data_.data() + pos_, sizeof(T));
+    pos_ += sizeof(T);
+  }
+  // Reads a count and refuses one that cannot fit in what is left.
+  std::size_t count(std::size_t /*n*/, std::size_t min_bytes) {
+    std::uint64_t v = 0;
+    raw(v);
+    if (ok() && v > remaining() / std::max<std::size_t>(min_bytes, 1))
+      fail("a list claims " + std::to_string(v) + " entries, more than the payload holds");
+    return ok() ? std::size_t(v) : 0;
+  }
+  void fail(const std::string& message) {
+    if (error_.empty()) error_ = message;
+  }
+  static constexpr bool kReading = true;
+
+ private:
+  std::span<const std::uint8_t> data_;
+  std::size_t pos_ = 0;
+  std::string error_;
+};
+
+template <class A, class T>
+  requires std::is_arithmetic_v<T>
+void io(A& a, T& v) {
+  a.raw(v);
+}
+template <class A>
+void io(A& a, bool& v) {
+  std::uint8_t b = v;
+  a.raw(b);
+  if (b > 1) a.fail("a flag holds " + std::to_string(b));
+  v = b != 0;
+}
+template <class A, class E>
+  requires std::is_enum_v<E>
+void ioEnum(A& a, E& e, int count) {
+  std::int32_t v = std::int32_t(e);
+  a.raw(v);
+  if (v < 0 || v >= count) a.fail("an enumeration holds " + std::to_string(v));
+  e = E(v);
+}
+template <class A>
+void io(A& a, std::string& s) {
+  const std::size_t n = a.count(s.size(), 1);
+  if (A::kReading) s.assign(n, '\0');
+  for (char& c : s) a.raw(c);
+}
+template <class A, int N, class T>
+void io(A& a, glm::vec<N, T, glm::defaultp>& v) {
+  for (int i = 0; i < N; ++i) a.raw(v[i]);
+}
+template <class A, class T>
+void io(A& a, std::vector<T>& list, std::size_t min_bytes = 1) {
+  const std::size_t n = a.count(list.size(), min_bytes);
+  if (A::kReading) list.resize(n);
+  for (T& item : list) io(a, item);
+}
+template <class A>
+void io(A& a, Orientation& o) {
+  io(a, o.heading_deg), io(a, o.pitch_deg), io(a, o.roll_deg);
+}
+template <class A>
+void io(A& a, Camera& c) {
+  io(a, c.position), io(a, c.orientation), io(a, c.vfov_deg), io(a, c.width), io(a, c.height);
+}
+template <class A>
+void io(A& a, Sun& s) {
+  io(a, s.azimuth_deg), io(a, s.elevation_deg), io(a, s.colour);
+}
+template <class A>
+void io(A& a, Sky& s) {
+  io(a, s.zenith), io(a, s.horizon), io(a, s.ground);
+}
+template <class A>
+void io(A& a, std::optional<Fog>& fog) {
+  bool present = fog.has_value();
+  io(a, present);
+  if (!present) return fog.reset();
+  if (!fog) fog.emplace();
+  io(a, fog->top_m), io(a, fog->visibility_m), io(a, fog->colour);
+}
+template <class A>
+void io(A& a, ShadingParams& s) {
+  io(a, s.ambient), io(a, s.texture_fraction), io(a, s.specular), io(a, s.shininess);
+}
+template <class A>
+void io(A& a, GardnerTextureParams& g) {
+  io(a, g.terms), io(a, g.fx1), io(a, g.fy1), io(a, g.t0), io(a, g.seeded_phases), io(a, g.seed);
+  if (g.terms < 1 || g.terms > GardnerTextureParams::kMaxTerms) a.fail("texture terms out of range");
+}
+template <class A>
+void io(A& a, LayerTextureSpec& t) {
+  ioEnum(a, t.source, 3);
+  io(a, t.gardner);
+  NoiseTableParams& n = t.table;
+  io(a, n.tile_size_m), io(a, n.size_log2), io(a, n.roughness), io(a, n.cells), io(a, n.octaves);
+  io(a, n.persistence), io(a, t.seed), io(a, t.drift_velocity);
+}
+template <class A>
+void io(A& a, CloudLayer& l) {
+  io(a, l.name), io(a, l.altitude_m), io(a, l.colour), io(a, l.threshold), io(a, l.transition);
+  io(a, l.shading), io(a, l.texture);
+}
+template <class A>
+void io(A& a, SolidTextureSpec& t) {
+  ioEnum(a, t.source, 2);
+  io(a, t.gardner), io(a, t.perlin_period_m), io(a, t.perlin_size_log2), io(a, t.perlin_cells);
+  io(a, t.perlin_octaves), io(a, t.perlin_persistence), io(a, t.seed);
+}
+template <class A>
+void io(A& a, Ellipsoid& e) {
+  io(a, e.radii), io(a, e.centre), io(a, e.orientation);
+}
+template <class A>
+void io(A& a, EllipsoidCloud& c) {
+  io(a, c.name), io(a, c.colour), io(a, c.threshold_centre), io(a, c.threshold_limb);
+  io(a, c.transition), io(a, c.shading), io(a, c.texture), io(a, c.ellipsoids, 72), io(a, c.drift_m);
+}
+template <class A>
+void io(A& a, std::array<std::uint32_t, 3>& triangle) {
+  for (std::uint32_t& v : triangle) a.raw(v);
+}
+template <class A>
+void io(A& a, Target& t) {
+  io(a, t.name);
+  ioEnum(a, t.shape, 3);
+  io(a, t.centre), io(a, t.orientation), io(a, t.size), io(a, t.colour);
+  bool has_mesh = t.mesh != nullptr;
+  io(a, has_mesh);
+  if (!has_mesh) return t.mesh.reset();
+  TriangleMesh mesh = t.mesh ? *t.mesh : TriangleMesh{};
+  io(a, mesh.vertices, 24), io(a, mesh.triangles, 12);
+  for (const auto& triangle : mesh.triangles)
+    for (std::uint32_t v : triangle)
+      if (v >= mesh.vertices.size()) a.fail("target " + t.name + ": a triangle names a missing vertex");
+  if (A::kReading) t.mesh = std::make_shared<const TriangleMesh>(std::move(mesh));
+}
+template <class A>
+void io(A& a, Scene& s) {
+  io(a, s.seed), io(a, s.camera), io(a, s.sun), io(a, s.sky), io(a, s.fog);
+  io(a, s.layers, 64), io(a, s.clouds, 64), io(a, s.targets, 64);
+}
+template <class A>
+void io(A& a, Schedule& s) {
+  io(a, s.times_s, 8), io(a, s.values, 8);
+}
+template <class A>
+void io(A& a, WindSample& w) {
+  io(a, w.altitude_m), io(a, w.velocity);
+}
+template <class A>
+void io(A& a, LayerDevelopment& d) {
+  io(a, d.threshold), io(a, d.transition), io(a, d.t0);
+}
+template <class A>
+void io(A& a, CloudDevelopment& d) {
+  io(a, d.threshold_centre), io(a, d.threshold_limb), io(a, d.transition);
+}
+template <class A>
+void io(A& a, GridSize& g) {
+  io(a, g.nx), io(a, g.ny), io(a, g.nz);
+}
+template <class A>
+void io(A& a, ShapeEllipsoid& e) {
+  io(a, e.centre), io(a, e.radii);
+}
+template <class A>
+void io(A& a, AutomatonCloudSpec& s) {
+  io(a, s.name), io(a, s.cells), io(a, s.cell_size_m), io(a, s.position), io(a, s.seed);
+  io(a, s.step_interval_s), io(a, s.warmup_steps), io(a, s.humidity), io(a, s.activation);
+  io(a, s.extinction), io(a, s.humidity_schedule), io(a, s.activation_schedule);
+  io(a, s.extinction_schedule), io(a, s.shape, 48), io(a, s.colour), io(a, s.ambient);
+  ioEnum(a, s.phase, 2);
+  io(a, s.phase_u), io(a, s.samples_per_cell);
+}
+template <class A>
+void io(A& a, WorldDynamics& d) {
+  io(a, d.wind.samples, 24), io(a, d.layers, 48), io(a, d.clouds, 48), io(a, d.automata, 64);
+}
+
+// One automaton's last two states.
+struct AutomatonState {
+  std::uint64_t previous_steps = 0;
+  std::vector<std::uint64_t> previous[3], current[3];
+};
+template <class A>
+void io(A& a, AutomatonState& s) {
+  io(a, s.previous_steps);
+  for (auto& bits : s.previous) io(a, bits, 8);
+  for (auto& bits : s.current) io(a, bits, 8);
+}
+
+std::uint64_t payloadHash(std::span<const std::uint8_t> payload) {
+  return XXH3_64bits(payload.data(), payload.size());
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> World::snapshot() const {
+  Writer w;
+  Scene scene = base_;
+  WorldDynamics dynamics = dynamics_;
+  std::int64_t time_ns = time_ns_;
+  io(w, scene), io(w, dynamics), io(w, time_ns);
+  for (const AutomatonCloud& cloud : automata_) {
+    AutomatonState state;
+    state.previous_steps = cloud.previous().steps();
+    for (int b = 0; b < 3; ++b) {
+      state.previous[b] = cloud.previous().words(CellBit(b));
+      state.current[b] = cloud.automaton().words(CellBit(b));
+    }
+    io(w, state);
+  }
+  std::vector<std::uint8_t> out(kMagic, kMagic + sizeof kMagic);
+  auto append = [&out](auto v) {
+    const auto* p = reinterpret_cast<const std::uint8_t*>(&v);
+    out.insert(out.end(), p, p + sizeof v);
+  };
+  append(kFormatVersion);
+  append(std::uint64_t(w.bytes.size()));
+  append(payloadHash(w.bytes));
+  out.insert(out.end(), w.bytes.begin(), w.bytes.end());
+  return out;
+}
+
+std::uint64_t World::hash() const {
+  const std::vector<std::uint8_t> bytes = snapshot();
+  return payloadHash(std::span(bytes).subspan(kHeaderBytes));
+}
+
+std::string World::restore(std::span<const std::uint8_t> bytes) {
+  if (bytes.size() < kHeaderBytes || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
+    return "snapshot: not a Nephele snapshot (bad magic or shorter than its header)";
+  std::uint32_t version = 0;
+  std::uint64_t length = 0, hash = 0;
+  std::memcpy(&version, bytes.data() + 8, 4);
+  std::memcpy(&length, bytes.data() + 12, 8);
+  std::memcpy(&hash, bytes.data() + 20, 8);
+  if (version != kFormatVersion)
+    return "snapshot: format version " + std::to_string(version) + " (this build reads " +
+           std::to_string(kFormatVersion) + ")";
+  const std::span<const std::uint8_t> payload = bytes.subspan(kHeaderBytes);
+  if (payload.size() != length)
+    return "snapshot: truncated or padded: payload of " + std::to_string(payload.size()) +
+           " bytes, header says " + std::to_string(length);
+  if (payloadHash(payload) != hash) return "snapshot: corrupt (checksum mismatch)";
+
+  Reader r(payload);
+  Scene scene;
+  WorldDynamics dynamics;
+  std::int64_t time_ns = 0;
+  io(r, scene), io(r, dynamics), io(r, time_ns);
+  if (!r.ok()) return "snapshot: " + r.error();
+  if (std::string e = worldDynamicsError(scene, dynamics); !e.empty()) return "snapshot: " + e;
+  for (const EllipsoidCloud& cloud : scene.clouds)
+    for (const Ellipsoid& e : cloud.ellipsoids)
+      if (std::string error = ellipsoidError(e); !error.empty())
+        return "snapshot: cloud " + cloud.name + ": " + error;
+  if (time_ns < 0) return "snapshot: negative time";
+
+  World restored(scene, dynamics, threads_, false);
+  restored.time_ns_ = time_ns;
+  for (AutomatonCloud& cloud : restored.automata_) {
+    AutomatonState s;
+    io(r, s);
+    if (!r.ok()) return "snapshot: " + r.error();
+    const GridSize size = cloud.spec().cells;
+    CellularAutomaton previous(size, cloud.spec().seed), current(size, cloud.spec().seed);
+    if (!previous.restore(s.previous_steps, s.previous[0], s.previous[1], s.previous[2]) ||
+        !current.restore(s.previous_steps + 1, s.current[0], s.current[1], s.current[2]) ||
+        !cloud.restore(s.previous_steps, previous, current))
+      return "snapshot: automaton " + cloud.spec().name + ": states do not fit its grid";
+    if (std::int64_t(cloud.stepsSinceStart()) != time_ns / cloud.stepIntervalNs() + 1)
+      return "snapshot: automaton " + cloud.spec().name + ": state does not match the time";
+  }
+  if (r.remaining() != 0) return "snapshot: " + std::to_string(r.remaining()) + " bytes left over";
+  *this = std::move(restored);
+  return {};
+}
+
+std::string World::saveSnapshot(const std::string& path) const {
+  const std::vector<std::uint8_t> bytes = snapshot();
+  // Write beside the target and rename, so a crash never leaves a half-written snapshot.
+  const std::string temporary = path + ".partial";
+  {
+    std::ofstream file(temporary, std::ios::binary | std::ios::trunc);
+    if (!file) return "snapshot: cannot write " + temporary;
+    file.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+    if (!file.flush()) return "snapshot: write to " + temporary + " failed";
+  }
+  if (std::rename(temporary.c_str(), path.c_str()) != 0)
+    return "snapshot: cannot rename " + temporary + " to " + path;
+  return {};
+}
+
+std::string World::restoreSnapshot(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  if (!file) return "snapshot: cannot read " + path;
+  const std::vector<std::uint8_t> bytes{std::istreambuf_iterator<char>(file),
+                                        std::istreambuf_iterator<char>()};
+  return restore(bytes);
+}
+
+}  // namespace nephele
