@@ -2,6 +2,7 @@
 
 #include <toml++/toml.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -94,6 +95,27 @@ class TableReader {
     if (!array || array->size() != std::size_t(N))
       fail(*node, key, "must be an array of " + std::to_string(N) + " numbers");
     for (int i = 0; i < N; ++i) out[i] = toNumber(*array->get(std::size_t(i)), key, lo, hi);
+  }
+
+  // An array of numbers, each in [lo, hi], of at most `max_count` entries.
+  void numbers(std::string_view key, std::vector<double>& out, double lo, double hi,
+               std::size_t max_count) {
+    const toml::node* node = take(key);
+    if (!node) return;
+    const toml::array* array = node->as_array();
+    if (!array || array->empty() || array->size() > max_count)
+      fail(*node, key, "must be an array of 1 to " + std::to_string(max_count) + " numbers");
+    out.clear();
+    for (const toml::node& v : *array) out.push_back(toNumber(v, key, lo, hi));
+  }
+
+  // Three integers, each in [lo, hi].
+  void integers3(std::string_view key, int (&out)[3], int lo, int hi) {
+    const toml::node* node = take(key);
+    if (!node) return;
+    const toml::array* array = node->as_array();
+    if (!array || array->size() != 3) fail(*node, key, "must be an array of 3 integers");
+    for (int i = 0; i < 3; ++i) out[i] = int(toInteger(*array->get(std::size_t(i)), key, lo, hi));
   }
 
   // A sub-table (absent: null). Its reader must be finished by the caller.
@@ -298,9 +320,40 @@ void readTexture(TableReader& t, LayerTextureSpec& texture) {
   t.finish();
 }
 
-void readLayer(TableReader& t, CloudLayer& layer) {
+// A [*.develop] table: `times` and, for each key in `keys`, one value per time.
+void readDevelop(TableReader& t, const std::vector<std::pair<std::string, Schedule*>>& keys,
+                 double lo, double hi) {
+  constexpr std::size_t kMaxKeyframes = 1024;
+  std::vector<std::string> allowed{"times"};
+  for (const auto& [key, schedule] : keys) allowed.push_back(key);
+  t.allow(allowed);
+  if (!t.has("times")) t.failHere("missing key times (seconds of simulation time, increasing)");
+  std::vector<double> times;
+  t.numbers("times", times, 0.0, Limits::kMaxTime, kMaxKeyframes);
+  for (std::size_t i = 1; i < times.size(); ++i)
+    if (!(times[i] > times[i - 1])) t.failAt("times", "must increase strictly");
+  for (const auto& [key, schedule] : keys) {
+    if (!t.has(key)) continue;
+    schedule->times_s = times;
+    t.numbers(key, schedule->values, lo, hi, kMaxKeyframes);
+    if (schedule->values.size() != times.size())
+      t.failAt(key, "has " + std::to_string(schedule->values.size()) + " values for " +
+                        std::to_string(times.size()) + " times (one per time)");
+  }
+  t.finish();
+}
+
+void readWind(TableReader& t, WindSample& sample) {
+  t.allow({"altitude", "velocity"});
+  if (!t.has("velocity")) t.failHere("missing key velocity ([east, north] in m/s)");
+  t.number("altitude", sample.altitude_m, 0.0, Limits::kMaxAltitude);
+  t.vector("velocity", sample.velocity, -200.0, 200.0);
+  t.finish();
+}
+
+void readLayer(TableReader& t, CloudLayer& layer, LayerDevelopment& develop) {
   t.allow({"name", "altitude", "colour", "threshold", "transition", "ambient", "texture_fraction",
-           "specular", "shininess", "drift", "seed", "texture"});
+           "specular", "shininess", "drift", "seed", "texture", "develop"});
   t.string("name", layer.name);
   t.number("altitude", layer.altitude_m, 0.0, Limits::kMaxAltitude);
   t.vector("colour", layer.colour, 0.0, kMaxColour);
@@ -313,6 +366,19 @@ void readLayer(TableReader& t, CloudLayer& layer) {
   t.vector("drift", layer.texture.drift_velocity, -300.0, 300.0);
   t.seed("seed", layer.texture.seed);
   if (auto texture = t.table("texture")) readTexture(*texture, layer.texture);
+  if (auto d = t.table("develop")) {
+    readDevelop(*d,
+                {{"threshold", &develop.threshold},
+                 {"transition", &develop.transition},
+                 {"t0", &develop.t0}},
+                0.0, 10.0);
+    if (!develop.t0.empty() && layer.texture.source != TextureSource::kGardner)
+      d->failAt("t0", "applies to texture source \"gardner\" only");
+    if (!develop.threshold.empty() && std::ranges::any_of(develop.threshold.values, [](double v) {
+          return v > 1.0;
+        }))
+      d->failAt("threshold", "values must lie in 0 to 1");
+  }
   t.finish();
 }
 
@@ -368,9 +434,11 @@ void readCumulus(TableReader& t, std::uint64_t seed, std::vector<Ellipsoid>& out
   out = cumulusEllipsoids(count, base, width, seed);
 }
 
-void readCloud(TableReader& t, std::uint64_t seed, EllipsoidCloud& cloud) {
+void readCloud(TableReader& t, std::uint64_t seed, EllipsoidCloud& cloud,
+               CloudDevelopment& develop) {
   t.allow({"name", "colour", "threshold", "limb_threshold", "transition", "ambient",
-           "texture_fraction", "specular", "shininess", "seed", "texture", "cumulus", "ellipsoid"});
+           "texture_fraction", "specular", "shininess", "seed", "texture", "cumulus", "ellipsoid",
+           "develop"});
   t.string("name", cloud.name);
   t.vector("colour", cloud.colour, 0.0, kMaxColour);
   t.number("threshold", cloud.threshold_centre, -2.0, 2.0);
@@ -392,6 +460,55 @@ void readCloud(TableReader& t, std::uint64_t seed, EllipsoidCloud& cloud) {
   for (TableReader& e : ellipsoids) readEllipsoid(e, cloud.ellipsoids.emplace_back());
   if (cloud.ellipsoids.empty())
     t.failHere("has no ellipsoids (add [[cloud.ellipsoid]] tables or a [cloud.cumulus] table)");
+  if (auto d = t.table("develop"))
+    readDevelop(*d,
+                {{"threshold", &develop.threshold_centre},
+                 {"limb_threshold", &develop.threshold_limb},
+                 {"transition", &develop.transition}},
+                -2.0, 10.0);
+  t.finish();
+}
+
+void readShape(TableReader& t, ShapeEllipsoid& shape) {
+  t.allow({"centre", "radii"});
+  t.vector("centre", shape.centre, -10.0, 10.0);
+  t.vector("radii", shape.radii, 1e-3, 10.0);
+  t.finish();
+}
+
+void readAutomaton(TableReader& t, std::uint64_t seed, AutomatonCloudSpec& a) {
+  t.allow({"name", "cells", "cell_size", "position", "seed", "step_interval", "warmup_steps",
+           "humidity", "activation", "extinction", "colour", "ambient", "phase", "phase_u",
+           "samples_per_cell", "shape", "develop"});
+  t.string("name", a.name);
+  int cells[3] = {a.cells.nx, a.cells.ny, a.cells.nz};
+  t.integers3("cells", cells, 1, 1024);
+  a.cells = {cells[0], cells[1], cells[2]};
+  if (a.cells.cells() > (std::int64_t(1) << 24))
+    t.failAt("cells", std::to_string(a.cells.cells()) + " cells (allowed: at most 16777216)");
+  t.number("cell_size", a.cell_size_m, 0.01, 1.0e4);
+  t.vector("position", a.position, -Limits::kMaxCoordinate, Limits::kMaxCoordinate);
+  a.seed = seed;
+  t.seed("seed", a.seed);
+  t.number("step_interval", a.step_interval_s, 1e-3, 3600.0);
+  t.integer("warmup_steps", a.warmup_steps, 0, 100000);
+  t.number("humidity", a.humidity, 0.0, 1.0);
+  t.number("activation", a.activation, 0.0, 1.0);
+  t.number("extinction", a.extinction, 0.0, 1.0);
+  t.vector("colour", a.colour, 0.0, kMaxColour);
+  t.number("ambient", a.ambient, 0.0, 1.0);
+  a.phase = PhaseFunction(t.choice("phase", kPhaseFunctionNames, int(a.phase)));
+  if (a.phase != PhaseFunction::kCornetteShanks)
+    t.forbid("phase_u", "applies to phase \"cornette-shanks\" only");
+  t.number("phase_u", a.phase_u, 0.0, 1.0);
+  t.integer("samples_per_cell", a.samples_per_cell, 1, 8);
+  for (TableReader& s : t.tables("shape")) readShape(s, a.shape.emplace_back());
+  if (auto d = t.table("develop"))
+    readDevelop(*d,
+                {{"humidity", &a.humidity_schedule},
+                 {"activation", &a.activation_schedule},
+                 {"extinction", &a.extinction_schedule}},
+                0.0, 1.0);
   t.finish();
 }
 
@@ -425,8 +542,8 @@ void readTarget(TableReader& t, const std::string& scene_path, Target& target) {
 
 void readScene(const toml::table& root, const std::string& file, SceneFile& out) {
   TableReader t(root, "", file);
-  t.allow({"seed", "time", "image", "camera", "sun", "sky", "fog", "render", "layer", "cloud",
-           "target"});
+  t.allow({"seed", "time", "image", "camera", "sun", "sky", "fog", "render", "wind", "layer",
+           "cloud", "automaton", "target"});
   Scene& scene = out.scene;
   t.seed("seed", scene.seed);
   t.number("time", scene.time_s, 0.0, Limits::kMaxTime);
@@ -436,19 +553,44 @@ void readScene(const toml::table& root, const std::string& file, SceneFile& out)
   if (auto sky = t.table("sky")) readSky(*sky, scene.sky);
   if (auto fog = t.table("fog")) readFog(*fog, scene.fog.emplace());
   if (auto render = t.table("render")) readRender(*render, out);
+  WorldDynamics& dynamics = out.dynamics;
+  std::vector<TableReader> wind = t.tables("wind");
+  for (TableReader& w : wind) readWind(w, dynamics.wind.samples.emplace_back());
+  std::sort(dynamics.wind.samples.begin(), dynamics.wind.samples.end(),
+            [](const WindSample& a, const WindSample& b) { return a.altitude_m < b.altitude_m; });
+  for (std::size_t i = 1; i < dynamics.wind.samples.size(); ++i)
+    if (dynamics.wind.samples[i].altitude_m == dynamics.wind.samples[i - 1].altitude_m)
+      t.failAt("wind", "two [[wind]] samples at altitude " +
+                           formatNumber(dynamics.wind.samples[i].altitude_m));
   std::vector<TableReader> layers = t.tables("layer");
   for (std::size_t i = 0; i < layers.size(); ++i) {
     CloudLayer& layer = scene.layers.emplace_back();
     layer.texture.seed = hashCounters(scene.seed, 0x4c61796572ull, i);  // unless given
-    readLayer(layers[i], layer);
+    if (!wind.empty())
+      layers[i].forbid("drift", "conflicts with [[wind]]: layers drift with the wind at their "
+                                "altitude (remove one of them)");
+    readLayer(layers[i], layer, dynamics.layers.emplace_back());
     if (layer.name.empty()) layer.name = "layer" + std::to_string(i);
   }
   std::vector<TableReader> clouds = t.tables("cloud");
   for (std::size_t i = 0; i < clouds.size(); ++i) {
     EllipsoidCloud& cloud = scene.clouds.emplace_back();
-    readCloud(clouds[i], hashCounters(scene.seed, 0x436c6f7564ull, i), cloud);
+    readCloud(clouds[i], hashCounters(scene.seed, 0x436c6f7564ull, i), cloud,
+              dynamics.clouds.emplace_back());
     if (cloud.name.empty()) cloud.name = "cloud" + std::to_string(i);
   }
+  std::vector<TableReader> automata = t.tables("automaton");
+  if (automata.size() > std::size_t(Limits::kMaxAutomata))
+    t.failAt("automaton", "more than " + std::to_string(Limits::kMaxAutomata) + " automaton clouds");
+  for (std::size_t i = 0; i < automata.size(); ++i) {
+    AutomatonCloudSpec& a = dynamics.automata.emplace_back();
+    readAutomaton(automata[i], hashCounters(scene.seed, 0x4175746f6dull, i), a);
+    if (a.name.empty()) a.name = "automaton" + std::to_string(i);
+  }
+  if (!automata.empty() && scene.time_s > Limits::kMaxAutomatonTime)
+    t.failAt("time", formatNumber(scene.time_s) + " is out of range with automaton clouds " +
+                         "(allowed: 0 to " + formatNumber(Limits::kMaxAutomatonTime) +
+                         " s; every automaton step is simulated)");
   std::vector<TableReader> targets = t.tables("target");
   for (std::size_t i = 0; i < targets.size(); ++i) {
     Target& target = scene.targets.emplace_back();
@@ -477,6 +619,9 @@ std::string parseSceneText(std::string_view text, const std::string& source_name
   } catch (const SceneError& e) {
     return e.message;
   }
+  // Whatever the per-key checks cannot see (a backstop; they should catch everything).
+  if (std::string e = worldDynamicsError(parsed.scene, parsed.dynamics); !e.empty())
+    return source_name + ": " + e;
   out = std::move(parsed);
   return "";
 }

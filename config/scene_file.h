@@ -7,11 +7,13 @@
 
 #include "renderer/render_settings.h"
 #include "world/scene.h"
+#include "world/world.h"
 
 namespace nephele {
 
 struct SceneFile {
   Scene scene;
+  WorldDynamics dynamics;  // wind, development schedules, automaton clouds
   RenderSettings render;
   ReferenceSettings reference;
 };
@@ -29,6 +31,10 @@ struct Limits {
   // Ellipsoid semi-axes and target sizes, metres: zero, negative and NaN are rejected.
   static constexpr double kMinRadius = 1.0e-3, kMaxRadius = 1.0e5;
   static constexpr int kMaxEllipsoidsPerCloud = 4096;
+  // Automaton steps are simulated one by one: a scene with automaton clouds may start at most
+  // a day into its simulation.
+  static constexpr double kMaxAutomatonTime = 86400.0;
+  static constexpr int kMaxAutomata = 256;
 };
 
 // Names of the render knobs in enum order, shared by scene files and the command line.
@@ -39,6 +45,8 @@ inline const std::vector<std::string> kEllipsoidPassesNames{"fused", "multipass"
 inline const std::vector<std::string> kEllipsoidOrderNames{"centre", "per-pixel"};
 inline const std::vector<std::string> kLimbNames{"exact", "spotlight"};
 inline const std::vector<std::string> kTileFormatNames{"rgba8", "float"};
+inline const std::vector<std::string> kPhaseFunctionNames{"rayleigh", "cornette-shanks"};
+inline const std::vector<std::string> kAutomatonMarchNames{"lattice", "exact"};
 
 // Position of `name` in `names`, or -1.
 int nameIndex(const std::vector<std::string>& names, std::string_view name);

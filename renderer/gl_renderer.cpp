@@ -86,6 +86,7 @@ GlRenderer::GlRenderer(const GlPlatform& platform)
       vertex_array_(createVertexArray(gl_)),
       framebuffer_(createFramebuffer(gl_)),
       ellipsoids_(gl_),
+      automata_(gl_),
       targets_(gl_) {}
 
 GlRenderer::~GlRenderer() = default;
@@ -331,6 +332,7 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
     gl_.Disable(GL_FRAMEBUFFER_SRGB);
   for (auto& [key, cached] : textures_) cached.used = false;
   ellipsoids_.beginFrame();
+  automata_.beginFrame();
 
   // A ray meets only the layers on one side of the camera: above it from the highest down,
   // below it from the lowest up. Those orders are back to front.
@@ -356,22 +358,31 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
   // side of the camera lie between the camera and the cloud's altitude: it is drawn after
   // the layers beyond it and before the b layers in front of it. Clouds in one band go
   // back to front by distance.
+  // Automaton clouds join the same order, by the middle of their box.
   struct CloudEntry {
+    bool automaton;
     std::size_t index;
     int band;
     double distance;
   };
   std::vector<CloudEntry> clouds;
-  for (std::size_t i = 0; i < scene.clouds.size(); ++i) {
-    const double altitude = cloudAltitude(scene.clouds[i]);
+  auto addCloud = [&](bool automaton, std::size_t index, glm::dvec3 centre, double altitude) {
     int band = 0;
     for (const CloudLayer& layer : scene.layers)
       band += (altitude > z) ? (layer.altitude_m > z && layer.altitude_m < altitude)
                              : (layer.altitude_m < z && layer.altitude_m > altitude);
+    clouds.push_back({automaton, index, band, glm::length(centre - camera.position)});
+  };
+  for (std::size_t i = 0; i < scene.clouds.size(); ++i) {
     glm::dvec3 centre(0.0);
     for (const Ellipsoid& e : scene.clouds[i].ellipsoids) centre += e.centre;
     centre /= double(scene.clouds[i].ellipsoids.size());
-    clouds.push_back({i, band, glm::length(centre - camera.position)});
+    addCloud(false, i, centre, cloudAltitude(scene.clouds[i]));
+  }
+  for (std::size_t i = 0; i < scene.automata.size(); ++i) {
+    const AutomatonCloudView& cloud = scene.automata[i];
+    const glm::dvec3 centre = 0.5 * (cloud.lowerBound() + cloud.upperBound());
+    addCloud(true, i, centre, centre.z);
   }
   std::sort(clouds.begin(), clouds.end(), [](const CloudEntry& a, const CloudEntry& b) {
     return a.band != b.band ? a.band > b.band : a.distance > b.distance;
@@ -393,7 +404,10 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
   for (int band = top_band; band >= 0; --band) {
     if (next_cloud != clouds.end() && next_cloud->band == band) flushSky();
     for (; next_cloud != clouds.end() && next_cloud->band == band; ++next_cloud)
-      ellipsoids_.drawCloud(scene, next_cloud->index, settings, frame, targets);
+      if (next_cloud->automaton)
+        automata_.drawCloud(scene, next_cloud->index, settings, targets);
+      else
+        ellipsoids_.drawCloud(scene, next_cloud->index, settings, frame, targets);
     // Then the layers of rank band - 1 (rank 0 is nearest the camera) on both sides.
     if (band >= 1) {
       if (std::size_t(band) <= above.size()) pending_above.push_back(above[above.size() - band]);
@@ -404,6 +418,7 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
   ellipsoids_.drawVeil(scene, settings);
   gl_.Disable(GL_BLEND);
   ellipsoids_.endFrame();
+  automata_.endFrame();
   std::erase_if(textures_, [](const auto& entry) { return !entry.second.used; });
 }
 

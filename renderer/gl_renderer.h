@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "renderer/automaton_renderer.h"
 #include "renderer/ellipsoid_renderer.h"
 #include "renderer/gl_objects.h"
 #include "renderer/gl_platform.h"
@@ -32,6 +33,8 @@ class GlRenderer {
 
   // Far-cloud impostors rendered since construction (each reuse saves one).
   int impostorRenders() const { return ellipsoids_.impostorRenders(); }
+  // Automaton volume uploads since construction (one per keyframe change of a cloud).
+  int volumeUploads() const { return automata_.uploads(); }
 
  private:
   enum class TargetFormat { kFloat, kSrgb8 };
@@ -71,6 +74,7 @@ class GlRenderer {
   std::map<std::string, GlObject> programs_;
   std::map<std::string, CachedTexture> textures_;
   EllipsoidRenderer ellipsoids_;
+  AutomatonRenderer automata_;
   TargetRenderer targets_;
 };
 

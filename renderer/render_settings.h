@@ -57,6 +57,10 @@ struct RenderSettings {
   // Far clouds drawn from an impostor rendered once and reused while the view of the cloud
   // changes by less than impostor_tolerance_px pixels; 0 turns impostors off.
   double impostor_tolerance_px = 0.0;
+
+  // Automaton clouds: the view march's step in lattice spacings (the lattice holds
+  // samples_per_cell samples per cell edge). Larger steps are faster and blur thin edges.
+  double volume_step = 1.0;
 };
 
 // The CPU reference (SPEC section 7).

@@ -7,6 +7,8 @@
 #include "config/scene_file.h"
 #include "renderer/gl_renderer.h"
 #include "renderer/reference_renderer.h"
+#include "world/check.h"
+#include "world/world.h"
 
 namespace nephele {
 namespace {
@@ -28,6 +30,9 @@ std::string applyOverrides(const RenderCommandOptions& o, SceneFile& file) {
   if (o.roll) camera.orientation.roll_deg = *o.roll;
   if (o.vfov) camera.vfov_deg = *o.vfov;
   if (o.time) file.scene.time_s = *o.time;
+  if (o.time && !file.dynamics.automata.empty() && *o.time > Limits::kMaxAutomatonTime)
+    return "command line: --time " + std::to_string(*o.time) +
+           " is out of range with automaton clouds (allowed: 0 to 86400 s)";
   // The names were checked against the same lists when the flags were parsed.
   if (o.texture)
     file.render.texture_evaluation =
@@ -49,6 +54,24 @@ std::string applyOverrides(const RenderCommandOptions& o, SceneFile& file) {
   std::string error = validateCamera(camera);
   if (error.empty()) error = validateRenderSettings(r);
   return error.empty() ? "" : "command line: " + error;
+}
+
+// The world at the scene's time: automaton clouds are stepped from time 0, with a progress
+// line when that takes a while.
+Scene sceneAtTime(const SceneFile& file) {
+  World world(file.scene, file.dynamics);
+  const std::int64_t target_ns = std::llround(file.scene.time_s / World::kTimeResolutionS);
+  const int chunks = world.automata().empty() ? 1 : 20;
+  const auto start = Clock::now();
+  for (int i = 1; i <= chunks; ++i) {
+    const std::int64_t next = target_ns / chunks * i + (i == chunks ? target_ns % chunks : 0);
+    const std::string error = world.advance(double(next - world.timeNs()) * World::kTimeResolutionS);
+    NEPHELE_CHECK(error.empty(), error);  // the time was validated with the scene
+    if (const double seconds = millisecondsSince(start) / 1000.0; seconds >= 2.0 && i < chunks)
+      spdlog::info("simulating to t = {:.1f} s: {} %, {} automaton steps", file.scene.time_s,
+                   100 * i / chunks, world.automatonStepsRun());
+  }
+  return world.scene();
 }
 
 GlBackend backendFromName(const std::string& name) {
@@ -141,15 +164,18 @@ int runRenderCommand(const RenderCommandOptions& o) {
     spdlog::error("{}", error);
     return 2;
   }
-  const Scene& scene = file.scene;
+  const auto start = Clock::now();
+  const Scene scene = sceneAtTime(file);
   std::size_t ellipsoids = 0;
   for (const EllipsoidCloud& cloud : scene.clouds) ellipsoids += cloud.ellipsoids.size();
-  spdlog::info("scene {}: {}x{}, {} layer(s), {} cloud(s) of {} ellipsoid(s), {} target(s){}",
-               o.scene_path, scene.camera.width, scene.camera.height, scene.layers.size(),
-               scene.clouds.size(), ellipsoids, scene.targets.size(), scene.fog ? ", fog" : "");
+  spdlog::info(
+      "scene {} at t = {} s: {}x{}, {} layer(s), {} cloud(s) of {} ellipsoid(s), {} automaton "
+      "cloud(s), {} target(s){}",
+      o.scene_path, scene.time_s, scene.camera.width, scene.camera.height, scene.layers.size(),
+      scene.clouds.size(), ellipsoids, scene.automata.size(), scene.targets.size(),
+      scene.fog ? ", fog" : "");
 
   std::string error;
-  const auto start = Clock::now();
   if (o.renderer == "reference") {
     const FloatImage image = renderReference(scene, file.reference, [&](double done) {
       const double seconds = millisecondsSince(start) / 1000.0;

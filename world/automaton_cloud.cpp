@@ -125,7 +125,7 @@ void AutomatonCloud::updateProbabilities(double time_s) {
         const double w = std::max(0.0f, shape_weight_[(std::size_t(k) * n.ny + j) * n.nx + i]);
         fields_.humidity.set(i, j, k, p.x * w);
         fields_.activation.set(i, j, k, p.y * w);
-        fields_.extinction.set(i, j, k, 1.0 - w * (1.0 - p.z));
+        fields_.extinction.set(i, j, k, p.z + (1.0 - p.z) * std::pow(1.0 - w, 4));
       }
 }
 

@@ -15,9 +15,11 @@
 
 namespace nephele {
 
-// Dobashi shapes a cloud with ellipsoids: p_hum and p_act are highest at their centres and
-// fall to 0 at their surfaces, while p_ext rises to 1 there. Centre and radii are fractions
-// of the grid's extent along each axis.
+// Dobashi shapes a cloud with ellipsoids. A cell's weight w = max over the ellipsoids of
+// 1 - |u|^2 (u the cell centre in the ellipsoid's unit frame; 0 outside all of them) sets
+// p_hum = humidity w, p_act = activation w and p_ext = extinction + (1 - extinction)(1 - w)^4:
+// vapour and seeds at the core, certain extinction outside. Centre and radii are fractions of
+// the grid's extent along each axis.
 struct ShapeEllipsoid {
   glm::dvec3 centre{0.5, 0.5, 0.5};
   glm::dvec3 radii{0.5, 0.5, 0.5};
@@ -31,9 +33,10 @@ struct AutomatonCloudSpec {
   std::uint64_t seed = 1;
   double step_interval_s = 2.0;  // simulation time between automaton steps
   int warmup_steps = 40;         // steps run before time 0, so the cloud exists at the start
-  // Probabilities at a shape's centre (weight 1); p = value * weight, p_ext = 1 - weight (1 - value).
-  double humidity = 0.1;
-  double activation = 0.01;
+  // Probabilities at a shape's centre (weight 1). The defaults keep about 70 % of the core
+  // cloudy in the steady state.
+  double humidity = 0.3;
+  double activation = 0.005;
   double extinction = 0.05;
   Schedule humidity_schedule, activation_schedule, extinction_schedule;  // override over time
   std::vector<ShapeEllipsoid> shape;  // none: one ellipsoid filling the grid
@@ -83,6 +86,7 @@ class AutomatonCloud {
   const AutomatonCloudSpec& spec() const { return spec_; }
   const CellularAutomaton& automaton() const { return current_; }
   const CellularAutomaton& previous() const { return previous_; }
+  const AutomatonProbabilities& probabilities() const { return fields_; }
   std::uint64_t stepsSinceStart() const { return current_.steps() - spec_.warmup_steps; }
 
   // Steps until the automaton holds the state after time t (the keyframe after t) and returns

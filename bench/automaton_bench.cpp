@@ -1,0 +1,106 @@
+// Automaton-cloud benchmark: automaton steps on Dobashi's 256x128x20 grid (cell updates per
+// second, one core and more), keyframe and light update times, and frames per second for
+// Shen's two scenes with error against the CPU reference. A program that prints figures.
+//
+//   automaton_bench [--steps N] [--threads 1,2] [--size 1280x1024] [--frames N] [--no-render]
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "bench/bench_common.h"
+#include "config/scene_file.h"
+#include "renderer/gl_renderer.h"
+#include "renderer/image_metrics.h"
+#include "renderer/reference_renderer.h"
+#include "world/world.h"
+
+namespace {
+
+using namespace nephele;
+using Clock = std::chrono::steady_clock;
+
+double millisecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+template <class F>
+double medianMilliseconds(int repeats, F&& f) {
+  std::vector<double> ms;
+  for (int i = 0; i < repeats; ++i) {
+    const auto start = Clock::now();
+    f();
+    ms.push_back(millisecondsSince(start));
+  }
+  std::sort(ms.begin(), ms.end());
+  return ms[ms.size() / 2];
+}
+
+// Dobashi's grid with one shaping ellipsoid filling it: a field of cloud that keeps growing
+// and dying. Steps of the automaton alone (no keyframes), in its steady state.
+void automatonSteps(int steps, const std::vector<int>& thread_counts) {
+  AutomatonCloudSpec spec;
+  spec.cells = {256, 128, 20};
+  spec.warmup_steps = 30;
+  const AutomatonCloud cloud(spec, {}, {0, 0, 1});
+  std::printf("automaton steps, %dx%dx%d cells (%lld)\n", spec.cells.nx, spec.cells.ny,
+              spec.cells.nz, static_cast<long long>(spec.cells.cells()));
+  std::printf("%-8s %12s %18s %10s\n", "threads", "ms/step", "cell updates/s", "cloud %");
+  for (int threads : thread_counts) {
+    CellularAutomaton automaton = cloud.automaton();
+    const double ms =
+        medianMilliseconds(steps, [&] { automaton.step(cloud.probabilities(), threads); });
+    std::printf("%-8d %12.3f %18.3g %10.1f\n", threads, ms, double(spec.cells.cells()) / ms * 1e3,
+                100.0 * double(automaton.count(CellBit::kCld)) / double(spec.cells.cells()));
+  }
+}
+
+// Keyframe (cell means, density lattice, sweep) and relight (sweep alone) times.
+void lightUpdates(int repeats) {
+  std::printf("\nkeyframe and light updates (one cloud, 2 samples per cell)\n");
+  std::printf("%-12s %10s %14s %14s %12s\n", "cells", "samples", "keyframe ms", "relight ms",
+              "step ms");
+  for (const GridSize cells : {GridSize{20, 20, 20}, GridSize{20, 18, 15}, GridSize{40, 40, 30}}) {
+    AutomatonCloudSpec spec;
+    spec.cells = cells;
+    World world(Scene{}, WorldDynamics{{}, {}, {}, {spec}});
+    Sun sun = world.base().sun;
+    double elevation = 30.0;
+    const double relight_ms = medianMilliseconds(repeats, [&] {
+      sun.elevation_deg = (elevation += 1.0);
+      world.setSun(sun);
+    });
+    // Each advance by one interval runs one step and builds one keyframe.
+    const double keyframe_ms =
+        medianMilliseconds(repeats, [&] { world.advance(spec.step_interval_s); });
+    CellularAutomaton automaton = world.automata()[0].automaton();
+    const AutomatonProbabilities& fields = world.automata()[0].probabilities();
+    const double step_ms = medianMilliseconds(repeats, [&] { automaton.step(fields); });
+    const glm::ivec3 dims = world.scene().automata[0].to->lattice.dims;
+    char name[32], samples[32];
+    std::snprintf(name, sizeof name, "%dx%dx%d", cells.nx, cells.ny, cells.nz);
+    std::snprintf(samples, sizeof samples, "%d", dims.x * dims.y * dims.z);
+    std::printf("%-12s %10s %14.3f %14.3f %12.4f\n", name, samples, keyframe_ms, relight_ms,
+                step_ms);
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app("Nephele automaton-cloud benchmark");
+  int steps = 50, repeats = 15;
+  std::vector<int> threads{1, 2};
+  app.add_option("--steps", steps, "Timed automaton steps (median reported)")
+      ->check(CLI::Range(1, 100000));
+  app.add_option("--repeats", repeats, "Timed repeats for light updates and frames")
+      ->check(CLI::Range(1, 1000));
+  app.add_option("--threads", threads, "Thread counts for the automaton table")->delimiter(',');
+  CLI11_PARSE(app, argc, argv);
+  automatonSteps(steps, threads);
+  lightUpdates(repeats);
+  return 0;
+}
