@@ -2,7 +2,7 @@
 // second, one core and more), keyframe and light update times, and frames per second for
 // Shen's two scenes with error against the CPU reference. A program that prints figures.
 //
-//   automaton_bench [--steps N] [--threads 1,2] [--size 1280x1024] [--frames N] [--no-render]
+//   automaton_bench [--steps N] [--repeats N] [--threads 1,2] [--size 1280x1024] [--no-render]
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -88,6 +88,60 @@ void lightUpdates(int repeats) {
   }
 }
 
+// Frames per second at `size` (median frame: render + readback into an 8-bit target) and
+// error against the CPU reference at a quarter of the size, for the march-step knob and the
+// lattice resolution.
+void renderTable(const std::string& presets, const std::string& size, int repeats) {
+  std::string error;
+  auto platform = createGlPlatform(GlBackend::kAuto, error);
+  if (!platform) {
+    std::fprintf(stderr, "%s\n", error.c_str());
+    return;
+  }
+  GlRenderer renderer(*platform);
+  std::printf("\nframes (%s, %s; error: sRGB RGB against the reference at a quarter size, 1 sample "
+              "per pixel)\n",
+              size.c_str(), platform->renderer().c_str());
+  std::printf("%-16s %-22s %9s %8s %9s %9s\n", "preset", "knob", "ms/frame", "fps", "PSNR dB",
+              "max err");
+  struct Case {
+    const char* name;
+    int samples_per_cell;
+    double volume_step;
+  };
+  const Case cases[] = {{"default (2, 1.0)", 2, 1.0},
+                        {"step 2.0", 2, 2.0},
+                        {"step 0.5", 2, 0.5},
+                        {"1 sample per cell", 1, 1.0},
+                        {"3 samples per cell", 3, 1.0}};
+  for (const char* name : {"automaton_cloud", "harbour"}) {
+    SceneFile file;
+    if (std::string e = loadSceneFile(presets + "/" + name + ".toml", file); !e.empty()) {
+      std::fprintf(stderr, "%s\n", e.c_str());
+      return;
+    }
+    if (std::sscanf(size.c_str(), "%dx%d", &file.scene.camera.width, &file.scene.camera.height) != 2)
+      return;
+    FloatImage reference;
+    for (const Case& c : cases) {
+      SceneFile edited = file;
+      for (AutomatonCloudSpec& a : edited.dynamics.automata) a.samples_per_cell = c.samples_per_cell;
+      const Scene scene = World(edited.scene, edited.dynamics).scene();
+      RenderSettings settings;
+      settings.volume_step = c.volume_step;
+      const double ms = bench::medianFrameMilliseconds(renderer, scene, settings, repeats, false);
+      Scene small = scene;
+      small.camera.width /= 4;
+      small.camera.height /= 4;
+      if (reference.rgba.empty()) reference = renderReference(small, {1, 0});
+      const ImageError err = compareImages(renderer.renderFloat(small, settings), reference);
+      std::printf("%-16s %-22s %9.1f %8.1f %9.2f %9.4f\n", name, c.name, ms, 1000.0 / ms,
+                  err.psnr_db, err.max_abs);
+      std::fflush(stdout);
+    }
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -99,8 +153,14 @@ int main(int argc, char** argv) {
   app.add_option("--repeats", repeats, "Timed repeats for light updates and frames")
       ->check(CLI::Range(1, 1000));
   app.add_option("--threads", threads, "Thread counts for the automaton table")->delimiter(',');
+  std::string presets = NEPHELE_SOURCE_DIR "/config/scenes", size = "1280x1024";
+  bool no_render = false;
+  app.add_option("--presets", presets, "Directory of scene files")->capture_default_str();
+  app.add_option("--size", size, "Image size WxH for the frame table")->capture_default_str();
+  app.add_flag("--no-render", no_render, "Skip the frame table");
   CLI11_PARSE(app, argc, argv);
   automatonSteps(steps, threads);
   lightUpdates(repeats);
+  if (!no_render) renderTable(presets, size, repeats);
   return 0;
 }

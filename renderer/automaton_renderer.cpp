@@ -169,8 +169,15 @@ AutomatonRenderer::Volume& AutomatonRenderer::volume(const Scene& scene, std::si
 void AutomatonRenderer::drawCloud(const Scene& scene, std::size_t index,
                                   const RenderSettings& settings, bool targets_drawn) {
   const AutomatonCloudView& cloud = scene.automata[index];
-  const std::vector<glm::vec2> polygon =
-      screenRectangle(scene.camera, cloud.lowerBound(), cloud.upperBound());
+  // March only where either keyframe has density: the lattice samples that bound it.
+  const DensityLattice& a = cloud.from->lattice;
+  const DensityLattice& b = cloud.to->lattice;
+  const glm::ivec3 lo = glm::min(a.occupied_lo, b.occupied_lo);
+  const glm::ivec3 hi = glm::max(a.occupied_hi, b.occupied_hi);
+  if (glm::any(glm::greaterThan(lo, hi))) return;  // no cloud in either keyframe
+  const glm::dvec3 box_lo = cloud.corner + a.position(lo.x, lo.y, lo.z);
+  const glm::dvec3 box_hi = cloud.corner + a.position(hi.x, hi.y, hi.z);
+  const std::vector<glm::vec2> polygon = screenRectangle(scene.camera, box_lo, box_hi);
   if (polygon.empty()) return;
   const Volume& v = volume(scene, index);
   const GLuint p = program(scene.fog.has_value(), targets_drawn, cloud.phase);
@@ -178,8 +185,8 @@ void AutomatonRenderer::drawCloud(const Scene& scene, std::size_t index,
   setViewUniforms(gl_, p, scene.camera, scene.fog);
   const glm::dvec3 eye = scene.camera.position;
   const DensityLattice& lattice = cloud.from->lattice;
-  setUniform3(gl_, p, "u_box_min", cloud.lowerBound() - eye);
-  setUniform3(gl_, p, "u_box_max", cloud.upperBound() - eye);
+  setUniform3(gl_, p, "u_box_min", box_lo - eye);
+  setUniform3(gl_, p, "u_box_max", box_hi - eye);
   setUniform3(gl_, p, "u_lattice_origin", cloud.corner + lattice.origin - eye);
   setUniform3(gl_, p, "u_inv_dims", 1.0 / glm::dvec3(lattice.dims));
   setUniform3(gl_, p, "u_light", cloud.colour * scene.sun.colour);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "world/check.h"
 
@@ -100,17 +101,24 @@ DensityLattice densityLattice(const std::vector<float>& means, GridSize size, do
         const double w = metaballField(glm::length(glm::dvec3(x, y, z)) * lattice.spacing, radius);
         if (w > 0.0) kernel.push_back({{x, y, z}, float(w)});
       }
+  glm::ivec3 lo(std::numeric_limits<int>::max()), hi(std::numeric_limits<int>::min());
   for (int k = 0; k < size.nz; ++k)
     for (int j = 0; j < size.ny; ++j)
       for (int i = 0; i < size.nx; ++i) {
         const float q = means[(std::size_t(k) * size.ny + j) * size.nx + i];
         if (q == 0.0f) continue;
         const glm::ivec3 centre = glm::ivec3(i, j, k) * r + margin;
+        lo = glm::min(lo, centre - margin);
+        hi = glm::max(hi, centre + margin);
         for (const Tap& tap : kernel) {
           const glm::ivec3 s = centre + tap.offset;
           lattice.density[lattice.index(s.x, s.y, s.z)] += q * tap.weight;
         }
       }
+  if (lo.x <= hi.x) {
+    lattice.occupied_lo = glm::max(lo - 1, glm::ivec3(0));
+    lattice.occupied_hi = glm::min(hi + 1, lattice.dims - 1);
+  }
   return lattice;
 }
 

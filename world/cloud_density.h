@@ -33,6 +33,9 @@ struct DensityLattice {
   glm::dvec3 origin{0.0};      // grid-frame position of sample (0, 0, 0)
   std::vector<float> density;  // x fastest
   std::vector<float> sunlight;  // transmittance towards the sun, exp(-tau)
+  // Samples bounding every non-zero density sample, widened by one: the trilinear density is
+  // 0 outside them (lo > hi when the cloud is empty).
+  glm::ivec3 occupied_lo{0}, occupied_hi{-1};
 
   std::size_t index(int x, int y, int z) const {
     return (std::size_t(z) * dims.y + y) * dims.x + x;
