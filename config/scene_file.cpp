@@ -263,7 +263,7 @@ void readFog(TableReader& t, Fog& fog) {
 void readRender(TableReader& t, SceneFile& out) {
   t.allow({"texture", "term_filter", "sky_passes", "bake_texels_per_cycle", "reference_samples",
            "ellipsoid_passes", "ellipsoid_order", "limb", "tile_resolution", "tile_format",
-           "tessellation", "impostor_tolerance"});
+           "tessellation", "impostor_tolerance", "volume_step"});
   out.render.texture_evaluation = TextureEvaluation(
       t.choice("texture", kTextureEvaluationNames, int(out.render.texture_evaluation)));
   out.render.term_filter =
@@ -284,6 +284,7 @@ void readRender(TableReader& t, SceneFile& out) {
   if (std::string error = validateRenderSettings(r); !error.empty())
     t.failAt(error.substr(0, error.find(':')), error.substr(error.find(':') + 2));
   t.number("impostor_tolerance", r.impostor_tolerance_px, 0.0, 100.0);
+  t.number("volume_step", r.volume_step, 0.25, 8.0);
   t.finish();
 }
 
@@ -646,6 +647,9 @@ std::string validateRenderSettings(const RenderSettings& r) {
   if (!(r.impostor_tolerance_px >= 0.0 && r.impostor_tolerance_px <= 100.0))
     return "impostor_tolerance: " + formatNumber(r.impostor_tolerance_px) +
            " is out of range (allowed: 0 to 100 pixels)";
+  if (!(r.volume_step >= 0.25 && r.volume_step <= 8.0))
+    return "volume_step: " + formatNumber(r.volume_step) +
+           " is out of range (allowed: 0.25 to 8 lattice spacings)";
   return "";
 }
 

@@ -50,6 +50,7 @@ std::string applyOverrides(const RenderCommandOptions& o, SceneFile& file) {
   if (o.tile_resolution) r.tile_resolution = *o.tile_resolution;
   if (o.tessellation) r.tessellation = *o.tessellation;
   if (o.impostor_tolerance) r.impostor_tolerance_px = *o.impostor_tolerance;
+  if (o.volume_step) r.volume_step = *o.volume_step;
   if (o.samples) file.reference.samples_per_axis = *o.samples;
   std::string error = validateCamera(camera);
   if (error.empty()) error = validateRenderSettings(r);
@@ -134,6 +135,8 @@ void addRenderCommand(CLI::App& app, RenderCommandOptions& o) {
                   "Multipass ellipsoid mesh: 0 adaptive, or N slices by N stacks (3..256)");
   cmd->add_option("--impostor-tolerance", o.impostor_tolerance,
                   "Reuse far-cloud impostors while they move less than this many pixels (0 off)");
+  cmd->add_option("--volume-step", o.volume_step,
+                  "Automaton clouds: view march step in lattice spacings (0.25..8)");
   cmd->add_option("--samples", o.samples, "Reference supersampling per pixel axis")
       ->check(CLI::Range(1, 16));
   cmd->add_option("--png-compression", o.encode.png_compression, "PNG zlib level")

@@ -88,8 +88,24 @@ TEST_F(RenderCommandTest, RendersACloudWithATargetFromItsMesh) {
       runNephele("render " NEPHELE_SOURCE_DIR "/config/scenes/cumulus_target.toml -o " +
                  path("target.png") + " --width 80 --height 60 --ellipsoid-passes multipass");
   EXPECT_EQ(run.exit_code, 0) << run.output;
-  EXPECT_THAT(run.output, HasSubstr("1 cloud(s) of 27 ellipsoid(s), 2 target(s)"));
+  EXPECT_THAT(run.output, HasSubstr("1 cloud(s) of 27 ellipsoid(s), 0 automaton cloud(s), 2 target(s)"));
   EXPECT_TRUE(std::filesystem::exists(path("target.png")));
+}
+
+TEST_F(RenderCommandTest, RendersAnAutomatonCloudLaterInItsLife) {
+  const CommandResult run =
+      runNephele("render " NEPHELE_SOURCE_DIR "/config/scenes/automaton_cloud.toml -o " +
+                 path("grown.png") + " --width 64 --height 48 --time 20 --volume-step 2");
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_THAT(run.output, HasSubstr("at t = 20 s"));
+  EXPECT_THAT(run.output, HasSubstr("1 automaton cloud(s)"));
+  EXPECT_TRUE(std::filesystem::exists(path("grown.png")));
+  const CommandResult late =
+      runNephele("render " NEPHELE_SOURCE_DIR "/config/scenes/automaton_cloud.toml -o " +
+                 path("late.png") + " --time 100000");
+  EXPECT_EQ(late.exit_code, 2);
+  EXPECT_THAT(late.output, HasSubstr("allowed: 0 to 86400 s"));
+  EXPECT_FALSE(std::filesystem::exists(path("late.png")));
 }
 
 TEST_F(RenderCommandTest, ReferenceRendererWritesExr) {

@@ -26,10 +26,12 @@ TEST(SceneFile, EveryPresetLoads) {
     if (entry.path().extension() != ".toml") continue;
     SceneFile file;
     EXPECT_EQ(loadSceneFile(entry.path().string(), file), "") << entry.path();
-    EXPECT_FALSE(file.scene.layers.empty() && file.scene.clouds.empty()) << entry.path();
+    EXPECT_FALSE(file.scene.layers.empty() && file.scene.clouds.empty() &&
+                 file.dynamics.automata.empty())
+        << entry.path();
     ++count;
   }
-  EXPECT_GE(count, 9);
+  EXPECT_GE(count, 13);
 }
 
 TEST(SceneFile, ReadsEveryField) {
@@ -282,6 +284,117 @@ TEST(SceneFile, MeshTargetsLoadRelativeToTheScene) {
   for (const Target& t : f.scene.targets)
     if (t.shape == TargetShape::kMesh) has_mesh = t.mesh && !t.mesh->triangles.empty();
   EXPECT_TRUE(has_mesh);
+}
+
+TEST(SceneFile, ReadsWindDevelopmentAndAutomata) {
+  SceneFile f;
+  ASSERT_EQ(parseError(R"(
+time = 30.0
+[[wind]]
+altitude = 3000.0
+velocity = [10.0, -2.0]
+[[wind]]
+altitude = 0.0
+velocity = [2.0, 0.0]
+[[layer]]
+altitude = 2000.0
+[layer.develop]
+times = [0.0, 600.0]
+threshold = [0.9, 0.1]
+t0 = [0.0, 2.0]
+[[cloud]]
+[[cloud.ellipsoid]]
+radii = [100.0, 100.0, 50.0]
+[cloud.develop]
+times = [10.0]
+transition = [0.05]
+[[automaton]]
+name = "a"
+cells = [8, 9, 10]
+cell_size = 25.0
+position = [1.0, 2.0, 900.0]
+seed = 77
+step_interval = 1.5
+warmup_steps = 12
+humidity = 0.2
+activation = 0.02
+extinction = 0.1
+phase = "cornette-shanks"
+phase_u = 0.75
+samples_per_cell = 3
+[[automaton.shape]]
+centre = [0.5, 0.5, 0.4]
+radii = [0.4, 0.4, 0.3]
+[automaton.develop]
+times = [0.0, 100.0]
+humidity = [0.2, 0.0]
+[render]
+volume_step = 2.0
+)",
+                       f),
+            "");
+  ASSERT_EQ(f.dynamics.wind.samples.size(), 2u);
+  EXPECT_EQ(f.dynamics.wind.samples[0].altitude_m, 0.0);  // sorted by altitude
+  EXPECT_EQ(f.dynamics.wind.at(3000.0), glm::dvec2(10.0, -2.0));
+  ASSERT_EQ(f.dynamics.layers.size(), 1u);
+  EXPECT_EQ(f.dynamics.layers[0].threshold.at(300.0, -1.0), 0.5);
+  EXPECT_EQ(f.dynamics.layers[0].t0.values.back(), 2.0);
+  EXPECT_TRUE(f.dynamics.layers[0].transition.empty());
+  EXPECT_EQ(f.dynamics.clouds[0].transition.at(0.0, -1.0), 0.05);
+  ASSERT_EQ(f.dynamics.automata.size(), 1u);
+  const AutomatonCloudSpec& a = f.dynamics.automata[0];
+  EXPECT_EQ(a.cells, (GridSize{8, 9, 10}));
+  EXPECT_EQ(a.cell_size_m, 25.0);
+  EXPECT_EQ(a.seed, 77u);
+  EXPECT_EQ(a.warmup_steps, 12);
+  EXPECT_EQ(a.phase, PhaseFunction::kCornetteShanks);
+  EXPECT_EQ(a.phase_u, 0.75);
+  EXPECT_EQ(a.samples_per_cell, 3);
+  ASSERT_EQ(a.shape.size(), 1u);
+  EXPECT_EQ(a.shape[0].radii, glm::dvec3(0.4, 0.4, 0.3));
+  EXPECT_EQ(a.humidity_schedule.at(50.0, -1.0), 0.1);
+  EXPECT_EQ(f.render.volume_step, 2.0);
+}
+
+TEST(SceneFile, BadWindDevelopmentAndAutomataAreRejected) {
+  EXPECT_THAT(parseError("[[automaton]]\ncells = [0, 5, 5]\n"),
+              HasSubstr("automaton[0].cells: 0 is out of range (allowed: 1 to 1024)"));
+  EXPECT_THAT(parseError("[[automaton]]\ncells = [1024, 1024, 1024]\n"),
+              HasSubstr("allowed: at most 16777216"));
+  EXPECT_THAT(parseError("[[automaton]]\ncells = [5, 5]\n"), HasSubstr("array of 3 integers"));
+  EXPECT_THAT(parseError("[[automaton]]\nhumidity = 1.5\n"),
+              HasSubstr("automaton[0].humidity: 1.5 is out of range (allowed: 0 to 1)"));
+  EXPECT_THAT(parseError("[[automaton]]\nphase_u = 0.8\n"),
+              HasSubstr("applies to phase \"cornette-shanks\" only"));
+  EXPECT_THAT(parseError("[[automaton]]\nphase = \"mie\"\n"),
+              HasSubstr("(one of: rayleigh, cornette-shanks)"));
+  EXPECT_THAT(parseError("[[automaton]]\nsize = 3\n"), HasSubstr("unknown key"));
+  EXPECT_THAT(parseError("[[automaton]]\n[automaton.develop]\ntimes = [0.0, 10.0]\n"
+                         "humidity = [0.1]\n"),
+              HasSubstr("has 1 values for 2 times"));
+  EXPECT_THAT(parseError("[[automaton]]\n[automaton.develop]\ntimes = [5.0, 1.0]\n"),
+              HasSubstr("times: must increase strictly"));
+  EXPECT_THAT(parseError("[[automaton]]\n[automaton.develop]\nhumidity = [0.1]\n"),
+              HasSubstr("missing key times"));
+  EXPECT_THAT(parseError("time = 90000.0\n[[automaton]]\n"),
+              HasSubstr("out of range with automaton clouds (allowed: 0 to 86400"));
+  EXPECT_THAT(parseError("[[wind]]\naltitude = 5.0\n"), HasSubstr("missing key velocity"));
+  EXPECT_THAT(parseError("[[wind]]\nvelocity = [1.0, 0.0]\n[[wind]]\nvelocity = [2.0, 0.0]\n"),
+              HasSubstr("two [[wind]] samples at altitude 0"));
+  EXPECT_THAT(parseError("[[wind]]\nvelocity = [1.0, 0.0]\n[[layer]]\ndrift = [1.0, 0.0]\n"),
+              HasSubstr("conflicts with [[wind]]"));
+  EXPECT_THAT(parseError("[[layer]]\n[layer.develop]\ntimes = [0.0]\nthreshold = [1.5]\n"),
+              HasSubstr("values must lie in 0 to 1"));
+  EXPECT_THAT(parseError("[[layer]]\n[layer.texture]\nsource = \"perlin\"\n[layer.develop]\n"
+                         "times = [0.0]\nt0 = [1.0]\n"),
+              HasSubstr("t0: applies to texture source \"gardner\" only"));
+  EXPECT_THAT(parseError("[render]\nvolume_step = 0.1\n"),
+              HasSubstr("render.volume_step: 0.1 is out of range (allowed: 0.25 to 8)"));
+  // A failed parse leaves the output as it was.
+  SceneFile kept;
+  kept.scene.seed = 12345;
+  EXPECT_NE(parseError("[[automaton]]\ncells = [0, 1, 1]\n", kept), "");
+  EXPECT_EQ(kept.scene.seed, 12345u);
 }
 
 }  // namespace
