@@ -99,9 +99,10 @@ void renderTable(const std::string& presets, const std::string& size, int repeat
     return;
   }
   GlRenderer renderer(*platform);
-  std::printf("\nframes (%s, %s; error: sRGB RGB against the reference at a quarter size, 1 sample "
-              "per pixel)\n",
-              size.c_str(), platform->renderer().c_str());
+  std::printf(
+      "\nframes (%s, %s; error: sRGB RGB against the reference at a quarter size, 1 sample "
+      "per pixel)\n",
+      size.c_str(), platform->renderer().c_str());
   std::printf("%-16s %-22s %9s %8s %9s %9s\n", "preset", "knob", "ms/frame", "fps", "PSNR dB",
               "max err");
   struct Case {
@@ -120,12 +121,14 @@ void renderTable(const std::string& presets, const std::string& size, int repeat
       std::fprintf(stderr, "%s\n", e.c_str());
       return;
     }
-    if (std::sscanf(size.c_str(), "%dx%d", &file.scene.camera.width, &file.scene.camera.height) != 2)
+    if (std::sscanf(size.c_str(), "%dx%d", &file.scene.camera.width, &file.scene.camera.height) !=
+        2)
       return;
     FloatImage reference;
     for (const Case& c : cases) {
       SceneFile edited = file;
-      for (AutomatonCloudSpec& a : edited.dynamics.automata) a.samples_per_cell = c.samples_per_cell;
+      for (AutomatonCloudSpec& a : edited.dynamics.automata)
+        a.samples_per_cell = c.samples_per_cell;
       const Scene scene = World(edited.scene, edited.dynamics).scene();
       RenderSettings settings;
       settings.volume_step = c.volume_step;

@@ -375,9 +375,8 @@ void readLayer(TableReader& t, CloudLayer& layer, LayerDevelopment& develop) {
                 0.0, 10.0);
     if (!develop.t0.empty() && layer.texture.source != TextureSource::kGardner)
       d->failAt("t0", "applies to texture source \"gardner\" only");
-    if (!develop.threshold.empty() && std::ranges::any_of(develop.threshold.values, [](double v) {
-          return v > 1.0;
-        }))
+    if (!develop.threshold.empty() &&
+        std::ranges::any_of(develop.threshold.values, [](double v) { return v > 1.0; }))
       d->failAt("threshold", "values must lie in 0 to 1");
   }
   t.finish();
@@ -568,8 +567,9 @@ void readScene(const toml::table& root, const std::string& file, SceneFile& out)
     CloudLayer& layer = scene.layers.emplace_back();
     layer.texture.seed = hashCounters(scene.seed, 0x4c61796572ull, i);  // unless given
     if (!wind.empty())
-      layers[i].forbid("drift", "conflicts with [[wind]]: layers drift with the wind at their "
-                                "altitude (remove one of them)");
+      layers[i].forbid("drift",
+                       "conflicts with [[wind]]: layers drift with the wind at their "
+                       "altitude (remove one of them)");
     readLayer(layers[i], layer, dynamics.layers.emplace_back());
     if (layer.name.empty()) layer.name = "layer" + std::to_string(i);
   }
@@ -582,7 +582,8 @@ void readScene(const toml::table& root, const std::string& file, SceneFile& out)
   }
   std::vector<TableReader> automata = t.tables("automaton");
   if (automata.size() > std::size_t(Limits::kMaxAutomata))
-    t.failAt("automaton", "more than " + std::to_string(Limits::kMaxAutomata) + " automaton clouds");
+    t.failAt("automaton",
+             "more than " + std::to_string(Limits::kMaxAutomata) + " automaton clouds");
   for (std::size_t i = 0; i < automata.size(); ++i) {
     AutomatonCloudSpec& a = dynamics.automata.emplace_back();
     readAutomaton(automata[i], hashCounters(scene.seed, 0x4175746f6dull, i), a);

@@ -87,9 +87,9 @@ std::vector<glm::vec2> screenRectangle(const Camera& camera, glm::dvec3 lo, glm:
   const std::vector<glm::vec2> full{{-1, -1}, {3, -1}, {-1, 3}};
   glm::dvec2 min_ndc(1e30), max_ndc(-1e30);
   for (int corner = 0; corner < 8; ++corner) {
-    const glm::dvec3 p = glm::dvec3(corner & 1 ? hi.x : lo.x, corner & 2 ? hi.y : lo.y,
-                                    corner & 4 ? hi.z : lo.z) -
-                         camera.position;
+    const glm::dvec3 p =
+        glm::dvec3(corner & 1 ? hi.x : lo.x, corner & 2 ? hi.y : lo.y, corner & 4 ? hi.z : lo.z) -
+        camera.position;
     const double depth = glm::dot(p, b.forward);
     if (depth <= 1e-3 * glm::length(p) + 1e-6) return full;
     const glm::dvec2 ndc(glm::dot(p, b.right) / (depth * b.tan_half_vfov * b.aspect),

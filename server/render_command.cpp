@@ -66,7 +66,8 @@ Scene sceneAtTime(const SceneFile& file) {
   const auto start = Clock::now();
   for (int i = 1; i <= chunks; ++i) {
     const std::int64_t next = target_ns / chunks * i + (i == chunks ? target_ns % chunks : 0);
-    const std::string error = world.advance(double(next - world.timeNs()) * World::kTimeResolutionS);
+    const std::string error =
+        world.advance(double(next - world.timeNs()) * World::kTimeResolutionS);
     NEPHELE_CHECK(error.empty(), error);  // the time was validated with the scene
     if (const double seconds = millisecondsSince(start) / 1000.0; seconds >= 2.0 && i < chunks)
       spdlog::info("simulating to t = {:.1f} s: {} %, {} automaton steps", file.scene.time_s,

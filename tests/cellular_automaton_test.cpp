@@ -24,12 +24,11 @@ PlainGrid plainGrowth(const PlainGrid& g) {
     for (int j = 0; j < g.n.ny; ++j)
       for (int i = 0; i < g.n.nx; ++i) {
         const std::size_t c = (std::size_t(k) * g.n.ny + j) * g.n.nx + i;
-        const bool f = g.at(g.act, i + 1, j, k) || g.at(g.act, i - 1, j, k) ||
-                       g.at(g.act, i, j + 1, k) || g.at(g.act, i, j - 1, k) ||
-                       g.at(g.act, i, j, k + 1) || g.at(g.act, i, j, k - 1) ||
-                       g.at(g.act, i + 2, j, k) || g.at(g.act, i - 2, j, k) ||
-                       g.at(g.act, i, j + 2, k) || g.at(g.act, i, j - 2, k) ||
-                       g.at(g.act, i, j, k - 2);
+        const bool f =
+            g.at(g.act, i + 1, j, k) || g.at(g.act, i - 1, j, k) || g.at(g.act, i, j + 1, k) ||
+            g.at(g.act, i, j - 1, k) || g.at(g.act, i, j, k + 1) || g.at(g.act, i, j, k - 1) ||
+            g.at(g.act, i + 2, j, k) || g.at(g.act, i - 2, j, k) || g.at(g.act, i, j + 2, k) ||
+            g.at(g.act, i, j - 2, k) || g.at(g.act, i, j, k - 2);
         next.hum[c] = g.hum[c] && !g.act[c];
         next.cld[c] = g.cld[c] || g.act[c];
         next.act[c] = !g.act[c] && g.hum[c] && f;

@@ -90,8 +90,8 @@ TEST(SweepSunlight, UniformSlabTransmitsExpMinusExRhoL) {
   // nothing and must reproduce the exact exponential; thin (Ex rho h = 0.016 per sample) and
   // optically thick (8 per sample) density. Oblique suns with fractional steps blur the light
   // (the sweep's error, measured against the reference in the render tests).
-  for (const glm::dvec3 direction : {glm::dvec3(0, 0, 1), glm::dvec3(1, 0, 1),
-                                     glm::dvec3(1, -1, 1), glm::dvec3(0, 1, -1)})
+  for (const glm::dvec3 direction :
+       {glm::dvec3(0, 0, 1), glm::dvec3(1, 0, 1), glm::dvec3(1, -1, 1), glm::dvec3(0, 1, -1)})
     for (const auto& [rho, spacing] : {std::pair{1.0f, 1.0}, std::pair{10.0f, 49.0}}) {
       const glm::dvec3 to_sun = glm::normalize(direction);
       DensityLattice l = uniformLattice({30, 30, 30}, spacing, rho);

@@ -88,7 +88,8 @@ TEST_F(RenderCommandTest, RendersACloudWithATargetFromItsMesh) {
       runNephele("render " NEPHELE_SOURCE_DIR "/config/scenes/cumulus_target.toml -o " +
                  path("target.png") + " --width 80 --height 60 --ellipsoid-passes multipass");
   EXPECT_EQ(run.exit_code, 0) << run.output;
-  EXPECT_THAT(run.output, HasSubstr("1 cloud(s) of 27 ellipsoid(s), 0 automaton cloud(s), 2 target(s)"));
+  EXPECT_THAT(run.output,
+              HasSubstr("1 cloud(s) of 27 ellipsoid(s), 0 automaton cloud(s), 2 target(s)"));
   EXPECT_TRUE(std::filesystem::exists(path("target.png")));
 }
 

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 namespace nephele {
@@ -87,11 +88,24 @@ TEST(World, RejectsBadStepsAndChangesNothing) {
   EXPECT_EQ(w.hash(), start);
 }
 
+TEST(World, RefusesToRunItsClockPastItsLimit) {
+  World w(Scene{}, WorldDynamics{});
+  std::string error;
+  int advances = 0;
+  while (error.empty() && advances < 2000) {
+    error = w.advance(World::kMaxAdvanceS);
+    ++advances;
+  }
+  EXPECT_THAT(error, ::testing::HasSubstr("limit"));
+  EXPECT_EQ(advances, 923);  // 2^63 ns is 922.3 advances of 1e7 s
+  EXPECT_GT(w.timeNs(), 0);
+}
+
 TEST(World, DevelopmentSchedulesAndDriftFollowTime) {
   World w = makeWorld();
   ASSERT_EQ(w.advance(600.0), "");
   const Scene s = w.scene();
-  EXPECT_NEAR(s.layers[0].threshold, 0.5, 1e-12);  // halfway from 0.9 to 0.1
+  EXPECT_NEAR(s.layers[0].threshold, 0.5, 1e-12);   // halfway from 0.9 to 0.1
   EXPECT_NEAR(s.clouds[0].transition, 0.1, 1e-12);  // held after its last keyframe
   // The layer at 4000 m drifts with the wind held above 3000 m.
   EXPECT_EQ(s.layers[0].texture.drift_velocity, glm::dvec2(12.0, -4.0));

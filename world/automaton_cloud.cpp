@@ -21,15 +21,16 @@ glm::ivec2 shearCells(glm::dvec2 velocity, std::uint64_t steps, double interval_
 std::string automatonCloudError(const AutomatonCloudSpec& s) {
   std::ostringstream out;
   auto probability = [&](const char* key, double p, const Schedule& schedule) {
-    if (!(p >= 0.0 && p <= 1.0)) out << key << ": " << p << " (allowed: 0 to 1)";
+    if (!(p >= 0.0 && p <= 1.0))
+      out << key << ": " << p << " (allowed: 0 to 1)";
     else if (std::string e = scheduleError(schedule, 0.0, 1.0); !e.empty())
       out << key << " schedule: " << e;
   };
   const int kMaxSide = 1024;
   if (s.cells.nx < 1 || s.cells.ny < 1 || s.cells.nz < 1 || s.cells.nx > kMaxSide ||
       s.cells.ny > kMaxSide || s.cells.nz > kMaxSide)
-    out << "cells: " << s.cells.nx << "x" << s.cells.ny << "x" << s.cells.nz
-        << " (allowed: 1 to " << kMaxSide << " per axis)";
+    out << "cells: " << s.cells.nx << "x" << s.cells.ny << "x" << s.cells.nz << " (allowed: 1 to "
+        << kMaxSide << " per axis)";
   else if (s.cells.cells() > (std::int64_t(1) << 24))
     out << "cells: " << s.cells.cells() << " cells (allowed: at most 16777216)";
   else if (!(s.cell_size_m >= 0.01 && s.cell_size_m <= 1.0e4))
@@ -60,8 +61,8 @@ glm::dvec3 AutomatonCloudView::lowerBound() const {
 }
 
 glm::dvec3 AutomatonCloudView::upperBound() const {
-  return corner + (glm::dvec3(cells.nx, cells.ny, cells.nz) - 0.5 + kMetaballRadiusCells) *
-                      cell_size_m;
+  return corner +
+         (glm::dvec3(cells.nx, cells.ny, cells.nz) - 0.5 + kMetaballRadiusCells) * cell_size_m;
 }
 
 double AutomatonCloudView::exactDensity(glm::dvec3 world) const {
@@ -162,7 +163,8 @@ void AutomatonCloud::rebuildKeyframes() {
 }
 
 int AutomatonCloud::advanceTo(std::int64_t time_ns, int threads) {
-  const std::uint64_t target = std::uint64_t(std::max<std::int64_t>(time_ns, 0) / stepIntervalNs()) + 1;
+  const std::uint64_t target =
+      std::uint64_t(std::max<std::int64_t>(time_ns, 0) / stepIntervalNs()) + 1;
   int ran = 0;
   while (stepsSinceStart() < target) {
     // Only the last two states are shown; earlier ones need no copy.

@@ -40,8 +40,8 @@ struct AutomatonCloudSpec {
   double extinction = 0.05;
   Schedule humidity_schedule, activation_schedule, extinction_schedule;  // override over time
   std::vector<ShapeEllipsoid> shape;  // none: one ellipsoid filling the grid
-  glm::dvec3 colour{1.0, 1.0, 1.0};    // linear RGB albedo
-  double ambient = 0.3;                // isotropic sky light, a fraction of the sun's
+  glm::dvec3 colour{1.0, 1.0, 1.0};   // linear RGB albedo
+  double ambient = 0.3;               // isotropic sky light, a fraction of the sun's
   PhaseFunction phase = PhaseFunction::kRayleigh;
   double phase_u = 0.8;      // Cornette-Shanks u (Shen: 0.7 to 0.85)
   int samples_per_cell = 2;  // density lattice resolution

@@ -11,7 +11,9 @@
 namespace nephele {
 namespace {
 
-int wordsFor(int nx) { return (nx + 63) / 64; }
+int wordsFor(int nx) {
+  return (nx + 63) / 64;
+}
 
 // Runs fn(k_begin, k_end) over [0, nz) split into `threads` slabs of layers.
 template <class Fn>
@@ -133,8 +135,8 @@ void CellularAutomaton::growRows(int k_begin, int k_end, std::vector<std::uint64
                                       (a << 2 | before >> 62) | (a >> 2 | after << 62);
         // f_act: (i+-1, j, k), (i, j+-1, k), (i, j, k+-1), (i+-2, j, k), (i, j+-2, k), (i, j, k-2).
         const std::uint64_t f_act = along_x | actAt(w, j - 1, k) | actAt(w, j + 1, k) |
-                                    actAt(w, j - 2, k) | actAt(w, j + 2, k) |
-                                    actAt(w, j, k - 1) | actAt(w, j, k + 1) | actAt(w, j, k - 2);
+                                    actAt(w, j - 2, k) | actAt(w, j + 2, k) | actAt(w, j, k - 1) |
+                                    actAt(w, j, k + 1) | actAt(w, j, k - 2);
         next[int(CellBit::kHum)][idx] = hum[idx] & ~a;
         next[int(CellBit::kCld)][idx] = cld[idx] | a;
         // hum is 0 in padding lanes, so the new act is too.
@@ -164,15 +166,17 @@ void CellularAutomaton::stochasticRows(const AutomatonProbabilities& p, int k_be
         // Draws only where they can change a bit; each draw depends on (seed, step, cell,
         // purpose) alone, so skipping the others changes nothing.
         if (cld[idx]) cld[idx] &= ~bernoulliWord(p.extinction, idx, cld[idx], ext_key);
-        if (~hum[idx] & lanes) hum[idx] |= bernoulliWord(p.humidity, idx, ~hum[idx] & lanes, hum_key);
-        if (~act[idx] & lanes) act[idx] |= bernoulliWord(p.activation, idx, ~act[idx] & lanes, act_key);
+        if (~hum[idx] & lanes)
+          hum[idx] |= bernoulliWord(p.humidity, idx, ~hum[idx] & lanes, hum_key);
+        if (~act[idx] & lanes)
+          act[idx] |= bernoulliWord(p.activation, idx, ~act[idx] & lanes, act_key);
       }
 }
 
 void CellularAutomaton::stochastic(const AutomatonProbabilities& p, int threads) {
-  NEPHELE_CHECK(p.humidity.size() == size_ && p.activation.size() == size_ &&
-                    p.extinction.size() == size_,
-                "probability fields sized for another grid");
+  NEPHELE_CHECK(
+      p.humidity.size() == size_ && p.activation.size() == size_ && p.extinction.size() == size_,
+      "probability fields sized for another grid");
   forSlabs(size_.nz, threads, [&](int k0, int k1) { stochasticRows(p, k0, k1); });
 }
 

@@ -83,7 +83,8 @@ DensityLattice densityLattice(const std::vector<float>& means, GridSize size, do
   const int margin = int(std::ceil(kMetaballRadiusCells * r));
   DensityLattice lattice;
   lattice.spacing = cell_size / r;
-  lattice.dims = glm::ivec3((size.nx - 1) * r, (size.ny - 1) * r, (size.nz - 1) * r) + 1 + 2 * margin;
+  lattice.dims =
+      glm::ivec3((size.nx - 1) * r, (size.ny - 1) * r, (size.nz - 1) * r) + 1 + 2 * margin;
   lattice.origin = glm::dvec3(0.5 * cell_size - margin * lattice.spacing);
   lattice.density.assign(std::size_t(lattice.dims.x) * lattice.dims.y * lattice.dims.z, 0.0f);
   lattice.sunlight.assign(lattice.density.size(), 1.0f);
@@ -147,7 +148,8 @@ void sweepSunlight(DensityLattice& lattice, glm::dvec3 to_sun, double extinction
     for (int ic = 0; ic < dims[c]; ++ic) {
       // Beyond the first slice lies empty space: its density is 0 at the lattice edge.
       const double rho = lattice.density[at(first, ib, ic)];
-      lattice.sunlight[at(first, ib, ic)] = float(segmentTransmittance(rho, 0.0, length, extinction_per_m));
+      lattice.sunlight[at(first, ib, ic)] =
+          float(segmentTransmittance(rho, 0.0, length, extinction_per_m));
     }
   for (int ia = first - toward_sun; ia >= 0 && ia < dims[a]; ia -= toward_sun) {
     const int up = ia + toward_sun;
@@ -174,7 +176,9 @@ void sweepSunlight(DensityLattice& lattice, glm::dvec3 to_sun, double extinction
   }
 }
 
-double rayleighPhase(double cos_theta) { return 0.75 * (1.0 + cos_theta * cos_theta); }
+double rayleighPhase(double cos_theta) {
+  return 0.75 * (1.0 + cos_theta * cos_theta);
+}
 
 double cornetteShanksPhase(double cos_theta, double g) {
   const double g2 = g * g;

@@ -11,7 +11,7 @@
 namespace nephele {
 
 inline constexpr double kCloudExtinctionPerMetre = 16.33e-3;  // Ex for density 1 (SPEC 6)
-inline constexpr double kMetaballRadiusCells = 2.0;            // R = 2 l (SPEC 6 default)
+inline constexpr double kMetaballRadiusCells = 2.0;           // R = 2 l (SPEC 6 default)
 
 // The metaball field f(r) = -4/9 a^6 + 17/9 a^4 - 22/9 a^2 + 1, a = r / R; 0 beyond R.
 double metaballField(double r, double radius);
@@ -29,9 +29,9 @@ double metaballDensity(const std::vector<float>& means, GridSize size, double ce
 // outside the lattice.
 struct DensityLattice {
   glm::ivec3 dims{0};
-  double spacing = 0.0;        // metres between samples
-  glm::dvec3 origin{0.0};      // grid-frame position of sample (0, 0, 0)
-  std::vector<float> density;  // x fastest
+  double spacing = 0.0;         // metres between samples
+  glm::dvec3 origin{0.0};       // grid-frame position of sample (0, 0, 0)
+  std::vector<float> density;   // x fastest
   std::vector<float> sunlight;  // transmittance towards the sun, exp(-tau)
   // Samples bounding every non-zero density sample, widened by one: the trilinear density is
   // 0 outside them (lo > hi when the cloud is empty).
@@ -67,8 +67,8 @@ enum class PhaseFunction { kRayleigh, kCornetteShanks };
 
 // Both integrate to 4 pi over the sphere (mean 1). cos_theta is the cosine of the scattering
 // angle between the sunlight's direction of travel and the scattered ray's.
-double rayleighPhase(double cos_theta);                      // 3/4 (1 + cos^2)
-double cornetteShanksPhase(double cos_theta, double g);      // Shen eq. 11
-double cornetteShanksAsymmetry(double u);                    // Shen eq. 12-13, g(u)
+double rayleighPhase(double cos_theta);                  // 3/4 (1 + cos^2)
+double cornetteShanksPhase(double cos_theta, double g);  // Shen eq. 11
+double cornetteShanksAsymmetry(double u);                // Shen eq. 12-13, g(u)
 
 }  // namespace nephele

@@ -1,6 +1,7 @@
 #include "world/world.h"
 
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "world/check.h"
@@ -16,7 +17,9 @@ double meanAltitude(const EllipsoidCloud& cloud) {
 
 // Development changes T0 in steps of 1/256 so that a developing layer rebakes its texture
 // a bounded number of times rather than every frame.
-double quantisedT0(double t0) { return std::round(t0 * 256.0) / 256.0; }
+double quantisedT0(double t0) {
+  return std::round(t0 * 256.0) / 256.0;
+}
 
 }  // namespace
 
@@ -51,7 +54,8 @@ std::string worldDynamicsError(const Scene& scene, const WorldDynamics& d) {
   }
   for (const AutomatonCloudSpec& a : d.automata)
     if (out.tellp() == 0)
-      if (std::string e = automatonCloudError(a); !e.empty()) out << "automaton " << a.name << ": " << e;
+      if (std::string e = automatonCloudError(a); !e.empty())
+        out << "automaton " << a.name << ": " << e;
   return out.str();
 }
 
@@ -84,6 +88,8 @@ std::string World::advance(double dt_s) {
   }
   const std::int64_t dt_ns = std::llround(dt_s / kTimeResolutionS);
   if (dt_ns == 0) return {};
+  if (time_ns_ > std::numeric_limits<std::int64_t>::max() - dt_ns)
+    return "dt: the world's clock would pass its limit of about 292 years";
   time_ns_ += dt_ns;
   refreshAutomata();
   return {};

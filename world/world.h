@@ -60,7 +60,6 @@ class World {
 
   // Relights automaton clouds only if the sun's direction changed.
   void setSun(const Sun& sun);
-  void setCamera(const Camera& camera) { base_.camera = camera; }
 
   // The render's view of the world now.
   Scene scene() const;

@@ -73,7 +73,7 @@ class Reader {
 };
 
 template <class A, class T>
-  requires std::is_arithmetic_v<T>
+requires std::is_arithmetic_v<T>
 void io(A& a, T& v) {
   a.raw(v);
 }
@@ -85,7 +85,7 @@ void io(A& a, bool& v) {
   v = b != 0;
 }
 template <class A, class E>
-  requires std::is_enum_v<E>
+requires std::is_enum_v<E>
 void ioEnum(A& a, E& e, int count) {
   std::int32_t v = std::int32_t(e);
   a.raw(v);
@@ -139,7 +139,8 @@ void io(A& a, ShadingParams& s) {
 template <class A>
 void io(A& a, GardnerTextureParams& g) {
   io(a, g.terms), io(a, g.fx1), io(a, g.fy1), io(a, g.t0), io(a, g.seeded_phases), io(a, g.seed);
-  if (g.terms < 1 || g.terms > GardnerTextureParams::kMaxTerms) a.fail("texture terms out of range");
+  if (g.terms < 1 || g.terms > GardnerTextureParams::kMaxTerms)
+    a.fail("texture terms out of range");
 }
 template <class A>
 void io(A& a, LayerTextureSpec& t) {
@@ -167,7 +168,8 @@ void io(A& a, Ellipsoid& e) {
 template <class A>
 void io(A& a, EllipsoidCloud& c) {
   io(a, c.name), io(a, c.colour), io(a, c.threshold_centre), io(a, c.threshold_limb);
-  io(a, c.transition), io(a, c.shading), io(a, c.texture), io(a, c.ellipsoids, 72), io(a, c.drift_m);
+  io(a, c.transition), io(a, c.shading), io(a, c.texture), io(a, c.ellipsoids, 72),
+      io(a, c.drift_m);
 }
 template <class A>
 void io(A& a, std::array<std::uint32_t, 3>& triangle) {
@@ -185,7 +187,8 @@ void io(A& a, Target& t) {
   io(a, mesh.vertices, 24), io(a, mesh.triangles, 12);
   for (const auto& triangle : mesh.triangles)
     for (std::uint32_t v : triangle)
-      if (v >= mesh.vertices.size()) a.fail("target " + t.name + ": a triangle names a missing vertex");
+      if (v >= mesh.vertices.size())
+        a.fail("target " + t.name + ": a triangle names a missing vertex");
   if (A::kReading) t.mesh = std::make_shared<const TriangleMesh>(std::move(mesh));
 }
 template <class A>
