@@ -153,19 +153,6 @@ bool makeEllipsoidRecord(const Ellipsoid& e, const Camera& camera, EllipsoidReco
   return true;
 }
 
-double cloudAltitude(const EllipsoidCloud& cloud) {
-  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  for (const Ellipsoid& e : cloud.ellipsoids) {
-    // Vertical half-extent: |row z of R S|.
-    const glm::dmat3 body = bodyToWorld(e.orientation);
-    const double half = glm::length(
-        glm::dvec3(body[0].z * e.radii.x, body[1].z * e.radii.y, body[2].z * e.radii.z));
-    lo = std::min(lo, e.centre.z - half);
-    hi = std::max(hi, e.centre.z + half);
-  }
-  return 0.5 * (lo + hi);
-}
-
 EllipsoidRenderer::EllipsoidRenderer(const GlApi& gl)
     : gl_(gl), vertex_array_(createVertexArray(gl)) {}
 

@@ -33,10 +33,6 @@ struct EllipsoidRecord {
 bool makeEllipsoidRecord(const Ellipsoid& ellipsoid, const Camera& camera, EllipsoidRecord& out,
                          double& centre_distance);
 
-// The altitude at which a cloud is interleaved with sky layers: the middle of the vertical
-// extent of its ellipsoids.
-double cloudAltitude(const EllipsoidCloud& cloud);
-
 class EllipsoidRenderer {
  public:
   explicit EllipsoidRenderer(const GlApi& gl);

@@ -113,6 +113,10 @@ std::int64_t AutomatonCloud::stepIntervalNs() const {
   return std::max<std::int64_t>(1, std::llround(spec_.step_interval_s * kNsPerSecond));
 }
 
+glm::dvec2 AutomatonCloud::gridWind() const {
+  return wind_.at(spec_.position.z + 0.5 * spec_.cells.nz * spec_.cell_size_m);
+}
+
 void AutomatonCloud::updateProbabilities(double time_s) {
   const glm::dvec3 p(spec_.humidity_schedule.at(time_s, spec_.humidity),
                      spec_.activation_schedule.at(time_s, spec_.activation),
@@ -135,10 +139,10 @@ void AutomatonCloud::stepOnce(int threads) {
   updateProbabilities(double(s) * spec_.step_interval_s);
   current_.step(fields_, threads);
   if (wind_.empty()) return;
-  // The grid rides with the wind at its middle; each layer shifts by its wind relative to that.
+  // Each layer shifts by its wind relative to the grid's.
   const GridSize n = spec_.cells;
   const double l = spec_.cell_size_m;
-  const glm::dvec2 reference = wind_.at(spec_.position.z + 0.5 * n.nz * l);
+  const glm::dvec2 reference = gridWind();
   for (int k = 0; k < n.nz; ++k) {
     const glm::dvec2 relative = wind_.at(spec_.position.z + (k + 0.5) * l) - reference;
     const glm::ivec2 shift = shearCells(relative, s, spec_.step_interval_s, l) -
@@ -209,7 +213,7 @@ AutomatonCloudView AutomatonCloud::view(std::int64_t time_ns) const {
   v.cell_size_m = spec_.cell_size_m;
   const double l = spec_.cell_size_m;
   const double t = double(time_ns) / kNsPerSecond;
-  const glm::dvec2 drift = wind_.at(spec_.position.z + 0.5 * spec_.cells.nz * l) * t;
+  const glm::dvec2 drift = gridWind() * t;
   v.corner = spec_.position - glm::dvec3(0.5 * spec_.cells.nx * l, 0.5 * spec_.cells.ny * l, 0.0) +
              glm::dvec3(drift, 0.0);
   v.from = from_;

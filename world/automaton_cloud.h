@@ -102,6 +102,8 @@ class AutomatonCloud {
   std::int64_t stepIntervalNs() const;
 
  private:
+  // The wind the grid rides with: the wind at its middle height.
+  glm::dvec2 gridWind() const;
   void updateProbabilities(double time_s);
   void stepOnce(int threads);
   std::shared_ptr<AutomatonKeyframe> keyframe(const CellularAutomaton& state) const;

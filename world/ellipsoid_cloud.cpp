@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "world/counter_random.h"
@@ -13,6 +14,19 @@ double smoothstep(double edge0, double edge1, double x) {
   return t * t * (3.0 - 2.0 * t);
 }
 }  // namespace
+
+double cloudAltitude(const EllipsoidCloud& cloud) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const Ellipsoid& e : cloud.ellipsoids) {
+    // Vertical half-extent: |row z of R S|.
+    const glm::dmat3 body = bodyToWorld(e.orientation);
+    const double half = glm::length(
+        glm::dvec3(body[0].z * e.radii.x, body[1].z * e.radii.y, body[2].z * e.radii.z));
+    lo = std::min(lo, e.centre.z - half);
+    hi = std::max(hi, e.centre.z + half);
+  }
+  return 0.5 * (lo + hi);
+}
 
 std::vector<Ellipsoid> cumulusEllipsoids(int count, glm::dvec3 base_centre, double width_m,
                                          std::uint64_t seed) {

@@ -29,6 +29,10 @@ struct EllipsoidCloud {
   glm::dvec3 drift_m{0.0};
 };
 
+// The middle of the vertical extent of a cloud's ellipsoids: where the renderer interleaves it
+// with sky layers and the altitude whose wind carries it.
+double cloudAltitude(const EllipsoidCloud& cloud);
+
 // A cumulus heap of `count` ellipsoids over a base at `base_centre` (the middle of its flat
 // bottom), about `width_m` across: a wide flat base row and smaller rounder lobes stacked
 // towards the top. Deterministic in `seed`.

@@ -9,12 +9,6 @@
 namespace nephele {
 namespace {
 
-double meanAltitude(const EllipsoidCloud& cloud) {
-  double z = 0.0;
-  for (const Ellipsoid& e : cloud.ellipsoids) z += e.centre.z;
-  return cloud.ellipsoids.empty() ? 0.0 : z / double(cloud.ellipsoids.size());
-}
-
 // Development changes T0 in steps of 1/256 so that a developing layer rebakes its texture
 // a bounded number of times rather than every frame.
 double quantisedT0(double t0) {
@@ -125,7 +119,7 @@ Scene World::scene() const {
   }
   if (!dynamics_.wind.empty())
     for (EllipsoidCloud& cloud : s.clouds) {
-      const glm::dvec3 drift(dynamics_.wind.at(meanAltitude(cloud)) * t, 0.0);
+      const glm::dvec3 drift(dynamics_.wind.at(cloudAltitude(cloud)) * t, 0.0);
       for (Ellipsoid& e : cloud.ellipsoids) e.centre += drift;
       cloud.drift_m += drift;
     }
