@@ -92,12 +92,8 @@ void lightUpdates(int repeats) {
 // error against the CPU reference at a quarter of the size, for the march-step knob and the
 // lattice resolution.
 void renderTable(const std::string& presets, const std::string& size, int repeats) {
-  std::string error;
-  auto platform = createGlPlatform(GlBackend::kAuto, error);
-  if (!platform) {
-    std::fprintf(stderr, "%s\n", error.c_str());
-    return;
-  }
+  const auto platform = bench::openPlatform();
+  if (!platform) return;
   GlRenderer renderer(*platform);
   std::printf(
       "\nframes (%s, %s; error: sRGB RGB against the reference at a quarter size, 1 sample "

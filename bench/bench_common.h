@@ -2,7 +2,9 @@
 // Pieces both benchmark programs share: a named knob setting and the timed frame.
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -21,6 +23,14 @@ Knob knob(const char* name, Edit edit) {
   Knob k{name, {}};
   edit(k.settings);
   return k;
+}
+
+// The default GL platform, or null after printing why there is none.
+inline std::unique_ptr<GlPlatform> openPlatform() {
+  std::string error;
+  auto platform = createGlPlatform(GlBackend::kAuto, error);
+  if (!platform) std::fprintf(stderr, "%s\n", error.c_str());
+  return platform;
 }
 
 // Median milliseconds of `repeats` frames after one warm-up (shader compile, texture bake).

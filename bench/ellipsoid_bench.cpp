@@ -91,12 +91,8 @@ int main(int argc, char** argv) {
   app.add_flag("--no-knobs", skip_knobs, "Print only the scaling table");
   CLI11_PARSE(app, argc, argv);
 
-  std::string error;
-  auto platform = createGlPlatform(GlBackend::kAuto, error);
-  if (!platform) {
-    std::fprintf(stderr, "%s\n", error.c_str());
-    return 1;
-  }
+  const auto platform = bench::openPlatform();
+  if (!platform) return 1;
   std::printf("GL: %s, %s; timed: render + readback, 8-bit sRGB target\n",
               std::string(platform->backendName()).c_str(), platform->renderer().c_str());
   GlRenderer renderer(*platform);

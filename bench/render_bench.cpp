@@ -65,12 +65,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
-  std::string error;
-  auto platform = createGlPlatform(GlBackend::kAuto, error);
-  if (!platform) {
-    std::fprintf(stderr, "%s\n", error.c_str());
-    return 1;
-  }
+  const auto platform = bench::openPlatform();
+  if (!platform) return 1;
   std::printf("GL: %s, %s\n", std::string(platform->backendName()).c_str(),
               platform->renderer().c_str());
   std::printf("timed: %s target, render + readback\n", target.c_str());

@@ -288,6 +288,16 @@ void readRender(TableReader& t, SceneFile& out) {
   t.finish();
 }
 
+// Gardner's texture keys, shared by layer and solid textures; base frequencies from
+// `min_frequency` to 10 radians per metre.
+void readGardnerParams(TableReader& t, GardnerTextureParams& g, double min_frequency) {
+  t.integer("terms", g.terms, 1, GardnerTextureParams::kMaxTerms);
+  t.number("fx1", g.fx1, min_frequency, 10.0);
+  t.number("fy1", g.fy1, min_frequency, 10.0);
+  t.number("t0", g.t0, 0.0, 10.0);
+  t.boolean("phases", g.seeded_phases);
+}
+
 void readTexture(TableReader& t, LayerTextureSpec& texture) {
   t.allow({"source", "terms", "fx1", "fy1", "t0", "phases", "tile_size", "size_log2", "roughness",
            "cells", "octaves", "persistence"});
@@ -305,12 +315,7 @@ void readTexture(TableReader& t, LayerTextureSpec& texture) {
   if (texture.source != TextureSource::kDiamondSquare)
     t.forbid("roughness", "applies to source \"diamond-square\" only, not \"" + source + "\"");
 
-  GardnerTextureParams& g = texture.gardner;
-  t.integer("terms", g.terms, 1, GardnerTextureParams::kMaxTerms);
-  t.number("fx1", g.fx1, 1.0e-7, 10.0);
-  t.number("fy1", g.fy1, 1.0e-7, 10.0);
-  t.number("t0", g.t0, 0.0, 10.0);
-  t.boolean("phases", g.seeded_phases);
+  readGardnerParams(t, texture.gardner, 1.0e-7);
   NoiseTableParams& n = texture.table;
   t.vector("tile_size", n.tile_size_m, 1.0, 1.0e7);
   t.integer("size_log2", n.size_log2, 4, 12);
@@ -392,12 +397,7 @@ void readSolidTexture(TableReader& t, SolidTextureSpec& texture) {
     if (!gardner) t.forbid(key, "applies to source \"gardner\" only, not \"perlin\"");
   for (const char* key : {"period", "size_log2", "cells", "octaves", "persistence"})
     if (gardner) t.forbid(key, "applies to source \"perlin\" only, not \"gardner\"");
-  GardnerTextureParams& g = texture.gardner;
-  t.integer("terms", g.terms, 1, GardnerTextureParams::kMaxTerms);
-  t.number("fx1", g.fx1, 1.0e-6, 10.0);
-  t.number("fy1", g.fy1, 1.0e-6, 10.0);
-  t.number("t0", g.t0, 0.0, 10.0);
-  t.boolean("phases", g.seeded_phases);
+  readGardnerParams(t, texture.gardner, 1.0e-6);
   t.number("period", texture.perlin_period_m, 1.0, 1.0e6);
   t.integer("size_log2", texture.perlin_size_log2, 3, 8);
   t.integer("cells", texture.perlin_cells, 1, 32);

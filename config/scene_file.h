@@ -46,7 +46,6 @@ inline const std::vector<std::string> kEllipsoidOrderNames{"centre", "per-pixel"
 inline const std::vector<std::string> kLimbNames{"exact", "spotlight"};
 inline const std::vector<std::string> kTileFormatNames{"rgba8", "float"};
 inline const std::vector<std::string> kPhaseFunctionNames{"rayleigh", "cornette-shanks"};
-inline const std::vector<std::string> kAutomatonMarchNames{"lattice", "exact"};
 
 // Position of `name` in `names`, or -1.
 int nameIndex(const std::vector<std::string>& names, std::string_view name);

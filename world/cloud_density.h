@@ -2,6 +2,7 @@
 // From automaton cells to light (SPEC section 6): metaball density, sunlight through it, and
 // the phase functions of single scattering. Grid frame: metres from the grid's lower corner,
 // cell (i, j, k) centred at ((i, j, k) + 0.5) * cell size.
+#include <cmath>
 #include <vector>
 
 #include <glm/glm.hpp>

@@ -24,7 +24,6 @@ constexpr std::size_t kHeaderBytes = sizeof kMagic + 4 + 8 + 8;
 class Writer {
  public:
   std::vector<std::uint8_t> bytes;
-  bool ok() const { return true; }
   template <class T>
   void raw(T& v) {
     const auto* p = reinterpret_cast<const std::uint8_t*>(&v);
