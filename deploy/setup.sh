@@ -10,7 +10,7 @@ packages=(
   libglm-dev libopenimageio-dev openimageio-tools
   libtomlplusplus-dev nlohmann-json3-dev libcli11-dev libspdlog-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  libxxhash-dev
+  libxxhash-dev libasio-dev
   libmodbus-dev python3-pymodbus python3-numpy mbpoll
 )
 

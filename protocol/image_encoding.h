@@ -4,6 +4,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "world/image.h"
 
@@ -31,6 +32,16 @@ std::string writeImageFile(const std::string& path, const FloatImage& image,
                            const EncodeOptions& options = {});
 std::string writeImageFile(const std::string& path, const Srgb8Image& image,
                            const EncodeOptions& options = {});
+
+// In-memory images for the socket protocol. `colour` selects RGB and `coverage` the alpha;
+// each returns an empty string on success, else what went wrong. PNG takes any selection,
+// JPEG colour only; EXR is linear float (half unless options say otherwise).
+std::string encodeImage(ImageFileFormat format, const Srgb8Image& image, bool colour,
+                        bool coverage, const EncodeOptions& options, std::vector<std::uint8_t>& out);
+std::string encodeImage(const FloatImage& image, bool colour, bool coverage,
+                        const EncodeOptions& options, std::vector<std::uint8_t>& out);
+// Raw 8-bit pixels, rows top-down, the selected channels packed per pixel.
+std::vector<std::uint8_t> packRaw(const Srgb8Image& image, bool colour, bool coverage);
 
 // sRGB-encodes a linear float image to bytes (top-down), keeping alpha linear.
 Srgb8Image toSrgb8(const FloatImage& image);

@@ -37,7 +37,8 @@ std::string textureKey(const LayerTextureSpec& spec, const RenderSettings& setti
   std::ostringstream key;
   key.precision(17);
   key << int(spec.source) << '/' << spec.seed << '/' << spec.drift_velocity.x << '/'
-      << spec.drift_velocity.y << '/';
+      << spec.drift_velocity.y << '/' << spec.drift_offset_m.x << '/' << spec.drift_offset_m.y
+      << '/';
   if (spec.source == TextureSource::kGardner) {
     const GardnerTextureParams& g = spec.gardner;
     key << g.terms << '/' << g.fx1 << '/' << g.fy1 << '/' << g.t0 << '/' << g.seeded_phases << '/'

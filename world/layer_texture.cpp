@@ -48,7 +48,8 @@ glm::dvec2 LayerTexture::driftOffset(double time_s) const {
     const double time_per_period = period_m / std::abs(velocity);
     return wrapPeriodic(velocity * wrapPeriodic(time_s, time_per_period), period_m);
   };
-  return {axis(spec_.drift_velocity.x, p.x), axis(spec_.drift_velocity.y, p.y)};
+  return {wrapPeriodic(axis(spec_.drift_velocity.x, p.x) + spec_.drift_offset_m.x, p.x),
+          wrapPeriodic(axis(spec_.drift_velocity.y, p.y) + spec_.drift_offset_m.y, p.y)};
 }
 
 glm::dvec2 LayerTexture::periodicCoordinate(glm::dvec2 world_xy, double time_s) const {

@@ -31,6 +31,8 @@ struct LayerTextureSpec {
   NoiseTableParams table;
   std::uint64_t seed = 0;               // seeds phases and noise
   glm::dvec2 drift_velocity{0.0, 0.0};  // metres per second, the layer moving with the wind
+  // Drift at time 0, metres: keeps the layer where it was when its wind changes mid-run.
+  glm::dvec2 drift_offset_m{0.0, 0.0};
 };
 
 // An evaluable layer texture: T(X, Y) in [0, 1] at world coordinates and a time.

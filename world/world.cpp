@@ -99,6 +99,41 @@ void World::setSun(const Sun& sun) {
   for (AutomatonCloud& cloud : automata_) cloud.setSun(to_sun);
 }
 
+void World::foldDrift(Scene& scene, const WorldDynamics& dynamics, double sign) const {
+  const double t = timeSeconds();
+  for (CloudLayer& layer : scene.layers)
+    layer.texture.drift_offset_m += sign * layer.texture.drift_velocity * t;
+  if (dynamics.wind.empty()) return;
+  for (EllipsoidCloud& cloud : scene.clouds) {
+    const glm::dvec3 drift(sign * dynamics.wind.at(cloudAltitude(cloud)) * t, 0.0);
+    for (Ellipsoid& e : cloud.ellipsoids) e.centre += drift;
+    cloud.drift_m += drift;
+  }
+}
+
+std::string World::edit(
+    const std::function<std::string(Scene& now, WorldDynamics& dynamics)>& change) {
+  Scene now = base_;
+  WorldDynamics dynamics = dynamics_;
+  foldDrift(now, dynamics, +1.0);
+  if (std::string error = change(now, dynamics); !error.empty()) return error;
+  if (dynamics.automata.size() != dynamics_.automata.size())
+    return "automaton clouds come from the scene file and cannot be added or removed";
+  if (std::string error = worldDynamicsError(now, dynamics); !error.empty()) return error;
+  if (!dynamics.wind.empty())
+    for (CloudLayer& layer : now.layers)
+      layer.texture.drift_velocity = dynamics.wind.at(layer.altitude_m);
+  foldDrift(now, dynamics, -1.0);
+  now.time_s = 0.0;
+  now.sun = base_.sun;  // the sun changes through setSun, which relights
+  now.automata.clear();
+  base_ = std::move(now);
+  dynamics_.wind = dynamics.wind;
+  dynamics_.layers = std::move(dynamics.layers);
+  dynamics_.clouds = std::move(dynamics.clouds);
+  return {};
+}
+
 Scene World::scene() const {
   Scene s = base_;
   const double t = timeSeconds();

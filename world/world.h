@@ -2,6 +2,7 @@
 // The World: every cloud (layers, ellipsoid clouds, automaton clouds), the sun, wind by
 // altitude and simulation time. advance(dt) moves it on; scene() is what a render sees now.
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
 #include <string>
@@ -61,6 +62,12 @@ class World {
   // Relights automaton clouds only if the sun's direction changed.
   void setSun(const Sun& sun);
 
+  // Changes layers, ellipsoid clouds, wind and their development while time, the sun and
+  // automaton clouds carry on. `change` edits the world as it stands now (positions include
+  // the drift so far) and returns an error to cancel. A layer or cloud whose wind changes
+  // stays where it is and drifts on with the new wind. On any error nothing changes.
+  std::string edit(const std::function<std::string(Scene& now, WorldDynamics& dynamics)>& change);
+
   // The render's view of the world now.
   Scene scene() const;
   const Scene& base() const { return base_; }
@@ -78,6 +85,8 @@ class World {
  private:
   World(const Scene& scene, const WorldDynamics& dynamics, int threads, bool warm_up);
   void refreshAutomata();
+  // Moves the drift up to now into (sign +1) or out of (sign -1) the base scene.
+  void foldDrift(Scene& scene, const WorldDynamics& dynamics, double sign) const;
 
   Scene base_;
   WorldDynamics dynamics_;

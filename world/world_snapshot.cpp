@@ -18,7 +18,7 @@ namespace {
 static_assert(std::endian::native == std::endian::little, "snapshots assume a little-endian host");
 
 constexpr char kMagic[8] = {'N', 'E', 'P', 'H', 'S', 'N', 'A', 'P'};
-constexpr std::uint32_t kFormatVersion = 1;
+constexpr std::uint32_t kFormatVersion = 2;
 constexpr std::size_t kHeaderBytes = sizeof kMagic + 4 + 8 + 8;
 
 class Writer {
@@ -147,7 +147,7 @@ void io(A& a, LayerTextureSpec& t) {
   io(a, t.gardner);
   NoiseTableParams& n = t.table;
   io(a, n.tile_size_m), io(a, n.size_log2), io(a, n.roughness), io(a, n.cells), io(a, n.octaves);
-  io(a, n.persistence), io(a, t.seed), io(a, t.drift_velocity);
+  io(a, n.persistence), io(a, t.seed), io(a, t.drift_velocity), io(a, t.drift_offset_m);
 }
 template <class A>
 void io(A& a, CloudLayer& l) {

@@ -1,0 +1,463 @@
+#include "protocol/messages.h"
+
+#include <cmath>
+#include <sstream>
+
+#include <set>
+
+#include "world/limits.h"
+
+namespace nephele {
+namespace {
+
+using nlohmann::json;
+
+struct FieldError {
+  ErrorCode code;
+  std::string message;
+};
+
+std::string formatNumber(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+// Reads one JSON object; every key must be read, and finish() names what is left over.
+class FieldReader {
+ public:
+  FieldReader(const json& object, std::string path) : object_(object), path_(std::move(path)) {}
+
+  bool has(const char* key) const { return object_.contains(key); }
+
+  std::optional<double> number(const char* key, double lo, double hi) {
+    const json* v = take(key);
+    if (!v) return std::nullopt;
+    if (!v->is_number()) fail(key, "must be a number (allowed: " + range(lo, hi) + ")");
+    const double x = v->get<double>();
+    if (!std::isfinite(x) || x < lo || x > hi)
+      fail(key, formatNumber(x) + " is out of range (allowed: " + range(lo, hi) + ")");
+    return x;
+  }
+
+  double requiredNumber(const char* key, double lo, double hi) {
+    if (!has(key)) fail(key, "is missing (allowed: " + range(lo, hi) + ")");
+    return *number(key, lo, hi);
+  }
+
+  std::optional<std::int64_t> integer(const char* key, std::int64_t lo, std::int64_t hi) {
+    const json* v = take(key);
+    if (!v) return std::nullopt;
+    if (!v->is_number_integer())
+      fail(key, "must be an integer (allowed: " + std::to_string(lo) + " to " +
+                    std::to_string(hi) + ")");
+    const bool negative = v->is_number_integer() && !v->is_number_unsigned();
+    const std::int64_t x = negative ? v->get<std::int64_t>()
+                                    : std::int64_t(std::min<std::uint64_t>(
+                                          v->get<std::uint64_t>(), std::uint64_t(INT64_MAX)));
+    if (x < lo || x > hi)
+      fail(key, std::to_string(x) + " is out of range (allowed: " + std::to_string(lo) + " to " +
+                    std::to_string(hi) + ")");
+    return x;
+  }
+
+  std::optional<bool> boolean(const char* key) {
+    const json* v = take(key);
+    if (!v) return std::nullopt;
+    if (!v->is_boolean()) fail(key, "must be true or false");
+    return v->get<bool>();
+  }
+
+  // A name: 1 to kMaxNameLength characters of letters, digits, '_', '-', '.', '/'.
+  std::optional<std::string> name(const char* key) {
+    const json* v = take(key);
+    if (!v) return std::nullopt;
+    const char* allowed =
+        "a string of 1 to 64 letters, digits, '_', '-', '.' or '/', not starting with '.'";
+    if (!v->is_string()) fail(key, std::string("must be ") + allowed);
+    const std::string s = v->get<std::string>();
+    bool ok = !s.empty() && s.size() <= ProtocolLimits::kMaxNameLength && s[0] != '.';
+    for (char c : s)
+      ok = ok && (std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' ||
+                  c == '.' || c == '/');
+    if (!ok) fail(key, std::string("is not allowed (allowed: ") + allowed + ")");
+    return s;
+  }
+
+  std::string requiredName(const char* key) {
+    if (!has(key)) fail(key, "is missing");
+    return *name(key);
+  }
+
+  std::optional<std::string> string(const char* key, std::size_t max_length) {
+    const json* v = take(key);
+    if (!v) return std::nullopt;
+    if (!v->is_string() || v->get_ref<const std::string&>().size() > max_length)
+      fail(key, "must be a string of at most " + std::to_string(max_length) + " characters");
+    return v->get<std::string>();
+  }
+
+  template <int N>
+  std::optional<glm::vec<N, double>> vector(const char* key, double lo, double hi) {
+    const json* v = take(key);
+    if (!v) return std::nullopt;
+    if (!v->is_array() || v->size() != std::size_t(N))
+      fail(key, "must be an array of " + std::to_string(N) + " numbers (allowed: each " +
+                    range(lo, hi) + ")");
+    glm::vec<N, double> out;
+    for (int i = 0; i < N; ++i) {
+      const json& e = (*v)[std::size_t(i)];
+      if (!e.is_number() || !std::isfinite(e.get<double>()) || e.get<double>() < lo ||
+          e.get<double>() > hi)
+        fail(key, "element " + std::to_string(i) + " is not a number in " + range(lo, hi));
+      out[i] = e.get<double>();
+    }
+    return out;
+  }
+
+  // The value of `key` as it is (null when absent), for arrays the reader has no getter for.
+  const json* raw(const char* key) { return take(key); }
+
+  const json* object(const char* key) {
+    const json* v = take(key);
+    if (v && !v->is_object()) fail(key, "must be an object");
+    return v;
+  }
+
+  void finish(const char* allowed) const {
+    for (auto it = object_.begin(); it != object_.end(); ++it)
+      if (!taken_.count(it.key()))
+        throw FieldError{ErrorCode::kBadField, qualified(it.key()) + ": unknown field (allowed: " +
+                                                   allowed + ")"};
+  }
+
+  [[noreturn]] void fail(const std::string& key, const std::string& what) const {
+    throw FieldError{ErrorCode::kBadField, qualified(key) + ": " + what};
+  }
+
+ private:
+  const json* take(const char* key) {
+    taken_.insert(key);
+    auto it = object_.find(key);
+    return it == object_.end() ? nullptr : &*it;
+  }
+  std::string qualified(const std::string& key) const {
+    return path_.empty() ? key : path_ + "." + key;
+  }
+  static std::string range(double lo, double hi) {
+    return formatNumber(lo) + " to " + formatNumber(hi);
+  }
+
+  const json& object_;
+  std::string path_;
+  std::set<std::string> taken_;
+};
+
+ImageFormat readFormat(FieldReader& r, ImageFormat current) {
+  const auto f = r.string("format", 16);
+  if (!f) return current;
+  if (*f == "raw") return ImageFormat::kRaw;
+  if (*f == "png") return ImageFormat::kPng;
+  if (*f == "jpeg") return ImageFormat::kJpeg;
+  if (*f == "exr") return ImageFormat::kExr;
+  r.fail("format", "\"" + *f + "\" is not allowed (allowed: " + std::string(kImageFormatNames) + ")");
+}
+
+// "format" and "channels", if either is given.
+std::optional<ImageRequest> readImage(FieldReader& r) {
+  if (!r.has("format") && !r.has("channels")) return std::nullopt;
+  ImageRequest image;
+  image.format = readFormat(r, image.format);
+  if (const json* channels = r.raw("channels")) {
+    const std::string allowed = " (allowed: a non-empty array of \"colour\" and \"coverage\")";
+    if (!channels->is_array() || channels->empty() || channels->size() > 2)
+      r.fail("channels", "must be an array of channel names" + allowed);
+    image.colour = image.coverage = false;
+    for (const json& c : *channels) {
+      const std::string name = c.is_string() ? c.get<std::string>() : c.dump();
+      bool& flag = name == "colour" ? image.colour : image.coverage;
+      if (name == "depth")
+        r.fail("channels", "\"depth\" is not available from this renderer" + allowed);
+      if ((name != "colour" && name != "coverage") || flag)
+        r.fail("channels", name + " is not allowed or repeated" + allowed);
+      flag = true;
+    }
+  }
+  if (image.format == ImageFormat::kJpeg && image.coverage)
+    r.fail("channels", "jpeg holds colour only (allowed with jpeg: [\"colour\"])");
+  return image;
+}
+
+ViewPatch readViewPatch(FieldReader& r) {
+  ViewPatch p;
+  p.position = r.vector<3>("position", -Limits::kMaxCoordinate, Limits::kMaxCoordinate);
+  if (p.position && p.position->z < 0.0)
+    r.fail("position", "z is below the ground (allowed: z >= 0)");
+  p.heading = r.number("heading", -Limits::kMaxHeading, Limits::kMaxHeading);
+  p.pitch = r.number("pitch", -Limits::kMaxPitch, Limits::kMaxPitch);
+  p.roll = r.number("roll", -Limits::kMaxRoll, Limits::kMaxRoll);
+  p.vfov = r.number("vfov", Limits::kMinVfov, Limits::kMaxVfov);
+  if (auto w = r.integer("width", 1, Limits::kMaxImageSide)) p.width = int(*w);
+  if (auto h = r.integer("height", 1, Limits::kMaxImageSide)) p.height = int(*h);
+  p.image = readImage(r);
+  return p;
+}
+
+WeatherLayer readWeather(FieldReader& r) {
+  WeatherLayer w;
+  if (auto t = r.integer("type", 0, kCloudTypeCount - 1)) w.type = CloudType(*t);
+  w.base_m = r.number("base", 0.0, WeatherLimits::kMaxBase).value_or(w.base_m);
+  w.thickness_m = r.number("thickness", WeatherLimits::kMinThickness, WeatherLimits::kMaxThickness)
+                      .value_or(w.thickness_m);
+  w.coverage = r.number("coverage", 0.0, 100.0).value_or(w.coverage * 100.0) / 100.0;
+  w.wind = r.vector<2>("wind", -WeatherLimits::kMaxWind, WeatherLimits::kMaxWind);
+  if (w.wind && glm::length(*w.wind) > WeatherLimits::kMaxWind)
+    r.fail("wind", "speed is above " + formatNumber(WeatherLimits::kMaxWind) + " m/s");
+  return w;
+}
+
+Command readCommand(const std::string& cmd, FieldReader& r) {
+  using namespace command;
+  if (cmd == "hello") {
+    Hello c{r.string("token", 256)};
+    r.finish("cmd, id, token");
+    return c;
+  }
+  if (cmd == "get_view") {
+    GetView c{r.name("view").value_or("")};
+    r.finish("cmd, id, view");
+    return c;
+  }
+  if (cmd == "set_view") {
+    SetView c{r.requiredName("view"), readViewPatch(r)};
+    r.finish("cmd, id, view, position, heading, pitch, roll, vfov, width, height, format, channels");
+    return c;
+  }
+  if (cmd == "set_weather") {
+    SetWeather c;
+    if (!r.has("layer")) r.fail("layer", "is missing (allowed: 1 to 3, the CIGI cloud layers)");
+    c.layer = int(*r.integer("layer", 1, ProtocolLimits::kWeatherLayers));
+    if (!r.has("type"))
+      r.fail("type", "is missing (allowed: 0 to 10, CIGI cloud types: 0 none, 1 altocumulus, 2 "
+                     "altostratus, 3 cirrocumulus, 4 cirrostratus, 5 cirrus, 6 cumulonimbus, 7 "
+                     "cumulus, 8 nimbostratus, 9 stratocumulus, 10 stratus)");
+    c.weather = readWeather(r);
+    r.finish("cmd, id, layer, type, base, thickness, coverage, wind");
+    return c;
+  }
+  if (cmd == "set_wind") {
+    if (!r.has("velocity")) r.fail("velocity", "is missing ([east, north] m/s)");
+    SetWind c{*r.vector<2>("velocity", -WeatherLimits::kMaxWind, WeatherLimits::kMaxWind)};
+    if (glm::length(c.velocity) > WeatherLimits::kMaxWind)
+      r.fail("velocity", "speed is above " + formatNumber(WeatherLimits::kMaxWind) + " m/s");
+    r.finish("cmd, id, velocity");
+    return c;
+  }
+  if (cmd == "set_sun") {
+    SetSun c{r.number("azimuth", -Limits::kMaxHeading, Limits::kMaxHeading),
+             r.number("elevation", -Limits::kMaxPitch, Limits::kMaxPitch)};
+    r.finish("cmd, id, azimuth, elevation");
+    return c;
+  }
+  if (cmd == "set_time") {
+    SetTime c{r.number("time_scale", 0.0, ProtocolLimits::kMaxTimeScale), r.boolean("paused"),
+              r.number("advance", 0.0, Limits::kMaxTime)};
+    r.finish("cmd, id, time_scale, paused, advance");
+    return c;
+  }
+  if (cmd == "add_cloud") {
+    const json* cloud = r.object("cloud");
+    if (!cloud) r.fail("cloud", "is missing (an object with the keys of a scene file's [[cloud]])");
+    AddCloud c{*cloud};
+    r.finish("cmd, id, cloud");
+    return c;
+  }
+  if (cmd == "change_cloud") {
+    ChangeCloud c;
+    c.name = r.requiredName("name");
+    c.move = r.vector<3>("move", -Limits::kMaxCoordinate, Limits::kMaxCoordinate);
+    c.threshold = r.number("threshold", -2.0, 2.0);
+    c.limb_threshold = r.number("limb_threshold", -2.0, 2.0);
+    c.transition = r.number("transition", 0.0, 10.0);
+    c.colour = r.vector<3>("colour", 0.0, 100.0);
+    r.finish("cmd, id, name, move, threshold, limb_threshold, transition, colour");
+    return c;
+  }
+  if (cmd == "remove_cloud") {
+    RemoveCloud c{r.requiredName("name")};
+    r.finish("cmd, id, name");
+    return c;
+  }
+  if (cmd == "tick") {
+    Tick c{r.requiredNumber("dt", 0.0, 3600.0)};
+    r.finish("cmd, id, dt");
+    return c;
+  }
+  if (cmd == "render") {
+    Render c{r.requiredName("view"), readImage(r)};
+    r.finish("cmd, id, view, format, channels");
+    return c;
+  }
+  if (cmd == "subscribe") {
+    Subscribe c;
+    c.view = r.requiredName("view");
+    c.rate_hz = r.number("rate", 0.01, ProtocolLimits::kMaxSubscriptionHz).value_or(c.rate_hz);
+    c.image = readImage(r);
+    r.finish("cmd, id, view, rate, format, channels");
+    return c;
+  }
+  if (cmd == "unsubscribe") {
+    if (!r.has("subscription")) r.fail("subscription", "is missing");
+    Unsubscribe c{*r.integer("subscription", 1, INT64_MAX)};
+    r.finish("cmd, id, subscription");
+    return c;
+  }
+  if (cmd == "snapshot" || cmd == "restore") {
+    const std::string name = r.requiredName("name");
+    if (name.find('/') != std::string::npos) r.fail("name", "must not contain '/'");
+    r.finish("cmd, id, name");
+    if (cmd == "snapshot") return Snapshot{name};
+    return Restore{name};
+  }
+  if (cmd == "stats" || cmd == "hash") {
+    r.finish("cmd, id");
+    if (cmd == "stats") return Stats{};
+    return Hash{};
+  }
+  throw FieldError{ErrorCode::kUnknownCommand,
+                   "cmd: \"" + cmd + "\" is not a command (allowed: " + std::string(kCommandNames) +
+                       ")"};
+}
+
+// Nesting depth of JSON text, counted before parsing so that deep input cannot exhaust
+// the stack of a recursive parser or destructor.
+int nestingDepth(std::string_view text) {
+  int depth = 0, deepest = 0;
+  bool in_string = false, escaped = false;
+  for (char c : text) {
+    if (in_string) {
+      if (escaped) escaped = false;
+      else if (c == '\\') escaped = true;
+      else if (c == '"') in_string = false;
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      deepest = std::max(deepest, ++depth);
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return deepest;
+}
+
+}  // namespace
+
+std::string_view errorCodeName(ErrorCode code) {
+  switch (code) {
+    case ErrorCode::kBadJson: return "bad_json";
+    case ErrorCode::kBadField: return "bad_field";
+    case ErrorCode::kUnknownCommand: return "unknown_command";
+    case ErrorCode::kTooLarge: return "too_large";
+    case ErrorCode::kUnauthorized: return "unauthorized";
+    case ErrorCode::kBusy: return "busy";
+    case ErrorCode::kNotFound: return "not_found";
+    case ErrorCode::kLimit: return "limit";
+    case ErrorCode::kFailed: return "failed";
+  }
+  return "failed";
+}
+
+std::string_view imageFormatName(ImageFormat format) {
+  switch (format) {
+    case ImageFormat::kRaw: return "raw";
+    case ImageFormat::kPng: return "png";
+    case ImageFormat::kJpeg: return "jpeg";
+    case ImageFormat::kExr: return "exr";
+  }
+  return "raw";
+}
+
+std::string_view commandName(const Command& command) {
+  static constexpr std::string_view kNames[] = {
+      "hello",        "get_view",     "set_view", "set_weather", "set_wind",  "set_sun",
+      "set_time",     "add_cloud",    "change_cloud", "remove_cloud", "tick", "render",
+      "subscribe",    "unsubscribe",  "snapshot", "restore",     "stats",     "hash"};
+  static_assert(std::size(kNames) == std::variant_size_v<Command>);
+  return kNames[command.index()];
+}
+
+std::variant<Request, BadRequest> parseRequest(std::string_view line) {
+  if (line.size() >= ProtocolLimits::kMaxRequestBytes)
+    return BadRequest{nullptr, {ErrorCode::kTooLarge,
+                                "request is " + std::to_string(line.size()) +
+                                    " bytes (allowed: less than " +
+                                    std::to_string(ProtocolLimits::kMaxRequestBytes) + ")"}};
+  if (nestingDepth(line) > ProtocolLimits::kMaxJsonDepth)
+    return BadRequest{nullptr, {ErrorCode::kBadJson,
+                                "request nests deeper than " +
+                                    std::to_string(ProtocolLimits::kMaxJsonDepth) + " levels"}};
+  json root = json::parse(line, nullptr, /*allow_exceptions=*/false);
+  if (root.is_discarded())
+    return BadRequest{nullptr, {ErrorCode::kBadJson, "request is not valid JSON"}};
+  if (!root.is_object())
+    return BadRequest{nullptr, {ErrorCode::kBadJson, "request must be a JSON object"}};
+  json id = nullptr;
+  if (auto it = root.find("id"); it != root.end()) {
+    if (!it->is_number() && !(it->is_string() && it->get_ref<const std::string&>().size() <= 64) &&
+        !it->is_null())
+      return BadRequest{nullptr,
+                        {ErrorCode::kBadField,
+                         "id: must be a number, a string of at most 64 characters, or null"}};
+    id = *it;
+  }
+  auto cmd = root.find("cmd");
+  if (cmd == root.end() || !cmd->is_string())
+    return BadRequest{id, {ErrorCode::kBadField,
+                           "cmd: is missing or not a string (allowed: " +
+                               std::string(kCommandNames) + ")"}};
+  try {
+    FieldReader reader(root, "");
+    reader.raw("cmd");
+    reader.raw("id");
+    return Request{id, readCommand(cmd->get<std::string>(), reader)};
+  } catch (const FieldError& e) {
+    return BadRequest{id, {e.code, e.message}};
+  } catch (const std::exception& e) {  // nlohmann type errors: a backstop
+    return BadRequest{id, {ErrorCode::kBadField, std::string("request: ") + e.what()}};
+  }
+}
+
+std::string okReply(const json& id, const json& result) {
+  return json{{"id", id}, {"ok", true}, {"result", result}}.dump(-1, ' ', false,
+                                                                  json::error_handler_t::replace) +
+         "\n";
+}
+
+std::string errorReply(const json& id, const ProtocolError& error) {
+  return json{{"id", id},
+              {"ok", false},
+              {"error", {{"code", errorCodeName(error.code)}, {"message", error.message}}}}
+             .dump(-1, ' ', false, json::error_handler_t::replace) +
+         "\n";
+}
+
+std::string imageReplyHeader(const json& id, json image, std::size_t byte_count) {
+  image["bytes"] = byte_count;
+  return okReply(id, json{{"image", std::move(image)}});
+}
+
+std::string frameEventHeader(std::int64_t subscription, json image, std::size_t byte_count) {
+  image["bytes"] = byte_count;
+  return json{{"event", "frame"}, {"subscription", subscription}, {"image", std::move(image)}}
+             .dump(-1, ' ', false, json::error_handler_t::replace) +
+         "\n";
+}
+
+json channelNames(const ImageRequest& image) {
+  json out = json::array();
+  if (image.colour) out.push_back("colour");
+  if (image.coverage) out.push_back("coverage");
+  return out;
+}
+
+}  // namespace nephele

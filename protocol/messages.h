@@ -1,0 +1,168 @@
+#pragma once
+// The socket protocol's messages (protocol/PROTOCOL.md): newline-delimited JSON requests
+// become typed commands here, and replies become bytes. No sockets.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
+
+#include "world/weather.h"
+
+namespace nephele {
+
+struct ProtocolLimits {
+  static constexpr std::size_t kMaxRequestBytes = 64 * 1024;  // one request line, newline included
+  static constexpr int kMaxJsonDepth = 16;                     // nesting of arrays and objects
+  static constexpr std::size_t kMaxNameLength = 64;            // view, cloud and snapshot names
+  static constexpr double kMaxSubscriptionHz = 60.0;
+  static constexpr double kMaxTimeScale = 1000.0;
+  static constexpr int kWeatherLayers = 3;  // CIGI cloud layers 1 to 3
+};
+
+enum class ErrorCode {
+  kBadJson,         // the line is not JSON, or not an object
+  kBadField,        // a field is missing, of the wrong type or out of range
+  kUnknownCommand,  // "cmd" names no command
+  kTooLarge,        // a request line longer than kMaxRequestBytes
+  kUnauthorized,    // a token is configured and this connection has not sent it
+  kBusy,            // the daemon's work queue is full; try again
+  kNotFound,        // no such view, cloud, subscription or snapshot
+  kLimit,           // a configured limit (image size, subscriptions, clients)
+  kFailed,          // the request was valid but could not be carried out (I/O, render)
+};
+std::string_view errorCodeName(ErrorCode code);
+
+struct ProtocolError {
+  ErrorCode code = ErrorCode::kBadField;
+  std::string message;
+};
+
+enum class ImageFormat { kRaw, kPng, kJpeg, kExr };
+inline constexpr std::string_view kImageFormatNames = "raw, png, jpeg, exr";
+std::string_view imageFormatName(ImageFormat format);
+
+// What an image carries: colour (RGB), coverage (A) or both, in that order.
+struct ImageRequest {
+  ImageFormat format = ImageFormat::kRaw;
+  bool colour = true;
+  bool coverage = true;
+  int channelCount() const { return (colour ? 3 : 0) + (coverage ? 1 : 0); }
+};
+
+// Fields of a view; unset ones stay as they are.
+struct ViewPatch {
+  std::optional<glm::dvec3> position;
+  std::optional<double> heading, pitch, roll, vfov;
+  std::optional<int> width, height;
+  std::optional<ImageRequest> image;  // the view's default format and channels
+};
+
+namespace command {
+struct Hello {
+  std::optional<std::string> token;
+};
+struct GetView {
+  std::string view;  // empty: every view
+};
+struct SetView {
+  std::string view;
+  ViewPatch patch;
+};
+struct SetWeather {
+  int layer = 1;  // 1 to kWeatherLayers
+  WeatherLayer weather;
+};
+struct SetWind {
+  glm::dvec2 velocity{0.0};  // east, north m/s, at every altitude
+};
+struct SetSun {
+  std::optional<double> azimuth, elevation;
+};
+struct SetTime {
+  std::optional<double> time_scale;  // simulated seconds per real second
+  std::optional<bool> paused;
+  std::optional<double> advance;  // seconds to move on at once
+};
+struct AddCloud {
+  nlohmann::json cloud;  // the keys of a scene file's [[cloud]] table
+};
+struct ChangeCloud {
+  std::string name;
+  std::optional<glm::dvec3> move;  // metres to move by
+  std::optional<double> threshold, limb_threshold, transition;
+  std::optional<glm::dvec3> colour;
+};
+struct RemoveCloud {
+  std::string name;
+};
+struct Tick {
+  double dt = 0.0;
+};
+struct Render {
+  std::string view;
+  std::optional<ImageRequest> image;  // unset: the view's own
+};
+struct Subscribe {
+  std::string view;
+  double rate_hz = 10.0;
+  std::optional<ImageRequest> image;
+};
+struct Unsubscribe {
+  std::int64_t subscription = 0;
+};
+struct Snapshot {
+  std::string name;
+};
+struct Restore {
+  std::string name;
+};
+struct Stats {};
+struct Hash {};
+}  // namespace command
+
+using Command =
+    std::variant<command::Hello, command::GetView, command::SetView, command::SetWeather,
+                 command::SetWind, command::SetSun, command::SetTime, command::AddCloud,
+                 command::ChangeCloud, command::RemoveCloud, command::Tick, command::Render,
+                 command::Subscribe, command::Unsubscribe, command::Snapshot, command::Restore,
+                 command::Stats, command::Hash>;
+std::string_view commandName(const Command& command);
+inline constexpr std::string_view kCommandNames =
+    "hello, get_view, set_view, set_weather, set_wind, set_sun, set_time, add_cloud, "
+    "change_cloud, remove_cloud, tick, render, subscribe, unsubscribe, snapshot, restore, "
+    "stats, hash";
+
+struct Request {
+  nlohmann::json id;  // echoed in the reply: a number, a string or null
+  Command command;
+};
+
+// A request that could not be parsed, with the id if one was readable.
+struct BadRequest {
+  nlohmann::json id;
+  ProtocolError error;
+};
+
+// One request line (without its newline). Never throws.
+std::variant<Request, BadRequest> parseRequest(std::string_view line);
+
+// Reply lines, each ending in a newline.
+std::string okReply(const nlohmann::json& id, const nlohmann::json& result);
+std::string errorReply(const nlohmann::json& id, const ProtocolError& error);
+// An image reply's header line; `image` describes the bytes that follow it
+// (format, width, height, channels, ...), and gets "bytes": byte_count.
+std::string imageReplyHeader(const nlohmann::json& id, nlohmann::json image,
+                             std::size_t byte_count);
+// A frame pushed to a subscriber: an event header line, then the bytes.
+std::string frameEventHeader(std::int64_t subscription, nlohmann::json image,
+                             std::size_t byte_count);
+
+// Channel names of an image request, e.g. ["colour", "coverage"].
+nlohmann::json channelNames(const ImageRequest& image);
+
+}  // namespace nephele
