@@ -2,6 +2,8 @@
 
 #include <toml++/toml.h>
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -11,207 +13,20 @@
 #include <limits>
 #include <set>
 #include <sstream>
+#include <variant>
 #include <vector>
 
 #include "config/obj_mesh.h"
+#include "config/table_reader.h"
 #include "world/counter_random.h"
 
 namespace nephele {
 namespace {
 
-struct SceneError {
-  std::string message;
-};
-
-std::string formatNumber(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
-std::string joinKeys(const std::vector<std::string>& keys) {
-  std::string out;
-  for (const auto& k : keys) out += (out.empty() ? "" : ", ") + k;
-  return out;
-}
-
-// Reads one TOML table; every key must be consumed by exactly one typed getter, and
-// finish() reports whatever is left as unknown.
-class TableReader {
- public:
-  TableReader(const toml::table& table, std::string path, const std::string& file)
-      : table_(table), path_(std::move(path)), file_(file) {}
-
-  bool has(std::string_view key) const { return table_.contains(key); }
-
-  void number(std::string_view key, double& out, double lo, double hi) {
-    const toml::node* node = take(key);
-    if (!node) return;
-    out = toNumber(*node, key, lo, hi);
-  }
-
-  void integer(std::string_view key, int& out, int lo, int hi) {
-    const toml::node* node = take(key);
-    if (!node) return;
-    out = int(toInteger(*node, key, lo, hi));
-  }
-
-  void seed(std::string_view key, std::uint64_t& out) {
-    const toml::node* node = take(key);
-    if (!node) return;
-    out = std::uint64_t(toInteger(*node, key, 0, std::numeric_limits<std::int64_t>::max()));
-  }
-
-  void boolean(std::string_view key, bool& out) {
-    const toml::node* node = take(key);
-    if (!node) return;
-    if (!node->is_boolean()) fail(*node, key, "must be true or false");
-    out = node->value<bool>().value();
-  }
-
-  // A string that must be one of `allowed`; returns its index.
-  int choice(std::string_view key, const std::vector<std::string>& allowed, int current) {
-    const toml::node* node = take(key);
-    if (!node) return current;
-    if (!node->is_string())
-      fail(*node, key, "must be a string (one of: " + joinKeys(allowed) + ")");
-    const std::string value = node->value<std::string>().value();
-    if (const int index = nameIndex(allowed, value); index >= 0) return index;
-    fail(*node, key, "\"" + value + "\" is not allowed (one of: " + joinKeys(allowed) + ")");
-  }
-
-  void string(std::string_view key, std::string& out) {
-    const toml::node* node = take(key);
-    if (!node) return;
-    if (!node->is_string()) fail(*node, key, "must be a string");
-    out = node->value<std::string>().value();
-  }
-
-  template <int N>
-  void vector(std::string_view key, glm::vec<N, double>& out, double lo, double hi) {
-    const toml::node* node = take(key);
-    if (!node) return;
-    const toml::array* array = node->as_array();
-    if (!array || array->size() != std::size_t(N))
-      fail(*node, key, "must be an array of " + std::to_string(N) + " numbers");
-    for (int i = 0; i < N; ++i) out[i] = toNumber(*array->get(std::size_t(i)), key, lo, hi);
-  }
-
-  // An array of numbers, each in [lo, hi], of at most `max_count` entries.
-  void numbers(std::string_view key, std::vector<double>& out, double lo, double hi,
-               std::size_t max_count) {
-    const toml::node* node = take(key);
-    if (!node) return;
-    const toml::array* array = node->as_array();
-    if (!array || array->empty() || array->size() > max_count)
-      fail(*node, key, "must be an array of 1 to " + std::to_string(max_count) + " numbers");
-    out.clear();
-    for (const toml::node& v : *array) out.push_back(toNumber(v, key, lo, hi));
-  }
-
-  // Three integers, each in [lo, hi].
-  void integers3(std::string_view key, int (&out)[3], int lo, int hi) {
-    const toml::node* node = take(key);
-    if (!node) return;
-    const toml::array* array = node->as_array();
-    if (!array || array->size() != 3) fail(*node, key, "must be an array of 3 integers");
-    for (int i = 0; i < 3; ++i) out[i] = int(toInteger(*array->get(std::size_t(i)), key, lo, hi));
-  }
-
-  // A sub-table (absent: null). Its reader must be finished by the caller.
-  std::optional<TableReader> table(std::string_view key) {
-    const toml::node* node = take(key);
-    if (!node) return std::nullopt;
-    if (!node->is_table()) fail(*node, key, "must be a table");
-    return TableReader(*node->as_table(), qualified(key), file_);
-  }
-
-  // An array of tables ([[key]]).
-  std::vector<TableReader> tables(std::string_view key) {
-    std::vector<TableReader> out;
-    const toml::node* node = take(key);
-    if (!node) return out;
-    const toml::array* array = node->as_array();
-    if (!array || !array->is_array_of_tables())
-      fail(*node, key, "must be an array of tables, written [[" + std::string(key) + "]]");
-    for (std::size_t i = 0; i < array->size(); ++i)
-      out.emplace_back(*array->get(i)->as_table(), qualified(key) + "[" + std::to_string(i) + "]",
-                       file_);
-    return out;
-  }
-
-  // Rejects a key that is present but does not apply here.
-  void forbid(std::string_view key, const std::string& why) {
-    if (const toml::node* node = table_.get(key)) fail(*node, key, why);
-  }
-
-  void finish() const {
-    for (auto&& [key, node] : table_) {
-      if (taken_.count(std::string(key.str()))) continue;
-      fail(node, key.str(), "unknown key (allowed here: " + joinKeys(allowed_) + ")");
-    }
-  }
-
-  // Declares the keys this table accepts, for the unknown-key message.
-  void allow(std::vector<std::string> keys) { allowed_ = std::move(keys); }
-
-  [[noreturn]] void failAt(std::string_view key, const std::string& what) const {
-    fail(*table_.get(key), key, what);
-  }
-
-  // An error about the table as a whole (a missing key, a missing part).
-  [[noreturn]] void failHere(const std::string& what) const {
-    throw SceneError{file_ + ":" + std::to_string(table_.source().begin.line) + ": " +
-                     (path_.empty() ? std::string("scene") : path_) + ": " + what};
-  }
-
-  [[noreturn]] void fail(const toml::node& node, std::string_view key,
-                         const std::string& what) const {
-    throw SceneError{file_ + ":" + std::to_string(node.source().begin.line) + ": " +
-                     qualified(key) + ": " + what};
-  }
-
- private:
-  const toml::node* take(std::string_view key) {
-    taken_.insert(std::string(key));
-    return table_.get(key);
-  }
-
-  std::string qualified(std::string_view key) const {
-    return path_.empty() ? std::string(key) : path_ + "." + std::string(key);
-  }
-
-  double toNumber(const toml::node& node, std::string_view key, double lo, double hi) const {
-    if (!node.is_number()) fail(node, key, "must be a number");
-    const double v = node.value<double>().value();
-    if (!std::isfinite(v))
-      fail(node, key,
-           formatNumber(v) + " is not a finite number (allowed: " + formatNumber(lo) + " to " +
-               formatNumber(hi) + ")");
-    if (v < lo || v > hi)
-      fail(node, key,
-           formatNumber(v) + " is out of range (allowed: " + formatNumber(lo) + " to " +
-               formatNumber(hi) + ")");
-    return v;
-  }
-
-  std::int64_t toInteger(const toml::node& node, std::string_view key, std::int64_t lo,
-                         std::int64_t hi) const {
-    if (!node.is_integer()) fail(node, key, "must be an integer");
-    const std::int64_t v = node.value<std::int64_t>().value();
-    if (v < lo || v > hi)
-      fail(node, key,
-           std::to_string(v) + " is out of range (allowed: " + std::to_string(lo) + " to " +
-               std::to_string(hi) + ")");
-    return v;
-  }
-
-  const toml::table& table_;
-  std::string path_;
-  const std::string& file_;
-  std::set<std::string> taken_;
-  std::vector<std::string> allowed_;
-};
+using config_detail::formatNumber;
+using config_detail::joinKeys;
+using config_detail::SceneError;
+using config_detail::TableReader;
 
 constexpr double kMaxColour = 100.0;  // linear RGB; above 1 is allowed for bright HDR suns
 
@@ -602,7 +417,67 @@ void readScene(const toml::table& root, const std::string& file, SceneFile& out)
   t.finish();
 }
 
+// JSON to TOML, so that JSON objects go through the same readers as scene files. Null has
+// no TOML form and yields nothing.
+using TomlValue =
+    std::variant<toml::table, toml::array, bool, std::int64_t, double, std::string>;
+
+std::optional<TomlValue> tomlFromJson(const nlohmann::json& j);
+
+bool fillTable(const nlohmann::json& j, toml::table& out) {
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    std::optional<TomlValue> v = tomlFromJson(*it);
+    if (!v) return false;
+    std::visit([&](auto&& x) { out.insert(it.key(), std::move(x)); }, std::move(*v));
+  }
+  return true;
+}
+
+std::optional<TomlValue> tomlFromJson(const nlohmann::json& j) {
+  if (j.is_object()) {
+    toml::table table;
+    if (!fillTable(j, table)) return std::nullopt;
+    return TomlValue(std::move(table));
+  }
+  if (j.is_array()) {
+    toml::array array;
+    for (const auto& e : j) {
+      std::optional<TomlValue> v = tomlFromJson(e);
+      if (!v) return std::nullopt;
+      std::visit([&](auto&& x) { array.push_back(std::move(x)); }, std::move(*v));
+    }
+    return TomlValue(std::move(array));
+  }
+  if (j.is_boolean()) return TomlValue(j.get<bool>());
+  if (j.is_number_integer() &&
+      !(j.is_number_unsigned() && j.get<std::uint64_t>() > std::uint64_t(INT64_MAX)))
+    return TomlValue(j.get<std::int64_t>());
+  if (j.is_number()) return TomlValue(j.get<double>());
+  if (j.is_string()) return TomlValue(j.get<std::string>());
+  return std::nullopt;
+}
+
 }  // namespace
+
+std::string parseCloudJson(const nlohmann::json& cloud, std::uint64_t seed, EllipsoidCloud& out) {
+  toml::table table;
+  if (!cloud.is_object() || !fillTable(cloud, table))
+    return "cloud: must be an object without null values";
+  const std::string source = "request";
+  try {
+    TableReader reader(table, "cloud", source);
+    EllipsoidCloud parsed;
+    CloudDevelopment develop;
+    reader.forbid("develop", "development schedules come from scene files only");
+    readCloud(reader, seed, parsed, develop);
+    out = std::move(parsed);
+  } catch (const SceneError& e) {
+    // "request:LINE: cloud.key: what": the line means nothing for JSON.
+    const std::size_t key = e.message.find(": ");
+    return key == std::string::npos ? e.message : e.message.substr(key + 2);
+  }
+  return "";
+}
 
 int nameIndex(const std::vector<std::string>& names, std::string_view name) {
   for (std::size_t i = 0; i < names.size(); ++i)

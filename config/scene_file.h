@@ -5,6 +5,8 @@
 #include <string_view>
 #include <vector>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "renderer/render_settings.h"
 #include "world/scene.h"
 #include "world/limits.h"
@@ -37,6 +39,11 @@ int nameIndex(const std::vector<std::string>& names, std::string_view name);
 std::string loadSceneFile(const std::string& path, SceneFile& out);
 // Parses TOML text; `source_name` is the file name used in messages.
 std::string parseSceneText(std::string_view text, const std::string& source_name, SceneFile& out);
+
+// A cloud given as a JSON object with the keys of a scene file's [[cloud]] table (the socket
+// protocol's add_cloud); `seed` seeds its texture unless the object names one. Errors name
+// the key and what is allowed.
+std::string parseCloudJson(const nlohmann::json& cloud, std::uint64_t seed, EllipsoidCloud& out);
 
 // Checks the render knobs whose allowed values are not a plain range: "key: what is wrong
 // (allowed: ...)", or empty when valid.

@@ -1,0 +1,172 @@
+#include "config/daemon_config.h"
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "config/table_reader.h"
+
+namespace nephele {
+namespace {
+
+using config_detail::SceneError;
+using config_detail::TableReader;
+
+void readListen(TableReader& t, ListenConfig& listen) {
+  t.string("bind", listen.bind);
+  t.integer("port", listen.port, 0, 65535);
+}
+
+void readView(TableReader& t, const Camera& scene_camera, ViewConfig& view) {
+  t.allow({"name", "position", "heading", "pitch", "roll", "vfov", "width", "height", "format",
+           "coverage"});
+  view.camera = scene_camera;
+  t.string("name", view.name);
+  Camera& c = view.camera;
+  t.vector("position", c.position, -Limits::kMaxCoordinate, Limits::kMaxCoordinate);
+  if (c.position.z < 0.0) t.failAt("position", "z is below the ground (allowed: z >= 0)");
+  t.number("heading", c.orientation.heading_deg, -Limits::kMaxHeading, Limits::kMaxHeading);
+  t.number("pitch", c.orientation.pitch_deg, -Limits::kMaxPitch, Limits::kMaxPitch);
+  t.number("roll", c.orientation.roll_deg, -Limits::kMaxRoll, Limits::kMaxRoll);
+  t.number("vfov", c.vfov_deg, Limits::kMinVfov, Limits::kMaxVfov);
+  t.integer("width", c.width, 1, Limits::kMaxImageSide);
+  t.integer("height", c.height, 1, Limits::kMaxImageSide);
+  view.image.format =
+      ImageFormat(t.choice("format", {"raw", "png", "jpeg", "exr"}, int(view.image.format)));
+  t.boolean("coverage", view.image.coverage);
+  if (view.image.format == ImageFormat::kJpeg) {
+    if (t.has("coverage") && view.image.coverage)
+      t.failAt("coverage", "jpeg holds colour only (allowed with jpeg: false)");
+    view.image.coverage = false;
+  }
+  if (view.name.empty()) t.failHere("missing key name (a name for requests, e.g. \"front\")");
+  t.finish();
+}
+
+void readDaemon(const toml::table& root, const std::string& file, DaemonConfig& out) {
+  TableReader t(root, "", file);
+  t.allow({"scene", "world", "view", "socket", "modbus", "metrics", "snapshot", "output"});
+  if (!t.has("scene")) t.failHere("missing key scene (the scene file to load)");
+  t.string("scene", out.scene_path);
+  const std::filesystem::path scene(out.scene_path);
+  if (scene.is_relative())
+    out.scene_path = (std::filesystem::path(file).parent_path() / scene).lexically_normal().string();
+  if (std::string error = loadSceneFile(out.scene_path, out.scene); !error.empty())
+    t.failAt("scene", error);
+
+  if (auto w = t.table("world")) {
+    w->allow({"mode", "tick_rate", "time_scale", "threads"});
+    out.mode = TickMode(w->choice("mode", {"realtime", "lockstep"}, int(out.mode)));
+    w->number("tick_rate", out.tick_rate_hz, DaemonLimits::kMinTickRate,
+              DaemonLimits::kMaxTickRate);
+    w->number("time_scale", out.time_scale, 0.0, ProtocolLimits::kMaxTimeScale);
+    w->integer("threads", out.world_threads, 1, 64);
+    w->finish();
+  }
+  std::vector<TableReader> views = t.tables("view");
+  if (views.size() > std::size_t(DaemonLimits::kMaxViews))
+    t.failAt("view", "more than " + std::to_string(DaemonLimits::kMaxViews) + " views");
+  for (TableReader& v : views) {
+    ViewConfig& view = out.views.emplace_back();
+    readView(v, out.scene.scene.camera, view);
+    for (std::size_t i = 0; i + 1 < out.views.size(); ++i)
+      if (out.views[i].name == view.name)
+        v.failAt("name", "\"" + view.name + "\" names two views");
+  }
+  if (out.views.empty()) out.views.push_back({"main", out.scene.scene.camera, {}});
+
+  if (auto s = t.table("socket")) {
+    s->allow({"enabled", "bind", "port", "token", "max_clients", "max_subscriptions", "max_queue",
+              "max_image_pixels", "max_pending_mb"});
+    s->boolean("enabled", out.socket_enabled);
+    readListen(*s, out.socket);
+    s->string("token", out.token);
+    s->integer("max_clients", out.max_clients, 1, DaemonLimits::kMaxClients);
+    s->integer("max_subscriptions", out.max_subscriptions, 0, 4096);
+    s->integer("max_queue", out.max_queue, 1, 65536);
+    int pixels_m = int(out.max_image_pixels >> 20);
+    s->integer("max_image_pixels", pixels_m, 1, 256);  // in mebipixels
+    out.max_image_pixels = std::int64_t(pixels_m) << 20;
+    int pending_mb = int(out.max_pending_bytes >> 20);
+    s->integer("max_pending_mb", pending_mb, 1, 4096);
+    out.max_pending_bytes = std::size_t(pending_mb) << 20;
+    s->finish();
+  }
+  if (auto m = t.table("modbus")) {
+    m->allow({"enabled", "bind", "port", "allow", "view", "max_clients"});
+    m->boolean("enabled", out.modbus_enabled);
+    readListen(*m, out.modbus);
+    if (m->has("allow")) {
+      out.modbus_allow.clear();
+      m->strings("allow", out.modbus_allow, 256);
+    }
+    m->string("view", out.modbus_view);
+    m->integer("max_clients", out.modbus_max_clients, 1, 256);
+    m->finish();
+  }
+  if (out.modbus_view.empty()) out.modbus_view = out.views.front().name;
+  else if (std::none_of(out.views.begin(), out.views.end(),
+                        [&](const ViewConfig& v) { return v.name == out.modbus_view; }))
+    t.failHere("modbus.view: \"" + out.modbus_view + "\" is not a view");
+  if (auto m = t.table("metrics")) {
+    m->allow({"enabled", "bind", "port"});
+    m->boolean("enabled", out.metrics_enabled);
+    readListen(*m, out.metrics);
+    m->finish();
+  }
+  if (auto s = t.table("snapshot")) {
+    s->allow({"path", "interval", "restore", "directory"});
+    s->string("path", out.snapshot_path);
+    s->number("interval", out.snapshot_interval_s, 0.0, 86400.0);
+    s->boolean("restore", out.restore_on_start);
+    s->string("directory", out.snapshot_directory);
+    s->finish();
+  }
+  if (out.snapshot_directory.empty())
+    out.snapshot_directory = out.snapshot_path.empty()
+                                 ? std::string()
+                                 : std::filesystem::path(out.snapshot_path).parent_path().string();
+  if (auto o = t.table("output")) {
+    o->allow({"directory", "format", "png_compression", "jpeg_quality"});
+    o->string("directory", out.output_directory);
+    out.output_format =
+        ImageFormat(o->choice("format", {"raw", "png", "jpeg", "exr"}, int(out.output_format)));
+    if (out.output_format == ImageFormat::kRaw)
+      o->failAt("format", "raw frames are for the socket (allowed here: png, jpeg, exr)");
+    o->integer("png_compression", out.encode.png_compression, 0, 9);
+    o->integer("jpeg_quality", out.encode.jpeg_quality, 1, 100);
+    o->finish();
+  }
+  t.finish();
+}
+
+}  // namespace
+
+std::string parseDaemonConfig(std::string_view text, const std::string& source_name,
+                              DaemonConfig& out) {
+  DaemonConfig parsed;
+  parsed.config_path = source_name;
+  try {
+    const toml::table root = toml::parse(text, source_name);
+    readDaemon(root, source_name, parsed);
+  } catch (const toml::parse_error& e) {
+    return source_name + ":" + std::to_string(e.source().begin.line) +
+           ": not valid TOML: " + std::string(e.description());
+  } catch (const SceneError& e) {
+    return e.message;
+  }
+  out = std::move(parsed);
+  return "";
+}
+
+std::string loadDaemonConfig(const std::string& path, DaemonConfig& out) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return "cannot read config file '" + path + "': " + std::strerror(errno);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parseDaemonConfig(text.str(), path, out);
+}
+
+}  // namespace nephele

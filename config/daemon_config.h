@@ -1,0 +1,80 @@
+#pragma once
+// Daemon configuration files (TOML, see deploy/nephele.toml) to typed settings, validated
+// once here like scene files: every error names the file, the line, the key and what is
+// allowed.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "config/scene_file.h"
+#include "protocol/image_encoding.h"
+#include "protocol/messages.h"
+
+namespace nephele {
+
+enum class TickMode {
+  kRealtime,  // the daemon advances the world tick_rate times per real second
+  kLockstep,  // the world advances only when the host sends tick requests
+};
+
+struct ViewConfig {
+  std::string name;
+  Camera camera;  // pose, field of view and size
+  ImageRequest image;
+};
+
+struct ListenConfig {
+  std::string bind = "127.0.0.1";
+  int port = 0;  // 0: any free port (printed on the ready line)
+};
+
+struct DaemonConfig {
+  std::string config_path;
+  std::string scene_path;  // relative paths are relative to the config file
+  SceneFile scene;
+
+  TickMode mode = TickMode::kRealtime;
+  double tick_rate_hz = 30.0;
+  double time_scale = 1.0;
+  int world_threads = 1;
+  std::vector<ViewConfig> views;  // at least one
+
+  bool socket_enabled = true;
+  ListenConfig socket{"127.0.0.1", 7600};
+  std::string token;  // empty: no token needed
+  int max_clients = 64;
+  int max_subscriptions = 32;    // over all clients
+  int max_queue = 64;            // requests waiting for the world thread
+  std::int64_t max_image_pixels = 4096 * 4096;
+  std::size_t max_pending_bytes = 64u << 20;  // per client; frames beyond it are dropped
+
+  bool modbus_enabled = true;
+  ListenConfig modbus{"127.0.0.1", 1502};
+  std::vector<std::string> modbus_allow{"127.0.0.1"};  // client addresses; "*" allows all
+  std::string modbus_view;  // the view the holding registers steer; default the first
+  int modbus_max_clients = 16;
+
+  bool metrics_enabled = false;
+  ListenConfig metrics{"127.0.0.1", 9464};
+
+  std::string snapshot_path;  // empty: no snapshots
+  double snapshot_interval_s = 60.0;  // 0: only at shutdown
+  bool restore_on_start = true;
+  std::string snapshot_directory;  // for the snapshot/restore requests; empty: beside the path
+
+  std::string output_directory = "frames";  // images written by the Modbus render coil
+  ImageFormat output_format = ImageFormat::kPng;
+  EncodeOptions encode;
+};
+
+struct DaemonLimits {
+  static constexpr double kMinTickRate = 0.1, kMaxTickRate = 1000.0;
+  static constexpr int kMaxViews = 64;
+  static constexpr int kMaxClients = 4096;
+};
+
+std::string loadDaemonConfig(const std::string& path, DaemonConfig& out);
+std::string parseDaemonConfig(std::string_view text, const std::string& source_name,
+                              DaemonConfig& out);
+
+}  // namespace nephele

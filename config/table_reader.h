@@ -1,0 +1,231 @@
+#pragma once
+// Typed, range-checked reading of TOML tables, shared by scene files and daemon configs.
+// Every error names the file, the line, the key and what is allowed.
+#include <toml++/toml.h>
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace nephele {
+
+int nameIndex(const std::vector<std::string>& names, std::string_view name);
+
+namespace config_detail {
+
+// Thrown by TableReader and caught at the edge of each file parser; never escapes config/.
+struct SceneError {
+  std::string message;
+};
+
+inline std::string formatNumber(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+inline std::string joinKeys(const std::vector<std::string>& keys) {
+  std::string out;
+  for (const auto& k : keys) out += (out.empty() ? "" : ", ") + k;
+  return out;
+}
+
+// Reads one TOML table; every key must be consumed by exactly one typed getter, and
+// finish() reports whatever is left as unknown.
+class TableReader {
+ public:
+  TableReader(const toml::table& table, std::string path, const std::string& file)
+      : table_(table), path_(std::move(path)), file_(file) {}
+
+  bool has(std::string_view key) const { return table_.contains(key); }
+
+  void number(std::string_view key, double& out, double lo, double hi) {
+    const toml::node* node = take(key);
+    if (!node) return;
+    out = toNumber(*node, key, lo, hi);
+  }
+
+  void integer(std::string_view key, int& out, int lo, int hi) {
+    const toml::node* node = take(key);
+    if (!node) return;
+    out = int(toInteger(*node, key, lo, hi));
+  }
+
+  void seed(std::string_view key, std::uint64_t& out) {
+    const toml::node* node = take(key);
+    if (!node) return;
+    out = std::uint64_t(toInteger(*node, key, 0, std::numeric_limits<std::int64_t>::max()));
+  }
+
+  void boolean(std::string_view key, bool& out) {
+    const toml::node* node = take(key);
+    if (!node) return;
+    if (!node->is_boolean()) fail(*node, key, "must be true or false");
+    out = node->value<bool>().value();
+  }
+
+  // A string that must be one of `allowed`; returns its index.
+  int choice(std::string_view key, const std::vector<std::string>& allowed, int current) {
+    const toml::node* node = take(key);
+    if (!node) return current;
+    if (!node->is_string())
+      fail(*node, key, "must be a string (one of: " + joinKeys(allowed) + ")");
+    const std::string value = node->value<std::string>().value();
+    if (const int index = nameIndex(allowed, value); index >= 0) return index;
+    fail(*node, key, "\"" + value + "\" is not allowed (one of: " + joinKeys(allowed) + ")");
+  }
+
+  void string(std::string_view key, std::string& out) {
+    const toml::node* node = take(key);
+    if (!node) return;
+    if (!node->is_string()) fail(*node, key, "must be a string");
+    out = node->value<std::string>().value();
+  }
+
+  template <int N>
+  void vector(std::string_view key, glm::vec<N, double>& out, double lo, double hi) {
+    const toml::node* node = take(key);
+    if (!node) return;
+    const toml::array* array = node->as_array();
+    if (!array || array->size() != std::size_t(N))
+      fail(*node, key, "must be an array of " + std::to_string(N) + " numbers");
+    for (int i = 0; i < N; ++i) out[i] = toNumber(*array->get(std::size_t(i)), key, lo, hi);
+  }
+
+  // An array of numbers, each in [lo, hi], of at most `max_count` entries.
+  void numbers(std::string_view key, std::vector<double>& out, double lo, double hi,
+               std::size_t max_count) {
+    const toml::node* node = take(key);
+    if (!node) return;
+    const toml::array* array = node->as_array();
+    if (!array || array->empty() || array->size() > max_count)
+      fail(*node, key, "must be an array of 1 to " + std::to_string(max_count) + " numbers");
+    out.clear();
+    for (const toml::node& v : *array) out.push_back(toNumber(v, key, lo, hi));
+  }
+
+  // An array of at most `max_count` strings.
+  void strings(std::string_view key, std::vector<std::string>& out, std::size_t max_count) {
+    const toml::node* node = take(key);
+    if (!node) return;
+    const toml::array* array = node->as_array();
+    if (!array || array->size() > max_count || !array->is_homogeneous(toml::node_type::string))
+      fail(*node, key, "must be an array of at most " + std::to_string(max_count) + " strings");
+    out.clear();
+    for (const toml::node& v : *array) out.push_back(v.value<std::string>().value());
+  }
+
+  // Three integers, each in [lo, hi].
+  void integers3(std::string_view key, int (&out)[3], int lo, int hi) {
+    const toml::node* node = take(key);
+    if (!node) return;
+    const toml::array* array = node->as_array();
+    if (!array || array->size() != 3) fail(*node, key, "must be an array of 3 integers");
+    for (int i = 0; i < 3; ++i) out[i] = int(toInteger(*array->get(std::size_t(i)), key, lo, hi));
+  }
+
+  // A sub-table (absent: null). Its reader must be finished by the caller.
+  std::optional<TableReader> table(std::string_view key) {
+    const toml::node* node = take(key);
+    if (!node) return std::nullopt;
+    if (!node->is_table()) fail(*node, key, "must be a table");
+    return TableReader(*node->as_table(), qualified(key), file_);
+  }
+
+  // An array of tables ([[key]]).
+  std::vector<TableReader> tables(std::string_view key) {
+    std::vector<TableReader> out;
+    const toml::node* node = take(key);
+    if (!node) return out;
+    const toml::array* array = node->as_array();
+    if (!array || !array->is_array_of_tables())
+      fail(*node, key, "must be an array of tables, written [[" + std::string(key) + "]]");
+    for (std::size_t i = 0; i < array->size(); ++i)
+      out.emplace_back(*array->get(i)->as_table(), qualified(key) + "[" + std::to_string(i) + "]",
+                       file_);
+    return out;
+  }
+
+  // Rejects a key that is present but does not apply here.
+  void forbid(std::string_view key, const std::string& why) {
+    if (const toml::node* node = table_.get(key)) fail(*node, key, why);
+  }
+
+  void finish() const {
+    for (auto&& [key, node] : table_) {
+      if (taken_.count(std::string(key.str()))) continue;
+      fail(node, key.str(), "unknown key (allowed here: " + joinKeys(allowed_) + ")");
+    }
+  }
+
+  // Declares the keys this table accepts, for the unknown-key message.
+  void allow(std::vector<std::string> keys) { allowed_ = std::move(keys); }
+
+  [[noreturn]] void failAt(std::string_view key, const std::string& what) const {
+    fail(*table_.get(key), key, what);
+  }
+
+  // An error about the table as a whole (a missing key, a missing part).
+  [[noreturn]] void failHere(const std::string& what) const {
+    throw SceneError{file_ + ":" + std::to_string(table_.source().begin.line) + ": " +
+                     (path_.empty() ? std::string("scene") : path_) + ": " + what};
+  }
+
+  [[noreturn]] void fail(const toml::node& node, std::string_view key,
+                         const std::string& what) const {
+    throw SceneError{file_ + ":" + std::to_string(node.source().begin.line) + ": " +
+                     qualified(key) + ": " + what};
+  }
+
+ private:
+  const toml::node* take(std::string_view key) {
+    taken_.insert(std::string(key));
+    return table_.get(key);
+  }
+
+  std::string qualified(std::string_view key) const {
+    return path_.empty() ? std::string(key) : path_ + "." + std::string(key);
+  }
+
+  double toNumber(const toml::node& node, std::string_view key, double lo, double hi) const {
+    if (!node.is_number()) fail(node, key, "must be a number");
+    const double v = node.value<double>().value();
+    if (!std::isfinite(v))
+      fail(node, key,
+           formatNumber(v) + " is not a finite number (allowed: " + formatNumber(lo) + " to " +
+               formatNumber(hi) + ")");
+    if (v < lo || v > hi)
+      fail(node, key,
+           formatNumber(v) + " is out of range (allowed: " + formatNumber(lo) + " to " +
+               formatNumber(hi) + ")");
+    return v;
+  }
+
+  std::int64_t toInteger(const toml::node& node, std::string_view key, std::int64_t lo,
+                         std::int64_t hi) const {
+    if (!node.is_integer()) fail(node, key, "must be an integer");
+    const std::int64_t v = node.value<std::int64_t>().value();
+    if (v < lo || v > hi)
+      fail(node, key,
+           std::to_string(v) + " is out of range (allowed: " + std::to_string(lo) + " to " +
+               std::to_string(hi) + ")");
+    return v;
+  }
+
+  const toml::table& table_;
+  std::string path_;
+  const std::string& file_;
+  std::set<std::string> taken_;
+  std::vector<std::string> allowed_;
+};
+
+}  // namespace config_detail
+}  // namespace nephele

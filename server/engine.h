@@ -1,0 +1,127 @@
+#pragma once
+// The daemon's world thread: it owns the World, the GL context and the views, advances time
+// (in real time or in lockstep with the host), carries out requests one at a time from a
+// bounded queue and delivers subscribed frames. Transports only parse bytes and queue work.
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <future>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <variant>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "config/daemon_config.h"
+#include "protocol/messages.h"
+#include "protocol/register_map.h"
+
+namespace nephele {
+
+// A reply: one JSON line, and for images the bytes that follow it.
+struct Reply {
+  std::string header;
+  std::vector<std::uint8_t> body;
+};
+using SharedReply = std::shared_ptr<const Reply>;
+
+// Receives a request's reply, once, on a daemon thread (not the caller's).
+using ReplySink = std::function<void(SharedReply)>;
+// Receives subscribed frames; returns false once the client is gone, which ends its
+// subscriptions.
+using FrameSink = std::function<bool(SharedReply)>;
+// Receives the outcome of a Modbus write or render trigger.
+using DoneSink = std::function<void(std::optional<ProtocolError>)>;
+
+class Engine {
+ public:
+  explicit Engine(DaemonConfig config);
+  ~Engine();
+  Engine(const Engine&) = delete;
+  Engine& operator=(const Engine&) = delete;
+
+  // Starts the world thread: GL context, world (restored from the snapshot if configured and
+  // present). Returns an error if either fails.
+  std::string start();
+  // Finishes the request in hand, answers queued ones with an error, saves a snapshot if
+  // configured and joins the thread.
+  void stop();
+
+  // Queues work; each returns false (and queues nothing) when the queue is full.
+  bool submit(Request request, std::int64_t client, FrameSink frames, ReplySink done);
+  // Modbus writes: every command is checked before any is applied.
+  bool submitBatch(std::vector<Command> commands, DoneSink done);
+  // The Modbus render coil: renders the Modbus view into the output directory and pushes the
+  // frame to the view's subscribers.
+  bool submitRenderTrigger(DoneSink done);
+
+  // Thread-safe readings for the Modbus registers, stats and metrics.
+  ModbusSettings modbusSettings() const;
+  ModbusStatus modbusStatus() const;
+  bool renderTriggerPending() const { return trigger_pending_.load(); }
+  nlohmann::json stats() const;
+  std::string prometheusText() const;
+
+  // Counters kept by the transports.
+  std::atomic<int> socket_clients{0};
+  std::atomic<int> modbus_clients{0};
+  std::atomic<std::uint64_t> frames_dropped{0};
+  void noteError(ErrorCode code);
+
+  const DaemonConfig& config() const { return config_; }
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  struct Job;
+  struct Subscription;
+  struct State;  // everything the world thread owns
+  class Encoder;
+
+  bool enqueue(Job job);
+  void run(std::promise<std::string>& started);
+  std::string openWorld();
+  void execute(Job& job);
+  // A request's result (or error); render and snapshot replies may come later from the
+  // encoder, in which case it returns nothing and `job.reply` is called there.
+  std::optional<std::variant<nlohmann::json, ProtocolError>> apply(const Command& command,
+                                                                   Job& job);
+  std::optional<ProtocolError> check(const Command& command) const;
+  std::optional<ProtocolError> setWeather(int layer, const WeatherLayer& weather);
+  std::optional<ProtocolError> checkAdvance(double dt_s) const;
+  void advance(double dt_s);  // one tick
+  // Renders a view (float for EXR, else 8-bit) and records its time.
+  void renderFrame(const ViewConfig& view, bool linear, struct Frame& frame);
+  void realtimeTicks();
+  void deliverFrames(bool only_due, const std::string& view);
+  void renderTrigger(Job& job);
+  void saveSnapshot(const std::string& path, const char* why);
+  Clock::time_point nextWake() const;
+  void publish();  // refreshes the thread-safe readings
+
+  DaemonConfig config_;
+  std::unique_ptr<State> state_;
+  std::unique_ptr<Encoder> encoder_;
+  std::thread thread_;
+
+  mutable std::mutex queue_mutex_;
+  std::condition_variable queue_cv_;
+  std::deque<Job> queue_;
+  bool stopping_ = false;
+
+  mutable std::mutex published_mutex_;
+  ModbusSettings published_settings_;
+  ModbusStatus published_status_;
+  nlohmann::json published_stats_;
+  std::atomic<bool> trigger_pending_{false};
+  std::atomic<std::uint64_t> errors_{0};
+  std::atomic<int> last_error_{0};
+};
+
+}  // namespace nephele
