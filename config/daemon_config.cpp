@@ -35,6 +35,7 @@ void readView(TableReader& t, const Camera& scene_camera, ViewConfig& view) {
   t.integer("height", c.height, 1, Limits::kMaxImageSide);
   view.image.format =
       ImageFormat(t.choice("format", {"raw", "png", "jpeg", "exr"}, int(view.image.format)));
+  view.image.coverage = defaultCoverage(view.image.format);
   t.boolean("coverage", view.image.coverage);
   if (view.image.format == ImageFormat::kJpeg) {
     if (t.has("coverage") && view.image.coverage)

@@ -168,6 +168,7 @@ std::optional<ImageRequest> readImage(FieldReader& r) {
   if (!r.has("format") && !r.has("channels")) return std::nullopt;
   ImageRequest image;
   image.format = readFormat(r, image.format);
+  image.coverage = defaultCoverage(image.format);
   if (const json* channels = r.raw("channels")) {
     const std::string allowed = " (allowed: a non-empty array of \"colour\" and \"coverage\")";
     if (!channels->is_array() || channels->empty() || channels->size() > 2)

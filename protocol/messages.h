@@ -46,6 +46,12 @@ enum class ImageFormat { kRaw, kPng, kJpeg, kExr };
 inline constexpr std::string_view kImageFormatNames = "raw, png, jpeg, exr";
 std::string_view imageFormatName(ImageFormat format);
 
+// Without a "channels" field, raw and EXR images carry coverage and PNG and JPEG do not
+// (a PNG whose sky is transparent surprises viewers).
+inline bool defaultCoverage(ImageFormat format) {
+  return format == ImageFormat::kRaw || format == ImageFormat::kExr;
+}
+
 // What an image carries: colour (RGB), coverage (A) or both, in that order.
 struct ImageRequest {
   ImageFormat format = ImageFormat::kRaw;

@@ -242,9 +242,10 @@ bool Engine::submitRenderTrigger(DoneSink done) {
   Job job;
   job.kind = Job::Kind::kTrigger;
   job.done = std::move(done);
-  if (!enqueue(std::move(job))) return false;
-  trigger_pending_ = true;
-  return true;
+  trigger_pending_ = true;  // before queueing: the world thread clears it when done
+  if (enqueue(std::move(job))) return true;
+  trigger_pending_ = false;
+  return false;
 }
 
 void Engine::noteError(ErrorCode code) {
@@ -396,6 +397,8 @@ Engine::Clock::time_point Engine::nextWake() const {
 
 void Engine::saveSnapshot(const std::string& path, const char* why) {
   const auto t0 = Clock::now();
+  std::error_code ec;
+  std::filesystem::create_directories(std::filesystem::path(path).parent_path(), ec);
   if (std::string e = state_->world->saveSnapshot(path); !e.empty()) {
     spdlog::error("event=snapshot_failed reason={} error=\"{}\"", why, e);
     return;
@@ -711,6 +714,8 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
                            "snapshot: no snapshot directory is configured ([snapshot] directory)"};
     const std::string path =
         (std::filesystem::path(config_.snapshot_directory) / (c->name + ".snap")).string();
+    std::error_code ec;
+    std::filesystem::create_directories(config_.snapshot_directory, ec);
     if (std::string e = world.saveSnapshot(path); !e.empty())
       return ProtocolError{ErrorCode::kFailed, e};
     return json{{"name", c->name}, {"time", world.timeSeconds()}, {"hash", hexHash(world.hash())}};

@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 
 #include "server/render_command.h"
+#include "server/serve_command.h"
 
 int main(int argc, char** argv) {
   spdlog::set_default_logger(spdlog::stderr_color_mt("nephele"));
@@ -18,9 +19,12 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   nephele::RenderCommandOptions render;
   nephele::addRenderCommand(app, render);
+  nephele::ServeCommandOptions serve;
+  nephele::addServeCommand(app, serve);
 
   CLI11_PARSE(app, argc, argv);
   spdlog::set_level(spdlog::level::from_str(log_level));
   if (app.got_subcommand("render")) return nephele::runRenderCommand(render);
+  if (app.got_subcommand("serve")) return nephele::runServeCommand(serve);
   return 2;
 }

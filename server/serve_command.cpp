@@ -1,0 +1,107 @@
+#include "server/serve_command.h"
+
+#include <signal.h>
+
+#include <spdlog/spdlog.h>
+
+#include <cstdio>
+#include <thread>
+
+#include "config/daemon_config.h"
+#include "server/engine.h"
+#include "server/modbus_server.h"
+#include "server/socket_server.h"
+
+namespace nephele {
+
+void addServeCommand(CLI::App& app, ServeCommandOptions& o) {
+  CLI::App* cmd = app.add_subcommand(
+      "serve", "Run the image generator daemon (socket protocol and Modbus TCP)");
+  cmd->add_option("-c,--config", o.config_path, "Daemon config file (TOML)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--socket-port", o.socket_port, "Socket protocol port (0: any free port)")
+      ->check(CLI::Range(0, 65535));
+  cmd->add_option("--modbus-port", o.modbus_port, "Modbus TCP port (0: any free port)")
+      ->check(CLI::Range(0, 65535));
+  cmd->add_option("--metrics-port", o.metrics_port,
+                  "Prometheus metrics port (0: any free port); turns metrics on")
+      ->check(CLI::Range(0, 65535));
+  cmd->add_option("--snapshot", o.snapshot_path,
+                  "Snapshot file: restored at start if present, saved periodically and at exit");
+}
+
+int runServeCommand(const ServeCommandOptions& o) {
+  // SIGTERM and SIGINT are taken by sigwait below; block them before any thread starts so
+  // that every thread inherits the mask.
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGINT);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  signal(SIGPIPE, SIG_IGN);  // a vanished client is a write error, not a dead daemon
+
+  DaemonConfig config;
+  if (std::string error = loadDaemonConfig(o.config_path, config); !error.empty()) {
+    spdlog::error("{}", error);
+    return 2;
+  }
+  if (o.socket_port) config.socket.port = *o.socket_port;
+  if (o.modbus_port) config.modbus.port = *o.modbus_port;
+  if (o.metrics_port) {
+    config.metrics.port = *o.metrics_port;
+    config.metrics_enabled = true;
+  }
+  if (o.snapshot_path) config.snapshot_path = *o.snapshot_path;
+  if (config.snapshot_directory.empty() && !config.snapshot_path.empty())
+    config.snapshot_directory =
+        std::filesystem::path(config.snapshot_path).parent_path().string();
+
+  Engine engine(config);
+  if (std::string error = engine.start(); !error.empty()) {
+    spdlog::error("{}", error);
+    return 1;
+  }
+  asio::io_context io;
+  SocketServer socket(io, engine);
+  MetricsServer metrics(io, engine);
+  ModbusServer modbus(engine);
+  std::string error;
+  if (config.socket_enabled) error = socket.listen(config.socket);
+  if (error.empty() && config.metrics_enabled) error = metrics.listen(config.metrics);
+  if (error.empty() && config.modbus_enabled) error = modbus.listen(config.modbus);
+  if (!error.empty()) {
+    spdlog::error("{}", error);
+    modbus.close();
+    engine.stop();
+    return 1;
+  }
+  auto work = asio::make_work_guard(io);
+  std::thread io_thread([&io] { io.run(); });
+
+  // The ready line: tests and supervisors read the ports from it.
+  std::printf("nephele ready socket=%d modbus=%d metrics=%d\n",
+              config.socket_enabled ? socket.port() : -1,
+              config.modbus_enabled ? modbus.port() : -1,
+              config.metrics_enabled ? metrics.port() : -1);
+  std::fflush(stdout);
+  spdlog::info("event=listening socket={}:{} modbus={}:{} metrics={}", config.socket.bind,
+               socket.port(), config.modbus.bind, modbus.port(),
+               config.metrics_enabled ? std::to_string(metrics.port()) : "off");
+
+  int received = 0;
+  sigwait(&signals, &received);
+  spdlog::info("event=stopping signal={}", received == SIGTERM ? "SIGTERM" : "SIGINT");
+  modbus.close();
+  engine.stop();  // the request in hand finishes, queued ones are cancelled, snapshot saved
+  asio::post(io, [&] {
+    socket.close();
+    metrics.close();
+  });
+  work.reset();
+  io_thread.join();  // replies already posted are written before the loop runs dry
+  spdlog::info("event=stopped");
+  return 0;
+}
+
+}  // namespace nephele

@@ -1,0 +1,60 @@
+#pragma once
+// The socket protocol's transport (protocol/PROTOCOL.md) and the Prometheus endpoint, on
+// Asio: connections read request lines, hand them to the Engine and write replies and
+// subscribed frames back. A slow client only fills its own bounded queue.
+#include <asio.hpp>
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "server/engine.h"
+
+namespace nephele {
+
+class Connection;
+
+class SocketServer {
+ public:
+  SocketServer(asio::io_context& io, Engine& engine);
+  ~SocketServer();
+  // Binds and starts accepting; returns an error naming the address on failure.
+  std::string listen(const ListenConfig& where);
+  int port() const { return port_; }
+  // Stops accepting and closes every connection (call on the io thread or before it runs).
+  void close();
+
+ private:
+  void accept();
+
+  asio::io_context& io_;
+  Engine& engine_;
+  asio::ip::tcp::acceptor acceptor_;
+  int port_ = 0;
+  std::int64_t next_id_ = 1;
+  std::map<std::int64_t, std::weak_ptr<Connection>> connections_;
+};
+
+// GET /metrics in the Prometheus text format; anything else is 404.
+class MetricsServer {
+ public:
+  MetricsServer(asio::io_context& io, Engine& engine);
+  std::string listen(const ListenConfig& where);
+  int port() const { return port_; }
+  void close();
+
+ private:
+  void accept();
+
+  asio::io_context& io_;
+  Engine& engine_;
+  asio::ip::tcp::acceptor acceptor_;
+  int port_ = 0;
+};
+
+// Opens `acceptor` on `where`; returns the error, naming the address, on failure.
+std::string openAcceptor(asio::ip::tcp::acceptor& acceptor, const ListenConfig& where,
+                         const char* what);
+
+}  // namespace nephele
