@@ -145,6 +145,9 @@ std::string encodeImage(ImageFileFormat format, const Srgb8Image& image, bool co
   oiio::ImageSpec spec(image.width, image.height, channels, oiio::TypeDesc::UINT8);
   spec.channelnames = channelNamesFor(colour, coverage);
   spec.alpha_channel = coverage ? channels - 1 : -1;
+  // Colour is the whole composited image (sky included), not premultiplied by coverage:
+  // write it as it is.
+  spec.attribute("oiio:UnassociatedAlpha", 1);
   spec.attribute("oiio:ColorSpace", "sRGB");
   if (format == ImageFileFormat::kPng)
     spec.attribute("png:compressionLevel", std::clamp(options.png_compression, 0, 9));

@@ -860,7 +860,7 @@ void Engine::deliverFrames(bool only_due, const std::string& view_name) {
 void Engine::renderTrigger(Job& job) {
   State& s = *state_;
   const ViewConfig& view = *s.view(config_.modbus_view);
-  const ImageRequest image{config_.output_format, true, config_.output_format != ImageFormat::kJpeg};
+  const ImageRequest image{config_.output_format, true, defaultCoverage(config_.output_format)};
   auto frame = std::make_shared<Frame>();
   renderFrame(view, image.format == ImageFormat::kExr, *frame);
   const std::string extension = image.format == ImageFormat::kPng    ? ".png"

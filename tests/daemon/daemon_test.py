@@ -1,0 +1,623 @@
+#!/usr/bin/python3
+"""End-to-end tests of `nephele serve`: the real daemon on port 0, driven over the socket
+protocol, pymodbus and mbpoll. Readiness is the daemon's ready line, never a sleep.
+
+Run by ctest with NEPHELE_BINARY and NEPHELE_SOURCE_DIR set; /usr/bin/python3 (Debian's,
+which has pymodbus)."""
+import json
+import os
+import signal
+import socket
+import struct
+import subprocess
+import tempfile
+import threading
+import time
+import unittest
+import zlib
+
+BINARY = os.environ.get("NEPHELE_BINARY", "build/nephele")
+SOURCE = os.environ.get("NEPHELE_SOURCE_DIR", ".")
+SCENE = os.path.join(SOURCE, "config", "scenes", "cumulus.toml")
+TIMEOUT = 60  # seconds any single wait may take (sanitizer builds are slow)
+
+
+def wait_until(condition, what, timeout=TIMEOUT):
+    """Polls `condition` until it holds; fails the test with `what` after `timeout`."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        value = condition()
+        if value:
+            return value
+        time.sleep(0.02)
+    raise AssertionError("timed out waiting for " + what)
+
+
+class Daemon:
+    """A `nephele serve` process with its own config in a temporary directory."""
+
+    def __init__(self, workdir, mode="lockstep", extra="", view_size=(64, 48), name="d"):
+        self.workdir = workdir
+        self.config = os.path.join(workdir, name + ".toml")
+        self.log_path = os.path.join(workdir, name + ".log")
+        self.snapshot = os.path.join(workdir, name + "-snap", "world.snap")
+        with open(self.config, "w") as f:
+            f.write(f'''scene = "{SCENE}"
+[world]
+mode = "{mode}"
+tick_rate = 30
+[[view]]
+name = "front"
+width = {view_size[0]}
+height = {view_size[1]}
+[[view]]
+name = "left"
+heading = -60.0
+width = 32
+height = 24
+format = "png"
+[socket]
+port = 0
+[modbus]
+port = 0
+[metrics]
+enabled = true
+port = 0
+[output]
+directory = "{os.path.join(workdir, name + "-frames")}"
+{extra}
+''')
+        self.start()
+
+    def start(self):
+        self.clients = []
+        self.log = open(self.log_path, "a")
+        self.proc = subprocess.Popen([BINARY, "serve", "-c", self.config],
+                                     stdout=subprocess.PIPE, stderr=self.log, text=True)
+        line = self.proc.stdout.readline()  # blocks until ready, or EOF if the start failed
+        if not line.startswith("nephele ready"):
+            self.proc.wait(TIMEOUT)
+            raise AssertionError("daemon did not start: " + open(self.log_path).read())
+        fields = dict(kv.split("=") for kv in line.split()[2:])
+        self.port, self.modbus_port, self.metrics_port = (
+            int(fields["socket"]), int(fields["modbus"]), int(fields["metrics"]))
+
+    def stop(self, sig=signal.SIGTERM):
+        if self.proc.poll() is None:
+            self.proc.send_signal(sig)
+        code = self.proc.wait(TIMEOUT)
+        for c in self.clients:
+            c.close()
+        self.proc.stdout.close()
+        self.log.close()
+        return code
+
+    def client(self):
+        c = Client(self.port)
+        self.clients.append(c)
+        return c
+
+    def log_text(self):
+        with open(self.log_path) as f:
+            return f.read()
+
+
+class Client:
+    def __init__(self, port):
+        self.sock = socket.create_connection(("127.0.0.1", port), timeout=TIMEOUT)
+        self.file = self.sock.makefile("rb")
+        self.next_id = 1
+
+    def close(self):
+        self.file.close()
+        self.sock.close()
+
+    def send(self, obj):
+        obj = dict(obj)
+        if "id" not in obj:
+            obj["id"] = self.next_id
+            self.next_id += 1
+        self.sock.sendall((json.dumps(obj) + "\n").encode())
+        return obj["id"]
+
+    def read(self):
+        """One reply or event: (header, body bytes or None)."""
+        line = self.file.readline()
+        if not line:
+            raise ConnectionError("connection closed")
+        header = json.loads(line)
+        image = (header.get("result") or {}).get("image") or header.get("image")
+        body = self.file.read(image["bytes"]) if image else None
+        return header, body
+
+    def request(self, obj):
+        sent = self.send(obj)
+        header, body = self.read()
+        assert header.get("id") == sent, (header, sent)
+        return header, body
+
+    def ok(self, obj):
+        header, body = self.request(obj)
+        assert header["ok"], header
+        return (header["result"], body) if body is not None else header["result"]
+
+    def error(self, obj):
+        header, _ = self.request(obj)
+        assert not header["ok"], header
+        return header["error"]
+
+
+def decode_png(data):
+    """8-bit, non-interlaced PNG to (width, height, channels, rows of bytes); an
+    independent decoder to check the daemon's PNG against its raw frame."""
+    assert data[:8] == b"\x89PNG\r\n\x1a\n"
+    pos, idat = 8, b""
+    while pos < len(data):
+        length, kind = struct.unpack(">I4s", data[pos:pos + 8])
+        chunk = data[pos + 8:pos + 8 + length]
+        if kind == b"IHDR":
+            width, height, depth, colour_type = struct.unpack(">IIBB", chunk[:10])
+            assert depth == 8
+            channels = {0: 1, 2: 3, 4: 2, 6: 4}[colour_type]
+        elif kind == b"IDAT":
+            idat += chunk
+        pos += 12 + length
+    raw = zlib.decompress(idat)
+    stride = width * channels
+    rows, previous = [], bytearray(stride)
+    for y in range(height):
+        kind = raw[y * (stride + 1)]
+        line = bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
+        for i in range(stride):
+            a = line[i - channels] if i >= channels else 0
+            b = previous[i]
+            c = previous[i - channels] if i >= channels else 0
+            if kind == 1:
+                line[i] = (line[i] + a) & 255
+            elif kind == 2:
+                line[i] = (line[i] + b) & 255
+            elif kind == 3:
+                line[i] = (line[i] + (a + b) // 2) & 255
+            elif kind == 4:
+                p = a + b - c
+                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+                line[i] = (line[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
+        rows.append(bytes(line))
+        previous = line
+    return width, height, channels, b"".join(rows)
+
+
+def floats(value):
+    return list(struct.unpack(">HH", struct.pack(">f", value)))
+
+
+class DaemonTest(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory()
+        self.daemons = []
+
+    def tearDown(self):
+        for d in self.daemons:
+            if d.proc.poll() is None:
+                d.stop(signal.SIGKILL)
+        self.tmp.cleanup()
+
+    def daemon(self, **kwargs):
+        d = Daemon(self.tmp.name, **kwargs)
+        self.daemons.append(d)
+        return d
+
+
+class SocketProtocolTest(DaemonTest):
+    def test_hello_views_and_renders(self):
+        d = self.daemon()
+        c = d.client()
+        hello = c.ok({"cmd": "hello"})
+        self.assertEqual(hello["views"], ["front", "left"])
+        self.assertEqual(hello["mode"], "lockstep")
+        view = c.ok({"cmd": "get_view", "view": "front"})
+        self.assertEqual((view["width"], view["height"]), (64, 48))
+        # Raw RGBA and PNG of the same world state carry the same pixels.
+        meta, raw = c.ok({"cmd": "render", "view": "front", "format": "raw"})
+        self.assertEqual(meta["image"]["channels"], ["colour", "coverage"])
+        self.assertEqual(len(raw), 64 * 48 * 4)
+        meta, png = c.ok({"cmd": "render", "view": "front", "format": "png",
+                          "channels": ["colour", "coverage"]})
+        self.assertEqual(decode_png(png), (64, 48, 4, raw))
+        # Channel selection: colour only drops every fourth byte.
+        _, rgb = c.ok({"cmd": "render", "view": "front", "channels": ["colour"]})
+        self.assertEqual(rgb, bytes(b for i, b in enumerate(raw) if i % 4 != 3))
+        _, jpeg = c.ok({"cmd": "render", "view": "front", "format": "jpeg"})
+        self.assertEqual(jpeg[:2], b"\xff\xd8")
+        _, exr = c.ok({"cmd": "render", "view": "front", "format": "exr"})
+        self.assertEqual(exr[:4], b"\x76\x2f\x31\x01")
+        # The cloud is in view: some pixels are covered, some are sky.
+        coverage = raw[3::4]
+        self.assertGreater(max(coverage), 200)
+        self.assertEqual(min(coverage), 0)
+
+    def test_set_view_changes_the_frame(self):
+        d = self.daemon()
+        c = d.client()
+        _, before = c.ok({"cmd": "render", "view": "front"})
+        result = c.ok({"cmd": "set_view", "view": "front", "heading": 180.0, "width": 40})
+        self.assertEqual((result["heading"], result["width"]), (180.0, 40))
+        meta, after = c.ok({"cmd": "render", "view": "front"})
+        self.assertEqual(meta["image"]["width"], 40)
+        self.assertEqual(max(after[3::4]), 0)  # looking away from the cloud: no coverage
+
+    def test_errors_name_the_field_and_change_nothing(self):
+        d = self.daemon()
+        c = d.client()
+        before = c.ok({"cmd": "hash"})["hash"]
+        cases = [
+            ({"cmd": "nonsense"}, "unknown_command", "allowed: hello"),
+            ({"cmd": "set_view", "view": "front", "vfov": 500}, "bad_field", "vfov"),
+            ({"cmd": "set_view", "view": "front", "pitch": "up"}, "bad_field", "pitch"),
+            ({"cmd": "set_view", "view": "nowhere"}, "not_found", "front, left"),
+            ({"cmd": "set_weather", "layer": 1, "type": 11}, "bad_field", "0 to 10"),
+            ({"cmd": "set_weather", "layer": 4, "type": 1}, "bad_field", "layer"),
+            ({"cmd": "set_weather", "layer": 1, "type": 7, "coverage": -5}, "bad_field",
+             "coverage"),
+            ({"cmd": "render", "view": "front", "format": "gif"}, "bad_field", "raw, png"),
+            ({"cmd": "render", "view": "front", "channels": ["depth"]}, "bad_field", "depth"),
+            ({"cmd": "render", "view": "front", "format": "jpeg", "channels": ["coverage"]},
+             "bad_field", "jpeg"),
+            ({"cmd": "tick", "dt": -1}, "bad_field", "dt"),
+            ({"cmd": "tick"}, "bad_field", "dt: is missing"),
+            ({"cmd": "add_cloud", "cloud": {"name": "x", "ellipsoid": [{"radii": [0, 1, 1]}]}},
+             "bad_field", "radii"),
+            ({"cmd": "add_cloud", "cloud": {"cumulus": {}}}, "bad_field", "name"),
+            ({"cmd": "remove_cloud", "name": "missing"}, "not_found", "missing"),
+            ({"cmd": "set_view", "view": "front", "width": 16384, "height": 16384}, "limit",
+             "pixels"),
+            ({"cmd": "hash", "extra": 1}, "bad_field", "extra"),
+            ({"cmd": "restore", "name": "../etc"}, "bad_field", "name"),
+        ]
+        for request, code, words in cases:
+            with self.subTest(request=request):
+                error = c.error(request)
+                self.assertEqual(error["code"], code)
+                self.assertIn(words, error["message"])
+        for raw in [b"{not json\n", b"[1,2]\n", b"\"text\"\n", b"[" * 100 + b"]" * 100 + b"\n"]:
+            c.sock.sendall(raw)
+            header, _ = c.read()
+            self.assertFalse(header["ok"])
+            self.assertEqual(header["error"]["code"], "bad_json")
+        # An oversized line is answered once and skipped; the connection stays usable.
+        c.sock.sendall(b'{"cmd":"hash","pad":"' + b"x" * 100000 + b'"}\n')
+        header, _ = c.read()
+        self.assertEqual(header["error"]["code"], "too_large")
+        self.assertEqual(c.ok({"cmd": "hash"})["hash"], before)
+        view = c.ok({"cmd": "get_view", "view": "front"})
+        self.assertEqual((view["vfov"], view["width"]), (40.0, 64))
+
+    def test_weather_clouds_tick_and_hash(self):
+        d = self.daemon()
+        c = d.client()
+        h0 = c.ok({"cmd": "hash"})
+        stratus = c.ok({"cmd": "set_weather", "layer": 1, "type": 10, "base": 800,
+                        "thickness": 300, "coverage": 80})
+        self.assertEqual(stratus["layers"], 1)
+        cumulus = c.ok({"cmd": "set_weather", "layer": 2, "type": 7, "base": 1200,
+                        "thickness": 900, "coverage": 10, "wind": [8, 2]})
+        self.assertGreater(cumulus["clouds"], 1)
+        c.ok({"cmd": "set_weather", "layer": 1, "type": 0})  # none removes the layer
+        self.assertEqual(c.ok({"cmd": "set_weather", "layer": 3, "type": 5})["layers"], 0 + 1)
+        c.ok({"cmd": "add_cloud", "cloud": {"name": "extra",
+                                             "cumulus": {"base": [0, 0, 900], "width": 500}}})
+        c.ok({"cmd": "change_cloud", "name": "extra", "move": [10, 0, 0], "threshold": 0.3})
+        self.assertEqual(c.error({"cmd": "add_cloud", "cloud": {
+            "name": "extra", "cumulus": {}}})["code"], "bad_field")
+        c.ok({"cmd": "set_sun", "azimuth": 90, "elevation": 20})
+        t = c.ok({"cmd": "tick", "dt": 0.5})
+        self.assertAlmostEqual(t["time"], 0.5)
+        self.assertEqual(t["ticks"], 1)
+        h1 = c.ok({"cmd": "hash"})
+        self.assertNotEqual(h0["hash"], h1["hash"])
+        self.assertEqual(h1["time_ns"], 500000000)
+        c.ok({"cmd": "remove_cloud", "name": "extra"})
+
+    def test_token(self):
+        d = Daemon(self.tmp.name, name="token")
+        self.daemons.append(d)
+        d.stop()
+        with open(d.config) as f:
+            text = f.read().replace("[socket]\nport = 0", '[socket]\nport = 0\ntoken = "s3cret"')
+        with open(d.config, "w") as f:
+            f.write(text)
+        d.start()
+        c = d.client()
+        self.assertEqual(c.error({"cmd": "hash"})["code"], "unauthorized")
+        self.assertEqual(c.error({"cmd": "hello", "token": "wrong"})["code"], "unauthorized")
+        self.assertEqual(c.error({"cmd": "hash"})["code"], "unauthorized")
+        c.ok({"cmd": "hello", "token": "s3cret"})
+        c.ok({"cmd": "hash"})
+
+    def test_subscriptions(self):
+        d = self.daemon(mode="realtime")
+        c = d.client()
+        sub = c.ok({"cmd": "subscribe", "view": "front", "rate": 20})
+        frames = []
+        while len(frames) < 3:
+            header, body = c.read()
+            if header.get("event") == "frame":
+                self.assertEqual(header["subscription"], sub["subscription"])
+                self.assertEqual(len(body), 64 * 48 * 4)
+                frames.append(header["image"]["frame"])
+        self.assertEqual(frames, sorted(frames))
+        sent = c.send({"cmd": "unsubscribe", "subscription": sub["subscription"]})
+        while True:  # frames already on their way may come first
+            header, _ = c.read()
+            if header.get("id") == sent:
+                self.assertTrue(header["ok"])
+                break
+        self.assertEqual(c.error({"cmd": "unsubscribe", "subscription": 999})["code"],
+                         "not_found")
+
+    def test_twenty_concurrent_clients(self):
+        d = self.daemon(mode="realtime")
+        failures = []
+
+        def work(i):
+            try:
+                c = d.client()
+                c.ok({"cmd": "hello"})
+                for _ in range(3):
+                    _, body = c.ok({"cmd": "render", "view": "left" if i % 2 else "front"})
+                    assert body[:4] == b"\x89PNG" if i % 2 else len(body) == 64 * 48 * 4
+                c.ok({"cmd": "stats"})
+                c.close()
+            except Exception as e:  # reported below
+                failures.append(repr(e))
+
+        threads = [threading.Thread(target=work, args=(i,)) for i in range(20)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join(TIMEOUT)
+        self.assertEqual(failures, [])
+        stats = d.client().ok({"cmd": "stats"})
+        self.assertGreaterEqual(stats["frames"], 60)
+
+    def test_full_queue_answers_busy(self):
+        d = self.daemon()
+        c = d.client()
+        # 300 requests in one write: the queue (64) overflows; every one is answered.
+        ids = list(range(1000, 1300))
+        c.sock.sendall(b"".join((json.dumps({"id": i, "cmd": "render", "view": "front"})
+                                 + "\n").encode() for i in ids))
+        answered, busy = set(), 0
+        while len(answered) < len(ids):
+            header, _ = c.read()
+            answered.add(header["id"])
+            if not header["ok"]:
+                self.assertEqual(header["error"]["code"], "busy")
+                busy += 1
+        self.assertEqual(answered, set(ids))
+        self.assertGreater(busy, 0)
+        c.ok({"cmd": "hash"})  # and the connection still works
+
+    def test_slow_and_vanished_clients_do_not_stall_others(self):
+        d = self.daemon(mode="realtime", view_size=(320, 240))
+        # A subscriber that never reads, a half-written request, an abrupt disconnect.
+        slow = d.client()
+        slow.ok({"cmd": "subscribe", "view": "front", "rate": 60})
+        half = d.client()
+        half.sock.sendall(b'{"cmd":"ha')
+        gone = d.client()
+        gone.send({"cmd": "render", "view": "front"})
+        gone.sock.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))
+        gone.sock.close()  # reset, with the reply still to come
+        c = d.client()
+        t0 = c.ok({"cmd": "stats"})
+        wait_until(lambda: c.ok({"cmd": "stats"})["frames_dropped"] > 0,
+                   "frames to be dropped for the slow subscriber")
+        t1 = c.ok({"cmd": "stats"})
+        self.assertGreater(t1["ticks"], t0["ticks"])  # time kept moving
+        _, body = c.ok({"cmd": "render", "view": "front"})
+        self.assertEqual(len(body), 320 * 240 * 4)
+        # The half-written request completes later and is answered.
+        half.sock.sendall(b'sh"}\n')
+        self.assertTrue(half.read()[0]["ok"])
+
+    def test_metrics_endpoint(self):
+        d = self.daemon()
+        s = socket.create_connection(("127.0.0.1", d.metrics_port), timeout=TIMEOUT)
+        s.sendall(b"GET /metrics HTTP/1.1\r\nHost: x\r\n\r\n")
+        text = b""
+        while chunk := s.recv(65536):
+            text += chunk
+        self.assertIn(b"200 OK", text)
+        self.assertIn(b"nephele_ticks_total", text)
+        self.assertIn(b"nephele_render_ms_p99", text)
+
+
+class LockstepAndSnapshotTest(DaemonTest):
+    def drive(self, c):
+        c.ok({"cmd": "set_weather", "layer": 1, "type": 9, "base": 900, "coverage": 60,
+              "wind": [6, -1]})
+        c.ok({"cmd": "add_cloud", "cloud": {"name": "a", "cumulus": {"base": [200, 0, 1000]}}})
+        for dt in [0.1, 0.25, 1.0 / 30, 2.0]:
+            c.ok({"cmd": "tick", "dt": dt})
+        c.ok({"cmd": "set_sun", "azimuth": 120})
+
+    def test_two_daemons_in_lockstep_agree(self):
+        a, b = self.daemon(name="a"), self.daemon(name="b")
+        ca, cb = a.client(), b.client()
+        self.assertEqual(ca.ok({"cmd": "hash"}), cb.ok({"cmd": "hash"}))
+        self.drive(ca)
+        self.drive(cb)
+        ha, hb = ca.ok({"cmd": "hash"}), cb.ok({"cmd": "hash"})
+        self.assertEqual(ha, hb)
+        self.assertAlmostEqual(ha["time"], 2.38333333, places=6)
+        self.assertEqual(ca.ok({"cmd": "render", "view": "front"})[1],
+                         cb.ok({"cmd": "render", "view": "front"})[1])
+        cb.ok({"cmd": "tick", "dt": 0.1})
+        self.assertNotEqual(ca.ok({"cmd": "hash"})["hash"], cb.ok({"cmd": "hash"})["hash"])
+
+    def test_sigterm_saves_and_restart_restores(self):
+        extra = '[snapshot]\npath = "{}"\ninterval = 0\n'
+        d = Daemon(self.tmp.name, name="r")
+        self.daemons.append(d)
+        d.stop()
+        with open(d.config, "a") as f:
+            f.write(extra.format(d.snapshot))
+        d.start()
+        c = d.client()
+        self.drive(c)
+        before = c.ok({"cmd": "hash"})
+        _, frame = c.ok({"cmd": "render", "view": "front"})
+        self.assertEqual(d.stop(), 0)
+        self.assertIn("event=snapshot reason=shutdown", d.log_text())
+        d.start()
+        c = d.client()
+        self.assertEqual(c.ok({"cmd": "hash"})["hash"], before["hash"])
+        self.assertEqual(c.ok({"cmd": "render", "view": "front"})[1], frame)
+        # Named snapshots: save, change, restore.
+        c.ok({"cmd": "snapshot", "name": "keep"})
+        c.ok({"cmd": "tick", "dt": 1.0})
+        self.assertNotEqual(c.ok({"cmd": "hash"})["hash"], before["hash"])
+        self.assertEqual(c.ok({"cmd": "restore", "name": "keep"})["hash"], before["hash"])
+        self.assertEqual(c.error({"cmd": "restore", "name": "nothing"})["code"], "not_found")
+
+    def test_kill_9_loses_only_ticks_after_the_last_periodic_snapshot(self):
+        d = Daemon(self.tmp.name, name="k")
+        self.daemons.append(d)
+        d.stop()
+        with open(d.config, "a") as f:
+            f.write('[snapshot]\npath = "{}"\ninterval = 0.1\n'.format(d.snapshot))
+        d.start()
+        c = d.client()
+        self.drive(c)
+        saved = c.ok({"cmd": "hash"})
+        wait_until(lambda: "reason=periodic path={} time={:.3f} hash={}".format(
+            d.snapshot, saved["time"], saved["hash"]) in d.log_text(),
+            "a periodic snapshot of the driven world")
+        self.assertEqual(d.stop(signal.SIGKILL), -signal.SIGKILL)
+        d.start()
+        self.assertEqual(d.client().ok({"cmd": "hash"})["hash"], saved["hash"])
+
+
+class ModbusTest(DaemonTest):
+    def setUp(self):
+        super().setUp()
+        from pymodbus.client import ModbusTcpClient
+        self.d = self.daemon()
+        self.mb = ModbusTcpClient("127.0.0.1", port=self.d.modbus_port, timeout=10)
+        self.assertTrue(self.mb.connect())
+        self.c = self.d.client()
+
+    def tearDown(self):
+        self.mb.close()
+        super().tearDown()
+
+    def test_registers_follow_the_view_and_writes_steer_it(self):
+        regs = self.mb.read_holding_registers(0, 56, slave=1).registers
+        self.assertEqual(regs[14:16], [64, 48])
+        z = struct.unpack(">f", struct.pack(">HH", *regs[4:6]))[0]
+        self.assertAlmostEqual(z, self.c.ok({"cmd": "get_view", "view": "front"})["position"][2])
+        self.assertFalse(self.mb.write_registers(6, floats(45.0) + floats(5.0), slave=1).isError())
+        view = self.c.ok({"cmd": "get_view", "view": "front"})
+        self.assertEqual((view["heading"], view["pitch"]), (45.0, 5.0))
+        self.c.ok({"cmd": "set_view", "view": "front", "vfov": 33.0})
+        regs = self.mb.read_holding_registers(12, 2, slave=1).registers
+        self.assertAlmostEqual(struct.unpack(">f", struct.pack(">HH", *regs))[0], 33.0, 5)
+        # Weather layer 1: cumulus at 1500 m, 25 % cover.
+        before = self.c.ok({"cmd": "hash"})["hash"]
+        self.assertFalse(self.mb.write_registers(
+            32, [7] + floats(1500.0) + floats(700.0) + floats(25.0), slave=1).isError())
+        self.assertNotEqual(self.c.ok({"cmd": "hash"})["hash"], before)
+        regs = self.mb.read_holding_registers(32, 7, slave=1).registers
+        self.assertEqual(regs[0], 7)
+
+    def test_bad_writes_get_exceptions_and_change_nothing(self):
+        before = self.c.ok({"cmd": "hash"})["hash"]
+        view = self.c.ok({"cmd": "get_view", "view": "front"})
+        nan = [0x7FC0, 0x0000]
+        cases = [
+            (6, nan, 3),                       # NaN heading: ILLEGAL_DATA_VALUE
+            (12, floats(500.0), 3),            # vfov out of range
+            (14, [0], 3),                      # width 0
+            (32, [11], 3),                     # cloud type 11
+            (7, [0x4200], 2),                  # half of the heading float: ILLEGAL_DATA_ADDRESS
+            (6, [0x4200, 0, 0x4200], 2),       # a float and a half
+            (26, [1], 2),                      # reserved register
+            (200, [1], 2),                     # outside the map
+            (0, floats(1.0) + floats(2.0) + floats(-5.0), 3),  # below the ground
+        ]
+        for address, values, code in cases:
+            with self.subTest(address=address, values=values):
+                r = self.mb.write_registers(address, values, slave=1)
+                self.assertTrue(r.isError())
+                self.assertEqual(r.exception_code, code)
+        self.assertEqual(self.c.ok({"cmd": "hash"})["hash"], before)
+        self.assertEqual(self.c.ok({"cmd": "get_view", "view": "front"}), view)
+        status = self.mb.read_input_registers(0, 12, slave=1).registers
+        self.assertEqual(status[9], 1 + 1)  # last error: bad field
+        r = self.mb.write_coil(5, True, slave=1)
+        self.assertTrue(r.isError())
+        self.assertEqual(r.exception_code, 2)
+
+    def test_render_coil_writes_a_file_and_pushes_to_subscribers(self):
+        sub = self.c.ok({"cmd": "subscribe", "view": "front", "rate": 0.01})
+        first, _ = self.c.read()  # a new subscription is due at once
+        self.assertEqual(first["event"], "frame")
+        frames_before = self.mb.read_input_registers(1, 2, slave=1).registers
+        self.assertFalse(self.mb.write_coil(0, True, slave=1).isError())
+        header, body = self.c.read()
+        self.assertEqual((header["event"], header["subscription"]), ("frame", sub["subscription"]))
+        out = os.path.join(self.tmp.name, "d-frames")
+        files = wait_until(lambda: [f for f in os.listdir(out) if f.endswith(".png")]
+                           if os.path.isdir(out) else None, "the triggered image")
+        with open(os.path.join(out, files[0]), "rb") as f:
+            w, h, channels, _ = decode_png(f.read())
+        self.assertEqual((w, h, channels), (64, 48, 3))
+        wait_until(lambda: not self.mb.read_coils(0, 1, slave=1).bits[0], "the coil to clear")
+        frames_after = self.mb.read_input_registers(1, 2, slave=1).registers
+        self.assertGreater(frames_after, frames_before)
+        # Pause coil: simulation time stands still, and the status register says so.
+        self.assertFalse(self.mb.write_coil(1, True, slave=1).isError())
+        self.assertEqual(self.mb.read_input_registers(0, 1, slave=1).registers[0], 3)  # lockstep
+
+    def test_mbpoll_reads_and_writes(self):
+        out = subprocess.run(["mbpoll", "-m", "tcp", "-a", "1", "-p", str(self.d.modbus_port),
+                              "-t", "4", "-0", "-r", "14", "-c", "2", "-1", "127.0.0.1"],
+                             capture_output=True, text=True, timeout=TIMEOUT)
+        self.assertEqual(out.returncode, 0, out.stderr)
+        self.assertIn("[14]: \t64", out.stdout)
+        self.assertIn("[15]: \t48", out.stdout)
+        out = subprocess.run(["mbpoll", "-m", "tcp", "-a", "1", "-p", str(self.d.modbus_port),
+                              "-t", "4", "-0", "-r", "14", "-1", "127.0.0.1", "80"],
+                             capture_output=True, text=True, timeout=TIMEOUT)
+        self.assertEqual(out.returncode, 0, out.stderr)
+        self.assertEqual(self.c.ok({"cmd": "get_view", "view": "front"})["width"], 80)
+        out = subprocess.run(["mbpoll", "-m", "tcp", "-a", "1", "-p", str(self.d.modbus_port),
+                              "-t", "4", "-0", "-r", "14", "-1", "127.0.0.1", "0"],
+                             capture_output=True, text=True, timeout=TIMEOUT)
+        self.assertNotEqual(out.returncode, 0)
+        self.assertEqual(self.c.ok({"cmd": "get_view", "view": "front"})["width"], 80)
+
+    def test_allow_list_refuses_other_addresses(self):
+        d = Daemon(self.tmp.name, name="deny")
+        self.daemons.append(d)
+        d.stop()
+        with open(d.config) as f:
+            text = f.read().replace("[modbus]\nport = 0", '[modbus]\nport = 0\nallow = ["10.9.8.7"]')
+        with open(d.config, "w") as f:
+            f.write(text)
+        d.start()
+        from pymodbus.client import ModbusTcpClient
+        mb = ModbusTcpClient("127.0.0.1", port=d.modbus_port, timeout=2, retries=0)
+        mb.connect()
+        try:
+            refused = mb.read_holding_registers(0, 1, slave=1).isError()
+        except Exception:  # pymodbus raises when the server closes the connection
+            refused = True
+        self.assertTrue(refused)
+        mb.close()
+        wait_until(lambda: "event=modbus_refused" in d.log_text(), "the refusal in the log")
+
+
+if __name__ == "__main__":
+    unittest.main()
