@@ -7,6 +7,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "world/layer_texture.h"
+
 namespace nephele {
 namespace {
 
@@ -203,6 +205,63 @@ TEST(World, CorruptOrTruncatedSnapshotsAreRefusedAndLeaveTheWorldAsItWas) {
   EXPECT_EQ(target.hash(), before);
   ASSERT_EQ(target.restore(good), "");
   EXPECT_EQ(target.hash(), source.hash());
+}
+
+TEST(World, AWindChangeKeepsCloudsAndLayersWhereTheyAre) {
+  World world = makeWorld();
+  ASSERT_EQ(world.advance(100.0), "");
+  const Scene before = world.scene();
+  const LayerTexture layer_before(before.layers[0].texture);
+  ASSERT_EQ(world.edit([](Scene&, WorldDynamics& d) {
+    d.wind.samples = {{0.0, {-20.0, 5.0}}};
+    return std::string();
+  }),
+            "");
+  const Scene now = world.scene();
+  const LayerTexture layer_now(now.layers[0].texture);
+  const glm::dvec3 c0 = before.clouds[0].ellipsoids[0].centre;
+  EXPECT_NEAR(glm::length(now.clouds[0].ellipsoids[0].centre - c0), 0.0, 1e-9);
+  EXPECT_NEAR(glm::length(now.clouds[0].drift_m - before.clouds[0].drift_m), 0.0, 1e-9);
+  EXPECT_NEAR(glm::length(layer_now.driftOffset(100.0) - layer_before.driftOffset(100.0)), 0.0,
+              1e-6);
+  // ... and from then on they drift with the new wind.
+  ASSERT_EQ(world.advance(10.0), "");
+  const glm::dvec3 moved = world.scene().clouds[0].ellipsoids[0].centre - c0;
+  EXPECT_NEAR(moved.x, -200.0, 1e-6);
+  EXPECT_NEAR(moved.y, 50.0, 1e-6);
+}
+
+TEST(World, AFailedEditChangesNothing) {
+  World world = makeWorld();
+  const std::uint64_t hash = world.hash();
+  EXPECT_EQ(world.edit([](Scene& now, WorldDynamics&) {
+    now.clouds.clear();
+    return std::string("refused");
+  }),
+            "refused");
+  EXPECT_THAT(world.edit([](Scene& now, WorldDynamics&) {
+    now.layers.push_back({});  // without a development entry: the schedules no longer fit
+    return std::string();
+  }),
+              ::testing::HasSubstr("layer schedules"));
+  EXPECT_THAT(world.edit([](Scene&, WorldDynamics& d) {
+    d.automata.clear();
+    return std::string();
+  }),
+              ::testing::HasSubstr("automaton"));
+  EXPECT_EQ(world.hash(), hash);
+  // An edit that succeeds survives a snapshot round trip.
+  ASSERT_EQ(world.edit([](Scene& now, WorldDynamics& d) {
+    now.clouds.push_back(now.clouds[0]);
+    now.clouds.back().name = "copy";
+    d.clouds.emplace_back();
+    return std::string();
+  }),
+            "");
+  World copy = makeWorld();
+  ASSERT_EQ(copy.restore(world.snapshot()), "");
+  EXPECT_EQ(copy.hash(), world.hash());
+  EXPECT_EQ(copy.scene().clouds.size(), 2u);
 }
 
 TEST(World, HashesDifferWhenTheWorldDiffers) {

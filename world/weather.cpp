@@ -38,6 +38,27 @@ constexpr std::array<std::string_view, kCloudTypeCount> kNames{
     "none",   "altocumulus",  "altostratus", "cirrocumulus",  "cirrostratus", "cirrus",
     "cumulonimbus", "cumulus", "nimbostratus", "stratocumulus", "stratus"};
 
+// Texture values on a grid over one period, sorted.
+std::vector<double> sortedSamples(const LayerTextureSpec& spec) {
+  constexpr int kGrid = 96;  // samples per period axis
+  const LayerTexture texture(spec);
+  const glm::dvec2 period = texture.period();
+  std::vector<double> values;
+  values.reserve(kGrid * kGrid);
+  for (int j = 0; j < kGrid; ++j)
+    for (int i = 0; i < kGrid; ++i)
+      values.push_back(
+          texture.value({(i + 0.5) / kGrid * period.x, (j + 0.5) / kGrid * period.y}, 0.0));
+  std::sort(values.begin(), values.end());
+  return values;
+}
+
+double positiveFraction(const LayerTextureSpec& spec) {
+  const std::vector<double> values = sortedSamples(spec);
+  const auto zeros = std::upper_bound(values.begin(), values.end(), 0.0) - values.begin();
+  return 1.0 - double(zeros) / double(values.size());
+}
+
 bool isConvective(CloudType type) {
   return type == CloudType::kCumulus || type == CloudType::kCumulonimbus;
 }
@@ -57,6 +78,12 @@ CloudLayer planeLayer(const WeatherLayer& w, const std::string& name, std::uint6
   layer.texture.gardner.terms = look.terms;
   layer.texture.gardner.t0 = look.t0;
   layer.texture.seed = seed;
+  // Gardner's T is zero wherever a sum of sines is negative, which caps the coverage any T1
+  // can give; raise T0 (fewer zeros, less contrast) until the asked coverage is within reach.
+  constexpr double kMaxT0 = 8.0;
+  while (w.coverage < 1.0 && layer.texture.gardner.t0 < kMaxT0 &&
+         positiveFraction(layer.texture) < w.coverage + 0.02)
+    layer.texture.gardner.t0 += 0.25;
   layer.threshold = thresholdForCoverage(layer.texture, w.coverage);
   return layer;
 }
@@ -108,16 +135,7 @@ WeatherClouds weatherClouds(const WeatherLayer& weather, const std::string& pref
 }
 
 double thresholdForCoverage(const LayerTextureSpec& spec, double coverage) {
-  constexpr int kGrid = 96;  // samples per period axis
-  const LayerTexture texture(spec);
-  const glm::dvec2 period = texture.period();
-  std::vector<double> values;
-  values.reserve(kGrid * kGrid);
-  for (int j = 0; j < kGrid; ++j)
-    for (int i = 0; i < kGrid; ++i)
-      values.push_back(texture.value(
-          {(i + 0.5) / kGrid * period.x, (j + 0.5) / kGrid * period.y}, 0.0));
-  std::sort(values.begin(), values.end());
+  const std::vector<double> values = sortedSamples(spec);
   const double c = std::clamp(coverage, 0.0, 1.0);
   if (c >= 1.0) return values.front() - 1e-3;
   if (c <= 0.0) return values.back() + 1e-3;

@@ -1,0 +1,59 @@
+#include "config/daemon_config.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+namespace nephele {
+namespace {
+
+using ::testing::HasSubstr;
+
+const std::string kScene =
+    "scene = \"" + std::string(NEPHELE_SOURCE_DIR) + "/config/scenes/cirrus.toml\"\n";
+
+TEST(DaemonConfig, DefaultsAndTheExample) {
+  DaemonConfig c;
+  ASSERT_EQ(parseDaemonConfig(kScene, "t.toml", c), "");
+  EXPECT_EQ(c.mode, TickMode::kRealtime);
+  EXPECT_EQ(c.socket.bind, "127.0.0.1");
+  EXPECT_EQ(c.modbus.bind, "127.0.0.1");
+  ASSERT_EQ(c.views.size(), 1u);
+  EXPECT_EQ(c.views[0].camera.width, 1280);  // the scene's camera
+  EXPECT_EQ(c.modbus_view, c.views[0].name);
+
+  DaemonConfig example;
+  ASSERT_EQ(loadDaemonConfig(std::string(NEPHELE_SOURCE_DIR) + "/deploy/nephele.toml", example),
+            "");
+  EXPECT_EQ(example.views.size(), 2u);
+  EXPECT_EQ(example.views[1].image.format, ImageFormat::kPng);
+  EXPECT_FALSE(example.views[1].image.coverage);
+  EXPECT_EQ(example.snapshot_directory, "/var/lib/nephele");
+}
+
+TEST(DaemonConfig, ErrorsNameTheKey) {
+  struct Case {
+    std::string text;
+    const char* words;
+  };
+  const Case cases[] = {
+      {"[world]\nmode = \"realtime\"\n", "missing key scene"},
+      {"scene = \"/nonexistent.toml\"\n", "cannot read scene file"},
+      {kScene + "[world]\nmode = \"fast\"\n", "world.mode: \"fast\" is not allowed"},
+      {kScene + "[world]\ntick_rate = 0\n", "world.tick_rate"},
+      {kScene + "[[view]]\nwidth = 10\n", "missing key name"},
+      {kScene + "[[view]]\nname = \"a\"\n[[view]]\nname = \"a\"\n", "names two views"},
+      {kScene + "[[view]]\nname = \"a\"\nformat = \"jpeg\"\ncoverage = true\n", "jpeg"},
+      {kScene + "[modbus]\nview = \"rear\"\n", "modbus.view: \"rear\" is not a view"},
+      {kScene + "[modbus]\nallow = [1]\n", "modbus.allow"},
+      {kScene + "[socket]\nport = 70000\n", "socket.port"},
+      {kScene + "[socket]\nmystery = 1\n", "socket.mystery: unknown key"},
+      {kScene + "[output]\nformat = \"raw\"\n", "output.format"},
+  };
+  for (const Case& c : cases) {
+    DaemonConfig out;
+    EXPECT_THAT(parseDaemonConfig(c.text, "t.toml", out), HasSubstr(c.words)) << c.text;
+  }
+}
+
+}  // namespace
+}  // namespace nephele

@@ -1,0 +1,129 @@
+#include "protocol/messages.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+namespace nephele {
+namespace {
+
+using ::testing::HasSubstr;
+
+Request parsed(std::string_view line) {
+  auto r = parseRequest(line);
+  EXPECT_TRUE(std::holds_alternative<Request>(r))
+      << (std::holds_alternative<BadRequest>(r) ? std::get<BadRequest>(r).error.message : "");
+  return std::holds_alternative<Request>(r) ? std::get<Request>(r) : Request{};
+}
+
+BadRequest rejected(std::string_view line) {
+  auto r = parseRequest(line);
+  EXPECT_TRUE(std::holds_alternative<BadRequest>(r)) << line;
+  return std::holds_alternative<BadRequest>(r) ? std::get<BadRequest>(r) : BadRequest{};
+}
+
+TEST(Messages, ParsesEveryCommandWithItsFields) {
+  const Request view = parsed(
+      R"({"id":7,"cmd":"set_view","view":"front","position":[1,2,3],"heading":-90,"width":320,)"
+      R"("format":"png","channels":["coverage"]})");
+  EXPECT_EQ(view.id, 7);
+  const auto& v = std::get<command::SetView>(view.command);
+  EXPECT_EQ(v.view, "front");
+  EXPECT_EQ(*v.patch.position, glm::dvec3(1, 2, 3));
+  EXPECT_EQ(*v.patch.heading, -90.0);
+  EXPECT_EQ(*v.patch.width, 320);
+  EXPECT_FALSE(v.patch.pitch.has_value());
+  EXPECT_EQ(v.patch.image->format, ImageFormat::kPng);
+  EXPECT_FALSE(v.patch.image->colour);
+  EXPECT_TRUE(v.patch.image->coverage);
+
+  const auto w = std::get<command::SetWeather>(
+      parsed(R"({"cmd":"set_weather","layer":2,"type":9,"base":1200,"thickness":400,)"
+             R"("coverage":75,"wind":[3,-4]})")
+          .command);
+  EXPECT_EQ(w.layer, 2);
+  EXPECT_EQ(w.weather.type, CloudType::kStratocumulus);
+  EXPECT_EQ(w.weather.base_m, 1200.0);
+  EXPECT_EQ(w.weather.coverage, 0.75);
+  EXPECT_EQ(*w.weather.wind, glm::dvec2(3, -4));
+
+  EXPECT_EQ(std::get<command::Tick>(parsed(R"({"cmd":"tick","dt":0.02})").command).dt, 0.02);
+  EXPECT_EQ(std::get<command::Subscribe>(parsed(R"({"cmd":"subscribe","view":"a","rate":5})").command)
+                .rate_hz,
+            5.0);
+  EXPECT_EQ(parsed(R"({"id":"abc","cmd":"hash"})").id, "abc");
+  EXPECT_EQ(commandName(parsed(R"({"cmd":"stats"})").command), "stats");
+}
+
+TEST(Messages, DefaultChannelsFollowTheFormat) {
+  auto image = [](std::string_view line) {
+    return *std::get<command::Render>(parsed(line).command).image;
+  };
+  EXPECT_TRUE(image(R"({"cmd":"render","view":"v","format":"raw"})").coverage);
+  EXPECT_TRUE(image(R"({"cmd":"render","view":"v","format":"exr"})").coverage);
+  EXPECT_FALSE(image(R"({"cmd":"render","view":"v","format":"png"})").coverage);
+  EXPECT_FALSE(std::get<command::Render>(parsed(R"({"cmd":"render","view":"v"})").command)
+                   .image.has_value());  // the view's own
+}
+
+TEST(Messages, ErrorsNameTheFieldAndWhatIsAllowed) {
+  struct Case {
+    const char* line;
+    ErrorCode code;
+    const char* words;
+  };
+  const Case cases[] = {
+      {"not json", ErrorCode::kBadJson, "not valid JSON"},
+      {"[1]", ErrorCode::kBadJson, "object"},
+      {R"({"id":3})", ErrorCode::kBadField, "cmd: is missing"},
+      {R"({"cmd":"fly"})", ErrorCode::kUnknownCommand, "allowed: hello, get_view"},
+      {R"({"cmd":"tick","dt":"1"})", ErrorCode::kBadField, "dt: must be a number"},
+      {R"({"cmd":"tick","dt":1e9})", ErrorCode::kBadField, "allowed: 0 to 3600"},
+      {R"({"cmd":"tick","dt":1,"speed":2})", ErrorCode::kBadField, "speed: unknown field"},
+      {R"({"cmd":"set_view","view":"a","position":[0,0,-1]})", ErrorCode::kBadField, "z >= 0"},
+      {R"({"cmd":"set_view","view":"a","position":[0,0]})", ErrorCode::kBadField, "3 numbers"},
+      {R"({"cmd":"set_view","view":"","heading":1})", ErrorCode::kBadField, "view"},
+      {R"({"cmd":"set_weather","type":1})", ErrorCode::kBadField, "layer: is missing"},
+      {R"({"cmd":"set_weather","layer":1})", ErrorCode::kBadField, "1 altocumulus"},
+      {R"({"cmd":"set_weather","layer":1,"type":3,"wind":[150,150]})", ErrorCode::kBadField,
+       "200 m/s"},
+      {R"({"cmd":"render","view":"a","channels":["colour","colour"]})", ErrorCode::kBadField,
+       "repeated"},
+      {R"({"cmd":"render","view":"a","channels":["depth"]})", ErrorCode::kBadField, "depth"},
+      {R"({"cmd":"subscribe","view":"a","rate":1000})", ErrorCode::kBadField, "0.01 to 60"},
+      {R"({"cmd":"snapshot","name":"a/b"})", ErrorCode::kBadField, "'/'"},
+      {R"({"cmd":"snapshot","name":".hidden"})", ErrorCode::kBadField, "not starting with"},
+      {R"({"cmd":"hash","id":{"a":1}})", ErrorCode::kBadField, "id: must be"},
+  };
+  for (const Case& c : cases) {
+    const BadRequest bad = rejected(c.line);
+    EXPECT_EQ(bad.error.code, c.code) << c.line;
+    EXPECT_THAT(bad.error.message, HasSubstr(c.words)) << c.line;
+  }
+  EXPECT_EQ(rejected(R"({"id":12,"cmd":"fly"})").id, 12);  // the id comes back when readable
+}
+
+TEST(Messages, LimitsOnSizeAndNesting) {
+  const std::string big = R"({"cmd":"hash","pad":")" +
+                          std::string(ProtocolLimits::kMaxRequestBytes, 'x') + "\"}";
+  EXPECT_EQ(rejected(big).error.code, ErrorCode::kTooLarge);
+  std::string deep = std::string(ProtocolLimits::kMaxJsonDepth + 1, '[') +
+                     std::string(ProtocolLimits::kMaxJsonDepth + 1, ']');
+  EXPECT_THAT(rejected(deep).error.message, HasSubstr("nests deeper"));
+  // Brackets inside strings do not count.
+  parsed(R"({"cmd":"hello","token":"[[[[[[[[[[[[[[[[[[[[[[["})");
+}
+
+TEST(Messages, RepliesAreOneLineEach) {
+  const std::string ok = okReply(5, {{"a", 1}});
+  EXPECT_EQ(ok, "{\"id\":5,\"ok\":true,\"result\":{\"a\":1}}\n");
+  const std::string error = errorReply(nullptr, {ErrorCode::kBusy, "full\nqueue"});
+  EXPECT_EQ(std::count(error.begin(), error.end(), '\n'), 1);
+  EXPECT_THAT(error, HasSubstr("\"code\":\"busy\""));
+  const std::string header = imageReplyHeader("x", {{"width", 2}}, 16);
+  EXPECT_THAT(header, HasSubstr("\"bytes\":16"));
+  // Invalid UTF-8 in a message is replaced, never thrown.
+  EXPECT_NO_THROW(errorReply(1, {ErrorCode::kBadField, "\xff\xfe"}));
+}
+
+}  // namespace
+}  // namespace nephele
