@@ -1,0 +1,249 @@
+// daemon_bench: starts the real `nephele serve` and measures what a host simulator sees.
+//   1. request-to-last-byte latency of a 640x480 frame, raw RGBA and PNG;
+//   2. Modbus write-to-visible latency: from a holding-register write (heading) to the first
+//      subscribed frame that shows it;
+//   3. frames per second delivered to 1, 4 and 16 subscribers at the 60 Hz maximum.
+// Figures only; these machines are shared and noisy.
+#include <arpa/inet.h>
+#include <fcntl.h>
+#include <modbus/modbus.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using nlohmann::json;
+
+double msBetween(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double, std::milli>(b - a).count();
+}
+
+double percentile(std::vector<double> v, double p) {
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, std::size_t(p * double(v.size())))];
+}
+
+// The daemon as a child process; the ports come from its ready line.
+struct Daemon {
+  pid_t pid = 0;
+  int socket_port = 0, modbus_port = 0;
+
+  explicit Daemon(const std::string& config) {
+    int out[2];
+    if (pipe(out)) throw std::runtime_error("pipe");
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_adddup2(&actions, out[1], STDOUT_FILENO);
+    posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, "/dev/null", O_WRONLY, 0);
+    std::string binary = NEPHELE_BINARY;
+    char* argv[] = {binary.data(), const_cast<char*>("serve"), const_cast<char*>("-c"),
+                    const_cast<char*>(config.c_str()), nullptr};
+    if (posix_spawn(&pid, binary.c_str(), &actions, nullptr, argv, environ))
+      throw std::runtime_error("cannot start " + binary);
+    close(out[1]);
+    std::string line;
+    char c;
+    while (read(out[0], &c, 1) == 1 && c != '\n') line += c;
+    close(out[0]);
+    if (std::sscanf(line.c_str(), "nephele ready socket=%d modbus=%d", &socket_port,
+                    &modbus_port) != 2)
+      throw std::runtime_error("the daemon did not start: " + line);
+  }
+  ~Daemon() {
+    kill(pid, SIGTERM);
+    waitpid(pid, nullptr, 0);
+  }
+};
+
+// A blocking client of the socket protocol.
+class Client {
+ public:
+  explicit Client(int port) {
+    fd_ = socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_port = htons(std::uint16_t(port));
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    if (connect(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a))
+      throw std::runtime_error("connect");
+    int one = 1;
+    setsockopt(fd_, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+  }
+  ~Client() { close(fd_); }
+
+  void send(const json& request) {
+    const std::string line = request.dump() + "\n";
+    if (write(fd_, line.data(), line.size()) != ssize_t(line.size()))
+      throw std::runtime_error("write");
+  }
+  // One reply or event; image bytes go into `body`.
+  json receive(std::vector<std::uint8_t>& body) {
+    std::string line;
+    for (;;) {
+      const auto nl = std::find(buffer_.begin(), buffer_.end(), '\n');
+      if (nl != buffer_.end()) {
+        line.assign(buffer_.begin(), nl);
+        buffer_.erase(buffer_.begin(), nl + 1);
+        break;
+      }
+      fill();
+    }
+    json header = json::parse(line);
+    const json* image = header.contains("image") ? &header["image"]
+                        : header.contains("result") && header["result"].contains("image")
+                            ? &header["result"]["image"]
+                            : nullptr;
+    body.clear();
+    if (image) {
+      const std::size_t n = (*image)["bytes"];
+      while (buffer_.size() < n) fill();
+      body.assign(buffer_.begin(), buffer_.begin() + std::ptrdiff_t(n));
+      buffer_.erase(buffer_.begin(), buffer_.begin() + std::ptrdiff_t(n));
+    }
+    return header;
+  }
+  json request(const json& r, std::vector<std::uint8_t>& body) {
+    send(r);
+    return receive(body);
+  }
+
+ private:
+  void fill() {
+    char chunk[1 << 16];
+    const ssize_t n = read(fd_, chunk, sizeof chunk);
+    if (n <= 0) throw std::runtime_error("connection closed");
+    buffer_.insert(buffer_.end(), chunk, chunk + n);
+  }
+  int fd_;
+  std::vector<char> buffer_;
+};
+
+std::string writeConfig(const std::filesystem::path& dir) {
+  const std::string path = (dir / "bench.toml").string();
+  std::ofstream(path) << "scene = \"" << NEPHELE_SOURCE_DIR
+                      << "/config/scenes/cumulus.toml\"\n"
+                         "[world]\ntick_rate = 60\n"
+                         "[[view]]\nname = \"front\"\nwidth = 640\nheight = 480\n"
+                         "[socket]\nport = 0\nmax_subscriptions = 64\n"
+                         "[modbus]\nport = 0\n"
+                         "[output]\ndirectory = \""
+                      << (dir / "frames").string() << "\"\n";
+  return path;
+}
+
+void latency(Client& client, const char* format, int repeats) {
+  std::vector<double> ms;
+  std::vector<std::uint8_t> body;
+  std::size_t bytes = 0;
+  for (int i = 0; i < repeats + 3; ++i) {
+    const auto t0 = Clock::now();
+    json reply = client.request({{"id", i}, {"cmd", "render"}, {"view", "front"}, {"format", format}},
+                                body);
+    const auto t1 = Clock::now();
+    if (!reply["ok"]) throw std::runtime_error(reply.dump());
+    if (i >= 3) ms.push_back(msBetween(t0, t1));  // after the warm-up
+    bytes = body.size();
+  }
+  std::printf("render %-4s 640x480: p50 %6.2f ms  p99 %6.2f ms  (%zu bytes, %d requests)\n",
+              format, percentile(ms, 0.5), percentile(ms, 0.99), bytes, repeats);
+}
+
+// Mean coverage of a raw RGBA frame.
+double meanCoverage(const std::vector<std::uint8_t>& rgba) {
+  double sum = 0.0;
+  for (std::size_t i = 3; i < rgba.size(); i += 4) sum += rgba[i];
+  return sum / double(rgba.size() / 4) / 255.0;
+}
+
+void modbusLatency(const Daemon& daemon, int repeats) {
+  modbus_t* mb = modbus_new_tcp("127.0.0.1", daemon.modbus_port);
+  if (modbus_connect(mb)) throw std::runtime_error("modbus connect");
+  Client sub(daemon.socket_port);
+  std::vector<std::uint8_t> body;
+  sub.request({{"cmd", "subscribe"}, {"view", "front"}, {"rate", 60}}, body);
+  std::vector<double> ms;
+  for (int i = 0; i < repeats; ++i) {
+    const float heading = i % 2 ? 0.0f : 180.0f;  // towards the cloud, or away from it
+    std::uint32_t bits;
+    std::memcpy(&bits, &heading, 4);
+    std::uint16_t words[2] = {std::uint16_t(bits >> 16), std::uint16_t(bits & 0xffff)};  // ABCD
+    const auto t0 = Clock::now();
+    if (modbus_write_registers(mb, 6, 2, words) != 2) throw std::runtime_error("modbus write");
+    for (;;) {  // the first frame rendered after the write that shows the new heading
+      json event = sub.receive(body);
+      if (event.value("event", "") != "frame") continue;
+      if ((meanCoverage(body) > 0.01) == (heading == 0.0f)) break;
+    }
+    ms.push_back(msBetween(t0, Clock::now()));
+  }
+  std::printf("modbus write to visible frame (60 Hz subscription, 640x480 raw): p50 %.1f ms  "
+              "p99 %.1f ms  (%d writes)\n",
+              percentile(ms, 0.5), percentile(ms, 0.99), repeats);
+  modbus_close(mb);
+  modbus_free(mb);
+}
+
+void subscribers(const Daemon& daemon, int count, double seconds) {
+  std::atomic<bool> stop{false};
+  std::vector<int> frames(std::size_t(count), 0);
+  std::vector<std::thread> threads;
+  for (int i = 0; i < count; ++i)
+    threads.emplace_back([&, i] {
+      Client c(daemon.socket_port);
+      std::vector<std::uint8_t> body;
+      c.request({{"cmd", "subscribe"}, {"view", "front"}, {"rate", 60}}, body);
+      while (!stop)
+        if (c.receive(body).value("event", "") == "frame") ++frames[std::size_t(i)];
+    });
+  std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
+  stop = true;
+  for (auto& t : threads) t.join();  // each sees one more frame within 1/60 s and stops
+  double total = 0.0;
+  for (int f : frames) total += f;
+  std::printf("%2d subscribers, 640x480 raw at 60 Hz asked: %5.1f fps each (mean), %6.1f fps "
+              "delivered in all\n",
+              count, total / count / seconds, total / seconds);
+}
+
+}  // namespace
+
+int main() {
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
+  try {
+    const auto dir = std::filesystem::temp_directory_path() / ("nephele-bench-" + std::to_string(getpid()));
+    std::filesystem::create_directories(dir);
+    {
+      Daemon daemon(writeConfig(dir));
+      Client client(daemon.socket_port);
+      latency(client, "raw", 200);
+      latency(client, "png", 100);
+      modbusLatency(daemon, 20);
+      for (int n : {1, 4, 16}) subscribers(daemon, n, 5.0);
+    }
+    std::filesystem::remove_all(dir);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "daemon_bench: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
