@@ -157,15 +157,15 @@ void latency(Client& client, const char* format, int repeats) {
   std::size_t bytes = 0;
   for (int i = 0; i < repeats + 3; ++i) {
     const auto t0 = Clock::now();
-    json reply = client.request({{"id", i}, {"cmd", "render"}, {"view", "front"}, {"format", format}},
-                                body);
+    json reply =
+        client.request({{"id", i}, {"cmd", "render"}, {"view", "front"}, {"format", format}}, body);
     const auto t1 = Clock::now();
     if (!reply["ok"]) throw std::runtime_error(reply.dump());
     if (i >= 3) ms.push_back(msBetween(t0, t1));  // after the warm-up
     bytes = body.size();
   }
-  std::printf("render %-4s 640x480: p50 %6.2f ms  p99 %6.2f ms  (%zu bytes, %d requests)\n",
-              format, percentile(ms, 0.5), percentile(ms, 0.99), bytes, repeats);
+  std::printf("render %-4s 640x480: p50 %6.2f ms  p99 %6.2f ms  (%zu bytes, %d requests)\n", format,
+              percentile(ms, 0.5), percentile(ms, 0.99), bytes, repeats);
 }
 
 // Mean coverage of a raw RGBA frame.
@@ -196,9 +196,10 @@ void modbusLatency(const Daemon& daemon, int repeats) {
     }
     ms.push_back(msBetween(t0, Clock::now()));
   }
-  std::printf("modbus write to visible frame (60 Hz subscription, 640x480 raw): p50 %.1f ms  "
-              "p99 %.1f ms  (%d writes)\n",
-              percentile(ms, 0.5), percentile(ms, 0.99), repeats);
+  std::printf(
+      "modbus write to visible frame (60 Hz subscription, 640x480 raw): p50 %.1f ms  "
+      "p99 %.1f ms  (%d writes)\n",
+      percentile(ms, 0.5), percentile(ms, 0.99), repeats);
   modbus_close(mb);
   modbus_free(mb);
 }
@@ -220,9 +221,10 @@ void subscribers(const Daemon& daemon, int count, double seconds) {
   for (auto& t : threads) t.join();  // each sees one more frame within 1/60 s and stops
   double total = 0.0;
   for (int f : frames) total += f;
-  std::printf("%2d subscribers, 640x480 raw at 60 Hz asked: %5.1f fps each (mean), %6.1f fps "
-              "delivered in all\n",
-              count, total / count / seconds, total / seconds);
+  std::printf(
+      "%2d subscribers, 640x480 raw at 60 Hz asked: %5.1f fps each (mean), %6.1f fps "
+      "delivered in all\n",
+      count, total / count / seconds, total / seconds);
 }
 
 }  // namespace
@@ -230,7 +232,8 @@ void subscribers(const Daemon& daemon, int count, double seconds) {
 int main() {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   try {
-    const auto dir = std::filesystem::temp_directory_path() / ("nephele-bench-" + std::to_string(getpid()));
+    const auto dir =
+        std::filesystem::temp_directory_path() / ("nephele-bench-" + std::to_string(getpid()));
     std::filesystem::create_directories(dir);
     {
       Daemon daemon(writeConfig(dir));

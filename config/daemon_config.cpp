@@ -53,7 +53,8 @@ void readDaemon(const toml::table& root, const std::string& file, DaemonConfig& 
   t.string("scene", out.scene_path);
   const std::filesystem::path scene(out.scene_path);
   if (scene.is_relative())
-    out.scene_path = (std::filesystem::path(file).parent_path() / scene).lexically_normal().string();
+    out.scene_path =
+        (std::filesystem::path(file).parent_path() / scene).lexically_normal().string();
   if (std::string error = loadSceneFile(out.scene_path, out.scene); !error.empty())
     t.failAt("scene", error);
 
@@ -73,8 +74,7 @@ void readDaemon(const toml::table& root, const std::string& file, DaemonConfig& 
     ViewConfig& view = out.views.emplace_back();
     readView(v, out.scene.scene.camera, view);
     for (std::size_t i = 0; i + 1 < out.views.size(); ++i)
-      if (out.views[i].name == view.name)
-        v.failAt("name", "\"" + view.name + "\" names two views");
+      if (out.views[i].name == view.name) v.failAt("name", "\"" + view.name + "\" names two views");
   }
   if (out.views.empty()) out.views.push_back({"main", out.scene.scene.camera, {}});
 
@@ -107,7 +107,8 @@ void readDaemon(const toml::table& root, const std::string& file, DaemonConfig& 
     m->integer("max_clients", out.modbus_max_clients, 1, 256);
     m->finish();
   }
-  if (out.modbus_view.empty()) out.modbus_view = out.views.front().name;
+  if (out.modbus_view.empty())
+    out.modbus_view = out.views.front().name;
   else if (std::none_of(out.views.begin(), out.views.end(),
                         [&](const ViewConfig& v) { return v.name == out.modbus_view; }))
     t.failHere("modbus.view: \"" + out.modbus_view + "\" is not a view");

@@ -43,8 +43,8 @@ struct DaemonConfig {
   ListenConfig socket{"127.0.0.1", 7600};
   std::string token;  // empty: no token needed
   int max_clients = 64;
-  int max_subscriptions = 32;    // over all clients
-  int max_queue = 64;            // requests waiting for the world thread
+  int max_subscriptions = 32;  // over all clients
+  int max_queue = 64;          // requests waiting for the world thread
   std::int64_t max_image_pixels = 4096 * 4096;
   std::size_t max_pending_bytes = 64u << 20;  // per client; frames beyond it are dropped
 
@@ -57,7 +57,7 @@ struct DaemonConfig {
   bool metrics_enabled = false;
   ListenConfig metrics{"127.0.0.1", 9464};
 
-  std::string snapshot_path;  // empty: no snapshots
+  std::string snapshot_path;          // empty: no snapshots
   double snapshot_interval_s = 60.0;  // 0: only at shutdown
   bool restore_on_start = true;
   std::string snapshot_directory;  // for the snapshot/restore requests; empty: beside the path

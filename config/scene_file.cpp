@@ -419,8 +419,7 @@ void readScene(const toml::table& root, const std::string& file, SceneFile& out)
 
 // JSON to TOML, so that JSON objects go through the same readers as scene files. Null has
 // no TOML form and yields nothing.
-using TomlValue =
-    std::variant<toml::table, toml::array, bool, std::int64_t, double, std::string>;
+using TomlValue = std::variant<toml::table, toml::array, bool, std::int64_t, double, std::string>;
 
 std::optional<TomlValue> tomlFromJson(const nlohmann::json& j);
 

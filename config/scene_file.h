@@ -8,8 +8,8 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include "renderer/render_settings.h"
-#include "world/scene.h"
 #include "world/limits.h"
+#include "world/scene.h"
 #include "world/world.h"
 
 namespace nephele {
@@ -20,7 +20,6 @@ struct SceneFile {
   RenderSettings render;
   ReferenceSettings reference;
 };
-
 
 // Names of the render knobs in enum order, shared by scene files and the command line.
 inline const std::vector<std::string> kTextureEvaluationNames{"baked", "procedural"};

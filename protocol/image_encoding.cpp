@@ -134,13 +134,11 @@ std::string writeImageFile(const std::string& path, const FloatImage& image,
                        row);
 }
 
-std::string encodeImage(ImageFileFormat format, const Srgb8Image& image, bool colour,
-                        bool coverage, const EncodeOptions& options,
-                        std::vector<std::uint8_t>& out) {
+std::string encodeImage(ImageFileFormat format, const Srgb8Image& image, bool colour, bool coverage,
+                        const EncodeOptions& options, std::vector<std::uint8_t>& out) {
   if (!colour && !coverage) return "no channels selected";
   if (format == ImageFileFormat::kExr) return "EXR needs a float image";
-  if (format == ImageFileFormat::kJpeg && (coverage || !colour))
-    return "JPEG holds colour only";
+  if (format == ImageFileFormat::kJpeg && (coverage || !colour)) return "JPEG holds colour only";
   const int channels = (colour ? 3 : 0) + (coverage ? 1 : 0);
   oiio::ImageSpec spec(image.width, image.height, channels, oiio::TypeDesc::UINT8);
   spec.channelnames = channelNamesFor(colour, coverage);

@@ -36,8 +36,8 @@ std::string writeImageFile(const std::string& path, const Srgb8Image& image,
 // In-memory images for the socket protocol. `colour` selects RGB and `coverage` the alpha;
 // each returns an empty string on success, else what went wrong. PNG takes any selection,
 // JPEG colour only; EXR is linear float (half unless options say otherwise).
-std::string encodeImage(ImageFileFormat format, const Srgb8Image& image, bool colour,
-                        bool coverage, const EncodeOptions& options, std::vector<std::uint8_t>& out);
+std::string encodeImage(ImageFileFormat format, const Srgb8Image& image, bool colour, bool coverage,
+                        const EncodeOptions& options, std::vector<std::uint8_t>& out);
 std::string encodeImage(const FloatImage& image, bool colour, bool coverage,
                         const EncodeOptions& options, std::vector<std::uint8_t>& out);
 // Raw 8-bit pixels, rows top-down, the selected channels packed per pixel.

@@ -49,8 +49,8 @@ class FieldReader {
     const json* v = take(key);
     if (!v) return std::nullopt;
     if (!v->is_number_integer())
-      fail(key, "must be an integer (allowed: " + std::to_string(lo) + " to " +
-                    std::to_string(hi) + ")");
+      fail(key, "must be an integer (allowed: " + std::to_string(lo) + " to " + std::to_string(hi) +
+                    ")");
     const bool negative = v->is_number_integer() && !v->is_number_unsigned();
     const std::int64_t x = negative ? v->get<std::int64_t>()
                                     : std::int64_t(std::min<std::uint64_t>(
@@ -78,8 +78,8 @@ class FieldReader {
     const std::string s = v->get<std::string>();
     bool ok = !s.empty() && s.size() <= ProtocolLimits::kMaxNameLength && s[0] != '.';
     for (char c : s)
-      ok = ok && (std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' ||
-                  c == '.' || c == '/');
+      ok = ok && (std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.' ||
+                  c == '/');
     if (!ok) fail(key, std::string("is not allowed (allowed: ") + allowed + ")");
     return s;
   }
@@ -127,8 +127,8 @@ class FieldReader {
   void finish(const char* allowed) const {
     for (auto it = object_.begin(); it != object_.end(); ++it)
       if (!taken_.count(it.key()))
-        throw FieldError{ErrorCode::kBadField, qualified(it.key()) + ": unknown field (allowed: " +
-                                                   allowed + ")"};
+        throw FieldError{ErrorCode::kBadField,
+                         qualified(it.key()) + ": unknown field (allowed: " + allowed + ")"};
   }
 
   [[noreturn]] void fail(const std::string& key, const std::string& what) const {
@@ -160,7 +160,8 @@ ImageFormat readFormat(FieldReader& r, ImageFormat current) {
   if (*f == "png") return ImageFormat::kPng;
   if (*f == "jpeg") return ImageFormat::kJpeg;
   if (*f == "exr") return ImageFormat::kExr;
-  r.fail("format", "\"" + *f + "\" is not allowed (allowed: " + std::string(kImageFormatNames) + ")");
+  r.fail("format",
+         "\"" + *f + "\" is not allowed (allowed: " + std::string(kImageFormatNames) + ")");
 }
 
 // "format" and "channels", if either is given.
@@ -231,7 +232,8 @@ Command readCommand(const std::string& cmd, FieldReader& r) {
   }
   if (cmd == "set_view") {
     SetView c{r.requiredName("view"), readViewPatch(r)};
-    r.finish("cmd, id, view, position, heading, pitch, roll, vfov, width, height, format, channels");
+    r.finish(
+        "cmd, id, view, position, heading, pitch, roll, vfov, width, height, format, channels");
     return c;
   }
   if (cmd == "set_weather") {
@@ -239,9 +241,10 @@ Command readCommand(const std::string& cmd, FieldReader& r) {
     if (!r.has("layer")) r.fail("layer", "is missing (allowed: 1 to 3, the CIGI cloud layers)");
     c.layer = int(*r.integer("layer", 1, ProtocolLimits::kWeatherLayers));
     if (!r.has("type"))
-      r.fail("type", "is missing (allowed: 0 to 10, CIGI cloud types: 0 none, 1 altocumulus, 2 "
-                     "altostratus, 3 cirrocumulus, 4 cirrostratus, 5 cirrus, 6 cumulonimbus, 7 "
-                     "cumulus, 8 nimbostratus, 9 stratocumulus, 10 stratus)");
+      r.fail("type",
+             "is missing (allowed: 0 to 10, CIGI cloud types: 0 none, 1 altocumulus, 2 "
+             "altostratus, 3 cirrocumulus, 4 cirrostratus, 5 cirrus, 6 cumulonimbus, 7 "
+             "cumulus, 8 nimbostratus, 9 stratocumulus, 10 stratus)");
     c.weather = readWeather(r);
     r.finish("cmd, id, layer, type, base, thickness, coverage, wind");
     return c;
@@ -325,9 +328,8 @@ Command readCommand(const std::string& cmd, FieldReader& r) {
     if (cmd == "stats") return Stats{};
     return Hash{};
   }
-  throw FieldError{ErrorCode::kUnknownCommand,
-                   "cmd: \"" + cmd + "\" is not a command (allowed: " + std::string(kCommandNames) +
-                       ")"};
+  throw FieldError{ErrorCode::kUnknownCommand, "cmd: \"" + cmd + "\" is not a command (allowed: " +
+                                                   std::string(kCommandNames) + ")"};
 }
 
 // Nesting depth of JSON text, counted before parsing so that deep input cannot exhaust
@@ -337,9 +339,12 @@ int nestingDepth(std::string_view text) {
   bool in_string = false, escaped = false;
   for (char c : text) {
     if (in_string) {
-      if (escaped) escaped = false;
-      else if (c == '\\') escaped = true;
-      else if (c == '"') in_string = false;
+      if (escaped)
+        escaped = false;
+      else if (c == '\\')
+        escaped = true;
+      else if (c == '"')
+        in_string = false;
     } else if (c == '"') {
       in_string = true;
     } else if (c == '[' || c == '{') {
@@ -355,48 +360,62 @@ int nestingDepth(std::string_view text) {
 
 std::string_view errorCodeName(ErrorCode code) {
   switch (code) {
-    case ErrorCode::kBadJson: return "bad_json";
-    case ErrorCode::kBadField: return "bad_field";
-    case ErrorCode::kUnknownCommand: return "unknown_command";
-    case ErrorCode::kTooLarge: return "too_large";
-    case ErrorCode::kUnauthorized: return "unauthorized";
-    case ErrorCode::kBusy: return "busy";
-    case ErrorCode::kNotFound: return "not_found";
-    case ErrorCode::kLimit: return "limit";
-    case ErrorCode::kFailed: return "failed";
+    case ErrorCode::kBadJson:
+      return "bad_json";
+    case ErrorCode::kBadField:
+      return "bad_field";
+    case ErrorCode::kUnknownCommand:
+      return "unknown_command";
+    case ErrorCode::kTooLarge:
+      return "too_large";
+    case ErrorCode::kUnauthorized:
+      return "unauthorized";
+    case ErrorCode::kBusy:
+      return "busy";
+    case ErrorCode::kNotFound:
+      return "not_found";
+    case ErrorCode::kLimit:
+      return "limit";
+    case ErrorCode::kFailed:
+      return "failed";
   }
   return "failed";
 }
 
 std::string_view imageFormatName(ImageFormat format) {
   switch (format) {
-    case ImageFormat::kRaw: return "raw";
-    case ImageFormat::kPng: return "png";
-    case ImageFormat::kJpeg: return "jpeg";
-    case ImageFormat::kExr: return "exr";
+    case ImageFormat::kRaw:
+      return "raw";
+    case ImageFormat::kPng:
+      return "png";
+    case ImageFormat::kJpeg:
+      return "jpeg";
+    case ImageFormat::kExr:
+      return "exr";
   }
   return "raw";
 }
 
 std::string_view commandName(const Command& command) {
   static constexpr std::string_view kNames[] = {
-      "hello",        "get_view",     "set_view", "set_weather", "set_wind",  "set_sun",
-      "set_time",     "add_cloud",    "change_cloud", "remove_cloud", "tick", "render",
-      "subscribe",    "unsubscribe",  "snapshot", "restore",     "stats",     "hash"};
+      "hello",     "get_view",    "set_view",     "set_weather",  "set_wind", "set_sun",
+      "set_time",  "add_cloud",   "change_cloud", "remove_cloud", "tick",     "render",
+      "subscribe", "unsubscribe", "snapshot",     "restore",      "stats",    "hash"};
   static_assert(std::size(kNames) == std::variant_size_v<Command>);
   return kNames[command.index()];
 }
 
 std::variant<Request, BadRequest> parseRequest(std::string_view line) {
   if (line.size() >= ProtocolLimits::kMaxRequestBytes)
-    return BadRequest{nullptr, {ErrorCode::kTooLarge,
-                                "request is " + std::to_string(line.size()) +
-                                    " bytes (allowed: less than " +
-                                    std::to_string(ProtocolLimits::kMaxRequestBytes) + ")"}};
+    return BadRequest{nullptr,
+                      {ErrorCode::kTooLarge,
+                       "request is " + std::to_string(line.size()) + " bytes (allowed: less than " +
+                           std::to_string(ProtocolLimits::kMaxRequestBytes) + ")"}};
   if (nestingDepth(line) > ProtocolLimits::kMaxJsonDepth)
-    return BadRequest{nullptr, {ErrorCode::kBadJson,
-                                "request nests deeper than " +
-                                    std::to_string(ProtocolLimits::kMaxJsonDepth) + " levels"}};
+    return BadRequest{
+        nullptr,
+        {ErrorCode::kBadJson,
+         "request nests deeper than " + std::to_string(ProtocolLimits::kMaxJsonDepth) + " levels"}};
   json root = json::parse(line, nullptr, /*allow_exceptions=*/false);
   if (root.is_discarded())
     return BadRequest{nullptr, {ErrorCode::kBadJson, "request is not valid JSON"}};
@@ -413,9 +432,9 @@ std::variant<Request, BadRequest> parseRequest(std::string_view line) {
   }
   auto cmd = root.find("cmd");
   if (cmd == root.end() || !cmd->is_string())
-    return BadRequest{id, {ErrorCode::kBadField,
-                           "cmd: is missing or not a string (allowed: " +
-                               std::string(kCommandNames) + ")"}};
+    return BadRequest{id,
+                      {ErrorCode::kBadField, "cmd: is missing or not a string (allowed: " +
+                                                 std::string(kCommandNames) + ")"}};
   try {
     FieldReader reader(root, "");
     reader.raw("cmd");
@@ -430,7 +449,7 @@ std::variant<Request, BadRequest> parseRequest(std::string_view line) {
 
 std::string okReply(const json& id, const json& result) {
   return json{{"id", id}, {"ok", true}, {"result", result}}.dump(-1, ' ', false,
-                                                                  json::error_handler_t::replace) +
+                                                                 json::error_handler_t::replace) +
          "\n";
 }
 
@@ -449,8 +468,8 @@ std::string imageReplyHeader(const json& id, json image, std::size_t byte_count)
 
 std::string frameEventHeader(std::int64_t subscription, json image, std::size_t byte_count) {
   image["bytes"] = byte_count;
-  return json{{"event", "frame"}, {"subscription", subscription}, {"image", std::move(image)}}
-             .dump(-1, ' ', false, json::error_handler_t::replace) +
+  return json{{"event", "frame"}, {"subscription", subscription}, {"image", std::move(image)}}.dump(
+             -1, ' ', false, json::error_handler_t::replace) +
          "\n";
 }
 

@@ -112,7 +112,8 @@ InputRegisters encodeInput(const ModbusStatus& s) {
   r[M::kFrames] = std::uint16_t(s.frames >> 16);
   r[M::kFrames + 1] = std::uint16_t(s.frames & 0xffffu);
   putFloat(&r[M::kRenderMs], s.render_ms);
-  for (int i = 0; i < 4; ++i) r[std::size_t(M::kTicks + i)] = std::uint16_t(s.ticks >> (48 - 16 * i));
+  for (int i = 0; i < 4; ++i)
+    r[std::size_t(M::kTicks + i)] = std::uint16_t(s.ticks >> (48 - 16 * i));
   r[M::kLastError] = s.last_error;
   putFloat(&r[M::kTime], s.time_s);
   return r;
@@ -123,11 +124,10 @@ std::variant<std::vector<Command>, RegisterError> decodeHoldingWrite(
     const std::string& view) {
   const int count = int(values.size());
   if (address < 0 || count < 1 || address + count > M::kHoldingCount)
-    return RegisterError{kIllegalDataAddress,
-                         "holding registers " + std::to_string(address) + " to " +
-                             std::to_string(address + count - 1) +
-                             " are outside the map (allowed: 0 to " +
-                             std::to_string(M::kHoldingCount - 1) + ")"};
+    return RegisterError{kIllegalDataAddress, "holding registers " + std::to_string(address) +
+                                                  " to " + std::to_string(address + count - 1) +
+                                                  " are outside the map (allowed: 0 to " +
+                                                  std::to_string(M::kHoldingCount - 1) + ")"};
   for (int a = address; a < address + count; ++a)
     if (isReserved(a))
       return RegisterError{kIllegalDataAddress,
@@ -173,15 +173,15 @@ std::variant<std::vector<Command>, RegisterError> decodeHoldingWrite(
   std::optional<double>* angles[] = {&p.heading, &p.pitch, &p.roll, &p.vfov};
   for (int i = 3; i < 7; ++i)
     if (w.touches(kViewFloats[i].address, 2)) *angles[i - 3] = readFloat(kViewFloats[i], 0);
-  for (auto [a, out, name] : {std::tuple{M::kWidth, &p.width, "width"},
-                              std::tuple{M::kHeight, &p.height, "height"}})
+  for (auto [a, out, name] :
+       {std::tuple{M::kWidth, &p.width, "width"}, std::tuple{M::kHeight, &p.height, "height"}})
     if (w.touches(a)) {
       if (!error && (next[std::size_t(a)] < 1 || next[std::size_t(a)] > Limits::kMaxImageSide))
-        error = RegisterError{kIllegalDataValue,
-                              std::string(name) + " (register " + std::to_string(a) + "): " +
-                                  std::to_string(next[std::size_t(a)]) +
-                                  " is out of range (allowed: 1 to " +
-                                  std::to_string(Limits::kMaxImageSide) + ")"};
+        error =
+            RegisterError{kIllegalDataValue, std::string(name) + " (register " + std::to_string(a) +
+                                                 "): " + std::to_string(next[std::size_t(a)]) +
+                                                 " is out of range (allowed: 1 to " +
+                                                 std::to_string(Limits::kMaxImageSide) + ")"};
       *out = next[std::size_t(a)];
     }
   if (w.touches(0, M::kHeight + 1)) commands.emplace_back(set_view);
@@ -225,11 +225,10 @@ std::variant<CoilWrite, RegisterError> decodeCoilWrite(int address,
                                                        std::span<const std::uint8_t> bits) {
   const int count = int(bits.size());
   if (address < 0 || count < 1 || address + count > M::kCoilCount)
-    return RegisterError{kIllegalDataAddress,
-                         "coils " + std::to_string(address) + " to " +
-                             std::to_string(address + count - 1) +
-                             " are outside the map (allowed: 0 to " +
-                             std::to_string(M::kCoilCount - 1) + ")"};
+    return RegisterError{kIllegalDataAddress, "coils " + std::to_string(address) + " to " +
+                                                  std::to_string(address + count - 1) +
+                                                  " are outside the map (allowed: 0 to " +
+                                                  std::to_string(M::kCoilCount - 1) + ")"};
   CoilWrite out;
   for (int i = 0; i < count; ++i) {
     const bool on = bits[std::size_t(i)] != 0;

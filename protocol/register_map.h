@@ -18,7 +18,7 @@ namespace nephele {
 
 struct ModbusMap {
   // Holding registers (read 0x03; write 0x06, 0x10).
-  static constexpr int kPositionX = 0, kPositionY = 2, kPositionZ = 4;  // float32 m
+  static constexpr int kPositionX = 0, kPositionY = 2, kPositionZ = 4;    // float32 m
   static constexpr int kHeading = 6, kPitch = 8, kRoll = 10, kVfov = 12;  // float32 degrees
   static constexpr int kWidth = 14, kHeight = 15;                         // uint16 pixels
   static constexpr int kWindEast = 16, kWindNorth = 18;                   // float32 m/s
@@ -92,8 +92,8 @@ std::variant<std::vector<Command>, RegisterError> decodeHoldingWrite(
     const std::string& view);
 
 struct CoilWrite {
-  bool render = false;           // the render coil was set to 1
-  std::optional<bool> paused;    // the pause coil was written
+  bool render = false;         // the render coil was set to 1
+  std::optional<bool> paused;  // the pause coil was written
 };
 std::variant<CoilWrite, RegisterError> decodeCoilWrite(int address,
                                                        std::span<const std::uint8_t> bits);

@@ -24,7 +24,7 @@ using nlohmann::json;
 using Outcome = std::variant<json, ProtocolError>;
 
 constexpr int kProtocolVersion = 1;
-constexpr int kMaxCatchUpTicks = 100;         // after a stall, ticks made up in one go
+constexpr int kMaxCatchUpTicks = 100;                   // after a stall, ticks made up in one go
 constexpr double kMaxAutomatonStepsPerRequest = 20000;  // bounds one request's simulation work
 constexpr std::size_t kMaxClouds = 4096;
 constexpr std::size_t kRenderHistory = 1024;  // renders kept for p50/p99
@@ -56,6 +56,12 @@ json viewJson(const ViewConfig& v) {
           {"height", c.height},
           {"format", imageFormatName(v.image.format)},
           {"channels", channelNames(v.image)}};
+}
+
+ProtocolError unknownView(const std::vector<ViewConfig>& views, const std::string& name) {
+  std::string names;
+  for (const ViewConfig& v : views) names += (names.empty() ? "" : ", ") + v.name;
+  return {ErrorCode::kNotFound, "view: \"" + name + "\" is not a view (allowed: " + names + ")"};
 }
 
 double percentile(std::vector<double> values, double p) {
@@ -176,9 +182,13 @@ struct Engine::State {
       if (v.name == name) return &v;
     return nullptr;
   }
+  const ViewConfig* view(const std::string& name) const {
+    return const_cast<State*>(this)->view(name);
+  }
 };
 
-Engine::Engine(DaemonConfig config) : config_(std::move(config)), state_(std::make_unique<State>()) {
+Engine::Engine(DaemonConfig config)
+    : config_(std::move(config)), state_(std::make_unique<State>()) {
   state_->views = config_.views;
   state_->time_scale = config_.time_scale;
 }
@@ -269,14 +279,15 @@ std::variant<std::vector<std::uint8_t>, std::string> encodeFrame(const Frame& fr
   std::vector<std::uint8_t> bytes;
   std::string error;
   switch (image.format) {
-    case ImageFormat::kRaw: return packRaw(frame.srgb, image.colour, image.coverage);
+    case ImageFormat::kRaw:
+      return packRaw(frame.srgb, image.colour, image.coverage);
     case ImageFormat::kPng:
       error = encodeImage(ImageFileFormat::kPng, frame.srgb, image.colour, image.coverage, options,
                           bytes);
       break;
     case ImageFormat::kJpeg:
-      error = encodeImage(ImageFileFormat::kJpeg, frame.srgb, image.colour, image.coverage,
-                          options, bytes);
+      error = encodeImage(ImageFileFormat::kJpeg, frame.srgb, image.colour, image.coverage, options,
+                          bytes);
       break;
     case ImageFormat::kExr:
       error = encodeImage(frame.linear, image.colour, image.coverage, options, bytes);
@@ -304,7 +315,8 @@ std::uint64_t nameHash(const std::string& name) {
 
 void setWindSample(WindProfile& profile, double altitude, glm::dvec2 velocity) {
   auto& samples = profile.samples;
-  std::erase_if(samples, [&](const WindSample& w) { return std::abs(w.altitude_m - altitude) < 1.0; });
+  std::erase_if(samples,
+                [&](const WindSample& w) { return std::abs(w.altitude_m - altitude) < 1.0; });
   samples.push_back({altitude, velocity});
   std::sort(samples.begin(), samples.end(),
             [](const WindSample& a, const WindSample& b) { return a.altitude_m < b.altitude_m; });
@@ -318,8 +330,8 @@ std::string Engine::openWorld() {
   s.platform = createGlPlatform(GlBackend::kAuto, error);
   if (!s.platform) return "no OpenGL context: " + error;
   s.renderer = std::make_unique<GlRenderer>(*s.platform);
-  s.world = std::make_unique<World>(config_.scene.scene, config_.scene.dynamics,
-                                    config_.world_threads);
+  s.world =
+      std::make_unique<World>(config_.scene.scene, config_.scene.dynamics, config_.world_threads);
   if (const double t = config_.scene.scene.time_s; t > 0.0) {
     if (std::string e = s.world->advance(t); !e.empty()) return "scene time: " + e;
   }
@@ -327,13 +339,12 @@ std::string Engine::openWorld() {
   if (config_.restore_on_start && !snapshot.empty() && std::filesystem::exists(snapshot)) {
     if (std::string e = s.world->restoreSnapshot(snapshot); !e.empty())
       return e + " (move the file away to start from the scene instead)";
-    spdlog::info("event=restored snapshot={} time={:.3f} hash={}", snapshot,
-                 s.world->timeSeconds(), hexHash(s.world->hash()));
+    spdlog::info("event=restored snapshot={} time={:.3f} hash={}", snapshot, s.world->timeSeconds(),
+                 hexHash(s.world->hash()));
   }
   spdlog::info("event=world_ready gl=\"{}\" backend={} views={} mode={} tick_rate={}",
                s.platform->renderer(), s.platform->backendName(), s.views.size(),
-               config_.mode == TickMode::kRealtime ? "realtime" : "lockstep",
-               config_.tick_rate_hz);
+               config_.mode == TickMode::kRealtime ? "realtime" : "lockstep", config_.tick_rate_hz);
   return "";
 }
 
@@ -376,8 +387,9 @@ void Engine::run(std::promise<std::string>& started) {
     if (config_.snapshot_interval_s > 0.0 && !config_.snapshot_path.empty() &&
         Clock::now() >= s.next_snapshot) {
       saveSnapshot(config_.snapshot_path, "periodic");
-      s.next_snapshot = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                           std::chrono::duration<double>(config_.snapshot_interval_s));
+      s.next_snapshot =
+          Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                             std::chrono::duration<double>(config_.snapshot_interval_s));
     }
     publish();
   }
@@ -457,20 +469,15 @@ void Engine::realtimeTicks() {
 std::optional<ProtocolError> Engine::check(const Command& command) const {
   const State& s = *state_;
   if (const auto* c = std::get_if<command::SetView>(&command)) {
-    const ViewConfig* view = const_cast<State&>(s).view(c->view);
-    if (!view) {
-      std::string names;
-      for (const ViewConfig& v : s.views) names += (names.empty() ? "" : ", ") + v.name;
-      return ProtocolError{ErrorCode::kNotFound,
-                           "view: \"" + c->view + "\" is not a view (allowed: " + names + ")"};
-    }
+    const ViewConfig* view = s.view(c->view);
+    if (!view) return unknownView(s.views, c->view);
     const std::int64_t w = c->patch.width.value_or(view->camera.width);
     const std::int64_t h = c->patch.height.value_or(view->camera.height);
     if (w * h > config_.max_image_pixels)
-      return ProtocolError{ErrorCode::kLimit,
-                           "width x height: " + std::to_string(w) + "x" + std::to_string(h) +
-                               " is above the limit of " +
-                               std::to_string(config_.max_image_pixels) + " pixels"};
+      return ProtocolError{ErrorCode::kLimit, "width x height: " + std::to_string(w) + "x" +
+                                                  std::to_string(h) + " is above the limit of " +
+                                                  std::to_string(config_.max_image_pixels) +
+                                                  " pixels"};
   }
   if (const auto* c = std::get_if<command::Tick>(&command)) return checkAdvance(c->dt);
   if (const auto* c = std::get_if<command::SetTime>(&command); c && c->advance)
@@ -493,23 +500,30 @@ void Engine::execute(Job& job) {
         return;
       }
     for (const Command& c : job.batch)
-      if (auto outcome = apply(c, job); outcome && std::holds_alternative<ProtocolError>(*outcome)) {
+      if (auto outcome = apply(c, job);
+          outcome && std::holds_alternative<ProtocolError>(*outcome)) {
         noteError(std::get<ProtocolError>(*outcome).code);
+        publish();
         job.done(std::get<ProtocolError>(*outcome));
         return;
       }
+    publish();  // so that a read right after the reply sees the change
     job.done(std::nullopt);
     return;
   }
   std::optional<Outcome> outcome;
-  if (auto error = check(job.request.command)) outcome = *error;
-  else outcome = apply(job.request.command, job);
+  if (auto error = check(job.request.command))
+    outcome = *error;
+  else
+    outcome = apply(job.request.command, job);
   if (!outcome) return;  // the encoder replies
+  publish();             // so that a read right after the reply sees the change
   if (const auto* error = std::get_if<ProtocolError>(&*outcome)) {
     noteError(error->code);
     job.reply(std::make_shared<Reply>(Reply{errorReply(job.request.id, *error), {}}));
   } else {
-    job.reply(std::make_shared<Reply>(Reply{okReply(job.request.id, std::get<json>(*outcome)), {}}));
+    job.reply(
+        std::make_shared<Reply>(Reply{okReply(job.request.id, std::get<json>(*outcome)), {}}));
   }
 }
 
@@ -518,10 +532,7 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
   World& world = *s.world;
   using namespace command;
   auto notFoundView = [&](const std::string& name) -> Outcome {
-    std::string names;
-    for (const ViewConfig& v : s.views) names += (names.empty() ? "" : ", ") + v.name;
-    return ProtocolError{ErrorCode::kNotFound,
-                         "view: \"" + name + "\" is not a view (allowed: " + names + ")"};
+    return unknownView(s.views, name);
   };
 
   if (const auto* c = std::get_if<Hello>(&command)) {
@@ -564,8 +575,8 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
     if (auto error = setWeather(c->layer, c->weather)) return *error;
     return json{{"layer", c->layer},
                 {"type", cloudTypeName(c->weather.type)},
-                {"layers", world.scene().layers.size()},
-                {"clouds", world.scene().clouds.size()}};
+                {"layers", world.base().layers.size()},
+                {"clouds", world.base().clouds.size()}};
   }
   if (const auto* c = std::get_if<SetWind>(&command)) {
     std::string error = world.edit([&](Scene&, WorldDynamics& d) {
@@ -594,9 +605,8 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
       return badField("cloud.name: is missing (a unique name, to change or remove the cloud by)");
     EllipsoidCloud cloud;
     const std::string cloud_name = name->get<std::string>();
-    if (std::string e = parseCloudJson(c->cloud, hashCounters(config_.scene.scene.seed,
-                                                              nameHash(cloud_name)),
-                                       cloud);
+    if (std::string e = parseCloudJson(
+            c->cloud, hashCounters(config_.scene.scene.seed, nameHash(cloud_name)), cloud);
         !e.empty())
       return badField(e);
     std::size_t ellipsoids = cloud.ellipsoids.size();
@@ -658,8 +668,8 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
       job.reply(std::make_shared<Reply>(Reply{std::move(header), std::move(body)}));
       return std::nullopt;
     }
-    const bool queued = encoder_->post([frame, image, meta, id = job.request.id,
-                                        reply = job.reply, options = config_.encode]() mutable {
+    const bool queued = encoder_->post([frame, image, meta, id = job.request.id, reply = job.reply,
+                                        options = config_.encode]() mutable {
       auto encoded = encodeFrame(*frame, image, options);
       if (auto* e = std::get_if<std::string>(&encoded)) {
         reply(std::make_shared<Reply>(Reply{errorReply(id, {ErrorCode::kFailed, *e}), {}}));
@@ -676,10 +686,9 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
     const ViewConfig* v = s.view(c->view);
     if (!v) return notFoundView(c->view);
     if (int(s.subscriptions.size()) >= config_.max_subscriptions)
-      return ProtocolError{ErrorCode::kLimit,
-                           "subscribe: the daemon serves " +
-                               std::to_string(config_.max_subscriptions) +
-                               " subscriptions already (the configured limit)"};
+      return ProtocolError{ErrorCode::kLimit, "subscribe: the daemon serves " +
+                                                  std::to_string(config_.max_subscriptions) +
+                                                  " subscriptions already (the configured limit)"};
     Subscription sub;
     sub.id = s.next_subscription++;
     sub.client = job.client;
@@ -770,9 +779,9 @@ std::optional<ProtocolError> Engine::setWeather(int layer, const WeatherLayer& w
   State& s = *state_;
   const std::string prefix = "weather" + std::to_string(layer);
   const ViewConfig& anchor = *s.view(config_.modbus_view);
-  const WeatherClouds add =
-      weatherClouds(weather, prefix, glm::dvec2(anchor.camera.position),
-                    hashCounters(config_.scene.scene.seed, 0x57656174686572ull, std::uint64_t(layer)));
+  const WeatherClouds add = weatherClouds(
+      weather, prefix, glm::dvec2(anchor.camera.position),
+      hashCounters(config_.scene.scene.seed, 0x57656174686572ull, std::uint64_t(layer)));
   std::string error = s.world->edit([&](Scene& now, WorldDynamics& d) -> std::string {
     eraseWithDevelopment(now.layers, d.layers,
                          [&](const CloudLayer& l) { return l.name == prefix; });
@@ -793,10 +802,11 @@ std::optional<ProtocolError> Engine::setWeather(int layer, const WeatherLayer& w
   });
   if (!error.empty()) return ProtocolError{ErrorCode::kFailed, error};
   s.weather[std::size_t(layer - 1)] = weather;
-  spdlog::info("event=weather layer={} type={} base={} thickness={} coverage={:.2f} layers={} "
-               "heaps={}",
-               layer, cloudTypeName(weather.type), weather.base_m, weather.thickness_m,
-               weather.coverage, add.layers.size(), add.clouds.size());
+  spdlog::info(
+      "event=weather layer={} type={} base={} thickness={} coverage={:.2f} layers={} "
+      "heaps={}",
+      layer, cloudTypeName(weather.type), weather.base_m, weather.thickness_m, weather.coverage,
+      add.layers.size(), add.clouds.size());
   return std::nullopt;
 }
 
@@ -824,8 +834,10 @@ void Engine::deliverFrames(bool only_due, const std::string& view_name) {
         return g.first.format == sub->image.format && g.first.colour == sub->image.colour &&
                g.first.coverage == sub->image.coverage;
       });
-      if (it == groups.end()) groups.push_back({sub->image, {sub}});
-      else it->second.push_back(sub);
+      if (it == groups.end())
+        groups.push_back({sub->image, {sub}});
+      else
+        it->second.push_back(sub);
     }
     for (auto& [image, members] : groups) {
       const bool linear = image.format == ImageFormat::kExr;
@@ -847,12 +859,15 @@ void Engine::deliverFrames(bool only_due, const std::string& view_name) {
             std::move(std::get<std::vector<std::uint8_t>>(encoded)));
         const json meta = imageMeta(*frame, image);
         for (const auto& [id, sink] : sinks) {
-          auto reply = std::make_shared<Reply>(Reply{frameEventHeader(id, meta, bytes->size()), *bytes});
+          auto reply =
+              std::make_shared<Reply>(Reply{frameEventHeader(id, meta, bytes->size()), *bytes});
           if (!sink.first(reply)) sink.second->store(true);
         }
       };
-      if (image.format == ImageFormat::kRaw) send();
-      else if (!encoder_->post(send)) frames_dropped += members.size();
+      if (image.format == ImageFormat::kRaw)
+        send();
+      else if (!encoder_->post(send))
+        frames_dropped += members.size();
     }
   }
 }
@@ -869,33 +884,36 @@ void Engine::renderTrigger(Job& job) {
   const std::filesystem::path path = std::filesystem::path(config_.output_directory) /
                                      (view.name + "_" + std::to_string(s.frames) + extension);
   deliverFrames(false, view.name);
-  const bool queued = encoder_->post([this, frame, image, path, done = job.done,
-                                      options = config_.encode]() {
-    auto encoded = encodeFrame(*frame, image, options);
-    std::optional<ProtocolError> error;
-    if (auto* e = std::get_if<std::string>(&encoded)) {
-      error = ProtocolError{ErrorCode::kFailed, *e};
-    } else {
-      const auto& bytes = std::get<std::vector<std::uint8_t>>(encoded);
-      std::error_code ec;
-      std::filesystem::create_directories(path.parent_path(), ec);
-      const std::string partial = path.string() + ".partial";
-      std::ofstream out(partial, std::ios::binary);
-      out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
-      out.close();
-      if (!out) error = ProtocolError{ErrorCode::kFailed, "cannot write " + partial};
-      else std::filesystem::rename(partial, path, ec);
-      if (!error && ec) error = ProtocolError{ErrorCode::kFailed, "cannot write " + path.string()};
-    }
-    if (error) {
-      spdlog::error("event=render_trigger_failed error=\"{}\"", error->message);
-      noteError(error->code);
-    } else {
-      spdlog::info("event=render_trigger path={}", path.string());
-    }
-    trigger_pending_ = false;
-    done(error);
-  });
+  const bool queued =
+      encoder_->post([this, frame, image, path, done = job.done, options = config_.encode]() {
+        auto encoded = encodeFrame(*frame, image, options);
+        std::optional<ProtocolError> error;
+        if (auto* e = std::get_if<std::string>(&encoded)) {
+          error = ProtocolError{ErrorCode::kFailed, *e};
+        } else {
+          const auto& bytes = std::get<std::vector<std::uint8_t>>(encoded);
+          std::error_code ec;
+          std::filesystem::create_directories(path.parent_path(), ec);
+          const std::string partial = path.string() + ".partial";
+          std::ofstream out(partial, std::ios::binary);
+          out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+          out.close();
+          if (!out)
+            error = ProtocolError{ErrorCode::kFailed, "cannot write " + partial};
+          else
+            std::filesystem::rename(partial, path, ec);
+          if (!error && ec)
+            error = ProtocolError{ErrorCode::kFailed, "cannot write " + path.string()};
+        }
+        if (error) {
+          spdlog::error("event=render_trigger_failed error=\"{}\"", error->message);
+          noteError(error->code);
+        } else {
+          spdlog::info("event=render_trigger path={}", path.string());
+        }
+        trigger_pending_ = false;
+        done(error);
+      });
   if (!queued) {
     trigger_pending_ = false;
     noteError(ErrorCode::kBusy);

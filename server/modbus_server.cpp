@@ -18,7 +18,7 @@
 namespace nephele {
 namespace {
 
-constexpr int kPollMs = 200;                  // how often idle threads look at the stop flag
+constexpr int kPollMs = 200;  // how often idle threads look at the stop flag
 constexpr auto kWriteTimeout = std::chrono::seconds(5);  // a write waits this long for the world
 
 std::uint16_t be16(const std::uint8_t* p) {
@@ -182,7 +182,8 @@ bool ModbusServer::handle(modbus_t* ctx, const std::uint8_t* query, int length) 
                      error->message);
   };
 
-  if (function == MODBUS_FC_WRITE_SINGLE_REGISTER || function == MODBUS_FC_WRITE_MULTIPLE_REGISTERS) {
+  if (function == MODBUS_FC_WRITE_SINGLE_REGISTER ||
+      function == MODBUS_FC_WRITE_MULTIPLE_REGISTERS) {
     const int address = be16(query + h + 1);
     std::vector<std::uint16_t> values;
     if (function == MODBUS_FC_WRITE_SINGLE_REGISTER) {

@@ -54,8 +54,7 @@ int runServeCommand(const ServeCommandOptions& o) {
   }
   if (o.snapshot_path) config.snapshot_path = *o.snapshot_path;
   if (config.snapshot_directory.empty() && !config.snapshot_path.empty())
-    config.snapshot_directory =
-        std::filesystem::path(config.snapshot_path).parent_path().string();
+    config.snapshot_directory = std::filesystem::path(config.snapshot_path).parent_path().string();
 
   Engine engine(config);
   if (std::string error = engine.start(); !error.empty()) {
@@ -80,10 +79,9 @@ int runServeCommand(const ServeCommandOptions& o) {
   std::thread io_thread([&io] { io.run(); });
 
   // The ready line: tests and supervisors read the ports from it.
-  std::printf("nephele ready socket=%d modbus=%d metrics=%d\n",
-              config.socket_enabled ? socket.port() : -1,
-              config.modbus_enabled ? modbus.port() : -1,
-              config.metrics_enabled ? metrics.port() : -1);
+  std::printf(
+      "nephele ready socket=%d modbus=%d metrics=%d\n", config.socket_enabled ? socket.port() : -1,
+      config.modbus_enabled ? modbus.port() : -1, config.metrics_enabled ? metrics.port() : -1);
   std::fflush(stdout);
   spdlog::info("event=listening socket={}:{} modbus={}:{} metrics={}", config.socket.bind,
                socket.port(), config.modbus.bind, modbus.port(),

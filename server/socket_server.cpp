@@ -14,7 +14,9 @@ using asio::ip::tcp;
 class Connection : public std::enable_shared_from_this<Connection> {
  public:
   Connection(tcp::socket socket, Engine& engine, std::int64_t id)
-      : socket_(std::move(socket)), engine_(engine), id_(id),
+      : socket_(std::move(socket)),
+        engine_(engine),
+        id_(id),
         authorised_(engine.config().token.empty()) {
     std::error_code ec;
     const tcp::endpoint peer = socket_.remote_endpoint(ec);
@@ -57,10 +59,9 @@ class Connection : public std::enable_shared_from_this<Connection> {
 
  private:
   void read() {
-    socket_.async_read_some(asio::buffer(chunk_),
-                            [self = shared_from_this()](std::error_code ec, std::size_t n) {
-                              self->onRead(ec, n);
-                            });
+    socket_.async_read_some(
+        asio::buffer(chunk_),
+        [self = shared_from_this()](std::error_code ec, std::size_t n) { self->onRead(ec, n); });
   }
 
   void onRead(std::error_code ec, std::size_t n) {
@@ -75,10 +76,10 @@ class Connection : public std::enable_shared_from_this<Connection> {
       if (!discarding_) line_.append(part);
       if (!discarding_ && line_.size() >= ProtocolLimits::kMaxRequestBytes) {
         // Answer once, then skip the rest of the line: the connection stays usable.
-        sendError(nullptr, {ErrorCode::kTooLarge,
-                            "request line is longer than " +
-                                std::to_string(ProtocolLimits::kMaxRequestBytes) +
-                                " bytes (allowed: less); it was skipped"});
+        sendError(nullptr,
+                  {ErrorCode::kTooLarge, "request line is longer than " +
+                                             std::to_string(ProtocolLimits::kMaxRequestBytes) +
+                                             " bytes (allowed: less); it was skipped"});
         discarding_ = true;
         line_.clear();
       }
@@ -116,9 +117,9 @@ class Connection : public std::enable_shared_from_this<Connection> {
       return;
     }
     if (pending_bytes_ > engine_.config().max_pending_bytes) {
-      sendError(request.id, {ErrorCode::kBusy, "this connection has " +
-                                                   std::to_string(pending_bytes_ >> 20) +
-                                                   " MiB of replies unread; read them first"});
+      sendError(request.id,
+                {ErrorCode::kBusy, "this connection has " + std::to_string(pending_bytes_ >> 20) +
+                                       " MiB of replies unread; read them first"});
       return;
     }
     const nlohmann::json id = request.id;
@@ -159,8 +160,10 @@ class Connection : public std::enable_shared_from_this<Connection> {
                           self->close("write_error");
                           return;
                         }
-                        if (!self->out_.empty()) self->write();
-                        else self->writing_ = false;
+                        if (!self->out_.empty())
+                          self->write();
+                        else
+                          self->writing_ = false;
                       });
   }
 
@@ -259,28 +262,25 @@ void MetricsServer::accept() {
     if (!ec) {
       auto s = std::make_shared<tcp::socket>(std::move(socket));
       auto request = std::make_shared<asio::streambuf>(8192);
-      asio::async_read_until(*s, *request, "\r\n\r\n",
-                             [this, s, request](std::error_code ec, std::size_t) {
-                               if (ec) return;
-                               std::string first_line;
-                               std::istream in(request.get());
-                               std::getline(in, first_line);
-                               const bool metrics = first_line.rfind("GET /metrics ", 0) == 0;
-                               const std::string body =
-                                   metrics ? engine_.prometheusText() : "not found\n";
-                               auto response = std::make_shared<std::string>(
-                                   std::string(metrics ? "HTTP/1.1 200 OK\r\n"
-                                                       : "HTTP/1.1 404 Not Found\r\n") +
-                                   "Content-Type: text/plain; version=0.0.4\r\n"
-                                   "Content-Length: " +
-                                   std::to_string(body.size()) +
-                                   "\r\nConnection: close\r\n\r\n" + body);
-                               asio::async_write(*s, asio::buffer(*response),
-                                                 [s, response](std::error_code, std::size_t) {
-                                                   std::error_code ignored;
-                                                   s->close(ignored);
-                                                 });
-                             });
+      asio::async_read_until(
+          *s, *request, "\r\n\r\n", [this, s, request](std::error_code ec, std::size_t) {
+            if (ec) return;
+            std::string first_line;
+            std::istream in(request.get());
+            std::getline(in, first_line);
+            const bool metrics = first_line.rfind("GET /metrics ", 0) == 0;
+            const std::string body = metrics ? engine_.prometheusText() : "not found\n";
+            auto response = std::make_shared<std::string>(
+                std::string(metrics ? "HTTP/1.1 200 OK\r\n" : "HTTP/1.1 404 Not Found\r\n") +
+                "Content-Type: text/plain; version=0.0.4\r\n"
+                "Content-Length: " +
+                std::to_string(body.size()) + "\r\nConnection: close\r\n\r\n" + body);
+            asio::async_write(*s, asio::buffer(*response),
+                              [s, response](std::error_code, std::size_t) {
+                                std::error_code ignored;
+                                s->close(ignored);
+                              });
+          });
     }
     accept();
   });

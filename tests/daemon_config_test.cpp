@@ -28,7 +28,8 @@ TEST(DaemonConfig, DefaultsAndTheExample) {
   EXPECT_EQ(example.views[1].image.format, ImageFormat::kPng);
   EXPECT_FALSE(example.views[1].image.coverage);
   EXPECT_EQ(example.snapshot_directory, "/var/lib/nephele");
-  for (const char* other : {"/config/daemon.toml", "/deploy/docker.toml", "/deploy/cockpit/left.toml"}) {
+  for (const char* other :
+       {"/config/daemon.toml", "/deploy/docker.toml", "/deploy/cockpit/left.toml"}) {
     DaemonConfig c;
     const std::string error = loadDaemonConfig(std::string(NEPHELE_SOURCE_DIR) + other, c);
     // docker.toml names the scene where the image puts it, so only that error is allowed.

@@ -47,9 +47,10 @@ TEST(Messages, ParsesEveryCommandWithItsFields) {
   EXPECT_EQ(*w.weather.wind, glm::dvec2(3, -4));
 
   EXPECT_EQ(std::get<command::Tick>(parsed(R"({"cmd":"tick","dt":0.02})").command).dt, 0.02);
-  EXPECT_EQ(std::get<command::Subscribe>(parsed(R"({"cmd":"subscribe","view":"a","rate":5})").command)
-                .rate_hz,
-            5.0);
+  EXPECT_EQ(
+      std::get<command::Subscribe>(parsed(R"({"cmd":"subscribe","view":"a","rate":5})").command)
+          .rate_hz,
+      5.0);
   EXPECT_EQ(parsed(R"({"id":"abc","cmd":"hash"})").id, "abc");
   EXPECT_EQ(commandName(parsed(R"({"cmd":"stats"})").command), "stats");
 }
@@ -103,8 +104,8 @@ TEST(Messages, ErrorsNameTheFieldAndWhatIsAllowed) {
 }
 
 TEST(Messages, LimitsOnSizeAndNesting) {
-  const std::string big = R"({"cmd":"hash","pad":")" +
-                          std::string(ProtocolLimits::kMaxRequestBytes, 'x') + "\"}";
+  const std::string big =
+      R"({"cmd":"hash","pad":")" + std::string(ProtocolLimits::kMaxRequestBytes, 'x') + "\"}";
   EXPECT_EQ(rejected(big).error.code, ErrorCode::kTooLarge);
   std::string deep = std::string(ProtocolLimits::kMaxJsonDepth + 1, '[') +
                      std::string(ProtocolLimits::kMaxJsonDepth + 1, ']');

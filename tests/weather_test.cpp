@@ -36,8 +36,8 @@ TEST(Weather, StratiformTypesCoverWhatIsAsked) {
 
 TEST(Weather, ConvectiveTypesBecomeHeapsOverTheField) {
   const glm::dvec2 centre{5000.0, -3000.0};
-  const WeatherClouds few = weatherClouds({CloudType::kCumulus, 1500.0, 800.0, 0.02, {}}, "w1",
-                                          centre, 3);
+  const WeatherClouds few =
+      weatherClouds({CloudType::kCumulus, 1500.0, 800.0, 0.02, {}}, "w1", centre, 3);
   // 0.02 * R^2 / (w/2)^2 with w = 1.2 * 800 m and R = 8 km: 5.6, rounded to 6.
   ASSERT_EQ(few.clouds.size(), 6u);
   EXPECT_TRUE(few.layers.empty());
@@ -58,14 +58,15 @@ TEST(Weather, ConvectiveTypesBecomeHeapsOverTheField) {
       weatherClouds({CloudType::kCumulus, 1000.0, 200.0, 1.0, {}}, "w3", centre, 3);
   EXPECT_EQ(capped.clouds.size(), std::size_t(WeatherLimits::kMaxHeaps));
   // Deterministic in the seed.
-  const WeatherClouds again = weatherClouds({CloudType::kCumulus, 1500.0, 800.0, 0.02, {}}, "w1",
-                                            centre, 3);
+  const WeatherClouds again =
+      weatherClouds({CloudType::kCumulus, 1500.0, 800.0, 0.02, {}}, "w1", centre, 3);
   EXPECT_EQ(again.clouds[2].ellipsoids[0].centre, few.clouds[2].ellipsoids[0].centre);
 }
 
 TEST(Weather, NoneOrNoCoverageAddsNothing) {
   EXPECT_TRUE(weatherClouds({CloudType::kNone, 1000.0, 500.0, 1.0, {}}, "w", {}, 1).layers.empty());
-  const WeatherClouds empty = weatherClouds({CloudType::kCumulus, 1000.0, 500.0, 0.0, {}}, "w", {}, 1);
+  const WeatherClouds empty =
+      weatherClouds({CloudType::kCumulus, 1000.0, 500.0, 0.0, {}}, "w", {}, 1);
   EXPECT_TRUE(empty.layers.empty() && empty.clouds.empty());
   EXPECT_EQ(cloudTypeName(CloudType::kStratocumulus), "stratocumulus");
 }

@@ -21,22 +21,22 @@ struct PlaneLook {
 
 // Indexed by CloudType; the convective types (cumulus, cumulonimbus) are drawn as heaps.
 constexpr std::array<PlaneLook, kCloudTypeCount> kPlaneLooks{{
-    {0, 0, 0, 0, 0, 0, 0, 0},                              // none
-    {3.0e-3, 3.0e-3, 6, 0.5, 0.20, 0.92, 0.60, 0.50},      // altocumulus: mid-level cells
-    {1.0e-3, 0.8e-3, 5, 2.0, 0.30, 0.75, 0.65, 0.35},      // altostratus: grey sheet
-    {8.0e-3, 8.0e-3, 6, 0.5, 0.30, 1.00, 0.70, 0.50},      // cirrocumulus: small ripples
-    {0.3e-3, 0.3e-3, 4, 1.0, 0.80, 1.00, 0.75, 0.30},      // cirrostratus: thin veil
-    {0.5e-3, 0.25e-3, 7, 0.25, 0.50, 1.00, 0.70, 0.60},    // cirrus: streaks
-    {0, 0, 0, 0, 0, 0, 0, 0},                              // cumulonimbus (heaps)
-    {0, 0, 0, 0, 0, 0, 0, 0},                              // cumulus (heaps)
-    {3.0e-3, 2.5e-3, 5, 3.0, 0.05, 0.45, 0.70, 0.40},      // nimbostratus: dark, uniform
-    {2.0e-3, 1.6e-3, 6, 0.8, 0.15, 0.80, 0.60, 0.55},      // stratocumulus: large lumps
-    {4.0e-3, 3.0e-3, 5, 2.0, 0.22, 0.78, 0.65, 0.45},      // stratus: low grey deck
+    {0, 0, 0, 0, 0, 0, 0, 0},                            // none
+    {3.0e-3, 3.0e-3, 6, 0.5, 0.20, 0.92, 0.60, 0.50},    // altocumulus: mid-level cells
+    {1.0e-3, 0.8e-3, 5, 2.0, 0.30, 0.75, 0.65, 0.35},    // altostratus: grey sheet
+    {8.0e-3, 8.0e-3, 6, 0.5, 0.30, 1.00, 0.70, 0.50},    // cirrocumulus: small ripples
+    {0.3e-3, 0.3e-3, 4, 1.0, 0.80, 1.00, 0.75, 0.30},    // cirrostratus: thin veil
+    {0.5e-3, 0.25e-3, 7, 0.25, 0.50, 1.00, 0.70, 0.60},  // cirrus: streaks
+    {0, 0, 0, 0, 0, 0, 0, 0},                            // cumulonimbus (heaps)
+    {0, 0, 0, 0, 0, 0, 0, 0},                            // cumulus (heaps)
+    {3.0e-3, 2.5e-3, 5, 3.0, 0.05, 0.45, 0.70, 0.40},    // nimbostratus: dark, uniform
+    {2.0e-3, 1.6e-3, 6, 0.8, 0.15, 0.80, 0.60, 0.55},    // stratocumulus: large lumps
+    {4.0e-3, 3.0e-3, 5, 2.0, 0.22, 0.78, 0.65, 0.45},    // stratus: low grey deck
 }};
 
 constexpr std::array<std::string_view, kCloudTypeCount> kNames{
-    "none",   "altocumulus",  "altostratus", "cirrocumulus",  "cirrostratus", "cirrus",
-    "cumulonimbus", "cumulus", "nimbostratus", "stratocumulus", "stratus"};
+    "none",         "altocumulus", "altostratus",  "cirrocumulus",  "cirrostratus", "cirrus",
+    "cumulonimbus", "cumulus",     "nimbostratus", "stratocumulus", "stratus"};
 
 // Texture values on a grid over one period, sorted.
 std::vector<double> sortedSamples(const LayerTextureSpec& spec) {
@@ -96,10 +96,10 @@ std::vector<EllipsoidCloud> heapField(const WeatherLayer& w, const std::string& 
   const double width = std::clamp(1.2 * w.thickness_m, 200.0, 8000.0);
   const double radius = WeatherLimits::kFieldRadius;
   const double footprint = 0.25 * width * width;  // (w/2)^2; the disc areas' pi cancels
-  const int count = w.coverage <= 0.0 ? 0
-                                      : std::clamp(int(std::lround(w.coverage * radius * radius /
-                                                                   footprint)),
-                                                   1, WeatherLimits::kMaxHeaps);
+  const int count = w.coverage <= 0.0
+                        ? 0
+                        : std::clamp(int(std::lround(w.coverage * radius * radius / footprint)), 1,
+                                     WeatherLimits::kMaxHeaps);
   std::vector<EllipsoidCloud> out;
   for (int i = 0; i < count; ++i) {
     // Uniform over the disc: radius from the square root of a uniform draw.

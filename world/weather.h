@@ -33,9 +33,9 @@ std::string_view cloudTypeName(CloudType type);
 
 struct WeatherLayer {
   CloudType type = CloudType::kNone;
-  double base_m = 1000.0;       // cloud base above the ground
-  double thickness_m = 500.0;   // base to top
-  double coverage = 0.5;        // fraction of the sky covered, 0..1
+  double base_m = 1000.0;          // cloud base above the ground
+  double thickness_m = 500.0;      // base to top
+  double coverage = 0.5;           // fraction of the sky covered, 0..1
   std::optional<glm::dvec2> wind;  // east, north m/s at this layer; unset keeps the world's
 };
 

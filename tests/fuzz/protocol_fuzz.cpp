@@ -15,8 +15,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::uint8_t selector = data[0];
   ++data, --size;
   if (selector % 3 == 0) {
-    const auto result =
-        parseRequest(std::string_view(reinterpret_cast<const char*>(data), size));
+    const auto result = parseRequest(std::string_view(reinterpret_cast<const char*>(data), size));
     // Every outcome must turn into a reply line.
     if (const auto* bad = std::get_if<BadRequest>(&result))
       (void)errorReply(bad->id, bad->error);
