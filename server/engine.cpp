@@ -534,6 +534,11 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
   auto notFoundView = [&](const std::string& name) -> Outcome {
     return unknownView(s.views, name);
   };
+  const ProtocolError noSnapshotDirectory{
+      ErrorCode::kFailed, "name: no snapshot directory is configured ([snapshot] directory)"};
+  auto snapshotPath = [&](const std::string& name) {
+    return (std::filesystem::path(config_.snapshot_directory) / (name + ".snap")).string();
+  };
 
   if (const auto* c = std::get_if<Hello>(&command)) {
     (void)c;  // the token is checked by the transport
@@ -718,23 +723,16 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
     return json{{"subscription", c->subscription}};
   }
   if (const auto* c = std::get_if<Snapshot>(&command)) {
-    if (config_.snapshot_directory.empty())
-      return ProtocolError{ErrorCode::kFailed,
-                           "snapshot: no snapshot directory is configured ([snapshot] directory)"};
-    const std::string path =
-        (std::filesystem::path(config_.snapshot_directory) / (c->name + ".snap")).string();
+    if (config_.snapshot_directory.empty()) return noSnapshotDirectory;
     std::error_code ec;
     std::filesystem::create_directories(config_.snapshot_directory, ec);
-    if (std::string e = world.saveSnapshot(path); !e.empty())
+    if (std::string e = world.saveSnapshot(snapshotPath(c->name)); !e.empty())
       return ProtocolError{ErrorCode::kFailed, e};
     return json{{"name", c->name}, {"time", world.timeSeconds()}, {"hash", hexHash(world.hash())}};
   }
   if (const auto* c = std::get_if<Restore>(&command)) {
-    if (config_.snapshot_directory.empty())
-      return ProtocolError{ErrorCode::kFailed,
-                           "restore: no snapshot directory is configured ([snapshot] directory)"};
-    const std::string path =
-        (std::filesystem::path(config_.snapshot_directory) / (c->name + ".snap")).string();
+    if (config_.snapshot_directory.empty()) return noSnapshotDirectory;
+    const std::string path = snapshotPath(c->name);
     if (!std::filesystem::exists(path))
       return ProtocolError{ErrorCode::kNotFound, "name: no snapshot \"" + c->name + "\""};
     if (std::string e = world.restoreSnapshot(path); !e.empty())

@@ -36,7 +36,10 @@ def wait_until(condition, what, timeout=TIMEOUT):
 class Daemon:
     """A `nephele serve` process with its own config in a temporary directory."""
 
-    def __init__(self, workdir, mode="lockstep", extra="", view_size=(64, 48), name="d"):
+    def __init__(self, workdir, mode="lockstep", extra="", view_size=(64, 48), name="d",
+                 socket_keys="", modbus_keys=""):
+        """`extra` is appended to the config ({snapshot} becomes this daemon's snapshot
+        path); `socket_keys` and `modbus_keys` go into those tables."""
         self.workdir = workdir
         self.config = os.path.join(workdir, name + ".toml")
         self.log_path = os.path.join(workdir, name + ".log")
@@ -58,14 +61,16 @@ height = 24
 format = "png"
 [socket]
 port = 0
+{socket_keys}
 [modbus]
 port = 0
+{modbus_keys}
 [metrics]
 enabled = true
 port = 0
 [output]
 directory = "{os.path.join(workdir, name + "-frames")}"
-{extra}
+{extra.format(snapshot=self.snapshot)}
 ''')
         self.start()
 
@@ -319,14 +324,7 @@ class SocketProtocolTest(DaemonTest):
         c.ok({"cmd": "remove_cloud", "name": "extra"})
 
     def test_token(self):
-        d = Daemon(self.tmp.name, name="token")
-        self.daemons.append(d)
-        d.stop()
-        with open(d.config) as f:
-            text = f.read().replace("[socket]\nport = 0", '[socket]\nport = 0\ntoken = "s3cret"')
-        with open(d.config, "w") as f:
-            f.write(text)
-        d.start()
+        d = self.daemon(name="token", socket_keys='token = "s3cret"')
         c = d.client()
         self.assertEqual(c.error({"cmd": "hash"})["code"], "unauthorized")
         self.assertEqual(c.error({"cmd": "hello", "token": "wrong"})["code"], "unauthorized")
@@ -457,13 +455,7 @@ class LockstepAndSnapshotTest(DaemonTest):
         self.assertNotEqual(ca.ok({"cmd": "hash"})["hash"], cb.ok({"cmd": "hash"})["hash"])
 
     def test_sigterm_saves_and_restart_restores(self):
-        extra = '[snapshot]\npath = "{}"\ninterval = 0\n'
-        d = Daemon(self.tmp.name, name="r")
-        self.daemons.append(d)
-        d.stop()
-        with open(d.config, "a") as f:
-            f.write(extra.format(d.snapshot))
-        d.start()
+        d = self.daemon(name="r", extra='[snapshot]\npath = "{snapshot}"\ninterval = 0')
         c = d.client()
         self.drive(c)
         before = c.ok({"cmd": "hash"})
@@ -482,12 +474,7 @@ class LockstepAndSnapshotTest(DaemonTest):
         self.assertEqual(c.error({"cmd": "restore", "name": "nothing"})["code"], "not_found")
 
     def test_kill_9_loses_only_ticks_after_the_last_periodic_snapshot(self):
-        d = Daemon(self.tmp.name, name="k")
-        self.daemons.append(d)
-        d.stop()
-        with open(d.config, "a") as f:
-            f.write('[snapshot]\npath = "{}"\ninterval = 0.1\n'.format(d.snapshot))
-        d.start()
+        d = self.daemon(name="k", extra='[snapshot]\npath = "{snapshot}"\ninterval = 0.1')
         c = d.client()
         self.drive(c)
         saved = c.ok({"cmd": "hash"})
@@ -599,14 +586,7 @@ class ModbusTest(DaemonTest):
         self.assertEqual(self.c.ok({"cmd": "get_view", "view": "front"})["width"], 80)
 
     def test_allow_list_refuses_other_addresses(self):
-        d = Daemon(self.tmp.name, name="deny")
-        self.daemons.append(d)
-        d.stop()
-        with open(d.config) as f:
-            text = f.read().replace("[modbus]\nport = 0", '[modbus]\nport = 0\nallow = ["10.9.8.7"]')
-        with open(d.config, "w") as f:
-            f.write(text)
-        d.start()
+        d = self.daemon(name="deny", modbus_keys='allow = ["10.9.8.7"]')
         from pymodbus.client import ModbusTcpClient
         mb = ModbusTcpClient("127.0.0.1", port=d.modbus_port, timeout=2, retries=0)
         mb.connect()
