@@ -377,8 +377,7 @@ void Engine::run(std::promise<std::string>& started) {
         continue;
       }
       const ProtocolError cancelled{ErrorCode::kFailed, "the daemon is shutting down"};
-      if (job.reply)
-        job.reply(std::make_shared<Reply>(Reply{errorReply(job.request.id, cancelled), {}}));
+      if (job.reply) job.reply(makeReply(errorReply(job.request.id, cancelled)));
       if (job.done) job.done(cancelled);
     }
     if (stopping) break;
@@ -520,10 +519,9 @@ void Engine::execute(Job& job) {
   publish();             // so that a read right after the reply sees the change
   if (const auto* error = std::get_if<ProtocolError>(&*outcome)) {
     noteError(error->code);
-    job.reply(std::make_shared<Reply>(Reply{errorReply(job.request.id, *error), {}}));
+    job.reply(makeReply(errorReply(job.request.id, *error)));
   } else {
-    job.reply(
-        std::make_shared<Reply>(Reply{okReply(job.request.id, std::get<json>(*outcome)), {}}));
+    job.reply(makeReply(okReply(job.request.id, std::get<json>(*outcome))));
   }
 }
 
@@ -670,19 +668,21 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
     if (image.format == ImageFormat::kRaw) {
       auto body = packRaw(frame->srgb, image.colour, image.coverage);
       std::string header = imageReplyHeader(job.request.id, std::move(meta), body.size());
-      job.reply(std::make_shared<Reply>(Reply{std::move(header), std::move(body)}));
+      job.reply(makeReply(std::move(header),
+                          std::make_shared<const std::vector<std::uint8_t>>(std::move(body))));
       return std::nullopt;
     }
     const bool queued = encoder_->post([frame, image, meta, id = job.request.id, reply = job.reply,
                                         options = config_.encode]() mutable {
       auto encoded = encodeFrame(*frame, image, options);
       if (auto* e = std::get_if<std::string>(&encoded)) {
-        reply(std::make_shared<Reply>(Reply{errorReply(id, {ErrorCode::kFailed, *e}), {}}));
+        reply(makeReply(errorReply(id, {ErrorCode::kFailed, *e})));
         return;
       }
       auto& bytes = std::get<std::vector<std::uint8_t>>(encoded);
       std::string header = imageReplyHeader(id, std::move(meta), bytes.size());
-      reply(std::make_shared<Reply>(Reply{std::move(header), std::move(bytes)}));
+      reply(makeReply(std::move(header),
+                      std::make_shared<const std::vector<std::uint8_t>>(std::move(bytes))));
     });
     if (!queued) return ProtocolError{ErrorCode::kBusy, "the image encoder is busy; try again"};
     return std::nullopt;
@@ -844,23 +844,20 @@ void Engine::deliverFrames(bool only_due, const std::string& view_name) {
         frame = std::make_shared<Frame>();
         renderFrame(*view, linear, *frame);
       }
-      std::vector<std::pair<std::int64_t, std::pair<FrameSink, std::shared_ptr<std::atomic<bool>>>>>
-          sinks;
-      for (Subscription* sub : members) sinks.push_back({sub->id, {sub->sink, sub->gone}});
-      auto send = [this, frame, image = image, sinks, options = config_.encode]() {
+      std::vector<Subscription> sinks;  // copies: the encoder may run after a change
+      for (Subscription* sub : members) sinks.push_back(*sub);
+      auto send = [frame, image = image, sinks, options = config_.encode]() {
         auto encoded = encodeFrame(*frame, image, options);
         if (auto* e = std::get_if<std::string>(&encoded)) {
           spdlog::error("event=encode_failed error=\"{}\"", *e);
           return;
         }
-        auto bytes = std::make_shared<std::vector<std::uint8_t>>(
+        auto bytes = std::make_shared<const std::vector<std::uint8_t>>(
             std::move(std::get<std::vector<std::uint8_t>>(encoded)));
         const json meta = imageMeta(*frame, image);
-        for (const auto& [id, sink] : sinks) {
-          auto reply =
-              std::make_shared<Reply>(Reply{frameEventHeader(id, meta, bytes->size()), *bytes});
-          if (!sink.first(reply)) sink.second->store(true);
-        }
+        for (const Subscription& sub : sinks)
+          if (!sub.sink(makeReply(frameEventHeader(sub.id, meta, bytes->size()), bytes)))
+            sub.gone->store(true);
       };
       if (image.format == ImageFormat::kRaw)
         send();

@@ -25,12 +25,19 @@
 
 namespace nephele {
 
-// A reply: one JSON line, and for images the bytes that follow it.
+// A reply: one JSON line, and for images the bytes that follow it (shared, so that one
+// encoded frame goes to every subscriber without a copy).
 struct Reply {
   std::string header;
-  std::vector<std::uint8_t> body;
+  std::shared_ptr<const std::vector<std::uint8_t>> body;
+  std::size_t size() const { return header.size() + (body ? body->size() : 0); }
 };
 using SharedReply = std::shared_ptr<const Reply>;
+
+inline SharedReply makeReply(std::string header,
+                             std::shared_ptr<const std::vector<std::uint8_t>> body = nullptr) {
+  return std::make_shared<const Reply>(Reply{std::move(header), std::move(body)});
+}
 
 // Receives a request's reply, once, on a daemon thread (not the caller's).
 using ReplySink = std::function<void(SharedReply)>;

@@ -42,7 +42,7 @@ class Connection : public std::enable_shared_from_this<Connection> {
   // Queues a reply or frame for writing.
   void send(SharedReply reply) {
     if (closed_) return;
-    pending_bytes_ += reply->header.size() + reply->body.size();
+    pending_bytes_ += reply->size();
     out_.push_back(std::move(reply));
     if (!writing_) write();
   }
@@ -50,7 +50,7 @@ class Connection : public std::enable_shared_from_this<Connection> {
   // A subscribed frame: dropped when the client is already too far behind.
   void offerFrame(SharedReply frame) {
     if (closed_) return;
-    if (pending_bytes_ + frame->body.size() > engine_.config().max_pending_bytes) {
+    if (pending_bytes_ + frame->size() > engine_.config().max_pending_bytes) {
       ++engine_.frames_dropped;
       return;
     }
@@ -144,17 +144,18 @@ class Connection : public std::enable_shared_from_this<Connection> {
 
   void sendError(const nlohmann::json& id, const ProtocolError& error) {
     engine_.noteError(error.code);
-    send(std::make_shared<Reply>(Reply{errorReply(id, error), {}}));
+    send(makeReply(errorReply(id, error)));
   }
 
   void write() {
     writing_ = true;
     const SharedReply& r = out_.front();
-    std::array<asio::const_buffer, 2> buffers{asio::buffer(r->header), asio::buffer(r->body)};
+    std::array<asio::const_buffer, 2> buffers{
+        asio::buffer(r->header), r->body ? asio::buffer(*r->body) : asio::const_buffer()};
     asio::async_write(socket_, buffers,
                       [self = shared_from_this()](std::error_code ec, std::size_t) {
                         const SharedReply& done = self->out_.front();
-                        self->pending_bytes_ -= done->header.size() + done->body.size();
+                        self->pending_bytes_ -= done->size();
                         self->out_.pop_front();
                         if (ec) {
                           self->close("write_error");
