@@ -126,10 +126,6 @@ void readDaemon(const toml::table& root, const std::string& file, DaemonConfig& 
     s->string("directory", out.snapshot_directory);
     s->finish();
   }
-  if (out.snapshot_directory.empty())
-    out.snapshot_directory = out.snapshot_path.empty()
-                                 ? std::string()
-                                 : std::filesystem::path(out.snapshot_path).parent_path().string();
   if (auto o = t.table("output")) {
     o->allow({"directory", "format", "png_compression", "jpeg_quality"});
     o->string("directory", out.output_directory);

@@ -3,6 +3,7 @@
 // once here like scene files: every error names the file, the line, the key and what is
 // allowed.
 #include <cstdint>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -61,6 +62,11 @@ struct DaemonConfig {
   double snapshot_interval_s = 60.0;  // 0: only at shutdown
   bool restore_on_start = true;
   std::string snapshot_directory;  // for the snapshot/restore requests; empty: beside the path
+  // Where named snapshots go: snapshot_directory, else the snapshot path's directory.
+  std::string snapshotDirectory() const {
+    return snapshot_directory.empty() ? std::filesystem::path(snapshot_path).parent_path().string()
+                                      : snapshot_directory;
+  }
 
   std::string output_directory = "frames";  // images written by the Modbus render coil
   ImageFormat output_format = ImageFormat::kPng;

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <numeric>
 #include <sstream>
@@ -535,7 +534,7 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
   const ProtocolError noSnapshotDirectory{
       ErrorCode::kFailed, "name: no snapshot directory is configured ([snapshot] directory)"};
   auto snapshotPath = [&](const std::string& name) {
-    return (std::filesystem::path(config_.snapshot_directory) / (name + ".snap")).string();
+    return (std::filesystem::path(config_.snapshotDirectory()) / (name + ".snap")).string();
   };
 
   if (const auto* c = std::get_if<Hello>(&command)) {
@@ -723,15 +722,15 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
     return json{{"subscription", c->subscription}};
   }
   if (const auto* c = std::get_if<Snapshot>(&command)) {
-    if (config_.snapshot_directory.empty()) return noSnapshotDirectory;
+    if (config_.snapshotDirectory().empty()) return noSnapshotDirectory;
     std::error_code ec;
-    std::filesystem::create_directories(config_.snapshot_directory, ec);
+    std::filesystem::create_directories(config_.snapshotDirectory(), ec);
     if (std::string e = world.saveSnapshot(snapshotPath(c->name)); !e.empty())
       return ProtocolError{ErrorCode::kFailed, e};
     return json{{"name", c->name}, {"time", world.timeSeconds()}, {"hash", hexHash(world.hash())}};
   }
   if (const auto* c = std::get_if<Restore>(&command)) {
-    if (config_.snapshot_directory.empty()) return noSnapshotDirectory;
+    if (config_.snapshotDirectory().empty()) return noSnapshotDirectory;
     const std::string path = snapshotPath(c->name);
     if (!std::filesystem::exists(path))
       return ProtocolError{ErrorCode::kNotFound, "name: no snapshot \"" + c->name + "\""};
@@ -870,36 +869,24 @@ void Engine::deliverFrames(bool only_due, const std::string& view_name) {
 void Engine::renderTrigger(Job& job) {
   State& s = *state_;
   const ViewConfig& view = *s.view(config_.modbus_view);
-  const ImageRequest image{config_.output_format, true, defaultCoverage(config_.output_format)};
+  const bool linear = config_.output_format == ImageFormat::kExr;
   auto frame = std::make_shared<Frame>();
-  renderFrame(view, image.format == ImageFormat::kExr, *frame);
-  const std::string extension = image.format == ImageFormat::kPng    ? ".png"
-                                : image.format == ImageFormat::kJpeg ? ".jpg"
-                                                                     : ".exr";
+  renderFrame(view, linear, *frame);
+  const std::string extension = config_.output_format == ImageFormat::kPng    ? ".png"
+                                : config_.output_format == ImageFormat::kJpeg ? ".jpg"
+                                                                              : ".exr";
   const std::filesystem::path path = std::filesystem::path(config_.output_directory) /
                                      (view.name + "_" + std::to_string(s.frames) + extension);
   deliverFrames(false, view.name);
   const bool queued =
-      encoder_->post([this, frame, image, path, done = job.done, options = config_.encode]() {
-        auto encoded = encodeFrame(*frame, image, options);
+      encoder_->post([this, frame, linear, path, done = job.done, options = config_.encode]() {
+        std::error_code ec;
+        std::filesystem::create_directories(path.parent_path(), ec);
+        // writeImageFile picks the format from the extension and renames into place.
+        const std::string e = linear ? writeImageFile(path.string(), frame->linear, options)
+                                     : writeImageFile(path.string(), frame->srgb, options);
         std::optional<ProtocolError> error;
-        if (auto* e = std::get_if<std::string>(&encoded)) {
-          error = ProtocolError{ErrorCode::kFailed, *e};
-        } else {
-          const auto& bytes = std::get<std::vector<std::uint8_t>>(encoded);
-          std::error_code ec;
-          std::filesystem::create_directories(path.parent_path(), ec);
-          const std::string partial = path.string() + ".partial";
-          std::ofstream out(partial, std::ios::binary);
-          out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
-          out.close();
-          if (!out)
-            error = ProtocolError{ErrorCode::kFailed, "cannot write " + partial};
-          else
-            std::filesystem::rename(partial, path, ec);
-          if (!error && ec)
-            error = ProtocolError{ErrorCode::kFailed, "cannot write " + path.string()};
-        }
+        if (!e.empty()) error = ProtocolError{ErrorCode::kFailed, e};
         if (error) {
           spdlog::error("event=render_trigger_failed error=\"{}\"", error->message);
           noteError(error->code);

@@ -53,8 +53,6 @@ int runServeCommand(const ServeCommandOptions& o) {
     config.metrics_enabled = true;
   }
   if (o.snapshot_path) config.snapshot_path = *o.snapshot_path;
-  if (config.snapshot_directory.empty() && !config.snapshot_path.empty())
-    config.snapshot_directory = std::filesystem::path(config.snapshot_path).parent_path().string();
 
   Engine engine(config);
   if (std::string error = engine.start(); !error.empty()) {

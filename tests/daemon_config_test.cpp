@@ -27,7 +27,7 @@ TEST(DaemonConfig, DefaultsAndTheExample) {
   EXPECT_EQ(example.views.size(), 2u);
   EXPECT_EQ(example.views[1].image.format, ImageFormat::kPng);
   EXPECT_FALSE(example.views[1].image.coverage);
-  EXPECT_EQ(example.snapshot_directory, "/var/lib/nephele");
+  EXPECT_EQ(example.snapshotDirectory(), "/var/lib/nephele");
   for (const char* other :
        {"/config/daemon.toml", "/deploy/docker.toml", "/deploy/cockpit/left.toml"}) {
     DaemonConfig c;
