@@ -57,6 +57,10 @@ json viewJson(const ViewConfig& v) {
           {"channels", channelNames(v.image)}};
 }
 
+const char* modeName(TickMode mode) {
+  return mode == TickMode::kRealtime ? "realtime" : "lockstep";
+}
+
 ProtocolError unknownView(const std::vector<ViewConfig>& views, const std::string& name) {
   std::string names;
   for (const ViewConfig& v : views) names += (names.empty() ? "" : ", ") + v.name;
@@ -343,7 +347,7 @@ std::string Engine::openWorld() {
   }
   spdlog::info("event=world_ready gl=\"{}\" backend={} views={} mode={} tick_rate={}",
                s.platform->renderer(), s.platform->backendName(), s.views.size(),
-               config_.mode == TickMode::kRealtime ? "realtime" : "lockstep", config_.tick_rate_hz);
+               modeName(config_.mode), config_.tick_rate_hz);
   return "";
 }
 
@@ -501,11 +505,11 @@ void Engine::execute(Job& job) {
       if (auto outcome = apply(c, job);
           outcome && std::holds_alternative<ProtocolError>(*outcome)) {
         noteError(std::get<ProtocolError>(*outcome).code);
-        publish();
+        publishReadings();
         job.done(std::get<ProtocolError>(*outcome));
         return;
       }
-    publish();  // so that a read right after the reply sees the change
+    publishReadings();  // so that a register read right after the reply sees the change
     job.done(std::nullopt);
     return;
   }
@@ -515,7 +519,7 @@ void Engine::execute(Job& job) {
   else
     outcome = apply(job.request.command, job);
   if (!outcome) return;  // the encoder replies
-  publish();             // so that a read right after the reply sees the change
+  publishReadings();     // so that a register read right after the reply sees the change
   if (const auto* error = std::get_if<ProtocolError>(&*outcome)) {
     noteError(error->code);
     job.reply(makeReply(errorReply(job.request.id, *error)));
@@ -545,7 +549,7 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
                 {"version", NEPHELE_VERSION},
                 {"protocol", kProtocolVersion},
                 {"views", views},
-                {"mode", config_.mode == TickMode::kRealtime ? "realtime" : "lockstep"},
+                {"mode", modeName(config_.mode)},
                 {"tick_rate", config_.tick_rate_hz}};
   }
   if (const auto* c = std::get_if<GetView>(&command)) {
@@ -927,7 +931,7 @@ void Engine::publish() {
       {"time", world.timeSeconds()},
       {"ticks", s.ticks},
       {"ticks_per_second", ticks_per_second},
-      {"mode", config_.mode == TickMode::kRealtime ? "realtime" : "lockstep"},
+      {"mode", modeName(config_.mode)},
       {"paused", s.paused},
       {"time_scale", s.time_scale},
       {"frames", s.frames},
@@ -948,6 +952,16 @@ void Engine::publish() {
       {"errors", errors_.load()},
       {"automaton_steps", world.automatonStepsRun()},
   };
+  {
+    std::lock_guard lock(published_mutex_);
+    published_stats_ = std::move(stats);
+  }
+  publishReadings();
+}
+
+void Engine::publishReadings() {
+  const State& s = *state_;
+  const World& world = *s.world;
   ModbusSettings settings;
   const ViewConfig& view = *s.view(config_.modbus_view);
   settings.position = view.camera.position;
@@ -970,10 +984,8 @@ void Engine::publish() {
   status.frames = std::uint32_t(s.frames);
   status.render_ms = s.last_render_ms;
   status.ticks = s.ticks;
-  status.last_error = std::uint16_t(last_error_.load());
   status.time_s = world.timeSeconds();
   std::lock_guard lock(published_mutex_);
-  published_stats_ = std::move(stats);
   published_settings_ = settings;
   published_status_ = status;
 }

@@ -110,7 +110,8 @@ class Engine {
   void renderTrigger(Job& job);
   void saveSnapshot(const std::string& path, const char* why);
   Clock::time_point nextWake() const;
-  void publish();  // refreshes the thread-safe readings
+  void publish();          // refreshes stats and the Modbus readings
+  void publishReadings();  // the Modbus readings alone (cheap: after every request)
 
   DaemonConfig config_;
   std::unique_ptr<State> state_;
