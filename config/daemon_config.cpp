@@ -1,10 +1,6 @@
 #include "config/daemon_config.h"
 
-#include <cerrno>
-#include <cstring>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include "config/table_reader.h"
 
@@ -25,12 +21,7 @@ void readView(TableReader& t, const Camera& scene_camera, ViewConfig& view) {
   view.camera = scene_camera;
   t.string("name", view.name);
   Camera& c = view.camera;
-  t.vector("position", c.position, -Limits::kMaxCoordinate, Limits::kMaxCoordinate);
-  if (c.position.z < 0.0) t.failAt("position", "z is below the ground (allowed: z >= 0)");
-  t.number("heading", c.orientation.heading_deg, -Limits::kMaxHeading, Limits::kMaxHeading);
-  t.number("pitch", c.orientation.pitch_deg, -Limits::kMaxPitch, Limits::kMaxPitch);
-  t.number("roll", c.orientation.roll_deg, -Limits::kMaxRoll, Limits::kMaxRoll);
-  t.number("vfov", c.vfov_deg, Limits::kMinVfov, Limits::kMaxVfov);
+  config_detail::readCameraKeys(t, c);
   t.integer("width", c.width, 1, Limits::kMaxImageSide);
   t.integer("height", c.height, 1, Limits::kMaxImageSide);
   view.image.format =
@@ -160,11 +151,10 @@ std::string parseDaemonConfig(std::string_view text, const std::string& source_n
 }
 
 std::string loadDaemonConfig(const std::string& path, DaemonConfig& out) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return "cannot read config file '" + path + "': " + std::strerror(errno);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parseDaemonConfig(text.str(), path, out);
+  std::string text;
+  if (std::string error = config_detail::readTextFile(path, "config file", text); !error.empty())
+    return error;
+  return parseDaemonConfig(text, path, out);
 }
 
 }  // namespace nephele

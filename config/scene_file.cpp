@@ -21,6 +21,17 @@
 #include "world/counter_random.h"
 
 namespace nephele {
+void config_detail::readCameraKeys(TableReader& t, Camera& camera) {
+  t.vector("position", camera.position, -Limits::kMaxCoordinate, Limits::kMaxCoordinate);
+  if (camera.position.z < 0.0)
+    t.failAt("position",
+             "z = " + formatNumber(camera.position.z) + " is below the ground (allowed: z >= 0)");
+  t.number("heading", camera.orientation.heading_deg, -Limits::kMaxHeading, Limits::kMaxHeading);
+  t.number("pitch", camera.orientation.pitch_deg, -Limits::kMaxPitch, Limits::kMaxPitch);
+  t.number("roll", camera.orientation.roll_deg, -Limits::kMaxRoll, Limits::kMaxRoll);
+  t.number("vfov", camera.vfov_deg, Limits::kMinVfov, Limits::kMaxVfov);
+}
+
 namespace {
 
 using config_detail::formatNumber;
@@ -39,14 +50,7 @@ void readImage(TableReader& t, Camera& camera) {
 
 void readCamera(TableReader& t, Camera& camera) {
   t.allow({"position", "heading", "pitch", "roll", "vfov"});
-  t.vector("position", camera.position, -Limits::kMaxCoordinate, Limits::kMaxCoordinate);
-  if (camera.position.z < 0.0)
-    t.failAt("position",
-             "z = " + formatNumber(camera.position.z) + " is below the ground (allowed: z >= 0)");
-  t.number("heading", camera.orientation.heading_deg, -Limits::kMaxHeading, Limits::kMaxHeading);
-  t.number("pitch", camera.orientation.pitch_deg, -Limits::kMaxPitch, Limits::kMaxPitch);
-  t.number("roll", camera.orientation.roll_deg, -Limits::kMaxRoll, Limits::kMaxRoll);
-  t.number("vfov", camera.vfov_deg, Limits::kMinVfov, Limits::kMaxVfov);
+  config_detail::readCameraKeys(t, camera);
   t.finish();
 }
 
@@ -503,12 +507,10 @@ std::string parseSceneText(std::string_view text, const std::string& source_name
 }
 
 std::string loadSceneFile(const std::string& path, SceneFile& out) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return "cannot read scene file '" + path + "': " + std::strerror(errno);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) return "cannot read scene file '" + path + "': " + std::strerror(errno);
-  return parseSceneText(text.str(), path, out);
+  std::string text;
+  if (std::string error = config_detail::readTextFile(path, "scene file", text); !error.empty())
+    return error;
+  return parseSceneText(text, path, out);
 }
 
 std::string validateRenderSettings(const RenderSettings& r) {

@@ -3,8 +3,11 @@
 // Every error names the file, the line, the key and what is allowed.
 #include <toml++/toml.h>
 
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
+#include <fstream>
 #include <limits>
 #include <optional>
 #include <set>
@@ -16,6 +19,8 @@
 #include <glm/glm.hpp>
 
 namespace nephele {
+
+struct Camera;
 
 int nameIndex(const std::vector<std::string>& names, std::string_view name);
 
@@ -226,6 +231,22 @@ class TableReader {
   std::set<std::string> taken_;
   std::vector<std::string> allowed_;
 };
+
+// Reads a whole file into `text`; on failure returns "cannot read WHAT 'path': reason".
+inline std::string readTextFile(const std::string& path, const char* what, std::string& text) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return std::string("cannot read ") + what + " '" + path + "': " + std::strerror(errno);
+  std::ostringstream contents;
+  contents << in.rdbuf();
+  if (in.bad())
+    return std::string("cannot read ") + what + " '" + path + "': " + std::strerror(errno);
+  text = contents.str();
+  return "";
+}
+
+// The camera keys shared by a scene's [camera] and a daemon's [[view]]: position, heading,
+// pitch, roll, vfov.
+void readCameraKeys(TableReader& t, Camera& camera);
 
 }  // namespace config_detail
 }  // namespace nephele
