@@ -52,11 +52,10 @@ void main() {
   vec3 near = min(s0, s1), far = max(s0, s1);
   float enter = max(max(near.x, near.y), max(near.z, 0.0));
   float leave = min(min(far.x, far.y), far.z);
-  if (d.z < 0.0) leave = min(leave, u_camera_z / -d.z);  // the ground hides what lies beyond
-#ifdef TARGETS
-  leave = min(leave, targetDistance());
-#endif
-  if (!(leave > enter)) discard;
+  leave = min(leave, opaqueDistance(d));  // the ground and targets hide what lies beyond
+  // The volume is composited as one surface at its entry (as the reference does), so it
+  // belongs to the layer band of its entry point.
+  if (!(leave > enter) || !inBand(enter * d.z)) discard;
   int steps = min(int(ceil((leave - enter) / u_step)), MAX_STEPS);
   float ds = (leave - enter) / float(steps);
   float scattering = phase(dot(u_to_sun, d));
@@ -167,7 +166,8 @@ AutomatonRenderer::Volume& AutomatonRenderer::volume(const Scene& scene, std::si
 }
 
 void AutomatonRenderer::drawCloud(const Scene& scene, std::size_t index,
-                                  const RenderSettings& settings, bool targets_drawn) {
+                                  const RenderSettings& settings, bool targets_drawn,
+                                  const AltitudeBand& band) {
   const AutomatonCloudView& cloud = scene.automata[index];
   // March only where either keyframe has density: the lattice samples that bound it.
   const DensityLattice& a = cloud.from->lattice;
@@ -182,7 +182,7 @@ void AutomatonRenderer::drawCloud(const Scene& scene, std::size_t index,
   const Volume& v = volume(scene, index);
   const GLuint p = program(scene.fog.has_value(), targets_drawn, cloud.phase);
   gl_.UseProgram(p);
-  setViewUniforms(gl_, p, scene.camera, scene.fog);
+  setViewUniforms(gl_, p, scene.camera, scene.fog, band);
   const glm::dvec3 eye = scene.camera.position;
   const DensityLattice& lattice = cloud.from->lattice;
   setUniform3(gl_, p, "u_box_min", box_lo - eye);

@@ -9,6 +9,7 @@
 
 #include "renderer/gl_objects.h"
 #include "renderer/render_settings.h"
+#include "renderer/view_uniforms.h"
 #include "world/scene.h"
 
 namespace nephele {
@@ -19,8 +20,9 @@ class AutomatonRenderer {
 
   void beginFrame();
   // Draws scene.automata[index] over what the framebuffer holds (blending set here).
+  // Only the rays whose entry into the volume lies in `band` (a layer cutting the cloud).
   void drawCloud(const Scene& scene, std::size_t index, const RenderSettings& settings,
-                 bool targets_drawn);
+                 bool targets_drawn, const AltitudeBand& band);
   // Releases the textures of clouds this frame did not draw.
   void endFrame();
 

@@ -249,8 +249,9 @@ const IndexedMesh& EllipsoidRenderer::sphereMesh(int slices) {
 }
 
 void EllipsoidRenderer::setCloudUniforms(GLuint p, const Scene& scene, const EllipsoidCloud& cloud,
-                                         const CachedTexture& cached, SolidTextureKind kind) {
-  setViewUniforms(gl_, p, scene.camera, scene.fog);
+                                         const CachedTexture& cached, SolidTextureKind kind,
+                                         const AltitudeBand& band) {
+  setViewUniforms(gl_, p, scene.camera, scene.fog, band);
   setUniform3(gl_, p, "u_cloud_colour", cloud.colour * scene.sun.colour);
   const ShadingParams& sh = cloud.shading;
   const glm::vec4 shading(sh.ambient, sh.texture_fraction, sh.specular, sh.shininess);
@@ -294,11 +295,11 @@ void EllipsoidRenderer::uploadRecords(const std::vector<EllipsoidRecord>& record
 
 void EllipsoidRenderer::drawCloud(const Scene& scene, std::size_t index,
                                   const RenderSettings& settings, const FrameTarget& target,
-                                  bool targets_drawn) {
+                                  bool targets_drawn, const AltitudeBand& band) {
   if (settings.impostor_tolerance_px > 0.0 &&
-      drawImpostor(scene, index, settings, target, targets_drawn))
+      drawImpostor(scene, index, settings, target, targets_drawn, band))
     return;
-  drawCloudDirect(scene, index, settings, target, targets_drawn);
+  drawCloudDirect(scene, index, settings, target, targets_drawn, band);
 }
 
 namespace {
@@ -344,7 +345,7 @@ std::string impostorKey(const Scene& scene, const EllipsoidCloud& cloud,
 
 bool EllipsoidRenderer::drawImpostor(const Scene& scene, std::size_t index,
                                      const RenderSettings& settings, const FrameTarget& target,
-                                     bool targets_drawn) {
+                                     bool targets_drawn, const AltitudeBand& band) {
   const EllipsoidCloud& cloud = scene.clouds[index];
   const Camera& camera = scene.camera;
   glm::dvec3 centre;
@@ -396,7 +397,7 @@ bool EllipsoidRenderer::drawImpostor(const Scene& scene, std::size_t index,
     gl_.BindFramebuffer(GL_FRAMEBUFFER, impostor.framebuffer.get());
     gl_.Viewport(0, 0, size, size);
     const FrameTarget impostor_target{impostor.framebuffer.get(), size, size};
-    drawCloudDirect(view, index, settings, impostor_target, false);
+    drawCloudDirect(view, index, settings, impostor_target, false, AltitudeBand{});
     gl_.BindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
     gl_.Viewport(0, 0, target.width, target.height);
     const ViewBasis basis = viewBasis(view.camera);
@@ -415,6 +416,7 @@ bool EllipsoidRenderer::drawImpostor(const Scene& scene, std::size_t index,
   layout.targets = targets_drawn;
   const GLuint p = program(layout);
   gl_.UseProgram(p);
+  setViewUniforms(gl_, p, camera, scene.fog, band);
   const ViewBasis basis = viewBasis(camera);
   setUniform3(gl_, p, "u_clip_x", basis.right / (basis.tan_half_vfov * basis.aspect));
   setUniform3(gl_, p, "u_clip_y", basis.up / basis.tan_half_vfov);
@@ -435,7 +437,7 @@ bool EllipsoidRenderer::drawImpostor(const Scene& scene, std::size_t index,
 
 void EllipsoidRenderer::drawCloudDirect(const Scene& scene, std::size_t index,
                                         const RenderSettings& settings, const FrameTarget& target,
-                                        bool targets_drawn) {
+                                        bool targets_drawn, const AltitudeBand& band) {
   const EllipsoidCloud& cloud = scene.clouds[index];
   // Visible ellipsoids, back to front by centre distance.
   std::vector<std::pair<double, EllipsoidRecord>> visible;
@@ -470,7 +472,7 @@ void EllipsoidRenderer::drawCloudDirect(const Scene& scene, std::size_t index,
   gl_.Enable(GL_BLEND);
   gl_.BlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
   if (settings.ellipsoid_passes == EllipsoidPasses::kMultipass) {
-    drawTiles(scene, cloud, texture, base, settings, records, target);
+    drawTiles(scene, cloud, texture, base, settings, records, target, band);
     return;
   }
   uploadRecords(records);
@@ -481,7 +483,7 @@ void EllipsoidRenderer::drawCloudDirect(const Scene& scene, std::size_t index,
     layout.program = EllipsoidProgram::kFusedCentre;
     const GLuint p = program(layout);
     gl_.UseProgram(p);
-    setCloudUniforms(p, scene, cloud, texture, layout.texture);
+    setCloudUniforms(p, scene, cloud, texture, layout.texture, band);
     gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_first"), 0);
     gl_.DrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(records.size()));
     return;
@@ -491,7 +493,7 @@ void EllipsoidRenderer::drawCloudDirect(const Scene& scene, std::size_t index,
   layout.program = EllipsoidProgram::kFusedPerPixel;
   const GLuint p = program(layout);
   gl_.UseProgram(p);
-  setCloudUniforms(p, scene, cloud, texture, layout.texture);
+  setCloudUniforms(p, scene, cloud, texture, layout.texture, band);
   const int bins_x = (target.width + kPerPixelBinSize - 1) / kPerPixelBinSize;
   const int bins_y = (target.height + kPerPixelBinSize - 1) / kPerPixelBinSize;
   std::vector<std::vector<GLint>> lists(std::size_t(bins_x) * bins_y);
@@ -549,8 +551,8 @@ void EllipsoidRenderer::prepareAtlas(TileFormat format) {
 void EllipsoidRenderer::drawTiles(const Scene& scene, const EllipsoidCloud& cloud,
                                   CachedTexture& texture, const EllipsoidPassLayout& base,
                                   const RenderSettings& settings,
-                                  std::vector<EllipsoidRecord>& records,
-                                  const FrameTarget& target) {
+                                  std::vector<EllipsoidRecord>& records, const FrameTarget& target,
+                                  const AltitudeBand& band) {
   prepareAtlas(settings.tile_format);
   // Tile sizes: the screen rectangle rounded up to powers of two, or the fixed knob.
   std::vector<Tile> all;
@@ -593,7 +595,7 @@ void EllipsoidRenderer::drawTiles(const Scene& scene, const EllipsoidCloud& clou
     }
     NEPHELE_CHECK(!batch.empty(), "tile larger than the atlas");
     next += batch.size();
-    renderAtlasBatch(scene, cloud, texture, base, settings, records, batch, target);
+    renderAtlasBatch(scene, cloud, texture, base, settings, records, batch, target, band);
   }
 }
 
@@ -602,7 +604,8 @@ void EllipsoidRenderer::renderAtlasBatch(const Scene& scene, const EllipsoidClou
                                          const EllipsoidPassLayout& base,
                                          const RenderSettings& settings,
                                          std::vector<EllipsoidRecord>& records,
-                                         std::vector<Tile>& tiles, const FrameTarget& target) {
+                                         std::vector<Tile>& tiles, const FrameTarget& target,
+                                         const AltitudeBand& band) {
   for (const Tile& t : tiles) records[t.record].v[15] = glm::vec4(t.x, t.y, t.width, t.height);
   uploadRecords(records);
   const ViewBasis basis = viewBasis(scene.camera);
@@ -626,7 +629,7 @@ void EllipsoidRenderer::renderAtlasBatch(const Scene& scene, const EllipsoidClou
     layout.targets = false;  // tiles are not in screen space; the composite tests targets
     const GLuint p = program(layout);
     gl_.UseProgram(p);
-    setCloudUniforms(p, scene, cloud, texture, layout.texture);
+    setCloudUniforms(p, scene, cloud, texture, layout.texture, band);
     if (pass == EllipsoidProgram::kTileThreshold) {
       gl_.Disable(GL_BLEND);
     } else if (pass == EllipsoidProgram::kTileLimb) {
@@ -667,7 +670,7 @@ void EllipsoidRenderer::renderAtlasBatch(const Scene& scene, const EllipsoidClou
   layout.program = EllipsoidProgram::kTileComposite;
   const GLuint p = program(layout);
   gl_.UseProgram(p);
-  setCloudUniforms(p, scene, cloud, texture, layout.texture);
+  setCloudUniforms(p, scene, cloud, texture, layout.texture, band);
   const glm::vec2 atlas_size(kAtlasSize, kAtlasSize);
   gl_.ProgramUniform2fv(p, gl_.GetUniformLocation(p, "u_atlas_size"), 1, &atlas_size.x);
   gl_.BindTextureUnit(kAtlasTextureUnit, atlas_.get());

@@ -11,6 +11,7 @@
 #include "renderer/ellipsoid_shaders.h"
 #include "renderer/gl_objects.h"
 #include "renderer/render_settings.h"
+#include "renderer/view_uniforms.h"
 #include "world/scene.h"
 
 namespace nephele {
@@ -44,9 +45,10 @@ class EllipsoidRenderer {
 
   // Draws cloud `index` of the scene "over" what `target` holds, blending premultiplied.
   // `targets_drawn`: the target colour and distance textures are bound. A far cloud may be
-  // drawn from its impostor (RenderSettings::impostor_tolerance_px).
+  // drawn from its impostor (RenderSettings::impostor_tolerance_px). Only the surfaces in
+  // `band` are drawn, so that a layer can cut through the cloud.
   void drawCloud(const Scene& scene, std::size_t index, const RenderSettings& settings,
-                 const FrameTarget& target, bool targets_drawn);
+                 const FrameTarget& target, bool targets_drawn, const AltitudeBand& band = {});
 
   // Impostors rendered so far (for measurement and tests).
   int impostorRenders() const { return impostor_renders_; }
@@ -78,26 +80,29 @@ class EllipsoidRenderer {
   };
 
   void drawCloudDirect(const Scene& scene, std::size_t index, const RenderSettings& settings,
-                       const FrameTarget& target, bool targets_drawn);
+                       const FrameTarget& target, bool targets_drawn, const AltitudeBand& band);
   // False when the cloud is too near for an impostor; then the caller draws it directly.
   bool drawImpostor(const Scene& scene, std::size_t index, const RenderSettings& settings,
-                    const FrameTarget& target, bool targets_drawn);
+                    const FrameTarget& target, bool targets_drawn, const AltitudeBand& band);
   GLuint program(const EllipsoidPassLayout& layout);
   CachedTexture& cachedTexture(const SolidTextureSpec& spec, const RenderSettings& settings);
   GLuint gpuTexture(CachedTexture& cached);
   const IndexedMesh& sphereMesh(int slices);  // cached per tessellation
   GLuint spotlightTexture();
   void setCloudUniforms(GLuint program, const Scene& scene, const EllipsoidCloud& cloud,
-                        const CachedTexture& texture, SolidTextureKind kind);
+                        const CachedTexture& texture, SolidTextureKind kind,
+                        const AltitudeBand& band);
   GLuint frameBuffer(const void* data, std::size_t bytes);
   void uploadRecords(const std::vector<EllipsoidRecord>& records);
   void drawTiles(const Scene& scene, const EllipsoidCloud& cloud, CachedTexture& texture,
                  const EllipsoidPassLayout& base, const RenderSettings& settings,
-                 std::vector<EllipsoidRecord>& records, const FrameTarget& target);
+                 std::vector<EllipsoidRecord>& records, const FrameTarget& target,
+                 const AltitudeBand& band);
   void renderAtlasBatch(const Scene& scene, const EllipsoidCloud& cloud,
                         const CachedTexture& texture, const EllipsoidPassLayout& base,
                         const RenderSettings& settings, std::vector<EllipsoidRecord>& records,
-                        std::vector<Tile>& tiles, const FrameTarget& target);
+                        std::vector<Tile>& tiles, const FrameTarget& target,
+                        const AltitudeBand& band);
   void prepareAtlas(TileFormat format);
 
   const GlApi& gl_;

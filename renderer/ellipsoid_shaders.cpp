@@ -168,6 +168,10 @@ vec4 ellipsoidSurface(int i, vec3 r, float s) {
   float alpha = opacityFromExcess(excess) * u_e[i].limb_axis.w;
   return vec4(surfaceColour(n, r, it, s * length(r)) * alpha, alpha);
 }
+
+// Whether a hit at s (units of r) shows in this pass: in front of the ground and targets,
+// and in the pass's layer band.
+bool hitShows(vec3 r, float s, float limit) { return s > 0.0 && s < limit && inBand(s * r.z); }
 )";
 
 const char* kFusedCentre = R"(
@@ -175,10 +179,7 @@ flat in int v_index;
 void main() {
   vec3 r = viewRay();
   float s = hitEllipsoid(v_index, r);
-  if (s <= 0.0) discard;
-#ifdef TARGETS
-  if (s * length(r) >= targetDistance()) discard;
-#endif
+  if (!hitShows(r, s, opaqueDistance(r) / length(r))) discard;
   o_colour = ellipsoidSurface(v_index, r, s);
 }
 )";
@@ -188,28 +189,29 @@ layout(std430, binding = 2) readonly buffer BinItems { int u_items[]; };
 flat in int v_first;  // this screen bin's ellipsoids: u_items[v_first .. v_first + v_count)
 flat in int v_count;
 const int kMaxHits = 8;
+
+// Hits are ordered by (depth, ellipsoid index), so equal depths still have one order.
+bool before(float s, int i, float t, int j) { return s < t || (s == t && i < j); }
+
 void main() {
   vec3 r = viewRay();
   vec2 ndc = 2.0 * gl_FragCoord.xy / u_viewport - 1.0;
-#ifdef TARGETS
-  float limit = targetDistance() / length(r);
-#else
-  float limit = 1e30;
-#endif
-  // The nearest kMaxHits hits, sorted near to far.
+  float limit = opaqueDistance(r) / length(r);
+  // The nearest kMaxHits hits, sorted near to far; `total` counts every hit.
   float depth[kMaxHits];
   int index[kMaxHits];
-  int n = 0;
+  int n = 0, total = 0;
   for (int k = 0; k < v_count; ++k) {
     int i = u_items[v_first + k];
     vec4 rect = u_e[i].rect;
     if (any(lessThan(ndc, rect.xy)) || any(greaterThan(ndc, rect.zw))) continue;
     float s = hitEllipsoid(i, r);
-    if (s <= 0.0 || s >= limit) continue;
-    if (n == kMaxHits && s >= depth[n - 1]) continue;
+    if (!hitShows(r, s, limit)) continue;
+    ++total;
+    if (n == kMaxHits && !before(s, i, depth[n - 1], index[n - 1])) continue;
     int j = min(n, kMaxHits - 1);
     n = min(n + 1, kMaxHits);
-    for (; j > 0 && depth[j - 1] > s; --j) {
+    for (; j > 0 && before(s, i, depth[j - 1], index[j - 1]); --j) {
       depth[j] = depth[j - 1];
       index[j] = index[j - 1];
     }
@@ -219,9 +221,33 @@ void main() {
   if (n == 0) discard;
   // "Over", accumulated front to back (the same sum), so that hits behind an opaque one are
   // never shaded; what they could add is below 1/1024.
+  const float kOpaque = 1.0 - 1.0 / 1024.0;
   vec4 result = vec4(0.0);
-  for (int j = 0; j < n && result.a < 1.0 - 1.0 / 1024.0; ++j)
+  for (int j = 0; j < n && result.a < kOpaque; ++j)
     result += (1.0 - result.a) * ellipsoidSurface(index[j], r, depth[j]);
+  // More hits than the stack holds (rare: a deep pile of translucent lobes): peel the rest
+  // exactly, one nearest-remaining hit per round, so that every hit is composited in order.
+  float last_s = depth[n - 1];
+  int last_i = index[n - 1];
+  for (int peeled = n; peeled < total && result.a < kOpaque; ++peeled) {
+    float best_s = 1e38;
+    int best_i = -1;
+    for (int k = 0; k < v_count; ++k) {
+      int i = u_items[v_first + k];
+      vec4 rect = u_e[i].rect;
+      if (any(lessThan(ndc, rect.xy)) || any(greaterThan(ndc, rect.zw))) continue;
+      float s = hitEllipsoid(i, r);
+      if (!hitShows(r, s, limit) || !before(last_s, last_i, s, i)) continue;
+      if (best_i < 0 || before(s, i, best_s, best_i)) {
+        best_s = s;
+        best_i = i;
+      }
+    }
+    if (best_i < 0) break;
+    result += (1.0 - result.a) * ellipsoidSurface(best_i, r, best_s);
+    last_s = best_s;
+    last_i = best_i;
+  }
   o_colour = result;
 }
 )";
@@ -259,11 +285,9 @@ void main() {
   vec4 t = texture(u_atlas, texel / u_atlas_size);
   // Elinas' colour-matrix step, here in the shader: alpha = (It - T1 - (T2 - T1)(1 - g)) / D.
   float alpha = opacityFromExcess(t.a) * u_e[u_index].limb_axis.w;
-#ifdef TARGETS
   vec3 r = viewRay();
   float s = hitEllipsoid(u_index, r);
-  if (s > 0.0 && s * length(r) >= targetDistance()) discard;
-#endif
+  if (s > 0.0 && !hitShows(r, s, opaqueDistance(r) / length(r))) discard;
   o_colour = vec4(t.rgb * alpha, alpha);
 }
 )";
@@ -273,9 +297,9 @@ layout(binding = 12) uniform sampler2D u_impostor;  // premultiplied colour, cov
 in vec2 v_uv;
 in vec3 v_position;  // camera-relative point on the billboard
 void main() {
-#ifdef TARGETS
-  if (length(v_position) >= targetDistance()) discard;
-#endif
+  // The billboard stands for the cloud: hidden where the ground or a target is nearer, and
+  // cut by the layer band at its own height.
+  if (length(v_position) >= opaqueDistance(v_position) || !inBand(v_position.z)) discard;
   o_colour = texture(u_impostor, v_uv);
 }
 )";

@@ -34,8 +34,6 @@ struct EllipsoidPassLayout {
 
 // Per-ellipsoid record in the shader storage buffer (std430, 16 vec4).
 inline constexpr int kEllipsoidRecordVec4s = 16;
-// Deepest stack of hits a per-pixel pass sorts; farther hits beyond it are dropped.
-inline constexpr int kMaxPerPixelHits = 8;
 // Storage-buffer and texture binding points.
 inline constexpr int kEllipsoidBufferBinding = 0;
 inline constexpr int kBinBufferBinding = 1;

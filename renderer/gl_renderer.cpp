@@ -80,6 +80,64 @@ void uploadTable(const GlApi& gl, GLuint texture, const TextureTable& table) {
   gl.TextureParameteri(texture, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
 }
 
+// The layer bands of SPEC's per-ray depth order. Along any ray altitude changes
+// monotonically, so the surfaces between the k-th and (k+1)-th layers on one side of the
+// camera are those between their altitudes. Heights are relative to the camera; band b on
+// the rising side is [A(b-1), A(b)) with A(-1) = 0 and A(n) = +inf, on the falling side
+// [B(b), B(b-1)) with B(-1) = 0 and B(n) = -inf.
+class CloudBands {
+ public:
+  struct Piece {
+    int band;
+    AltitudeBand window;
+  };
+
+  template <typename Slots>
+  CloudBands(const Slots& above, const Slots& below, double camera_z) : camera_z_(camera_z) {
+    // `above` runs farthest first; rank 0 is the nearest layer.
+    for (auto it = above.rbegin(); it != above.rend(); ++it)
+      rising_.push_back(it->layer->altitude_m - camera_z);
+    for (auto it = below.rbegin(); it != below.rend(); ++it)
+      falling_.push_back(it->layer->altitude_m - camera_z);
+  }
+
+  // One piece per band that altitudes [z_lo, z_hi] reach, each with its window.
+  std::vector<Piece> pieces(double z_lo, double z_hi) const {
+    const double lo = z_lo - camera_z_, hi = z_hi - camera_z_;
+    int rise_first = -1, rise_last = -2, fall_first = -1, fall_last = -2;
+    if (hi >= 0.0) rise_first = risingBand(std::max(lo, 0.0)), rise_last = risingBand(hi);
+    if (lo < 0.0) fall_first = fallingBand(std::min(hi, -0.0)), fall_last = fallingBand(lo);
+    std::vector<Piece> out;
+    const int top = std::max(rise_last, fall_last);
+    for (int b = 0; b <= top; ++b) {
+      const bool rising = b >= rise_first && b <= rise_last;
+      const bool falling = b >= fall_first && b <= fall_last;
+      if (!rising && !falling) continue;
+      glm::vec4 slabs(0.0f);
+      if (rising) slabs.x = bound(rising_, b - 1, 0.0), slabs.y = bound(rising_, b, 1e38);
+      if (falling) slabs.z = bound(falling_, b, -1e38), slabs.w = bound(falling_, b - 1, 0.0);
+      out.push_back({b, {slabs}});
+    }
+    return out;
+  }
+
+ private:
+  // Layers crossed before reaching height dz >= 0 (resp. dz < 0).
+  int risingBand(double dz) const {
+    return int(std::count_if(rising_.begin(), rising_.end(), [&](double a) { return a <= dz; }));
+  }
+  int fallingBand(double dz) const {
+    return int(std::count_if(falling_.begin(), falling_.end(), [&](double b) { return b > dz; }));
+  }
+  static float bound(const std::vector<double>& heights, int rank, double beyond) {
+    if (rank < 0) return 0.0f;
+    return float(std::size_t(rank) < heights.size() ? heights[rank] : beyond);
+  }
+
+  double camera_z_;
+  std::vector<double> rising_, falling_;  // nearest first
+};
+
 }  // namespace
 
 GlRenderer::GlRenderer(const GlPlatform& platform)
@@ -355,35 +413,40 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
     return a.layer->altitude_m < b.layer->altitude_m;
   });
 
-  // Interleave ellipsoid clouds with the layers. A cloud lies in band b when b layers on its
-  // side of the camera lie between the camera and the cloud's altitude: it is drawn after
-  // the layers beyond it and before the b layers in front of it. Clouds in one band go
-  // back to front by distance.
-  // Automaton clouds join the same order, by the middle of their box.
+  // Interleave clouds with the layers (docs/MODEL.md, "Compositing order"). On each side of
+  // the camera, band b holds what lies beyond the b nearest layers of that side and before
+  // the next; surfaces in band b are drawn after the layers beyond them and before the b
+  // layers in front. A cloud whose altitudes span several bands is drawn once per band,
+  // each time keeping only its surfaces in that band, so a layer cuts through it. Clouds
+  // in one band go back to front by distance.
+  const CloudBands bands(above, below, z);
   struct CloudEntry {
     bool automaton;
     std::size_t index;
     int band;
     double distance;
+    AltitudeBand window;
   };
   std::vector<CloudEntry> clouds;
-  auto addCloud = [&](bool automaton, std::size_t index, glm::dvec3 centre, double altitude) {
-    int band = 0;
-    for (const CloudLayer& layer : scene.layers)
-      band += (altitude > z) ? (layer.altitude_m > z && layer.altitude_m < altitude)
-                             : (layer.altitude_m < z && layer.altitude_m > altitude);
-    clouds.push_back({automaton, index, band, glm::length(centre - camera.position)});
+  auto addCloud = [&](bool automaton, std::size_t index, glm::dvec3 centre, double z_lo,
+                      double z_hi) {
+    const double distance = glm::length(centre - camera.position);
+    const std::vector<CloudBands::Piece> pieces = bands.pieces(z_lo, z_hi);
+    for (const CloudBands::Piece& piece : pieces)
+      clouds.push_back({automaton, index, piece.band, distance,
+                        pieces.size() == 1 ? AltitudeBand{} : piece.window});
   };
   for (std::size_t i = 0; i < scene.clouds.size(); ++i) {
     glm::dvec3 centre(0.0);
     for (const Ellipsoid& e : scene.clouds[i].ellipsoids) centre += e.centre;
     centre /= double(scene.clouds[i].ellipsoids.size());
-    addCloud(false, i, centre, cloudAltitude(scene.clouds[i]));
+    const auto [z_lo, z_hi] = cloudVerticalExtent(scene.clouds[i]);
+    addCloud(false, i, centre, z_lo, z_hi);
   }
   for (std::size_t i = 0; i < scene.automata.size(); ++i) {
     const AutomatonCloudView& cloud = scene.automata[i];
-    const glm::dvec3 centre = 0.5 * (cloud.lowerBound() + cloud.upperBound());
-    addCloud(true, i, centre, centre.z);
+    const glm::dvec3 lo = cloud.lowerBound(), hi = cloud.upperBound();
+    addCloud(true, i, 0.5 * (lo + hi), lo.z, hi.z);
   }
   std::sort(clouds.begin(), clouds.end(), [](const CloudEntry& a, const CloudEntry& b) {
     return a.band != b.band ? a.band > b.band : a.distance > b.distance;
@@ -406,9 +469,10 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
     if (next_cloud != clouds.end() && next_cloud->band == band) flushSky();
     for (; next_cloud != clouds.end() && next_cloud->band == band; ++next_cloud)
       if (next_cloud->automaton)
-        automata_.drawCloud(scene, next_cloud->index, settings, targets);
+        automata_.drawCloud(scene, next_cloud->index, settings, targets, next_cloud->window);
       else
-        ellipsoids_.drawCloud(scene, next_cloud->index, settings, frame, targets);
+        ellipsoids_.drawCloud(scene, next_cloud->index, settings, frame, targets,
+                              next_cloud->window);
     // Then the layers of rank band - 1 (rank 0 is nearest the camera) on both sides.
     if (band >= 1) {
       if (std::size_t(band) <= above.size()) pending_above.push_back(above[above.size() - band]);

@@ -53,6 +53,25 @@ float targetDistance() { return texelFetch(u_target_distance, ivec2(gl_FragCoord
 vec3 targetColour() { return texelFetch(u_target_colour, ivec2(gl_FragCoord.xy), 0).rgb; }
 #endif
 
+// Distance in metres along r (any length) to the first opaque surface: the ground plane
+// (SPEC section 5) or a target; kFar where the ray reaches the sky.
+float opaqueDistance(vec3 r) {
+  float distance = r.z < 0.0 ? u_camera_z * (length(r) / -r.z) : kFar;
+#ifdef TARGETS
+  distance = min(distance, targetDistance());
+#endif
+  return distance;
+}
+
+// The altitude band a cloud pass draws (docs/MODEL.md, "Compositing order"): a surface at
+// height dz above the camera belongs to this pass when u_band.x <= dz < u_band.y or
+// u_band.z <= dz < u_band.w. Layers are horizontal planes, so along every ray the surfaces
+// between two layers are exactly those between their altitudes.
+uniform vec4 u_band = vec4(-1e38, 1e38, 0.0, 0.0);
+bool inBand(float dz) {
+  return (dz >= u_band.x && dz < u_band.y) || (dz >= u_band.z && dz < u_band.w);
+}
+
 #ifdef BACKGROUND
 uniform vec3 u_zenith;
 uniform vec3 u_horizon;

@@ -7,8 +7,9 @@ void setUniform3(const GlApi& gl, GLuint program, const char* name, glm::dvec3 v
   gl.ProgramUniform3fv(program, gl.GetUniformLocation(program, name), 1, &f.x);
 }
 
-void setViewUniforms(const GlApi& gl, GLuint p, const Camera& camera,
-                     const std::optional<Fog>& fog) {
+void setViewUniforms(const GlApi& gl, GLuint p, const Camera& camera, const std::optional<Fog>& fog,
+                     const AltitudeBand& band) {
+  gl.ProgramUniform4fv(p, gl.GetUniformLocation(p, "u_band"), 1, &band.slabs.x);
   const ViewBasis basis = viewBasis(camera);
   setUniform3(gl, p, "u_right", basis.right * basis.tan_half_vfov * basis.aspect);
   setUniform3(gl, p, "u_up", basis.up * basis.tan_half_vfov);

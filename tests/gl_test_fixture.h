@@ -4,6 +4,7 @@
 // NEPHELE_TEST_OUTPUT when it fails.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <string>
 
@@ -44,6 +45,23 @@ class GlRenderTest : public ::testing::Test {
     EXPECT_GE(e.psnr_db, min_psnr) << name;
     EXPECT_LE(e.max_abs, max_abs) << name;
     if (e.non_finite == 0 && e.psnr_db >= min_psnr && e.max_abs <= max_abs) return;
+    writeFailureImages(actual, expected, name);
+  }
+
+  // Pixels whose coverage differs by more than `tolerance`, at most `max_pixels` of them;
+  // writes the images when there are more.
+  static void expectCoverageClose(const FloatImage& actual, const FloatImage& expected,
+                                  float tolerance, int max_pixels, const std::string& name) {
+    int differing = 0;
+    for (std::size_t i = 3; i < actual.rgba.size(); i += 4)
+      differing += !(std::abs(actual.rgba[i] - expected.rgba[i]) <= tolerance);
+    EXPECT_LE(differing, max_pixels) << name << ": coverage differs by over " << tolerance;
+    if (differing <= max_pixels) return;
+    writeFailureImages(actual, expected, name);
+  }
+
+  static void writeFailureImages(const FloatImage& actual, const FloatImage& expected,
+                                 const std::string& name) {
     const std::filesystem::path dir(NEPHELE_TEST_OUTPUT);
     std::filesystem::create_directories(dir);
     writeImageFile((dir / (name + "_actual.png")).string(), actual);

@@ -15,7 +15,7 @@ double smoothstep(double edge0, double edge1, double x) {
 }
 }  // namespace
 
-double cloudAltitude(const EllipsoidCloud& cloud) {
+std::pair<double, double> cloudVerticalExtent(const EllipsoidCloud& cloud) {
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (const Ellipsoid& e : cloud.ellipsoids) {
     // Vertical half-extent: |row z of R S|.
@@ -25,6 +25,11 @@ double cloudAltitude(const EllipsoidCloud& cloud) {
     lo = std::min(lo, e.centre.z - half);
     hi = std::max(hi, e.centre.z + half);
   }
+  return {lo, hi};
+}
+
+double cloudAltitude(const EllipsoidCloud& cloud) {
+  const auto [lo, hi] = cloudVerticalExtent(cloud);
   return 0.5 * (lo + hi);
 }
 

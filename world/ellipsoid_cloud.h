@@ -4,6 +4,7 @@
 // camera sees when it flies into one.
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -29,8 +30,9 @@ struct EllipsoidCloud {
   glm::dvec3 drift_m{0.0};
 };
 
-// The middle of the vertical extent of a cloud's ellipsoids: where the renderer interleaves it
-// with sky layers and the altitude whose wind carries it.
+// The lowest and highest altitudes its ellipsoids reach.
+std::pair<double, double> cloudVerticalExtent(const EllipsoidCloud& cloud);
+// The middle of that extent: the altitude whose wind carries the cloud.
 double cloudAltitude(const EllipsoidCloud& cloud);
 
 // A cumulus heap of `count` ellipsoids over a base at `base_centre` (the middle of its flat
