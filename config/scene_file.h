@@ -22,7 +22,7 @@ struct SceneFile {
 };
 
 // Names of the render knobs in enum order, shared by scene files and the command line.
-inline const std::vector<std::string> kTextureEvaluationNames{"baked", "procedural"};
+inline const std::vector<std::string> kTextureEvaluationNames{"auto", "baked", "procedural"};
 inline const std::vector<std::string> kTermFilterNames{"fade", "cut", "none"};
 inline const std::vector<std::string> kSkyPassesNames{"fused", "multipass"};
 inline const std::vector<std::string> kEllipsoidPassesNames{"fused", "multipass"};

@@ -91,8 +91,12 @@ std::string textureKey(const SolidTextureSpec& spec, const RenderSettings& setti
 // Baked solid Gardner: 4 texels per cycle of the highest term at level 0 (at most 128 a
 // side), level l holding n - l terms. With 4 texels per cycle GL's trilinear LOD equals the
 // fade schedule of SPEC section 2, so trilinear filtering fades each term over its octave.
+int bakedSolidSize(const GardnerTexture& gardner) {
+  return std::min(4 << gardner.terms(), 128);
+}
+
 void uploadBakedSolid(const GlApi& gl, GLuint texture, const GardnerTexture& gardner) {
-  const int base = std::min(4 << gardner.terms(), 128);
+  const int base = bakedSolidSize(gardner);
   const int levels = int(std::log2(base)) + 1;
   gl.TextureStorage3D(texture, levels, GL_R16, base, base, base);
   for (int level = 0; level < levels; ++level) {
@@ -111,6 +115,21 @@ void uploadVolume(const GlApi& gl, GLuint texture, const VolumeTable& table) {
                        table.values.data());
   gl.GenerateTextureMipmap(texture);
   gl.TextureParameteri(texture, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+}
+
+// TextureEvaluation::kAuto: a baked texel may cover at most this many pixels where the cloud
+// is nearest; closer, bilinear magnification blurs the texture (a cumulus filling a 4 degree
+// view loses 28 dB) and the sines are evaluated per fragment instead. Measured by
+// `nephele bench` (docs/ACCURACY.md).
+constexpr double kMaxBakedTexelPixels = 2.0;
+
+bool bakedTextureMagnified(const SolidTexture& texture, double nearest_m, const Camera& camera) {
+  const glm::dvec3 period = texture.period();
+  const double texel_m =
+      std::min({period.x, period.y, period.z}) / bakedSolidSize(*texture.gardner());
+  const double pixel_m = std::max(nearest_m, 0.0) * 2.0 *
+                         std::tan(glm::radians(camera.vfov_deg) / 2.0) / camera.height;
+  return texel_m > kMaxBakedTexelPixels * pixel_m;
 }
 
 // Slices for a silhouette within half a pixel of the true one: a polygon of n sides around
@@ -439,13 +458,15 @@ void EllipsoidRenderer::drawCloudDirect(const Scene& scene, std::size_t index,
                                         const RenderSettings& settings, const FrameTarget& target,
                                         bool targets_drawn, const AltitudeBand& band) {
   const EllipsoidCloud& cloud = scene.clouds[index];
-  // Visible ellipsoids, back to front by centre distance.
+  // Visible ellipsoids, back to front by centre distance; the nearest surface distance.
   std::vector<std::pair<double, EllipsoidRecord>> visible;
+  double nearest_m = std::numeric_limits<double>::infinity();
   for (const Ellipsoid& e : cloud.ellipsoids) {
     EllipsoidRecord record;
     double distance = 0.0;
-    if (makeEllipsoidRecord(e, scene.camera, record, distance))
-      visible.push_back({distance, record});
+    if (!makeEllipsoidRecord(e, scene.camera, record, distance)) continue;
+    visible.push_back({distance, record});
+    nearest_m = std::min(nearest_m, distance - std::max({e.radii.x, e.radii.y, e.radii.z}));
   }
   if (visible.empty()) return;
   std::stable_sort(visible.begin(), visible.end(),
@@ -456,10 +477,13 @@ void EllipsoidRenderer::drawCloudDirect(const Scene& scene, std::size_t index,
 
   CachedTexture& texture = cachedTexture(cloud.texture, settings);
   EllipsoidPassLayout base;
+  const bool procedural =
+      settings.texture_evaluation == TextureEvaluation::kProcedural ||
+      (settings.texture_evaluation == TextureEvaluation::kAuto && texture.source->gardner() &&
+       bakedTextureMagnified(*texture.source, nearest_m, scene.camera));
   base.texture = !texture.source->gardner() ? SolidTextureKind::kTable
-                 : settings.texture_evaluation == TextureEvaluation::kProcedural
-                     ? SolidTextureKind::kProcedural
-                     : SolidTextureKind::kBakedGardner;
+                 : procedural               ? SolidTextureKind::kProcedural
+                                            : SolidTextureKind::kBakedGardner;
   base.term_filter = settings.term_filter;
   base.spotlight = settings.limb == LimbEvaluation::kSpotlight;
   base.fog = scene.fog.has_value();

@@ -6,6 +6,7 @@
 namespace nephele {
 
 enum class TextureEvaluation {
+  kAuto,        // baked, except on clouds so near that the solid table would be magnified
   kBaked,       // Gardner's texture baked per layer into a mip chain of term truncations
   kProcedural,  // Gardner's sum of sines evaluated per fragment
 };
@@ -37,7 +38,7 @@ enum class TileFormat { kRgba8, kFloat };
 
 struct RenderSettings {
   SkyPasses sky_passes = SkyPasses::kFused;
-  TextureEvaluation texture_evaluation = TextureEvaluation::kBaked;
+  TextureEvaluation texture_evaluation = TextureEvaluation::kAuto;
   TermFilter term_filter = TermFilter::kFade;
   // Baked texture resolution per cycle of each level's highest term. Bilinear error falls as
   // 1/tpc^2 (mean 0.0075, 0.0020, 0.0005 for 4, 8, 16 on a close deck); cost rises with it

@@ -113,7 +113,7 @@ void addRenderCommand(CLI::App& app, RenderCommandOptions& o) {
       ->check(CLI::Range(Limits::kMinVfov, Limits::kMaxVfov));
   cmd->add_option("--time", o.time, "Simulation time in seconds (layers drift with it)")
       ->check(CLI::Range(0.0, Limits::kMaxTime));
-  cmd->add_option("--texture", o.texture, "Gardner texture on the GPU: baked or procedural")
+  cmd->add_option("--texture", o.texture, "Gardner texture on the GPU: auto, baked or procedural")
       ->check(CLI::IsMember(kTextureEvaluationNames));
   cmd->add_option("--term-filter", o.term_filter,
                   "Removal of texture terms above the pixel frequency: fade, cut or none")

@@ -302,6 +302,30 @@ TEST_F(EllipsoidRenderTest, ExtremeCasesStayFinite) {
     EXPECT_TRUE(allFinite(renderReference(scenes[i], {1, 0}))) << i;
 }
 
+// A cumulus filling a 4 degree view: a baked solid-texture texel spans about ten pixels
+// there, and bilinear magnification blurs the cloud. The default (auto) evaluates the sines
+// per fragment on such close-ups and stays with the table on distant clouds.
+TEST_F(EllipsoidRenderTest, CloseUpsKeepTheirTexture) {
+  const SceneFile close_up = preset("cumulus_target");
+  const FloatImage reference = renderReference(close_up.scene, close_up.reference);
+  RenderSettings baked = close_up.render;
+  baked.texture_evaluation = TextureEvaluation::kBaked;
+  const ImageError baked_error =
+      compareImages(renderer_->renderFloat(close_up.scene, baked), reference);
+  const ImageError auto_error =
+      compareImages(renderer_->renderFloat(close_up.scene, close_up.render), reference);
+  EXPECT_EQ(close_up.render.texture_evaluation, TextureEvaluation::kAuto);
+  EXPECT_GT(auto_error.psnr_db, baked_error.psnr_db + 6.0);
+  expectClose(renderer_->renderFloat(close_up.scene, close_up.render), reference, 45.0, 0.3,
+              "close_up_auto");
+  // From 4.5 km in a 60 degree view the table is not magnified: auto draws what baked draws.
+  const SceneFile far = preset("cumulus");
+  RenderSettings far_baked = far.render;
+  far_baked.texture_evaluation = TextureEvaluation::kBaked;
+  expectClose(renderer_->renderFloat(far.scene, far.render),
+              renderer_->renderFloat(far.scene, far_baked), 90.0, 1e-6, "far_auto_is_baked");
+}
+
 // The three ellipsoid pass structures, for the defect tests below.
 std::vector<std::pair<std::string, RenderSettings>> passStructures() {
   RenderSettings per_pixel, centre, multipass;
