@@ -39,8 +39,6 @@ using config_detail::joinKeys;
 using config_detail::SceneError;
 using config_detail::TableReader;
 
-constexpr double kMaxColour = 100.0;  // linear RGB; above 1 is allowed for bright HDR suns
-
 void readImage(TableReader& t, Camera& camera) {
   t.allow({"width", "height"});
   t.integer("width", camera.width, 1, Limits::kMaxImageSide);
@@ -58,16 +56,16 @@ void readSun(TableReader& t, Sun& sun) {
   t.allow({"azimuth", "elevation", "colour"});
   t.number("azimuth", sun.azimuth_deg, -Limits::kMaxHeading, Limits::kMaxHeading);
   t.number("elevation", sun.elevation_deg, -Limits::kMaxPitch, Limits::kMaxPitch);
-  t.vector("colour", sun.colour, 0.0, kMaxColour);
+  t.vector("colour", sun.colour, Limits::kColour);
   t.finish();
 }
 
 void readSky(TableReader& t, Sky& sky) {
   t.allow({"model", "zenith", "horizon", "ground"});
   t.choice("model", {"gradient"}, 0);
-  t.vector("zenith", sky.zenith, 0.0, kMaxColour);
-  t.vector("horizon", sky.horizon, 0.0, kMaxColour);
-  t.vector("ground", sky.ground, 0.0, kMaxColour);
+  t.vector("zenith", sky.zenith, Limits::kColour);
+  t.vector("horizon", sky.horizon, Limits::kColour);
+  t.vector("ground", sky.ground, Limits::kColour);
   t.finish();
 }
 
@@ -75,7 +73,7 @@ void readFog(TableReader& t, Fog& fog) {
   t.allow({"top", "visibility", "colour"});
   t.number("top", fog.top_m, 0.0, Limits::kMaxAltitude);
   t.number("visibility", fog.visibility_m, 1.0, 1.0e7);
-  t.vector("colour", fog.colour, 0.0, kMaxColour);
+  t.vector("colour", fog.colour, Limits::kColour);
   t.finish();
 }
 
@@ -113,7 +111,7 @@ void readGardnerParams(TableReader& t, GardnerTextureParams& g, double min_frequ
   t.integer("terms", g.terms, 1, GardnerTextureParams::kMaxTerms);
   t.number("fx1", g.fx1, min_frequency, 10.0);
   t.number("fy1", g.fy1, min_frequency, 10.0);
-  t.number("t0", g.t0, 0.0, 10.0);
+  t.number("t0", g.t0, Limits::kContrastOffset);
   t.boolean("phases", g.seeded_phases);
 }
 
@@ -172,7 +170,7 @@ void readWind(TableReader& t, WindSample& sample) {
   t.allow({"altitude", "velocity"});
   if (!t.has("velocity")) t.failHere("missing key velocity ([east, north] in m/s)");
   t.number("altitude", sample.altitude_m, 0.0, Limits::kMaxAltitude);
-  t.vector("velocity", sample.velocity, -200.0, 200.0);
+  t.vector("velocity", sample.velocity, -Limits::kMaxWind, Limits::kMaxWind);
   t.finish();
 }
 
@@ -181,14 +179,14 @@ void readLayer(TableReader& t, CloudLayer& layer, LayerDevelopment& develop) {
            "specular", "shininess", "drift", "seed", "texture", "develop"});
   t.string("name", layer.name);
   t.number("altitude", layer.altitude_m, 0.0, Limits::kMaxAltitude);
-  t.vector("colour", layer.colour, 0.0, kMaxColour);
-  t.number("threshold", layer.threshold, 0.0, 1.0);
-  t.number("transition", layer.transition, 0.0, 10.0);
-  t.number("ambient", layer.shading.ambient, 0.0, 1.0);
-  t.number("texture_fraction", layer.shading.texture_fraction, 0.0, 1.0);
-  t.number("specular", layer.shading.specular, 0.0, 1.0);
-  t.number("shininess", layer.shading.shininess, 1.0, 1000.0);
-  t.vector("drift", layer.texture.drift_velocity, -300.0, 300.0);
+  t.vector("colour", layer.colour, Limits::kColour);
+  t.number("threshold", layer.threshold, Limits::kLayerThreshold);
+  t.number("transition", layer.transition, Limits::kTransition);
+  t.number("ambient", layer.shading.ambient, Limits::kFraction);
+  t.number("texture_fraction", layer.shading.texture_fraction, Limits::kFraction);
+  t.number("specular", layer.shading.specular, Limits::kFraction);
+  t.number("shininess", layer.shading.shininess, Limits::kShininess);
+  t.vector("drift", layer.texture.drift_velocity, -Limits::kMaxDrift, Limits::kMaxDrift);
   t.seed("seed", layer.texture.seed);
   if (auto texture = t.table("texture")) readTexture(*texture, layer.texture);
   if (auto d = t.table("develop")) {
@@ -259,14 +257,14 @@ void readCloud(TableReader& t, std::uint64_t seed, EllipsoidCloud& cloud,
            "texture_fraction", "specular", "shininess", "seed", "texture", "cumulus", "ellipsoid",
            "develop"});
   t.string("name", cloud.name);
-  t.vector("colour", cloud.colour, 0.0, kMaxColour);
-  t.number("threshold", cloud.threshold_centre, -2.0, 2.0);
-  t.number("limb_threshold", cloud.threshold_limb, -2.0, 2.0);
-  t.number("transition", cloud.transition, 0.0, 10.0);
-  t.number("ambient", cloud.shading.ambient, 0.0, 1.0);
-  t.number("texture_fraction", cloud.shading.texture_fraction, 0.0, 1.0);
-  t.number("specular", cloud.shading.specular, 0.0, 1.0);
-  t.number("shininess", cloud.shading.shininess, 1.0, 1000.0);
+  t.vector("colour", cloud.colour, Limits::kColour);
+  t.number("threshold", cloud.threshold_centre, Limits::kCloudThreshold);
+  t.number("limb_threshold", cloud.threshold_limb, Limits::kCloudThreshold);
+  t.number("transition", cloud.transition, Limits::kTransition);
+  t.number("ambient", cloud.shading.ambient, Limits::kFraction);
+  t.number("texture_fraction", cloud.shading.texture_fraction, Limits::kFraction);
+  t.number("specular", cloud.shading.specular, Limits::kFraction);
+  t.number("shininess", cloud.shading.shininess, Limits::kShininess);
   cloud.texture.seed = seed;
   t.seed("seed", cloud.texture.seed);
   if (auto texture = t.table("texture")) readSolidTexture(*texture, cloud.texture);
@@ -301,26 +299,27 @@ void readAutomaton(TableReader& t, std::uint64_t seed, AutomatonCloudSpec& a) {
            "samples_per_cell", "shape", "develop"});
   t.string("name", a.name);
   int cells[3] = {a.cells.nx, a.cells.ny, a.cells.nz};
-  t.integers3("cells", cells, 1, 1024);
+  t.integers3("cells", cells, 1, Limits::kMaxCellsPerAxis);
   a.cells = {cells[0], cells[1], cells[2]};
-  if (a.cells.cells() > (std::int64_t(1) << 24))
-    t.failAt("cells", std::to_string(a.cells.cells()) + " cells (allowed: at most 16777216)");
-  t.number("cell_size", a.cell_size_m, 0.01, 1.0e4);
+  if (a.cells.cells() > Limits::kMaxCells)
+    t.failAt("cells", std::to_string(a.cells.cells()) + " cells (allowed: at most " +
+                          std::to_string(Limits::kMaxCells) + ")");
+  t.number("cell_size", a.cell_size_m, Limits::kCellSize);
   t.vector("position", a.position, -Limits::kMaxCoordinate, Limits::kMaxCoordinate);
   a.seed = seed;
   t.seed("seed", a.seed);
-  t.number("step_interval", a.step_interval_s, 1e-3, 3600.0);
-  t.integer("warmup_steps", a.warmup_steps, 0, 100000);
-  t.number("humidity", a.humidity, 0.0, 1.0);
-  t.number("activation", a.activation, 0.0, 1.0);
-  t.number("extinction", a.extinction, 0.0, 1.0);
-  t.vector("colour", a.colour, 0.0, kMaxColour);
-  t.number("ambient", a.ambient, 0.0, 1.0);
+  t.number("step_interval", a.step_interval_s, Limits::kStepInterval);
+  t.integer("warmup_steps", a.warmup_steps, 0, Limits::kMaxWarmupSteps);
+  t.number("humidity", a.humidity, Limits::kFraction);
+  t.number("activation", a.activation, Limits::kFraction);
+  t.number("extinction", a.extinction, Limits::kFraction);
+  t.vector("colour", a.colour, Limits::kColour);
+  t.number("ambient", a.ambient, Limits::kFraction);
   a.phase = PhaseFunction(t.choice("phase", kPhaseFunctionNames, int(a.phase)));
   if (a.phase != PhaseFunction::kCornetteShanks)
     t.forbid("phase_u", "applies to phase \"cornette-shanks\" only");
   t.number("phase_u", a.phase_u, 0.0, 1.0);
-  t.integer("samples_per_cell", a.samples_per_cell, 1, 8);
+  t.integer("samples_per_cell", a.samples_per_cell, 1, Limits::kMaxSamplesPerCell);
   for (TableReader& s : t.tables("shape")) readShape(s, a.shape.emplace_back());
   if (auto d = t.table("develop"))
     readDevelop(*d,
@@ -339,7 +338,7 @@ void readTarget(TableReader& t, const std::string& scene_path, Target& target) {
   readOrientation(t, target.orientation);
   if (target.shape == TargetShape::kMesh) target.size = glm::dvec3(1.0);
   t.vector("size", target.size, Limits::kMinRadius, Limits::kMaxRadius);
-  t.vector("colour", target.colour, 0.0, kMaxColour);
+  t.vector("colour", target.colour, Limits::kColour);
   std::string mesh_path;
   t.string("mesh", mesh_path);
   if (target.shape == TargetShape::kMesh) {

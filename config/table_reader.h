@@ -18,6 +18,8 @@
 
 #include <glm/glm.hpp>
 
+#include "world/limits.h"
+
 namespace nephele {
 
 struct Camera;
@@ -52,6 +54,9 @@ class TableReader {
 
   bool has(std::string_view key) const { return table_.contains(key); }
 
+  void number(std::string_view key, double& out, Range range) {
+    number(key, out, range.lo, range.hi);
+  }
   void number(std::string_view key, double& out, double lo, double hi) {
     const toml::node* node = take(key);
     if (!node) return;
@@ -95,6 +100,10 @@ class TableReader {
     out = node->value<std::string>().value();
   }
 
+  template <int N>
+  void vector(std::string_view key, glm::vec<N, double>& out, Range range) {
+    vector(key, out, range.lo, range.hi);
+  }
   template <int N>
   void vector(std::string_view key, glm::vec<N, double>& out, double lo, double hi) {
     const toml::node* node = take(key);

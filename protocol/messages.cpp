@@ -30,6 +30,9 @@ class FieldReader {
 
   bool has(const char* key) const { return object_.contains(key); }
 
+  std::optional<double> number(const char* key, Range range) {
+    return number(key, range.lo, range.hi);
+  }
   std::optional<double> number(const char* key, double lo, double hi) {
     const json* v = take(key);
     if (!v) return std::nullopt;
@@ -208,13 +211,12 @@ ViewPatch readViewPatch(FieldReader& r) {
 WeatherLayer readWeather(FieldReader& r) {
   WeatherLayer w;
   if (auto t = r.integer("type", 0, kCloudTypeCount - 1)) w.type = CloudType(*t);
-  w.base_m = r.number("base", 0.0, WeatherLimits::kMaxBase).value_or(w.base_m);
-  w.thickness_m = r.number("thickness", WeatherLimits::kMinThickness, WeatherLimits::kMaxThickness)
-                      .value_or(w.thickness_m);
-  w.coverage = r.number("coverage", 0.0, 100.0).value_or(w.coverage * 100.0) / 100.0;
-  w.wind = r.vector<2>("wind", -WeatherLimits::kMaxWind, WeatherLimits::kMaxWind);
-  if (w.wind && glm::length(*w.wind) > WeatherLimits::kMaxWind)
-    r.fail("wind", "speed is above " + formatNumber(WeatherLimits::kMaxWind) + " m/s");
+  w.base_m = r.number("base", 0.0, Limits::kMaxBase).value_or(w.base_m);
+  w.thickness_m = r.number("thickness", Limits::kThickness).value_or(w.thickness_m);
+  w.coverage = r.number("coverage", Limits::kCoveragePercent).value_or(w.coverage * 100.0) / 100.0;
+  w.wind = r.vector<2>("wind", -Limits::kMaxWind, Limits::kMaxWind);
+  if (w.wind && glm::length(*w.wind) > Limits::kMaxWind)
+    r.fail("wind", "speed is above " + formatNumber(Limits::kMaxWind) + " m/s");
   return w;
 }
 
@@ -251,9 +253,9 @@ Command readCommand(const std::string& cmd, FieldReader& r) {
   }
   if (cmd == "set_wind") {
     if (!r.has("velocity")) r.fail("velocity", "is missing ([east, north] m/s)");
-    SetWind c{*r.vector<2>("velocity", -WeatherLimits::kMaxWind, WeatherLimits::kMaxWind)};
-    if (glm::length(c.velocity) > WeatherLimits::kMaxWind)
-      r.fail("velocity", "speed is above " + formatNumber(WeatherLimits::kMaxWind) + " m/s");
+    SetWind c{*r.vector<2>("velocity", -Limits::kMaxWind, Limits::kMaxWind)};
+    if (glm::length(c.velocity) > Limits::kMaxWind)
+      r.fail("velocity", "speed is above " + formatNumber(Limits::kMaxWind) + " m/s");
     r.finish("cmd, id, velocity");
     return c;
   }
@@ -265,7 +267,7 @@ Command readCommand(const std::string& cmd, FieldReader& r) {
   }
   if (cmd == "set_time") {
     SetTime c{r.number("time_scale", 0.0, ProtocolLimits::kMaxTimeScale), r.boolean("paused"),
-              r.number("advance", 0.0, Limits::kMaxTime)};
+              r.number("advance", 0.0, Limits::kMaxAdvance)};
     r.finish("cmd, id, time_scale, paused, advance");
     return c;
   }
@@ -280,10 +282,10 @@ Command readCommand(const std::string& cmd, FieldReader& r) {
     ChangeCloud c;
     c.name = r.requiredName("name");
     c.move = r.vector<3>("move", -Limits::kMaxCoordinate, Limits::kMaxCoordinate);
-    c.threshold = r.number("threshold", -2.0, 2.0);
-    c.limb_threshold = r.number("limb_threshold", -2.0, 2.0);
-    c.transition = r.number("transition", 0.0, 10.0);
-    c.colour = r.vector<3>("colour", 0.0, 100.0);
+    c.threshold = r.number("threshold", Limits::kCloudThreshold);
+    c.limb_threshold = r.number("limb_threshold", Limits::kCloudThreshold);
+    c.transition = r.number("transition", Limits::kTransition);
+    c.colour = r.vector<3>("colour", Limits::kColour.lo, Limits::kColour.hi);
     r.finish("cmd, id, name, move, threshold, limb_threshold, transition, colour");
     return c;
   }
@@ -293,7 +295,7 @@ Command readCommand(const std::string& cmd, FieldReader& r) {
     return c;
   }
   if (cmd == "tick") {
-    Tick c{r.requiredNumber("dt", 0.0, 3600.0)};
+    Tick c{r.requiredNumber("dt", 0.0, Limits::kMaxTick)};
     r.finish("cmd, id, dt");
     return c;
   }

@@ -28,16 +28,16 @@ constexpr FloatField kViewFloats[] = {
     {M::kVfov, "vfov", Limits::kMinVfov, Limits::kMaxVfov},
 };
 constexpr FloatField kOtherFloats[] = {
-    {M::kWindEast, "wind east", -WeatherLimits::kMaxWind, WeatherLimits::kMaxWind},
-    {M::kWindNorth, "wind north", -WeatherLimits::kMaxWind, WeatherLimits::kMaxWind},
+    {M::kWindEast, "wind east", -Limits::kMaxWind, Limits::kMaxWind},
+    {M::kWindNorth, "wind north", -Limits::kMaxWind, Limits::kMaxWind},
     {M::kSunAzimuth, "sun azimuth", -Limits::kMaxHeading, Limits::kMaxHeading},
     {M::kSunElevation, "sun elevation", -Limits::kMaxPitch, Limits::kMaxPitch},
     {M::kTimeScale, "time scale", 0.0, ProtocolLimits::kMaxTimeScale},
 };
 constexpr FloatField kLayerFloats[] = {
-    {M::kLayerBase, "base", 0.0, WeatherLimits::kMaxBase},
-    {M::kLayerThickness, "thickness", WeatherLimits::kMinThickness, WeatherLimits::kMaxThickness},
-    {M::kLayerCoverage, "coverage", 0.0, 100.0},
+    {M::kLayerBase, "base", 0.0, Limits::kMaxBase},
+    {M::kLayerThickness, "thickness", Limits::kThickness.lo, Limits::kThickness.hi},
+    {M::kLayerCoverage, "coverage", Limits::kCoveragePercent.lo, Limits::kCoveragePercent.hi},
 };
 
 std::string formatNumber(double v) {
@@ -188,7 +188,7 @@ std::variant<std::vector<Command>, RegisterError> decodeHoldingWrite(
 
   if (w.touches(M::kWindEast, 4)) {
     const glm::dvec2 wind(readFloat(kOtherFloats[0], 0), readFloat(kOtherFloats[1], 0));
-    if (!error && glm::length(wind) > WeatherLimits::kMaxWind)
+    if (!error && glm::length(wind) > Limits::kMaxWind)
       error = RegisterError{kIllegalDataValue, "wind: speed above 200 m/s"};
     commands.emplace_back(command::SetWind{wind});
   }

@@ -422,6 +422,10 @@ void Engine::saveSnapshot(const std::string& path, const char* why) {
 }
 
 std::optional<ProtocolError> Engine::checkAdvance(double dt_s) const {
+  // The World's own refusal, asked before anything is applied, so a refused advance is an
+  // error reply and changes nothing.
+  if (std::string e = state_->world->advanceError(dt_s); !e.empty())
+    return ProtocolError{ErrorCode::kLimit, e};
   double steps = 0.0;
   for (const AutomatonCloudSpec& a : state_->world->dynamics().automata)
     steps += dt_s / a.step_interval_s;

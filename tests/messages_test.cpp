@@ -80,6 +80,7 @@ TEST(Messages, ErrorsNameTheFieldAndWhatIsAllowed) {
       {R"({"cmd":"tick","dt":"1"})", ErrorCode::kBadField, "dt: must be a number"},
       {R"({"cmd":"tick","dt":1e9})", ErrorCode::kBadField, "allowed: 0 to 3600"},
       {R"({"cmd":"tick","dt":1,"speed":2})", ErrorCode::kBadField, "speed: unknown field"},
+      {R"({"cmd":"set_time","advance":2e7})", ErrorCode::kBadField, "allowed: 0 to 1e+07"},
       {R"({"cmd":"set_view","view":"a","position":[0,0,-1]})", ErrorCode::kBadField, "z >= 0"},
       {R"({"cmd":"set_view","view":"a","position":[0,0]})", ErrorCode::kBadField, "3 numbers"},
       {R"({"cmd":"set_view","view":"","heading":1})", ErrorCode::kBadField, "view"},

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "world/layer_texture.h"
+#include "world/limits.h"
 
 namespace nephele {
 namespace {
@@ -95,7 +96,7 @@ TEST(World, RefusesToRunItsClockPastItsLimit) {
   std::string error;
   int advances = 0;
   while (error.empty() && advances < 2000) {
-    error = w.advance(World::kMaxAdvanceS);
+    error = w.advance(Limits::kMaxAdvance);
     ++advances;
   }
   EXPECT_THAT(error, ::testing::HasSubstr("limit"));

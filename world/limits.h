@@ -1,10 +1,19 @@
 #pragma once
-// Allowed ranges for user input, shared by scene files, the command line, the socket
-// protocol and the Modbus register map.
-
+// The one table of allowed input ranges. Scene files, the command line, the socket protocol,
+// the Modbus register map and the World all read their edges from here, so that a value one
+// of them accepts is never refused by another (docs/ACCURACY.md lists how each edge is
+// tested).
 namespace nephele {
 
+// A closed interval [lo, hi].
+struct Range {
+  double lo;
+  double hi;
+  constexpr bool contains(double x) const { return x >= lo && x <= hi; }
+};
+
 struct Limits {
+  // Camera and image.
   static constexpr int kMaxImageSide = 16384;      // GL_MAX_RENDERBUFFER_SIZE on llvmpipe
   static constexpr double kMaxCoordinate = 1.0e8;  // metres from the origin
   static constexpr double kMaxAltitude = 1.0e5;
@@ -12,14 +21,43 @@ struct Limits {
   // Angles in degrees, each allowed from -max to +max; sun azimuth and elevation follow
   // heading and pitch.
   static constexpr double kMaxHeading = 360.0, kMaxPitch = 90.0, kMaxRoll = 180.0;
-  static constexpr double kMaxTime = 1.0e9;  // seconds of simulation time
-  // Ellipsoid semi-axes and target sizes, metres: zero, negative and NaN are rejected.
-  static constexpr double kMinRadius = 1.0e-3, kMaxRadius = 1.0e5;
-  static constexpr int kMaxEllipsoidsPerCloud = 4096;
+
+  // Time, seconds of simulation time.
+  static constexpr double kMaxTime = 1.0e9;     // a scene's start time
+  static constexpr double kMaxAdvance = 1.0e7;  // one advance of the World's clock
+  static constexpr double kMaxTick = 3600.0;    // one lockstep tick
   // Automaton steps are simulated one by one: a scene with automaton clouds may start at most
   // a day into its simulation.
   static constexpr double kMaxAutomatonTime = 86400.0;
+
+  // Appearance (Gardner eq. 8, 9 and 11).
+  static constexpr Range kLayerThreshold{0.0, 1.0};   // T1 of a sky plane
+  static constexpr Range kCloudThreshold{-2.0, 2.0};  // T1 and T2 of an ellipsoid cloud
+  static constexpr Range kTransition{0.0, 10.0};      // D; 0 is a hard threshold
+  static constexpr Range kFraction{0.0, 1.0};         // a, t, s of eq. 8; probabilities
+  static constexpr Range kShininess{1.0, 1000.0};
+  static constexpr Range kColour{0.0, 100.0};         // linear RGB; above 1 for bright HDR suns
+  static constexpr Range kContrastOffset{0.0, 10.0};  // Gardner's T0
+
+  // Ellipsoids and targets, metres: zero, negative and NaN are rejected.
+  static constexpr double kMinRadius = 1.0e-3, kMaxRadius = 1.0e5;
+  static constexpr int kMaxEllipsoidsPerCloud = 4096;
+
+  // Wind, drift and weather.
+  static constexpr double kMaxWind = 200.0;   // m/s, the speed of a wind sample
+  static constexpr double kMaxDrift = 300.0;  // m/s, a layer's own drift per axis
+  static constexpr double kMaxBase = 20000.0;
+  static constexpr Range kThickness{1.0, 15000.0};
+  static constexpr Range kCoveragePercent{0.0, 100.0};
+
+  // Automaton clouds (Dobashi; Shen).
   static constexpr int kMaxAutomata = 256;
+  static constexpr int kMaxCellsPerAxis = 1024;
+  static constexpr long long kMaxCells = 1LL << 24;
+  static constexpr Range kCellSize{0.01, 1.0e4};
+  static constexpr Range kStepInterval{1.0e-3, 3600.0};
+  static constexpr int kMaxWarmupSteps = 100000;
+  static constexpr int kMaxSamplesPerCell = 8;
 };
 
 }  // namespace nephele

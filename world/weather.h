@@ -39,9 +39,8 @@ struct WeatherLayer {
   std::optional<glm::dvec2> wind;  // east, north m/s at this layer; unset keeps the world's
 };
 
+// Input ranges are in world/limits.h.
 struct WeatherLimits {
-  static constexpr double kMaxBase = 20000.0, kMinThickness = 1.0, kMaxThickness = 15000.0;
-  static constexpr double kMaxWind = 200.0;
   // Convective layers become at most this many heaps, spread over a disc of this radius.
   static constexpr int kMaxHeaps = 32;
   static constexpr double kFieldRadius = 8000.0;

@@ -1,5 +1,7 @@
 #include "world/world.h"
 
+#include "world/limits.h"
+
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -74,16 +76,21 @@ World::~World() = default;
 World::World(World&&) noexcept = default;
 World& World::operator=(World&&) noexcept = default;
 
-std::string World::advance(double dt_s) {
-  if (!std::isfinite(dt_s) || dt_s < 0.0 || dt_s > kMaxAdvanceS) {
+std::string World::advanceError(double dt_s) const {
+  if (!std::isfinite(dt_s) || dt_s < 0.0 || dt_s > Limits::kMaxAdvance) {
     std::ostringstream out;
-    out << "dt: " << dt_s << " (allowed: 0 to " << kMaxAdvanceS << " seconds)";
+    out << "dt: " << dt_s << " (allowed: 0 to " << Limits::kMaxAdvance << " seconds)";
     return out.str();
   }
+  if (time_ns_ > std::numeric_limits<std::int64_t>::max() - std::llround(dt_s / kTimeResolutionS))
+    return "dt: the world's clock would pass its limit of about 292 years";
+  return {};
+}
+
+std::string World::advance(double dt_s) {
+  if (std::string e = advanceError(dt_s); !e.empty()) return e;
   const std::int64_t dt_ns = std::llround(dt_s / kTimeResolutionS);
   if (dt_ns == 0) return {};
-  if (time_ns_ > std::numeric_limits<std::int64_t>::max() - dt_ns)
-    return "dt: the world's clock would pass its limit of about 292 years";
   time_ns_ += dt_ns;
   refreshAutomata();
   return {};

@@ -42,7 +42,6 @@ class World {
  public:
   // Simulation time is kept in whole nanoseconds, so that split advances add up exactly.
   static constexpr double kTimeResolutionS = 1e-9;
-  static constexpr double kMaxAdvanceS = 1e7;
 
   // `scene` is the world at time 0 (its time_s is ignored); `threads` runs the automaton.
   World(const Scene& scene, const WorldDynamics& dynamics, int threads = 1);
@@ -52,8 +51,10 @@ class World {
 
   // Moves time on by dt seconds (rounded to the nanosecond): drift, development schedules and
   // automaton steps at their fixed interval. Returns an error (and changes nothing) for a
-  // negative, non-finite or too large dt.
+  // negative, non-finite or too large dt (Limits::kMaxAdvance).
   std::string advance(double dt_s);
+  // The error advance(dt_s) would return, without advancing.
+  std::string advanceError(double dt_s) const;
   std::int64_t timeNs() const { return time_ns_; }
   double timeSeconds() const { return double(time_ns_) * kTimeResolutionS; }
   // Automaton steps run since construction or restore, summed over clouds.

@@ -269,6 +269,9 @@ class SocketProtocolTest(DaemonTest):
             ({"cmd": "render", "view": "front", "format": "jpeg", "channels": ["coverage"]},
              "bad_field", "jpeg"),
             ({"cmd": "tick", "dt": -1}, "bad_field", "dt"),
+            # One edge for every reader (world/limits.h): the World's own limit on one advance.
+            ({"cmd": "set_time", "advance": 2e7, "paused": True}, "bad_field",
+             "advance: 2e+07 is out of range (allowed: 0 to 1e+07)"),
             ({"cmd": "tick"}, "bad_field", "dt: is missing"),
             ({"cmd": "add_cloud", "cloud": {"name": "x", "ellipsoid": [{"radii": [0, 1, 1]}]}},
              "bad_field", "radii"),
