@@ -2,7 +2,9 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include "config/scene_file.h"
 #include "renderer/gl_renderer.h"
@@ -62,7 +64,10 @@ std::string applyOverrides(const RenderCommandOptions& o, SceneFile& file) {
 Scene sceneAtTime(const SceneFile& file) {
   World world(file.scene, file.dynamics);
   const std::int64_t target_ns = std::llround(file.scene.time_s / World::kTimeResolutionS);
-  const int chunks = world.automata().empty() ? 1 : 20;
+  // Pieces no longer than the World takes in one advance (a scene may start at up to
+  // Limits::kMaxTime), and twenty with automaton clouds for the progress line.
+  const int chunks = std::max(world.automata().empty() ? 1 : 20,
+                              int(std::ceil(file.scene.time_s / Limits::kMaxAdvance)));
   const auto start = Clock::now();
   for (int i = 1; i <= chunks; ++i) {
     const std::int64_t next = target_ns / chunks * i + (i == chunks ? target_ns % chunks : 0);

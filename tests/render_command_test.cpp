@@ -53,6 +53,16 @@ TEST_F(RenderCommandTest, RendersAPresetWithOverrides) {
   EXPECT_TRUE(std::filesystem::exists(path("out.png")));
 }
 
+// The latest start time a scene may have (Limits::kMaxTime, 1e9 s) is longer than one
+// advance of the World (1e7 s): the command gets there in pieces instead of aborting.
+TEST_F(RenderCommandTest, RendersAtTheLatestAllowedTime) {
+  const CommandResult run =
+      runNephele("render " NEPHELE_SOURCE_DIR "/config/scenes/developing_sky.toml -o " +
+                 path("late.png") + " --width 16 --height 12 --time 1e9");
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_TRUE(std::filesystem::exists(path("late.png")));
+}
+
 TEST_F(RenderCommandTest, BadSceneFailsWithMessageAndWritesNothing) {
   const std::string scene = writeScene("[[layer]]\naltitude = 1000\nthreshold = 7\n");
   const CommandResult run = runNephele("render " + scene + " -o " + path("out.png"));
