@@ -21,23 +21,6 @@
 namespace {
 
 using namespace nephele;
-using Clock = std::chrono::steady_clock;
-
-double millisecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-template <class F>
-double medianMilliseconds(int repeats, F&& f) {
-  std::vector<double> ms;
-  for (int i = 0; i < repeats; ++i) {
-    const auto start = Clock::now();
-    f();
-    ms.push_back(millisecondsSince(start));
-  }
-  std::sort(ms.begin(), ms.end());
-  return ms[ms.size() / 2];
-}
 
 // Dobashi's grid with one shaping ellipsoid filling it: a field of cloud that keeps growing
 // and dying. Steps of the automaton alone (no keyframes), in its steady state.

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "renderer/frame_timing.h"
 #include "renderer/gl_renderer.h"
 
 namespace nephele::bench {
@@ -38,22 +39,12 @@ inline std::unique_ptr<GlPlatform> openPlatform() {
 inline double medianFrameMilliseconds(GlRenderer& renderer, const Scene& scene,
                                       const RenderSettings& settings, int repeats,
                                       bool float_target) {
-  auto frame = [&] {
+  return medianMilliseconds(repeats, [&] {
     if (float_target)
       renderer.renderFloat(scene, settings);
     else
       renderer.renderSrgb8(scene, settings);
-  };
-  frame();
-  std::vector<double> ms;
-  for (int i = 0; i < repeats; ++i) {
-    const auto start = std::chrono::steady_clock::now();
-    frame();
-    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-                     .count());
-  }
-  std::sort(ms.begin(), ms.end());
-  return ms[ms.size() / 2];
+  });
 }
 
 // The scene files (*.toml) in `directory`, sorted by name.

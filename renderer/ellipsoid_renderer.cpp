@@ -501,8 +501,28 @@ void EllipsoidRenderer::drawCloudDirect(const Scene& scene, std::size_t index,
   }
   uploadRecords(records);
   gl_.BindVertexArray(vertex_array_.get());
-  // One ellipsoid needs no per-pixel sorting: the centre pass draws the same image, faster.
-  if (settings.ellipsoid_order == EllipsoidOrder::kCentre || records.size() == 1) {
+  // Screen bins, each listing the ellipsoids whose rectangles overlap it.
+  const int bins_x = (target.width + kPerPixelBinSize - 1) / kPerPixelBinSize;
+  const int bins_y = (target.height + kPerPixelBinSize - 1) / kPerPixelBinSize;
+  std::vector<std::vector<GLint>> lists(std::size_t(bins_x) * bins_y);
+  auto pixel = [](float ndc, int size) { return (double(ndc) + 1.0) * 0.5 * size; };
+  std::size_t deepest = 0;
+  for (int i = 0; i < int(records.size()); ++i) {
+    const glm::vec4 rect = records[i].v[10];
+    const int x0 = std::clamp(int(pixel(rect.x, target.width)) / kPerPixelBinSize, 0, bins_x - 1);
+    const int x1 = std::clamp(int(pixel(rect.z, target.width)) / kPerPixelBinSize, 0, bins_x - 1);
+    const int y0 = std::clamp(int(pixel(rect.y, target.height)) / kPerPixelBinSize, 0, bins_y - 1);
+    const int y1 = std::clamp(int(pixel(rect.w, target.height)) / kPerPixelBinSize, 0, bins_y - 1);
+    for (int y = y0; y <= y1; ++y)
+      for (int x = x0; x <= x1; ++x) {
+        std::vector<GLint>& list = lists[std::size_t(y) * bins_x + x];
+        list.push_back(i);
+        deepest = std::max(deepest, list.size());
+      }
+  }
+  // Where no two ellipsoids share a bin, no pixel has two hits to sort: the centre pass
+  // draws the same image, faster.
+  if (settings.ellipsoid_order == EllipsoidOrder::kCentre || deepest <= 1) {
     EllipsoidPassLayout layout = base;
     layout.program = EllipsoidProgram::kFusedCentre;
     const GLuint p = program(layout);
@@ -512,25 +532,12 @@ void EllipsoidRenderer::drawCloudDirect(const Scene& scene, std::size_t index,
     gl_.DrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(records.size()));
     return;
   }
-  // Per pixel: screen bins, each listing the ellipsoids that overlap it, in one draw.
+  // Per pixel: every bin in one draw, each pixel sorting its bin's hits.
   EllipsoidPassLayout layout = base;
   layout.program = EllipsoidProgram::kFusedPerPixel;
   const GLuint p = program(layout);
   gl_.UseProgram(p);
   setCloudUniforms(p, scene, cloud, texture, layout.texture, band);
-  const int bins_x = (target.width + kPerPixelBinSize - 1) / kPerPixelBinSize;
-  const int bins_y = (target.height + kPerPixelBinSize - 1) / kPerPixelBinSize;
-  std::vector<std::vector<GLint>> lists(std::size_t(bins_x) * bins_y);
-  auto pixel = [](float ndc, int size) { return (double(ndc) + 1.0) * 0.5 * size; };
-  for (int i = 0; i < int(records.size()); ++i) {
-    const glm::vec4 rect = records[i].v[10];
-    const int x0 = std::clamp(int(pixel(rect.x, target.width)) / kPerPixelBinSize, 0, bins_x - 1);
-    const int x1 = std::clamp(int(pixel(rect.z, target.width)) / kPerPixelBinSize, 0, bins_x - 1);
-    const int y0 = std::clamp(int(pixel(rect.y, target.height)) / kPerPixelBinSize, 0, bins_y - 1);
-    const int y1 = std::clamp(int(pixel(rect.w, target.height)) / kPerPixelBinSize, 0, bins_y - 1);
-    for (int y = y0; y <= y1; ++y)
-      for (int x = x0; x <= x1; ++x) lists[std::size_t(y) * bins_x + x].push_back(i);
-  }
   struct Bin {
     glm::vec4 rect;
     glm::ivec4 items;  // first, count

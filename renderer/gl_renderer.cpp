@@ -173,6 +173,39 @@ Srgb8Image GlRenderer::renderSrgb8(const Scene& scene, const RenderSettings& set
   return image;
 }
 
+Srgb8Image GlRenderer::renderFloor(int width, int height) {
+  prepareTarget(width, height, TargetFormat::kSrgb8);
+  if (!floor_program_) {
+    std::string error;
+    floor_program_ = createProgram(gl_, polygonVertexSource(), R"(#version 450 core
+uniform vec4 u_colour;
+layout(location = 0) out vec4 o_colour;
+void main() { o_colour = u_colour; }
+)",
+                                   error);
+    NEPHELE_CHECK(floor_program_, "floor program: " << error);
+  }
+  const GLuint p = floor_program_.get();
+  gl_.BindFramebuffer(GL_FRAMEBUFFER, framebuffer_.get());
+  gl_.Viewport(0, 0, width, height);
+  gl_.BindVertexArray(vertex_array_.get());
+  gl_.Enable(GL_FRAMEBUFFER_SRGB);
+  gl_.UseProgram(p);
+  const glm::vec4 colour(0.25f, 0.3f, 0.4f, 0.5f);
+  gl_.ProgramUniform4fv(p, gl_.GetUniformLocation(p, "u_colour"), 1, &colour.x);
+  const glm::vec2 triangle[3] = {{-1, -1}, {3, -1}, {-1, 3}};
+  gl_.ProgramUniform2fv(p, gl_.GetUniformLocation(p, "u_polygon"), 3, &triangle[0].x);
+  gl_.Enable(GL_BLEND);
+  gl_.BlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  gl_.DrawArrays(GL_TRIANGLE_FAN, 0, 3);
+  gl_.Disable(GL_BLEND);
+  Srgb8Image image{width, height, /*bottom_up=*/true,
+                   std::vector<std::uint8_t>(std::size_t(width) * height * 4)};
+  gl_.PixelStorei(GL_PACK_ALIGNMENT, 4);
+  gl_.ReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, image.rgba.data());
+  return image;
+}
+
 void GlRenderer::prepareTarget(int width, int height, TargetFormat format) {
   if (colour_buffer_ && width == target_width_ && height == target_height_ &&
       format == target_format_)

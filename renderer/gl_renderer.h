@@ -31,6 +31,11 @@ class GlRenderer {
   // sRGB-encoded bytes, rows bottom-up as GL reads them (PNG, JPEG, TIFF).
   Srgb8Image renderSrgb8(const Scene& scene, const RenderSettings& settings);
 
+  // The platform floor: one constant-colour full-screen pass, blended, and its readback into
+  // the 8-bit target renderSrgb8 uses. Benchmarks print frame times as multiples of it, since
+  // absolute times on shared machines vary by 30 % between runs.
+  Srgb8Image renderFloor(int width, int height);
+
   // Far-cloud impostors rendered since construction (each reuse saves one).
   int impostorRenders() const { return ellipsoids_.impostorRenders(); }
   // Automaton volume uploads since construction (one per keyframe change of a cloud).
@@ -73,6 +78,7 @@ class GlRenderer {
   TargetFormat target_format_ = TargetFormat::kFloat;
   std::map<std::string, GlObject> programs_;
   std::map<std::string, CachedTexture> textures_;
+  GlObject floor_program_;
   EllipsoidRenderer ellipsoids_;
   AutomatonRenderer automata_;
   TargetRenderer targets_;

@@ -13,7 +13,7 @@ ImageError compareImages(const FloatImage& actual, const FloatImage& expected) {
       actual.width == expected.width && actual.height == expected.height,
       actual.width << "x" << actual.height << " vs " << expected.width << "x" << expected.height);
   ImageError e;
-  double sum_sq = 0.0;
+  double sum_sq = 0.0, coverage_sum_sq = 0.0;
   std::size_t count = 0;
   for (std::size_t i = 0; i < actual.rgba.size(); i += 4) {
     bool finite = true;
@@ -29,12 +29,19 @@ ImageError compareImages(const FloatImage& actual, const FloatImage& expected) {
       e.max_abs = std::max(e.max_abs, std::abs(d));
       ++count;
     }
-    e.coverage_max =
-        std::max(e.coverage_max, double(std::abs(actual.rgba[i + 3] - expected.rgba[i + 3])));
+    const double coverage = std::abs(actual.rgba[i + 3] - expected.rgba[i + 3]);
+    e.coverage_max = std::max(e.coverage_max, coverage);
+    coverage_sum_sq += coverage * coverage;
   }
+  auto psnr = [](double mse) {
+    return mse > 0.0 ? 10.0 * std::log10(1.0 / mse) : std::numeric_limits<double>::infinity();
+  };
   const double mse = count ? sum_sq / double(count) : 0.0;
+  const double coverage_mse = count ? coverage_sum_sq / double(count / 3) : 0.0;
   e.rms = std::sqrt(mse);
-  e.psnr_db = mse > 0.0 ? 10.0 * std::log10(1.0 / mse) : std::numeric_limits<double>::infinity();
+  e.psnr_db = psnr(mse);
+  e.coverage_rms = std::sqrt(coverage_mse);
+  e.coverage_psnr = psnr(coverage_mse);
   return e;
 }
 

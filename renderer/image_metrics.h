@@ -6,11 +6,13 @@
 namespace nephele {
 
 struct ImageError {
-  double psnr_db = 0.0;       // 10 log10(1 / MSE) over sRGB RGB; +inf when identical
-  double max_abs = 0.0;       // largest sRGB channel difference, in [0, 1]
-  double rms = 0.0;           // root mean square sRGB difference
-  double coverage_max = 0.0;  // largest coverage (alpha) difference
-  int non_finite = 0;         // pixels with a NaN or Inf in either image
+  double psnr_db = 0.0;        // 10 log10(1 / MSE) over sRGB RGB; +inf when identical
+  double max_abs = 0.0;        // largest sRGB channel difference, in [0, 1]
+  double rms = 0.0;            // root mean square sRGB difference
+  double coverage_max = 0.0;   // largest coverage (alpha) difference
+  double coverage_rms = 0.0;   // root mean square coverage difference
+  double coverage_psnr = 0.0;  // 10 log10(1 / coverage MSE); +inf when identical
+  int non_finite = 0;          // pixels with a NaN or Inf in either image
 };
 
 ImageError compareImages(const FloatImage& actual, const FloatImage& expected);

@@ -1,4 +1,4 @@
-#include "server/render_command.h"
+#include "cli/render_command.h"
 
 #include <spdlog/spdlog.h>
 
@@ -59,8 +59,8 @@ std::string applyOverrides(const RenderCommandOptions& o, SceneFile& file) {
   return error.empty() ? "" : "command line: " + error;
 }
 
-// The world at the scene's time: automaton clouds are stepped from time 0, with a progress
-// line when that takes a while.
+}  // namespace
+
 Scene sceneAtTime(const SceneFile& file) {
   World world(file.scene, file.dynamics);
   const std::int64_t target_ns = std::llround(file.scene.time_s / World::kTimeResolutionS);
@@ -86,8 +86,6 @@ GlBackend backendFromName(const std::string& name) {
   if (name == "osmesa") return GlBackend::kOsmesa;
   return GlBackend::kAuto;
 }
-
-}  // namespace
 
 void addRenderCommand(CLI::App& app, RenderCommandOptions& o) {
   CLI::App* cmd = app.add_subcommand("render", "Render one image of a scene file");

@@ -4,7 +4,8 @@
 
 #include <CLI/CLI.hpp>
 
-#include "server/render_command.h"
+#include "cli/bench_command.h"
+#include "cli/render_command.h"
 #include "server/serve_command.h"
 
 int main(int argc, char** argv) {
@@ -21,10 +22,13 @@ int main(int argc, char** argv) {
   nephele::addRenderCommand(app, render);
   nephele::ServeCommandOptions serve;
   nephele::addServeCommand(app, serve);
+  nephele::BenchCommandOptions bench;
+  nephele::addBenchCommand(app, bench);
 
   CLI11_PARSE(app, argc, argv);
   spdlog::set_level(spdlog::level::from_str(log_level));
   if (app.got_subcommand("render")) return nephele::runRenderCommand(render);
   if (app.got_subcommand("serve")) return nephele::runServeCommand(serve);
+  if (app.got_subcommand("bench")) return nephele::runBenchCommand(bench);
   return 2;
 }

@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "config/scene_file.h"
 #include "protocol/image_encoding.h"
 #include "renderer/gl_platform.h"
 
@@ -28,6 +29,13 @@ struct RenderCommandOptions {
 };
 
 void addRenderCommand(CLI::App& app, RenderCommandOptions& options);
+
+// The world at the scene file's time: automaton clouds are stepped from time 0, with a
+// progress line when that takes a while.
+Scene sceneAtTime(const SceneFile& file);
+
+// "auto", "egl" or "osmesa" (checked when the flag was parsed).
+GlBackend backendFromName(const std::string& name);
 
 // Runs the command; returns the process exit code (0 ok, 2 bad input, 1 failure).
 int runRenderCommand(const RenderCommandOptions& options);

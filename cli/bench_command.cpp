@@ -1,0 +1,480 @@
+#include "cli/bench_command.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <limits>
+#include <sstream>
+
+#include <unistd.h>
+
+#include "cli/render_command.h"
+#include "config/scene_file.h"
+#include "renderer/frame_timing.h"
+#include "renderer/gl_renderer.h"
+#include "renderer/image_metrics.h"
+#include "renderer/reference_renderer.h"
+#include "world/ellipsoid_cloud.h"
+
+namespace nephele {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// One point of the sweep: the scene's own settings with one knob changed (or none).
+struct Setting {
+  std::string knob;   // empty for the defaults
+  std::string value;  // the knob's value, as a scene file or flag spells it
+  std::function<void(RenderSettings&)> edit = [](RenderSettings&) {};
+  int samples_per_cell = 0;  // automaton lattice resolution; 0 keeps the scene's
+
+  std::string name() const { return knob.empty() ? "defaults" : knob + "=" + value; }
+};
+
+struct BenchScene {
+  std::string name;
+  std::string what;
+  SceneFile file;
+};
+
+struct Point {
+  Setting setting;
+  double ms = 0.0;
+  double floor_multiple = 0.0;
+  ImageError error;
+  bool same_image = false;  // draws exactly what the defaults draw: its time is noise
+  bool front = false;
+};
+
+struct SceneResult {
+  std::string name;
+  std::string what;
+  double floor_ms = 0.0;
+  double reference_s = 0.0;
+  std::vector<Point> points;  // points[0] is the defaults
+  std::string default_status;
+};
+
+std::string withKnob(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+
+// The knobs that act on what a scene holds; a knob that cannot change its image is left out.
+std::vector<Setting> settingsFor(const SceneFile& file) {
+  std::vector<Setting> out{{}};
+  auto add = [&](std::string knob, std::string value, std::function<void(RenderSettings&)> edit) {
+    out.push_back({std::move(knob), std::move(value), std::move(edit)});
+  };
+  const bool layers = !file.scene.layers.empty(), clouds = !file.scene.clouds.empty();
+  if (layers || clouds) {
+    add("texture", "baked",
+        [](RenderSettings& s) { s.texture_evaluation = TextureEvaluation::kBaked; });
+    add("texture", "procedural",
+        [](RenderSettings& s) { s.texture_evaluation = TextureEvaluation::kProcedural; });
+    add("term_filter", "cut", [](RenderSettings& s) { s.term_filter = TermFilter::kCut; });
+    add("term_filter", "none", [](RenderSettings& s) { s.term_filter = TermFilter::kNone; });
+  }
+  if (layers) {
+    for (int tpc : {2, 4, 16, 32})
+      add("bake_texels_per_cycle", std::to_string(tpc),
+          [tpc](RenderSettings& s) { s.bake_texels_per_cycle = tpc; });
+    add("sky_passes", "multipass", [](RenderSettings& s) { s.sky_passes = SkyPasses::kMultipass; });
+  }
+  if (clouds) {
+    add("ellipsoid_order", "centre",
+        [](RenderSettings& s) { s.ellipsoid_order = EllipsoidOrder::kCentre; });
+    add("limb", "spotlight", [](RenderSettings& s) { s.limb = LimbEvaluation::kSpotlight; });
+    auto multipass = [](std::function<void(RenderSettings&)> more) {
+      return [more](RenderSettings& s) {
+        s.ellipsoid_passes = EllipsoidPasses::kMultipass;
+        more(s);
+      };
+    };
+    add("ellipsoid_passes", "multipass", multipass([](RenderSettings&) {}));
+    for (int size : {64, 256})
+      add("ellipsoid_passes=multipass tile_resolution", std::to_string(size),
+          multipass([size](RenderSettings& s) { s.tile_resolution = size; }));
+    add("ellipsoid_passes=multipass tile_format", "rgba8",
+        multipass([](RenderSettings& s) { s.tile_format = TileFormat::kRgba8; }));
+    add("ellipsoid_passes=multipass tessellation", "10",
+        multipass([](RenderSettings& s) { s.tessellation = 10; }));
+    for (double px : {0.5, 2.0})
+      add("impostor_tolerance", withKnob(px),
+          [px](RenderSettings& s) { s.impostor_tolerance_px = px; });
+  }
+  if (!file.dynamics.automata.empty()) {
+    for (double step : {0.5, 2.0, 4.0})
+      add("volume_step", withKnob(step), [step](RenderSettings& s) { s.volume_step = step; });
+    for (int samples : {1, 3}) {
+      out.push_back({"samples_per_cell", std::to_string(samples), [](RenderSettings&) {}, samples});
+    }
+  }
+  return out;
+}
+
+// Twenty cumuli of 25 lobes over a 15 km by 12 km field, seen from 1.5 km: 500 ellipsoids.
+SceneFile cumulusField(const SceneFile& cumulus) {
+  SceneFile file = cumulus;
+  const EllipsoidCloud model = cumulus.scene.clouds.at(0);
+  file.scene.clouds.clear();
+  for (int row = 0; row < 4; ++row)
+    for (int column = 0; column < 5; ++column) {
+      EllipsoidCloud cloud = model;
+      cloud.name = "cumulus_" + std::to_string(row) + "_" + std::to_string(column);
+      const glm::dvec3 base(-6000.0 + 3000.0 * column + 700.0 * (row % 2), 4000.0 + 3000.0 * row,
+                            900.0);
+      cloud.ellipsoids = cumulusEllipsoids(25, base, 1500.0, 100 + 5 * row + column);
+      file.scene.clouds.push_back(cloud);
+    }
+  if (!file.dynamics.clouds.empty())
+    file.dynamics.clouds.assign(file.scene.clouds.size(), file.dynamics.clouds.front());
+  file.scene.camera.position = {0.0, -2000.0, 1500.0};
+  file.scene.camera.orientation = {0.0, -4.0, 0.0};
+  file.scene.camera.vfov_deg = 60.0;
+  return file;
+}
+
+// The fixed scene set of issue 11, in the order the report lists them.
+std::string loadScenes(std::vector<BenchScene>& out) {
+  const std::string dir = NEPHELE_SOURCE_DIR "/config/scenes/";
+  auto load = [&](const std::string& preset, SceneFile& file) {
+    return loadSceneFile(dir + preset + ".toml", file);
+  };
+  struct Entry {
+    const char* name;
+    const char* preset;
+    const char* what;
+  };
+  const Entry entries[] = {
+      {"cirrus", "cirrus", "cirrus layer at 10 km"},
+      {"stratus", "stratus", "stratus layer at 2 km"},
+      {"cumulus", "cumulus", "the 27-lobe cumulus from 4.5 km"},
+      {"close_up", "cumulus_target", "a cumulus filling a 4 degree view, with targets"},
+      {"field_500", "cumulus", "20 cumuli, 500 ellipsoids, from 1.5 km"},
+      {"automaton", "automaton_cloud", "one automaton cloud of 20x20x20 cells"},
+      {"harbour", "harbour", "Shen's harbour: 20 automaton clouds, sea fog"},
+      {"inside", "inside_cloud", "a camera inside the edge of a cloud lobe"},
+  };
+  for (const Entry& e : entries) {
+    SceneFile file;
+    if (std::string error = load(e.preset, file); !error.empty()) return error;
+    if (std::string(e.name) == "field_500") file = cumulusField(file);
+    out.push_back({e.name, e.what, file});
+  }
+  return {};
+}
+
+// Pareto front over (time, colour RMSE): no other point is as fast and as accurate and
+// better in one of them. A setting that draws the defaults' image exactly is the defaults
+// timed again, so it takes no part.
+void markFront(std::vector<Point>& points) {
+  for (Point& p : points) {
+    p.front = !p.same_image && std::none_of(points.begin(), points.end(), [&](const Point& q) {
+      return !q.same_image && q.ms <= p.ms && q.error.rms <= p.error.rms &&
+             (q.ms < p.ms || q.error.rms < p.error.rms);
+    });
+  }
+}
+
+// Where the defaults stand: on the front, within 10 % of it (no point both 10 % faster and
+// as accurate, or 10 % more accurate and as fast), or which point dominates them.
+std::string defaultStatus(const std::vector<Point>& points) {
+  const Point& d = points.front();
+  if (d.front) return "on the front";
+  for (const Point& q : points) {
+    if (q.same_image) continue;
+    const bool much_faster = q.ms < 0.9 * d.ms && q.error.rms <= d.error.rms;
+    const bool much_better = q.error.rms < 0.9 * d.error.rms && q.ms <= d.ms;
+    if (much_faster || much_better) return "dominated by " + q.setting.name();
+  }
+  return "within 10 % of the front";
+}
+
+std::string fixed(double value, int decimals) {
+  if (std::isinf(value)) return "inf";
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
+  return buffer;
+}
+
+void printScene(const SceneResult& r, int width, int height, int samples) {
+  std::printf("\n%s: %s (%dx%d; reference %dx%d samples, %.1f s; floor %.2f ms)\n", r.name.c_str(),
+              r.what.c_str(), width, height, samples, samples, r.reference_s, r.floor_ms);
+  std::printf("  %-46s %9s %7s %8s %8s %7s %8s %8s %7s\n", "setting", "ms", "xfloor", "PSNR",
+              "RMSE", "max", "covPSNR", "covRMSE", "covmax");
+  for (const Point& p : r.points) {
+    const ImageError& e = p.error;
+    std::printf("%s %-46s %9.2f %7.1f %8s %8.5f %7.4f %8s %8.5f %7.4f%s\n",
+                p.front        ? "*"
+                : p.same_image ? "="
+                               : " ",
+                p.setting.name().c_str(), p.ms, p.floor_multiple, fixed(e.psnr_db, 1).c_str(),
+                e.rms, e.max_abs, fixed(e.coverage_psnr, 1).c_str(), e.coverage_rms, e.coverage_max,
+                e.non_finite ? "  NON-FINITE" : "");
+  }
+  std::printf("  defaults: %s   (* front, = same image as the defaults)\n",
+              r.default_status.c_str());
+  std::fflush(stdout);
+}
+
+void writeCsv(const std::filesystem::path& path, const std::vector<SceneResult>& results) {
+  std::ofstream out(path);
+  out << "scene,setting,default,front,ms,floor_ms,floor_multiple,psnr_db,rmse,max_abs,"
+         "coverage_psnr_db,coverage_rmse,coverage_max,non_finite\n";
+  for (const SceneResult& r : results)
+    for (const Point& p : r.points)
+      out << r.name << ',' << p.setting.name() << ',' << p.setting.knob.empty() << ',' << p.front
+          << ',' << p.ms << ',' << r.floor_ms << ',' << p.floor_multiple << ',' << p.error.psnr_db
+          << ',' << p.error.rms << ',' << p.error.max_abs << ',' << p.error.coverage_psnr << ','
+          << p.error.coverage_rms << ',' << p.error.coverage_max << ',' << p.error.non_finite
+          << '\n';
+}
+
+void writeMarkdown(const std::filesystem::path& path, const std::vector<SceneResult>& results,
+                   const std::string& header) {
+  std::ofstream out(path);
+  out << header << "\n\n";
+  for (const SceneResult& r : results) {
+    out << "#### " << r.name << ": " << r.what << "\n\n"
+        << "Floor " << fixed(r.floor_ms, 2) << " ms; defaults " << r.default_status << ".\n\n"
+        << "| setting | ms | x floor | PSNR dB | RMSE | max | coverage PSNR | coverage RMSE | "
+           "coverage max | front |\n"
+        << "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+    for (const Point& p : r.points) {
+      const ImageError& e = p.error;
+      out << "| " << (p.setting.knob.empty() ? "**defaults**" : p.setting.name()) << " | "
+          << fixed(p.ms, 2) << " | " << fixed(p.floor_multiple, 1) << " | " << fixed(e.psnr_db, 1)
+          << " | " << fixed(e.rms, 5) << " | " << fixed(e.max_abs, 4) << " | "
+          << fixed(e.coverage_psnr, 1) << " | " << fixed(e.coverage_rms, 5) << " | "
+          << fixed(e.coverage_max, 4) << " | "
+          << (p.front        ? "yes"
+              : p.same_image ? "same image"
+                             : "")
+          << " |\n";
+    }
+    out << "\n";
+  }
+}
+
+// Error against time, one panel per scene: x the frame time in multiples of the floor (log
+// scale), y the colour PSNR; the front joined by a line, the defaults ringed.
+void writePlot(const std::filesystem::path& path, const std::vector<SceneResult>& results) {
+  const int columns = 4, panel_w = 300, panel_h = 230, margin = 45;
+  const int rows = int(results.size() + columns - 1) / columns;
+  std::ofstream svg(path);
+  svg << "<svg xmlns='http://www.w3.org/2000/svg' width='" << columns * panel_w << "' height='"
+      << rows * panel_h + 40 << "' font-family='sans-serif' font-size='11'>\n"
+      << "<rect width='100%' height='100%' fill='white'/>\n"
+      << "<text x='10' y='20' font-size='14'>Error against run time: colour PSNR (dB, up is "
+         "better) against frame time in multiples of the platform floor (log, left is faster). "
+         "Blue: Pareto front; red ring: defaults.</text>\n";
+  for (std::size_t i = 0; i < results.size(); ++i) {
+    const SceneResult& r = results[i];
+    const double ox = double(i % columns) * panel_w, oy = 40.0 + double(i / columns) * panel_h;
+    double x_lo = 1e30, x_hi = -1e30, y_lo = 1e30, y_hi = -1e30;
+    auto psnr = [](const Point& p) { return std::min(p.error.psnr_db, 80.0); };
+    for (const Point& p : r.points) {
+      x_lo = std::min(x_lo, std::log10(p.floor_multiple));
+      x_hi = std::max(x_hi, std::log10(p.floor_multiple));
+      y_lo = std::min(y_lo, psnr(p));
+      y_hi = std::max(y_hi, psnr(p));
+    }
+    x_lo -= 0.05, x_hi += 0.05, y_lo = std::floor(y_lo / 5.0) * 5.0,
+                                y_hi = std::ceil(y_hi / 5.0) * 5.0 + 1e-9;
+    const double w = panel_w - margin - 10, h = panel_h - margin - 25;
+    auto px = [&](const Point& p) {
+      return ox + margin + (std::log10(p.floor_multiple) - x_lo) / (x_hi - x_lo) * w;
+    };
+    auto py = [&](const Point& p) { return oy + 20 + (y_hi - psnr(p)) / (y_hi - y_lo) * h; };
+    svg << "<text x='" << ox + margin << "' y='" << oy + 12 << "' font-weight='bold'>" << r.name
+        << "</text>\n<rect x='" << ox + margin << "' y='" << oy + 20 << "' width='" << w
+        << "' height='" << h << "' fill='none' stroke='#888'/>\n";
+    svg << "<text x='" << ox + 2 << "' y='" << oy + 28 << "'>" << fixed(y_hi, 0) << " dB</text>\n"
+        << "<text x='" << ox + 2 << "' y='" << oy + 20 + h << "'>" << fixed(y_lo, 0)
+        << " dB</text>\n<text x='" << ox + margin << "' y='" << oy + 35 + h << "'>"
+        << fixed(std::pow(10.0, x_lo), 1) << "x</text>\n<text x='" << ox + margin + w - 30
+        << "' y='" << oy + 35 + h << "'>" << fixed(std::pow(10.0, x_hi), 1) << "x</text>\n";
+    std::vector<const Point*> front;
+    for (const Point& p : r.points)
+      if (p.front) front.push_back(&p);
+    std::sort(front.begin(), front.end(),
+              [](const Point* a, const Point* b) { return a->ms < b->ms; });
+    svg << "<polyline fill='none' stroke='#2a6fdb' stroke-width='1.5' points='";
+    for (const Point* p : front) svg << px(*p) << ',' << py(*p) << ' ';
+    svg << "'/>\n";
+    for (const Point& p : r.points) {
+      svg << "<circle cx='" << px(p) << "' cy='" << py(p) << "' r='3' fill='"
+          << (p.front ? "#2a6fdb" : "#999") << "'><title>" << p.setting.name() << ": "
+          << fixed(p.ms, 2) << " ms, " << fixed(p.error.psnr_db, 1) << " dB</title></circle>\n";
+      if (p.setting.knob.empty())
+        svg << "<circle cx='" << px(p) << "' cy='" << py(p)
+            << "' r='7' fill='none' stroke='#d62728' stroke-width='2'/>\n";
+    }
+  }
+  svg << "</svg>\n";
+}
+
+}  // namespace
+
+void addBenchCommand(CLI::App& app, BenchCommandOptions& o) {
+  CLI::App* cmd = app.add_subcommand(
+      "bench", "Sweep every quality knob: error against the CPU reference and frame time");
+  cmd->add_flag("--quick", o.quick, "Small images and few repeats (under two minutes)");
+  cmd->add_option("--size", o.size, "Image size WxH (default 640x480; --quick 200x150)");
+  cmd->add_option("--repeats", o.repeats, "Timed frames per setting (default 7; --quick 3)")
+      ->check(CLI::Range(1, 1000));
+  cmd->add_option("--samples", o.samples,
+                  "Reference supersampling per pixel axis (default 4; --quick 2)")
+      ->check(CLI::Range(1, 16));
+  cmd->add_option("--scenes", o.scenes,
+                  "Only these scenes: cirrus, stratus, cumulus, close_up, field_500, automaton, "
+                  "harbour, inside")
+      ->delimiter(',');
+  cmd->add_option("-o,--output", o.output_dir, "Directory for accuracy.csv, .md and .svg")
+      ->capture_default_str();
+  cmd->add_option("--gl", o.gl_backend, "OpenGL back end")
+      ->check(CLI::IsMember({"auto", "egl", "osmesa"}))
+      ->capture_default_str();
+}
+
+int runBenchCommand(const BenchCommandOptions& o) {
+  int width = o.quick ? 200 : 640, height = o.quick ? 150 : 480;
+  if (!o.size.empty() && (std::sscanf(o.size.c_str(), "%dx%d", &width, &height) != 2 || width < 1 ||
+                          height < 1 || width > 4096 || height > 4096)) {
+    spdlog::error("--size: '{}' is not WxH with each side 1 to 4096", o.size);
+    return 2;
+  }
+  const int repeats = o.repeats > 0 ? o.repeats : o.quick ? 3 : 7;
+  const int samples = o.samples > 0 ? o.samples : o.quick ? 2 : 4;
+
+  std::vector<BenchScene> scenes;
+  if (std::string error = loadScenes(scenes); !error.empty()) {
+    spdlog::error("{}", error);
+    return 1;
+  }
+  for (const std::string& name : o.scenes)
+    if (std::none_of(scenes.begin(), scenes.end(),
+                     [&](const BenchScene& s) { return s.name == name; })) {
+      spdlog::error(
+          "--scenes: unknown scene '{}' (allowed: cirrus, stratus, cumulus, close_up, "
+          "field_500, automaton, harbour, inside)",
+          name);
+      return 2;
+    }
+  if (!o.scenes.empty())
+    std::erase_if(scenes, [&](const BenchScene& s) {
+      return std::find(o.scenes.begin(), o.scenes.end(), s.name) == o.scenes.end();
+    });
+
+  std::string error;
+  const auto platform = createGlPlatform(backendFromName(o.gl_backend), error);
+  if (!platform) {
+    spdlog::error("{}", error);
+    return 1;
+  }
+  GlRenderer renderer(*platform);
+  const std::string header = "Measured by `nephele bench" + std::string(o.quick ? " --quick" : "") +
+                             "` at " + std::to_string(width) + "x" + std::to_string(height) +
+                             ", median of " + std::to_string(repeats) +
+                             " frames (render + readback into an 8-bit target), " +
+                             platform->renderer() + " (" + std::string(platform->backendName()) +
+                             "); error against the CPU reference at " + std::to_string(samples) +
+                             "x" + std::to_string(samples) + " samples per pixel.";
+  std::printf("%s\n", header.c_str());
+
+  const auto start = Clock::now();
+  const bool tty = isatty(fileno(stderr));  // progress on one rewritten line, else a line each
+  std::vector<SceneResult> results;
+  for (std::size_t index = 0; index < scenes.size(); ++index) {
+    BenchScene& bench_scene = scenes[index];
+    bench_scene.file.scene.camera.width = width;
+    bench_scene.file.scene.camera.height = height;
+    const std::string tag = "[" + std::to_string(index + 1) + "/" + std::to_string(scenes.size()) +
+                            "] " + bench_scene.name;
+    const Scene scene = sceneAtTime(bench_scene.file);
+    SceneResult result;
+    result.name = bench_scene.name;
+    result.what = bench_scene.what;
+
+    const auto ref_start = Clock::now();
+    const FloatImage reference = renderReference(scene, {samples, 0}, [&](double fraction) {
+      if (tty) std::fprintf(stderr, "\r%s: reference %3.0f %%", tag.c_str(), 100.0 * fraction);
+    });
+    result.reference_s = secondsSince(ref_start);
+    std::fprintf(stderr, "%s%s: reference in %.2f s\n", tty ? "\r" : "", tag.c_str(),
+                 result.reference_s);
+    result.floor_ms = medianMilliseconds(repeats, [&] { renderer.renderFloor(width, height); });
+
+    const std::vector<Setting> settings = settingsFor(bench_scene.file);
+    std::vector<Scene> edited(settings.size(), scene);
+    std::vector<RenderSettings> renders(settings.size(), bench_scene.file.render);
+    FloatImage defaults_image;
+    for (std::size_t k = 0; k < settings.size(); ++k) {
+      const Setting& setting = settings[k];
+      setting.edit(renders[k]);
+      if (setting.samples_per_cell > 0) {
+        SceneFile file = bench_scene.file;
+        for (AutomatonCloudSpec& a : file.dynamics.automata)
+          a.samples_per_cell = setting.samples_per_cell;
+        edited[k] = sceneAtTime(file);
+      }
+      Point point;
+      point.setting = setting;
+      const FloatImage image = renderer.renderFloat(edited[k], renders[k]);
+      point.error = compareImages(image, reference);
+      if (k == 0)
+        defaults_image = image;
+      else
+        point.same_image = image.rgba == defaults_image.rgba;
+      point.ms = std::numeric_limits<double>::infinity();
+      result.points.push_back(point);
+    }
+    // Two timing rounds over every setting, each setting's time the lower of its two medians,
+    // so that the machine's drift and the order of the settings do not decide the front.
+    for (int round = 1; round <= 2; ++round)
+      for (std::size_t k = 0; k < settings.size(); ++k) {
+        if (tty)
+          std::fprintf(stderr, "\r%s: timing round %d, %zu/%zu %-50s", tag.c_str(), round, k + 1,
+                       settings.size(), settings[k].name().c_str());
+        Point& point = result.points[k];
+        point.ms = std::min(point.ms, medianMilliseconds(repeats, [&] {
+                              renderer.renderSrgb8(edited[k], renders[k]);
+                            }));
+        point.floor_multiple = point.ms / result.floor_ms;
+      }
+    std::fprintf(stderr, "%s%s: %zu settings, %.0f s since the start%40s\n", tty ? "\r" : "",
+                 tag.c_str(), settings.size(), secondsSince(start), "");
+    markFront(result.points);
+    result.default_status = defaultStatus(result.points);
+    printScene(result, width, height, samples);
+    results.push_back(std::move(result));
+  }
+
+  const std::filesystem::path dir(o.output_dir);
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) {
+    spdlog::error("{}: {}", o.output_dir, ec.message());
+    return 1;
+  }
+  writeCsv(dir / "accuracy.csv", results);
+  writeMarkdown(dir / "accuracy.md", results, header);
+  writePlot(dir / "accuracy.svg", results);
+  std::printf("\nwrote %s, %s and %s in %.0f s\n", (dir / "accuracy.csv").c_str(),
+              (dir / "accuracy.md").c_str(), (dir / "accuracy.svg").c_str(), secondsSince(start));
+  return 0;
+}
+
+}  // namespace nephele
