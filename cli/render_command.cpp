@@ -62,6 +62,10 @@ std::string applyOverrides(const RenderCommandOptions& o, SceneFile& file) {
 }  // namespace
 
 Scene sceneAtTime(const SceneFile& file) {
+  return worldAtTime(file).scene();
+}
+
+World worldAtTime(const SceneFile& file) {
   World world(file.scene, file.dynamics);
   const std::int64_t target_ns = std::llround(file.scene.time_s / World::kTimeResolutionS);
   // Pieces no longer than the World takes in one advance (a scene may start at up to
@@ -78,7 +82,7 @@ Scene sceneAtTime(const SceneFile& file) {
       spdlog::info("simulating to t = {:.1f} s: {} %, {} automaton steps", file.scene.time_s,
                    100 * i / chunks, world.automatonStepsRun());
   }
-  return world.scene();
+  return world;
 }
 
 GlBackend backendFromName(const std::string& name) {
@@ -116,6 +120,9 @@ void addRenderCommand(CLI::App& app, RenderCommandOptions& o) {
       ->check(CLI::Range(Limits::kMinVfov, Limits::kMaxVfov));
   cmd->add_option("--time", o.time, "Simulation time in seconds (layers drift with it)")
       ->check(CLI::Range(0.0, Limits::kMaxTime));
+  cmd->add_flag("--stats", o.stats,
+                "Print what the frame did: passes, ellipsoids drawn and culled, texture terms, "
+                "automaton steps and relights");
   cmd->add_option("--texture", o.texture, "Gardner texture on the GPU: auto, baked or procedural")
       ->check(CLI::IsMember(kTextureEvaluationNames));
   cmd->add_option("--term-filter", o.term_filter,
@@ -172,7 +179,8 @@ int runRenderCommand(const RenderCommandOptions& o) {
     return 2;
   }
   const auto start = Clock::now();
-  const Scene scene = sceneAtTime(file);
+  const World world = worldAtTime(file);
+  const Scene scene = world.scene();
   std::size_t ellipsoids = 0;
   for (const EllipsoidCloud& cloud : scene.clouds) ellipsoids += cloud.ellipsoids.size();
   spdlog::info(
@@ -212,6 +220,11 @@ int runRenderCommand(const RenderCommandOptions& o) {
       spdlog::info("render: {:.1f} ms", millisecondsSince(render_start));
       error = writeImageFile(o.output_path, image, o.encode);
     }
+    if (o.stats)
+      std::printf("stats: %s automaton_steps=%llu relights=%llu\n",
+                  renderer.lastFrameStats().line().c_str(),
+                  static_cast<unsigned long long>(world.automatonStepsRun()),
+                  static_cast<unsigned long long>(world.relightsRun()));
   }
   if (!error.empty()) {
     spdlog::error("{}", error);

@@ -8,6 +8,7 @@
 #include "config/scene_file.h"
 #include "protocol/image_encoding.h"
 #include "renderer/gl_platform.h"
+#include "world/world.h"
 
 namespace nephele {
 
@@ -25,6 +26,7 @@ struct RenderCommandOptions {
   std::optional<double> impostor_tolerance;
   std::optional<double> volume_step;
   std::optional<int> samples;
+  bool stats = false;
   EncodeOptions encode;
 };
 
@@ -33,6 +35,7 @@ void addRenderCommand(CLI::App& app, RenderCommandOptions& options);
 // The world at the scene file's time: automaton clouds are stepped from time 0, with a
 // progress line when that takes a while.
 Scene sceneAtTime(const SceneFile& file);
+World worldAtTime(const SceneFile& file);
 
 // "auto", "egl" or "osmesa" (checked when the flag was parsed).
 GlBackend backendFromName(const std::string& name);

@@ -109,7 +109,8 @@ std::vector<glm::vec2> screenRectangle(const Camera& camera, glm::dvec3 lo, glm:
 AutomatonRenderer::AutomatonRenderer(const GlApi& gl)
     : gl_(gl), vertex_array_(createVertexArray(gl)) {}
 
-void AutomatonRenderer::beginFrame() {
+void AutomatonRenderer::beginFrame(FrameStats& stats) {
+  stats_ = &stats;
   for (auto& [key, volume] : volumes_) volume.used = false;
 }
 
@@ -162,6 +163,7 @@ AutomatonRenderer::Volume& AutomatonRenderer::volume(const Scene& scene, std::si
   v.from = cloud.from;
   v.to = cloud.to;
   ++uploads_;
+  ++stats_->volume_uploads;
   return v;
 }
 
@@ -207,6 +209,7 @@ void AutomatonRenderer::drawCloud(const Scene& scene, std::size_t index,
   gl_.BlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
   gl_.BindVertexArray(vertex_array_.get());
   gl_.DrawArrays(GL_TRIANGLE_FAN, 0, GLsizei(polygon.size()));
+  ++stats_->automaton_passes;
 }
 
 }  // namespace nephele

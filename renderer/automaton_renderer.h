@@ -7,6 +7,7 @@
 #include <memory>
 #include <string>
 
+#include "renderer/frame_stats.h"
 #include "renderer/gl_objects.h"
 #include "renderer/render_settings.h"
 #include "renderer/view_uniforms.h"
@@ -18,7 +19,8 @@ class AutomatonRenderer {
  public:
   explicit AutomatonRenderer(const GlApi& gl);
 
-  void beginFrame();
+  // Starts a frame whose passes and uploads are counted into `stats`.
+  void beginFrame(FrameStats& stats);
   // Draws scene.automata[index] over what the framebuffer holds (blending set here).
   // Only the rays whose entry into the volume lies in `band` (a layer cutting the cloud).
   void drawCloud(const Scene& scene, std::size_t index, const RenderSettings& settings,
@@ -44,6 +46,7 @@ class AutomatonRenderer {
   std::map<std::string, GlObject> programs_;
   std::map<std::string, Volume> volumes_;  // by cloud index and name
   int uploads_ = 0;
+  FrameStats* stats_ = nullptr;  // the current frame's, borrowed from the GlRenderer
 };
 
 }  // namespace nephele

@@ -177,7 +177,8 @@ EllipsoidRenderer::EllipsoidRenderer(const GlApi& gl)
 
 EllipsoidRenderer::~EllipsoidRenderer() = default;
 
-void EllipsoidRenderer::beginFrame() {
+void EllipsoidRenderer::beginFrame(FrameStats& stats) {
+  stats_ = &stats;
   for (auto& [key, cached] : textures_) cached.used = false;
   next_buffer_ = 0;
 }
@@ -428,6 +429,7 @@ bool EllipsoidRenderer::drawImpostor(const Scene& scene, std::size_t index,
     impostor.half_size = distance * std::tan(half_angle);
     impostor.size = size;
     ++impostor_renders_;
+    ++stats_->impostors_rendered;
   }
 
   EllipsoidPassLayout layout;
@@ -451,6 +453,8 @@ bool EllipsoidRenderer::drawImpostor(const Scene& scene, std::size_t index,
   gl_.BlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
   gl_.BindVertexArray(vertex_array_.get());
   gl_.DrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+  ++stats_->ellipsoid_passes;
+  ++stats_->impostors_drawn;
   return true;
 }
 
@@ -468,6 +472,8 @@ void EllipsoidRenderer::drawCloudDirect(const Scene& scene, std::size_t index,
     visible.push_back({distance, record});
     nearest_m = std::min(nearest_m, distance - std::max({e.radii.x, e.radii.y, e.radii.z}));
   }
+  stats_->ellipsoids_drawn += int(visible.size());
+  stats_->ellipsoids_culled += int(cloud.ellipsoids.size() - visible.size());
   if (visible.empty()) return;
   std::stable_sort(visible.begin(), visible.end(),
                    [](const auto& a, const auto& b) { return a.first > b.first; });
@@ -530,6 +536,7 @@ void EllipsoidRenderer::drawCloudDirect(const Scene& scene, std::size_t index,
     setCloudUniforms(p, scene, cloud, texture, layout.texture, band);
     gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_first"), 0);
     gl_.DrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(records.size()));
+    ++stats_->ellipsoid_passes;
     return;
   }
   // Per pixel: every bin in one draw, each pixel sorting its bin's hits.
@@ -561,6 +568,7 @@ void EllipsoidRenderer::drawCloudDirect(const Scene& scene, std::size_t index,
   gl_.BindBufferBase(GL_SHADER_STORAGE_BUFFER, kBinItemBufferBinding,
                      frameBuffer(items.data(), items.size() * sizeof(GLint)));
   gl_.DrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(bins.size()));
+  ++stats_->ellipsoid_passes;
 }
 
 void EllipsoidRenderer::prepareAtlas(TileFormat format) {
@@ -686,6 +694,7 @@ void EllipsoidRenderer::renderAtlasBatch(const Scene& scene, const EllipsoidClou
           sphereMesh(settings.tessellation > 0 ? settings.tessellation : adaptiveSlices(radius_px));
       gl_.BindVertexArray(mesh.vertex_array.get());
       gl_.DrawElements(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr);
+      ++stats_->atlas_passes;
     }
   }
   gl_.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
@@ -716,6 +725,7 @@ void EllipsoidRenderer::renderAtlasBatch(const Scene& scene, const EllipsoidClou
     gl_.ProgramUniform2fv(p, gl_.GetUniformLocation(p, "u_polygon"), 4, &polygon[0].x);
     gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_index"), i);
     gl_.DrawArrays(GL_TRIANGLE_FAN, 0, 4);
+    ++stats_->ellipsoid_passes;
   }
 }
 
@@ -738,6 +748,7 @@ void EllipsoidRenderer::drawVeil(const Scene& scene, const RenderSettings& setti
   gl_.BlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
   gl_.BindVertexArray(vertex_array_.get());
   gl_.DrawArrays(GL_TRIANGLE_FAN, 0, 3);
+  ++stats_->veil_passes;
 }
 
 }  // namespace nephele

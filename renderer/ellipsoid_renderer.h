@@ -9,6 +9,7 @@
 #include <glm/glm.hpp>
 
 #include "renderer/ellipsoid_shaders.h"
+#include "renderer/frame_stats.h"
 #include "renderer/gl_objects.h"
 #include "renderer/render_settings.h"
 #include "renderer/view_uniforms.h"
@@ -39,8 +40,9 @@ class EllipsoidRenderer {
   explicit EllipsoidRenderer(const GlApi& gl);
   ~EllipsoidRenderer();
 
-  // Starts a frame: marks cached textures unused until a cloud asks for them again.
-  void beginFrame();
+  // Starts a frame: marks cached textures unused until a cloud asks for them again; the
+  // frame's passes and ellipsoids are counted into `stats`.
+  void beginFrame(FrameStats& stats);
   void endFrame();
 
   // Draws cloud `index` of the scene "over" what `target` holds, blending premultiplied.
@@ -118,6 +120,7 @@ class EllipsoidRenderer {
   std::map<int, IndexedMesh> meshes_;
   std::map<std::size_t, Impostor> impostors_;  // by cloud index
   int impostor_renders_ = 0;
+  FrameStats* stats_ = nullptr;  // the current frame's, borrowed from the GlRenderer
 };
 
 }  // namespace nephele

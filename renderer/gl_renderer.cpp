@@ -32,6 +32,21 @@ std::vector<glm::vec2> clipScreenToHalfPlane(double a, double b, double c) {
   return out;
 }
 
+// The Gardner terms the sky shader's termCount lets a pixel of this layer evaluate at most:
+// at the finest footprint it can show, straight above or below the camera, where a pixel
+// spans the layer's distance times 2 tan(vfov / 2) / height (SPEC section 2's filter).
+int layerTermsAtMost(const CloudLayer& layer, const LayerTexture& texture, const Camera& camera,
+                     TermFilter filter) {
+  const int terms = texture.gardner()->terms();
+  if (filter == TermFilter::kNone) return terms;
+  const glm::dvec2 period = texture.period();
+  const double footprint_m = std::abs(layer.altitude_m - camera.position.z) * 2.0 *
+                             std::tan(glm::radians(camera.vfov_deg) / 2.0) / camera.height;
+  const double highest = std::log2(0.5 / (footprint_m / std::min(period.x, period.y)));
+  const double count = filter == TermFilter::kCut ? std::floor(highest) : highest - 1.0;
+  return std::clamp(int(std::ceil(count)), 0, terms);
+}
+
 // Cache key: every parameter of a layer texture and the settings its GPU form depends on.
 std::string textureKey(const LayerTextureSpec& spec, const RenderSettings& settings) {
   std::ostringstream key;
@@ -344,6 +359,7 @@ void GlRenderer::drawSkyPass(const Scene& scene, const RenderSettings& settings,
   gl_.ProgramUniform2fv(p, gl_.GetUniformLocation(p, "u_polygon"), GLsizei(polygon.size()),
                         &polygon[0].x);
   gl_.DrawArrays(GL_TRIANGLE_FAN, 0, GLsizei(polygon.size()));
+  ++stats_.sky_passes;
 }
 
 void GlRenderer::drawSkyGroup(const Scene& scene, const RenderSettings& settings,
@@ -413,8 +429,10 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
                            TargetFormat format) {
   const Camera& camera = scene.camera;
   prepareTarget(camera.width, camera.height, format);
+  stats_ = {};
   // Opaque targets first, into their own colour and distance textures.
   const bool targets = targets_.draw(scene);
+  if (targets) stats_.target_passes = int(scene.targets.size());
   gl_.BindFramebuffer(GL_FRAMEBUFFER, framebuffer_.get());
   gl_.Viewport(0, 0, camera.width, camera.height);
   gl_.BindVertexArray(vertex_array_.get());
@@ -423,8 +441,8 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
   else
     gl_.Disable(GL_FRAMEBUFFER_SRGB);
   for (auto& [key, cached] : textures_) cached.used = false;
-  ellipsoids_.beginFrame();
-  automata_.beginFrame();
+  ellipsoids_.beginFrame(stats_);
+  automata_.beginFrame(stats_);
 
   // A ray meets only the layers on one side of the camera: above it from the highest down,
   // below it from the lowest up. Those orders are back to front.
@@ -438,6 +456,10 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
                                ? LayerKind::kProceduralGardner
                                : LayerKind::kBakedGardner;
     (layer.altitude_m > z ? above : below).push_back({&layer, &texture, kind});
+    if (const GardnerTexture* g = texture.source->gardner()) {
+      stats_.layer_terms += layerTermsAtMost(layer, *texture.source, camera, settings.term_filter);
+      stats_.layer_terms_total += g->terms();
+    }
   }
   std::sort(above.begin(), above.end(), [](const LayerSlot& a, const LayerSlot& b) {
     return a.layer->altitude_m > b.layer->altitude_m;

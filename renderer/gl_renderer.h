@@ -8,6 +8,7 @@
 
 #include "renderer/automaton_renderer.h"
 #include "renderer/ellipsoid_renderer.h"
+#include "renderer/frame_stats.h"
 #include "renderer/gl_objects.h"
 #include "renderer/gl_platform.h"
 #include "renderer/render_settings.h"
@@ -35,6 +36,9 @@ class GlRenderer {
   // the 8-bit target renderSrgb8 uses. Benchmarks print frame times as multiples of it, since
   // absolute times on shared machines vary by 30 % between runs.
   Srgb8Image renderFloor(int width, int height);
+
+  // What the last frame did: passes, ellipsoids drawn and culled, terms evaluated.
+  const FrameStats& lastFrameStats() const { return stats_; }
 
   // Far-cloud impostors rendered since construction (each reuse saves one).
   int impostorRenders() const { return ellipsoids_.impostorRenders(); }
@@ -79,6 +83,7 @@ class GlRenderer {
   std::map<std::string, GlObject> programs_;
   std::map<std::string, CachedTexture> textures_;
   GlObject floor_program_;
+  FrameStats stats_;
   EllipsoidRenderer ellipsoids_;
   AutomatonRenderer automata_;
   TargetRenderer targets_;

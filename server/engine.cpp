@@ -43,6 +43,24 @@ ProtocolError badField(std::string message) {
   return {ErrorCode::kBadField, std::move(message)};
 }
 
+// What the last rendered frame did (renderer/frame_stats.h).
+json frameStatsJson(const FrameStats& f) {
+  return {{"passes", f.passes()},
+          {"sky_passes", f.sky_passes},
+          {"ellipsoid_passes", f.ellipsoid_passes},
+          {"atlas_passes", f.atlas_passes},
+          {"automaton_passes", f.automaton_passes},
+          {"target_passes", f.target_passes},
+          {"veil_passes", f.veil_passes},
+          {"ellipsoids_drawn", f.ellipsoids_drawn},
+          {"ellipsoids_culled", f.ellipsoids_culled},
+          {"impostors_drawn", f.impostors_drawn},
+          {"impostors_rendered", f.impostors_rendered},
+          {"layer_terms", f.layer_terms},
+          {"layer_terms_total", f.layer_terms_total},
+          {"volume_uploads", f.volume_uploads}};
+}
+
 json viewJson(const ViewConfig& v) {
   const Camera& c = v.camera;
   return {{"name", v.name},
@@ -955,6 +973,8 @@ void Engine::publish() {
       {"requests", s.requests},
       {"errors", errors_.load()},
       {"automaton_steps", world.automatonStepsRun()},
+      {"relights", world.relightsRun()},
+      {"last_frame", frameStatsJson(s.renderer->lastFrameStats())},
   };
   {
     std::lock_guard lock(published_mutex_);

@@ -103,7 +103,7 @@ void World::refreshAutomata() {
 void World::setSun(const Sun& sun) {
   base_.sun = sun;
   const glm::dvec3 to_sun = sunDirection(sun);
-  for (AutomatonCloud& cloud : automata_) cloud.setSun(to_sun);
+  for (AutomatonCloud& cloud : automata_) relights_run_ += cloud.setSun(to_sun);
 }
 
 void World::foldDrift(Scene& scene, const WorldDynamics& dynamics, double sign) const {

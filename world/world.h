@@ -59,6 +59,8 @@ class World {
   double timeSeconds() const { return double(time_ns_) * kTimeResolutionS; }
   // Automaton steps run since construction or restore, summed over clouds.
   std::uint64_t automatonStepsRun() const { return steps_run_; }
+  // Sunlight sweeps recomputed after the sun moved, summed over automaton clouds.
+  std::uint64_t relightsRun() const { return relights_run_; }
 
   // Relights automaton clouds only if the sun's direction changed.
   void setSun(const Sun& sun);
@@ -94,6 +96,7 @@ class World {
   int threads_ = 1;
   std::int64_t time_ns_ = 0;
   std::uint64_t steps_run_ = 0;
+  std::uint64_t relights_run_ = 0;
   std::vector<AutomatonCloud> automata_;
 };
 

@@ -380,6 +380,14 @@ class SocketProtocolTest(DaemonTest):
         self.assertEqual(failures, [])
         stats = d.client().ok({"cmd": "stats"})
         self.assertGreaterEqual(stats["frames"], 60)
+        # What the last frame did: passes by kind, never more than it counts in all.
+        frame = stats["last_frame"]
+        self.assertGreater(frame["passes"], 0)
+        self.assertEqual(frame["passes"], sum(frame[k] for k in (
+            "sky_passes", "ellipsoid_passes", "atlas_passes", "automaton_passes",
+            "target_passes", "veil_passes")))
+        self.assertLessEqual(frame["layer_terms"], frame["layer_terms_total"])
+        self.assertIn("relights", stats)
 
     def test_full_queue_answers_busy(self):
         d = self.daemon()

@@ -1,0 +1,96 @@
+// Leave out what a scene does not need: a frame pays only for the kinds of cloud it holds
+// and for the texture terms its pixels can resolve (renderer/frame_stats.h).
+#include <gtest/gtest.h>
+
+#include "tests/gl_test_fixture.h"
+#include "world/world.h"
+
+namespace nephele {
+namespace {
+
+class FrameStatsTest : public GlRenderTest {
+ protected:
+  static FrameStats statsOf(const Scene& scene, const RenderSettings& settings = {}) {
+    renderer_->renderSrgb8(scene, settings);
+    return renderer_->lastFrameStats();
+  }
+};
+
+// Ellipsoid clouds cost ellipsoid passes (and atlas passes with multipass); without them
+// there is no ellipsoid, atlas or veil pass and nothing is drawn or culled.
+TEST_F(FrameStatsTest, NoEllipsoidWorkWithoutEllipsoids) {
+  Scene scene = preset("cumulus").scene;
+  RenderSettings multipass;
+  multipass.ellipsoid_passes = EllipsoidPasses::kMultipass;
+  const FrameStats with = statsOf(scene), with_tiles = statsOf(scene, multipass);
+  EXPECT_GE(with.ellipsoid_passes, 1);
+  EXPECT_EQ(with.ellipsoids_drawn, 27);
+  EXPECT_EQ(with.atlas_passes, 0);
+  EXPECT_EQ(with_tiles.atlas_passes, 3 * 27);  // threshold, limb and colour per tile
+  scene.clouds.clear();
+  for (const RenderSettings& settings : {RenderSettings{}, multipass}) {
+    const FrameStats without = statsOf(scene, settings);
+    EXPECT_EQ(without.ellipsoid_passes + without.atlas_passes + without.veil_passes, 0);
+    EXPECT_EQ(without.ellipsoids_drawn + without.ellipsoids_culled, 0);
+    EXPECT_EQ(without.passes(), without.sky_passes);
+  }
+}
+
+// Ellipsoids behind the camera are culled, not drawn.
+TEST_F(FrameStatsTest, EllipsoidsOutOfViewAreCulled) {
+  Scene scene = preset("cumulus").scene;
+  scene.camera.orientation.heading_deg += 180.0;
+  const FrameStats behind = statsOf(scene);
+  EXPECT_EQ(behind.ellipsoids_drawn, 0);
+  EXPECT_EQ(behind.ellipsoids_culled, 27);
+  EXPECT_EQ(behind.ellipsoid_passes, 0);
+}
+
+// An automaton cloud costs a volume pass and an upload per new keyframe; without automata
+// there is neither, and the World runs no automaton step or relight.
+TEST_F(FrameStatsTest, NoAutomatonWorkWithoutAutomata) {
+  const SceneFile file = preset("automaton_cloud");
+  World world(file.scene, file.dynamics);
+  world.advance(60.0);
+  const FrameStats with = statsOf(world.scene());
+  EXPECT_EQ(with.automaton_passes, 1);
+  EXPECT_EQ(with.volume_uploads, 1);
+  EXPECT_EQ(statsOf(world.scene()).volume_uploads, 0);  // the same keyframes: no upload
+
+  WorldDynamics none = file.dynamics;
+  none.automata.clear();
+  World empty(file.scene, none);
+  empty.advance(60.0);
+  Sun sun = empty.base().sun;
+  sun.elevation_deg += 10.0;
+  empty.setSun(sun);
+  EXPECT_EQ(empty.automatonStepsRun(), 0u);
+  EXPECT_EQ(empty.relightsRun(), 0u);
+  const FrameStats without = statsOf(empty.scene());
+  EXPECT_EQ(without.automaton_passes + without.volume_uploads, 0);
+}
+
+// The term filter leaves out the terms a pixel cannot resolve: a layer 10 km up seen in a
+// 16 x 12 image evaluates fewer terms than in a 1280 x 1024 one, and never more than it has.
+TEST_F(FrameStatsTest, NoTermAboveTheSamplingFrequency) {
+  SceneFile file = preset("cirrus", 1280, 1024);
+  const FrameStats fine = statsOf(file.scene);
+  file.scene.camera.width = 16;
+  file.scene.camera.height = 12;
+  const FrameStats coarse = statsOf(file.scene);
+  ASSERT_GT(fine.layer_terms_total, 0);
+  EXPECT_LE(fine.layer_terms, fine.layer_terms_total);
+  EXPECT_LT(coarse.layer_terms, fine.layer_terms);
+  RenderSettings every_term;
+  every_term.term_filter = TermFilter::kNone;
+  EXPECT_EQ(statsOf(file.scene, every_term).layer_terms, fine.layer_terms_total);
+  // Without layers there is only the background.
+  file.scene.layers.clear();
+  const FrameStats bare = statsOf(file.scene);
+  EXPECT_EQ(bare.layer_terms_total, 0);
+  EXPECT_EQ(bare.passes(), bare.sky_passes);
+  EXPECT_LE(bare.sky_passes, 2);  // one per side of the horizon
+}
+
+}  // namespace
+}  // namespace nephele
