@@ -314,7 +314,12 @@ void writePlot(const std::filesystem::path& path, const std::vector<SceneResult>
     svg << "<polyline fill='none' stroke='#2a6fdb' stroke-width='1.5' points='";
     for (const Point* p : front) svg << px(*p) << ',' << py(*p) << ' ';
     svg << "'/>\n";
-    for (const Point& p : r.points) {
+    // The front last, so that a point equal to a front point does not hide it.
+    std::vector<const Point*> order;
+    for (const Point& p : r.points) order.push_back(&p);
+    std::stable_partition(order.begin(), order.end(), [](const Point* p) { return !p->front; });
+    for (const Point* point : order) {
+      const Point& p = *point;
       svg << "<circle cx='" << px(p) << "' cy='" << py(p) << "' r='3' fill='"
           << (p.front ? "#2a6fdb" : "#999") << "'><title>" << p.setting.name() << ": "
           << fixed(p.ms, 2) << " ms, " << fixed(p.error.psnr_db, 1) << " dB</title></circle>\n";

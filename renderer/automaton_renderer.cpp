@@ -64,7 +64,7 @@ void main() {
   vec2 a = densityAndSunlight(enter * d);
   for (int i = 1; i <= steps && transmittance > 1e-3; ++i) {
     vec2 b = densityAndSunlight((enter + float(i) * ds) * d);
-    // Exact attenuation over the step for density linear along it (SPEC 6), with the source
+    // Exact attenuation over the step for density linear along it (MODEL.md section 6), with the source
     // held at the mean of the step's ends, as the reference does.
     float segment = exp(-u_extinction * 0.5 * (a.x + b.x) * ds);
     float source = scattering * 0.5 * (a.y + b.y) + u_ambient;

@@ -90,7 +90,7 @@ std::string textureKey(const SolidTextureSpec& spec, const RenderSettings& setti
 
 // Baked solid Gardner: 4 texels per cycle of the highest term at level 0 (at most 128 a
 // side), level l holding n - l terms. With 4 texels per cycle GL's trilinear LOD equals the
-// fade schedule of SPEC section 2, so trilinear filtering fades each term over its octave.
+// fade schedule of MODEL.md section 2, so trilinear filtering fades each term over its octave.
 int bakedSolidSize(const GardnerTexture& gardner) {
   return std::min(4 << gardner.terms(), 128);
 }
@@ -145,7 +145,7 @@ int adaptiveSlices(double radius_px) {
 bool makeEllipsoidRecord(const Ellipsoid& e, const Camera& camera, EllipsoidRecord& out,
                          double& centre_distance) {
   const EllipsoidView view(e, camera.position);
-  if (view.eyeInside()) return false;  // SPEC section 4: the in-cloud veil shows it
+  if (view.eyeInside()) return false;  // MODEL.md section 4: the in-cloud veil shows it
   const double fade = surfaceFade(view.eyeRadius());
   if (fade <= 0.0) return false;
   const ViewBasis basis = viewBasis(camera);
@@ -279,8 +279,8 @@ void EllipsoidRenderer::setCloudUniforms(GLuint p, const Scene& scene, const Ell
   setUniform3(gl_, p, "u_thresholds",
               {cloud.threshold_centre, cloud.threshold_limb, cloud.transition});
   setUniform3(gl_, p, "u_to_sun", sunDirection(scene.sun));
-  // SPEC precision rule: the texture's local origin is the eye, reduced modulo the period
-  // in double; shaders see camera-relative offsets only.
+  // The precision rule of MODEL.md section 2: the texture's local origin is the eye, reduced modulo
+  // the period in double; shaders see camera-relative offsets only.
   const SolidTexture& texture = *cached.source;
   const glm::dvec3 origin_uvw = texture.periodicCoordinate(scene.camera.position - cloud.drift_m);
   setUniform3(gl_, p, "u_tex_origin", origin_uvw);

@@ -56,7 +56,7 @@ float hitEllipsoid(int i, vec3 r) {
 layout(binding = 10) uniform sampler2D u_spotlight;  // 1 - rho^2 over [-1, 1]^2
 #endif
 
-// The limb function g (SPEC section 4) for view direction d.
+// The limb function g (MODEL.md section 4) for view direction d.
 float limbG(int i, vec3 d) {
   vec3 a = u_e[i].limb_axis.xyz;
   float along = dot(d, a);
@@ -73,7 +73,7 @@ float limbG(int i, vec3 d) {
 }
 
 #if defined(PROCEDURAL)
-// Gardner's solid texture per fragment (SPEC section 2); term j's phases at the eye are
+// Gardner's solid texture per fragment (MODEL.md section 2); term j's phases at the eye are
 // reduced modulo 2 pi on the CPU in double, so p is camera-relative.
 uniform float u_fx[8];
 uniform float u_fy[8];
@@ -96,19 +96,8 @@ void addSolidTerm(int j, vec3 p, inout float sx, inout float sy) {
 }
 
 float solidValue(vec3 p, vec3 dpdx, vec3 dpdy) {
-#if defined(FILTER_NONE)
-  float count = u_terms;
-#else
-  // Footprint in periods; term j (1-based) resolves while 2^j footprint <= 1/2.
-  float footprint = max(max(length(dpdx), length(dpdy)) * max(u_inv_period.x, u_inv_period.y),
-                        1e-30);
-  float highest = log2(0.5 / footprint);
-#if defined(FILTER_CUT)
-  float count = clamp(floor(highest), 0.0, u_terms);
-#else
-  float count = clamp(highest - 1.0, 0.0, u_terms);
-#endif
-#endif
+  float count = resolvedTerms(
+      max(length(dpdx), length(dpdy)) * max(u_inv_period.x, u_inv_period.y), u_terms);
   int whole = int(count);
   float sx = u_t0, sy = u_t0;
   for (int j = 0; j < whole; ++j) addSolidTerm(j, p, sx, sy);
@@ -142,16 +131,12 @@ vec3 surfaceColour(vec3 n, vec3 r, float it, float distance) {
     highlight = pow(max(dot(reflected, -normalize(r)), 0.0), u_shading.w);
   }
 #endif
-  float a = u_shading.x, t = u_shading.y, s = u_shading.z;
-  float intensity = (1.0 - a) * ((1.0 - t) * ((1.0 - s) * diffuse + s * highlight) + t * it) + a;
-  return applyFog(intensity * u_cloud_colour, normalize(r), distance);
+  return applyFog(gardnerIntensity(u_shading, diffuse, highlight, it) * u_cloud_colour,
+                  normalize(r), distance);
 }
 
 // Gardner eq. 11 given the threshold excess x = It - T1 - (T2 - T1)(1 - g): opacity 1 - TR.
-float opacityFromExcess(float x) {
-  float d = u_thresholds.z;
-  return d <= 0.0 ? (x > 0.0 ? 1.0 : 0.0) : clamp(x / d, 0.0, 1.0);
-}
+float opacityFromExcess(float x) { return 1.0 - translucence(x, u_thresholds.z); }
 
 // Premultiplied colour and opacity of ellipsoid i where the ray r meets it at s.
 vec4 ellipsoidSurface(int i, vec3 r, float s) {

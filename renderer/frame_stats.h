@@ -17,7 +17,7 @@ struct FrameStats {
   int impostors_drawn = 0;     // far clouds drawn from an impostor
   int impostors_rendered = 0;  // impostors (re)rendered this frame
   // Gardner terms a pixel of the layers evaluates at most, summed over the layers drawn: the
-  // term filter (SPEC section 2) drops terms above half the sampling frequency, at the
+  // term filter (MODEL.md section 2) drops terms above half the sampling frequency, at the
   // finest footprint a layer can show (straight above or below the camera).
   int layer_terms = 0;
   int layer_terms_total = 0;  // the layers' terms before the filter

@@ -34,17 +34,15 @@ std::vector<glm::vec2> clipScreenToHalfPlane(double a, double b, double c) {
 
 // The Gardner terms the sky shader's termCount lets a pixel of this layer evaluate at most:
 // at the finest footprint it can show, straight above or below the camera, where a pixel
-// spans the layer's distance times 2 tan(vfov / 2) / height (SPEC section 2's filter).
+// spans the layer's distance times 2 tan(vfov / 2) / height (MODEL.md section 2's filter).
 int layerTermsAtMost(const CloudLayer& layer, const LayerTexture& texture, const Camera& camera,
                      TermFilter filter) {
-  const int terms = texture.gardner()->terms();
-  if (filter == TermFilter::kNone) return terms;
   const glm::dvec2 period = texture.period();
   const double footprint_m = std::abs(layer.altitude_m - camera.position.z) * 2.0 *
                              std::tan(glm::radians(camera.vfov_deg) / 2.0) / camera.height;
-  const double highest = std::log2(0.5 / (footprint_m / std::min(period.x, period.y)));
-  const double count = filter == TermFilter::kCut ? std::floor(highest) : highest - 1.0;
-  return std::clamp(int(std::ceil(count)), 0, terms);
+  // A fractional count evaluates one more term, faded.
+  return int(std::ceil(texture.gardner()->termCountForFootprint(
+      footprint_m / std::min(period.x, period.y), filter)));
 }
 
 // Cache key: every parameter of a layer texture and the settings its GPU form depends on.
@@ -95,7 +93,7 @@ void uploadTable(const GlApi& gl, GLuint texture, const TextureTable& table) {
   gl.TextureParameteri(texture, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
 }
 
-// The layer bands of SPEC's per-ray depth order. Along any ray altitude changes
+// The layer bands of the per-ray depth order of MODEL.md section 4. Along any ray altitude changes
 // monotonically, so the surfaces between the k-th and (k+1)-th layers on one side of the
 // camera are those between their altitudes. Heights are relative to the camera; band b on
 // the rising side is [A(b-1), A(b)) with A(-1) = 0 and A(n) = +inf, on the falling side
@@ -284,21 +282,14 @@ void GlRenderer::setSlotUniforms(GLuint p, int slot, const LayerSlot& entry, con
   gl_.ProgramUniform1f(p, location("u_height", slot), float(layer.altitude_m - camera.position.z));
   const glm::vec3 colour(layer.colour * scene.sun.colour);
   gl_.ProgramUniform3fv(p, location("u_colour", slot), 1, &colour.x);
-  // Gardner eq. 8, I = (1-a){(1-t)[(1-s) Id + s Is] + t It} + a, regrouped around what
-  // varies per pixel: Id = max(0, N.L) is constant over a plane, It and Is are not.
   const ShadingParams& sh = layer.shading;
-  const double to_viewer_z = layer.altitude_m > camera.position.z ? -1.0 : 1.0;  // N.z
-  const double diffuse = std::max(0.0, to_viewer_z * sunDirection(scene.sun).z);
-  const glm::vec4 intensity(
-      (1.0 - sh.ambient) * (1.0 - sh.texture_fraction) * (1.0 - sh.specular) * diffuse + sh.ambient,
-      (1.0 - sh.ambient) * sh.texture_fraction,
-      (1.0 - sh.ambient) * (1.0 - sh.texture_fraction) * sh.specular, sh.shininess);
-  gl_.ProgramUniform4fv(p, location("u_intensity", slot), 1, &intensity.x);
+  const glm::vec4 shading(sh.ambient, sh.texture_fraction, sh.specular, sh.shininess);
+  gl_.ProgramUniform4fv(p, location("u_shading", slot), 1, &shading.x);
   gl_.ProgramUniform1f(p, location("u_threshold", slot), float(layer.threshold));
   gl_.ProgramUniform1f(p, location("u_transition", slot), float(layer.transition));
 
-  // SPEC precision rule: the texture's local origin is the point under the camera, reduced
-  // modulo the period in double; the shader only sees offsets from it.
+  // The precision rule of MODEL.md section 2: the texture's local origin is the point under the
+  // camera, reduced modulo the period in double; the shader only sees offsets from it.
   const glm::dvec2 period = texture.period();
   const glm::dvec2 origin_uv =
       texture.periodicCoordinate({camera.position.x, camera.position.y}, scene.time_s);

@@ -59,7 +59,7 @@ class ReferenceTracer {
       solid_pointers.push_back(&solid_textures_.emplace_back(scene.clouds[c].texture));
       for (const Ellipsoid& e : scene.clouds[c].ellipsoids) {
         EllipsoidView view(e, scene.camera.position);
-        if (view.eyeInside()) continue;  // SPEC section 4: no surface to show
+        if (view.eyeInside()) continue;  // MODEL.md section 4: no surface to show
         const double fade = surfaceFade(view.eyeRadius());
         if (fade > 0.0) ellipsoids_.push_back({view, c, fade});
       }
@@ -130,9 +130,9 @@ class ReferenceTracer {
             (1.0 - tr) * entry.fade};
   }
 
-  // An automaton cloud along the ray, as one surface at the ray's entry into its box: SPEC 6's
-  // single scattering with the exact metaball density, marched in steps of l/8 with the exact
-  // exponential per step; sunlight marched towards the sun in steps of l/4 the same way.
+  // An automaton cloud along the ray, as one surface at the ray's entry into its box: MODEL.md
+  // section 6's single scattering with the exact metaball density, marched in steps of l/8 with the
+  // exact exponential per step; sunlight marched towards the sun in steps of l/4 the same way.
   std::optional<Surface> volumeSurface(const AutomatonCloudView& cloud, glm::dvec3 direction,
                                        double nearest_opaque) const {
     const glm::dvec3 eye = scene_.camera.position;

@@ -1,5 +1,5 @@
 #pragma once
-// The CPU reference renderer (SPEC section 7): double precision, exact ray-plane hits, every
+// The CPU reference renderer (MODEL.md section 7): double precision, exact ray-plane hits, every
 // texture term, exact ray-ellipsoid hits and limb function, per-pixel depth order,
 // supersampled. Slow and simple enough to trust.
 #include <functional>

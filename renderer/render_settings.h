@@ -30,7 +30,7 @@ enum class EllipsoidOrder {
 };
 
 enum class LimbEvaluation {
-  kExact,      // g from the discriminant form per fragment (SPEC section 4)
+  kExact,      // g from the discriminant form per fragment (MODEL.md section 4)
   kSpotlight,  // Elinas: a radial 1 - rho^2 texture projected from the eye along the cone
 };
 
@@ -64,7 +64,7 @@ struct RenderSettings {
   double volume_step = 1.0;
 };
 
-// The CPU reference (SPEC section 7).
+// The CPU reference (MODEL.md section 7).
 struct ReferenceSettings {
   int samples_per_axis = 4;  // supersampling grid per pixel
   int threads = 0;           // 0: one per hardware thread

@@ -53,8 +53,36 @@ float targetDistance() { return texelFetch(u_target_distance, ivec2(gl_FragCoord
 vec3 targetColour() { return texelFetch(u_target_colour, ivec2(gl_FragCoord.xy), 0).rgb; }
 #endif
 
+// Gardner eq. 8 (MODEL.md section 3) from its terms; shading = (a, t, s, e).
+float gardnerIntensity(vec4 shading, float diffuse, float highlight, float it) {
+  float a = shading.x, t = shading.y, s = shading.z;
+  return (1.0 - a) * ((1.0 - t) * ((1.0 - s) * diffuse + s * highlight) + t * it) + a;
+}
+
+// Gardner eq. 9 and 11 (MODEL.md section 4): translucence TR for the texture's excess over
+// the threshold; D = 0 is a hard threshold.
+float translucence(float excess, float d) {
+  return d <= 0.0 ? (excess <= 0.0 ? 1.0 : 0.0) : clamp(1.0 - excess / d, 0.0, 1.0);
+}
+
+// Gardner terms a pixel resolves (MODEL.md section 2), fractional where one fades, for a
+// footprint in periods: term j (1-based) resolves while 2^j footprint <= 1/2
+// (GardnerTexture::termCountForFootprint on the CPU).
+float resolvedTerms(float footprint, float terms) {
+#if defined(FILTER_NONE)
+  return terms;
+#else
+  float highest = log2(0.5 / max(footprint, 1e-30));
+#if defined(FILTER_CUT)
+  return clamp(floor(highest), 0.0, terms);
+#else
+  return clamp(highest - 1.0, 0.0, terms);  // fade over the octave below
+#endif
+#endif
+}
+
 // Distance in metres along r (any length) to the first opaque surface: the ground plane
-// (SPEC section 5) or a target; kFar where the ray reaches the sky.
+// (MODEL.md section 5) or a target; kFar where the ray reaches the sky.
 float opaqueDistance(vec3 r) {
   float distance = r.z < 0.0 ? u_camera_z * (length(r) / -r.z) : kFar;
 #ifdef TARGETS
@@ -84,7 +112,7 @@ vec3 background(vec3 r) {
   // The ground's share of the pixel: r.z is linear across the image, so the horizon is a
   // straight edge and its box-filtered coverage is exact.
   float ground = clamp(0.5 - r.z / u_horizon_slope, 0.0, 1.0);
-  vec3 sky = u_horizon + (u_zenith - u_horizon) * sqrt(max(d.z, 0.0));  // SPEC section 5
+  vec3 sky = u_horizon + (u_zenith - u_horizon) * sqrt(max(d.z, 0.0));  // MODEL.md section 5
 #ifdef FOG
   // Each part carries its own fog. The ground seen at the horizon lies behind an infinite
   // stretch of fog (the fog touches the ground), so there it is the fog colour.
@@ -101,9 +129,7 @@ const char* kLayers = R"(
 const int kSlots = 8;
 uniform float u_height[kSlots];     // layer altitude minus camera altitude, never 0
 uniform vec3 u_colour[kSlots];      // layer colour times sun colour
-// Gardner eq. 8 per slot, with Id constant over a plane: I = base + texture * It
-// + specular * Is (see GlRenderer::setSlotUniforms).
-uniform vec4 u_intensity[kSlots];   // base, texture, specular weight, shininess e
+uniform vec4 u_shading[kSlots];     // Gardner eq. 8: ambient a, texture t, specular s, shininess e
 uniform float u_threshold[kSlots];  // T1
 uniform float u_transition[kSlots]; // D
 uniform vec2 u_origin[kSlots];      // texture coordinate under the camera, periods, in [0, 1)
@@ -135,20 +161,10 @@ LayerHit hitLayer(int i, vec3 r) {
 
 vec2 layerCoordinate(int i, LayerHit hit) { return u_origin[i] + hit.p * u_inv_period[i]; }
 
-// Number of Gardner terms a pixel resolves (SPEC section 2). Term j (1-based) has 2^j
-// cycles per period and resolves while 2^j * footprint <= 1/2.
+// Number of Gardner terms a pixel of slot i resolves.
 float termCount(int i, LayerHit hit) {
-#if defined(FILTER_NONE)
-  return u_terms[i];
-#else
-  float footprint = max(length(hit.dpdx * u_inv_period[i]), length(hit.dpdy * u_inv_period[i]));
-  float highest_resolved = log2(0.5 / footprint);
-#if defined(FILTER_CUT)
-  return clamp(floor(highest_resolved), 0.0, u_terms[i]);
-#else
-  return clamp(highest_resolved - 1.0, 0.0, u_terms[i]);  // fade over the octave below
-#endif
-#endif
+  return resolvedTerms(
+      max(length(hit.dpdx * u_inv_period[i]), length(hit.dpdy * u_inv_period[i])), u_terms[i]);
 }
 
 // Baked Gardner: level l holds the truncation to n - l terms in red and to n - l - 1 in
@@ -205,20 +221,17 @@ float proceduralValue(int i, LayerHit hit) {
 // Slot i's surface "over" what lies behind it.
 void composite(int i, vec3 r, LayerHit hit, float it, inout vec3 colour,
                inout float transmittance) {
-  float excess = it - u_threshold[i];
-  float tr = u_transition[i] <= 0.0 ? (excess <= 0.0 ? 1.0 : 0.0)     // D = 0: hard threshold
-                                    : clamp(1.0 - excess / u_transition[i], 0.0, 1.0);  // eq. 9
-  vec4 weights = u_intensity[i];
-  float intensity = weights.x + weights.y * it;
-#ifdef SPECULAR
+  float tr = translucence(it - u_threshold[i], u_transition[i]);  // Gardner eq. 9
   vec3 normal = vec3(0.0, 0.0, u_height[i] > 0.0 ? -1.0 : 1.0);  // turned towards the viewer
   float n_dot_l = dot(normal, u_to_sun);
+  float highlight = 0.0;
+#ifdef SPECULAR
   if (n_dot_l > 0.0) {
     vec3 reflected = 2.0 * n_dot_l * normal - u_to_sun;
-    intensity += weights.z * pow(max(dot(reflected, -normalize(r)), 0.0), weights.w);
+    highlight = pow(max(dot(reflected, -normalize(r)), 0.0), u_shading[i].w);
   }
 #endif
-  vec3 surface = intensity * u_colour[i];
+  vec3 surface = gardnerIntensity(u_shading[i], max(n_dot_l, 0.0), highlight, it) * u_colour[i];
 #ifdef FOG
   surface = applyFog(surface, normalize(r), hit.distance);
 #endif

@@ -1,4 +1,4 @@
-// Automaton clouds on the GL against the CPU reference (SPEC sections 6, 7). The reference
+// Automaton clouds on the GL against the CPU reference (MODEL.md sections 6, 7). The reference
 // marches the exact metaball density in steps of l/8 and the sunlight in steps of l/4; the GL
 // marches the density lattice (2 samples per cell) and reads sunlight swept over it. Both
 // sample pixel centres only, so the difference is the lattice, the sweep and float maths.

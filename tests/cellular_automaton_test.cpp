@@ -8,7 +8,7 @@
 namespace nephele {
 namespace {
 
-// An independent, cell-by-cell statement of SPEC 6's growth rules on plain bool arrays.
+// An independent, cell-by-cell statement of MODEL.md section 6's growth rules on plain bool arrays.
 struct PlainGrid {
   GridSize n;
   std::vector<bool> hum, act, cld;

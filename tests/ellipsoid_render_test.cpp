@@ -1,4 +1,4 @@
-// Ellipsoid clouds and targets on the GL against the CPU reference (SPEC sections 4, 5, 7).
+// Ellipsoid clouds and targets on the GL against the CPU reference (MODEL.md sections 4, 5, 7).
 // Metric: PSNR over sRGB-encoded RGB and the largest sRGB channel difference; each test
 // states its tolerance and why.
 #include <gtest/gtest.h>
@@ -338,7 +338,7 @@ std::vector<std::pair<std::string, RenderSettings>> passStructures() {
   return {{"per_pixel", per_pixel}, {"centre", centre}, {"multipass", multipass}};
 }
 
-// The ground is opaque (SPEC section 5): a cloud reaching below the ground's line of sight is
+// The ground is opaque (MODEL.md section 5): a cloud reaching below the ground's line of sight is
 // hidden where the ray meets the ground first, in every pass structure. Point-sampled
 // reference; only pixels along silhouettes may differ (the multipass mesh's silhouette
 // strays by up to half a pixel).

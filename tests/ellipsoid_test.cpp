@@ -1,6 +1,6 @@
-// The ellipsoid primitive (SPEC sections 4 and 5): quadric, ray hits, the limb function g
-// against SPEC's definition restated here, the silhouette conic, the eye-space box, solid
-// textures, the in-cloud model and targets.
+// The ellipsoid primitive (MODEL.md sections 4 and 5): quadric, ray hits, the limb function g
+// against the definition of MODEL.md section 4 restated here, the silhouette conic, the eye-space
+// box, solid textures, the in-cloud model and targets.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -19,7 +19,7 @@ Ellipsoid tilted() {
   return {{500.0, 300.0, 120.0}, {200.0, 900.0, 1500.0}, {30.0, 20.0, -15.0}};
 }
 
-// SPEC section 4, restated: Q(X) = (X - C)^T M (X - C) - 1 with M from the nine parameters,
+// MODEL.md section 4, restated: Q(X) = (X - C)^T M (X - C) - 1 with M from the nine parameters,
 // the ray quadratic a s^2 + b s + c and its discriminant.
 struct Quadratic {
   double a, b, c;

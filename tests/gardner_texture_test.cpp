@@ -13,7 +13,7 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-// SPEC section 2 written out independently: m of n terms, k for all n terms.
+// MODEL.md section 2 written out independently: m of n terms, k for all n terms.
 double specTexture(const GardnerTexture& g, glm::dvec3 p, int m, bool solid) {
   const GardnerTextureParams& params = g.params();
   double c = 1.0, sum_c = 0.0, sx = params.t0, sy = params.t0;

@@ -1,4 +1,4 @@
-// GL renderer against the CPU reference (SPEC section 7). Metric: PSNR over sRGB-encoded RGB
+// GL renderer against the CPU reference (MODEL.md section 7). Metric: PSNR over sRGB-encoded RGB
 // in [0, 1] and the largest sRGB channel difference; tolerances are stated per test. On
 // failure the actual, expected and 8x difference images go to NEPHELE_TEST_OUTPUT.
 #include <gtest/gtest.h>
@@ -127,8 +127,8 @@ TEST_F(GlRenderTest, HardThresholdMatchesReference) {
   expectClose(renderer_->renderFloat(file.scene, file.render), reference, 26.0, 0.6, "hard");
 }
 
-// SPEC precision rule: shifted by whole texture periods to about 100 km from the origin, a
-// layer must look as it does at the origin.
+// The precision rule of MODEL.md section 2: shifted by whole texture periods to about 100 km from
+// the origin, a layer must look as it does at the origin.
 TEST_F(GlRenderTest, LayerFarFromOriginLooksAsAtOrigin) {
   for (const char* name : {"cirrus", "overcast"}) {
     SceneFile file = preset(name);

@@ -72,7 +72,8 @@ struct AutomatonCloudView {
 
   glm::dvec3 lowerBound() const;  // world box where the density can be non-zero
   glm::dvec3 upperBound() const;
-  // Density at a world point, blended in time (SPEC 6: exact metaballs, the reference's).
+  // Density at a world point, blended in time (MODEL.md section 6: exact metaballs, the
+  // reference's).
   double exactDensity(glm::dvec3 world) const;
   double phaseValue(double cos_theta) const;
 };

@@ -118,7 +118,7 @@ void CellularAutomaton::growRows(int k_begin, int k_end, std::vector<std::uint64
   const auto& act = bits_[int(CellBit::kAct)];
   const auto& cld = bits_[int(CellBit::kCld)];
   const int nw = words_per_row_;
-  // act of row (j, k), word w; 0 outside the grid (SPEC: cells outside read 0).
+  // act of row (j, k), word w; 0 outside the grid (MODEL.md section 6: cells outside read 0).
   auto actAt = [&](int w, int j, int k) -> std::uint64_t {
     if (j < 0 || j >= size_.ny || k < 0 || k >= size_.nz) return 0;
     return act[wordIndex(w, j, k)];

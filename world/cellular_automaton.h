@@ -1,5 +1,5 @@
 #pragma once
-// Dobashi's cellular automaton for cloud growth (SPEC section 6). Each of the three bits
+// Dobashi's cellular automaton for cloud growth (MODEL.md section 6). Each of the three bits
 // (hum, act, cld) is packed 64 cells to a word along x, so the growth rules run as bitwise
 // operations over whole words, and the stochastic rules make 64 Bernoulli draws at once.
 #include <cstdint>

@@ -1,5 +1,5 @@
 #pragma once
-// From automaton cells to light (SPEC section 6): metaball density, sunlight through it, and
+// From automaton cells to light (MODEL.md section 6): metaball density, sunlight through it, and
 // the phase functions of single scattering. Grid frame: metres from the grid's lower corner,
 // cell (i, j, k) centred at ((i, j, k) + 0.5) * cell size.
 #include <cmath>
@@ -11,8 +11,9 @@
 
 namespace nephele {
 
-inline constexpr double kCloudExtinctionPerMetre = 16.33e-3;  // Ex for density 1 (SPEC 6)
-inline constexpr double kMetaballRadiusCells = 2.0;           // R = 2 l (SPEC 6 default)
+inline constexpr double kCloudExtinctionPerMetre =
+    16.33e-3;                                        // Ex for density 1 (MODEL.md section 6)
+inline constexpr double kMetaballRadiusCells = 2.0;  // R = 2 l (MODEL.md section 6 default)
 
 // The metaball field f(r) = -4/9 a^6 + 17/9 a^4 - 22/9 a^2 + 1, a = r / R; 0 beyond R.
 double metaballField(double r, double radius);

@@ -1,5 +1,5 @@
 #pragma once
-// Gardner's ellipsoid primitive (SPEC sections 4 and 5): nine parameters, its quadric, and,
+// Gardner's ellipsoid primitive (MODEL.md sections 4 and 5): nine parameters, its quadric, and,
 // for one eye, the ray quadratic, the exact limb function g, the silhouette conic and the
 // eye-space bounding box. Everything is camera-relative and in double, so a cloud 100 km
 // from the origin is as exact as one at it.
@@ -25,7 +25,7 @@ std::string ellipsoidError(const Ellipsoid& ellipsoid);
 // so the surface is |W (X - centre)| = 1.
 glm::dmat3 worldToUnitSphere(const Ellipsoid& ellipsoid);
 
-// The quadric Q(X) = (X - C)^T M (X - C) - 1 with M = W^T W (SPEC section 5).
+// The quadric Q(X) = (X - C)^T M (X - C) - 1 with M = W^T W (MODEL.md section 5).
 double quadricValue(const Ellipsoid& ellipsoid, glm::dvec3 point);
 
 // Entry and exit distances of a ray along a unit or non-unit direction.
@@ -57,14 +57,15 @@ class EllipsoidView {
   // nullopt when it misses or only grazes. Hits may lie behind the eye (negative).
   std::optional<RaySpan> intersect(glm::dvec3 direction) const;
 
-  // The discriminant Delta(d) = b^2 - 4ac as the quadratic form d^T K d (SPEC section 4).
+  // The discriminant Delta(d) = b^2 - 4ac as the quadratic form d^T K d (MODEL.md section 4).
   const glm::dmat3& discriminantForm() const { return k_; }
   // K's single positive eigenvalue and its unit eigenvector turned towards the ellipsoid
   // (the axis of the cone of tangent rays). Valid only while the eye is outside.
   double limbEigenvalue() const { return lambda_; }
   glm::dvec3 limbAxis() const { return axis_; }
   // P = -(K - lam a a^T) / lam, so that g(d) = 1 - q^T P q with q = d / (d.a) - a: the same
-  // g as SPEC's Delta / (lam (d.a)^2), written so floats keep it accurate near the axis.
+  // g as the limb function's Delta / (lam (d.a)^2), written so floats keep it accurate near the
+  // axis.
   const glm::dmat3& limbForm() const { return limb_form_; }
 
   // The exact limb function g(d) = Delta(d) / (lam (d.a)^2), clamped to [0, 1]: 1 on the
@@ -85,7 +86,7 @@ class EllipsoidView {
 };
 
 // Silhouette conic of the ellipsoid in the image plane: with d = u right + v up + forward
-// (SPEC section 1), the rays that touch the ellipsoid are [u v 1] C [u v 1]^T = 0 and the
+// (MODEL.md section 1), the rays that touch the ellipsoid are [u v 1] C [u v 1]^T = 0 and the
 // rays that meet it have a non-negative value. C = B^T K B with B = [right up forward].
 glm::dmat3 silhouetteConic(const EllipsoidView& view, const ViewBasis& basis);
 

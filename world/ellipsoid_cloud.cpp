@@ -90,12 +90,8 @@ Veil inCloudVeil(const std::vector<EllipsoidCloud>& clouds,
       cloud_transmittance *= 1.0 - veilOpacity(glm::length(o));
     }
     if (cloud_transmittance == 1.0) continue;
-    const ShadingParams& sh = cloud.shading;
     const double it = textures[c]->value(eye - clouds[c].drift_m);
-    const double intensity =
-        (1.0 - sh.ambient) * ((1.0 - sh.texture_fraction) * (1.0 - sh.specular) * lit_from_above +
-                              sh.texture_fraction * it) +
-        sh.ambient;
+    const double intensity = gardnerIntensity(cloud.shading, lit_from_above, 0.0, it);
     const double opacity = 1.0 - cloud_transmittance;
     weighted += opacity * intensity * cloud.colour * sun.colour;
     weight += opacity;

@@ -1,6 +1,6 @@
 #pragma once
 // Gardner's cloud formations: clusters of textured, translucent ellipsoids sharing one colour,
-// one texture and one set of thresholds (SPEC sections 4 and 5), and the in-cloud fog a
+// one texture and one set of thresholds (MODEL.md sections 4 and 5), and the in-cloud fog a
 // camera sees when it flies into one.
 #include <cstdint>
 #include <string>
@@ -41,7 +41,7 @@ double cloudAltitude(const EllipsoidCloud& cloud);
 std::vector<Ellipsoid> cumulusEllipsoids(int count, glm::dvec3 base_centre, double width_m,
                                          std::uint64_t seed);
 
-// In-cloud fog. SPEC leaves the view from inside an ellipsoid to the renderer; this model is
+// In-cloud fog. The papers leave the view from inside an ellipsoid to the renderer; this model is
 // shared by the GL renderer and the reference so both show the same thing.
 //
 // With rho = |W (eye - centre)| (1 on the surface, 0 at the centre) and a band

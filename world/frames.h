@@ -1,5 +1,5 @@
 #pragma once
-// World frame, orientation and camera (SPEC section 1).
+// World frame, orientation and camera (MODEL.md section 1).
 #include <glm/glm.hpp>
 
 namespace nephele {

@@ -53,7 +53,7 @@ double GardnerTexture::solid(glm::dvec3 p, double term_count) const {
 }
 
 void GardnerTexture::addTerm(int i, glm::dvec3 p, bool solid, double& sx, double& sy) const {
-  // Planar phases, plus the Z term for solid textures (SPEC section 2).
+  // Planar phases, plus the Z term for solid textures (MODEL.md section 2).
   double px = 0.5 * kPi * std::sin(0.5 * fy_[i] * p.y);
   double py = 0.5 * kPi * std::sin(0.5 * fx_[i] * p.x);
   if (solid) {

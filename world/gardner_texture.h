@@ -1,5 +1,5 @@
 #pragma once
-// Gardner's sum-of-sines texture (SPEC section 2), evaluated in double.
+// Gardner's sum-of-sines texture (MODEL.md section 2), evaluated in double.
 #include <cstdint>
 #include <vector>
 
@@ -17,7 +17,7 @@ struct GardnerTextureParams {
   std::uint64_t seed = 0;
 };
 
-// How terms above the local sampling frequency are removed (SPEC section 2).
+// How terms above the local sampling frequency are removed (MODEL.md section 2).
 enum class TermFilter {
   kFade,  // fade each term out over the octave below half the sampling frequency
   kCut,   // drop a term as soon as it exceeds half the sampling frequency

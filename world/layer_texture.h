@@ -43,7 +43,7 @@ class LayerTexture {
   const LayerTextureSpec& spec() const { return spec_; }
   // Repeat lengths in metres.
   glm::dvec2 period() const;
-  // Drift offset at time t in double, wrapped into [0, period) (SPEC section 2).
+  // Drift offset at time t in double, wrapped into [0, period) (MODEL.md section 2).
   glm::dvec2 driftOffset(double time_s) const;
   // Position inside one period, in periods [0, 1), of world point p at time t.
   glm::dvec2 periodicCoordinate(glm::dvec2 world_xy, double time_s) const;

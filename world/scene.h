@@ -17,7 +17,7 @@
 
 namespace nephele {
 
-// A textured sky plane Z = altitude (SPEC section 5), seen from below or above.
+// A textured sky plane Z = altitude (MODEL.md section 5), seen from below or above.
 struct CloudLayer {
   std::string name;
   double altitude_m = 3000.0;

@@ -14,6 +14,13 @@ double translucenceFromExcess(double excess, double transition) {
 
 }  // namespace
 
+double gardnerIntensity(const ShadingParams& shading, double diffuse, double highlight,
+                        double texture_value) {
+  const double a = shading.ambient, t = shading.texture_fraction, s = shading.specular;
+  return (1.0 - a) * ((1.0 - t) * ((1.0 - s) * diffuse + s * highlight) + t * texture_value) +
+         a;  // Gardner eq. 8
+}
+
 double gardnerIntensity(const ShadingParams& shading, double texture_value, glm::dvec3 normal,
                         glm::dvec3 to_sun, glm::dvec3 to_viewer) {
   glm::dvec3 n = glm::normalize(normal);
@@ -25,9 +32,7 @@ double gardnerIntensity(const ShadingParams& shading, double texture_value, glm:
     const glm::dvec3 reflected = 2.0 * n_dot_l * n - to_sun;
     highlight = std::pow(std::max(0.0, glm::dot(reflected, to_viewer)), shading.shininess);
   }
-  const double a = shading.ambient, t = shading.texture_fraction, s = shading.specular;
-  return (1.0 - a) * ((1.0 - t) * ((1.0 - s) * diffuse + s * highlight) + t * texture_value) +
-         a;  // Gardner eq. 8
+  return gardnerIntensity(shading, diffuse, highlight, texture_value);
 }
 
 double skyPlaneTranslucence(double texture_value, double threshold, double transition) {

@@ -1,5 +1,5 @@
 #pragma once
-// Gardner's shading equation (SPEC section 3) and translucence (SPEC section 4).
+// Gardner's shading equation (MODEL.md section 3) and translucence (MODEL.md section 4).
 #include <glm/glm.hpp>
 
 namespace nephele {
@@ -11,8 +11,12 @@ struct ShadingParams {
   double shininess = 8.0;         // e
 };
 
-// Gardner eq. 8. `normal` is any surface normal (it is turned towards the viewer here),
-// `to_sun` and `to_viewer` are unit vectors.
+// Gardner eq. 8 from its terms: I = (1 - a){(1 - t)[(1 - s) Id + s Is] + t It} + a.
+double gardnerIntensity(const ShadingParams& shading, double diffuse, double highlight,
+                        double texture_value);
+
+// Gardner eq. 8 at a surface: Id and Is from the geometry. `normal` is any surface normal
+// (it is turned towards the viewer here), `to_sun` and `to_viewer` are unit vectors.
 double gardnerIntensity(const ShadingParams& shading, double texture_value, glm::dvec3 normal,
                         glm::dvec3 to_sun, glm::dvec3 to_viewer);
 

@@ -1,5 +1,5 @@
 #pragma once
-// Sky background, ground, sun (SPEC sections 1 and 5) and ground fog.
+// Sky background, ground, sun (MODEL.md sections 1 and 5) and ground fog.
 #include <glm/glm.hpp>
 
 namespace nephele {

@@ -46,7 +46,7 @@ VolumeTable bakeGardnerSolid(const GardnerTexture& texture, int size, int terms)
   const glm::dvec2 p2 = texture.period();
   const glm::dvec3 period(p2.x, p2.y, p2.x);  // Z phases run at FX / 2
   const std::size_t n = std::size_t(size);
-  // Term i along X is sin(a(x) + b(y, z)), along Y sin(a'(y) + b'(x, z)) (SPEC section 2,
+  // Term i along X is sin(a(x) + b(y, z)), along Y sin(a'(y) + b'(x, z)) (MODEL.md section 2,
   // solid phases): tabulate a per coordinate and b per pair, then sin(a + b) by addition.
   std::vector<double> sin_ax(m * n), cos_ax(m * n), sin_ay(m * n), cos_ay(m * n);
   std::vector<double> sin_bx(m * n * n), cos_bx(m * n * n), sin_by(m * n * n), cos_by(m * n * n);

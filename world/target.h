@@ -1,6 +1,6 @@
 #pragma once
 // Opaque objects for sensor simulation (targets): a box, an ellipsoid or a triangle mesh,
-// placed and oriented like every body (SPEC section 1). Clouds hide them and they hide
+// placed and oriented like every body (MODEL.md section 1). Clouds hide them and they hide
 // clouds, per pixel.
 #include <array>
 #include <cstdint>
