@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "renderer/frame_timing.h"
-#include "renderer/gl_renderer.h"
+#include "renderer/gl/gl_renderer.h"
 
 namespace nephele::bench {
 

@@ -14,9 +14,9 @@
 
 #include "bench/bench_common.h"
 #include "config/scene_file.h"
-#include "renderer/gl_renderer.h"
-#include "renderer/image_metrics.h"
-#include "renderer/reference_renderer.h"
+#include "image/image_metrics.h"
+#include "renderer/gl/gl_renderer.h"
+#include "renderer/reference/reference_renderer.h"
 
 namespace {
 

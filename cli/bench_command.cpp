@@ -16,11 +16,11 @@
 
 #include "cli/render_command.h"
 #include "config/scene_file.h"
+#include "image/image_metrics.h"
 #include "renderer/frame_timing.h"
-#include "renderer/gl_renderer.h"
-#include "renderer/image_metrics.h"
-#include "renderer/reference_renderer.h"
-#include "world/ellipsoid_cloud.h"
+#include "renderer/gl/gl_renderer.h"
+#include "renderer/reference/reference_renderer.h"
+#include "world/formations/ellipsoid_cloud.h"
 
 namespace nephele {
 namespace {

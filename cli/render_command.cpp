@@ -7,8 +7,8 @@
 #include <cmath>
 
 #include "config/scene_file.h"
-#include "renderer/gl_renderer.h"
-#include "renderer/reference_renderer.h"
+#include "renderer/gl/gl_renderer.h"
+#include "renderer/reference/reference_renderer.h"
 #include "world/check.h"
 #include "world/world.h"
 

@@ -6,8 +6,8 @@
 #include <CLI/CLI.hpp>
 
 #include "config/scene_file.h"
-#include "protocol/image_encoding.h"
-#include "renderer/gl_platform.h"
+#include "image/image_encoding.h"
+#include "renderer/gl/gl_platform.h"
 #include "world/world.h"
 
 namespace nephele {

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "config/scene_file.h"
-#include "protocol/image_encoding.h"
+#include "image/image_encoding.h"
 #include "protocol/messages.h"
 
 namespace nephele {

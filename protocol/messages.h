@@ -11,7 +11,7 @@
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
-#include "world/weather.h"
+#include "world/formations/weather.h"
 
 namespace nephele {
 

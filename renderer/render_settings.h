@@ -1,7 +1,7 @@
 #pragma once
 // Speed-for-accuracy knobs of the GL renderer; each is measured against the CPU reference by
 // bench/render_bench.
-#include "world/gardner_texture.h"
+#include "world/textures/gardner_texture.h"
 
 namespace nephele {
 

@@ -9,9 +9,9 @@
 #include <numeric>
 #include <sstream>
 
-#include "protocol/image_encoding.h"
-#include "renderer/gl_platform.h"
-#include "renderer/gl_renderer.h"
+#include "image/image_encoding.h"
+#include "renderer/gl/gl_platform.h"
+#include "renderer/gl/gl_renderer.h"
 #include "world/counter_random.h"
 #include "world/world.h"
 
@@ -43,7 +43,7 @@ ProtocolError badField(std::string message) {
   return {ErrorCode::kBadField, std::move(message)};
 }
 
-// What the last rendered frame did (renderer/frame_stats.h).
+// What the last rendered frame did (renderer/gl/frame_stats.h).
 json frameStatsJson(const FrameStats& f) {
   return {{"passes", f.passes()},
           {"sky_passes", f.sky_passes},

@@ -1,4 +1,4 @@
-#include "world/cellular_automaton.h"
+#include "world/automaton/cellular_automaton.h"
 
 #include <cmath>
 #include <random>

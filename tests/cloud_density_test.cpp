@@ -1,4 +1,4 @@
-#include "world/cloud_density.h"
+#include "world/automaton/cloud_density.h"
 
 #include <cmath>
 #include <numbers>

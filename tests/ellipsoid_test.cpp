@@ -7,10 +7,10 @@
 #include <limits>
 #include <random>
 
-#include "world/ellipsoid.h"
-#include "world/ellipsoid_cloud.h"
-#include "world/solid_texture.h"
+#include "world/formations/ellipsoid.h"
+#include "world/formations/ellipsoid_cloud.h"
 #include "world/target.h"
+#include "world/textures/solid_texture.h"
 
 namespace nephele {
 namespace {

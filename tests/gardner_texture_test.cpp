@@ -1,4 +1,4 @@
-#include "world/gardner_texture.h"
+#include "world/textures/gardner_texture.h"
 
 #include <gtest/gtest.h>
 
@@ -6,7 +6,7 @@
 #include <numbers>
 #include <random>
 
-#include "world/layer_texture.h"
+#include "world/textures/layer_texture.h"
 
 namespace nephele {
 namespace {

@@ -9,10 +9,10 @@
 #include <string>
 
 #include "config/scene_file.h"
-#include "protocol/image_encoding.h"
-#include "renderer/gl_renderer.h"
-#include "renderer/image_metrics.h"
-#include "renderer/reference_renderer.h"
+#include "image/image_encoding.h"
+#include "image/image_metrics.h"
+#include "renderer/gl/gl_renderer.h"
+#include "renderer/reference/reference_renderer.h"
 
 namespace nephele {
 

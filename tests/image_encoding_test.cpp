@@ -1,4 +1,4 @@
-#include "protocol/image_encoding.h"
+#include "image/image_encoding.h"
 
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>

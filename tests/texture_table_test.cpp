@@ -1,4 +1,4 @@
-#include "world/texture_table.h"
+#include "world/textures/texture_table.h"
 
 #include <gtest/gtest.h>
 

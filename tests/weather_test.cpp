@@ -1,8 +1,8 @@
-#include "world/weather.h"
+#include "world/formations/weather.h"
 
 #include <gtest/gtest.h>
 
-#include "world/layer_texture.h"
+#include "world/textures/layer_texture.h"
 
 namespace nephele {
 namespace {

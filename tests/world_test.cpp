@@ -7,8 +7,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "world/layer_texture.h"
 #include "world/limits.h"
+#include "world/textures/layer_texture.h"
 
 namespace nephele {
 namespace {

@@ -7,13 +7,13 @@
 
 #include <glm/glm.hpp>
 
-#include "world/automaton_cloud.h"
-#include "world/ellipsoid_cloud.h"
+#include "world/automaton/automaton_cloud.h"
+#include "world/formations/ellipsoid_cloud.h"
 #include "world/frames.h"
-#include "world/layer_texture.h"
 #include "world/shading.h"
 #include "world/sky.h"
 #include "world/target.h"
+#include "world/textures/layer_texture.h"
 
 namespace nephele {
 

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <limits>
 
-#include "world/ellipsoid.h"
+#include "world/formations/ellipsoid.h"
 
 namespace nephele {
 namespace {

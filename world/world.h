@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "world/automaton_cloud.h"
+#include "world/automaton/automaton_cloud.h"
 #include "world/scene.h"
 #include "world/schedule.h"
 

@@ -1,0 +1,201 @@
+#include "image/image_encoding.h"
+
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+
+namespace nephele {
+namespace {
+
+namespace oiio = OIIO;
+
+std::string lowerExtension(std::string_view path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
+  return ext;
+}
+
+// Opens `path` for `spec`, writes the pixels with the given strides, and renames into place.
+std::string writeWithOiio(const std::string& path, oiio::ImageSpec spec, oiio::TypeDesc pixel_type,
+                          const void* first_row, std::ptrdiff_t x_stride, std::ptrdiff_t y_stride) {
+  const std::string temporary = path + ".partial" + lowerExtension(path);
+  auto out = oiio::ImageOutput::create(path);
+  if (!out) return "cannot write '" + path + "': " + oiio::geterror();
+  if (!out->open(temporary, spec)) {
+    std::string why = out->geterror();
+    return "cannot open '" + path + "' for writing: " + why;
+  }
+  const bool written = out->write_image(pixel_type, first_row, x_stride, y_stride);
+  const std::string write_error = written ? "" : out->geterror();
+  const bool closed = out->close();
+  if (!written || !closed) {
+    std::remove(temporary.c_str());
+    return "writing '" + path + "' failed: " + (written ? out->geterror() : write_error);
+  }
+  std::error_code ec;
+  std::filesystem::rename(temporary, path, ec);
+  if (ec) {
+    std::remove(temporary.c_str());
+    return "cannot move the image into place at '" + path + "': " + ec.message();
+  }
+  return "";
+}
+
+// Writes one image into `out` through an in-memory proxy.
+std::string encodeWithOiio(const char* extension, const oiio::ImageSpec& spec,
+                           oiio::TypeDesc pixel_type, const void* first_row,
+                           std::ptrdiff_t x_stride, std::ptrdiff_t y_stride,
+                           std::vector<std::uint8_t>& out) {
+  out.clear();
+  oiio::Filesystem::IOVecOutput proxy(out);
+  const std::string name = std::string("frame") + extension;
+  auto writer = oiio::ImageOutput::create(name);
+  if (!writer) return "no encoder for " + name + ": " + oiio::geterror();
+  if (!writer->set_ioproxy(&proxy) || !writer->open(name, spec))
+    return "cannot encode " + name + ": " + writer->geterror();
+  const bool written = writer->write_image(pixel_type, first_row, x_stride, y_stride);
+  const std::string write_error = written ? "" : writer->geterror();
+  if (!writer->close() || !written)
+    return "encoding " + name + " failed: " + (written ? writer->geterror() : write_error);
+  return "";
+}
+
+std::vector<std::string> channelNamesFor(bool colour, bool coverage) {
+  std::vector<std::string> names;
+  if (colour) names = {"R", "G", "B"};
+  if (coverage) names.push_back("A");
+  return names;
+}
+
+std::string unknownExtension(const std::string& path) {
+  return "unknown image extension in '" + path + "' (allowed: " + std::string(kImageExtensions) +
+         ")";
+}
+
+}  // namespace
+
+std::optional<ImageFileFormat> imageFileFormatForPath(std::string_view path) {
+  const std::string ext = lowerExtension(path);
+  if (ext == ".png") return ImageFileFormat::kPng;
+  if (ext == ".jpg" || ext == ".jpeg") return ImageFileFormat::kJpeg;
+  if (ext == ".tif" || ext == ".tiff") return ImageFileFormat::kTiff;
+  if (ext == ".exr") return ImageFileFormat::kExr;
+  return std::nullopt;
+}
+
+Srgb8Image toSrgb8(const FloatImage& image) {
+  Srgb8Image out{image.width, image.height, false, std::vector<std::uint8_t>(image.rgba.size())};
+  for (std::size_t i = 0; i < image.rgba.size(); i += 4) {
+    for (int c = 0; c < 3; ++c) out.rgba[i + c] = toByte(srgbEncode(image.rgba[i + c]));
+    out.rgba[i + 3] = toByte(image.rgba[i + 3]);
+  }
+  return out;
+}
+
+std::string writeImageFile(const std::string& path, const Srgb8Image& image,
+                           const EncodeOptions& options) {
+  const auto format = imageFileFormatForPath(path);
+  if (!format) return unknownExtension(path);
+  if (isFloatFormat(*format)) return "'" + path + "' is a float format; it needs a float image";
+  // 8-bit files are for viewing: RGB only (coverage goes to EXR, where it is the alpha).
+  oiio::ImageSpec spec(image.width, image.height, 3, oiio::TypeDesc::UINT8);
+  spec.attribute("oiio:ColorSpace", "sRGB");
+  if (*format == ImageFileFormat::kPng)
+    spec.attribute("png:compressionLevel", std::clamp(options.png_compression, 0, 9));
+  if (*format == ImageFileFormat::kJpeg)
+    spec.attribute("Compression",
+                   "jpeg:" + std::to_string(std::clamp(options.jpeg_quality, 1, 100)));
+  const std::ptrdiff_t row = std::ptrdiff_t(image.width) * 4;
+  // GL readback is bottom-up: write it with a negative row stride instead of copying.
+  const std::uint8_t* first =
+      image.bottom_up ? image.rgba.data() + row * (image.height - 1) : image.rgba.data();
+  return writeWithOiio(path, spec, oiio::TypeDesc::UINT8, first, 4, image.bottom_up ? -row : row);
+}
+
+std::string writeImageFile(const std::string& path, const FloatImage& image,
+                           const EncodeOptions& options) {
+  const auto format = imageFileFormatForPath(path);
+  if (!format) return unknownExtension(path);
+  if (!isFloatFormat(*format)) return writeImageFile(path, toSrgb8(image), options);
+  oiio::ImageSpec spec(image.width, image.height, 4,
+                       options.exr_half ? oiio::TypeDesc::HALF : oiio::TypeDesc::FLOAT);
+  spec.channelnames = {"R", "G", "B", "A"};
+  spec.alpha_channel = 3;
+  spec.attribute("compression", options.exr_compression);
+  spec.attribute("oiio:ColorSpace", "Linear");
+  const std::ptrdiff_t row = std::ptrdiff_t(image.width) * 4 * sizeof(float);
+  return writeWithOiio(path, spec, oiio::TypeDesc::FLOAT, image.rgba.data(), 4 * sizeof(float),
+                       row);
+}
+
+std::string encodeImage(ImageFileFormat format, const Srgb8Image& image, bool colour, bool coverage,
+                        const EncodeOptions& options, std::vector<std::uint8_t>& out) {
+  if (!colour && !coverage) return "no channels selected";
+  if (format == ImageFileFormat::kExr) return "EXR needs a float image";
+  if (format == ImageFileFormat::kJpeg && (coverage || !colour)) return "JPEG holds colour only";
+  const int channels = (colour ? 3 : 0) + (coverage ? 1 : 0);
+  oiio::ImageSpec spec(image.width, image.height, channels, oiio::TypeDesc::UINT8);
+  spec.channelnames = channelNamesFor(colour, coverage);
+  spec.alpha_channel = coverage ? channels - 1 : -1;
+  // Colour is the whole composited image (sky included), not premultiplied by coverage:
+  // write it as it is.
+  spec.attribute("oiio:UnassociatedAlpha", 1);
+  spec.attribute("oiio:ColorSpace", "sRGB");
+  if (format == ImageFileFormat::kPng)
+    spec.attribute("png:compressionLevel", std::clamp(options.png_compression, 0, 9));
+  if (format == ImageFileFormat::kJpeg)
+    spec.attribute("Compression",
+                   "jpeg:" + std::to_string(std::clamp(options.jpeg_quality, 1, 100)));
+  const std::ptrdiff_t row = std::ptrdiff_t(image.width) * 4;
+  const std::uint8_t* first =
+      (image.bottom_up ? image.rgba.data() + row * (image.height - 1) : image.rgba.data()) +
+      (colour ? 0 : 3);
+  const char* extension = format == ImageFileFormat::kPng    ? ".png"
+                          : format == ImageFileFormat::kJpeg ? ".jpg"
+                                                             : ".tif";
+  return encodeWithOiio(extension, spec, oiio::TypeDesc::UINT8, first, 4,
+                        image.bottom_up ? -row : row, out);
+}
+
+std::string encodeImage(const FloatImage& image, bool colour, bool coverage,
+                        const EncodeOptions& options, std::vector<std::uint8_t>& out) {
+  if (!colour && !coverage) return "no channels selected";
+  const int channels = (colour ? 3 : 0) + (coverage ? 1 : 0);
+  oiio::ImageSpec spec(image.width, image.height, channels,
+                       options.exr_half ? oiio::TypeDesc::HALF : oiio::TypeDesc::FLOAT);
+  spec.channelnames = channelNamesFor(colour, coverage);
+  spec.alpha_channel = coverage ? channels - 1 : -1;
+  spec.attribute("compression", options.exr_compression);
+  spec.attribute("oiio:ColorSpace", "Linear");
+  const std::ptrdiff_t pixel = 4 * sizeof(float);
+  return encodeWithOiio(".exr", spec, oiio::TypeDesc::FLOAT, image.rgba.data() + (colour ? 0 : 3),
+                        pixel, pixel * image.width, out);
+}
+
+std::vector<std::uint8_t> packRaw(const Srgb8Image& image, bool colour, bool coverage) {
+  const int channels = (colour ? 3 : 0) + (coverage ? 1 : 0);
+  std::vector<std::uint8_t> out(std::size_t(image.width) * image.height * channels);
+  std::uint8_t* dst = out.data();
+  for (int y = 0; y < image.height; ++y) {
+    const int source_row = image.bottom_up ? image.height - 1 - y : y;
+    const std::uint8_t* src = image.rgba.data() + std::size_t(source_row) * image.width * 4;
+    if (channels == 4) {
+      std::memcpy(dst, src, std::size_t(image.width) * 4);
+      dst += std::size_t(image.width) * 4;
+      continue;
+    }
+    for (int x = 0; x < image.width; ++x, src += 4) {
+      if (colour) dst = std::copy(src, src + 3, dst);
+      if (coverage) *dst++ = src[3];
+    }
+  }
+  return out;
+}
+
+}  // namespace nephele

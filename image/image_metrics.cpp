@@ -1,0 +1,55 @@
+#include "image/image_metrics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "world/check.h"
+
+namespace nephele {
+
+ImageError compareImages(const FloatImage& actual, const FloatImage& expected) {
+  NEPHELE_CHECK(
+      actual.width == expected.width && actual.height == expected.height,
+      actual.width << "x" << actual.height << " vs " << expected.width << "x" << expected.height);
+  ImageError e;
+  double sum_sq = 0.0, coverage_sum_sq = 0.0;
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < actual.rgba.size(); i += 4) {
+    bool finite = true;
+    for (int c = 0; c < 4; ++c)
+      finite = finite && std::isfinite(actual.rgba[i + c]) && std::isfinite(expected.rgba[i + c]);
+    if (!finite) {
+      ++e.non_finite;
+      continue;
+    }
+    for (int c = 0; c < 3; ++c) {
+      const double d = srgbEncode(actual.rgba[i + c]) - srgbEncode(expected.rgba[i + c]);
+      sum_sq += d * d;
+      e.max_abs = std::max(e.max_abs, std::abs(d));
+      ++count;
+    }
+    const double coverage = std::abs(actual.rgba[i + 3] - expected.rgba[i + 3]);
+    e.coverage_max = std::max(e.coverage_max, coverage);
+    coverage_sum_sq += coverage * coverage;
+  }
+  auto psnr = [](double mse) {
+    return mse > 0.0 ? 10.0 * std::log10(1.0 / mse) : std::numeric_limits<double>::infinity();
+  };
+  const double mse = count ? sum_sq / double(count) : 0.0;
+  const double coverage_mse = count ? coverage_sum_sq / double(count / 3) : 0.0;
+  e.rms = std::sqrt(mse);
+  e.psnr_db = psnr(mse);
+  e.coverage_rms = std::sqrt(coverage_mse);
+  e.coverage_psnr = psnr(coverage_mse);
+  return e;
+}
+
+FloatImage differenceImage(const FloatImage& actual, const FloatImage& expected, float gain) {
+  FloatImage out{actual.width, actual.height, std::vector<float>(actual.rgba.size())};
+  for (std::size_t i = 0; i < actual.rgba.size(); ++i)
+    out.rgba[i] = (i % 4 == 3) ? 1.0f : gain * std::abs(actual.rgba[i] - expected.rgba[i]);
+  return out;
+}
+
+}  // namespace nephele

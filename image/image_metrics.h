@@ -1,0 +1,23 @@
+#pragma once
+// Error between two renders of the same view, measured as a viewer sees it: on sRGB-encoded
+// RGB in [0, 1] (coverage is compared separately, linearly).
+#include "image/image.h"
+
+namespace nephele {
+
+struct ImageError {
+  double psnr_db = 0.0;        // 10 log10(1 / MSE) over sRGB RGB; +inf when identical
+  double max_abs = 0.0;        // largest sRGB channel difference, in [0, 1]
+  double rms = 0.0;            // root mean square sRGB difference
+  double coverage_max = 0.0;   // largest coverage (alpha) difference
+  double coverage_rms = 0.0;   // root mean square coverage difference
+  double coverage_psnr = 0.0;  // 10 log10(1 / coverage MSE); +inf when identical
+  int non_finite = 0;          // pixels with a NaN or Inf in either image
+};
+
+ImageError compareImages(const FloatImage& actual, const FloatImage& expected);
+
+// |actual - expected| per channel, scaled by `gain`, as a float image for inspection.
+FloatImage differenceImage(const FloatImage& actual, const FloatImage& expected, float gain);
+
+}  // namespace nephele

@@ -1,0 +1,215 @@
+#include "renderer/gl/automaton_renderer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "renderer/gl/sky_shaders.h"
+#include "renderer/gl/view_uniforms.h"
+#include "world/check.h"
+
+namespace nephele {
+namespace {
+
+constexpr int kVolumeTextureUnit = 13;
+constexpr int kMaxMarchSteps = 2048;
+
+const char* kVolumePass = R"(
+layout(binding = 13) uniform sampler3D u_volume;  // rho and sunlight of both keyframes
+uniform vec3 u_box_min;         // camera-relative box where the density can be non-zero
+uniform vec3 u_box_max;
+uniform vec3 u_lattice_origin;  // camera-relative position of lattice sample (0, 0, 0)
+uniform float u_inv_spacing;    // lattice samples per metre
+uniform vec3 u_inv_dims;
+uniform float u_blend;          // 0: first keyframe, 1: second
+uniform float u_step;           // march step, metres
+uniform float u_extinction;     // Ex per metre for density 1
+uniform vec3 u_light;           // cloud colour times sun colour
+uniform float u_ambient;
+uniform vec3 u_to_sun;
+uniform float u_phase_g;
+
+vec2 densityAndSunlight(vec3 p) {
+  vec4 v = texture(u_volume, ((p - u_lattice_origin) * u_inv_spacing + 0.5) * u_inv_dims);
+  return mix(v.xy, v.zw, u_blend);
+}
+
+float phase(float c) {
+#ifdef CORNETTE_SHANKS
+  float g2 = u_phase_g * u_phase_g;  // Shen eq. 11
+  return 1.5 * (1.0 - g2) / (2.0 + g2) * (1.0 + c * c) /
+         pow(max(1.0 + g2 - 2.0 * u_phase_g * c, 1e-6), 1.5);
+#else
+  return 0.75 * (1.0 + c * c);
+#endif
+}
+
+void main() {
+  vec3 d = normalize(viewRay());
+  // Slab test against the box; the camera sits at the origin of these coordinates.
+  vec3 inv = 1.0 / mix(d, vec3(1e-20), equal(d, vec3(0.0)));
+  vec3 s0 = u_box_min * inv, s1 = u_box_max * inv;
+  vec3 near = min(s0, s1), far = max(s0, s1);
+  float enter = max(max(near.x, near.y), max(near.z, 0.0));
+  float leave = min(min(far.x, far.y), far.z);
+  leave = min(leave, opaqueDistance(d));  // the ground and targets hide what lies beyond
+  // The volume is composited as one surface at its entry (as the reference does), so it
+  // belongs to the layer band of its entry point.
+  if (!(leave > enter) || !inBand(enter * d.z)) discard;
+  int steps = min(int(ceil((leave - enter) / u_step)), MAX_STEPS);
+  float ds = (leave - enter) / float(steps);
+  float scattering = phase(dot(u_to_sun, d));
+  vec3 radiance = vec3(0.0);
+  float transmittance = 1.0;
+  vec2 a = densityAndSunlight(enter * d);
+  for (int i = 1; i <= steps && transmittance > 1e-3; ++i) {
+    vec2 b = densityAndSunlight((enter + float(i) * ds) * d);
+    // Exact attenuation over the step for density linear along it (MODEL.md section 6), with the source
+    // held at the mean of the step's ends, as the reference does.
+    float segment = exp(-u_extinction * 0.5 * (a.x + b.x) * ds);
+    float source = scattering * 0.5 * (a.y + b.y) + u_ambient;
+    radiance += transmittance * (1.0 - segment) * source * u_light;
+    transmittance *= segment;
+    a = b;
+  }
+  float alpha = 1.0 - transmittance;
+  if (alpha <= 0.0) discard;
+  // Fog as for a surface at the entry point, on the straight colour.
+  o_colour = vec4(alpha * applyFog(radiance / alpha, d, enter), alpha);
+}
+)";
+
+// The screen rectangle (NDC) covering the box, or the whole screen when the box reaches
+// behind the camera.
+std::vector<glm::vec2> screenRectangle(const Camera& camera, glm::dvec3 lo, glm::dvec3 hi) {
+  const ViewBasis b = viewBasis(camera);
+  const std::vector<glm::vec2> full{{-1, -1}, {3, -1}, {-1, 3}};
+  glm::dvec2 min_ndc(1e30), max_ndc(-1e30);
+  for (int corner = 0; corner < 8; ++corner) {
+    const glm::dvec3 p =
+        glm::dvec3(corner & 1 ? hi.x : lo.x, corner & 2 ? hi.y : lo.y, corner & 4 ? hi.z : lo.z) -
+        camera.position;
+    const double depth = glm::dot(p, b.forward);
+    if (depth <= 1e-3 * glm::length(p) + 1e-6) return full;
+    const glm::dvec2 ndc(glm::dot(p, b.right) / (depth * b.tan_half_vfov * b.aspect),
+                         glm::dot(p, b.up) / (depth * b.tan_half_vfov));
+    min_ndc = glm::min(min_ndc, ndc);
+    max_ndc = glm::max(max_ndc, ndc);
+  }
+  // One pixel of margin; the shader discards what misses the box.
+  const glm::dvec2 pixel(2.0 / camera.width, 2.0 / camera.height);
+  min_ndc = glm::clamp(min_ndc - pixel, -1.0, 1.0);
+  max_ndc = glm::clamp(max_ndc + pixel, -1.0, 1.0);
+  if (min_ndc.x >= max_ndc.x || min_ndc.y >= max_ndc.y) return {};
+  return {glm::vec2(min_ndc), {max_ndc.x, min_ndc.y}, glm::vec2(max_ndc), {min_ndc.x, max_ndc.y}};
+}
+
+}  // namespace
+
+AutomatonRenderer::AutomatonRenderer(const GlApi& gl)
+    : gl_(gl), vertex_array_(createVertexArray(gl)) {}
+
+void AutomatonRenderer::beginFrame(FrameStats& stats) {
+  stats_ = &stats;
+  for (auto& [key, volume] : volumes_) volume.used = false;
+}
+
+void AutomatonRenderer::endFrame() {
+  std::erase_if(volumes_, [](const auto& entry) { return !entry.second.used; });
+}
+
+GLuint AutomatonRenderer::program(bool fog, bool targets, PhaseFunction phase) {
+  std::string defines;
+  if (fog) defines += "#define FOG\n";
+  if (targets) defines += "#define TARGETS\n";
+  if (phase == PhaseFunction::kCornetteShanks) defines += "#define CORNETTE_SHANKS\n";
+  auto found = programs_.find(defines);
+  if (found != programs_.end()) return found->second.get();
+  const std::string fragment = "#version 450 core\n" + defines + "#define MAX_STEPS " +
+                               std::to_string(kMaxMarchSteps) + "\n" + viewShaderSource() +
+                               kVolumePass;
+  std::string error;
+  GlObject compiled = createProgram(gl_, polygonVertexSource(), fragment, error);
+  NEPHELE_CHECK(compiled, "automaton cloud pass: " << error);
+  return programs_.emplace(defines, std::move(compiled)).first->second.get();
+}
+
+AutomatonRenderer::Volume& AutomatonRenderer::volume(const Scene& scene, std::size_t index) {
+  const AutomatonCloudView& cloud = scene.automata[index];
+  Volume& v = volumes_[std::to_string(index) + "/" + cloud.name];
+  v.used = true;
+  if (v.texture && v.from == cloud.from && v.to == cloud.to) return v;
+  // New keyframes: interleave both into one RGBA texture (density, sunlight, density, sunlight).
+  const DensityLattice& a = cloud.from->lattice;
+  const DensityLattice& b = cloud.to->lattice;
+  NEPHELE_CHECK(a.dims == b.dims, "keyframes on different lattices");
+  std::vector<float> texels(a.density.size() * 4);
+  for (std::size_t i = 0; i < a.density.size(); ++i) {
+    texels[4 * i + 0] = a.density[i];
+    texels[4 * i + 1] = a.sunlight[i];
+    texels[4 * i + 2] = b.density[i];
+    texels[4 * i + 3] = b.sunlight[i];
+  }
+  if (!v.texture || !v.from || v.from->lattice.dims != a.dims) {
+    v.texture = createTexture(gl_, GL_TEXTURE_3D);
+    gl_.TextureStorage3D(v.texture.get(), 1, GL_RGBA32F, a.dims.x, a.dims.y, a.dims.z);
+    gl_.TextureParameteri(v.texture.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    gl_.TextureParameteri(v.texture.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    for (GLenum wrap : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R})
+      gl_.TextureParameteri(v.texture.get(), wrap, GL_CLAMP_TO_EDGE);
+  }
+  gl_.TextureSubImage3D(v.texture.get(), 0, 0, 0, 0, a.dims.x, a.dims.y, a.dims.z, GL_RGBA,
+                        GL_FLOAT, texels.data());
+  v.from = cloud.from;
+  v.to = cloud.to;
+  ++uploads_;
+  ++stats_->volume_uploads;
+  return v;
+}
+
+void AutomatonRenderer::drawCloud(const Scene& scene, std::size_t index,
+                                  const RenderSettings& settings, bool targets_drawn,
+                                  const AltitudeBand& band) {
+  const AutomatonCloudView& cloud = scene.automata[index];
+  // March only where either keyframe has density: the lattice samples that bound it.
+  const DensityLattice& a = cloud.from->lattice;
+  const DensityLattice& b = cloud.to->lattice;
+  const glm::ivec3 lo = glm::min(a.occupied_lo, b.occupied_lo);
+  const glm::ivec3 hi = glm::max(a.occupied_hi, b.occupied_hi);
+  if (glm::any(glm::greaterThan(lo, hi))) return;  // no cloud in either keyframe
+  const glm::dvec3 box_lo = cloud.corner + a.position(lo.x, lo.y, lo.z);
+  const glm::dvec3 box_hi = cloud.corner + a.position(hi.x, hi.y, hi.z);
+  const std::vector<glm::vec2> polygon = screenRectangle(scene.camera, box_lo, box_hi);
+  if (polygon.empty()) return;
+  const Volume& v = volume(scene, index);
+  const GLuint p = program(scene.fog.has_value(), targets_drawn, cloud.phase);
+  gl_.UseProgram(p);
+  setViewUniforms(gl_, p, scene.camera, scene.fog, band);
+  const glm::dvec3 eye = scene.camera.position;
+  const DensityLattice& lattice = cloud.from->lattice;
+  setUniform3(gl_, p, "u_box_min", box_lo - eye);
+  setUniform3(gl_, p, "u_box_max", box_hi - eye);
+  setUniform3(gl_, p, "u_lattice_origin", cloud.corner + lattice.origin - eye);
+  setUniform3(gl_, p, "u_inv_dims", 1.0 / glm::dvec3(lattice.dims));
+  setUniform3(gl_, p, "u_light", cloud.colour * scene.sun.colour);
+  setUniform3(gl_, p, "u_to_sun", sunDirection(scene.sun));
+  auto set = [&](const char* name, double value) {
+    gl_.ProgramUniform1f(p, gl_.GetUniformLocation(p, name), float(value));
+  };
+  set("u_inv_spacing", 1.0 / lattice.spacing);
+  set("u_blend", cloud.blend);
+  set("u_step", lattice.spacing * settings.volume_step);
+  set("u_extinction", kCloudExtinctionPerMetre);
+  set("u_ambient", cloud.ambient);
+  set("u_phase_g", cloud.phase_g);
+  gl_.BindTextureUnit(kVolumeTextureUnit, v.texture.get());
+  gl_.ProgramUniform2fv(p, gl_.GetUniformLocation(p, "u_polygon"), GLsizei(polygon.size()),
+                        &polygon[0].x);
+  gl_.Enable(GL_BLEND);
+  gl_.BlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  gl_.BindVertexArray(vertex_array_.get());
+  gl_.DrawArrays(GL_TRIANGLE_FAN, 0, GLsizei(polygon.size()));
+  ++stats_->automaton_passes;
+}
+
+}  // namespace nephele

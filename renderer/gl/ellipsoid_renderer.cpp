@@ -1,0 +1,754 @@
+#include "renderer/gl/ellipsoid_renderer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <numbers>
+#include <sstream>
+
+#include "renderer/gl/sky_shaders.h"
+#include "renderer/gl/view_uniforms.h"
+#include "world/check.h"
+#include "world/formations/ellipsoid.h"
+
+namespace nephele {
+namespace {
+
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+constexpr int kAtlasSize = 2048;
+constexpr int kMaxTileSize = 1024;
+constexpr int kSpotlightSize = 64;
+constexpr double kTileNear = 1.0e-3;  // metres: the tile frusta's near plane
+
+int nextPowerOfTwo(double x) {
+  int p = 1;
+  while (p < x && p < (1 << 20)) p *= 2;
+  return p;
+}
+
+glm::vec4 row(glm::dvec3 v, double w = 0.0) {
+  return glm::vec4(glm::dvec4(v, w));
+}
+
+// Rectangle [x0, x1] x [y0, y1] in NDC covering the eye-space box's projection, widened by
+// a pixel; the whole screen when the box reaches behind the eye. False when off screen.
+bool screenRectangle(const EyeBox& box, const Camera& camera, const ViewBasis& basis,
+                     glm::dvec4& rect) {
+  const glm::dvec3 lo = box.centre - box.half_extent, hi = box.centre + box.half_extent;
+  if (hi.z <= 0.0) return false;  // wholly behind the eye
+  if (lo.z <= 0.0) {
+    rect = {-1.0, -1.0, 1.0, 1.0};
+    return true;
+  }
+  const double sx = 1.0 / (basis.tan_half_vfov * basis.aspect), sy = 1.0 / basis.tan_half_vfov;
+  rect = {1e30, 1e30, -1e30, -1e30};
+  for (int corner = 0; corner < 8; ++corner) {
+    const glm::dvec3 p((corner & 1) ? hi.x : lo.x, (corner & 2) ? hi.y : lo.y,
+                       (corner & 4) ? hi.z : lo.z);
+    const double x = sx * p.x / p.z, y = sy * p.y / p.z;
+    rect = {std::min(rect.x, x), std::min(rect.y, y), std::max(rect.z, x), std::max(rect.w, y)};
+  }
+  const double mx = 2.0 / camera.width, my = 2.0 / camera.height;
+  rect = {std::max(rect.x - mx, -1.0), std::max(rect.y - my, -1.0), std::min(rect.z + mx, 1.0),
+          std::min(rect.w + my, 1.0)};
+  return rect.x < rect.z && rect.y < rect.w;
+}
+
+// The tile's off-axis frustum: clip coordinates of camera-relative points for the part
+// `rect` of the camera's image, with the near plane at kTileNear.
+glm::mat4 tileProjection(const ViewBasis& basis, glm::dvec4 rect) {
+  const glm::dvec3 x = basis.right / (basis.tan_half_vfov * basis.aspect);
+  const glm::dvec3 y = basis.up / basis.tan_half_vfov;
+  const glm::dvec3 w = basis.forward;
+  const glm::dvec3 tile_x = (2.0 * x - (rect.x + rect.z) * w) / (rect.z - rect.x);
+  const glm::dvec3 tile_y = (2.0 * y - (rect.y + rect.w) * w) / (rect.w - rect.y);
+  glm::dmat4 m(0.0);  // m[column][row]
+  for (int c = 0; c < 3; ++c) {
+    m[c][0] = tile_x[c];
+    m[c][1] = tile_y[c];
+    m[c][2] = w[c];
+    m[c][3] = w[c];
+  }
+  m[3][2] = -2.0 * kTileNear;  // z = w - 2 near: clipped where w < near
+  return glm::mat4(m);
+}
+
+std::string textureKey(const SolidTextureSpec& spec, const RenderSettings& settings) {
+  std::ostringstream key;
+  key.precision(17);
+  const GardnerTextureParams& g = spec.gardner;
+  key << int(spec.source) << '/' << spec.seed << '/';
+  if (spec.source == SolidTextureSource::kGardner)
+    key << g.terms << '/' << g.fx1 << '/' << g.fy1 << '/' << g.t0 << '/' << g.seeded_phases << '/'
+        << int(settings.texture_evaluation);
+  else
+    key << spec.perlin_period_m << '/' << spec.perlin_size_log2 << '/' << spec.perlin_cells << '/'
+        << spec.perlin_octaves << '/' << spec.perlin_persistence;
+  return key.str();
+}
+
+// Baked solid Gardner: 4 texels per cycle of the highest term at level 0 (at most 128 a
+// side), level l holding n - l terms. With 4 texels per cycle GL's trilinear LOD equals the
+// fade schedule of MODEL.md section 2, so trilinear filtering fades each term over its octave.
+int bakedSolidSize(const GardnerTexture& gardner) {
+  return std::min(4 << gardner.terms(), 128);
+}
+
+void uploadBakedSolid(const GlApi& gl, GLuint texture, const GardnerTexture& gardner) {
+  const int base = bakedSolidSize(gardner);
+  const int levels = int(std::log2(base)) + 1;
+  gl.TextureStorage3D(texture, levels, GL_R16, base, base, base);
+  for (int level = 0; level < levels; ++level) {
+    const int size = base >> level;
+    const VolumeTable baked = bakeGardnerSolid(gardner, size, gardner.terms() - level);
+    gl.TextureSubImage3D(texture, level, 0, 0, 0, size, size, size, GL_RED, GL_FLOAT,
+                         baked.values.data());
+  }
+  gl.TextureParameteri(texture, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+}
+
+void uploadVolume(const GlApi& gl, GLuint texture, const VolumeTable& table) {
+  const int levels = int(std::log2(table.size)) + 1;
+  gl.TextureStorage3D(texture, levels, GL_R16, table.size, table.size, table.size);
+  gl.TextureSubImage3D(texture, 0, 0, 0, 0, table.size, table.size, table.size, GL_RED, GL_FLOAT,
+                       table.values.data());
+  gl.GenerateTextureMipmap(texture);
+  gl.TextureParameteri(texture, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+}
+
+// TextureEvaluation::kAuto: a baked texel may cover at most this many pixels where the cloud
+// is nearest; closer, bilinear magnification blurs the texture (a cumulus filling a 4 degree
+// view loses 28 dB) and the sines are evaluated per fragment instead. Measured by
+// `nephele bench` (docs/ACCURACY.md).
+constexpr double kMaxBakedTexelPixels = 2.0;
+
+bool bakedTextureMagnified(const SolidTexture& texture, double nearest_m, const Camera& camera) {
+  const glm::dvec3 period = texture.period();
+  const double texel_m =
+      std::min({period.x, period.y, period.z}) / bakedSolidSize(*texture.gardner());
+  const double pixel_m = std::max(nearest_m, 0.0) * 2.0 *
+                         std::tan(glm::radians(camera.vfov_deg) / 2.0) / camera.height;
+  return texel_m > kMaxBakedTexelPixels * pixel_m;
+}
+
+// Slices for a silhouette within half a pixel of the true one: a polygon of n sides around
+// a circle of r pixels strays by r (1 - cos(pi / n)).
+int adaptiveSlices(double radius_px) {
+  if (radius_px <= 1.0) return 8;
+  const double n = std::numbers::pi / std::acos(std::max(1.0 - 0.5 / radius_px, -1.0));
+  return std::clamp(4 * int(std::ceil(n / 4.0)), 8, 128);
+}
+
+}  // namespace
+
+bool makeEllipsoidRecord(const Ellipsoid& e, const Camera& camera, EllipsoidRecord& out,
+                         double& centre_distance) {
+  const EllipsoidView view(e, camera.position);
+  if (view.eyeInside()) return false;  // MODEL.md section 4: the in-cloud veil shows it
+  const double fade = surfaceFade(view.eyeRadius());
+  if (fade <= 0.0) return false;
+  const ViewBasis basis = viewBasis(camera);
+  glm::dvec4 rect;
+  if (!screenRectangle(eyeSpaceBox(e, camera.position, basis), camera, basis, rect)) return false;
+
+  const glm::dmat3& w = view.toUnitSphere();
+  for (int i = 0; i < 3; ++i) out.v[i] = row(glm::dvec3(w[0][i], w[1][i], w[2][i]));
+  const double c = glm::dot(view.eyeInUnitSphere(), view.eyeInUnitSphere()) - 1.0;
+  out.v[3] = row(view.eyeInUnitSphere(), c);
+  out.v[4] = row(view.limbAxis(), fade);
+  const glm::dmat3& p = view.limbForm();
+  for (int i = 0; i < 3; ++i) out.v[5 + i] = row(glm::dvec3(p[0][i], p[1][i], p[2][i]));
+  // Spotlight coordinates: P = L^T L from P's two non-negative eigenpairs.
+  const SymmetricEigen eigen = symmetricEigen(p);
+  for (int i = 0; i < 2; ++i)
+    out.v[8 + i] = row(std::sqrt(std::max(eigen.values[2 - i], 0.0)) * eigen.vectors[2 - i]);
+  out.v[10] = glm::vec4(rect);
+  const glm::dmat3 body = bodyToWorld(e.orientation);
+  for (int i = 0; i < 3; ++i) out.v[11 + i] = row(body[i] * e.radii[i]);
+  out.v[14] = row(e.centre - camera.position);
+  out.v[15] = glm::vec4(0.0f);
+  centre_distance = glm::length(e.centre - camera.position);
+  return true;
+}
+
+EllipsoidRenderer::EllipsoidRenderer(const GlApi& gl)
+    : gl_(gl), vertex_array_(createVertexArray(gl)) {}
+
+EllipsoidRenderer::~EllipsoidRenderer() = default;
+
+void EllipsoidRenderer::beginFrame(FrameStats& stats) {
+  stats_ = &stats;
+  for (auto& [key, cached] : textures_) cached.used = false;
+  next_buffer_ = 0;
+}
+
+GLuint EllipsoidRenderer::frameBuffer(const void* data, std::size_t bytes) {
+  // A fresh buffer for every upload in a frame: llvmpipe may still be drawing from the last
+  // one (it defers rasterisation), and rewriting it in place would change earlier draws.
+  if (next_buffer_ == buffer_pool_.size()) buffer_pool_.push_back(createBuffer(gl_));
+  const GLuint buffer = buffer_pool_[next_buffer_++].get();
+  if (bytes >= 16) {
+    gl_.NamedBufferData(buffer, GLsizeiptr(bytes), data, GL_STREAM_DRAW);
+  } else {  // never bind an empty store
+    const std::uint8_t zeros[16] = {};
+    gl_.NamedBufferData(buffer, 16, zeros, GL_STREAM_DRAW);
+    if (bytes > 0) gl_.NamedBufferSubData(buffer, 0, GLsizeiptr(bytes), data);
+  }
+  return buffer;
+}
+
+void EllipsoidRenderer::endFrame() {
+  std::erase_if(textures_, [](const auto& entry) { return !entry.second.used; });
+  std::erase_if(impostors_, [](const auto& entry) { return !entry.second.used; });
+  for (auto& [index, impostor] : impostors_) impostor.used = false;
+}
+
+GLuint EllipsoidRenderer::program(const EllipsoidPassLayout& layout) {
+  const std::string key = layout.key();
+  auto found = programs_.find(key);
+  if (found != programs_.end()) return found->second.get();
+  std::string error;
+  GlObject compiled =
+      createProgram(gl_, ellipsoidVertexSource(layout), ellipsoidFragmentSource(layout), error);
+  NEPHELE_CHECK(compiled, key << ": " << error);
+  return programs_.emplace(key, std::move(compiled)).first->second.get();
+}
+
+EllipsoidRenderer::CachedTexture& EllipsoidRenderer::cachedTexture(const SolidTextureSpec& spec,
+                                                                   const RenderSettings& settings) {
+  auto [entry, inserted] = textures_.try_emplace(textureKey(spec, settings));
+  if (inserted) entry->second.source = std::make_unique<SolidTexture>(spec);
+  entry->second.used = true;
+  return entry->second;
+}
+
+GLuint EllipsoidRenderer::gpuTexture(CachedTexture& cached) {
+  if (cached.texture) return cached.texture.get();
+  cached.texture = createTexture(gl_, GL_TEXTURE_3D);
+  const GLuint t = cached.texture.get();
+  if (const GardnerTexture* gardner = cached.source->gardner())
+    uploadBakedSolid(gl_, t, *gardner);
+  else
+    uploadVolume(gl_, t, *cached.source->volume());
+  for (GLenum wrap : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R})
+    gl_.TextureParameteri(t, wrap, GL_REPEAT);
+  gl_.TextureParameteri(t, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  return t;
+}
+
+GLuint EllipsoidRenderer::spotlightTexture() {
+  if (spotlight_) return spotlight_.get();
+  // Elinas' radial spotlight: 1 - rho^2 inside the unit disc, 0 outside.
+  std::vector<float> values(kSpotlightSize * kSpotlightSize);
+  for (int y = 0; y < kSpotlightSize; ++y)
+    for (int x = 0; x < kSpotlightSize; ++x) {
+      const double u = 2.0 * (x + 0.5) / kSpotlightSize - 1.0;
+      const double v = 2.0 * (y + 0.5) / kSpotlightSize - 1.0;
+      values[y * kSpotlightSize + x] = float(std::max(0.0, 1.0 - u * u - v * v));
+    }
+  spotlight_ = createTexture(gl_, GL_TEXTURE_2D);
+  const GLuint t = spotlight_.get();
+  gl_.TextureStorage2D(t, 1, GL_R16, kSpotlightSize, kSpotlightSize);
+  gl_.TextureSubImage2D(t, 0, 0, 0, kSpotlightSize, kSpotlightSize, GL_RED, GL_FLOAT,
+                        values.data());
+  gl_.TextureParameteri(t, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  gl_.TextureParameteri(t, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  gl_.TextureParameteri(t, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  gl_.TextureParameteri(t, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  return t;
+}
+
+const IndexedMesh& EllipsoidRenderer::sphereMesh(int slices) {
+  auto found = meshes_.find(slices);
+  if (found != meshes_.end()) return found->second;
+  std::vector<glm::vec3> vertices;
+  std::vector<GLuint> indices;
+  unitSphere(slices, vertices, indices);
+  return meshes_.emplace(slices, uploadMesh(gl_, vertices, indices)).first->second;
+}
+
+void EllipsoidRenderer::setCloudUniforms(GLuint p, const Scene& scene, const EllipsoidCloud& cloud,
+                                         const CachedTexture& cached, SolidTextureKind kind,
+                                         const AltitudeBand& band) {
+  setViewUniforms(gl_, p, scene.camera, scene.fog, band);
+  setUniform3(gl_, p, "u_cloud_colour", cloud.colour * scene.sun.colour);
+  const ShadingParams& sh = cloud.shading;
+  const glm::vec4 shading(sh.ambient, sh.texture_fraction, sh.specular, sh.shininess);
+  gl_.ProgramUniform4fv(p, gl_.GetUniformLocation(p, "u_shading"), 1, &shading.x);
+  setUniform3(gl_, p, "u_thresholds",
+              {cloud.threshold_centre, cloud.threshold_limb, cloud.transition});
+  setUniform3(gl_, p, "u_to_sun", sunDirection(scene.sun));
+  // The precision rule of MODEL.md section 2: the texture's local origin is the eye, reduced modulo
+  // the period in double; shaders see camera-relative offsets only.
+  const SolidTexture& texture = *cached.source;
+  const glm::dvec3 origin_uvw = texture.periodicCoordinate(scene.camera.position - cloud.drift_m);
+  setUniform3(gl_, p, "u_tex_origin", origin_uvw);
+  setUniform3(gl_, p, "u_inv_period", 1.0 / texture.period());
+  if (kind != SolidTextureKind::kProcedural) return;
+  const GardnerTexture& g = *texture.gardner();
+  const glm::dvec3 eye = origin_uvw * texture.period();
+  auto set = [&](const char* name, int j, double v) {
+    char element[32];
+    std::snprintf(element, sizeof element, "%s[%d]", name, j);
+    gl_.ProgramUniform1f(p, gl_.GetUniformLocation(p, element), float(v));
+  };
+  for (int j = 0; j < g.terms(); ++j) {
+    set("u_fx", j, g.frequencyX(j));
+    set("u_fy", j, g.frequencyY(j));
+    set("u_amplitude", j, g.amplitude(j));
+    set("u_phase_x", j, wrapPeriodic(g.frequencyX(j) * eye.x + g.phaseX(j), kTwoPi));
+    set("u_phase_y", j, wrapPeriodic(g.frequencyY(j) * eye.y + g.phaseY(j), kTwoPi));
+    set("u_half_x", j, wrapPeriodic(0.5 * g.frequencyX(j) * eye.x, kTwoPi));
+    set("u_half_y", j, wrapPeriodic(0.5 * g.frequencyY(j) * eye.y, kTwoPi));
+    set("u_half_z", j, wrapPeriodic(0.5 * g.frequencyX(j) * eye.z, kTwoPi));
+  }
+  gl_.ProgramUniform1f(p, gl_.GetUniformLocation(p, "u_t0"), float(g.params().t0));
+  gl_.ProgramUniform1f(p, gl_.GetUniformLocation(p, "u_k"), float(g.normalisation()));
+  gl_.ProgramUniform1f(p, gl_.GetUniformLocation(p, "u_terms"), float(g.terms()));
+}
+
+void EllipsoidRenderer::uploadRecords(const std::vector<EllipsoidRecord>& records) {
+  gl_.BindBufferBase(GL_SHADER_STORAGE_BUFFER, kEllipsoidBufferBinding,
+                     frameBuffer(records.data(), records.size() * sizeof(EllipsoidRecord)));
+}
+
+void EllipsoidRenderer::drawCloud(const Scene& scene, std::size_t index,
+                                  const RenderSettings& settings, const FrameTarget& target,
+                                  bool targets_drawn, const AltitudeBand& band) {
+  if (settings.impostor_tolerance_px > 0.0 &&
+      drawImpostor(scene, index, settings, target, targets_drawn, band))
+    return;
+  drawCloudDirect(scene, index, settings, target, targets_drawn, band);
+}
+
+namespace {
+
+// The bounding sphere of a cloud: the centre of its ellipsoids' bounding box, and the
+// largest distance from it to a centre plus that ellipsoid's longest semi-axis.
+void boundingSphere(const EllipsoidCloud& cloud, glm::dvec3& centre, double& radius) {
+  glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-lo);
+  for (const Ellipsoid& e : cloud.ellipsoids) {
+    const double r = std::max({e.radii.x, e.radii.y, e.radii.z});
+    lo = glm::min(lo, e.centre - r);
+    hi = glm::max(hi, e.centre + r);
+  }
+  centre = 0.5 * (lo + hi);
+  radius = 0.0;
+  for (const Ellipsoid& e : cloud.ellipsoids)
+    radius = std::max(radius,
+                      glm::length(e.centre - centre) + std::max({e.radii.x, e.radii.y, e.radii.z}));
+}
+
+// Everything an impostor's picture depends on besides the eye.
+std::string impostorKey(const Scene& scene, const EllipsoidCloud& cloud,
+                        const RenderSettings& settings) {
+  std::ostringstream key;
+  key.precision(17);
+  key << cloud.colour.x << cloud.colour.y << cloud.colour.z << '/' << cloud.threshold_centre << '/'
+      << cloud.threshold_limb << '/' << cloud.transition << '/' << cloud.shading.ambient << '/'
+      << cloud.shading.texture_fraction << '/' << cloud.shading.specular << '/'
+      << cloud.shading.shininess << '/' << textureKey(cloud.texture, settings) << '/'
+      << int(settings.ellipsoid_passes) << int(settings.ellipsoid_order) << int(settings.limb)
+      << int(settings.term_filter) << '/' << scene.sun.azimuth_deg << '/' << scene.sun.elevation_deg
+      << '/' << scene.sun.colour.x << scene.sun.colour.y << scene.sun.colour.z << '/'
+      << scene.fog.has_value();
+  if (scene.fog) key << scene.fog->top_m << '/' << scene.fog->visibility_m;
+  for (const Ellipsoid& e : cloud.ellipsoids)
+    key << '|' << e.radii.x << ',' << e.radii.y << ',' << e.radii.z << ',' << e.centre.x << ','
+        << e.centre.y << ',' << e.centre.z << ',' << e.orientation.heading_deg << ','
+        << e.orientation.pitch_deg << ',' << e.orientation.roll_deg;
+  return key.str();
+}
+
+}  // namespace
+
+bool EllipsoidRenderer::drawImpostor(const Scene& scene, std::size_t index,
+                                     const RenderSettings& settings, const FrameTarget& target,
+                                     bool targets_drawn, const AltitudeBand& band) {
+  const EllipsoidCloud& cloud = scene.clouds[index];
+  const Camera& camera = scene.camera;
+  glm::dvec3 centre;
+  double radius;
+  boundingSphere(cloud, centre, radius);
+  const double distance = glm::length(centre - camera.position);
+  // Only far clouds: the sphere well away from the eye and small on screen.
+  const double pixels_per_radian = camera.height / glm::radians(camera.vfov_deg);
+  const double diameter_px = 2.0 * radius / distance * pixels_per_radian;
+  if (distance < 4.0 * radius || diameter_px > 512.0) return false;
+  const int size = std::clamp(nextPowerOfTwo(diameter_px), 16, 512);
+
+  Impostor& impostor = impostors_[index];
+  impostor.used = true;
+  const std::string key = impostorKey(scene, cloud, settings);
+  // Reuse while the billboard's parallax, about R theta / distance in pixels for a change
+  // theta in the direction to the centre, stays within the tolerance.
+  const double theta = std::acos(std::clamp(
+      glm::dot(glm::normalize(centre - impostor.eye), glm::normalize(centre - camera.position)),
+      -1.0, 1.0));
+  const double parallax_px =
+      pixels_per_radian * radius *
+      (theta + std::abs(glm::length(centre - impostor.eye) - distance) / distance) / distance;
+  const bool fresh = impostor.key == key && glm::distance(impostor.centre, centre) == 0.0 &&
+                     impostor.size >= size && parallax_px <= settings.impostor_tolerance_px;
+  if (!fresh) {
+    // Render the cloud alone from here, looking at its centre, into a square texture.
+    Scene view = scene;
+    const glm::dvec3 d = glm::normalize(centre - camera.position);
+    view.camera.position = camera.position;
+    view.camera.orientation = {glm::degrees(std::atan2(d.x, d.y)),
+                               glm::degrees(std::asin(std::clamp(d.z, -1.0, 1.0))), 0.0};
+    const double half_angle = std::asin(std::min(1.0, radius / distance)) * 1.02;
+    view.camera.vfov_deg = glm::degrees(2.0 * half_angle);
+    view.camera.width = view.camera.height = size;
+    if (impostor.size != size || !impostor.texture) {
+      impostor.texture = createTexture(gl_, GL_TEXTURE_2D);
+      gl_.TextureStorage2D(impostor.texture.get(), 1, GL_RGBA16F, size, size);
+      gl_.TextureParameteri(impostor.texture.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+      gl_.TextureParameteri(impostor.texture.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+      gl_.TextureParameteri(impostor.texture.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+      gl_.TextureParameteri(impostor.texture.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+      impostor.framebuffer = createFramebuffer(gl_);
+      gl_.NamedFramebufferTexture(impostor.framebuffer.get(), GL_COLOR_ATTACHMENT0,
+                                  impostor.texture.get(), 0);
+    }
+    const float clear[4] = {0, 0, 0, 0};
+    gl_.ClearNamedFramebufferfv(impostor.framebuffer.get(), GL_COLOR, 0, clear);
+    gl_.BindFramebuffer(GL_FRAMEBUFFER, impostor.framebuffer.get());
+    gl_.Viewport(0, 0, size, size);
+    const FrameTarget impostor_target{impostor.framebuffer.get(), size, size};
+    drawCloudDirect(view, index, settings, impostor_target, false, AltitudeBand{});
+    gl_.BindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
+    gl_.Viewport(0, 0, target.width, target.height);
+    const ViewBasis basis = viewBasis(view.camera);
+    impostor.key = key;
+    impostor.eye = camera.position;
+    impostor.centre = centre;
+    impostor.right = basis.right;
+    impostor.up = basis.up;
+    impostor.half_size = distance * std::tan(half_angle);
+    impostor.size = size;
+    ++impostor_renders_;
+    ++stats_->impostors_rendered;
+  }
+
+  EllipsoidPassLayout layout;
+  layout.program = EllipsoidProgram::kImpostor;
+  layout.targets = targets_drawn;
+  const GLuint p = program(layout);
+  gl_.UseProgram(p);
+  setViewUniforms(gl_, p, camera, scene.fog, band);
+  const ViewBasis basis = viewBasis(camera);
+  setUniform3(gl_, p, "u_clip_x", basis.right / (basis.tan_half_vfov * basis.aspect));
+  setUniform3(gl_, p, "u_clip_y", basis.up / basis.tan_half_vfov);
+  setUniform3(gl_, p, "u_clip_w", basis.forward);
+  glm::vec3 corners[4];
+  for (int k = 0; k < 4; ++k)
+    corners[k] = glm::vec3(centre - camera.position +
+                           impostor.half_size * ((k & 1 ? 1.0 : -1.0) * impostor.right +
+                                                 (k & 2 ? 1.0 : -1.0) * impostor.up));
+  gl_.ProgramUniform3fv(p, gl_.GetUniformLocation(p, "u_corner"), 4, &corners[0].x);
+  gl_.BindTextureUnit(kImpostorTextureUnit, impostor.texture.get());
+  gl_.Enable(GL_BLEND);
+  gl_.BlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  gl_.BindVertexArray(vertex_array_.get());
+  gl_.DrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+  ++stats_->ellipsoid_passes;
+  ++stats_->impostors_drawn;
+  return true;
+}
+
+void EllipsoidRenderer::drawCloudDirect(const Scene& scene, std::size_t index,
+                                        const RenderSettings& settings, const FrameTarget& target,
+                                        bool targets_drawn, const AltitudeBand& band) {
+  const EllipsoidCloud& cloud = scene.clouds[index];
+  // Visible ellipsoids, back to front by centre distance; the nearest surface distance.
+  std::vector<std::pair<double, EllipsoidRecord>> visible;
+  double nearest_m = std::numeric_limits<double>::infinity();
+  for (const Ellipsoid& e : cloud.ellipsoids) {
+    EllipsoidRecord record;
+    double distance = 0.0;
+    if (!makeEllipsoidRecord(e, scene.camera, record, distance)) continue;
+    visible.push_back({distance, record});
+    nearest_m = std::min(nearest_m, distance - std::max({e.radii.x, e.radii.y, e.radii.z}));
+  }
+  stats_->ellipsoids_drawn += int(visible.size());
+  stats_->ellipsoids_culled += int(cloud.ellipsoids.size() - visible.size());
+  if (visible.empty()) return;
+  std::stable_sort(visible.begin(), visible.end(),
+                   [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::vector<EllipsoidRecord> records;
+  records.reserve(visible.size());
+  for (const auto& entry : visible) records.push_back(entry.second);
+
+  CachedTexture& texture = cachedTexture(cloud.texture, settings);
+  EllipsoidPassLayout base;
+  const bool procedural =
+      settings.texture_evaluation == TextureEvaluation::kProcedural ||
+      (settings.texture_evaluation == TextureEvaluation::kAuto && texture.source->gardner() &&
+       bakedTextureMagnified(*texture.source, nearest_m, scene.camera));
+  base.texture = !texture.source->gardner() ? SolidTextureKind::kTable
+                 : procedural               ? SolidTextureKind::kProcedural
+                                            : SolidTextureKind::kBakedGardner;
+  base.term_filter = settings.term_filter;
+  base.spotlight = settings.limb == LimbEvaluation::kSpotlight;
+  base.fog = scene.fog.has_value();
+  base.specular = cloud.shading.specular > 0.0;
+  base.targets = targets_drawn;
+  if (base.texture != SolidTextureKind::kProcedural)
+    gl_.BindTextureUnit(kVolumeTextureUnit, gpuTexture(texture));
+  if (base.spotlight) gl_.BindTextureUnit(kSpotlightTextureUnit, spotlightTexture());
+
+  gl_.Enable(GL_BLEND);
+  gl_.BlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  if (settings.ellipsoid_passes == EllipsoidPasses::kMultipass) {
+    drawTiles(scene, cloud, texture, base, settings, records, target, band);
+    return;
+  }
+  uploadRecords(records);
+  gl_.BindVertexArray(vertex_array_.get());
+  // Screen bins, each listing the ellipsoids whose rectangles overlap it.
+  const int bins_x = (target.width + kPerPixelBinSize - 1) / kPerPixelBinSize;
+  const int bins_y = (target.height + kPerPixelBinSize - 1) / kPerPixelBinSize;
+  std::vector<std::vector<GLint>> lists(std::size_t(bins_x) * bins_y);
+  auto pixel = [](float ndc, int size) { return (double(ndc) + 1.0) * 0.5 * size; };
+  std::size_t deepest = 0;
+  for (int i = 0; i < int(records.size()); ++i) {
+    const glm::vec4 rect = records[i].v[10];
+    const int x0 = std::clamp(int(pixel(rect.x, target.width)) / kPerPixelBinSize, 0, bins_x - 1);
+    const int x1 = std::clamp(int(pixel(rect.z, target.width)) / kPerPixelBinSize, 0, bins_x - 1);
+    const int y0 = std::clamp(int(pixel(rect.y, target.height)) / kPerPixelBinSize, 0, bins_y - 1);
+    const int y1 = std::clamp(int(pixel(rect.w, target.height)) / kPerPixelBinSize, 0, bins_y - 1);
+    for (int y = y0; y <= y1; ++y)
+      for (int x = x0; x <= x1; ++x) {
+        std::vector<GLint>& list = lists[std::size_t(y) * bins_x + x];
+        list.push_back(i);
+        deepest = std::max(deepest, list.size());
+      }
+  }
+  // Where no two ellipsoids share a bin, no pixel has two hits to sort: the centre pass
+  // draws the same image, faster.
+  if (settings.ellipsoid_order == EllipsoidOrder::kCentre || deepest <= 1) {
+    EllipsoidPassLayout layout = base;
+    layout.program = EllipsoidProgram::kFusedCentre;
+    const GLuint p = program(layout);
+    gl_.UseProgram(p);
+    setCloudUniforms(p, scene, cloud, texture, layout.texture, band);
+    gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_first"), 0);
+    gl_.DrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(records.size()));
+    ++stats_->ellipsoid_passes;
+    return;
+  }
+  // Per pixel: every bin in one draw, each pixel sorting its bin's hits.
+  EllipsoidPassLayout layout = base;
+  layout.program = EllipsoidProgram::kFusedPerPixel;
+  const GLuint p = program(layout);
+  gl_.UseProgram(p);
+  setCloudUniforms(p, scene, cloud, texture, layout.texture, band);
+  struct Bin {
+    glm::vec4 rect;
+    glm::ivec4 items;  // first, count
+  };
+  std::vector<Bin> bins;
+  std::vector<GLint> items;
+  auto ndc = [](int p, int size) { return float(2.0 * std::min(p, size) / size - 1.0); };
+  for (int y = 0; y < bins_y; ++y)
+    for (int x = 0; x < bins_x; ++x) {
+      const std::vector<GLint>& list = lists[std::size_t(y) * bins_x + x];
+      if (list.empty()) continue;
+      const int px = x * kPerPixelBinSize, py = y * kPerPixelBinSize;
+      bins.push_back(
+          {{ndc(px, target.width), ndc(py, target.height), ndc(px + kPerPixelBinSize, target.width),
+            ndc(py + kPerPixelBinSize, target.height)},
+           {GLint(items.size()), GLint(list.size()), 0, 0}});
+      items.insert(items.end(), list.begin(), list.end());
+    }
+  gl_.BindBufferBase(GL_SHADER_STORAGE_BUFFER, kBinBufferBinding,
+                     frameBuffer(bins.data(), bins.size() * sizeof(Bin)));
+  gl_.BindBufferBase(GL_SHADER_STORAGE_BUFFER, kBinItemBufferBinding,
+                     frameBuffer(items.data(), items.size() * sizeof(GLint)));
+  gl_.DrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(bins.size()));
+  ++stats_->ellipsoid_passes;
+}
+
+void EllipsoidRenderer::prepareAtlas(TileFormat format) {
+  if (atlas_ && atlas_format_ == format) return;
+  atlas_ = createTexture(gl_, GL_TEXTURE_2D);
+  gl_.TextureStorage2D(atlas_.get(), 1, format == TileFormat::kFloat ? GL_RGBA16F : GL_RGBA8,
+                       kAtlasSize, kAtlasSize);
+  gl_.TextureParameteri(atlas_.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  gl_.TextureParameteri(atlas_.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  gl_.TextureParameteri(atlas_.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  gl_.TextureParameteri(atlas_.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  atlas_framebuffer_ = createFramebuffer(gl_);
+  gl_.NamedFramebufferTexture(atlas_framebuffer_.get(), GL_COLOR_ATTACHMENT0, atlas_.get(), 0);
+  const GLenum status = gl_.CheckNamedFramebufferStatus(atlas_framebuffer_.get(), GL_FRAMEBUFFER);
+  NEPHELE_CHECK(status == GL_FRAMEBUFFER_COMPLETE, "atlas status 0x" << std::hex << status);
+  atlas_format_ = format;
+}
+
+void EllipsoidRenderer::drawTiles(const Scene& scene, const EllipsoidCloud& cloud,
+                                  CachedTexture& texture, const EllipsoidPassLayout& base,
+                                  const RenderSettings& settings,
+                                  std::vector<EllipsoidRecord>& records, const FrameTarget& target,
+                                  const AltitudeBand& band) {
+  prepareAtlas(settings.tile_format);
+  // Tile sizes: the screen rectangle rounded up to powers of two, or the fixed knob.
+  std::vector<Tile> all;
+  for (int i = 0; i < int(records.size()); ++i) {
+    const glm::vec4 rect = records[i].v[10];
+    const double w = 0.5 * (rect.z - rect.x) * target.width;
+    const double h = 0.5 * (rect.w - rect.y) * target.height;
+    Tile tile{i, settings.tile_resolution, settings.tile_resolution};
+    if (settings.tile_resolution == 0)
+      tile = {i, std::clamp(nextPowerOfTwo(w), 8, kMaxTileSize),
+              std::clamp(nextPowerOfTwo(h), 8, kMaxTileSize)};
+    all.push_back(tile);
+  }
+  // Batches in back-to-front order, each as many tiles as the atlas holds, packed first-fit
+  // by decreasing size onto shelves.
+  std::size_t next = 0;
+  while (next < all.size()) {
+    std::vector<Tile> batch;
+    std::vector<Tile> trial;
+    for (std::size_t i = next; i < all.size(); ++i) {
+      trial.push_back(all[i]);
+      std::vector<Tile> packed = trial;
+      std::stable_sort(packed.begin(), packed.end(), [](const Tile& a, const Tile& b) {
+        return a.height != b.height ? a.height > b.height : a.width > b.width;
+      });
+      int x = 0, y = 0, shelf = 0;
+      bool fits = true;
+      for (Tile& t : packed) {
+        if (x + t.width > kAtlasSize) x = 0, y += shelf, shelf = 0;
+        if (y + t.height > kAtlasSize) {
+          fits = false;
+          break;
+        }
+        t.x = x, t.y = y;
+        x += t.width;
+        shelf = std::max(shelf, t.height);
+      }
+      if (!fits) break;
+      batch = packed;
+    }
+    NEPHELE_CHECK(!batch.empty(), "tile larger than the atlas");
+    next += batch.size();
+    renderAtlasBatch(scene, cloud, texture, base, settings, records, batch, target, band);
+  }
+}
+
+void EllipsoidRenderer::renderAtlasBatch(const Scene& scene, const EllipsoidCloud& cloud,
+                                         const CachedTexture& texture,
+                                         const EllipsoidPassLayout& base,
+                                         const RenderSettings& settings,
+                                         std::vector<EllipsoidRecord>& records,
+                                         std::vector<Tile>& tiles, const FrameTarget& target,
+                                         const AltitudeBand& band) {
+  for (const Tile& t : tiles) records[t.record].v[15] = glm::vec4(t.x, t.y, t.width, t.height);
+  uploadRecords(records);
+  const ViewBasis basis = viewBasis(scene.camera);
+
+  // The tile passes, into the atlas.
+  gl_.BindFramebuffer(GL_FRAMEBUFFER, atlas_framebuffer_.get());
+  gl_.Enable(GL_SCISSOR_TEST);
+  const float zero[4] = {0, 0, 0, 0};
+  for (const Tile& t : tiles) {
+    gl_.Scissor(t.x, t.y, t.width, t.height);
+    gl_.ClearNamedFramebufferfv(atlas_framebuffer_.get(), GL_COLOR, 0, zero);
+  }
+  gl_.Disable(GL_SCISSOR_TEST);
+  gl_.Enable(GL_CULL_FACE);
+  gl_.CullFace(GL_BACK);
+  gl_.FrontFace(GL_CCW);
+  for (EllipsoidProgram pass : {EllipsoidProgram::kTileThreshold, EllipsoidProgram::kTileLimb,
+                                EllipsoidProgram::kTileColour}) {
+    EllipsoidPassLayout layout = base;
+    layout.program = pass;
+    layout.targets = false;  // tiles are not in screen space; the composite tests targets
+    const GLuint p = program(layout);
+    gl_.UseProgram(p);
+    setCloudUniforms(p, scene, cloud, texture, layout.texture, band);
+    if (pass == EllipsoidProgram::kTileThreshold) {
+      gl_.Disable(GL_BLEND);
+    } else if (pass == EllipsoidProgram::kTileLimb) {
+      // alpha -= (T2 - T1)(1 - g): reverse subtraction, alpha only.
+      gl_.Enable(GL_BLEND);
+      gl_.BlendEquationSeparate(GL_FUNC_ADD, GL_FUNC_REVERSE_SUBTRACT);
+      gl_.BlendFuncSeparate(GL_ONE, GL_ONE, GL_ONE, GL_ONE);
+      gl_.ColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_TRUE);
+    } else {
+      gl_.Disable(GL_BLEND);
+      gl_.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_FALSE);
+    }
+    for (const Tile& t : tiles) {
+      const EllipsoidRecord& r = records[t.record];
+      gl_.Viewport(t.x, t.y, t.width, t.height);
+      const glm::mat4 projection = tileProjection(basis, glm::dvec4(r.v[10]));
+      gl_.ProgramUniformMatrix4fv(p, gl_.GetUniformLocation(p, "u_projection"), 1, GL_FALSE,
+                                  &projection[0][0]);
+      gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_index"), t.record);
+      const double radius_px = 0.25 * std::max((r.v[10].z - r.v[10].x) * target.width,
+                                               (r.v[10].w - r.v[10].y) * target.height);
+      const IndexedMesh& mesh =
+          sphereMesh(settings.tessellation > 0 ? settings.tessellation : adaptiveSlices(radius_px));
+      gl_.BindVertexArray(mesh.vertex_array.get());
+      gl_.DrawElements(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr);
+      ++stats_->atlas_passes;
+    }
+  }
+  gl_.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  gl_.BlendEquationSeparate(GL_FUNC_ADD, GL_FUNC_ADD);
+  gl_.Disable(GL_CULL_FACE);
+
+  // Composite every tile as a screen rectangle, back to front (records are in that order).
+  gl_.BindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
+  gl_.Viewport(0, 0, target.width, target.height);
+  gl_.Enable(GL_BLEND);
+  gl_.BlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  EllipsoidPassLayout layout = base;
+  layout.program = EllipsoidProgram::kTileComposite;
+  const GLuint p = program(layout);
+  gl_.UseProgram(p);
+  setCloudUniforms(p, scene, cloud, texture, layout.texture, band);
+  const glm::vec2 atlas_size(kAtlasSize, kAtlasSize);
+  gl_.ProgramUniform2fv(p, gl_.GetUniformLocation(p, "u_atlas_size"), 1, &atlas_size.x);
+  gl_.BindTextureUnit(kAtlasTextureUnit, atlas_.get());
+  gl_.BindVertexArray(vertex_array_.get());
+  std::vector<int> order;
+  for (const Tile& t : tiles) order.push_back(t.record);
+  std::sort(order.begin(), order.end());
+  for (int i : order) {
+    const glm::vec4 rect = records[i].v[10];
+    const glm::vec2 polygon[4] = {
+        {rect.x, rect.y}, {rect.z, rect.y}, {rect.z, rect.w}, {rect.x, rect.w}};
+    gl_.ProgramUniform2fv(p, gl_.GetUniformLocation(p, "u_polygon"), 4, &polygon[0].x);
+    gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_index"), i);
+    gl_.DrawArrays(GL_TRIANGLE_FAN, 0, 4);
+    ++stats_->ellipsoid_passes;
+  }
+}
+
+void EllipsoidRenderer::drawVeil(const Scene& scene, const RenderSettings& settings) {
+  if (scene.clouds.empty()) return;
+  std::vector<const SolidTexture*> textures;
+  for (const EllipsoidCloud& cloud : scene.clouds)
+    textures.push_back(cachedTexture(cloud.texture, settings).source.get());
+  const Veil veil = inCloudVeil(scene.clouds, textures, scene.camera.position, scene.sun);
+  if (veil.opacity <= 0.0) return;
+  EllipsoidPassLayout layout;
+  layout.program = EllipsoidProgram::kVeil;
+  const GLuint p = program(layout);
+  gl_.UseProgram(p);
+  const glm::vec4 premultiplied(glm::dvec4(veil.colour * veil.opacity, veil.opacity));
+  gl_.ProgramUniform4fv(p, gl_.GetUniformLocation(p, "u_veil"), 1, &premultiplied.x);
+  const glm::vec2 polygon[3] = {{-1, -1}, {3, -1}, {-1, 3}};
+  gl_.ProgramUniform2fv(p, gl_.GetUniformLocation(p, "u_polygon"), 3, &polygon[0].x);
+  gl_.Enable(GL_BLEND);
+  gl_.BlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  gl_.BindVertexArray(vertex_array_.get());
+  gl_.DrawArrays(GL_TRIANGLE_FAN, 0, 3);
+  ++stats_->veil_passes;
+}
+
+}  // namespace nephele

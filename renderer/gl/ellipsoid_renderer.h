@@ -1,0 +1,126 @@
+#pragma once
+// Ellipsoid clouds on the GL: visible ellipsoids culled and ordered on the CPU in double,
+// then drawn either fused (exact per-fragment hits) or with Elinas and Stuerzlinger's tiles.
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "renderer/gl/ellipsoid_shaders.h"
+#include "renderer/gl/frame_stats.h"
+#include "renderer/gl/gl_objects.h"
+#include "renderer/gl/view_uniforms.h"
+#include "renderer/render_settings.h"
+#include "world/scene.h"
+
+namespace nephele {
+
+// Where a pass draws: the framebuffer and its size.
+struct FrameTarget {
+  GLuint framebuffer = 0;
+  int width = 0;
+  int height = 0;
+};
+
+// One ellipsoid as the shaders see it (EllipsoidRecord in ellipsoid_shaders.cpp).
+struct EllipsoidRecord {
+  glm::vec4 v[kEllipsoidRecordVec4s];
+};
+
+// Everything the GPU needs for one ellipsoid seen from `camera`; false when it cannot show
+// (behind the eye, off screen, the eye inside it, or faded out by the in-cloud model).
+// `centre_distance` is the back-to-front sort key.
+bool makeEllipsoidRecord(const Ellipsoid& ellipsoid, const Camera& camera, EllipsoidRecord& out,
+                         double& centre_distance);
+
+class EllipsoidRenderer {
+ public:
+  explicit EllipsoidRenderer(const GlApi& gl);
+  ~EllipsoidRenderer();
+
+  // Starts a frame: marks cached textures unused until a cloud asks for them again; the
+  // frame's passes and ellipsoids are counted into `stats`.
+  void beginFrame(FrameStats& stats);
+  void endFrame();
+
+  // Draws cloud `index` of the scene "over" what `target` holds, blending premultiplied.
+  // `targets_drawn`: the target colour and distance textures are bound. A far cloud may be
+  // drawn from its impostor (RenderSettings::impostor_tolerance_px). Only the surfaces in
+  // `band` are drawn, so that a layer can cut through the cloud.
+  void drawCloud(const Scene& scene, std::size_t index, const RenderSettings& settings,
+                 const FrameTarget& target, bool targets_drawn, const AltitudeBand& band = {});
+
+  // Impostors rendered so far (for measurement and tests).
+  int impostorRenders() const { return impostor_renders_; }
+
+  // The in-cloud veil over the whole frame, if the eye is in or near any ellipsoid.
+  void drawVeil(const Scene& scene, const RenderSettings& settings);
+
+ private:
+  struct CachedTexture {
+    std::unique_ptr<SolidTexture> source;
+    GlObject texture;
+    bool used = false;
+  };
+  struct Tile {
+    int record;  // index into the batch's records
+    int width, height;
+    int x = 0, y = 0;
+  };
+
+  // A far cloud rendered once from `eye` into a texture and shown as a billboard through
+  // its bounding sphere's centre, facing that eye.
+  struct Impostor {
+    std::string key;  // everything the picture depends on besides the eye
+    glm::dvec3 eye{0.0}, centre{0.0}, right{0.0}, up{0.0};
+    double half_size = 0.0;  // billboard half-extent, metres
+    int size = 0;            // texels a side
+    GlObject texture, framebuffer;
+    bool used = false;
+  };
+
+  void drawCloudDirect(const Scene& scene, std::size_t index, const RenderSettings& settings,
+                       const FrameTarget& target, bool targets_drawn, const AltitudeBand& band);
+  // False when the cloud is too near for an impostor; then the caller draws it directly.
+  bool drawImpostor(const Scene& scene, std::size_t index, const RenderSettings& settings,
+                    const FrameTarget& target, bool targets_drawn, const AltitudeBand& band);
+  GLuint program(const EllipsoidPassLayout& layout);
+  CachedTexture& cachedTexture(const SolidTextureSpec& spec, const RenderSettings& settings);
+  GLuint gpuTexture(CachedTexture& cached);
+  const IndexedMesh& sphereMesh(int slices);  // cached per tessellation
+  GLuint spotlightTexture();
+  void setCloudUniforms(GLuint program, const Scene& scene, const EllipsoidCloud& cloud,
+                        const CachedTexture& texture, SolidTextureKind kind,
+                        const AltitudeBand& band);
+  GLuint frameBuffer(const void* data, std::size_t bytes);
+  void uploadRecords(const std::vector<EllipsoidRecord>& records);
+  void drawTiles(const Scene& scene, const EllipsoidCloud& cloud, CachedTexture& texture,
+                 const EllipsoidPassLayout& base, const RenderSettings& settings,
+                 std::vector<EllipsoidRecord>& records, const FrameTarget& target,
+                 const AltitudeBand& band);
+  void renderAtlasBatch(const Scene& scene, const EllipsoidCloud& cloud,
+                        const CachedTexture& texture, const EllipsoidPassLayout& base,
+                        const RenderSettings& settings, std::vector<EllipsoidRecord>& records,
+                        std::vector<Tile>& tiles, const FrameTarget& target,
+                        const AltitudeBand& band);
+  void prepareAtlas(TileFormat format);
+
+  const GlApi& gl_;
+  GlObject vertex_array_;              // empty: attribute-less draws
+  std::vector<GlObject> buffer_pool_;  // storage buffers, one per upload in a frame
+  std::size_t next_buffer_ = 0;
+  GlObject spotlight_;
+  GlObject atlas_;
+  GlObject atlas_framebuffer_;
+  TileFormat atlas_format_ = TileFormat::kFloat;
+  std::map<std::string, GlObject> programs_;
+  std::map<std::string, CachedTexture> textures_;
+  std::map<int, IndexedMesh> meshes_;
+  std::map<std::size_t, Impostor> impostors_;  // by cloud index
+  int impostor_renders_ = 0;
+  FrameStats* stats_ = nullptr;  // the current frame's, borrowed from the GlRenderer
+};
+
+}  // namespace nephele

@@ -1,0 +1,19 @@
+#include "renderer/gl/frame_stats.h"
+
+#include <sstream>
+
+namespace nephele {
+
+std::string FrameStats::line() const {
+  std::ostringstream out;
+  out << "passes=" << passes() << " sky_passes=" << sky_passes
+      << " ellipsoid_passes=" << ellipsoid_passes << " atlas_passes=" << atlas_passes
+      << " automaton_passes=" << automaton_passes << " target_passes=" << target_passes
+      << " veil_passes=" << veil_passes << " ellipsoids_drawn=" << ellipsoids_drawn
+      << " ellipsoids_culled=" << ellipsoids_culled << " impostors_drawn=" << impostors_drawn
+      << " impostors_rendered=" << impostors_rendered << " layer_terms=" << layer_terms << "/"
+      << layer_terms_total << " volume_uploads=" << volume_uploads;
+  return out.str();
+}
+
+}  // namespace nephele

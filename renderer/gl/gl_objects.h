@@ -1,0 +1,75 @@
+#pragma once
+// RAII ownership of GL object names. Every object borrows the GlApi of the context that made
+// it; the context must outlive its objects.
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "renderer/gl/gl_api.h"
+
+namespace nephele {
+
+class GlObject {
+ public:
+  enum class Kind {
+    kTexture,
+    kFramebuffer,
+    kRenderbuffer,
+    kVertexArray,
+    kProgram,
+    kShader,
+    kBuffer
+  };
+
+  GlObject() = default;
+  GlObject(const GlApi& gl, Kind kind, GLuint name) : gl_(&gl), kind_(kind), name_(name) {}
+  GlObject(GlObject&& other) noexcept { *this = std::move(other); }
+  GlObject& operator=(GlObject&& other) noexcept {
+    if (this != &other) {
+      reset();
+      gl_ = std::exchange(other.gl_, nullptr);
+      kind_ = other.kind_;
+      name_ = std::exchange(other.name_, 0);
+    }
+    return *this;
+  }
+  GlObject(const GlObject&) = delete;
+  GlObject& operator=(const GlObject&) = delete;
+  ~GlObject() { reset(); }
+
+  GLuint get() const { return name_; }
+  explicit operator bool() const { return name_ != 0; }
+  void reset();
+
+ private:
+  const GlApi* gl_ = nullptr;
+  Kind kind_ = Kind::kTexture;
+  GLuint name_ = 0;
+};
+
+GlObject createTexture(const GlApi& gl, GLenum target);
+GlObject createFramebuffer(const GlApi& gl);
+GlObject createRenderbuffer(const GlApi& gl);
+GlObject createVertexArray(const GlApi& gl);
+GlObject createBuffer(const GlApi& gl);
+
+// A triangle mesh on the GPU: positions (attribute 0, vec3) and 32-bit indices.
+struct IndexedMesh {
+  GlObject vertex_array, vertices, indices;
+  GLsizei index_count = 0;
+};
+IndexedMesh uploadMesh(const GlApi& gl, const std::vector<glm::vec3>& vertices,
+                       const std::vector<GLuint>& indices);
+
+// The unit sphere, `slices` around and `slices` from pole to pole, counter-clockwise seen
+// from outside.
+void unitSphere(int slices, std::vector<glm::vec3>& vertices, std::vector<GLuint>& indices);
+
+// Compiles and links a vertex + fragment program. On failure returns an empty object and
+// puts the driver's log in `error`.
+GlObject createProgram(const GlApi& gl, const std::string& vertex_source,
+                       const std::string& fragment_source, std::string& error);
+
+}  // namespace nephele

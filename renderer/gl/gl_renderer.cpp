@@ -1,0 +1,536 @@
+#include "renderer/gl/gl_renderer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <sstream>
+#include <vector>
+
+#include "renderer/gl/sky_shaders.h"
+#include "renderer/gl/view_uniforms.h"
+#include "world/check.h"
+#include "world/textures/layer_texture.h"
+#include "world/textures/texture_table.h"
+
+namespace nephele {
+namespace {
+
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+
+// The part of the screen square [-1, 1]^2 where a * x + b * y + c >= 0, as a convex polygon
+// (Sutherland-Hodgman against one line). Empty when nothing is left.
+std::vector<glm::vec2> clipScreenToHalfPlane(double a, double b, double c) {
+  const glm::dvec2 square[4] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+  std::vector<glm::vec2> out;
+  for (int i = 0; i < 4; ++i) {
+    const glm::dvec2 p = square[i], q = square[(i + 1) % 4];
+    const double fp = a * p.x + b * p.y + c, fq = a * q.x + b * q.y + c;
+    if (fp >= 0.0) out.emplace_back(p);
+    if ((fp >= 0.0) != (fq >= 0.0)) out.emplace_back(p + (q - p) * (fp / (fp - fq)));
+  }
+  return out;
+}
+
+// The Gardner terms the sky shader's termCount lets a pixel of this layer evaluate at most:
+// at the finest footprint it can show, straight above or below the camera, where a pixel
+// spans the layer's distance times 2 tan(vfov / 2) / height (MODEL.md section 2's filter).
+int layerTermsAtMost(const CloudLayer& layer, const LayerTexture& texture, const Camera& camera,
+                     TermFilter filter) {
+  const glm::dvec2 period = texture.period();
+  const double footprint_m = std::abs(layer.altitude_m - camera.position.z) * 2.0 *
+                             std::tan(glm::radians(camera.vfov_deg) / 2.0) / camera.height;
+  // A fractional count evaluates one more term, faded.
+  return int(std::ceil(texture.gardner()->termCountForFootprint(
+      footprint_m / std::min(period.x, period.y), filter)));
+}
+
+// Cache key: every parameter of a layer texture and the settings its GPU form depends on.
+std::string textureKey(const LayerTextureSpec& spec, const RenderSettings& settings) {
+  std::ostringstream key;
+  key.precision(17);
+  key << int(spec.source) << '/' << spec.seed << '/' << spec.drift_velocity.x << '/'
+      << spec.drift_velocity.y << '/' << spec.drift_offset_m.x << '/' << spec.drift_offset_m.y
+      << '/';
+  if (spec.source == TextureSource::kGardner) {
+    const GardnerTextureParams& g = spec.gardner;
+    key << g.terms << '/' << g.fx1 << '/' << g.fy1 << '/' << g.t0 << '/' << g.seeded_phases << '/'
+        << settings.bake_texels_per_cycle;
+  } else {
+    const NoiseTableParams& t = spec.table;
+    key << t.tile_size_m.x << '/' << t.tile_size_m.y << '/' << t.size_log2 << '/' << t.roughness
+        << '/' << t.cells << '/' << t.octaves << '/' << t.persistence;
+  }
+  return key.str();
+}
+
+// Baked Gardner chain: level l holds the truncations to n - l terms (red) and n - l - 1
+// terms (green) at (texels_per_cycle * 2^n) >> l texels a side.
+void uploadBakedGardner(const GlApi& gl, GLuint texture, const GardnerTexture& gardner,
+                        int texels_per_cycle) {
+  const int base = gardnerBakeSize(gardner.terms(), texels_per_cycle);
+  const int levels = int(std::log2(base)) + 1;
+  gl.TextureStorage2D(texture, levels, GL_RG16, base, base);
+  for (int level = 0; level < levels; ++level) {
+    const int size = base >> level, terms = gardner.terms() - level;
+    const GardnerTruncations baked = bakeGardner(gardner, size, terms);
+    std::vector<float> rg(baked.with_terms.values.size() * 2);
+    for (std::size_t i = 0; i < baked.with_terms.values.size(); ++i) {
+      rg[2 * i] = baked.with_terms.values[i];
+      rg[2 * i + 1] = baked.one_fewer.values[i];
+    }
+    gl.TextureSubImage2D(texture, level, 0, 0, size, size, GL_RG, GL_FLOAT, rg.data());
+  }
+  gl.TextureParameteri(texture, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_NEAREST);
+}
+
+void uploadTable(const GlApi& gl, GLuint texture, const TextureTable& table) {
+  const int levels = int(std::log2(std::max(table.width, table.height))) + 1;
+  gl.TextureStorage2D(texture, levels, GL_R16, table.width, table.height);
+  gl.TextureSubImage2D(texture, 0, 0, 0, table.width, table.height, GL_RED, GL_FLOAT,
+                       table.values.data());
+  gl.GenerateTextureMipmap(texture);
+  gl.TextureParameteri(texture, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+}
+
+// The layer bands of the per-ray depth order of MODEL.md section 4. Along any ray altitude changes
+// monotonically, so the surfaces between the k-th and (k+1)-th layers on one side of the
+// camera are those between their altitudes. Heights are relative to the camera; band b on
+// the rising side is [A(b-1), A(b)) with A(-1) = 0 and A(n) = +inf, on the falling side
+// [B(b), B(b-1)) with B(-1) = 0 and B(n) = -inf.
+class CloudBands {
+ public:
+  struct Piece {
+    int band;
+    AltitudeBand window;
+  };
+
+  template <typename Slots>
+  CloudBands(const Slots& above, const Slots& below, double camera_z) : camera_z_(camera_z) {
+    // `above` runs farthest first; rank 0 is the nearest layer.
+    for (auto it = above.rbegin(); it != above.rend(); ++it)
+      rising_.push_back(it->layer->altitude_m - camera_z);
+    for (auto it = below.rbegin(); it != below.rend(); ++it)
+      falling_.push_back(it->layer->altitude_m - camera_z);
+  }
+
+  // One piece per band that altitudes [z_lo, z_hi] reach, each with its window.
+  std::vector<Piece> pieces(double z_lo, double z_hi) const {
+    const double lo = z_lo - camera_z_, hi = z_hi - camera_z_;
+    int rise_first = -1, rise_last = -2, fall_first = -1, fall_last = -2;
+    if (hi >= 0.0) rise_first = risingBand(std::max(lo, 0.0)), rise_last = risingBand(hi);
+    if (lo < 0.0) fall_first = fallingBand(std::min(hi, -0.0)), fall_last = fallingBand(lo);
+    std::vector<Piece> out;
+    const int top = std::max(rise_last, fall_last);
+    for (int b = 0; b <= top; ++b) {
+      const bool rising = b >= rise_first && b <= rise_last;
+      const bool falling = b >= fall_first && b <= fall_last;
+      if (!rising && !falling) continue;
+      glm::vec4 slabs(0.0f);
+      if (rising) slabs.x = bound(rising_, b - 1, 0.0), slabs.y = bound(rising_, b, 1e38);
+      if (falling) slabs.z = bound(falling_, b, -1e38), slabs.w = bound(falling_, b - 1, 0.0);
+      out.push_back({b, {slabs}});
+    }
+    return out;
+  }
+
+ private:
+  // Layers crossed before reaching height dz >= 0 (resp. dz < 0).
+  int risingBand(double dz) const {
+    return int(std::count_if(rising_.begin(), rising_.end(), [&](double a) { return a <= dz; }));
+  }
+  int fallingBand(double dz) const {
+    return int(std::count_if(falling_.begin(), falling_.end(), [&](double b) { return b > dz; }));
+  }
+  static float bound(const std::vector<double>& heights, int rank, double beyond) {
+    if (rank < 0) return 0.0f;
+    return float(std::size_t(rank) < heights.size() ? heights[rank] : beyond);
+  }
+
+  double camera_z_;
+  std::vector<double> rising_, falling_;  // nearest first
+};
+
+}  // namespace
+
+GlRenderer::GlRenderer(const GlPlatform& platform)
+    : gl_(platform.gl()),
+      vertex_array_(createVertexArray(gl_)),
+      framebuffer_(createFramebuffer(gl_)),
+      ellipsoids_(gl_),
+      automata_(gl_),
+      targets_(gl_) {}
+
+GlRenderer::~GlRenderer() = default;
+
+FloatImage GlRenderer::renderFloat(const Scene& scene, const RenderSettings& settings) {
+  drawFrame(scene, settings, TargetFormat::kFloat);
+  const int w = scene.camera.width, h = scene.camera.height;
+  FloatImage image{w, h, std::vector<float>(std::size_t(w) * h * 4)};
+  gl_.PixelStorei(GL_PACK_ALIGNMENT, 4);
+  gl_.ReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, image.rgba.data());
+  // GL rows run bottom-up; FloatImage rows run top-down.
+  const std::size_t row = std::size_t(w) * 4;
+  for (int y = 0; y < h / 2; ++y)
+    std::swap_ranges(image.rgba.begin() + y * row, image.rgba.begin() + (y + 1) * row,
+                     image.rgba.begin() + (h - 1 - y) * row);
+  return image;
+}
+
+Srgb8Image GlRenderer::renderSrgb8(const Scene& scene, const RenderSettings& settings) {
+  drawFrame(scene, settings, TargetFormat::kSrgb8);
+  const int w = scene.camera.width, h = scene.camera.height;
+  Srgb8Image image{w, h, /*bottom_up=*/true, std::vector<std::uint8_t>(std::size_t(w) * h * 4)};
+  gl_.PixelStorei(GL_PACK_ALIGNMENT, 4);
+  gl_.ReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, image.rgba.data());
+  return image;
+}
+
+Srgb8Image GlRenderer::renderFloor(int width, int height) {
+  prepareTarget(width, height, TargetFormat::kSrgb8);
+  if (!floor_program_) {
+    std::string error;
+    floor_program_ = createProgram(gl_, polygonVertexSource(), R"(#version 450 core
+uniform vec4 u_colour;
+layout(location = 0) out vec4 o_colour;
+void main() { o_colour = u_colour; }
+)",
+                                   error);
+    NEPHELE_CHECK(floor_program_, "floor program: " << error);
+  }
+  const GLuint p = floor_program_.get();
+  gl_.BindFramebuffer(GL_FRAMEBUFFER, framebuffer_.get());
+  gl_.Viewport(0, 0, width, height);
+  gl_.BindVertexArray(vertex_array_.get());
+  gl_.Enable(GL_FRAMEBUFFER_SRGB);
+  gl_.UseProgram(p);
+  const glm::vec4 colour(0.25f, 0.3f, 0.4f, 0.5f);
+  gl_.ProgramUniform4fv(p, gl_.GetUniformLocation(p, "u_colour"), 1, &colour.x);
+  const glm::vec2 triangle[3] = {{-1, -1}, {3, -1}, {-1, 3}};
+  gl_.ProgramUniform2fv(p, gl_.GetUniformLocation(p, "u_polygon"), 3, &triangle[0].x);
+  gl_.Enable(GL_BLEND);
+  gl_.BlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  gl_.DrawArrays(GL_TRIANGLE_FAN, 0, 3);
+  gl_.Disable(GL_BLEND);
+  Srgb8Image image{width, height, /*bottom_up=*/true,
+                   std::vector<std::uint8_t>(std::size_t(width) * height * 4)};
+  gl_.PixelStorei(GL_PACK_ALIGNMENT, 4);
+  gl_.ReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, image.rgba.data());
+  return image;
+}
+
+void GlRenderer::prepareTarget(int width, int height, TargetFormat format) {
+  if (colour_buffer_ && width == target_width_ && height == target_height_ &&
+      format == target_format_)
+    return;
+  colour_buffer_ = createRenderbuffer(gl_);
+  gl_.NamedRenderbufferStorage(colour_buffer_.get(),
+                               format == TargetFormat::kFloat ? GL_RGBA32F : GL_SRGB8_ALPHA8, width,
+                               height);
+  gl_.NamedFramebufferRenderbuffer(framebuffer_.get(), GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER,
+                                   colour_buffer_.get());
+  const GLenum status = gl_.CheckNamedFramebufferStatus(framebuffer_.get(), GL_FRAMEBUFFER);
+  NEPHELE_CHECK(status == GL_FRAMEBUFFER_COMPLETE,
+                "framebuffer " << width << "x" << height << " status 0x" << std::hex << status);
+  target_width_ = width;
+  target_height_ = height;
+  target_format_ = format;
+}
+
+GLuint GlRenderer::program(const SkyPassLayout& layout) {
+  const std::string key = layout.key();
+  auto found = programs_.find(key);
+  if (found != programs_.end()) return found->second.get();
+  std::string error;
+  GlObject compiled = createProgram(gl_, polygonVertexSource(), skyFragmentSource(layout), error);
+  NEPHELE_CHECK(compiled, key << ": " << error);
+  return programs_.emplace(key, std::move(compiled)).first->second.get();
+}
+
+GlRenderer::CachedTexture& GlRenderer::cachedTexture(const LayerTextureSpec& spec,
+                                                     const RenderSettings& settings) {
+  auto [entry, inserted] = textures_.try_emplace(textureKey(spec, settings));
+  if (inserted) entry->second.source = std::make_unique<LayerTexture>(spec);
+  entry->second.used = true;
+  return entry->second;
+}
+
+GLuint GlRenderer::gpuTexture(CachedTexture& cached, const RenderSettings& settings) {
+  if (cached.texture) return cached.texture.get();
+  cached.texture = createTexture(gl_, GL_TEXTURE_2D);
+  const GLuint t = cached.texture.get();
+  if (const GardnerTexture* gardner = cached.source->gardner())
+    uploadBakedGardner(gl_, t, *gardner, settings.bake_texels_per_cycle);
+  else
+    uploadTable(gl_, t, *cached.source->table());
+  gl_.TextureParameteri(t, GL_TEXTURE_WRAP_S, GL_REPEAT);
+  gl_.TextureParameteri(t, GL_TEXTURE_WRAP_T, GL_REPEAT);
+  gl_.TextureParameteri(t, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  return t;
+}
+
+void GlRenderer::setSlotUniforms(GLuint p, int slot, const LayerSlot& entry, const Scene& scene,
+                                 const RenderSettings& settings) {
+  const CloudLayer& layer = *entry.layer;
+  const LayerTexture& texture = *entry.texture->source;
+  const Camera& camera = scene.camera;
+  auto location = [&](const char* name, int index) {
+    char element[48];
+    std::snprintf(element, sizeof element, "%s[%d]", name, index);
+    return gl_.GetUniformLocation(p, element);
+  };
+  gl_.ProgramUniform1f(p, location("u_height", slot), float(layer.altitude_m - camera.position.z));
+  const glm::vec3 colour(layer.colour * scene.sun.colour);
+  gl_.ProgramUniform3fv(p, location("u_colour", slot), 1, &colour.x);
+  const ShadingParams& sh = layer.shading;
+  const glm::vec4 shading(sh.ambient, sh.texture_fraction, sh.specular, sh.shininess);
+  gl_.ProgramUniform4fv(p, location("u_shading", slot), 1, &shading.x);
+  gl_.ProgramUniform1f(p, location("u_threshold", slot), float(layer.threshold));
+  gl_.ProgramUniform1f(p, location("u_transition", slot), float(layer.transition));
+
+  // The precision rule of MODEL.md section 2: the texture's local origin is the point under the
+  // camera, reduced modulo the period in double; the shader only sees offsets from it.
+  const glm::dvec2 period = texture.period();
+  const glm::dvec2 origin_uv =
+      texture.periodicCoordinate({camera.position.x, camera.position.y}, scene.time_s);
+  const glm::vec2 origin_f(origin_uv), inv_period(1.0 / period);
+  gl_.ProgramUniform2fv(p, location("u_origin", slot), 1, &origin_f.x);
+  gl_.ProgramUniform2fv(p, location("u_inv_period", slot), 1, &inv_period.x);
+
+  if (const GardnerTexture* g = texture.gardner()) {
+    gl_.ProgramUniform1f(p, location("u_terms", slot), float(g->terms()));
+    if (entry.kind == LayerKind::kProceduralGardner) {
+      const glm::dvec2 origin = origin_uv * period;  // metres inside one period
+      for (int j = 0; j < g->terms(); ++j) {
+        const int k = 8 * slot + j;
+        auto set = [&](const char* name, double v) {
+          gl_.ProgramUniform1f(p, location(name, k), float(v));
+        };
+        set("u_fx", g->frequencyX(j));
+        set("u_fy", g->frequencyY(j));
+        set("u_amplitude", g->amplitude(j));
+        set("u_phase_x", wrapPeriodic(g->frequencyX(j) * origin.x + g->phaseX(j), kTwoPi));
+        set("u_phase_y", wrapPeriodic(g->frequencyY(j) * origin.y + g->phaseY(j), kTwoPi));
+        set("u_half_phase_x", wrapPeriodic(0.5 * g->frequencyX(j) * origin.x, kTwoPi));
+        set("u_half_phase_y", wrapPeriodic(0.5 * g->frequencyY(j) * origin.y, kTwoPi));
+      }
+      gl_.ProgramUniform1f(p, location("u_t0", slot), float(g->params().t0));
+      gl_.ProgramUniform1f(p, location("u_k", slot), float(g->normalisation()));
+    }
+  }
+  if (entry.kind != LayerKind::kProceduralGardner) {
+    gl_.BindTextureUnit(GLuint(slot), gpuTexture(*entry.texture, settings));
+    const std::string sampler = "u_table" + std::to_string(slot);
+    gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, sampler.c_str()), slot);
+  }
+}
+
+void GlRenderer::drawSkyPass(const Scene& scene, const RenderSettings& settings,
+                             const SkyPassLayout& layout, const std::vector<LayerSlot>& slots,
+                             const std::vector<glm::vec2>& polygon) {
+  const GLuint p = program(layout);
+  gl_.UseProgram(p);
+  const Camera& camera = scene.camera;
+  const ViewBasis basis = viewBasis(camera);
+  auto uniform3 = [&](const char* name, glm::dvec3 v) { setUniform3(gl_, p, name, v); };
+  setViewUniforms(gl_, p, camera, scene.fog);
+  if (layout.background) {
+    uniform3("u_zenith", scene.sky.zenith);
+    uniform3("u_horizon", scene.sky.horizon);
+    uniform3("u_ground", scene.sky.ground);
+    const double slope =
+        std::hypot(basis.right.z * basis.tan_half_vfov * basis.aspect * 2.0 / camera.width,
+                   basis.up.z * basis.tan_half_vfov * 2.0 / camera.height);
+    gl_.ProgramUniform1f(p, gl_.GetUniformLocation(p, "u_horizon_slope"),
+                         float(std::max(slope, 1e-12)));
+  }
+  if (!slots.empty()) uniform3("u_to_sun", sunDirection(scene.sun));
+  for (std::size_t i = 0; i < slots.size(); ++i)
+    setSlotUniforms(p, int(i), slots[i], scene, settings);
+  gl_.ProgramUniform2fv(p, gl_.GetUniformLocation(p, "u_polygon"), GLsizei(polygon.size()),
+                        &polygon[0].x);
+  gl_.DrawArrays(GL_TRIANGLE_FAN, 0, GLsizei(polygon.size()));
+  ++stats_.sky_passes;
+}
+
+void GlRenderer::drawSkyGroup(const Scene& scene, const RenderSettings& settings,
+                              const std::vector<LayerSlot>& above,
+                              const std::vector<LayerSlot>& below, bool background, bool targets) {
+  const Camera& camera = scene.camera;
+  SkyPassLayout base;
+  base.fog = scene.fog.has_value();
+  base.term_filter = settings.term_filter;
+  base.targets = targets;
+  for (const CloudLayer& layer : scene.layers) base.specular |= layer.shading.specular > 0.0;
+  const bool fused = settings.sky_passes == SkyPasses::kFused &&
+                     int(std::max(above.size(), below.size())) <= kMaxLayerSlots;
+
+  // The screen region whose rays climb (sign = 1) or descend (sign = -1), widened by
+  // `margin_pixels`: ray.z is linear across the image, so the horizon is a straight line.
+  const ViewBasis basis = viewBasis(camera);
+  auto sideOfHorizon = [&](double sign, double margin_pixels) {
+    const double a = sign * basis.right.z * basis.tan_half_vfov * basis.aspect;
+    const double b = sign * basis.up.z * basis.tan_half_vfov;
+    const double margin =
+        margin_pixels * (std::abs(a) * 2.0 / camera.width + std::abs(b) * 2.0 / camera.height);
+    return clipScreenToHalfPlane(a, b, sign * basis.forward.z + margin);
+  };
+
+  // Every pass writes premultiplied colour and coverage; a pass with the background
+  // overwrites, the others blend "over".
+  gl_.BlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  if (background)
+    gl_.Disable(GL_BLEND);
+  else
+    gl_.Enable(GL_BLEND);
+  if (fused) {
+    // One pass per side of the horizon, each with the background and that side's layers:
+    // pixels below the horizon never run the code of layers above the camera. The two
+    // polygons share their edge exactly, so every pixel is drawn once.
+    for (const auto* side : {&above, &below}) {
+      if (!background && side->empty()) continue;
+      const std::vector<glm::vec2> polygon = sideOfHorizon(side == &above ? 1.0 : -1.0, 0.0);
+      if (polygon.size() < 3) continue;
+      SkyPassLayout layout = base;
+      layout.background = background;
+      for (const LayerSlot& slot : *side)
+        (side == &above ? layout.above : layout.below).push_back(slot.kind);
+      drawSkyPass(scene, settings, layout, *side, polygon);
+    }
+    return;
+  }
+  if (background) {
+    // One triangle covering the screen: no diagonal edge for the rasteriser to split tiles on.
+    drawSkyPass(scene, settings, base, {}, {{-1, -1}, {3, -1}, {-1, 3}});
+    gl_.Enable(GL_BLEND);
+  }
+  for (const auto* side : {&above, &below})
+    for (const LayerSlot& slot : *side) {
+      // Only where rays meet the plane, plus two pixels the shader leaves untouched.
+      const std::vector<glm::vec2> polygon = sideOfHorizon(side == &above ? 1.0 : -1.0, 2.0);
+      if (polygon.size() < 3) continue;
+      SkyPassLayout layout = base;
+      layout.background = false;
+      (side == &above ? layout.above : layout.below).push_back(slot.kind);
+      drawSkyPass(scene, settings, layout, {slot}, polygon);
+    }
+}
+
+void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
+                           TargetFormat format) {
+  const Camera& camera = scene.camera;
+  prepareTarget(camera.width, camera.height, format);
+  stats_ = {};
+  // Opaque targets first, into their own colour and distance textures.
+  const bool targets = targets_.draw(scene);
+  if (targets) stats_.target_passes = int(scene.targets.size());
+  gl_.BindFramebuffer(GL_FRAMEBUFFER, framebuffer_.get());
+  gl_.Viewport(0, 0, camera.width, camera.height);
+  gl_.BindVertexArray(vertex_array_.get());
+  if (format == TargetFormat::kSrgb8)
+    gl_.Enable(GL_FRAMEBUFFER_SRGB);  // blend in linear, store sRGB
+  else
+    gl_.Disable(GL_FRAMEBUFFER_SRGB);
+  for (auto& [key, cached] : textures_) cached.used = false;
+  ellipsoids_.beginFrame(stats_);
+  automata_.beginFrame(stats_);
+
+  // A ray meets only the layers on one side of the camera: above it from the highest down,
+  // below it from the lowest up. Those orders are back to front.
+  const double z = camera.position.z;
+  std::vector<LayerSlot> above, below;
+  for (const CloudLayer& layer : scene.layers) {
+    if (layer.altitude_m == z) continue;  // seen edge-on: covers no pixel
+    CachedTexture& texture = cachedTexture(layer.texture, settings);
+    const LayerKind kind = !texture.source->gardner() ? LayerKind::kTable
+                           : settings.texture_evaluation == TextureEvaluation::kProcedural
+                               ? LayerKind::kProceduralGardner
+                               : LayerKind::kBakedGardner;
+    (layer.altitude_m > z ? above : below).push_back({&layer, &texture, kind});
+    if (const GardnerTexture* g = texture.source->gardner()) {
+      stats_.layer_terms += layerTermsAtMost(layer, *texture.source, camera, settings.term_filter);
+      stats_.layer_terms_total += g->terms();
+    }
+  }
+  std::sort(above.begin(), above.end(), [](const LayerSlot& a, const LayerSlot& b) {
+    return a.layer->altitude_m > b.layer->altitude_m;
+  });
+  std::sort(below.begin(), below.end(), [](const LayerSlot& a, const LayerSlot& b) {
+    return a.layer->altitude_m < b.layer->altitude_m;
+  });
+
+  // Interleave clouds with the layers (docs/MODEL.md, "Compositing order"). On each side of
+  // the camera, band b holds what lies beyond the b nearest layers of that side and before
+  // the next; surfaces in band b are drawn after the layers beyond them and before the b
+  // layers in front. A cloud whose altitudes span several bands is drawn once per band,
+  // each time keeping only its surfaces in that band, so a layer cuts through it. Clouds
+  // in one band go back to front by distance.
+  const CloudBands bands(above, below, z);
+  struct CloudEntry {
+    bool automaton;
+    std::size_t index;
+    int band;
+    double distance;
+    AltitudeBand window;
+  };
+  std::vector<CloudEntry> clouds;
+  auto addCloud = [&](bool automaton, std::size_t index, glm::dvec3 centre, double z_lo,
+                      double z_hi) {
+    const double distance = glm::length(centre - camera.position);
+    const std::vector<CloudBands::Piece> pieces = bands.pieces(z_lo, z_hi);
+    for (const CloudBands::Piece& piece : pieces)
+      clouds.push_back({automaton, index, piece.band, distance,
+                        pieces.size() == 1 ? AltitudeBand{} : piece.window});
+  };
+  for (std::size_t i = 0; i < scene.clouds.size(); ++i) {
+    glm::dvec3 centre(0.0);
+    for (const Ellipsoid& e : scene.clouds[i].ellipsoids) centre += e.centre;
+    centre /= double(scene.clouds[i].ellipsoids.size());
+    const auto [z_lo, z_hi] = cloudVerticalExtent(scene.clouds[i]);
+    addCloud(false, i, centre, z_lo, z_hi);
+  }
+  for (std::size_t i = 0; i < scene.automata.size(); ++i) {
+    const AutomatonCloudView& cloud = scene.automata[i];
+    const glm::dvec3 lo = cloud.lowerBound(), hi = cloud.upperBound();
+    addCloud(true, i, 0.5 * (lo + hi), lo.z, hi.z);
+  }
+  std::sort(clouds.begin(), clouds.end(), [](const CloudEntry& a, const CloudEntry& b) {
+    return a.band != b.band ? a.band > b.band : a.distance > b.distance;
+  });
+
+  std::vector<LayerSlot> pending_above, pending_below;
+  bool background_pending = true;
+  auto flushSky = [&] {
+    if (!background_pending && pending_above.empty() && pending_below.empty()) return;
+    drawSkyGroup(scene, settings, pending_above, pending_below, background_pending, targets);
+    background_pending = false;
+    pending_above.clear();
+    pending_below.clear();
+  };
+  const FrameTarget frame{framebuffer_.get(), camera.width, camera.height};
+  const int top_band = int(std::max(
+      {above.size(), below.size(), clouds.empty() ? std::size_t(0) : std::size_t(clouds[0].band)}));
+  auto next_cloud = clouds.begin();
+  for (int band = top_band; band >= 0; --band) {
+    if (next_cloud != clouds.end() && next_cloud->band == band) flushSky();
+    for (; next_cloud != clouds.end() && next_cloud->band == band; ++next_cloud)
+      if (next_cloud->automaton)
+        automata_.drawCloud(scene, next_cloud->index, settings, targets, next_cloud->window);
+      else
+        ellipsoids_.drawCloud(scene, next_cloud->index, settings, frame, targets,
+                              next_cloud->window);
+    // Then the layers of rank band - 1 (rank 0 is nearest the camera) on both sides.
+    if (band >= 1) {
+      if (std::size_t(band) <= above.size()) pending_above.push_back(above[above.size() - band]);
+      if (std::size_t(band) <= below.size()) pending_below.push_back(below[below.size() - band]);
+    }
+  }
+  flushSky();
+  ellipsoids_.drawVeil(scene, settings);
+  gl_.Disable(GL_BLEND);
+  ellipsoids_.endFrame();
+  automata_.endFrame();
+  std::erase_if(textures_, [](const auto& entry) { return !entry.second.used; });
+}
+
+}  // namespace nephele

@@ -1,0 +1,92 @@
+#pragma once
+// The GL renderer: opaque targets, then the sky background, cloud layers and ellipsoid
+// clouds composited back to front into a framebuffer object, then read back.
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "image/image.h"
+#include "renderer/gl/automaton_renderer.h"
+#include "renderer/gl/ellipsoid_renderer.h"
+#include "renderer/gl/frame_stats.h"
+#include "renderer/gl/gl_objects.h"
+#include "renderer/gl/gl_platform.h"
+#include "renderer/gl/sky_shaders.h"
+#include "renderer/gl/target_renderer.h"
+#include "renderer/render_settings.h"
+#include "world/scene.h"
+
+namespace nephele {
+
+class LayerTexture;
+
+class GlRenderer {
+ public:
+  // Borrows the platform, whose context must stay current on this thread.
+  explicit GlRenderer(const GlPlatform& platform);
+  ~GlRenderer();
+
+  // Linear float RGB plus coverage (for EXR and for measuring error).
+  FloatImage renderFloat(const Scene& scene, const RenderSettings& settings);
+  // sRGB-encoded bytes, rows bottom-up as GL reads them (PNG, JPEG, TIFF).
+  Srgb8Image renderSrgb8(const Scene& scene, const RenderSettings& settings);
+
+  // The platform floor: one constant-colour full-screen pass, blended, and its readback into
+  // the 8-bit target renderSrgb8 uses. Benchmarks print frame times as multiples of it, since
+  // absolute times on shared machines vary by 30 % between runs.
+  Srgb8Image renderFloor(int width, int height);
+
+  // What the last frame did: passes, ellipsoids drawn and culled, terms evaluated.
+  const FrameStats& lastFrameStats() const { return stats_; }
+
+  // Far-cloud impostors rendered since construction (each reuse saves one).
+  int impostorRenders() const { return ellipsoids_.impostorRenders(); }
+  // Automaton volume uploads since construction (one per keyframe change of a cloud).
+  int volumeUploads() const { return automata_.uploads(); }
+
+ private:
+  enum class TargetFormat { kFloat, kSrgb8 };
+  // A layer's texture, built once and kept while frames keep using it.
+  struct CachedTexture {
+    std::unique_ptr<LayerTexture> source;
+    GlObject texture;  // made on first use by a pass that samples it
+    bool used = false;
+  };
+  struct LayerSlot {
+    const CloudLayer* layer;
+    CachedTexture* texture;
+    LayerKind kind;
+  };
+
+  void drawFrame(const Scene& scene, const RenderSettings& settings, TargetFormat format);
+  // Background (if asked) and the given layers, fused or one pass per layer.
+  void drawSkyGroup(const Scene& scene, const RenderSettings& settings,
+                    const std::vector<LayerSlot>& above, const std::vector<LayerSlot>& below,
+                    bool background, bool targets);
+  void drawSkyPass(const Scene& scene, const RenderSettings& settings, const SkyPassLayout& layout,
+                   const std::vector<LayerSlot>& slots, const std::vector<glm::vec2>& polygon);
+  void setSlotUniforms(GLuint program, int slot, const LayerSlot& layer, const Scene& scene,
+                       const RenderSettings& settings);
+  void prepareTarget(int width, int height, TargetFormat format);
+  GLuint program(const SkyPassLayout& layout);
+  CachedTexture& cachedTexture(const LayerTextureSpec& spec, const RenderSettings& settings);
+  GLuint gpuTexture(CachedTexture& cached, const RenderSettings& settings);
+
+  const GlApi& gl_;
+  GlObject vertex_array_;
+  GlObject framebuffer_;
+  GlObject colour_buffer_;
+  int target_width_ = 0;
+  int target_height_ = 0;
+  TargetFormat target_format_ = TargetFormat::kFloat;
+  std::map<std::string, GlObject> programs_;
+  std::map<std::string, CachedTexture> textures_;
+  GlObject floor_program_;
+  FrameStats stats_;
+  EllipsoidRenderer ellipsoids_;
+  AutomatonRenderer automata_;
+  TargetRenderer targets_;
+};
+
+}  // namespace nephele

@@ -1,0 +1,333 @@
+#include "renderer/gl/sky_shaders.h"
+
+namespace nephele {
+namespace {
+
+// View (camera-relative: the shader knows only the camera's altitude), output, fog. Fog is
+// unlit and applied to each surface by its camera distance, which is exact under "over".
+const char* kCommon = R"(
+uniform vec3 u_right;    // image-plane basis, scaled by tan(vfov/2) * aspect
+uniform vec3 u_up;       // scaled by tan(vfov/2)
+uniform vec3 u_forward;
+uniform vec2 u_viewport;
+uniform float u_camera_z;
+layout(location = 0) out vec4 o_colour;  // premultiplied colour, coverage
+const float kFar = 1e30;
+
+vec3 viewRay() {
+  vec2 ndc = 2.0 * gl_FragCoord.xy / u_viewport - 1.0;
+  return u_right * ndc.x + u_up * ndc.y + u_forward;
+}
+
+#ifdef FOG
+uniform float u_fog_top;
+uniform float u_fog_sigma;
+uniform vec3 u_fog_colour;
+
+// Length inside the slab 0 <= z <= top of the unit ray from the camera, up to `distance`.
+float fogPathLength(vec3 d, float distance) {
+  float enter = 0.0, leave = distance;
+  if (abs(d.z) < 1e-9) {
+    if (u_camera_z < 0.0 || u_camera_z > u_fog_top) return 0.0;
+  } else {
+    float s0 = -u_camera_z / d.z, s1 = (u_fog_top - u_camera_z) / d.z;
+    enter = max(enter, min(s0, s1));
+    leave = min(leave, max(s0, s1));
+  }
+  return max(leave - enter, 0.0);
+}
+
+vec3 applyFog(vec3 colour, vec3 d, float distance) {
+  return mix(u_fog_colour, colour, exp(-u_fog_sigma * fogPathLength(d, distance)));
+}
+#else
+vec3 applyFog(vec3 colour, vec3 d, float distance) { return colour; }
+#endif
+
+#ifdef TARGETS
+// Opaque targets drawn first: their fogged colour and their distance along the unit ray
+// (1e30 where there is none), read at this pixel.
+layout(binding = 14) uniform sampler2D u_target_colour;
+layout(binding = 15) uniform sampler2D u_target_distance;
+float targetDistance() { return texelFetch(u_target_distance, ivec2(gl_FragCoord.xy), 0).r; }
+vec3 targetColour() { return texelFetch(u_target_colour, ivec2(gl_FragCoord.xy), 0).rgb; }
+#endif
+
+// Gardner eq. 8 (MODEL.md section 3) from its terms; shading = (a, t, s, e).
+float gardnerIntensity(vec4 shading, float diffuse, float highlight, float it) {
+  float a = shading.x, t = shading.y, s = shading.z;
+  return (1.0 - a) * ((1.0 - t) * ((1.0 - s) * diffuse + s * highlight) + t * it) + a;
+}
+
+// Gardner eq. 9 and 11 (MODEL.md section 4): translucence TR for the texture's excess over
+// the threshold; D = 0 is a hard threshold.
+float translucence(float excess, float d) {
+  return d <= 0.0 ? (excess <= 0.0 ? 1.0 : 0.0) : clamp(1.0 - excess / d, 0.0, 1.0);
+}
+
+// Gardner terms a pixel resolves (MODEL.md section 2), fractional where one fades, for a
+// footprint in periods: term j (1-based) resolves while 2^j footprint <= 1/2
+// (GardnerTexture::termCountForFootprint on the CPU).
+float resolvedTerms(float footprint, float terms) {
+#if defined(FILTER_NONE)
+  return terms;
+#else
+  float highest = log2(0.5 / max(footprint, 1e-30));
+#if defined(FILTER_CUT)
+  return clamp(floor(highest), 0.0, terms);
+#else
+  return clamp(highest - 1.0, 0.0, terms);  // fade over the octave below
+#endif
+#endif
+}
+
+// Distance in metres along r (any length) to the first opaque surface: the ground plane
+// (MODEL.md section 5) or a target; kFar where the ray reaches the sky.
+float opaqueDistance(vec3 r) {
+  float distance = r.z < 0.0 ? u_camera_z * (length(r) / -r.z) : kFar;
+#ifdef TARGETS
+  distance = min(distance, targetDistance());
+#endif
+  return distance;
+}
+
+// The altitude band a cloud pass draws (docs/MODEL.md, "Compositing order"): a surface at
+// height dz above the camera belongs to this pass when u_band.x <= dz < u_band.y or
+// u_band.z <= dz < u_band.w. Layers are horizontal planes, so along every ray the surfaces
+// between two layers are exactly those between their altitudes.
+uniform vec4 u_band = vec4(-1e38, 1e38, 0.0, 0.0);
+bool inBand(float dz) {
+  return (dz >= u_band.x && dz < u_band.y) || (dz >= u_band.z && dz < u_band.w);
+}
+
+#ifdef BACKGROUND
+uniform vec3 u_zenith;
+uniform vec3 u_horizon;
+uniform vec3 u_ground;
+
+uniform float u_horizon_slope;  // |gradient of r.z| per pixel
+
+vec3 background(vec3 r) {
+  vec3 d = normalize(r);
+  // The ground's share of the pixel: r.z is linear across the image, so the horizon is a
+  // straight edge and its box-filtered coverage is exact.
+  float ground = clamp(0.5 - r.z / u_horizon_slope, 0.0, 1.0);
+  vec3 sky = u_horizon + (u_zenith - u_horizon) * sqrt(max(d.z, 0.0));  // MODEL.md section 5
+#ifdef FOG
+  // Each part carries its own fog. The ground seen at the horizon lies behind an infinite
+  // stretch of fog (the fog touches the ground), so there it is the fog colour.
+  vec3 fogged_ground = d.z < 0.0 ? applyFog(u_ground, d, u_camera_z / -d.z) : u_fog_colour;
+  return mix(applyFog(sky, d, kFar), fogged_ground, ground);
+#else
+  return mix(sky, u_ground, ground);
+#endif
+}
+#endif
+)";
+
+const char* kLayers = R"(
+const int kSlots = 8;
+uniform float u_height[kSlots];     // layer altitude minus camera altitude, never 0
+uniform vec3 u_colour[kSlots];      // layer colour times sun colour
+uniform vec4 u_shading[kSlots];     // Gardner eq. 8: ambient a, texture t, specular s, shininess e
+uniform float u_threshold[kSlots];  // T1
+uniform float u_transition[kSlots]; // D
+uniform vec2 u_origin[kSlots];      // texture coordinate under the camera, periods, in [0, 1)
+uniform vec2 u_inv_period[kSlots];  // periods per metre
+uniform float u_terms[kSlots];      // n
+uniform vec3 u_to_sun;
+
+struct LayerHit {
+  vec2 p;        // hit point relative to the camera, metres
+  vec2 dpdx;     // its change per pixel step right
+  vec2 dpdy;     // and up
+  float distance;
+};
+
+// Hit of the view ray on slot i's plane; the caller has checked that the ray meets it.
+LayerHit hitLayer(int i, vec3 r) {
+  float h = u_height[i];
+  // Near the horizon keep the hit finite; its footprint is then far too large for any term.
+  float rz = sign(h) * max(abs(r.z), 1e-6 * length(r));
+  LayerHit hit;
+  hit.p = (h / rz) * r.xy;
+  // Exact derivatives of the hit point per pixel (the plane's perspective Jacobian).
+  float scale = h / (rz * rz);
+  hit.dpdx = (u_right.xy * rz - r.xy * u_right.z) * scale * (2.0 / u_viewport.x);
+  hit.dpdy = (u_up.xy * rz - r.xy * u_up.z) * scale * (2.0 / u_viewport.y);
+  hit.distance = (h / rz) * length(r);
+  return hit;
+}
+
+vec2 layerCoordinate(int i, LayerHit hit) { return u_origin[i] + hit.p * u_inv_period[i]; }
+
+// Number of Gardner terms a pixel of slot i resolves.
+float termCount(int i, LayerHit hit) {
+  return resolvedTerms(
+      max(length(hit.dpdx * u_inv_period[i]), length(hit.dpdy * u_inv_period[i])), u_terms[i]);
+}
+
+// Baked Gardner: level l holds the truncation to n - l terms in red and to n - l - 1 in
+// green, so one bilinear fetch gives both truncations the fade blends.
+float bakedValue(sampler2D table, int i, LayerHit hit) {
+  float lod = u_terms[i] - termCount(i, hit);
+  float level = floor(lod);
+  vec2 t = textureLod(table, layerCoordinate(i, hit), level).rg;
+  return mix(t.r, t.g, lod - level);
+}
+
+// Tabulated noise: trilinear mipmapping with the exact footprint.
+float tableValue(sampler2D table, int i, LayerHit hit) {
+  return textureGrad(table, layerCoordinate(i, hit), hit.dpdx * u_inv_period[i],
+                     hit.dpdy * u_inv_period[i]).r;
+}
+
+#ifdef PROCEDURAL
+// Per-term constants, slot i's term j at [8 i + j]; the local origin's phases are reduced
+// modulo 2 pi on the CPU in double.
+uniform float u_fx[kSlots * 8];
+uniform float u_fy[kSlots * 8];
+uniform float u_amplitude[kSlots * 8];
+uniform float u_phase_x[kSlots * 8];       // FX(j) * origin.x + phx(j), mod 2 pi
+uniform float u_phase_y[kSlots * 8];       // FY(j) * origin.y + phy(j), mod 2 pi
+uniform float u_half_phase_x[kSlots * 8];  // 0.5 FX(j) * origin.x, mod 2 pi
+uniform float u_half_phase_y[kSlots * 8];  // 0.5 FY(j) * origin.y, mod 2 pi
+uniform float u_t0[kSlots];
+uniform float u_k[kSlots];
+const float kHalfPi = 1.5707963267948966;
+
+void addTerm(int j, vec2 p, inout float sx, inout float sy) {
+  float px = kHalfPi * sin(0.5 * u_fy[j] * p.y + u_half_phase_y[j]);
+  float py = kHalfPi * sin(0.5 * u_fx[j] * p.x + u_half_phase_x[j]);
+  sx += u_amplitude[j] * sin(u_fx[j] * p.x + u_phase_x[j] + px);
+  sy += u_amplitude[j] * sin(u_fy[j] * p.y + u_phase_y[j] + py);
+}
+
+float proceduralValue(int i, LayerHit hit) {
+  float count = termCount(i, hit);
+  int whole = int(count);
+  float sx = u_t0[i], sy = u_t0[i];
+  for (int j = 0; j < whole; ++j) addTerm(8 * i + j, hit.p, sx, sy);
+  float t = u_k[i] * max(sx, 0.0) * max(sy, 0.0);
+  float fraction = count - float(whole);
+  if (fraction > 0.0) {
+    addTerm(8 * i + whole, hit.p, sx, sy);
+    t = mix(t, u_k[i] * max(sx, 0.0) * max(sy, 0.0), fraction);
+  }
+  return t;
+}
+#endif
+
+// Slot i's surface "over" what lies behind it.
+void composite(int i, vec3 r, LayerHit hit, float it, inout vec3 colour,
+               inout float transmittance) {
+  float tr = translucence(it - u_threshold[i], u_transition[i]);  // Gardner eq. 9
+  vec3 normal = vec3(0.0, 0.0, u_height[i] > 0.0 ? -1.0 : 1.0);  // turned towards the viewer
+  float n_dot_l = dot(normal, u_to_sun);
+  float highlight = 0.0;
+#ifdef SPECULAR
+  if (n_dot_l > 0.0) {
+    vec3 reflected = 2.0 * n_dot_l * normal - u_to_sun;
+    highlight = pow(max(dot(reflected, -normalize(r)), 0.0), u_shading[i].w);
+  }
+#endif
+  vec3 surface = gardnerIntensity(u_shading[i], max(n_dot_l, 0.0), highlight, it) * u_colour[i];
+#ifdef FOG
+  surface = applyFog(surface, normalize(r), hit.distance);
+#endif
+  colour = mix(colour, surface, 1.0 - tr);
+  transmittance *= tr;
+}
+)";
+
+std::string slotStatement(int slot, LayerKind kind) {
+  const std::string i = std::to_string(slot);
+  std::string value;
+  switch (kind) {
+    case LayerKind::kBakedGardner:
+      value = "bakedValue(u_table" + i + ", " + i + ", hit)";
+      break;
+    case LayerKind::kTable:
+      value = "tableValue(u_table" + i + ", " + i + ", hit)";
+      break;
+    case LayerKind::kProceduralGardner:
+      value = "proceduralValue(" + i + ", hit)";
+      break;
+  }
+  return "    { LayerHit hit = hitLayer(" + i + ", r); if (inFront(hit.distance)) composite(" + i +
+         ", r, hit, " + value + ", colour, transmittance); }\n";
+}
+
+}  // namespace
+
+std::string SkyPassLayout::key() const {
+  std::string k = background ? "bg/" : "--/";
+  for (LayerKind kind : above) k += char('a' + int(kind));
+  k += '/';
+  for (LayerKind kind : below) k += char('a' + int(kind));
+  k += '/';
+  k += char('0' + int(term_filter));
+  k += fog ? 'f' : '-';
+  k += specular ? 's' : '-';
+  k += targets ? 't' : '-';
+  return k;
+}
+
+std::string viewShaderSource() {
+  return kCommon;
+}
+
+std::string polygonVertexSource() {
+  return R"(#version 450 core
+uniform vec2 u_polygon[8];  // convex polygon in normalised device coordinates, a triangle fan
+void main() { gl_Position = vec4(u_polygon[gl_VertexID], 0.0, 1.0); }
+)";
+}
+
+std::string skyFragmentSource(const SkyPassLayout& layout) {
+  std::string s = "#version 450 core\n";
+  if (layout.fog) s += "#define FOG\n";
+  if (layout.background) s += "#define BACKGROUND\n";
+  if (layout.specular) s += "#define SPECULAR\n";
+  if (layout.targets) s += "#define TARGETS\n";
+  if (layout.term_filter == TermFilter::kCut) s += "#define FILTER_CUT\n";
+  if (layout.term_filter == TermFilter::kNone) s += "#define FILTER_NONE\n";
+  bool procedural = false, sampled = false;
+  for (const auto* side : {&layout.above, &layout.below})
+    for (LayerKind kind : *side)
+      (kind == LayerKind::kProceduralGardner ? procedural : sampled) = true;
+  if (procedural) s += "#define PROCEDURAL\n";
+  s += kCommon;
+  if (layout.slots() > 0) s += kLayers;
+  // One sampler uniform per slot: llvmpipe samples a sampler-array element far more slowly.
+  if (sampled)
+    for (int i = 0; i < layout.slots(); ++i)
+      s += "uniform sampler2D u_table" + std::to_string(i) + ";\n";
+
+  s += "void main() {\n  vec3 r = viewRay();\n";
+  s += layout.background ? "  vec3 colour = background(r);\n" : "  vec3 colour = vec3(0.0);\n";
+  if (layout.targets) {
+    // Layers behind a target are hidden; the target replaces the background.
+    s += "  float target_distance = targetDistance();\n";
+    if (layout.background) s += "  if (target_distance < kFar) colour = targetColour();\n";
+    s += "#define inFront(d) ((d) < target_distance)\n";
+  } else {
+    s += "#define inFront(d) true\n";
+  }
+  s += "  float transmittance = 1.0;\n";
+  int slot = 0;
+  if (!layout.above.empty()) {
+    s += "  if (r.z > 0.0) {\n";
+    for (LayerKind kind : layout.above) s += slotStatement(slot++, kind);
+    s += "  }\n";
+  }
+  if (!layout.below.empty()) {
+    s += "  if (r.z < 0.0) {\n";
+    for (LayerKind kind : layout.below) s += slotStatement(slot++, kind);
+    s += "  }\n";
+  }
+  s += "  o_colour = vec4(colour, 1.0 - transmittance);\n}\n";
+  return s;
+}
+
+}  // namespace nephele

@@ -1,0 +1,169 @@
+#include "renderer/gl/target_renderer.h"
+
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "renderer/gl/ellipsoid_shaders.h"
+#include "renderer/gl/sky_shaders.h"
+#include "renderer/gl/view_uniforms.h"
+#include "world/check.h"
+
+namespace nephele {
+namespace {
+
+constexpr float kNear = 0.05f;  // metres
+constexpr int kTargetSphereSlices = 64;
+const char kBoxTag = 'b', kSphereTag = 's';  // their addresses key the shape meshes
+
+const char* kVertex = R"(#version 450 core
+layout(location = 0) in vec3 a_body;  // body coordinates before scaling
+uniform mat3 u_model;                 // R S
+uniform vec3 u_offset;                // centre - eye
+uniform vec3 u_clip_x;                // right / (tan(vfov/2) aspect)
+uniform vec3 u_clip_y;                // up / tan(vfov/2)
+uniform vec3 u_clip_w;                // forward
+out vec3 v_position;                  // camera-relative
+out vec3 v_body;
+void main() {
+  v_body = a_body;
+  v_position = u_model * a_body + u_offset;
+  // Reversed, infinite depth: with clip z in [0, w], depth = near / w.
+  gl_Position = vec4(dot(v_position, u_clip_x), dot(v_position, u_clip_y), 0.05,
+                     dot(v_position, u_clip_w));
+}
+)";
+
+const char* kFragment = R"(
+layout(location = 1) out float o_distance;
+uniform vec3 u_albedo;          // colour times sun colour
+uniform vec3 u_to_sun;
+uniform int u_smooth;           // 1: analytic ellipsoid normals, 0: facet normals
+uniform mat3 u_normal_matrix;   // R S^-1
+in vec3 v_position;
+in vec3 v_body;
+const float kAmbient = 0.3;     // kTargetAmbient
+void main() {
+  vec3 n = u_smooth != 0 ? u_normal_matrix * v_body : cross(dFdx(v_position), dFdy(v_position));
+  n = normalize(n);
+  if (dot(n, v_position) > 0.0) n = -n;
+  vec3 colour = u_albedo * (kAmbient + (1.0 - kAmbient) * max(dot(n, u_to_sun), 0.0));
+  float distance = length(v_position);
+  o_colour = vec4(applyFog(colour, v_position / distance, distance), 1.0);
+  o_distance = distance;
+}
+)";
+
+}  // namespace
+
+TargetRenderer::TargetRenderer(const GlApi& gl) : gl_(gl) {}
+TargetRenderer::~TargetRenderer() = default;
+
+GLuint TargetRenderer::program() {
+  if (program_) return program_.get();
+  std::string error;
+  program_ = createProgram(
+      gl_, kVertex, "#version 450 core\n#define FOG\n" + viewShaderSource() + kFragment, error);
+  NEPHELE_CHECK(program_, "target program: " << error);
+  return program_.get();
+}
+
+void TargetRenderer::prepare(int width, int height) {
+  if (framebuffer_ && width == width_ && height == height_) return;
+  framebuffer_ = createFramebuffer(gl_);
+  colour_ = createTexture(gl_, GL_TEXTURE_2D);
+  distance_ = createTexture(gl_, GL_TEXTURE_2D);
+  depth_ = createRenderbuffer(gl_);
+  gl_.TextureStorage2D(colour_.get(), 1, GL_RGBA16F, width, height);
+  gl_.TextureStorage2D(distance_.get(), 1, GL_R32F, width, height);
+  gl_.NamedRenderbufferStorage(depth_.get(), GL_DEPTH_COMPONENT32F, width, height);
+  for (GLuint t : {colour_.get(), distance_.get()}) {
+    gl_.TextureParameteri(t, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    gl_.TextureParameteri(t, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  }
+  const GLuint f = framebuffer_.get();
+  gl_.NamedFramebufferTexture(f, GL_COLOR_ATTACHMENT0, colour_.get(), 0);
+  gl_.NamedFramebufferTexture(f, GL_COLOR_ATTACHMENT1, distance_.get(), 0);
+  gl_.NamedFramebufferRenderbuffer(f, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_.get());
+  const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+  gl_.NamedFramebufferDrawBuffers(f, 2, buffers);
+  const GLenum status = gl_.CheckNamedFramebufferStatus(f, GL_FRAMEBUFFER);
+  NEPHELE_CHECK(status == GL_FRAMEBUFFER_COMPLETE, "target framebuffer 0x" << std::hex << status);
+  width_ = width;
+  height_ = height;
+}
+
+const IndexedMesh& TargetRenderer::mesh(const Target& target) {
+  const void* key = target.mesh.get();
+  if (target.shape == TargetShape::kBox) key = &kBoxTag;
+  if (target.shape == TargetShape::kEllipsoid) key = &kSphereTag;
+  auto found = meshes_.find(key);
+  if (found != meshes_.end()) return found->second;
+  std::vector<glm::vec3> vertices;
+  std::vector<GLuint> indices;
+  if (target.shape == TargetShape::kBox) {
+    for (int i = 0; i < 8; ++i)
+      vertices.emplace_back(i & 1 ? 1 : -1, i & 2 ? 1 : -1, i & 4 ? 1 : -1);
+    indices = {0, 1, 3, 0, 3, 2, 4, 6, 7, 4, 7, 5, 0, 4, 5, 0, 5, 1,
+               2, 3, 7, 2, 7, 6, 0, 2, 6, 0, 6, 4, 1, 5, 7, 1, 7, 3};
+  } else if (target.shape == TargetShape::kEllipsoid) {
+    unitSphere(kTargetSphereSlices, vertices, indices);
+  } else {
+    for (const glm::dvec3& v : target.mesh->vertices) vertices.emplace_back(v);
+    for (const auto& t : target.mesh->triangles) indices.insert(indices.end(), t.begin(), t.end());
+  }
+  return meshes_.emplace(key, uploadMesh(gl_, vertices, indices)).first->second;
+}
+
+bool TargetRenderer::draw(const Scene& scene) {
+  if (scene.targets.empty()) return false;
+  const Camera& camera = scene.camera;
+  prepare(camera.width, camera.height);
+  const GLuint f = framebuffer_.get();
+  const float clear_colour[4] = {0, 0, 0, 0}, far_distance[4] = {1e30f, 0, 0, 0};
+  const float nearest_depth = 0.0f;
+  gl_.ClearNamedFramebufferfv(f, GL_COLOR, 0, clear_colour);
+  gl_.ClearNamedFramebufferfv(f, GL_COLOR, 1, far_distance);
+  gl_.ClearNamedFramebufferfv(f, GL_DEPTH, 0, &nearest_depth);
+  gl_.BindFramebuffer(GL_FRAMEBUFFER, f);
+  gl_.Viewport(0, 0, camera.width, camera.height);
+  gl_.ClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+  gl_.Enable(GL_DEPTH_TEST);
+  gl_.DepthFunc(GL_GREATER);
+  gl_.Disable(GL_BLEND);
+
+  const GLuint p = program();
+  gl_.UseProgram(p);
+  setViewUniforms(gl_, p, camera, scene.fog);
+  const ViewBasis basis = viewBasis(camera);
+  setUniform3(gl_, p, "u_clip_x", basis.right / (basis.tan_half_vfov * basis.aspect));
+  setUniform3(gl_, p, "u_clip_y", basis.up / basis.tan_half_vfov);
+  setUniform3(gl_, p, "u_clip_w", basis.forward);
+  setUniform3(gl_, p, "u_to_sun", sunDirection(scene.sun));
+  for (const Target& target : scene.targets) {
+    if (target.shape == TargetShape::kMesh && !target.mesh) continue;
+    const glm::dmat3 rotation = bodyToWorld(target.orientation);
+    const glm::mat3 model(
+        rotation * glm::dmat3(target.size.x, 0, 0, 0, target.size.y, 0, 0, 0, target.size.z));
+    const glm::mat3 normal_matrix(rotation * glm::dmat3(1.0 / target.size.x, 0, 0, 0,
+                                                        1.0 / target.size.y, 0, 0, 0,
+                                                        1.0 / target.size.z));
+    gl_.ProgramUniformMatrix3fv(p, gl_.GetUniformLocation(p, "u_model"), 1, GL_FALSE, &model[0][0]);
+    gl_.ProgramUniformMatrix3fv(p, gl_.GetUniformLocation(p, "u_normal_matrix"), 1, GL_FALSE,
+                                &normal_matrix[0][0]);
+    setUniform3(gl_, p, "u_offset", target.centre - camera.position);
+    setUniform3(gl_, p, "u_albedo", target.colour * scene.sun.colour);
+    gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_smooth"),
+                         target.shape == TargetShape::kEllipsoid ? 1 : 0);
+    const IndexedMesh& m = mesh(target);
+    gl_.BindVertexArray(m.vertex_array.get());
+    gl_.DrawElements(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr);
+  }
+  gl_.Disable(GL_DEPTH_TEST);
+  gl_.ClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
+  gl_.BindTextureUnit(kTargetColourUnit, colour_.get());
+  gl_.BindTextureUnit(kTargetDistanceUnit, distance_.get());
+  return true;
+}
+
+}  // namespace nephele

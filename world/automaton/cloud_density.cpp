@@ -1,0 +1,197 @@
+#include "world/automaton/cloud_density.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "world/check.h"
+
+namespace nephele {
+
+double metaballField(double r, double radius) {
+  if (!(r < radius)) return 0.0;
+  const double a2 = (r / radius) * (r / radius);
+  const double a4 = a2 * a2;
+  return -4.0 / 9.0 * a4 * a2 + 17.0 / 9.0 * a4 - 22.0 / 9.0 * a2 + 1.0;
+}
+
+std::vector<float> cellMeans(const CellularAutomaton& automaton, double radius_cells) {
+  const GridSize n = automaton.size();
+  const int reach = int(std::floor(radius_cells));
+  std::vector<glm::ivec3> offsets;
+  for (int dz = -reach; dz <= reach; ++dz)
+    for (int dy = -reach; dy <= reach; ++dy)
+      for (int dx = -reach; dx <= reach; ++dx)
+        if (dx * dx + dy * dy + dz * dz <= radius_cells * radius_cells)
+          offsets.push_back({dx, dy, dz});
+  std::vector<float> means(std::size_t(n.cells()), 0.0f);
+  const float share = 1.0f / float(offsets.size());
+  // Scatter each cloudy cell's share to its neighbours: cost follows the cloudy cells.
+  for (int k = 0; k < n.nz; ++k)
+    for (int j = 0; j < n.ny; ++j)
+      for (int i = 0; i < n.nx; ++i) {
+        if (!automaton.get(CellBit::kCld, i, j, k)) continue;
+        for (const glm::ivec3& o : offsets) {
+          const glm::ivec3 c(i + o.x, j + o.y, k + o.z);
+          if (c.x < 0 || c.y < 0 || c.z < 0 || c.x >= n.nx || c.y >= n.ny || c.z >= n.nz) continue;
+          means[(std::size_t(c.z) * n.ny + c.y) * n.nx + c.x] += share;
+        }
+      }
+  return means;
+}
+
+double metaballDensity(const std::vector<float>& means, GridSize size, double cell_size,
+                       glm::dvec3 x, double radius_cells) {
+  const double radius = radius_cells * cell_size;
+  const glm::dvec3 c = x / cell_size - 0.5;  // position in cell-centre units
+  const glm::ivec3 lo = glm::max(glm::ivec3(glm::ceil(c - radius_cells)), glm::ivec3(0));
+  const glm::ivec3 hi =
+      glm::min(glm::ivec3(glm::floor(c + radius_cells)), glm::ivec3(size.nx, size.ny, size.nz) - 1);
+  double rho = 0.0;
+  for (int k = lo.z; k <= hi.z; ++k)
+    for (int j = lo.y; j <= hi.y; ++j)
+      for (int i = lo.x; i <= hi.x; ++i) {
+        const float q = means[(std::size_t(k) * size.ny + j) * size.nx + i];
+        if (q == 0.0f) continue;
+        const glm::dvec3 centre = (glm::dvec3(i, j, k) + 0.5) * cell_size;
+        rho += q * metaballField(glm::length(x - centre), radius);
+      }
+  return rho;
+}
+
+double DensityLattice::densityAt(glm::dvec3 x) const {
+  const glm::dvec3 u = (x - origin) / spacing;
+  const glm::ivec3 base(glm::floor(u));
+  const glm::dvec3 f = u - glm::dvec3(base);
+  double rho = 0.0;
+  for (int corner = 0; corner < 8; ++corner) {
+    const glm::ivec3 o(corner & 1, (corner >> 1) & 1, corner >> 2);
+    const glm::ivec3 s = base + o;
+    if (glm::any(glm::lessThan(s, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(s, dims)))
+      continue;
+    const double w = (o.x ? f.x : 1.0 - f.x) * (o.y ? f.y : 1.0 - f.y) * (o.z ? f.z : 1.0 - f.z);
+    rho += w * density[index(s.x, s.y, s.z)];
+  }
+  return rho;
+}
+
+DensityLattice densityLattice(const std::vector<float>& means, GridSize size, double cell_size,
+                              int samples_per_cell) {
+  NEPHELE_CHECK(samples_per_cell >= 1, samples_per_cell);
+  NEPHELE_CHECK(means.size() == std::size_t(size.cells()), means.size());
+  const int r = samples_per_cell;
+  const int margin = int(std::ceil(kMetaballRadiusCells * r));
+  DensityLattice lattice;
+  lattice.spacing = cell_size / r;
+  lattice.dims =
+      glm::ivec3((size.nx - 1) * r, (size.ny - 1) * r, (size.nz - 1) * r) + 1 + 2 * margin;
+  lattice.origin = glm::dvec3(0.5 * cell_size - margin * lattice.spacing);
+  lattice.density.assign(std::size_t(lattice.dims.x) * lattice.dims.y * lattice.dims.z, 0.0f);
+  lattice.sunlight.assign(lattice.density.size(), 1.0f);
+
+  // Samples are aligned with cell centres, so every cell sees the same kernel of weights.
+  const double radius = kMetaballRadiusCells * cell_size;
+  struct Tap {
+    glm::ivec3 offset;
+    float weight;
+  };
+  std::vector<Tap> kernel;
+  for (int z = -margin; z <= margin; ++z)
+    for (int y = -margin; y <= margin; ++y)
+      for (int x = -margin; x <= margin; ++x) {
+        const double w = metaballField(glm::length(glm::dvec3(x, y, z)) * lattice.spacing, radius);
+        if (w > 0.0) kernel.push_back({{x, y, z}, float(w)});
+      }
+  glm::ivec3 lo(std::numeric_limits<int>::max()), hi(std::numeric_limits<int>::min());
+  for (int k = 0; k < size.nz; ++k)
+    for (int j = 0; j < size.ny; ++j)
+      for (int i = 0; i < size.nx; ++i) {
+        const float q = means[(std::size_t(k) * size.ny + j) * size.nx + i];
+        if (q == 0.0f) continue;
+        const glm::ivec3 centre = glm::ivec3(i, j, k) * r + margin;
+        lo = glm::min(lo, centre - margin);
+        hi = glm::max(hi, centre + margin);
+        for (const Tap& tap : kernel) {
+          const glm::ivec3 s = centre + tap.offset;
+          lattice.density[lattice.index(s.x, s.y, s.z)] += q * tap.weight;
+        }
+      }
+  if (lo.x <= hi.x) {
+    lattice.occupied_lo = glm::max(lo - 1, glm::ivec3(0));
+    lattice.occupied_hi = glm::min(hi + 1, lattice.dims - 1);
+  }
+  return lattice;
+}
+
+void sweepSunlight(DensityLattice& lattice, glm::dvec3 to_sun, double extinction_per_m) {
+  to_sun = glm::normalize(to_sun);
+  // Sweep along the axis the sun direction leans on most; B and C are the other two.
+  int a = 0;
+  for (int axis = 1; axis < 3; ++axis)
+    if (std::abs(to_sun[axis]) > std::abs(to_sun[a])) a = axis;
+  const int b = (a + 1) % 3, c = (a + 2) % 3;
+  const glm::ivec3 dims = lattice.dims;
+  const double da = std::abs(to_sun[a]);
+  const int toward_sun = to_sun[a] >= 0.0 ? 1 : -1;
+  // One slice towards the sun moves by (db, dc) samples across and `length` metres.
+  const double db = to_sun[b] / da, dc = to_sun[c] / da;
+  const double length = lattice.spacing / da;
+  auto at = [&](int ia, int ib, int ic) {
+    glm::ivec3 s;
+    s[a] = ia;
+    s[b] = ib;
+    s[c] = ic;
+    return lattice.index(s.x, s.y, s.z);
+  };
+  const int first = toward_sun > 0 ? dims[a] - 1 : 0;
+  for (int ib = 0; ib < dims[b]; ++ib)
+    for (int ic = 0; ic < dims[c]; ++ic) {
+      // Beyond the first slice lies empty space: its density is 0 at the lattice edge.
+      const double rho = lattice.density[at(first, ib, ic)];
+      lattice.sunlight[at(first, ib, ic)] =
+          float(segmentTransmittance(rho, 0.0, length, extinction_per_m));
+    }
+  for (int ia = first - toward_sun; ia >= 0 && ia < dims[a]; ia -= toward_sun) {
+    const int up = ia + toward_sun;
+    for (int ib = 0; ib < dims[b]; ++ib)
+      for (int ic = 0; ic < dims[c]; ++ic) {
+        const double ub = ib + db, uc = ic + dc;
+        const int b0 = int(std::floor(ub)), c0 = int(std::floor(uc));
+        const double fb = ub - b0, fc = uc - c0;
+        double t_up = 0.0, rho_up = 0.0;
+        for (int corner = 0; corner < 4; ++corner) {
+          const int sb = b0 + (corner & 1), sc = c0 + (corner >> 1);
+          const double w = ((corner & 1) ? fb : 1.0 - fb) * ((corner >> 1) ? fc : 1.0 - fc);
+          if (sb < 0 || sc < 0 || sb >= dims[b] || sc >= dims[c]) {
+            t_up += w;  // open sky: full sunlight, no density
+            continue;
+          }
+          t_up += w * lattice.sunlight[at(up, sb, sc)];
+          rho_up += w * lattice.density[at(up, sb, sc)];
+        }
+        const std::size_t here = at(ia, ib, ic);
+        lattice.sunlight[here] = float(
+            t_up * segmentTransmittance(lattice.density[here], rho_up, length, extinction_per_m));
+      }
+  }
+}
+
+double rayleighPhase(double cos_theta) {
+  return 0.75 * (1.0 + cos_theta * cos_theta);
+}
+
+double cornetteShanksPhase(double cos_theta, double g) {
+  const double g2 = g * g;
+  const double denominator = std::pow(std::max(1.0 + g2 - 2.0 * g * cos_theta, 1e-12), 1.5);
+  return 1.5 * (1.0 - g2) / (2.0 + g2) * (1.0 + cos_theta * cos_theta) / denominator;
+}
+
+double cornetteShanksAsymmetry(double u) {
+  const double u2 = u * u;
+  const double x = 5.0 / 9.0 * u + 125.0 / 729.0 * u2 * u +
+                   std::sqrt(64.0 / 27.0 - 325.0 / 243.0 * u2 + 1250.0 / 2187.0 * u2 * u2);
+  const double cube_root = std::cbrt(x);
+  return 5.0 / 9.0 * u - (4.0 / 3.0 - 25.0 / 81.0 * u2) / cube_root + cube_root;
+}
+
+}  // namespace nephele

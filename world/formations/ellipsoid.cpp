@@ -1,0 +1,139 @@
+#include "world/formations/ellipsoid.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <utility>
+
+namespace nephele {
+
+std::string ellipsoidError(const Ellipsoid& e) {
+  std::ostringstream out;
+  for (int i = 0; i < 3; ++i)
+    if (!(std::isfinite(e.radii[i]) && e.radii[i] > 0.0)) {
+      out << "radius "
+          << "xyz"[i] << " = " << e.radii[i] << " is not allowed (allowed: a finite number > 0)";
+      return out.str();
+    }
+  for (int i = 0; i < 3; ++i)
+    if (!std::isfinite(e.centre[i])) return "centre is not finite (allowed: finite numbers)";
+  const Orientation& o = e.orientation;
+  if (!std::isfinite(o.heading_deg) || !std::isfinite(o.pitch_deg) || !std::isfinite(o.roll_deg))
+    return "orientation is not finite (allowed: finite angles in degrees)";
+  return "";
+}
+
+glm::dmat3 worldToUnitSphere(const Ellipsoid& e) {
+  const glm::dmat3 inverse_scale(1.0 / e.radii.x, 0, 0, 0, 1.0 / e.radii.y, 0, 0, 0,
+                                 1.0 / e.radii.z);
+  return inverse_scale * glm::transpose(bodyToWorld(e.orientation));
+}
+
+double quadricValue(const Ellipsoid& e, glm::dvec3 point) {
+  const glm::dvec3 o = worldToUnitSphere(e) * (point - e.centre);
+  return glm::dot(o, o) - 1.0;
+}
+
+SymmetricEigen symmetricEigen(const glm::dmat3& m) {
+  double a[3][3], v[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) a[i][j] = 0.5 * (m[j][i] + m[i][j]);
+  const int pairs[3][2] = {{0, 1}, {0, 2}, {1, 2}};
+  for (int sweep = 0; sweep < 60; ++sweep) {
+    const double off = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2];
+    const double diag = a[0][0] * a[0][0] + a[1][1] * a[1][1] + a[2][2] * a[2][2];
+    if (off <= 1e-32 * diag || off == 0.0) break;
+    for (const auto& pq : pairs) {
+      const int p = pq[0], q = pq[1];
+      if (a[p][q] == 0.0) continue;
+      // Rotation J (J_pp = J_qq = c, J_pq = s, J_qp = -s) that zeroes a_pq in J^T A J.
+      const double theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
+      const double t = (theta >= 0.0 ? 1.0 : -1.0) / (std::abs(theta) + std::hypot(theta, 1.0));
+      const double c = 1.0 / std::sqrt(t * t + 1.0), s = t * c;
+      for (int k = 0; k < 3; ++k) {  // A J
+        const double kp = a[k][p], kq = a[k][q];
+        a[k][p] = c * kp - s * kq;
+        a[k][q] = s * kp + c * kq;
+      }
+      for (int k = 0; k < 3; ++k) {  // J^T (A J)
+        const double pk = a[p][k], qk = a[q][k];
+        a[p][k] = c * pk - s * qk;
+        a[q][k] = s * pk + c * qk;
+      }
+      for (int k = 0; k < 3; ++k) {  // V J
+        const double kp = v[k][p], kq = v[k][q];
+        v[k][p] = c * kp - s * kq;
+        v[k][q] = s * kp + c * kq;
+      }
+    }
+  }
+  int order[3] = {0, 1, 2};
+  std::sort(order, order + 3, [&](int x, int y) { return a[x][x] < a[y][y]; });
+  SymmetricEigen out;
+  for (int i = 0; i < 3; ++i) {
+    out.values[i] = a[order[i]][order[i]];
+    out.vectors[i] = glm::dvec3(v[0][order[i]], v[1][order[i]], v[2][order[i]]);
+  }
+  return out;
+}
+
+EllipsoidView::EllipsoidView(const Ellipsoid& ellipsoid, glm::dvec3 eye)
+    : to_unit_(worldToUnitSphere(ellipsoid)), eye_unit_(to_unit_ * (eye - ellipsoid.centre)) {
+  c_ = glm::dot(eye_unit_, eye_unit_) - 1.0;
+  // Delta(d) = 4 [(o.Wd)^2 - |Wd|^2 c] = 4 (Wd)^T (o o^T - c I) (Wd).
+  const glm::dmat3 inner = glm::outerProduct(eye_unit_, eye_unit_) - c_ * glm::dmat3(1.0);
+  k_ = 4.0 * glm::transpose(to_unit_) * inner * to_unit_;
+  if (eyeInside()) return;
+  // Outside, K has one positive eigenvalue (Sylvester: o o^T - c I has eigenvalues 1, -c, -c).
+  const SymmetricEigen eigen = symmetricEigen(k_);
+  lambda_ = eigen.values[2];
+  axis_ = glm::normalize(eigen.vectors[2]);
+  if (glm::dot(axis_, ellipsoid.centre - eye) < 0.0) axis_ = -axis_;
+  limb_form_ = -(k_ - lambda_ * glm::outerProduct(axis_, axis_)) / lambda_;
+}
+
+std::optional<RaySpan> EllipsoidView::intersect(glm::dvec3 direction) const {
+  const glm::dvec3 w = to_unit_ * direction;
+  const double a = glm::dot(w, w);
+  if (!(a > 0.0)) return std::nullopt;
+  // Delta / 4 = (o.w)^2 - |w|^2 (|o|^2 - 1) = |w|^2 - |o x w|^2, free of cancellation far away.
+  const glm::dvec3 cross = glm::cross(eye_unit_, w);
+  const double quarter_delta = a - glm::dot(cross, cross);
+  if (!(quarter_delta > 0.0)) return std::nullopt;
+  const double half_b = glm::dot(eye_unit_, w);
+  const double q = -(half_b + std::copysign(std::sqrt(quarter_delta), half_b));
+  const double s1 = q / a, s2 = c_ / q;
+  return RaySpan{std::min(s1, s2), std::max(s1, s2)};
+}
+
+double EllipsoidView::limb(glm::dvec3 direction) const {
+  if (eyeInside()) return 0.0;
+  const double along = glm::dot(direction, axis_);
+  if (!(along > 0.0)) return 0.0;
+  const glm::dvec3 q = direction / along - axis_;
+  return std::clamp(1.0 - glm::dot(q, limb_form_ * q), 0.0, 1.0);
+}
+
+glm::dvec3 EllipsoidView::normalAt(glm::dvec3 direction, double s) const {
+  const glm::dvec3 gradient = glm::transpose(to_unit_) * (eye_unit_ + s * (to_unit_ * direction));
+  return glm::normalize(gradient);
+}
+
+glm::dmat3 silhouetteConic(const EllipsoidView& view, const ViewBasis& basis) {
+  const glm::dmat3 b(basis.right, basis.up, basis.forward);
+  return glm::transpose(b) * view.discriminantForm() * b;
+}
+
+EyeBox eyeSpaceBox(const Ellipsoid& e, glm::dvec3 eye, const ViewBasis& basis) {
+  const glm::dvec3 rel = e.centre - eye;
+  // Half-extent along unit axis n is |S R^T n| (the support function of the ellipsoid).
+  const glm::dmat3 scaled_body = glm::dmat3(e.radii.x, 0, 0, 0, e.radii.y, 0, 0, 0, e.radii.z) *
+                                 glm::transpose(bodyToWorld(e.orientation));
+  EyeBox box;
+  box.centre = {glm::dot(rel, basis.right), glm::dot(rel, basis.up), glm::dot(rel, basis.forward)};
+  box.half_extent = {glm::length(scaled_body * basis.right), glm::length(scaled_body * basis.up),
+                     glm::length(scaled_body * basis.forward)};
+  return box;
+}
+
+}  // namespace nephele

@@ -1,0 +1,72 @@
+#pragma once
+// Gardner's cloud formations: clusters of textured, translucent ellipsoids sharing one colour,
+// one texture and one set of thresholds (MODEL.md sections 4 and 5), and the in-cloud fog a
+// camera sees when it flies into one.
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "world/formations/ellipsoid.h"
+#include "world/shading.h"
+#include "world/sky.h"
+#include "world/textures/solid_texture.h"
+
+namespace nephele {
+
+struct EllipsoidCloud {
+  std::string name;
+  glm::dvec3 colour{1.0, 1.0, 1.0};  // linear RGB
+  double threshold_centre = 0.25;    // Gardner's T1
+  double threshold_limb = 0.6;       // Gardner's T2 (Elinas' "T2" is T2 - T1)
+  double transition = 0.25;          // D, >= 0
+  ShadingParams shading{0.35, 0.5, 0.0, 8.0};
+  SolidTextureSpec texture;
+  std::vector<Ellipsoid> ellipsoids;
+  // How far the cloud has drifted since time 0. Its ellipsoid centres already include it; the
+  // texture is looked up at (X - drift) so that it moves with the cloud.
+  glm::dvec3 drift_m{0.0};
+};
+
+// The lowest and highest altitudes its ellipsoids reach.
+std::pair<double, double> cloudVerticalExtent(const EllipsoidCloud& cloud);
+// The middle of that extent: the altitude whose wind carries the cloud.
+double cloudAltitude(const EllipsoidCloud& cloud);
+
+// A cumulus heap of `count` ellipsoids over a base at `base_centre` (the middle of its flat
+// bottom), about `width_m` across: a wide flat base row and smaller rounder lobes stacked
+// towards the top. Deterministic in `seed`.
+std::vector<Ellipsoid> cumulusEllipsoids(int count, glm::dvec3 base_centre, double width_m,
+                                         std::uint64_t seed);
+
+// In-cloud fog. The papers leave the view from inside an ellipsoid to the renderer; this model is
+// shared by the GL renderer and the reference so both show the same thing.
+//
+// With rho = |W (eye - centre)| (1 on the surface, 0 at the centre) and a band
+// w = kInCloudBand:
+// - the ellipsoid's own surface fades out as the eye comes within w of it from outside:
+//   its opacity is multiplied by surfaceFade(rho) = smoothstep(1, 1 + w, rho);
+// - a veil at the eye takes over: opacity veilOpacity(rho) = 1 - smoothstep(1 - w, 1 + w, rho),
+//   0 beyond 1 + w, 1/2 on the surface, 1 deeper than 1 - w.
+// Both are continuous in the eye position, so entering or leaving a cloud has no jump.
+// The veil's colour is Gardner eq. 8 for a horizontal surface lit from above (Id = max(0,
+// L.z), no highlight) with It the cloud's texture at the eye, times cloud and sun colours.
+// Several veils combine order-independently: opacity 1 - prod(1 - v_i), colour the
+// opacity-weighted mean.
+inline constexpr double kInCloudBand = 0.25;
+double surfaceFade(double eye_radius);
+double veilOpacity(double eye_radius);
+
+// The combined veil over everything, straight (not premultiplied) colour and opacity;
+// opacity 0 when the eye is far from every ellipsoid.
+struct Veil {
+  glm::dvec3 colour{0.0};
+  double opacity = 0.0;
+};
+// `textures[i]` is cloud i's texture (the caller keeps them built).
+Veil inCloudVeil(const std::vector<EllipsoidCloud>& clouds,
+                 const std::vector<const SolidTexture*>& textures, glm::dvec3 eye, const Sun& sun);
+
+}  // namespace nephele

@@ -1,0 +1,94 @@
+#include "world/textures/gardner_texture.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "world/counter_random.h"
+
+namespace nephele {
+namespace {
+constexpr double kPi = std::numbers::pi;
+constexpr double kAmplitudeRatio = 0.707;  // C(i+1) = 0.707 C(i)
+
+double textureFromSums(double sx, double sy, double k) {
+  return k * std::max(sx, 0.0) * std::max(sy, 0.0);
+}
+}  // namespace
+
+double wrapPeriodic(double x, double period) {
+  double r = std::fmod(x, period);
+  if (r < 0.0) r += period;
+  return r >= period ? 0.0 : r;  // -tiny + period may round up to period
+}
+
+GardnerTexture::GardnerTexture(const GardnerTextureParams& params) : params_(params) {
+  double amplitude_sum = 0.0;
+  double c = 1.0;
+  for (int i = 0; i < params_.terms; ++i) {
+    fx_[i] = params_.fx1 * std::ldexp(1.0, i);  // FX(i+1) = 2 FX(i)
+    fy_[i] = params_.fy1 * std::ldexp(1.0, i);
+    c_[i] = c;
+    amplitude_sum += c;
+    c *= kAmplitudeRatio;
+    if (params_.seeded_phases) {
+      phx_[i] = 2.0 * kPi * unitFromBits(hashCounters(params_.seed, 0x47617264ull, i, 0));
+      phy_[i] = 2.0 * kPi * unitFromBits(hashCounters(params_.seed, 0x47617264ull, i, 1));
+    }
+  }
+  const double denom = amplitude_sum + params_.t0;
+  k_ = 1.0 / (denom * denom);
+}
+
+glm::dvec2 GardnerTexture::period() const {
+  return {4.0 * kPi / params_.fx1, 4.0 * kPi / params_.fy1};
+}
+
+double GardnerTexture::planar(glm::dvec2 p, double term_count) const {
+  return evaluate({p.x, p.y, 0.0}, /*solid=*/false, term_count);
+}
+
+double GardnerTexture::solid(glm::dvec3 p, double term_count) const {
+  return evaluate(p, /*solid=*/true, term_count);
+}
+
+void GardnerTexture::addTerm(int i, glm::dvec3 p, bool solid, double& sx, double& sy) const {
+  // Planar phases, plus the Z term for solid textures (MODEL.md section 2).
+  double px = 0.5 * kPi * std::sin(0.5 * fy_[i] * p.y);
+  double py = 0.5 * kPi * std::sin(0.5 * fx_[i] * p.x);
+  if (solid) {
+    const double pz = kPi * std::sin(0.5 * fx_[i] * p.z);
+    px += pz;
+    py += pz;
+  }
+  sx += c_[i] * std::sin(fx_[i] * p.x + px + phx_[i]);
+  sy += c_[i] * std::sin(fy_[i] * p.y + py + phy_[i]);
+}
+
+double GardnerTexture::evaluate(glm::dvec3 p, bool solid, double term_count) const {
+  const int n = params_.terms;
+  term_count = std::clamp(term_count, 0.0, double(n));
+  const int whole = int(std::floor(term_count));
+  const double fraction = term_count - whole;
+
+  double sx = params_.t0, sy = params_.t0;
+  for (int i = 0; i < whole; ++i) addTerm(i, p, solid, sx, sy);
+  const double t_whole = textureFromSums(sx, sy, k_);
+  if (fraction == 0.0 || whole >= n) return t_whole;
+
+  addTerm(whole, p, solid, sx, sy);
+  return (1.0 - fraction) * t_whole + fraction * textureFromSums(sx, sy, k_);
+}
+
+double GardnerTexture::termCountForFootprint(double footprint_periods, TermFilter filter) const {
+  const int n = params_.terms;
+  if (filter == TermFilter::kNone) return n;
+  if (!(footprint_periods > 0.0)) return n;           // zero footprint: every term resolves
+  if (!std::isfinite(footprint_periods)) return 0.0;  // infinite footprint: nothing resolves
+  // Term i (1-based) has 2^i cycles per period; it resolves while 2^i * footprint <= 1/2.
+  const double highest_resolved = std::log2(0.5 / footprint_periods);
+  if (filter == TermFilter::kCut) return std::clamp(std::floor(highest_resolved), 0.0, double(n));
+  return std::clamp(highest_resolved - 1.0, 0.0, double(n));
+}
+
+}  // namespace nephele

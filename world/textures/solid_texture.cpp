@@ -1,0 +1,152 @@
+#include "world/textures/solid_texture.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "world/counter_random.h"
+#include "world/textures/texture_table.h"
+
+namespace nephele {
+namespace {
+constexpr double kPi = std::numbers::pi;
+
+// Unit gradient for a lattice point: uniform on the sphere from two counter-based draws.
+glm::dvec3 latticeGradient(std::uint64_t seed, int octave, int x, int y, int z) {
+  const std::uint64_t cell = (std::uint64_t(std::uint32_t(x)) << 32) | std::uint32_t(y);
+  const double u = unitFromBits(hashCounters(seed, 0x50336430ull + octave, cell, std::uint32_t(z)));
+  const double v = unitFromBits(hashCounters(seed, 0x50336431ull + octave, cell, std::uint32_t(z)));
+  const double cos_theta = 2.0 * u - 1.0, sin_theta = std::sqrt(1.0 - cos_theta * cos_theta);
+  const double phi = 2.0 * kPi * v;
+  return {sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta};
+}
+}  // namespace
+
+float VolumeTable::at(int x, int y, int z) const {
+  return values[(std::size_t(wrapIndex(z, size)) * size + wrapIndex(y, size)) * size +
+                wrapIndex(x, size)];
+}
+
+double VolumeTable::sampleTrilinear(glm::dvec3 uvw) const {
+  const glm::dvec3 p = uvw * double(size) - 0.5;
+  const glm::dvec3 f = glm::floor(p), t = p - f;
+  const int ix = int(std::fmod(f.x, double(size))), iy = int(std::fmod(f.y, double(size))),
+            iz = int(std::fmod(f.z, double(size)));
+  double sum = 0.0;
+  for (int dz = 0; dz < 2; ++dz)
+    for (int dy = 0; dy < 2; ++dy)
+      for (int dx = 0; dx < 2; ++dx)
+        sum += (dx ? t.x : 1.0 - t.x) * (dy ? t.y : 1.0 - t.y) * (dz ? t.z : 1.0 - t.z) *
+               at(ix + dx, iy + dy, iz + dz);
+  return sum;
+}
+
+VolumeTable bakeGardnerSolid(const GardnerTexture& texture, int size, int terms) {
+  const int m = std::clamp(terms, 0, texture.terms());
+  const glm::dvec2 p2 = texture.period();
+  const glm::dvec3 period(p2.x, p2.y, p2.x);  // Z phases run at FX / 2
+  const std::size_t n = std::size_t(size);
+  // Term i along X is sin(a(x) + b(y, z)), along Y sin(a'(y) + b'(x, z)) (MODEL.md section 2,
+  // solid phases): tabulate a per coordinate and b per pair, then sin(a + b) by addition.
+  std::vector<double> sin_ax(m * n), cos_ax(m * n), sin_ay(m * n), cos_ay(m * n);
+  std::vector<double> sin_bx(m * n * n), cos_bx(m * n * n), sin_by(m * n * n), cos_by(m * n * n);
+  auto coordinate = [&](std::size_t t, int axis) { return (t + 0.5) / size * period[axis]; };
+  for (int i = 0; i < m; ++i) {
+    const double fx = texture.frequencyX(i), fy = texture.frequencyY(i);
+    for (std::size_t t = 0; t < n; ++t) {
+      const double ax = fx * coordinate(t, 0) + texture.phaseX(i);
+      const double ay = fy * coordinate(t, 1) + texture.phaseY(i);
+      sin_ax[i * n + t] = std::sin(ax), cos_ax[i * n + t] = std::cos(ax);
+      sin_ay[i * n + t] = std::sin(ay), cos_ay[i * n + t] = std::cos(ay);
+    }
+    for (std::size_t z = 0; z < n; ++z) {
+      const double pz = kPi * std::sin(0.5 * fx * coordinate(z, 2));
+      for (std::size_t t = 0; t < n; ++t) {
+        const double bx = 0.5 * kPi * std::sin(0.5 * fy * coordinate(t, 1)) + pz;  // PX at (y, z)
+        const double by = 0.5 * kPi * std::sin(0.5 * fx * coordinate(t, 0)) + pz;  // PY at (x, z)
+        const std::size_t j = (i * n + z) * n + t;
+        sin_bx[j] = std::sin(bx), cos_bx[j] = std::cos(bx);
+        sin_by[j] = std::sin(by), cos_by[j] = std::cos(by);
+      }
+    }
+  }
+  VolumeTable out{size, std::vector<float>(n * n * n)};
+  const double t0 = texture.params().t0, k = texture.normalisation();
+  for (std::size_t z = 0; z < n; ++z)
+    for (std::size_t y = 0; y < n; ++y)
+      for (std::size_t x = 0; x < n; ++x) {
+        double sx = t0, sy = t0;
+        for (int i = 0; i < m; ++i) {
+          const std::size_t jx = (i * n + z) * n + y, jy = (i * n + z) * n + x;
+          const double c = texture.amplitude(i);
+          sx += c * (sin_ax[i * n + x] * cos_bx[jx] + cos_ax[i * n + x] * sin_bx[jx]);
+          sy += c * (sin_ay[i * n + y] * cos_by[jy] + cos_ay[i * n + y] * sin_by[jy]);
+        }
+        out.values[(z * n + y) * n + x] = float(k * std::max(sx, 0.0) * std::max(sy, 0.0));
+      }
+  return out;
+}
+
+VolumeTable perlinVolume(int size, int cells, int octaves, double persistence, std::uint64_t seed) {
+  const std::size_t n = std::size_t(size);
+  VolumeTable table{size, std::vector<float>(n * n * n, 0.0f)};
+  double amplitude = 1.0;
+  for (int octave = 0; octave < octaves; ++octave, amplitude *= persistence) {
+    const int lattice = cells << octave;
+    for (std::size_t z = 0; z < n; ++z)
+      for (std::size_t y = 0; y < n; ++y)
+        for (std::size_t x = 0; x < n; ++x) {
+          const glm::dvec3 p = (glm::dvec3(x, y, z) + 0.5) * double(lattice) / double(size);
+          const glm::ivec3 g(glm::floor(p));
+          const glm::dvec3 f = p - glm::dvec3(g);
+          auto corner = [&](int dx, int dy, int dz) {
+            const glm::dvec3 grad =
+                latticeGradient(seed, octave, wrapIndex(g.x + dx, lattice),
+                                wrapIndex(g.y + dy, lattice), wrapIndex(g.z + dz, lattice));
+            return glm::dot(grad, f - glm::dvec3(dx, dy, dz));
+          };
+          const glm::dvec3 s(smootherstep(f.x), smootherstep(f.y), smootherstep(f.z));
+          double v = 0.0;
+          for (int dz = 0; dz < 2; ++dz)
+            for (int dy = 0; dy < 2; ++dy)
+              for (int dx = 0; dx < 2; ++dx)
+                v += (dx ? s.x : 1.0 - s.x) * (dy ? s.y : 1.0 - s.y) * (dz ? s.z : 1.0 - s.z) *
+                     corner(dx, dy, dz);
+          table.values[(z * n + y) * n + x] += float(amplitude * v);
+        }
+  }
+  normaliseToUnit(table.values);
+  return table;
+}
+
+SolidTexture::SolidTexture(const SolidTextureSpec& spec) : spec_(spec) {
+  if (spec_.source == SolidTextureSource::kGardner) {
+    GardnerTextureParams params = spec_.gardner;
+    params.seed = spec_.seed;
+    gardner_ = std::make_unique<GardnerTexture>(params);
+  } else {
+    volume_ = std::make_unique<VolumeTable>(perlinVolume(1 << spec_.perlin_size_log2,
+                                                         spec_.perlin_cells, spec_.perlin_octaves,
+                                                         spec_.perlin_persistence, spec_.seed));
+  }
+}
+
+glm::dvec3 SolidTexture::period() const {
+  if (!gardner_) return glm::dvec3(spec_.perlin_period_m);
+  const glm::dvec2 p = gardner_->period();
+  return {p.x, p.y, p.x};
+}
+
+glm::dvec3 SolidTexture::periodicCoordinate(glm::dvec3 world) const {
+  const glm::dvec3 p = period();
+  return {wrapPeriodic(world.x, p.x) / p.x, wrapPeriodic(world.y, p.y) / p.y,
+          wrapPeriodic(world.z, p.z) / p.z};
+}
+
+double SolidTexture::value(glm::dvec3 world) const {
+  const glm::dvec3 uvw = periodicCoordinate(world);
+  if (gardner_) return gardner_->solid(uvw * period(), gardner_->terms());
+  return volume_->sampleTrilinear(uvw);
+}
+
+}  // namespace nephele
