@@ -174,6 +174,14 @@ void readWind(TableReader& t, WindSample& sample) {
   t.finish();
 }
 
+// Gardner eq. 8's a, t, s and e, as layers and clouds spell them.
+void readShading(TableReader& t, ShadingParams& shading) {
+  t.number("ambient", shading.ambient, Limits::kFraction);
+  t.number("texture_fraction", shading.texture_fraction, Limits::kFraction);
+  t.number("specular", shading.specular, Limits::kFraction);
+  t.number("shininess", shading.shininess, Limits::kShininess);
+}
+
 void readLayer(TableReader& t, CloudLayer& layer, LayerDevelopment& develop) {
   t.allow({"name", "altitude", "colour", "threshold", "transition", "ambient", "texture_fraction",
            "specular", "shininess", "drift", "seed", "texture", "develop"});
@@ -182,10 +190,7 @@ void readLayer(TableReader& t, CloudLayer& layer, LayerDevelopment& develop) {
   t.vector("colour", layer.colour, Limits::kColour);
   t.number("threshold", layer.threshold, Limits::kLayerThreshold);
   t.number("transition", layer.transition, Limits::kTransition);
-  t.number("ambient", layer.shading.ambient, Limits::kFraction);
-  t.number("texture_fraction", layer.shading.texture_fraction, Limits::kFraction);
-  t.number("specular", layer.shading.specular, Limits::kFraction);
-  t.number("shininess", layer.shading.shininess, Limits::kShininess);
+  readShading(t, layer.shading);
   t.vector("drift", layer.texture.drift_velocity, -Limits::kMaxDrift, Limits::kMaxDrift);
   t.seed("seed", layer.texture.seed);
   if (auto texture = t.table("texture")) readTexture(*texture, layer.texture);
@@ -261,10 +266,7 @@ void readCloud(TableReader& t, std::uint64_t seed, EllipsoidCloud& cloud,
   t.number("threshold", cloud.threshold_centre, Limits::kCloudThreshold);
   t.number("limb_threshold", cloud.threshold_limb, Limits::kCloudThreshold);
   t.number("transition", cloud.transition, Limits::kTransition);
-  t.number("ambient", cloud.shading.ambient, Limits::kFraction);
-  t.number("texture_fraction", cloud.shading.texture_fraction, Limits::kFraction);
-  t.number("specular", cloud.shading.specular, Limits::kFraction);
-  t.number("shininess", cloud.shading.shininess, Limits::kShininess);
+  readShading(t, cloud.shading);
   cloud.texture.seed = seed;
   t.seed("seed", cloud.texture.seed);
   if (auto texture = t.table("texture")) readSolidTexture(*texture, cloud.texture);

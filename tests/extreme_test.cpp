@@ -1,8 +1,9 @@
 // Stiff and extreme cases (docs/ACCURACY.md, "Stiff and extreme cases"): for every legal input
 // at the edges of its range, every GL output is finite and in range, and where the model is
 // defined there (MODEL.md section 7) the GL agrees with the reference within a stated
-// tolerance (30 dB, measured 34 to 54). One scene holds a layer, an ellipsoid cloud and an automaton cloud, so each edit
-// reaches every kind of primitive; images are small (48x36) to keep the suite lean.
+// tolerance (30 dB, measured 34 to 54). One scene holds a layer, an ellipsoid cloud and an
+// automaton cloud, so each edit reaches every kind of primitive; images are small (48x36) to keep
+// the suite lean.
 #include <gtest/gtest.h>
 
 #include <cmath>
