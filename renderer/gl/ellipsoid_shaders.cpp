@@ -272,7 +272,10 @@ void main() {
   float alpha = opacityFromExcess(t.a) * u_e[u_index].limb_axis.w;
   vec3 r = viewRay();
   float s = hitEllipsoid(u_index, r);
-  if (s > 0.0 && !hitShows(r, s, opaqueDistance(r) / length(r))) discard;
+  // A tile texel just outside the exact silhouette (no hit) stands at the ray's closest
+  // approach to the centre, so a cloud drawn in several bands draws it in exactly one.
+  if (s <= 0.0) s = max(dot(u_e[u_index].centre.xyz, r) / dot(r, r), 0.0);
+  if (!hitShows(r, s, opaqueDistance(r) / length(r))) discard;
   o_colour = vec4(t.rgb * alpha, alpha);
 }
 )";
