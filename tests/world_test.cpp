@@ -1,5 +1,8 @@
 #include "world/world.h"
 
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -206,6 +209,36 @@ TEST(World, CorruptOrTruncatedSnapshotsAreRefusedAndLeaveTheWorldAsItWas) {
   EXPECT_EQ(target.hash(), before);
   ASSERT_EQ(target.restore(good), "");
   EXPECT_EQ(target.hash(), source.hash());
+}
+
+// Issue 12, case 1: restoring from a directory, a FIFO (no writer), a 1 GiB sparse file or a
+// file longer than its header says is refused at once with a message, reads at most the
+// header, and leaves the world as it was.
+TEST(World, RestoreRefusesWhatIsNotASnapshotFileWithoutReadingIt) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("nephele_restore_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir / "a_directory");
+  const std::string fifo = (dir / "a_fifo").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::string sparse = (dir / "sparse").string();
+  {
+    std::ofstream(sparse).close();
+    std::filesystem::resize_file(sparse, std::uintmax_t(1) << 30);
+  }
+  World source = makeWorld();
+  const std::string padded = (dir / "padded").string();
+  ASSERT_EQ(source.saveSnapshot(padded), "");
+  std::ofstream(padded, std::ios::app) << "trailing";
+
+  World target = makeWorld();
+  const std::uint64_t before = target.hash();
+  EXPECT_THAT(target.restoreSnapshot((dir / "a_directory").string()),
+              ::testing::HasSubstr("not a regular file"));
+  EXPECT_THAT(target.restoreSnapshot(fifo), ::testing::HasSubstr("not a regular file"));
+  EXPECT_THAT(target.restoreSnapshot(sparse), ::testing::HasSubstr("not a Nephele snapshot"));
+  EXPECT_THAT(target.restoreSnapshot(padded), ::testing::HasSubstr("header promises"));
+  EXPECT_EQ(target.hash(), before);
+  std::filesystem::remove_all(dir);
 }
 
 TEST(World, AWindChangeKeepsCloudsAndLayersWhereTheyAre) {

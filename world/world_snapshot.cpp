@@ -1,7 +1,12 @@
 // World snapshots: a header (magic, format version, payload length, XXH3 of the payload)
 // and a payload holding the scene at time 0, the dynamics, the time and each automaton's last
 // two states. Numbers are stored as their little-endian bytes (bit-exact doubles).
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <bit>
+#include <cerrno>
 #include <cstring>
 #include <fstream>
 #include <iterator>
@@ -349,10 +354,40 @@ std::string World::saveSnapshot(const std::string& path) const {
 }
 
 std::string World::restoreSnapshot(const std::string& path) {
-  std::ifstream file(path, std::ios::binary);
-  if (!file) return "snapshot: cannot read " + path;
-  const std::vector<std::uint8_t> bytes{std::istreambuf_iterator<char>(file),
-                                        std::istreambuf_iterator<char>()};
+  // Opened without blocking (a FIFO would wait for a writer forever) and checked to be a
+  // regular file (a directory, device or FIFO is refused), then read only as far as its
+  // header promises: a large file of anything else costs one header read.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) return "snapshot: cannot read " + path + ": " + std::strerror(errno);
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  struct stat info {};
+  if (::fstat(fd, &info) != 0 || !S_ISREG(info.st_mode))
+    return "snapshot: " + path + " is not a regular file";
+  auto readFully = [&](std::uint8_t* out, std::size_t count) {
+    while (count > 0) {
+      const ssize_t got = ::read(fd, out, count);
+      if (got < 0 && errno == EINTR) continue;
+      if (got <= 0) return false;
+      out += got, count -= std::size_t(got);
+    }
+    return true;
+  };
+  std::vector<std::uint8_t> bytes(kHeaderBytes);
+  if (std::uint64_t(info.st_size) < kHeaderBytes || !readFully(bytes.data(), kHeaderBytes) ||
+      std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
+    return "snapshot: " + path +
+           " is not a Nephele snapshot (bad magic or shorter than its header)";
+  std::uint64_t length = 0;
+  std::memcpy(&length, bytes.data() + 12, 8);
+  if (length != std::uint64_t(info.st_size) - kHeaderBytes)
+    return "snapshot: " + path + " is " + std::to_string(info.st_size) +
+           " bytes, its header promises " + std::to_string(length + kHeaderBytes);
+  bytes.resize(kHeaderBytes + length);
+  if (!readFully(bytes.data() + kHeaderBytes, length))
+    return "snapshot: cannot read " + path + ": " + std::strerror(errno);
   return restore(bytes);
 }
 

@@ -37,7 +37,7 @@ class Daemon:
     """A `nephele serve` process with its own config in a temporary directory."""
 
     def __init__(self, workdir, mode="lockstep", extra="", view_size=(64, 48), name="d",
-                 socket_keys="", modbus_keys=""):
+                 socket_keys="", modbus_keys="", scene=SCENE):
         """`extra` is appended to the config ({snapshot} becomes this daemon's snapshot
         path); `socket_keys` and `modbus_keys` go into those tables."""
         self.workdir = workdir
@@ -45,7 +45,7 @@ class Daemon:
         self.log_path = os.path.join(workdir, name + ".log")
         self.snapshot = os.path.join(workdir, name + "-snap", "world.snap")
         with open(self.config, "w") as f:
-            f.write(f'''scene = "{SCENE}"
+            f.write(f'''scene = "{scene}"
 [world]
 mode = "{mode}"
 tick_rate = 30
@@ -483,6 +483,31 @@ class LockstepAndSnapshotTest(DaemonTest):
         self.assertNotEqual(c.ok({"cmd": "hash"})["hash"], before["hash"])
         self.assertEqual(c.ok({"cmd": "restore", "name": "keep"})["hash"], before["hash"])
         self.assertEqual(c.error({"cmd": "restore", "name": "nothing"})["code"], "not_found")
+        # Issue 12, case 1: a name whose file is a directory, a FIFO or a sparse gigabyte is
+        # refused with a message; the daemon keeps answering and the world is unchanged.
+        snap_dir = os.path.dirname(d.snapshot)
+        os.makedirs(os.path.join(snap_dir, "dir.snap"))
+        os.mkfifo(os.path.join(snap_dir, "fifo.snap"))
+        with open(os.path.join(snap_dir, "sparse.snap"), "wb") as f:
+            f.truncate(1 << 30)
+        for name, words in [("dir", "not a regular file"), ("fifo", "not a regular file"),
+                            ("sparse", "not a Nephele snapshot")]:
+            with self.subTest(name=name):
+                error = c.error({"cmd": "restore", "name": name})
+                self.assertEqual(error["code"], "failed")
+                self.assertIn(words, error["message"])
+        self.assertEqual(c.ok({"cmd": "hash"})["hash"], before["hash"])
+
+    def test_a_scene_may_start_later_than_one_advance_reaches(self):
+        # A scene's time may be up to 1e9 s; one World advance is at most 1e7 s. The daemon
+        # gets there in pieces instead of refusing to start.
+        scene = os.path.join(self.tmp.name, "late_scene.toml")
+        with open(SCENE) as f:
+            text = f.read()
+        with open(scene, "w") as f:
+            f.write("time = 2.5e7\n" + text)
+        d = self.daemon(name="late", scene=scene)
+        self.assertAlmostEqual(d.client().ok({"cmd": "hash"})["time"], 2.5e7, delta=1e-3)
 
     def test_kill_9_loses_only_ticks_after_the_last_periodic_snapshot(self):
         d = self.daemon(name="k", extra='[snapshot]\npath = "{snapshot}"\ninterval = 0.1')
