@@ -178,6 +178,28 @@ int runRenderCommand(const RenderCommandOptions& o) {
     spdlog::error("{}", error);
     return 2;
   }
+  // The GL and its target first: a size the platform cannot allocate is refused before the
+  // world is simulated or anything is drawn.
+  std::unique_ptr<GlPlatform> platform;
+  std::unique_ptr<GlRenderer> renderer;
+  if (o.renderer != "reference") {
+    std::string platform_error;
+    platform = createGlPlatform(backendFromName(o.gl_backend), platform_error);
+    if (!platform) {
+      spdlog::error("{}", platform_error);
+      return 1;
+    }
+    spdlog::info("OpenGL: {} ({}), GL_RENDERER {}", platform->backendName(), platform->version(),
+                 platform->renderer());
+    renderer = std::make_unique<GlRenderer>(*platform);
+    const Camera& camera = file.scene.camera;
+    if (std::string e =
+            renderer->reserveTarget(camera.width, camera.height, isFloatFormat(*format));
+        !e.empty()) {
+      spdlog::error("--width/--height: {}", e);
+      return 2;
+    }
+  }
   const auto start = Clock::now();
   const World world = worldAtTime(file);
   const Scene scene = world.scene();
@@ -201,28 +223,20 @@ int runRenderCommand(const RenderCommandOptions& o) {
                  file.reference.samples_per_axis, file.reference.samples_per_axis);
     error = writeImageFile(o.output_path, image, o.encode);
   } else {
-    std::string platform_error;
-    const auto platform = createGlPlatform(backendFromName(o.gl_backend), platform_error);
-    if (!platform) {
-      spdlog::error("{}", platform_error);
-      return 1;
-    }
-    spdlog::info("OpenGL: {} ({}), GL_RENDERER {}", platform->backendName(), platform->version(),
-                 platform->renderer());
-    GlRenderer renderer(*platform);
+    GlRenderer& gl = *renderer;
     const auto render_start = Clock::now();
     if (isFloatFormat(*format)) {
-      const FloatImage image = renderer.renderFloat(scene, file.render);
+      const FloatImage image = gl.renderFloat(scene, file.render);
       spdlog::info("render: {:.1f} ms", millisecondsSince(render_start));
       error = writeImageFile(o.output_path, image, o.encode);
     } else {
-      const Srgb8Image image = renderer.renderSrgb8(scene, file.render);
+      const Srgb8Image image = gl.renderSrgb8(scene, file.render);
       spdlog::info("render: {:.1f} ms", millisecondsSince(render_start));
       error = writeImageFile(o.output_path, image, o.encode);
     }
     if (o.stats)
       std::printf("stats: %s automaton_steps=%llu relights=%llu\n",
-                  renderer.lastFrameStats().line().c_str(),
+                  gl.lastFrameStats().line().c_str(),
                   static_cast<unsigned long long>(world.automatonStepsRun()),
                   static_cast<unsigned long long>(world.relightsRun()));
   }

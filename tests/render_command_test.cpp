@@ -63,6 +63,17 @@ TEST_F(RenderCommandTest, RendersAtTheLatestAllowedTime) {
   EXPECT_TRUE(std::filesystem::exists(path("late.png")));
 }
 
+// Issue 12, case 2: the largest allowed side as a float (EXR) frame is 4 GiB, more than the
+// platform allocates; it is refused before any work with a message, and nothing is written.
+TEST_F(RenderCommandTest, ATargetThePlatformCannotAllocateIsRefused) {
+  const CommandResult run =
+      runNephele("render " NEPHELE_SOURCE_DIR "/config/scenes/cirrus.toml -o " + path("huge.exr") +
+                 " --width 16384 --height 16384");
+  EXPECT_EQ(run.exit_code, 2) << run.output;
+  EXPECT_THAT(run.output, HasSubstr("cannot allocate"));
+  EXPECT_FALSE(std::filesystem::exists(path("huge.exr")));
+}
+
 TEST_F(RenderCommandTest, BadSceneFailsWithMessageAndWritesNothing) {
   const std::string scene = writeScene("[[layer]]\naltitude = 1000\nthreshold = 7\n");
   const CommandResult run = runNephele("render " + scene + " -o " + path("out.png"));

@@ -219,22 +219,42 @@ void main() { o_colour = u_colour; }
   return image;
 }
 
-void GlRenderer::prepareTarget(int width, int height, TargetFormat format) {
+std::string GlRenderer::reserveTarget(int width, int height, bool linear) {
+  const TargetFormat format = linear ? TargetFormat::kFloat : TargetFormat::kSrgb8;
+  if (allocateTarget(width, height, format)) return {};
+  const double gib = double(width) * height * (linear ? 16.0 : 4.0) / double(1 << 30);
+  std::ostringstream out;
+  out.precision(3);
+  out << width << "x" << height << (linear ? " float (EXR)" : " 8-bit") << " target of " << gib
+      << " GiB: this OpenGL cannot allocate it (llvmpipe allocates up to 1 GiB per target: "
+         "16384x16384 8-bit, 8192x8192 float); use a smaller size or an 8-bit format";
+  return out.str();
+}
+
+bool GlRenderer::allocateTarget(int width, int height, TargetFormat format) {
   if (colour_buffer_ && width == target_width_ && height == target_height_ &&
       format == target_format_)
-    return;
+    return true;
   colour_buffer_ = createRenderbuffer(gl_);
   gl_.NamedRenderbufferStorage(colour_buffer_.get(),
                                format == TargetFormat::kFloat ? GL_RGBA32F : GL_SRGB8_ALPHA8, width,
                                height);
   gl_.NamedFramebufferRenderbuffer(framebuffer_.get(), GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER,
                                    colour_buffer_.get());
-  const GLenum status = gl_.CheckNamedFramebufferStatus(framebuffer_.get(), GL_FRAMEBUFFER);
-  NEPHELE_CHECK(status == GL_FRAMEBUFFER_COMPLETE,
-                "framebuffer " << width << "x" << height << " status 0x" << std::hex << status);
+  if (gl_.CheckNamedFramebufferStatus(framebuffer_.get(), GL_FRAMEBUFFER) !=
+      GL_FRAMEBUFFER_COMPLETE) {
+    colour_buffer_ = GlObject();
+    return false;
+  }
   target_width_ = width;
   target_height_ = height;
   target_format_ = format;
+  return true;
+}
+
+void GlRenderer::prepareTarget(int width, int height, TargetFormat format) {
+  NEPHELE_CHECK(allocateTarget(width, height, format),
+                "framebuffer " << width << "x" << height << " incomplete (reserveTarget first)");
 }
 
 GLuint GlRenderer::program(const SkyPassLayout& layout) {

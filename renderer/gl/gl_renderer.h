@@ -40,6 +40,11 @@ class GlRenderer {
   // What the last frame did: passes, ellipsoids drawn and culled, terms evaluated.
   const FrameStats& lastFrameStats() const { return stats_; }
 
+  // Allocates the target a width x height frame needs (linear float or 8-bit sRGB) and says,
+  // before any work, when this GL cannot: what a platform can allocate depends on its memory
+  // limits, not only on GL_MAX_RENDERBUFFER_SIZE. Empty when the target is ready.
+  std::string reserveTarget(int width, int height, bool linear);
+
   // Far-cloud impostors rendered since construction (each reuse saves one).
   int impostorRenders() const { return ellipsoids_.impostorRenders(); }
   // Automaton volume uploads since construction (one per keyframe change of a cloud).
@@ -69,6 +74,7 @@ class GlRenderer {
   void setSlotUniforms(GLuint program, int slot, const LayerSlot& layer, const Scene& scene,
                        const RenderSettings& settings);
   void prepareTarget(int width, int height, TargetFormat format);
+  bool allocateTarget(int width, int height, TargetFormat format);
   GLuint program(const SkyPassLayout& layout);
   CachedTexture& cachedTexture(const LayerTextureSpec& spec, const RenderSettings& settings);
   GLuint gpuTexture(CachedTexture& cached, const RenderSettings& settings);
