@@ -1,5 +1,6 @@
 #include "protocol/messages.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -418,9 +419,32 @@ std::variant<Request, BadRequest> parseRequest(std::string_view line) {
         nullptr,
         {ErrorCode::kBadJson,
          "request nests deeper than " + std::to_string(ProtocolLimits::kMaxJsonDepth) + " levels"}};
-  json root = json::parse(line, nullptr, /*allow_exceptions=*/false);
+  // Strict JSON (RFC 8259): no byte-order mark in a protocol line (section 8.1), no NUL, and
+  // object names unique (section 4) so that no command means two things.
+  if (line.starts_with("\xEF\xBB\xBF"))
+    return BadRequest{nullptr, {ErrorCode::kBadJson, "request starts with a byte-order mark"}};
+  if (line.find('\0') != std::string_view::npos)
+    return BadRequest{nullptr, {ErrorCode::kBadJson, "request is not valid JSON (a NUL byte)"}};
+  std::vector<std::vector<std::string>> keys;  // the names seen in each open object
+  std::string duplicate;
+  const json::parser_callback_t check_keys = [&](int, json::parse_event_t event, json& parsed) {
+    if (event == json::parse_event_t::object_start) keys.emplace_back();
+    if (event == json::parse_event_t::object_end && !keys.empty()) keys.pop_back();
+    if (event == json::parse_event_t::key && !keys.empty()) {
+      const std::string& name = parsed.get_ref<const std::string&>();
+      std::vector<std::string>& seen = keys.back();
+      if (duplicate.empty() && std::find(seen.begin(), seen.end(), name) != seen.end())
+        duplicate = name;
+      seen.push_back(name);
+    }
+    return true;
+  };
+  json root = json::parse(line, check_keys, /*allow_exceptions=*/false);
   if (root.is_discarded())
     return BadRequest{nullptr, {ErrorCode::kBadJson, "request is not valid JSON"}};
+  if (!duplicate.empty())
+    return BadRequest{nullptr,
+                      {ErrorCode::kBadJson, "request has a duplicate key \"" + duplicate + "\""}};
   if (!root.is_object())
     return BadRequest{nullptr, {ErrorCode::kBadJson, "request must be a JSON object"}};
   json id = nullptr;

@@ -104,6 +104,26 @@ TEST(Messages, ErrorsNameTheFieldAndWhatIsAllowed) {
   EXPECT_EQ(rejected(R"({"id":12,"cmd":"fly"})").id, 12);  // the id comes back when readable
 }
 
+// Issue 12, case 13: JSON the protocol must refuse though a lenient parser reads it.
+TEST(Messages, RefusesByteOrderMarksDuplicateKeysAndTrailingBytes) {
+  const std::string nul_after = std::string(R"({"cmd":"hash"})") + '\0';
+  const std::pair<std::string, const char*> cases[] = {
+      {"\xEF\xBB\xBF{\"cmd\":\"hash\"}", "byte-order mark"},
+      {R"({"cmd":"tick","dt":1,"dt":2})", "duplicate key \"dt\""},
+      {R"({"cmd":"add_cloud","cloud":{"name":"a","name":"b"}})", "duplicate key \"name\""},
+      {R"({"cmd":"hash"} trailing)", "not valid JSON"},
+      {nul_after, "not valid JSON"},
+  };
+  for (const auto& [line, words] : cases) {
+    const BadRequest bad = rejected(line);
+    EXPECT_EQ(bad.error.code, ErrorCode::kBadJson) << line;
+    EXPECT_THAT(bad.error.message, HasSubstr(words)) << line;
+  }
+  // The same key in two different objects is fine.
+  parsed(
+      R"({"cmd":"add_cloud","cloud":{"name":"a","ellipsoid":[{"centre":[0,0,1000]},{"centre":[0,0,1200]}]}})");
+}
+
 TEST(Messages, LimitsOnSizeAndNesting) {
   const std::string big =
       R"({"cmd":"hash","pad":")" + std::string(ProtocolLimits::kMaxRequestBytes, 'x') + "\"}";
