@@ -147,29 +147,34 @@ SceneFile cumulusField(const SceneFile& cumulus) {
 }
 
 // The fixed scene set of issue 11, in the order the report lists them.
+struct SceneEntry {
+  const char* name;
+  const char* preset;
+  const char* what;
+};
+constexpr SceneEntry kScenes[] = {
+    {"cirrus", "cirrus", "cirrus layer at 10 km"},
+    {"stratus", "stratus", "stratus layer at 2 km"},
+    {"cumulus", "cumulus", "the 27-lobe cumulus from 4.5 km"},
+    {"close_up", "cumulus_target", "a cumulus filling a 4 degree view, with targets"},
+    {"field_500", "cumulus", "20 cumuli, 500 ellipsoids, from 1.5 km"},
+    {"automaton", "automaton_cloud", "one automaton cloud of 20x20x20 cells"},
+    {"harbour", "harbour", "Shen's harbour: 20 automaton clouds, sea fog"},
+    {"inside", "inside_cloud", "a camera inside the edge of a cloud lobe"},
+};
+
+// "cirrus, stratus, ...": the names --scenes allows.
+std::string sceneNames() {
+  std::string names;
+  for (const SceneEntry& e : kScenes) names += (names.empty() ? "" : ", ") + std::string(e.name);
+  return names;
+}
+
 std::string loadScenes(std::vector<BenchScene>& out) {
-  const std::string dir = NEPHELE_SOURCE_DIR "/config/scenes/";
-  auto load = [&](const std::string& preset, SceneFile& file) {
-    return loadSceneFile(dir + preset + ".toml", file);
-  };
-  struct Entry {
-    const char* name;
-    const char* preset;
-    const char* what;
-  };
-  const Entry entries[] = {
-      {"cirrus", "cirrus", "cirrus layer at 10 km"},
-      {"stratus", "stratus", "stratus layer at 2 km"},
-      {"cumulus", "cumulus", "the 27-lobe cumulus from 4.5 km"},
-      {"close_up", "cumulus_target", "a cumulus filling a 4 degree view, with targets"},
-      {"field_500", "cumulus", "20 cumuli, 500 ellipsoids, from 1.5 km"},
-      {"automaton", "automaton_cloud", "one automaton cloud of 20x20x20 cells"},
-      {"harbour", "harbour", "Shen's harbour: 20 automaton clouds, sea fog"},
-      {"inside", "inside_cloud", "a camera inside the edge of a cloud lobe"},
-  };
-  for (const Entry& e : entries) {
+  for (const SceneEntry& e : kScenes) {
     SceneFile file;
-    if (std::string error = load(e.preset, file); !error.empty()) return error;
+    const std::string path = NEPHELE_SOURCE_DIR "/config/scenes/" + std::string(e.preset) + ".toml";
+    if (std::string error = loadSceneFile(path, file); !error.empty()) return error;
     if (std::string(e.name) == "field_500") file = cumulusField(file);
     out.push_back({e.name, e.what, file});
   }
@@ -343,14 +348,11 @@ void addBenchCommand(CLI::App& app, BenchCommandOptions& o) {
   cmd->add_option("--samples", o.samples,
                   "Reference supersampling per pixel axis (default 4; --quick 2)")
       ->check(CLI::Range(1, 16));
-  cmd->add_option("--scenes", o.scenes,
-                  "Only these scenes: cirrus, stratus, cumulus, close_up, field_500, automaton, "
-                  "harbour, inside")
-      ->delimiter(',');
+  cmd->add_option("--scenes", o.scenes, "Only these scenes: " + sceneNames())->delimiter(',');
   cmd->add_option("-o,--output", o.output_dir, "Directory for accuracy.csv, .md and .svg")
       ->capture_default_str();
   cmd->add_option("--gl", o.gl_backend, "OpenGL back end")
-      ->check(CLI::IsMember({"auto", "egl", "osmesa"}))
+      ->check(CLI::IsMember(kGlBackendNames))
       ->capture_default_str();
 }
 
@@ -372,10 +374,7 @@ int runBenchCommand(const BenchCommandOptions& o) {
   for (const std::string& name : o.scenes)
     if (std::none_of(scenes.begin(), scenes.end(),
                      [&](const BenchScene& s) { return s.name == name; })) {
-      spdlog::error(
-          "--scenes: unknown scene '{}' (allowed: cirrus, stratus, cumulus, close_up, "
-          "field_500, automaton, harbour, inside)",
-          name);
+      spdlog::error("--scenes: unknown scene '{}' (allowed: {})", name, sceneNames());
       return 2;
     }
   if (!o.scenes.empty())

@@ -98,7 +98,7 @@ void addRenderCommand(CLI::App& app, RenderCommandOptions& o) {
                   "Output image; the extension picks the format: " + std::string(kImageExtensions))
       ->required();
   cmd->add_option("--gl", o.gl_backend, "OpenGL back end")
-      ->check(CLI::IsMember({"auto", "egl", "osmesa"}))
+      ->check(CLI::IsMember(kGlBackendNames))
       ->capture_default_str();
   cmd->add_option("--renderer", o.renderer, "gl, or the CPU reference (slow, exact)")
       ->check(CLI::IsMember({"gl", "reference"}))

@@ -2,6 +2,7 @@
 // `nephele render SCENE -o OUT`: one image of a scene file.
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -37,7 +38,8 @@ void addRenderCommand(CLI::App& app, RenderCommandOptions& options);
 Scene sceneAtTime(const SceneFile& file);
 World worldAtTime(const SceneFile& file);
 
-// "auto", "egl" or "osmesa" (checked when the flag was parsed).
+// The --gl values, and the back end each names (checked when the flag was parsed).
+inline const std::vector<std::string> kGlBackendNames{"auto", "egl", "osmesa"};
 GlBackend backendFromName(const std::string& name);
 
 // Runs the command; returns the process exit code (0 ok, 2 bad input, 1 failure).
