@@ -46,20 +46,9 @@ ProtocolError badField(std::string message) {
 
 // What the last rendered frame did (renderer/gl/frame_stats.h).
 json frameStatsJson(const FrameStats& f) {
-  return {{"passes", f.passes()},
-          {"sky_passes", f.sky_passes},
-          {"ellipsoid_passes", f.ellipsoid_passes},
-          {"atlas_passes", f.atlas_passes},
-          {"automaton_passes", f.automaton_passes},
-          {"target_passes", f.target_passes},
-          {"veil_passes", f.veil_passes},
-          {"ellipsoids_drawn", f.ellipsoids_drawn},
-          {"ellipsoids_culled", f.ellipsoids_culled},
-          {"impostors_drawn", f.impostors_drawn},
-          {"impostors_rendered", f.impostors_rendered},
-          {"layer_terms", f.layer_terms},
-          {"layer_terms_total", f.layer_terms_total},
-          {"volume_uploads", f.volume_uploads}};
+  json out = json::object();
+  for (const auto& [name, value] : f.fields()) out[name] = value;
+  return out;
 }
 
 json viewJson(const ViewConfig& v) {

@@ -2,6 +2,8 @@
 // What one GL frame did, so that a user can see that a scene pays only for what it shows
 // (`nephele render --stats`, the daemon's `stats`).
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace nephele {
 
@@ -27,6 +29,8 @@ struct FrameStats {
     return sky_passes + ellipsoid_passes + atlas_passes + automaton_passes + target_passes +
            veil_passes;
   }
+  // Every figure with its name, `passes` first: one list for the log line and the daemon.
+  std::vector<std::pair<const char*, int>> fields() const;
   // One line of key=value pairs.
   std::string line() const;
 };
