@@ -178,6 +178,14 @@ const int kMaxHits = 8;
 // Hits are ordered by (depth, ellipsoid index), so equal depths still have one order.
 bool before(float s, int i, float t, int j) { return s < t || (s == t && i < j); }
 
+// Ellipsoid i's hit on this pixel's ray where it shows, else -1.
+float shownHit(int i, vec2 ndc, vec3 r, float limit) {
+  vec4 rect = u_e[i].rect;
+  if (any(lessThan(ndc, rect.xy)) || any(greaterThan(ndc, rect.zw))) return -1.0;
+  float s = hitEllipsoid(i, r);
+  return hitShows(r, s, limit) ? s : -1.0;
+}
+
 void main() {
   vec3 r = viewRay();
   vec2 ndc = 2.0 * gl_FragCoord.xy / u_viewport - 1.0;
@@ -188,10 +196,8 @@ void main() {
   int n = 0, total = 0;
   for (int k = 0; k < v_count; ++k) {
     int i = u_items[v_first + k];
-    vec4 rect = u_e[i].rect;
-    if (any(lessThan(ndc, rect.xy)) || any(greaterThan(ndc, rect.zw))) continue;
-    float s = hitEllipsoid(i, r);
-    if (!hitShows(r, s, limit)) continue;
+    float s = shownHit(i, ndc, r, limit);
+    if (s < 0.0) continue;
     ++total;
     if (n == kMaxHits && !before(s, i, depth[n - 1], index[n - 1])) continue;
     int j = min(n, kMaxHits - 1);
@@ -219,10 +225,8 @@ void main() {
     int best_i = -1;
     for (int k = 0; k < v_count; ++k) {
       int i = u_items[v_first + k];
-      vec4 rect = u_e[i].rect;
-      if (any(lessThan(ndc, rect.xy)) || any(greaterThan(ndc, rect.zw))) continue;
-      float s = hitEllipsoid(i, r);
-      if (!hitShows(r, s, limit) || !before(last_s, last_i, s, i)) continue;
+      float s = shownHit(i, ndc, r, limit);
+      if (s < 0.0 || !before(last_s, last_i, s, i)) continue;
       if (best_i < 0 || before(s, i, best_s, best_i)) {
         best_s = s;
         best_i = i;
