@@ -67,21 +67,15 @@ Scene sceneAtTime(const SceneFile& file) {
 
 World worldAtTime(const SceneFile& file) {
   World world(file.scene, file.dynamics);
-  const std::int64_t target_ns = std::llround(file.scene.time_s / World::kTimeResolutionS);
-  // Pieces no longer than the World takes in one advance (a scene may start at up to
-  // Limits::kMaxTime), and twenty with automaton clouds for the progress line.
-  const int chunks = std::max(world.automata().empty() ? 1 : 20,
-                              int(std::ceil(file.scene.time_s / Limits::kMaxAdvance)));
+  // Twenty pieces with automaton clouds, for the progress line.
   const auto start = Clock::now();
-  for (int i = 1; i <= chunks; ++i) {
-    const std::int64_t next = target_ns / chunks * i + (i == chunks ? target_ns % chunks : 0);
-    const std::string error =
-        world.advance(double(next - world.timeNs()) * World::kTimeResolutionS);
-    NEPHELE_CHECK(error.empty(), error);  // the time was validated with the scene
-    if (const double seconds = millisecondsSince(start) / 1000.0; seconds >= 2.0 && i < chunks)
-      spdlog::info("simulating to t = {:.1f} s: {} %, {} automaton steps", file.scene.time_s,
-                   100 * i / chunks, world.automatonStepsRun());
-  }
+  const std::string error = world.advanceInPieces(
+      file.scene.time_s, world.automata().empty() ? 1 : 20, [&](int i, int n) {
+        if (const double seconds = millisecondsSince(start) / 1000.0; seconds >= 2.0 && i < n)
+          spdlog::info("simulating to t = {:.1f} s: {} %, {} automaton steps", file.scene.time_s,
+                       100 * i / n, world.automatonStepsRun());
+      });
+  NEPHELE_CHECK(error.empty(), error);  // the time was validated with the scene
   return world;
 }
 

@@ -13,7 +13,6 @@
 #include "renderer/gl/gl_platform.h"
 #include "renderer/gl/gl_renderer.h"
 #include "world/counter_random.h"
-#include "world/limits.h"
 #include "world/world.h"
 
 namespace nephele {
@@ -343,12 +342,8 @@ std::string Engine::openWorld() {
   s.renderer = std::make_unique<GlRenderer>(*s.platform);
   s.world =
       std::make_unique<World>(config_.scene.scene, config_.scene.dynamics, config_.world_threads);
-  // A scene may start at up to Limits::kMaxTime, later than one World advance reaches.
-  for (double left = config_.scene.scene.time_s; left > 0.0;) {
-    const double dt = std::min(left, Limits::kMaxAdvance);
-    if (std::string e = s.world->advance(dt); !e.empty()) return "scene time: " + e;
-    left -= dt;
-  }
+  if (std::string e = s.world->advanceInPieces(config_.scene.scene.time_s); !e.empty())
+    return "scene time: " + e;
   const std::string& snapshot = config_.snapshot_path;
   if (config_.restore_on_start && !snapshot.empty() && std::filesystem::exists(snapshot)) {
     if (std::string e = s.world->restoreSnapshot(snapshot); !e.empty())

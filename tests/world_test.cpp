@@ -107,6 +107,21 @@ TEST(World, RefusesToRunItsClockPastItsLimit) {
   EXPECT_GT(w.timeNs(), 0);
 }
 
+// A scene may start later than one advance reaches: the pieces land on the same nanosecond
+// as the whole, and a span beyond the latest start is refused with nothing changed.
+TEST(World, LongSpansAdvanceInPieces) {
+  World w(Scene{}, WorldDynamics{});
+  int calls = 0, of = 0;
+  const double span = 2.5e7 + 0.123456789;
+  const std::int64_t whole = std::llround(span / World::kTimeResolutionS);
+  ASSERT_EQ(w.advanceInPieces(span, 3, [&](int, int n) { ++calls, of = n; }), "");
+  EXPECT_EQ(w.timeNs(), whole);
+  EXPECT_EQ(calls, 3);
+  EXPECT_EQ(of, 3);
+  EXPECT_THAT(w.advanceInPieces(Limits::kMaxTime * 2), ::testing::HasSubstr("allowed: 0 to"));
+  EXPECT_EQ(w.timeNs(), whole);
+}
+
 TEST(World, DevelopmentSchedulesAndDriftFollowTime) {
   World w = makeWorld();
   ASSERT_EQ(w.advance(600.0), "");

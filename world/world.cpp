@@ -87,13 +87,38 @@ std::string World::advanceError(double dt_s) const {
   return {};
 }
 
+std::string World::advanceInPieces(double dt_s, int pieces,
+                                   const std::function<void(int, int)>& after_piece) {
+  if (!std::isfinite(dt_s) || dt_s < 0.0 || dt_s > Limits::kMaxTime) {
+    std::ostringstream out;
+    out << "dt: " << dt_s << " (allowed: 0 to " << Limits::kMaxTime << " seconds)";
+    return out.str();
+  }
+  const std::int64_t total_ns = std::llround(dt_s / kTimeResolutionS);
+  if (time_ns_ > std::numeric_limits<std::int64_t>::max() - total_ns)
+    return "dt: the world's clock would pass its limit of about 292 years";
+  const int n = std::max(pieces, int(std::ceil(dt_s / Limits::kMaxAdvance)));
+  // Whole nanoseconds per piece, so the pieces add up to exactly one advance of dt_s.
+  std::int64_t done = 0;
+  for (int i = 1; i <= n; ++i) {
+    const std::int64_t next = total_ns / n * i + (i == n ? total_ns % n : 0);
+    advanceNs(next - done);
+    done = next;
+    if (after_piece) after_piece(i, n);
+  }
+  return {};
+}
+
 std::string World::advance(double dt_s) {
   if (std::string e = advanceError(dt_s); !e.empty()) return e;
-  const std::int64_t dt_ns = std::llround(dt_s / kTimeResolutionS);
-  if (dt_ns == 0) return {};
+  advanceNs(std::llround(dt_s / kTimeResolutionS));
+  return {};
+}
+
+void World::advanceNs(std::int64_t dt_ns) {
+  if (dt_ns == 0) return;
   time_ns_ += dt_ns;
   refreshAutomata();
-  return {};
 }
 
 void World::refreshAutomata() {

@@ -55,6 +55,12 @@ class World {
   std::string advance(double dt_s);
   // The error advance(dt_s) would return, without advancing.
   std::string advanceError(double dt_s) const;
+  // Moves time on by dt_s seconds, up to Limits::kMaxTime (a scene's latest start), in at
+  // least `pieces` advances of at most Limits::kMaxAdvance each, landing on the same
+  // nanosecond as one advance would; `after_piece(i, n)` runs after piece i of n (for a
+  // progress line). On an error nothing after the failed piece happens.
+  std::string advanceInPieces(double dt_s, int pieces = 1,
+                              const std::function<void(int, int)>& after_piece = {});
   std::int64_t timeNs() const { return time_ns_; }
   double timeSeconds() const { return double(time_ns_) * kTimeResolutionS; }
   // Automaton steps run since construction or restore, summed over clouds.
@@ -88,6 +94,7 @@ class World {
  private:
   World(const Scene& scene, const WorldDynamics& dynamics, int threads, bool warm_up);
   void refreshAutomata();
+  void advanceNs(std::int64_t dt_ns);  // checked by the caller
   // Moves the drift up to now into (sign +1) or out of (sign -1) the base scene.
   void foldDrift(Scene& scene, const WorldDynamics& dynamics, double sign) const;
 
