@@ -38,6 +38,18 @@ class GlRenderTest : public ::testing::Test {
     return file;
   }
 
+  // Channels not finite or out of range: colour in [0, 64] (HDR suns may exceed 1),
+  // coverage in [0, 1].
+  static int outOfRange(const FloatImage& image) {
+    int bad = 0;
+    for (std::size_t i = 0; i < image.rgba.size(); ++i) {
+      const float v = image.rgba[i];
+      const float hi = i % 4 == 3 ? 1.0f : 64.0f;
+      bad += !(std::isfinite(v) && v >= 0.0f && v <= hi);
+    }
+    return bad;
+  }
+
   static void expectClose(const FloatImage& actual, const FloatImage& expected, double min_psnr,
                           double max_abs, const std::string& name) {
     const ImageError e = compareImages(actual, expected);
