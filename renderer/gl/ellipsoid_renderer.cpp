@@ -507,13 +507,15 @@ void EllipsoidRenderer::drawCloudDirect(const Scene& scene, std::size_t index,
   }
   uploadRecords(records);
   gl_.BindVertexArray(vertex_array_.get());
-  // Screen bins, each listing the ellipsoids whose rectangles overlap it.
+  // Screen bins, each listing the ellipsoids whose rectangles overlap it (not needed when
+  // the centre order is asked for).
+  const bool by_centre = settings.ellipsoid_order == EllipsoidOrder::kCentre;
   const int bins_x = (target.width + kPerPixelBinSize - 1) / kPerPixelBinSize;
   const int bins_y = (target.height + kPerPixelBinSize - 1) / kPerPixelBinSize;
   std::vector<std::vector<GLint>> lists(std::size_t(bins_x) * bins_y);
   auto pixel = [](float ndc, int size) { return (double(ndc) + 1.0) * 0.5 * size; };
   std::size_t deepest = 0;
-  for (int i = 0; i < int(records.size()); ++i) {
+  for (int i = 0; i < int(records.size()) && !by_centre; ++i) {
     const glm::vec4 rect = records[i].v[10];
     const int x0 = std::clamp(int(pixel(rect.x, target.width)) / kPerPixelBinSize, 0, bins_x - 1);
     const int x1 = std::clamp(int(pixel(rect.z, target.width)) / kPerPixelBinSize, 0, bins_x - 1);
@@ -528,7 +530,7 @@ void EllipsoidRenderer::drawCloudDirect(const Scene& scene, std::size_t index,
   }
   // Where no two ellipsoids share a bin, no pixel has two hits to sort: the centre pass
   // draws the same image, faster.
-  if (settings.ellipsoid_order == EllipsoidOrder::kCentre || deepest <= 1) {
+  if (by_centre || deepest <= 1) {
     EllipsoidPassLayout layout = base;
     layout.program = EllipsoidProgram::kFusedCentre;
     const GLuint p = program(layout);
