@@ -15,6 +15,12 @@ void readListen(TableReader& t, ListenConfig& listen) {
   t.integer("port", listen.port, 0, 65535);
 }
 
+void readTimeouts(TableReader& t, Timeouts& timeouts) {
+  t.number("request_timeout", timeouts.request_s, DaemonLimits::kMinRequestTimeout,
+           DaemonLimits::kMaxRequestTimeout);
+  t.number("idle_timeout", timeouts.idle_s, 0.0, DaemonLimits::kMaxIdleTimeout);
+}
+
 void readView(TableReader& t, const Camera& scene_camera, ViewConfig& view) {
   t.allow({"name", "position", "heading", "pitch", "roll", "vfov", "width", "height", "format",
            "coverage"});
@@ -71,7 +77,7 @@ void readDaemon(const toml::table& root, const std::string& file, DaemonConfig& 
 
   if (auto s = t.table("socket")) {
     s->allow({"enabled", "bind", "port", "token", "max_clients", "max_subscriptions", "max_queue",
-              "max_image_pixels", "max_pending_mb"});
+              "max_image_pixels", "max_pending_mb", "request_timeout", "idle_timeout"});
     s->boolean("enabled", out.socket_enabled);
     readListen(*s, out.socket);
     s->string("token", out.token);
@@ -84,10 +90,12 @@ void readDaemon(const toml::table& root, const std::string& file, DaemonConfig& 
     int pending_mb = int(out.max_pending_bytes >> 20);
     s->integer("max_pending_mb", pending_mb, 1, 4096);
     out.max_pending_bytes = std::size_t(pending_mb) << 20;
+    readTimeouts(*s, out.socket_timeouts);
     s->finish();
   }
   if (auto m = t.table("modbus")) {
-    m->allow({"enabled", "bind", "port", "allow", "view", "max_clients"});
+    m->allow({"enabled", "bind", "port", "allow", "view", "max_clients", "request_timeout",
+              "idle_timeout"});
     m->boolean("enabled", out.modbus_enabled);
     readListen(*m, out.modbus);
     if (m->has("allow")) {
@@ -96,6 +104,7 @@ void readDaemon(const toml::table& root, const std::string& file, DaemonConfig& 
     }
     m->string("view", out.modbus_view);
     m->integer("max_clients", out.modbus_max_clients, 1, 256);
+    readTimeouts(*m, out.modbus_timeouts);
     m->finish();
   }
   if (out.modbus_view.empty())

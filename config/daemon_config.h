@@ -29,6 +29,12 @@ struct ListenConfig {
   int port = 0;  // 0: any free port (printed on the ready line)
 };
 
+// How long a listener waits on a client (docs/RELIABILITY.md).
+struct Timeouts {
+  double request_s;  // a request begun must be complete within this
+  double idle_s;     // a connection with nothing to do is closed after this; 0: never
+};
+
 struct DaemonConfig {
   std::string config_path;
   std::string scene_path;  // relative paths are relative to the config file
@@ -47,13 +53,15 @@ struct DaemonConfig {
   int max_subscriptions = 32;  // over all clients
   int max_queue = 64;          // requests waiting for the world thread
   std::int64_t max_image_pixels = 4096 * 4096;
-  std::size_t max_pending_bytes = 64u << 20;  // per client; frames beyond it are dropped
+  std::size_t max_pending_bytes = 64u << 20;  // unread output per client (docs/RELIABILITY.md)
+  Timeouts socket_timeouts{10.0, 300.0};
 
   bool modbus_enabled = true;
   ListenConfig modbus{"127.0.0.1", 1502};
   std::vector<std::string> modbus_allow{"127.0.0.1"};  // client addresses; "*" allows all
   std::string modbus_view;  // the view the holding registers steer; default the first
   int modbus_max_clients = 16;
+  Timeouts modbus_timeouts{2.0, 300.0};
 
   bool metrics_enabled = false;
   ListenConfig metrics{"127.0.0.1", 9464};
@@ -77,6 +85,8 @@ struct DaemonLimits {
   static constexpr double kMinTickRate = 0.1, kMaxTickRate = 1000.0;
   static constexpr int kMaxViews = 64;
   static constexpr int kMaxClients = 4096;
+  static constexpr double kMinRequestTimeout = 0.05, kMaxRequestTimeout = 3600.0;
+  static constexpr double kMaxIdleTimeout = 7 * 86400.0;
 };
 
 std::string loadDaemonConfig(const std::string& path, DaemonConfig& out);

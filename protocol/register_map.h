@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "protocol/messages.h"
+#include "protocol/modbus_frame.h"
 
 namespace nephele {
 
@@ -46,11 +47,6 @@ struct ModbusMap {
   static constexpr int kTime = 10;      // float32, simulation seconds
   static constexpr int kInputCount = 12;
 };
-
-// Modbus exception codes (Modbus Application Protocol v1.1b3, section 7).
-inline constexpr int kIllegalDataAddress = 0x02;
-inline constexpr int kIllegalDataValue = 0x03;
-inline constexpr int kServerDeviceBusy = 0x06;
 
 enum class ModbusStatusCode : std::uint16_t { kRunning = 1, kPaused = 2, kLockstep = 3 };
 

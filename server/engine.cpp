@@ -99,12 +99,14 @@ void eraseWithDevelopment(std::vector<T>& items, std::vector<D>& development, Pr
 
 // One queued piece of work.
 struct Engine::Job {
-  enum class Kind { kRequest, kBatch, kTrigger } kind = Kind::kRequest;
+  enum class Kind { kRequest, kBatch } kind = Kind::kRequest;
   Request request;
   std::int64_t client = 0;
   FrameSink frames;
   ReplySink reply;
   std::vector<Command> batch;
+  bool render = false;  // a batch with the render coil
+  std::shared_ptr<BatchTicket> ticket;
   DoneSink done;
 };
 
@@ -220,15 +222,42 @@ std::string Engine::start() {
   return "";
 }
 
-void Engine::stop() {
+bool Engine::stop() {
   {
     std::lock_guard lock(queue_mutex_);
-    if (stopping_ && !thread_.joinable()) return;
+    if (stopping_ && !thread_.joinable()) return shutdown_saved_;
     stopping_ = true;
   }
   queue_cv_.notify_all();
   if (thread_.joinable()) thread_.join();
   encoder_.reset();  // sends what it holds, then stops
+  return shutdown_saved_;
+}
+
+bool Engine::stopping() const {
+  std::lock_guard lock(queue_mutex_);
+  return stopping_;
+}
+
+void Engine::clientGone(std::int64_t client) {
+  {
+    std::lock_guard lock(queue_mutex_);
+    gone_clients_.push_back(client);
+  }
+  queue_cv_.notify_one();
+}
+
+int Engine::subscriptionsOf(std::int64_t client) const {
+  std::lock_guard lock(subscribers_mutex_);
+  const auto it = subscribers_.find(client);
+  return it == subscribers_.end() ? 0 : it->second;
+}
+
+void Engine::countSubscriptions() {
+  std::map<std::int64_t, int> counts;
+  for (const Subscription& sub : state_->subscriptions) ++counts[sub.client];
+  std::lock_guard lock(subscribers_mutex_);
+  subscribers_ = std::move(counts);
 }
 
 bool Engine::enqueue(Job job) {
@@ -250,21 +279,17 @@ bool Engine::submit(Request request, std::int64_t client, FrameSink frames, Repl
   return enqueue(std::move(job));
 }
 
-bool Engine::submitBatch(std::vector<Command> commands, DoneSink done) {
+bool Engine::submitBatch(std::vector<Command> commands, bool render,
+                         std::shared_ptr<BatchTicket> ticket, DoneSink done) {
   Job job;
   job.kind = Job::Kind::kBatch;
   job.batch = std::move(commands);
+  job.render = render;
+  job.ticket = std::move(ticket);
   job.done = std::move(done);
-  return enqueue(std::move(job));
-}
-
-bool Engine::submitRenderTrigger(DoneSink done) {
-  Job job;
-  job.kind = Job::Kind::kTrigger;
-  job.done = std::move(done);
-  trigger_pending_ = true;  // before queueing: the world thread clears it when done
+  if (render) trigger_pending_ = true;  // before queueing: the world thread clears it when done
   if (enqueue(std::move(job))) return true;
-  trigger_pending_ = false;
+  if (render) trigger_pending_ = false;
   return false;
 }
 
@@ -373,12 +398,21 @@ void Engine::run(std::promise<std::string>& started) {
 
   for (;;) {
     std::deque<Job> jobs;
+    std::vector<std::int64_t> gone;
     bool stopping = false;
     {
       std::unique_lock lock(queue_mutex_);
-      queue_cv_.wait_until(lock, nextWake(), [&] { return stopping_ || !queue_.empty(); });
+      queue_cv_.wait_until(lock, nextWake(),
+                           [&] { return stopping_ || !queue_.empty() || !gone_clients_.empty(); });
       jobs.swap(queue_);
+      gone.swap(gone_clients_);
       stopping = stopping_;
+    }
+    if (!gone.empty()) {
+      std::erase_if(s.subscriptions, [&](const Subscription& sub) {
+        return std::find(gone.begin(), gone.end(), sub.client) != gone.end();
+      });
+      countSubscriptions();
     }
     for (Job& job : jobs) {
       if (!stopping) {
@@ -401,8 +435,10 @@ void Engine::run(std::promise<std::string>& started) {
     }
     publish();
   }
-  if (!config_.snapshot_path.empty()) saveSnapshot(config_.snapshot_path, "shutdown");
+  if (!config_.snapshot_path.empty())
+    shutdown_saved_ = saveSnapshot(config_.snapshot_path, "shutdown");
   s.subscriptions.clear();
+  countSubscriptions();
   s.renderer.reset();  // GL objects go while their context is current
   s.platform.reset();
 }
@@ -415,16 +451,18 @@ Engine::Clock::time_point Engine::nextWake() const {
   return wake;
 }
 
-void Engine::saveSnapshot(const std::string& path, const char* why) {
+bool Engine::saveSnapshot(const std::string& path, const char* why) {
   const auto t0 = Clock::now();
   std::error_code ec;
   std::filesystem::create_directories(std::filesystem::path(path).parent_path(), ec);
   if (std::string e = state_->world->saveSnapshot(path); !e.empty()) {
     spdlog::error("event=snapshot_failed reason={} error=\"{}\"", why, e);
-    return;
+    noteError(ErrorCode::kFailed);
+    return false;
   }
   spdlog::info("event=snapshot reason={} path={} time={:.3f} hash={} ms={:.1f}", why, path,
                state_->world->timeSeconds(), hexHash(state_->world->hash()), msSince(t0));
+  return true;
 }
 
 std::optional<ProtocolError> Engine::checkAdvance(double dt_s) const {
@@ -500,27 +538,26 @@ std::optional<ProtocolError> Engine::check(const Command& command) const {
 void Engine::execute(Job& job) {
   State& s = *state_;
   ++s.requests;
-  if (job.kind == Job::Kind::kTrigger) {
-    renderTrigger(job);
-    return;
-  }
   if (job.kind == Job::Kind::kBatch) {
+    if (job.ticket && !job.ticket->claim()) return;  // withdrawn: its sender answered busy
+    auto refuse = [&](const ProtocolError& error) {
+      noteError(error.code);
+      if (job.render) trigger_pending_ = false;
+      job.done(error);
+    };
     for (const Command& c : job.batch)
-      if (auto error = check(c)) {
-        noteError(error->code);
-        job.done(error);
-        return;
-      }
+      if (auto error = check(c)) return refuse(*error);
+    if (job.render && encoder_->depth() >= kEncoderQueue)
+      return refuse({ErrorCode::kBusy, "the image encoder is busy"});
     for (const Command& c : job.batch)
       if (auto outcome = apply(c, job);
           outcome && std::holds_alternative<ProtocolError>(*outcome)) {
-        noteError(std::get<ProtocolError>(*outcome).code);
         publishReadings();
-        job.done(std::get<ProtocolError>(*outcome));
-        return;
+        return refuse(std::get<ProtocolError>(*outcome));
       }
     publishReadings();  // so that a register read right after the reply sees the change
     job.done(std::nullopt);
+    if (job.render) renderTrigger();  // the render coil reads 1 until the file is written
     return;
   }
   std::optional<Outcome> outcome;
@@ -718,6 +755,7 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
     sub.sink = job.frames;
     sub.gone = std::make_shared<std::atomic<bool>>(false);
     s.subscriptions.push_back(sub);
+    countSubscriptions();
     return json{{"subscription", sub.id},
                 {"view", sub.view},
                 {"rate", c->rate_hz},
@@ -729,6 +767,7 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
     std::erase_if(s.subscriptions, [&](const Subscription& sub) {
       return sub.id == c->subscription && sub.client == job.client;
     });
+    countSubscriptions();
     if (s.subscriptions.size() == before)
       return ProtocolError{ErrorCode::kNotFound,
                            "subscription: " + std::to_string(c->subscription) +
@@ -823,7 +862,8 @@ std::optional<ProtocolError> Engine::setWeather(int layer, const WeatherLayer& w
 
 void Engine::deliverFrames(bool only_due, const std::string& view_name) {
   State& s = *state_;
-  std::erase_if(s.subscriptions, [](const Subscription& sub) { return sub.gone->load(); });
+  if (std::erase_if(s.subscriptions, [](const Subscription& sub) { return sub.gone->load(); }))
+    countSubscriptions();
   const auto now = Clock::now();
   // Group the subscriptions that are due by view and by image request: one render per view
   // (and per kind of pixel), one encoding per request.
@@ -880,7 +920,7 @@ void Engine::deliverFrames(bool only_due, const std::string& view_name) {
   }
 }
 
-void Engine::renderTrigger(Job& job) {
+void Engine::renderTrigger() {
   State& s = *state_;
   const ViewConfig& view = *s.view(config_.modbus_view);
   const bool linear = config_.output_format == ImageFormat::kExr;
@@ -891,30 +931,23 @@ void Engine::renderTrigger(Job& job) {
                                                                               : ".exr";
   const std::filesystem::path path = std::filesystem::path(config_.output_directory) /
                                      (view.name + "_" + std::to_string(s.frames) + extension);
-  deliverFrames(false, view.name);
-  const bool queued =
-      encoder_->post([this, frame, linear, path, done = job.done, options = config_.encode]() {
-        std::error_code ec;
-        std::filesystem::create_directories(path.parent_path(), ec);
-        // writeImageFile picks the format from the extension and renames into place.
-        const std::string e = linear ? writeImageFile(path.string(), frame->linear, options)
-                                     : writeImageFile(path.string(), frame->srgb, options);
-        std::optional<ProtocolError> error;
-        if (!e.empty()) error = ProtocolError{ErrorCode::kFailed, e};
-        if (error) {
-          spdlog::error("event=render_trigger_failed error=\"{}\"", error->message);
-          noteError(error->code);
-        } else {
-          spdlog::info("event=render_trigger path={}", path.string());
-        }
-        trigger_pending_ = false;
-        done(error);
-      });
-  if (!queued) {
+  // The caller checked that the encoder has room, and only this thread feeds it; the
+  // subscribers' frames come after.
+  encoder_->post([this, frame, linear, path, options = config_.encode]() {
+    std::error_code ec;
+    std::filesystem::create_directories(path.parent_path(), ec);
+    // writeImageFile picks the format from the extension and renames into place.
+    const std::string e = linear ? writeImageFile(path.string(), frame->linear, options)
+                                 : writeImageFile(path.string(), frame->srgb, options);
+    if (!e.empty()) {
+      spdlog::error("event=render_trigger_failed error=\"{}\"", e);
+      noteError(ErrorCode::kFailed);
+    } else {
+      spdlog::info("event=render_trigger path={}", path.string());
+    }
     trigger_pending_ = false;
-    noteError(ErrorCode::kBusy);
-    job.done(ProtocolError{ErrorCode::kBusy, "the image encoder is busy"});
-  }
+  });
+  deliverFrames(false, view.name);
 }
 
 void Engine::publish() {

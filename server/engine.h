@@ -9,6 +9,7 @@
 #include <deque>
 #include <functional>
 #include <future>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -47,6 +48,21 @@ using FrameSink = std::function<bool(SharedReply)>;
 // Receives the outcome of a Modbus write or render trigger.
 using DoneSink = std::function<void(std::optional<ProtocolError>)>;
 
+// Decides, once, between the world thread applying a batch and its submitter withdrawing it.
+class BatchTicket {
+ public:
+  bool claim() { return take(kClaimed); }
+  bool withdraw() { return take(kWithdrawn); }
+
+ private:
+  enum : int { kOpen, kClaimed, kWithdrawn };
+  bool take(int to) {
+    int open = kOpen;
+    return state_.compare_exchange_strong(open, to);
+  }
+  std::atomic<int> state_{kOpen};
+};
+
 class Engine {
  public:
   explicit Engine(DaemonConfig config);
@@ -58,21 +74,29 @@ class Engine {
   // present). Returns an error if either fails.
   std::string start();
   // Finishes the request in hand, answers queued ones with an error, saves a snapshot if
-  // configured and joins the thread.
-  void stop();
+  // configured and joins the thread. False when the shutdown snapshot could not be saved.
+  bool stop();
+  bool stopping() const;
 
   // Queues work; each returns false (and queues nothing) when the queue is full.
   bool submit(Request request, std::int64_t client, FrameSink frames, ReplySink done);
-  // Modbus writes: every command is checked before any is applied.
-  bool submitBatch(std::vector<Command> commands, DoneSink done);
-  // The Modbus render coil: renders the Modbus view into the output directory and pushes the
-  // frame to the view's subscribers.
-  bool submitRenderTrigger(DoneSink done);
+  // A Modbus write: every command is checked before any is applied; with `render` (the
+  // render coil) the Modbus view is then rendered into the output directory and pushed to
+  // the view's subscribers. `done` hears the outcome once the commands are applied and the
+  // render queued. Unless the world thread has claimed `ticket` first, the submitter may
+  // withdraw the batch, and then nothing of it is applied.
+  bool submitBatch(std::vector<Command> commands, bool render, std::shared_ptr<BatchTicket> ticket,
+                   DoneSink done);
+  // A socket client has gone: its subscriptions end now, not at their next frame.
+  void clientGone(std::int64_t client);
+  // How many subscriptions a socket client holds (any thread).
+  int subscriptionsOf(std::int64_t client) const;
 
   // Thread-safe readings for the Modbus registers, stats and metrics.
   ModbusSettings modbusSettings() const;
   ModbusStatus modbusStatus() const;
   bool renderTriggerPending() const { return trigger_pending_.load(); }
+  void clearRenderTrigger() { trigger_pending_ = false; }  // a withdrawn render write
   nlohmann::json stats() const;
   std::string prometheusText() const;
 
@@ -107,8 +131,9 @@ class Engine {
   void renderFrame(const ViewConfig& view, bool linear, struct Frame& frame);
   void realtimeTicks();
   void deliverFrames(bool only_due, const std::string& view);
-  void renderTrigger(Job& job);
-  void saveSnapshot(const std::string& path, const char* why);
+  void renderTrigger();
+  bool saveSnapshot(const std::string& path, const char* why);
+  void countSubscriptions();  // refreshes subscribers_ from the world thread's list
   Clock::time_point nextWake() const;
   void publish();          // refreshes stats and the Modbus readings
   void publishReadings();  // the Modbus readings alone (cheap: after every request)
@@ -121,7 +146,9 @@ class Engine {
   mutable std::mutex queue_mutex_;
   std::condition_variable queue_cv_;
   std::deque<Job> queue_;
+  std::vector<std::int64_t> gone_clients_;
   bool stopping_ = false;
+  bool shutdown_saved_ = true;
 
   mutable std::mutex published_mutex_;
   ModbusSettings published_settings_;
@@ -130,6 +157,8 @@ class Engine {
   std::atomic<bool> trigger_pending_{false};
   std::atomic<std::uint64_t> errors_{0};
   std::atomic<int> last_error_{0};
+  mutable std::mutex subscribers_mutex_;
+  std::map<std::int64_t, int> subscribers_;  // client: subscriptions, for subscriptionsOf
 };
 
 }  // namespace nephele

@@ -1,7 +1,6 @@
 #include "server/modbus_server.h"
 
 #include <arpa/inet.h>
-#include <modbus/modbus.h>
 #include <netinet/in.h>
 #include <poll.h>
 #include <sys/socket.h>
@@ -10,31 +9,39 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
-#include <chrono>
 #include <cstring>
 #include <future>
 
 namespace nephele {
 namespace {
 
-constexpr int kPollMs = 200;  // how often idle threads look at the stop flag
-constexpr auto kWriteTimeout = std::chrono::seconds(5);  // a write waits this long for the world
+constexpr int kPollMs = 100;  // how often waiting threads look at their flags and deadlines
 
-std::uint16_t be16(const std::uint8_t* p) {
-  return std::uint16_t(p[0] << 8 | p[1]);
+std::chrono::steady_clock::duration seconds(double s) {
+  return std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+      std::chrono::duration<double>(s));
+}
+
+// Writes all of `bytes`; false if the peer is gone or does not read within the send timeout.
+bool sendAll(int fd, const std::vector<std::uint8_t>& bytes) {
+  std::size_t sent = 0;
+  while (sent < bytes.size()) {
+    const ssize_t n = ::send(fd, bytes.data() + sent, bytes.size() - sent, MSG_NOSIGNAL);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return false;
+    sent += std::size_t(n);
+  }
+  return true;
 }
 
 }  // namespace
 
-ModbusServer::ModbusServer(Engine& engine) : engine_(engine) {
-  mapping_ = modbus_mapping_new(ModbusMap::kCoilCount, 0, ModbusMap::kHoldingCount,
-                                ModbusMap::kInputCount);
-}
+ModbusServer::ModbusServer(Engine& engine) : engine_(engine) {}
 
 ModbusServer::~ModbusServer() {
   close();
-  modbus_mapping_free(mapping_);
 }
 
 std::string ModbusServer::listen(const ListenConfig& where) {
@@ -93,148 +100,218 @@ void ModbusServer::acceptLoop() {
     }
     std::lock_guard lock(clients_mutex_);
     std::erase_if(clients_, [](Client& c) {
-      if (!c.finished->load()) return false;
+      if (!c.state->finished) return false;
       c.thread.join();
       return true;
     });
-    if (int(clients_.size()) >= config.modbus_max_clients) {
+    auto active = [&] {
+      return std::count_if(clients_.begin(), clients_.end(),
+                           [](const Client& c) { return !c.state->evict; });
+    };
+    if (active() >= config.modbus_max_clients) {
+      // At the limit, the newcomer takes the place of the client idle longest, if that has
+      // been idle (between frames) for at least the request timeout.
+      const Clock::rep now = Clock::now().time_since_epoch().count();
+      ClientState* idlest = nullptr;
+      Clock::rep longest = seconds(config.modbus_timeouts.request_s).count();
+      for (Client& c : clients_) {
+        ClientState& s = *c.state;
+        if (s.evict || s.mid_request) continue;
+        if (const Clock::rep idle = now - s.last_activity; idle >= longest) {
+          longest = idle;
+          idlest = &s;
+        }
+      }
+      if (idlest) idlest->evict = true;
+    }
+    if (active() >= config.modbus_max_clients) {
       spdlog::warn("event=modbus_refused peer={} reason=max_clients", address);
       engine_.noteError(ErrorCode::kLimit);
       ::close(fd);
       continue;
     }
-    auto finished = std::make_shared<std::atomic<bool>>(false);
+    auto state = std::make_shared<ClientState>();
+    state->last_activity = Clock::now().time_since_epoch().count();
     const std::string peer_name = address + ":" + std::to_string(ntohs(peer.sin_port));
-    clients_.push_back({std::thread([this, fd, peer_name, finished] {
-                          serveClient(fd, peer_name);
-                          *finished = true;
+    clients_.push_back({std::thread([this, fd, peer_name, state] {
+                          serveClient(fd, peer_name, *state);
+                          state->finished = true;
                         }),
-                        finished});
+                        state});
   }
 }
 
-void ModbusServer::serveClient(int fd, std::string peer) {
+void ModbusServer::serveClient(int fd, const std::string& peer, ClientState& state) {
   ++engine_.modbus_clients;
   spdlog::info("event=modbus_connected peer={}", peer);
-  modbus_t* ctx = modbus_new_tcp("127.0.0.1", 0);  // the address is unused: the socket is given
-  modbus_set_socket(ctx, fd);
-  modbus_set_byte_timeout(ctx, 0, 500000);  // a half-written request is dropped after 0.5 s
-  std::uint8_t query[MODBUS_TCP_MAX_ADU_LENGTH];
+  const Timeouts& timeouts = engine_.config().modbus_timeouts;
+  // A client that does not read its replies is dropped rather than blocking this thread.
+  const auto send_timeout = seconds(timeouts.request_s);
+  timeval tv{};
+  tv.tv_sec = std::chrono::duration_cast<std::chrono::seconds>(send_timeout).count();
+  tv.tv_usec =
+      long(std::chrono::duration_cast<std::chrono::microseconds>(send_timeout).count() % 1000000);
+  setsockopt(fd, SOL_SOCKET, SO_SNDTIMEO, &tv, sizeof tv);
+
+  std::array<std::uint8_t, ModbusFrame::kMaxAduBytes> frame{};
+  std::size_t have = 0;  // bytes of the current frame received
+  MbapHeader header;
+  Clock::time_point started;  // when the current frame's first byte arrived
+  Clock::time_point last_activity = Clock::now();
   const char* why = "stop";
   while (!stop_) {
-    pollfd p{fd, POLLIN, 0};
-    if (poll(&p, 1, kPollMs) <= 0) continue;
-    const int length = modbus_receive(ctx, query);
-    if (length == 0) continue;  // a request for another unit
-    if (length < 0) {
-      why = errno == ETIMEDOUT ? "incomplete_request" : "closed";
+    if (state.evict) {
+      why = "evicted_idle";
       break;
     }
-    if (!handle(ctx, query, length)) {
+    const auto now = Clock::now();
+    if (have > 0 && now - started > seconds(timeouts.request_s)) {
+      why = "request_timeout";
+      break;
+    }
+    if (have == 0 && timeouts.idle_s > 0.0 && now - last_activity > seconds(timeouts.idle_s)) {
+      why = "idle_timeout";
+      break;
+    }
+    pollfd p{fd, POLLIN, 0};
+    if (poll(&p, 1, kPollMs) <= 0) continue;
+    // Read no further than the frame: the header first, then exactly what it announces.
+    const std::size_t wanted =
+        have < ModbusFrame::kHeaderBytes ? ModbusFrame::kHeaderBytes : 7 + header.pduBytes();
+    const ssize_t n = ::recv(fd, frame.data() + have, wanted - have, 0);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      why = n == 0 ? "closed" : "read_error";
+      break;
+    }
+    if (have == 0) {
+      started = Clock::now();
+      state.mid_request = true;
+    }
+    have += std::size_t(n);
+    if (have == ModbusFrame::kHeaderBytes) {
+      auto decoded = decodeMbapHeader(
+          std::span<const std::uint8_t, ModbusFrame::kHeaderBytes>(frame.data(), 7));
+      if (auto* e = std::get_if<std::string>(&decoded)) {
+        // The stream cannot be framed past this header: close rather than guess.
+        spdlog::warn("event=modbus_bad_frame peer={} error=\"{}\"", peer, *e);
+        engine_.noteError(ErrorCode::kBadField);
+        why = "bad_frame";
+        break;
+      }
+      header = std::get<MbapHeader>(decoded);
+    }
+    if (have < ModbusFrame::kHeaderBytes || have < 7 + header.pduBytes()) continue;
+    const std::span<const std::uint8_t> pdu(frame.data() + 7, header.pduBytes());
+    auto request = decodeModbusPdu(header, pdu);
+    const std::vector<std::uint8_t> reply =
+        std::holds_alternative<ModbusRequest>(request)
+            ? answer(std::get<ModbusRequest>(request))
+            : refuse(header, std::get<ModbusException>(request));
+    have = 0;
+    state.mid_request = false;
+    last_activity = Clock::now();
+    state.last_activity = last_activity.time_since_epoch().count();
+    if (!sendAll(fd, reply)) {
       why = "reply_failed";
       break;
     }
   }
-  modbus_close(ctx);
-  modbus_free(ctx);
+  ::close(fd);
   --engine_.modbus_clients;
   spdlog::info("event=modbus_closed peer={} reason={}", peer, why);
 }
 
-void ModbusServer::refreshMapping() {
-  const HoldingRegisters holding = encodeHolding(engine_.modbusSettings());
-  const ModbusStatus status = engine_.modbusStatus();
-  const InputRegisters input = encodeInput(status);
-  std::copy(holding.begin(), holding.end(), mapping_->tab_registers);
-  std::copy(input.begin(), input.end(), mapping_->tab_input_registers);
-  mapping_->tab_bits[ModbusMap::kRenderCoil] = engine_.renderTriggerPending() ? 1 : 0;
-  mapping_->tab_bits[ModbusMap::kPauseCoil] = status.status == ModbusStatusCode::kPaused ? 1 : 0;
+std::vector<std::uint8_t> ModbusServer::refuse(const MbapHeader& header,
+                                               const ModbusException& exception) {
+  spdlog::warn("event=modbus_exception function=0x{:02x} code={} message=\"{}\"",
+               exception.function, exception.code, exception.message);
+  engine_.noteError(exception.code == kServerDeviceBusy ? ErrorCode::kBusy : ErrorCode::kBadField);
+  return encodeModbusException(header, exception);
 }
 
-std::optional<ProtocolError> ModbusServer::runBatch(std::vector<Command> commands) {
+std::optional<ProtocolError> ModbusServer::runBatch(std::vector<Command> commands, bool render) {
+  auto ticket = std::make_shared<BatchTicket>();
   auto outcome = std::make_shared<std::promise<std::optional<ProtocolError>>>();
   std::future<std::optional<ProtocolError>> result = outcome->get_future();
-  if (!engine_.submitBatch(std::move(commands),
+  if (!engine_.submitBatch(std::move(commands), render, ticket,
                            [outcome](std::optional<ProtocolError> e) { outcome->set_value(e); }))
-    return ProtocolError{ErrorCode::kBusy, "the request queue is full"};
-  if (result.wait_for(kWriteTimeout) != std::future_status::ready)
-    return ProtocolError{ErrorCode::kBusy, "the world thread did not answer in time"};
-  return result.get();
+    return ProtocolError{ErrorCode::kBusy, "the request queue is full; nothing was changed"};
+  if (result.wait_for(seconds(engine_.config().modbus_timeouts.request_s)) !=
+          std::future_status::ready &&
+      ticket->withdraw()) {
+    if (render) engine_.clearRenderTrigger();
+    return ProtocolError{ErrorCode::kBusy,
+                         "the world thread did not take the write in time; nothing was changed"};
+  }
+  return result.get();  // taken by the world thread: its outcome, whenever it comes
 }
 
-bool ModbusServer::handle(modbus_t* ctx, const std::uint8_t* query, int length) {
-  const int h = modbus_get_header_length(ctx);
-  const std::uint8_t function = query[h];
-  auto exception = [&](int code, const std::string& message) {
-    spdlog::warn("event=modbus_exception function=0x{:02x} code={} message=\"{}\"", function, code,
-                 message);
-    engine_.noteError(code == kServerDeviceBusy ? ErrorCode::kBusy : ErrorCode::kBadField);
-    return modbus_reply_exception(ctx, query, unsigned(code)) >= 0;
+std::vector<std::uint8_t> ModbusServer::answer(const ModbusRequest& request) {
+  const std::uint8_t function = std::uint8_t(request.function);
+  auto exception = [&](int code, std::string message) {
+    return refuse(request.header, {function, code, std::move(message)});
   };
-  auto reply = [&] {
-    std::lock_guard lock(mapping_mutex_);
-    refreshMapping();
-    return modbus_reply(ctx, query, length, mapping_) >= 0;
+  auto outOfMap = [&](int size, const char* what) {
+    return exception(kIllegalDataAddress,
+                     std::string(what) + " " + std::to_string(request.address) + " to " +
+                         std::to_string(request.address + request.count - 1) +
+                         " are not in the map (allowed: 0 to " + std::to_string(size - 1) + ")");
   };
+  auto fits = [&](int size) { return request.address + request.count <= size; };
   auto applied = [&](std::optional<ProtocolError> error) {
-    if (!error) return reply();
+    if (!error) return encodeWriteReply(request);
     return exception(error->code == ErrorCode::kBusy ? kServerDeviceBusy : kIllegalDataValue,
                      error->message);
   };
 
-  if (function == MODBUS_FC_WRITE_SINGLE_REGISTER ||
-      function == MODBUS_FC_WRITE_MULTIPLE_REGISTERS) {
-    const int address = be16(query + h + 1);
-    std::vector<std::uint16_t> values;
-    if (function == MODBUS_FC_WRITE_SINGLE_REGISTER) {
-      values.push_back(be16(query + h + 3));
-    } else {
-      const int count = be16(query + h + 3);
-      const int bytes = query[h + 5];
-      if (count < 1 || count > MODBUS_MAX_WRITE_REGISTERS || bytes != 2 * count ||
-          h + 6 + bytes > length)
-        return exception(kIllegalDataValue, "register count and byte count disagree");
-      for (int i = 0; i < count; ++i) values.push_back(be16(query + h + 6 + 2 * i));
+  switch (request.function) {
+    case ModbusFunction::kReadCoils: {
+      if (!fits(ModbusMap::kCoilCount)) return outOfMap(ModbusMap::kCoilCount, "coils");
+      std::array<std::uint8_t, ModbusMap::kCoilCount> coils{};
+      coils[ModbusMap::kRenderCoil] = engine_.renderTriggerPending();
+      coils[ModbusMap::kPauseCoil] = engine_.modbusStatus().status == ModbusStatusCode::kPaused;
+      return encodeReadBits(request, std::span(coils).subspan(std::size_t(request.address),
+                                                              std::size_t(request.count)));
     }
-    HoldingRegisters current;
-    {
-      std::lock_guard lock(mapping_mutex_);
-      current = encodeHolding(engine_.modbusSettings());
+    case ModbusFunction::kReadDiscreteInputs:
+      return exception(kIllegalDataAddress,
+                       "the map has no discrete inputs (read the coils with function 1)");
+    case ModbusFunction::kReadHoldingRegisters: {
+      if (!fits(ModbusMap::kHoldingCount))
+        return outOfMap(ModbusMap::kHoldingCount, "holding registers");
+      const HoldingRegisters holding = encodeHolding(engine_.modbusSettings());
+      return encodeReadRegisters(request, std::span(holding).subspan(std::size_t(request.address),
+                                                                     std::size_t(request.count)));
     }
-    auto decoded = decodeHoldingWrite(current, address, values, engine_.config().modbus_view);
-    if (auto* e = std::get_if<RegisterError>(&decoded)) return exception(e->exception, e->message);
-    return applied(runBatch(std::move(std::get<std::vector<Command>>(decoded))));
+    case ModbusFunction::kReadInputRegisters: {
+      if (!fits(ModbusMap::kInputCount)) return outOfMap(ModbusMap::kInputCount, "input registers");
+      const InputRegisters input = encodeInput(engine_.modbusStatus());
+      return encodeReadRegisters(request, std::span(input).subspan(std::size_t(request.address),
+                                                                   std::size_t(request.count)));
+    }
+    case ModbusFunction::kWriteSingleRegister:
+    case ModbusFunction::kWriteMultipleRegisters: {
+      const HoldingRegisters current = encodeHolding(engine_.modbusSettings());
+      auto decoded = decodeHoldingWrite(current, request.address, request.registers,
+                                        engine_.config().modbus_view);
+      if (auto* e = std::get_if<RegisterError>(&decoded))
+        return exception(e->exception, e->message);
+      return applied(runBatch(std::move(std::get<std::vector<Command>>(decoded)), false));
+    }
+    case ModbusFunction::kWriteSingleCoil:
+    case ModbusFunction::kWriteMultipleCoils: {
+      auto decoded = decodeCoilWrite(request.address, request.bits);
+      if (auto* e = std::get_if<RegisterError>(&decoded))
+        return exception(e->exception, e->message);
+      const CoilWrite& write = std::get<CoilWrite>(decoded);
+      std::vector<Command> commands;
+      if (write.paused) commands.push_back(command::SetTime{{}, write.paused, {}});
+      if (commands.empty() && !write.render) return encodeWriteReply(request);
+      return applied(runBatch(std::move(commands), write.render));
+    }
   }
-  if (function == MODBUS_FC_WRITE_SINGLE_COIL || function == MODBUS_FC_WRITE_MULTIPLE_COILS) {
-    const int address = be16(query + h + 1);
-    std::vector<std::uint8_t> bits;
-    if (function == MODBUS_FC_WRITE_SINGLE_COIL) {
-      const std::uint16_t value = be16(query + h + 3);
-      if (value != 0xFF00 && value != 0x0000)
-        return exception(kIllegalDataValue, "a coil takes 0xFF00 (on) or 0x0000 (off)");
-      bits.push_back(value == 0xFF00);
-    } else {
-      const int count = be16(query + h + 3);
-      const int bytes = query[h + 5];
-      if (count < 1 || count > MODBUS_MAX_WRITE_BITS || bytes != (count + 7) / 8 ||
-          h + 6 + bytes > length)
-        return exception(kIllegalDataValue, "coil count and byte count disagree");
-      for (int i = 0; i < count; ++i) bits.push_back((query[h + 6 + i / 8] >> (i % 8)) & 1);
-    }
-    auto decoded = decodeCoilWrite(address, bits);
-    if (auto* e = std::get_if<RegisterError>(&decoded)) return exception(e->exception, e->message);
-    const CoilWrite& write = std::get<CoilWrite>(decoded);
-    if (write.paused) {
-      if (auto error = runBatch({command::SetTime{{}, write.paused, {}}})) return applied(error);
-    }
-    if (write.render && !engine_.submitRenderTrigger([](std::optional<ProtocolError>) {}))
-      return exception(kServerDeviceBusy, "the request queue is full");
-    return reply();
-  }
-  if (function == MODBUS_FC_WRITE_AND_READ_REGISTERS || function == MODBUS_FC_MASK_WRITE_REGISTER)
-    return exception(MODBUS_EXCEPTION_ILLEGAL_FUNCTION,
-                     "write holding registers with function 0x06 or 0x10");
-  return reply();  // reads, and libmodbus's own answers for anything else
+  return exception(kIllegalFunction, "function is not served");
 }
 
 }  // namespace nephele

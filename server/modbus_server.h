@@ -1,18 +1,21 @@
 #pragma once
-// Modbus TCP (libmodbus) for the host simulator, register map in protocol/MODBUS.md. Each
-// client has its own thread, so a slow or half-written request holds up only its sender.
-// Writes are decoded and checked before anything changes; a bad one gets an exception.
+// Modbus TCP for the host simulator, register map in protocol/MODBUS.md, frames decoded by
+// protocol/modbus_frame.h. Each client has its own thread, so a slow or half-written request
+// holds up only its sender; request and idle timeouts, and room made at the client limit by
+// closing the idlest connection, keep a few clients from starving the rest
+// (docs/RELIABILITY.md). Writes are decoded and checked before anything changes; a refused
+// one changes nothing.
 #include <atomic>
+#include <chrono>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "protocol/modbus_frame.h"
 #include "server/engine.h"
-
-typedef struct _modbus modbus_t;
-typedef struct _modbus_mapping_t modbus_mapping_t;
 
 namespace nephele {
 
@@ -25,16 +28,26 @@ class ModbusServer {
   void close();  // stops accepting, ends every client thread
 
  private:
+  using Clock = std::chrono::steady_clock;
+  // What the accept thread knows of a client thread.
+  struct ClientState {
+    std::atomic<bool> finished{false};
+    std::atomic<bool> evict{false};        // set by the accept thread to make room
+    std::atomic<bool> mid_request{false};  // part of a frame has arrived
+    std::atomic<Clock::rep> last_activity{0};
+  };
   struct Client {
     std::thread thread;
-    std::shared_ptr<std::atomic<bool>> finished;
+    std::shared_ptr<ClientState> state;
   };
   void acceptLoop();
-  void serveClient(int fd, std::string peer);
-  // Answers one request; false when the connection should close.
-  bool handle(modbus_t* ctx, const std::uint8_t* query, int length);
-  std::optional<ProtocolError> runBatch(std::vector<Command> commands);
-  void refreshMapping();  // from the engine's published state; call with mapping_mutex_ held
+  void serveClient(int fd, const std::string& peer, ClientState& state);
+  // The reply to one decoded request (an exception or the data).
+  std::vector<std::uint8_t> answer(const ModbusRequest& request);
+  std::vector<std::uint8_t> refuse(const MbapHeader& header, const ModbusException& exception);
+  // Runs a write on the world thread and waits for it, at most the request timeout; on
+  // timeout the write is withdrawn and answered busy, having changed nothing.
+  std::optional<ProtocolError> runBatch(std::vector<Command> commands, bool render);
 
   Engine& engine_;
   int listen_fd_ = -1;
@@ -43,8 +56,6 @@ class ModbusServer {
   std::thread accept_thread_;
   std::mutex clients_mutex_;
   std::vector<Client> clients_;
-  std::mutex mapping_mutex_;
-  modbus_mapping_t* mapping_ = nullptr;
 };
 
 }  // namespace nephele

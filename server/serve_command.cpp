@@ -89,13 +89,20 @@ int runServeCommand(const ServeCommandOptions& o) {
   sigwait(&signals, &received);
   spdlog::info("event=stopping signal={}", received == SIGTERM ? "SIGTERM" : "SIGINT");
   modbus.close();
-  engine.stop();  // the request in hand finishes, queued ones are cancelled, snapshot saved
+  // The request in hand finishes, queued ones are answered "shutting down", the snapshot is
+  // saved. Then each connection writes out what it was sent (docs/RELIABILITY.md).
+  const bool saved = engine.stop();
   asio::post(io, [&] {
     socket.close();
     metrics.close();
   });
   work.reset();
-  io_thread.join();  // replies already posted are written before the loop runs dry
+  io_thread.join();
+  if (!saved) {
+    // A supervisor must know that the world's state was lost.
+    spdlog::error("event=stopped error=\"the shutdown snapshot could not be saved\"");
+    return 1;
+  }
   spdlog::info("event=stopped");
   return 0;
 }

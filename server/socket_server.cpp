@@ -3,21 +3,61 @@
 #include <spdlog/spdlog.h>
 
 #include <array>
+#include <chrono>
 #include <deque>
+#include <optional>
 
 namespace nephele {
 
 using asio::ip::tcp;
 
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+constexpr int kMaxInFlight = 16;  // requests of one connection waiting for the world thread
+constexpr int kMaxBadTokens = 3;  // wrong tokens before the connection is closed
+constexpr int kMaxRefusing = 64;  // over-limit connections being answered at once
+constexpr auto kRefusalWait = std::chrono::seconds(2);     // for an over-limit client's request
+constexpr auto kShutdownDrain = std::chrono::seconds(10);  // to finish writing at shutdown
+constexpr auto kSweepPeriod = std::chrono::milliseconds(250);
+
+Clock::duration seconds(double s) {
+  return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
+}
+
+// Compares a presented token with the configured one in time that depends only on the
+// configured token's length, so that timing tells a guesser nothing about a prefix.
+bool tokenMatches(std::string_view presented, std::string_view expected) {
+  unsigned char diff = presented.size() == expected.size() ? 0 : 1;
+  for (std::size_t i = 0; i < expected.size(); ++i)
+    diff |= static_cast<unsigned char>(expected[i] ^ (i < presented.size() ? presented[i] : 0));
+  return diff == 0;
+}
+
+std::string overLimitRefusal(const nlohmann::json& id, int max_clients) {
+  return errorReply(
+      id, {ErrorCode::kLimit, "too many clients (allowed: " + std::to_string(max_clients) +
+                                  "); the connection is closed"});
+}
+
+}  // namespace
+
 // One client of the socket protocol. Every member is used on the io thread only, except
 // closed_, which frame sinks on other threads read.
+//
+// Memory per connection is bounded (docs/RELIABILITY.md): at most kMaxInFlight requests wait
+// for the world thread, reading stops while that many are out or the unread output exceeds
+// max_pending_bytes, and an image reply that would take the output beyond that limit is
+// replaced by a busy error (rendering changes nothing, so refusing it late is still clean).
 class Connection : public std::enable_shared_from_this<Connection> {
  public:
   Connection(tcp::socket socket, Engine& engine, std::int64_t id)
       : socket_(std::move(socket)),
         engine_(engine),
         id_(id),
-        authorised_(engine.config().token.empty()) {
+        authorised_(engine.config().token.empty()),
+        last_activity_(Clock::now()) {
     std::error_code ec;
     const tcp::endpoint peer = socket_.remote_endpoint(ec);
     peer_ = ec ? "?" : peer.address().to_string() + ":" + std::to_string(peer.port());
@@ -27,16 +67,36 @@ class Connection : public std::enable_shared_from_this<Connection> {
   void start() {
     ++engine_.socket_clients;
     spdlog::info("event=client_connected id={} peer={}", id_, peer_);
-    read();
+    resume();
   }
+
+  bool closed() const { return closed_; }
 
   void close(const char* why) {
     if (closed_.exchange(true)) return;
     std::error_code ec;
     socket_.shutdown(tcp::socket::shutdown_both, ec);
     socket_.close(ec);
+    if (drain_timer_) drain_timer_->cancel();
     --engine_.socket_clients;
+    engine_.clientGone(id_);
     spdlog::info("event=client_closed id={} peer={} reason={}", id_, peer_, why);
+  }
+
+  // Stops reading and closes once everything queued is written, or after `limit`.
+  void finish(const char* why, Clock::duration limit) {
+    if (closed_ || finishing_) return;
+    finishing_ = why;
+    std::error_code ec;
+    socket_.shutdown(tcp::socket::shutdown_receive, ec);
+    if (out_.empty()) {
+      close(why);
+      return;
+    }
+    drain_timer_ = std::make_unique<asio::steady_timer>(socket_.get_executor(), limit);
+    drain_timer_->async_wait([self = shared_from_this()](std::error_code ec) {
+      if (!ec) self->close("drain_timeout");
+    });
   }
 
   // Queues a reply or frame for writing.
@@ -45,6 +105,23 @@ class Connection : public std::enable_shared_from_this<Connection> {
     pending_bytes_ += reply->size();
     out_.push_back(std::move(reply));
     if (!writing_) write();
+  }
+
+  // A request's reply, from the world thread or the encoder.
+  void reply(const nlohmann::json& id, SharedReply r) {
+    --in_flight_;
+    if (closed_) return;
+    if (r->body && pending_bytes_ > 0 &&
+        pending_bytes_ + r->size() > engine_.config().max_pending_bytes) {
+      engine_.noteError(ErrorCode::kBusy);
+      r = makeReply(errorReply(
+          id, {ErrorCode::kBusy, "this connection has " + std::to_string(pending_bytes_ >> 20) +
+                                     " MiB of output unread (allowed: " +
+                                     std::to_string(engine_.config().max_pending_bytes >> 20) +
+                                     " MiB); the image was not sent; read first, then ask again"}));
+    }
+    send(std::move(r));
+    resume();
   }
 
   // A subscribed frame: dropped when the client is already too far behind.
@@ -57,39 +134,99 @@ class Connection : public std::enable_shared_from_this<Connection> {
     send(std::move(frame));
   }
 
+  // Why the connection should close now (a timeout), or nullptr.
+  const char* overdue(Clock::time_point now) const {
+    if (closed_ || finishing_) return nullptr;
+    const Timeouts& t = engine_.config().socket_timeouts;
+    if (line_started_ && now - *line_started_ > seconds(t.request_s)) return "request_timeout";
+    if (t.idle_s > 0.0 && now - last_activity_ > seconds(t.idle_s) &&
+        (in_flight_ == 0 || !out_.empty()) && engine_.subscriptionsOf(id_) == 0)
+      return out_.empty() ? "idle_timeout" : "write_timeout";
+    return nullptr;
+  }
+
+  // How long the connection has had nothing to do, if it has nothing to do at all: no
+  // request begun or waiting, no output, no subscription.
+  std::optional<Clock::duration> idleFor(Clock::time_point now) const {
+    if (closed_ || finishing_ || line_started_ || in_flight_ > 0 || !out_.empty() ||
+        engine_.subscriptionsOf(id_) > 0)
+      return std::nullopt;
+    return now - last_activity_;
+  }
+
  private:
+  bool paused() const {
+    return in_flight_ >= kMaxInFlight || pending_bytes_ > engine_.config().max_pending_bytes;
+  }
+
+  // Handles what has been read, then reads more, unless paused, reading or closing.
+  void resume() {
+    if (closed_ || finishing_ || processing_) return;
+    processing_ = true;
+    processInput();
+    processing_ = false;
+    if (!closed_ && !finishing_ && !reading_ && !paused()) read();
+  }
+
   void read() {
-    socket_.async_read_some(
-        asio::buffer(chunk_),
-        [self = shared_from_this()](std::error_code ec, std::size_t n) { self->onRead(ec, n); });
+    reading_ = true;
+    socket_.async_read_some(asio::buffer(chunk_),
+                            [self = shared_from_this()](std::error_code ec, std::size_t n) {
+                              self->reading_ = false;
+                              self->onRead(ec, n);
+                            });
   }
 
   void onRead(std::error_code ec, std::size_t n) {
+    if (closed_ || finishing_) return;
     if (ec) {
       close(ec == asio::error::eof ? "eof" : "read_error");
       return;
     }
-    std::string_view data(chunk_.data(), n);
-    while (!data.empty() && !closed_) {
-      const std::size_t newline = data.find('\n');
-      const std::string_view part = data.substr(0, newline);
-      if (!discarding_) line_.append(part);
-      if (!discarding_ && line_.size() >= ProtocolLimits::kMaxRequestBytes) {
-        // Answer once, then skip the rest of the line: the connection stays usable.
-        sendError(nullptr,
-                  {ErrorCode::kTooLarge, "request line is longer than " +
-                                             std::to_string(ProtocolLimits::kMaxRequestBytes) +
-                                             " bytes (allowed: less); it was skipped"});
-        discarding_ = true;
-        line_.clear();
+    last_activity_ = Clock::now();
+    if (!line_started_) line_started_ = last_activity_;
+    in_.append(chunk_.data(), n);
+    resume();
+  }
+
+  // Splits in_ into request lines and handles them while the connection is not paused.
+  void processInput() {
+    while (!closed_ && !finishing_ && !paused()) {
+      const std::size_t newline = in_.find('\n');
+      if (newline == std::string::npos) break;
+      if (!discarding_) {
+        line_.assign(in_, 0, newline);
+        handleLine();
       }
-      if (newline == std::string_view::npos) break;
-      if (!discarding_) handleLine();
       discarding_ = false;
-      line_.clear();
-      data.remove_prefix(newline + 1);
+      in_.erase(0, newline + 1);
     }
-    if (!closed_) read();
+    if (!discarding_ && in_.find('\n') == std::string::npos &&
+        in_.size() >= ProtocolLimits::kMaxRequestBytes) {
+      // Answer once, then skip the rest of the line: the connection stays usable.
+      sendError(nullptr,
+                {ErrorCode::kTooLarge, "request line is longer than " +
+                                           std::to_string(ProtocolLimits::kMaxRequestBytes) +
+                                           " bytes (allowed: less); it was skipped"});
+      discarding_ = true;
+    }
+    if (discarding_) {
+      const std::size_t newline = in_.find('\n');
+      if (newline == std::string::npos) {
+        in_.clear();
+      } else {
+        in_.erase(0, newline + 1);
+        discarding_ = false;
+        processInput();
+        return;
+      }
+    }
+    // A request begun and not finished is held to the request timeout from its first byte
+    // (or from when the previous one was taken).
+    if (in_.empty() && !discarding_)
+      line_started_.reset();
+    else if (!line_started_)
+      line_started_ = Clock::now();
   }
 
   void handleLine() {
@@ -101,12 +238,18 @@ class Connection : public std::enable_shared_from_this<Connection> {
       return;
     }
     Request& request = std::get<Request>(parsed);
-    if (auto* hello = std::get_if<command::Hello>(&request.command);
-        hello && !engine_.config().token.empty()) {
-      authorised_ = hello->token && *hello->token == engine_.config().token;
+    const std::string& token = engine_.config().token;
+    if (auto* hello = std::get_if<command::Hello>(&request.command); hello && !token.empty()) {
+      authorised_ = hello->token && tokenMatches(*hello->token, token);
       if (!authorised_) {
-        spdlog::warn("event=bad_token id={} peer={}", id_, peer_);
-        sendError(request.id, {ErrorCode::kUnauthorized, "token: missing or wrong"});
+        ++bad_tokens_;
+        spdlog::warn("event=bad_token id={} peer={} count={}", id_, peer_, bad_tokens_);
+        const bool last = bad_tokens_ >= kMaxBadTokens;
+        sendError(request.id, {ErrorCode::kUnauthorized,
+                               last ? "token: wrong " + std::to_string(kMaxBadTokens) +
+                                          " times; the connection is closed"
+                                    : "token: missing or wrong"});
+        if (last) finish("bad_tokens", kShutdownDrain);
         return;
       }
     }
@@ -116,18 +259,12 @@ class Connection : public std::enable_shared_from_this<Connection> {
                              "first"});
       return;
     }
-    if (pending_bytes_ > engine_.config().max_pending_bytes) {
-      sendError(request.id,
-                {ErrorCode::kBusy, "this connection has " + std::to_string(pending_bytes_ >> 20) +
-                                       " MiB of replies unread; read them first"});
-      return;
-    }
     const nlohmann::json id = request.id;
     std::weak_ptr<Connection> weak = weak_from_this();
     asio::io_context& io = static_cast<asio::io_context&>(socket_.get_executor().context());
-    auto reply = [weak, &io](SharedReply r) {
-      asio::post(io, [weak, r = std::move(r)] {
-        if (auto c = weak.lock()) c->send(r);
+    auto reply = [weak, &io, id](SharedReply r) {
+      asio::post(io, [weak, id, r = std::move(r)] {
+        if (auto c = weak.lock()) c->reply(id, r);
       });
     };
     auto frames = [weak, &io](SharedReply r) {
@@ -136,10 +273,16 @@ class Connection : public std::enable_shared_from_this<Connection> {
       asio::post(io, [c, r = std::move(r)] { c->offerFrame(r); });
       return true;
     };
-    if (!engine_.submit(std::move(request), id_, frames, reply))
-      sendError(id, {ErrorCode::kBusy, "the request queue is full (" +
-                                           std::to_string(engine_.config().max_queue) +
-                                           " waiting); try again"});
+    ++in_flight_;
+    if (!engine_.submit(std::move(request), id_, frames, reply)) {
+      --in_flight_;
+      sendError(
+          id, engine_.stopping()
+                  ? ProtocolError{ErrorCode::kFailed, "the daemon is shutting down"}
+                  : ProtocolError{ErrorCode::kBusy, "the request queue is full (" +
+                                                        std::to_string(engine_.config().max_queue) +
+                                                        " waiting); try again"});
+    }
   }
 
   void sendError(const nlohmann::json& id, const ProtocolError& error) {
@@ -157,14 +300,20 @@ class Connection : public std::enable_shared_from_this<Connection> {
                         const SharedReply& done = self->out_.front();
                         self->pending_bytes_ -= done->size();
                         self->out_.pop_front();
+                        self->last_activity_ = Clock::now();
                         if (ec) {
                           self->close("write_error");
                           return;
                         }
-                        if (!self->out_.empty())
+                        if (!self->out_.empty()) {
                           self->write();
+                          return;
+                        }
+                        self->writing_ = false;
+                        if (self->finishing_)
+                          self->close(self->finishing_);
                         else
-                          self->writing_ = false;
+                          self->resume();
                       });
   }
 
@@ -173,16 +322,70 @@ class Connection : public std::enable_shared_from_this<Connection> {
   std::int64_t id_;
   std::string peer_;
   bool authorised_;
+  int bad_tokens_ = 0;
   std::array<char, 16384> chunk_{};
-  std::string line_;
+  std::string in_;    // bytes read and not yet handled
+  std::string line_;  // the request line being handled
   bool discarding_ = false;
+  bool reading_ = false;
+  bool processing_ = false;
+  int in_flight_ = 0;
+  Clock::time_point last_activity_;
+  std::optional<Clock::time_point> line_started_;
   std::deque<SharedReply> out_;
   std::size_t pending_bytes_ = 0;
   bool writing_ = false;
+  const char* finishing_ = nullptr;  // why the connection is closing once written out
+  std::unique_ptr<asio::steady_timer> drain_timer_;
   std::atomic<bool> closed_{false};
-
-  friend class SocketServer;
 };
+
+// A connection over the client limit: it is told so in answer to its first request, with
+// that request's id, so that the client knows which request was refused.
+void refuseOverLimit(tcp::socket socket, int max_clients, std::shared_ptr<std::atomic<int>> count) {
+  struct Refusal {
+    Refusal(tcp::socket s, std::shared_ptr<std::atomic<int>> n)
+        : socket(std::move(s)), timer(socket.get_executor(), kRefusalWait), count(std::move(n)) {
+      ++*count;
+    }
+    ~Refusal() { --*count; }
+    tcp::socket socket;
+    asio::streambuf in{ProtocolLimits::kMaxRequestBytes};
+    asio::steady_timer timer;
+    std::string reply;
+    bool answered = false;
+    std::shared_ptr<std::atomic<int>> count;
+  };
+  auto r = std::make_shared<Refusal>(std::move(socket), std::move(count));
+  auto answer = [r](const nlohmann::json& id, int max) {
+    if (r->answered) return;
+    r->answered = true;
+    r->timer.cancel();
+    r->reply = overLimitRefusal(id, max);
+    asio::async_write(r->socket, asio::buffer(r->reply), [r](std::error_code, std::size_t) {
+      std::error_code ignored;
+      r->socket.shutdown(tcp::socket::shutdown_both, ignored);
+      r->socket.close(ignored);
+    });
+  };
+  r->timer.async_wait([r, answer, max_clients](std::error_code ec) {
+    if (!ec) answer(nullptr, max_clients);  // no request in time: refuse without an id
+  });
+  asio::async_read_until(r->socket, r->in, '\n',
+                         [r, answer, max_clients](std::error_code ec, std::size_t n) {
+                           nlohmann::json id = nullptr;
+                           if (!ec) {
+                             std::string line(asio::buffers_begin(r->in.data()),
+                                              asio::buffers_begin(r->in.data()) + n);
+                             auto parsed = parseRequest(line);
+                             if (auto* bad = std::get_if<BadRequest>(&parsed))
+                               id = bad->id;
+                             else
+                               id = std::get<Request>(parsed).id;
+                           }
+                           answer(id, max_clients);
+                         });
+}
 
 std::string openAcceptor(tcp::acceptor& acceptor, const ListenConfig& where, const char* what) {
   std::error_code ec;
@@ -200,7 +403,11 @@ std::string openAcceptor(tcp::acceptor& acceptor, const ListenConfig& where, con
 }
 
 SocketServer::SocketServer(asio::io_context& io, Engine& engine)
-    : io_(io), engine_(engine), acceptor_(io) {}
+    : io_(io),
+      engine_(engine),
+      acceptor_(io),
+      sweep_timer_(io),
+      refusing_(std::make_shared<std::atomic<int>>(0)) {}
 
 SocketServer::~SocketServer() = default;
 
@@ -208,7 +415,21 @@ std::string SocketServer::listen(const ListenConfig& where) {
   if (std::string e = openAcceptor(acceptor_, where, "socket"); !e.empty()) return e;
   port_ = acceptor_.local_endpoint().port();
   accept();
+  sweep();
   return "";
+}
+
+void SocketServer::sweep() {
+  const auto now = Clock::now();
+  std::erase_if(connections_, [&](const auto& entry) {
+    Connection& c = *entry.second;
+    if (const char* why = c.overdue(now)) c.close(why);
+    return c.closed();
+  });
+  sweep_timer_.expires_after(kSweepPeriod);
+  sweep_timer_.async_wait([this](std::error_code ec) {
+    if (!ec) sweep();
+  });
 }
 
 void SocketServer::accept() {
@@ -220,16 +441,38 @@ void SocketServer::accept() {
       }
       return;
     }
-    std::erase_if(connections_, [](const auto& entry) { return entry.second.expired(); });
-    if (engine_.socket_clients.load() >= engine_.config().max_clients) {
-      const std::string refusal = errorReply(
-          nullptr, {ErrorCode::kLimit, "too many clients (allowed: " +
-                                           std::to_string(engine_.config().max_clients) + ")"});
-      std::error_code ignored;
-      socket.non_blocking(true, ignored);
-      asio::write(socket, asio::buffer(refusal), ignored);
-      socket.close(ignored);
+    auto dropClosed = [&] {
+      std::erase_if(connections_, [](const auto& entry) { return entry.second->closed(); });
+    };
+    dropClosed();
+    const int max_clients = engine_.config().max_clients;
+    if (int(connections_.size()) >= max_clients) {
+      // At the limit, a newcomer takes the place of the connection that has had nothing to
+      // do for longest, if that has been idle for at least the request timeout: idle
+      // connections never starve a working one.
+      const auto now = Clock::now();
+      std::shared_ptr<Connection> idlest;
+      Clock::duration longest = seconds(engine_.config().socket_timeouts.request_s);
+      for (auto& [id, c] : connections_)
+        if (auto idle = c->idleFor(now); idle && *idle >= longest) {
+          longest = *idle;
+          idlest = c;
+        }
+      if (idlest) idlest->close("evicted_idle");
+      dropClosed();
+    }
+    if (int(connections_.size()) >= max_clients) {
       spdlog::warn("event=client_refused reason=max_clients");
+      engine_.noteError(ErrorCode::kLimit);
+      if (refusing_->load() < kMaxRefusing) {
+        refuseOverLimit(std::move(socket), max_clients, refusing_);
+      } else {
+        const std::string refusal = overLimitRefusal(nullptr, max_clients);
+        std::error_code ignored;
+        socket.non_blocking(true, ignored);
+        asio::write(socket, asio::buffer(refusal), ignored);
+        socket.close(ignored);
+      }
     } else {
       auto connection = std::make_shared<Connection>(std::move(socket), engine_, next_id_);
       connections_[next_id_++] = connection;
@@ -242,8 +485,9 @@ void SocketServer::accept() {
 void SocketServer::close() {
   std::error_code ec;
   acceptor_.close(ec);
-  for (auto& [id, weak] : connections_)
-    if (auto c = weak.lock()) c->close("shutdown");
+  sweep_timer_.cancel();
+  // Replies already posted are written out (within kShutdownDrain) before each closes.
+  for (auto& [id, c] : connections_) c->finish("shutdown", kShutdownDrain);
   connections_.clear();
 }
 

@@ -4,6 +4,7 @@
 // subscribed frames back. A slow client only fills its own bounded queue.
 #include <asio.hpp>
 
+#include <atomic>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -22,18 +23,24 @@ class SocketServer {
   // Binds and starts accepting; returns an error naming the address on failure.
   std::string listen(const ListenConfig& where);
   int port() const { return port_; }
-  // Stops accepting and closes every connection (call on the io thread or before it runs).
+  // Stops accepting; every connection finishes writing what it was sent, then closes (call on
+  // the io thread or before it runs).
   void close();
 
  private:
   void accept();
+  void sweep();  // closes connections past their request or idle timeout
 
   asio::io_context& io_;
   Engine& engine_;
   asio::ip::tcp::acceptor acceptor_;
+  asio::steady_timer sweep_timer_;
+  std::shared_ptr<std::atomic<int>> refusing_;  // over-limit connections being answered
   int port_ = 0;
   std::int64_t next_id_ = 1;
-  std::map<std::int64_t, std::weak_ptr<Connection>> connections_;
+  // Owned here while open (a connection that has paused reading has no pending operation
+  // to keep it alive); closed ones are dropped by the sweep.
+  std::map<std::int64_t, std::shared_ptr<Connection>> connections_;
 };
 
 // GET /metrics in the Prometheus text format; anything else is 404.

@@ -391,21 +391,27 @@ class SocketProtocolTest(DaemonTest):
 
     def test_full_queue_answers_busy(self):
         d = self.daemon()
-        c = d.client()
-        # 300 requests in one write: the queue (64) overflows; every one is answered.
-        ids = list(range(1000, 1300))
-        c.sock.sendall(b"".join((json.dumps({"id": i, "cmd": "render", "view": "front"})
-                                 + "\n").encode() for i in ids))
-        answered, busy = set(), 0
-        while len(answered) < len(ids):
-            header, _ = c.read()
-            answered.add(header["id"])
-            if not header["ok"]:
-                self.assertEqual(header["error"]["code"], "busy")
-                busy += 1
-        self.assertEqual(answered, set(ids))
+        # Five clients pipeline 60 requests each in one write. One connection has at most 16
+        # waiting (its reading pauses there), but five overflow the daemon's queue (64):
+        # every request is answered, some "busy".
+        clients = [d.client() for _ in range(5)]
+        sent = {}
+        for k, c in enumerate(clients):
+            sent[c] = list(range(1000 * (k + 1), 1000 * (k + 1) + 60))
+            c.sock.sendall(b"".join((json.dumps({"id": i, "cmd": "render", "view": "front"})
+                                     + "\n").encode() for i in sent[c]))
+        busy = 0
+        for c in clients:
+            answered = set()
+            while len(answered) < len(sent[c]):
+                header, _ = c.read()
+                answered.add(header["id"])
+                if not header["ok"]:
+                    self.assertEqual(header["error"]["code"], "busy")
+                    busy += 1
+            self.assertEqual(answered, set(sent[c]))
         self.assertGreater(busy, 0)
-        c.ok({"cmd": "hash"})  # and the connection still works
+        clients[0].ok({"cmd": "hash"})  # and the connections still work
 
     def test_slow_and_vanished_clients_do_not_stall_others(self):
         d = self.daemon(mode="realtime", view_size=(320, 240))
@@ -633,6 +639,259 @@ class ModbusTest(DaemonTest):
         self.assertTrue(refused)
         mb.close()
         wait_until(lambda: "event=modbus_refused" in d.log_text(), "the refusal in the log")
+
+
+def rss_mib(pid):
+    with open(f"/proc/{pid}/status") as f:
+        for line in f:
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1]) / 1024
+    raise AssertionError("no VmRSS")
+
+
+def closed_by_peer(sock, timeout=TIMEOUT):
+    """True once the daemon has closed `sock` (reads drain any last reply first)."""
+    sock.settimeout(timeout)
+    try:
+        while sock.recv(65536):
+            pass
+        return True
+    except ConnectionResetError:
+        return True
+    except socket.timeout:
+        return False
+
+
+def mbap(transaction, pdu, protocol=0, length=None, unit=1):
+    """A Modbus TCP frame, built byte by byte from the Messaging on TCP/IP guide."""
+    n = len(pdu) + 1 if length is None else length
+    return struct.pack(">HHHB", transaction, protocol, n, unit) + pdu
+
+
+def modbus_reply(sock):
+    """(transaction, function, data) of one reply frame read from `sock`."""
+    def exactly(n):
+        data = b""
+        while len(data) < n:
+            chunk = sock.recv(n - len(data))
+            if not chunk:
+                raise ConnectionError("closed")
+            data += chunk
+        return data
+    transaction, protocol, length, unit = struct.unpack(">HHHB", exactly(7))
+    pdu = exactly(length - 1)
+    return transaction, pdu[0], pdu[1:]
+
+
+class AbuseTest(DaemonTest):
+    """The abuse cases of docs/RELIABILITY.md, each named by its number there."""
+
+    def test_case04_half_lines_drips_and_idle_clients_never_starve_a_working_one(self):
+        d = self.daemon(socket_keys="max_clients = 4\nrequest_timeout = 0.5\nidle_timeout = 0",
+                        modbus_keys="max_clients = 2\nrequest_timeout = 0.5\nidle_timeout = 0")
+        # Socket: four connections hold half a request line each; the request timeout
+        # closes them and a new client is served.
+        holders = [socket.create_connection(("127.0.0.1", d.port)) for _ in range(4)]
+        for h in holders:
+            h.sendall(b'{"cmd": "he')
+        for h in holders:
+            self.assertTrue(closed_by_peer(h, 10))
+        c = d.client()
+        c.ok({"cmd": "hello"})
+        # A connection dripping a byte every 0.2 s is closed although bytes keep coming.
+        drip = socket.create_connection(("127.0.0.1", d.port))
+        closed = False
+        for b in b'{"cmd": "hello", "id": 1}':
+            try:
+                drip.sendall(bytes([b]))
+            except OSError:
+                closed = True
+                break
+            time.sleep(0.2)
+        self.assertTrue(closed or closed_by_peer(drip, 10))
+        # Idle connections at the limit: a newcomer takes the place of the idlest.
+        idle = [d.client() for _ in range(3)]
+        time.sleep(0.6)  # longer than the request timeout: they count as idle
+        newcomer = d.client()
+        newcomer.ok({"cmd": "hello"})
+        self.assertTrue(any(closed_by_peer(i.sock, 0.5) for i in [c] + idle))
+        self.assertIn("reason=evicted_idle", d.log_text())
+        # Modbus: two idle clients at the limit, a third is served; a dripping one is closed.
+        idle_mb = [socket.create_connection(("127.0.0.1", d.modbus_port)) for _ in range(2)]
+        time.sleep(0.6)
+        mb = socket.create_connection(("127.0.0.1", d.modbus_port), timeout=TIMEOUT)
+        mb.sendall(mbap(7, struct.pack(">BHH", 3, 14, 2)))
+        self.assertEqual(modbus_reply(mb), (7, 3, struct.pack(">BHH", 4, 64, 48)))
+        drip = socket.create_connection(("127.0.0.1", d.modbus_port))
+        try:
+            for b in mbap(8, struct.pack(">BHH", 3, 14, 2))[:6]:
+                drip.sendall(bytes([b]))
+                time.sleep(0.2)
+        except OSError:
+            pass  # closed while dripping
+        self.assertTrue(closed_by_peer(drip, 10))
+        mb.sendall(mbap(9, struct.pack(">BHH", 3, 14, 1)))
+        self.assertEqual(modbus_reply(mb)[0], 9)
+        for s in idle_mb + [mb, drip]:
+            s.close()
+
+    def test_case05_unread_image_replies_stay_within_the_pending_limit(self):
+        d = self.daemon(socket_keys="max_pending_mb = 1", view_size=(512, 512))
+        c = d.client()
+        c.ok({"cmd": "render", "view": "front"})  # 1 MiB, and the renderer is warm
+        before = rss_mib(d.proc.pid)
+        ids = [c.send({"cmd": "render", "view": "front"}) for _ in range(40)]
+        watcher = d.client()
+        # Wait until the daemon has done what it will with the 40 without their being read.
+        last = -10
+        while True:
+            stats = watcher.ok({"cmd": "stats"})  # itself one request
+            if stats["requests"] == last + 1 and stats["queue"]["depth"] == 0:
+                break
+            last = stats["requests"]
+            time.sleep(0.3)
+        grown = rss_mib(d.proc.pid) - before
+        self.assertLess(grown, 12, f"the daemon grew by {grown:.0f} MiB for one unread client")
+        answered, images, busy = set(), 0, 0
+        while len(answered) < len(ids):
+            header, body = c.read()
+            answered.add(header["id"])
+            if header["ok"]:
+                self.assertEqual(len(body), 512 * 512 * 4)
+                images += 1
+            else:
+                self.assertEqual(header["error"]["code"], "busy")
+                busy += 1
+        self.assertEqual(answered, set(ids))
+        self.assertGreater(images, 0)
+
+    def test_case06_subscriptions_end_with_their_client_and_resets_are_counted(self):
+        d = self.daemon(socket_keys="max_subscriptions = 2", view_size=(512, 512))
+        watcher = d.client()
+        for _ in range(2):
+            c = d.client()
+            c.ok({"cmd": "subscribe", "view": "front", "rate": 0.01})  # one frame per 100 s
+            c.read()  # the first frame
+            c.close()
+        wait_until(lambda: watcher.ok({"cmd": "stats"})["subscriptions"] == 0,
+                   "the vanished clients' subscriptions to end", timeout=5)
+        subscriber = d.client()  # the limit is free again
+        self.assertIn("subscription", subscriber.ok(
+            {"cmd": "subscribe", "view": "front", "rate": 0.01}))
+        # Thirty clients reset in the middle of a 1 MiB image.
+        for _ in range(30):
+            c = Client(d.port)
+            c.send({"cmd": "render", "view": "front"})
+            c.file.readline()
+            c.sock.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))
+            c.close()
+        wait_until(lambda: watcher.ok({"cmd": "stats"})["clients"]["socket"] == 2,
+                   "the client count to come back to two", timeout=10)
+
+    def test_case07_a_client_over_the_limit_is_refused_with_its_request_id(self):
+        d = self.daemon(socket_keys="max_clients = 2")
+        held = [d.client() for _ in range(2)]
+        for c in held:
+            c.ok({"cmd": "hello"})  # busy, so not idle
+        extra = Client(d.port)
+        error = extra.error({"cmd": "hello", "id": "refused-7"})
+        self.assertEqual(error["code"], "limit")
+        self.assertTrue(closed_by_peer(extra.sock, 5))
+        extra.close()
+
+    def test_case08_wrong_tokens_close_the_connection(self):
+        d = self.daemon(socket_keys='token = "s3cret-token"')
+        c = d.client()
+        for i in range(3):
+            self.assertEqual(c.error({"cmd": "hello", "token": "guess%d" % i})["code"],
+                             "unauthorized")
+        self.assertTrue(closed_by_peer(c.sock, 5))
+        ok = d.client()
+        ok.ok({"cmd": "hello", "token": "s3cret-token"})
+        ok.ok({"cmd": "hash"})
+
+    def test_case09_a_modbus_write_refused_busy_changes_nothing(self):
+        from pymodbus.client import ModbusTcpClient
+        d = self.daemon(modbus_keys="request_timeout = 0.2", view_size=(2048, 2048))
+        c = d.client()
+        heading = c.ok({"cmd": "get_view", "view": "front"})["heading"]
+        mb = ModbusTcpClient("127.0.0.1", port=d.modbus_port, timeout=10, retries=0)
+        self.assertTrue(mb.connect())
+        # Twelve 16 MiB renders keep the world thread busy for seconds.
+        ids = [c.send({"cmd": "render", "view": "front", "channels": ["colour"]})
+               for _ in range(12)]
+        r = mb.write_registers(6, floats(123.0), slave=1)
+        self.assertTrue(r.isError())
+        self.assertEqual(r.exception_code, 6)
+        for _ in ids:
+            c.read()
+        self.assertEqual(c.ok({"cmd": "get_view", "view": "front"})["heading"], heading)
+        # An accepted write is answered once applied.
+        self.assertFalse(mb.write_registers(6, floats(77.0), slave=1).isError())
+        self.assertEqual(c.ok({"cmd": "get_view", "view": "front"})["heading"], 77.0)
+        mb.close()
+
+    def test_case10_modbus_frames_are_framed_strictly_by_the_mbap_header(self):
+        d = self.daemon()
+        c = d.client()
+        view = c.ok({"cmd": "get_view", "view": "front"})
+
+        def connect():
+            return socket.create_connection(("127.0.0.1", d.modbus_port), timeout=TIMEOUT)
+        s = connect()
+        # A read whose length also covers a hidden write frame: refused, nothing written.
+        hidden = mbap(2, struct.pack(">BHHB", 16, 6, 2, 4) + struct.pack(">f", 99.0))
+        s.sendall(mbap(1, struct.pack(">BHH", 3, 0, 2) + hidden))
+        self.assertEqual(modbus_reply(s), (1, 0x83, bytes([3])))
+        # Trailing bytes inside the length: refused.
+        s.sendall(mbap(3, struct.pack(">BHH", 3, 0, 2) + b"\0"))
+        self.assertEqual(modbus_reply(s), (3, 0x83, bytes([3])))
+        # Function codes this server does not serve, 0x80 and above included: exception 1,
+        # and the stream stays in step.
+        for transaction, function in ((4, 0x83), (5, 0x07), (6, 0x2B), (7, 0x80)):
+            s.sendall(mbap(transaction, bytes([function])))
+            self.assertEqual(modbus_reply(s), (transaction, function | 0x80, bytes([1])))
+        s.sendall(mbap(8, struct.pack(">BHH", 3, 14, 2)))
+        self.assertEqual(modbus_reply(s), (8, 3, struct.pack(">BHH", 4, 64, 48)))
+        # A protocol id other than 0, and lengths that cannot be framed: the connection closes.
+        for frame in (mbap(9, struct.pack(">BHH", 3, 0, 1), protocol=0x1234),
+                      mbap(10, b"", length=1), mbap(11, b"", length=300)):
+            t = connect()
+            t.sendall(frame)
+            self.assertTrue(closed_by_peer(t, 5))
+            t.close()
+        self.assertEqual(c.ok({"cmd": "get_view", "view": "front"}), view)
+        s.close()
+
+    def test_case11_sigterm_finishes_promised_replies_and_answers_queued_ones(self):
+        d = self.daemon(view_size=(2048, 2048), extra="[snapshot]\npath = \"{snapshot}\"\n"
+                                                        "interval = 0\n")
+        c = d.client()
+        first = c.send({"cmd": "render", "view": "front"})  # 16 MiB, not read yet
+        rest = [c.send({"cmd": "tick", "dt": 0.1}) for _ in range(10)]
+        watcher = d.client()
+        wait_until(lambda: watcher.ok({"cmd": "stats"})["frames"] >= 1, "the render")
+        d.proc.send_signal(signal.SIGTERM)
+        header, body = c.read()
+        self.assertEqual(header["id"], first)
+        self.assertEqual(len(body), 2048 * 2048 * 4)
+        answered = {}
+        for _ in rest:
+            header, _ = c.read()
+            answered[header["id"]] = header
+        self.assertEqual(set(answered), set(rest))
+        for h in answered.values():
+            self.assertTrue(h["ok"] or "shutting down" in h["error"]["message"], h)
+        self.assertEqual(d.stop(), 0)
+        # A shutdown snapshot that cannot be written makes the exit code say so.
+        d.start()
+        snapshot_dir = os.path.dirname(d.snapshot)
+        for name in os.listdir(snapshot_dir):
+            os.remove(os.path.join(snapshot_dir, name))
+        os.rmdir(snapshot_dir)
+        open(snapshot_dir, "w").close()  # a file where the directory should be
+        self.assertEqual(d.stop(), 1)
+        self.assertIn("event=snapshot_failed", d.log_text())
 
 
 if __name__ == "__main__":
