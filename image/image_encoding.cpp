@@ -1,5 +1,7 @@
 #include "image/image_encoding.h"
 
+#include "world/file_output.h"
+
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
@@ -21,32 +23,6 @@ std::string lowerExtension(std::string_view path) {
   return ext;
 }
 
-// Opens `path` for `spec`, writes the pixels with the given strides, and renames into place.
-std::string writeWithOiio(const std::string& path, oiio::ImageSpec spec, oiio::TypeDesc pixel_type,
-                          const void* first_row, std::ptrdiff_t x_stride, std::ptrdiff_t y_stride) {
-  const std::string temporary = path + ".partial" + lowerExtension(path);
-  auto out = oiio::ImageOutput::create(path);
-  if (!out) return "cannot write '" + path + "': " + oiio::geterror();
-  if (!out->open(temporary, spec)) {
-    std::string why = out->geterror();
-    return "cannot open '" + path + "' for writing: " + why;
-  }
-  const bool written = out->write_image(pixel_type, first_row, x_stride, y_stride);
-  const std::string write_error = written ? "" : out->geterror();
-  const bool closed = out->close();
-  if (!written || !closed) {
-    std::remove(temporary.c_str());
-    return "writing '" + path + "' failed: " + (written ? out->geterror() : write_error);
-  }
-  std::error_code ec;
-  std::filesystem::rename(temporary, path, ec);
-  if (ec) {
-    std::remove(temporary.c_str());
-    return "cannot move the image into place at '" + path + "': " + ec.message();
-  }
-  return "";
-}
-
 // Writes one image into `out` through an in-memory proxy.
 std::string encodeWithOiio(const char* extension, const oiio::ImageSpec& spec,
                            oiio::TypeDesc pixel_type, const void* first_row,
@@ -64,6 +40,23 @@ std::string encodeWithOiio(const char* extension, const oiio::ImageSpec& spec,
   if (!writer->close() || !written)
     return "encoding " + name + " failed: " + (written ? writer->geterror() : write_error);
   return "";
+}
+
+// Encodes in memory and writes the file through writeFileAtomically: the codec never touches
+// the disk, so no codec's I/O error handling can end the process or leave a partial file.
+std::string writeWithOiio(const std::string& path, ImageFileFormat format,
+                          const oiio::ImageSpec& spec, oiio::TypeDesc pixel_type,
+                          const void* first_row, std::ptrdiff_t x_stride, std::ptrdiff_t y_stride) {
+  const char* extension = format == ImageFileFormat::kPng    ? ".png"
+                          : format == ImageFileFormat::kJpeg ? ".jpg"
+                          : format == ImageFileFormat::kTiff ? ".tif"
+                                                             : ".exr";
+  std::vector<std::uint8_t> bytes;
+  if (std::string e =
+          encodeWithOiio(extension, spec, pixel_type, first_row, x_stride, y_stride, bytes);
+      !e.empty())
+    return "cannot write '" + path + "': " + e;
+  return writeFileAtomically(path, bytes, "image");
 }
 
 std::vector<std::string> channelNamesFor(bool colour, bool coverage) {
@@ -115,7 +108,8 @@ std::string writeImageFile(const std::string& path, const Srgb8Image& image,
   // GL readback is bottom-up: write it with a negative row stride instead of copying.
   const std::uint8_t* first =
       image.bottom_up ? image.rgba.data() + row * (image.height - 1) : image.rgba.data();
-  return writeWithOiio(path, spec, oiio::TypeDesc::UINT8, first, 4, image.bottom_up ? -row : row);
+  return writeWithOiio(path, *format, spec, oiio::TypeDesc::UINT8, first, 4,
+                       image.bottom_up ? -row : row);
 }
 
 std::string writeImageFile(const std::string& path, const FloatImage& image,
@@ -130,8 +124,8 @@ std::string writeImageFile(const std::string& path, const FloatImage& image,
   spec.attribute("compression", options.exr_compression);
   spec.attribute("oiio:ColorSpace", "Linear");
   const std::ptrdiff_t row = std::ptrdiff_t(image.width) * 4 * sizeof(float);
-  return writeWithOiio(path, spec, oiio::TypeDesc::FLOAT, image.rgba.data(), 4 * sizeof(float),
-                       row);
+  return writeWithOiio(path, *format, spec, oiio::TypeDesc::FLOAT, image.rgba.data(),
+                       4 * sizeof(float), row);
 }
 
 std::string encodeImage(ImageFileFormat format, const Srgb8Image& image, bool colour, bool coverage,

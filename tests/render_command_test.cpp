@@ -16,8 +16,10 @@ struct CommandResult {
   std::string output;
 };
 
-CommandResult runNephele(const std::string& arguments) {
-  const std::string command = std::string(NEPHELE_BINARY) + " " + arguments + " 2>&1";
+// Runs the binary through /bin/sh; `shell_prefix` may set limits first (e.g. "ulimit -f 1;").
+CommandResult runNephele(const std::string& arguments, const std::string& shell_prefix = "") {
+  const std::string command =
+      shell_prefix + " exec " + std::string(NEPHELE_BINARY) + " " + arguments + " 2>&1";
   CommandResult run{-1, ""};
   FILE* pipe = popen(command.c_str(), "r");
   if (!pipe) return run;
@@ -72,6 +74,21 @@ TEST_F(RenderCommandTest, ATargetThePlatformCannotAllocateIsRefused) {
   EXPECT_EQ(run.exit_code, 2) << run.output;
   EXPECT_THAT(run.output, HasSubstr("cannot allocate"));
   EXPECT_FALSE(std::filesystem::exists(path("huge.exr")));
+}
+
+// Issue 12, case 12: a full disk. A file-size limit of 512 bytes (with SIGXFSZ ignored, so
+// that the write fails with EFBIG instead of killing the process) stands in for the full
+// filesystem: every format must fail with exit 1 and a message, leaving no file behind.
+TEST_F(RenderCommandTest, AWriteThatFailsLeavesNoFileAndExitsNonZero) {
+  for (const char* name : {"full.png", "full.jpg", "full.tif", "full.exr"}) {
+    const CommandResult run =
+        runNephele("render " NEPHELE_SOURCE_DIR "/config/scenes/cirrus.toml -o " + path(name) +
+                       " --width 160 --height 120",
+                   "trap '' XFSZ; ulimit -f 1;");
+    EXPECT_EQ(run.exit_code, 1) << name << ": " << run.output;
+    EXPECT_THAT(run.output, HasSubstr("File too large")) << name;
+    EXPECT_TRUE(std::filesystem::is_empty(dir_)) << name << " left a file behind";
+  }
 }
 
 TEST_F(RenderCommandTest, BadSceneFailsWithMessageAndWritesNothing) {

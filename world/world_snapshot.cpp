@@ -15,6 +15,7 @@
 
 #include <xxhash.h>
 
+#include "world/file_output.h"
 #include "world/world.h"
 
 namespace nephele {
@@ -339,18 +340,7 @@ std::string World::restore(std::span<const std::uint8_t> bytes) {
 }
 
 std::string World::saveSnapshot(const std::string& path) const {
-  const std::vector<std::uint8_t> bytes = snapshot();
-  // Write beside the target and rename, so a crash never leaves a half-written snapshot.
-  const std::string temporary = path + ".partial";
-  {
-    std::ofstream file(temporary, std::ios::binary | std::ios::trunc);
-    if (!file) return "snapshot: cannot write " + temporary;
-    file.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
-    if (!file.flush()) return "snapshot: write to " + temporary + " failed";
-  }
-  if (std::rename(temporary.c_str(), path.c_str()) != 0)
-    return "snapshot: cannot rename " + temporary + " to " + path;
-  return {};
+  return writeFileAtomically(path, snapshot(), "snapshot");
 }
 
 std::string World::restoreSnapshot(const std::string& path) {

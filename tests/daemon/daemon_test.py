@@ -37,7 +37,7 @@ class Daemon:
     """A `nephele serve` process with its own config in a temporary directory."""
 
     def __init__(self, workdir, mode="lockstep", extra="", view_size=(64, 48), name="d",
-                 socket_keys="", modbus_keys="", scene=SCENE):
+                 socket_keys="", modbus_keys="", scene=SCENE, frames=None):
         """`extra` is appended to the config ({snapshot} becomes this daemon's snapshot
         path); `socket_keys` and `modbus_keys` go into those tables."""
         self.workdir = workdir
@@ -69,7 +69,7 @@ port = 0
 enabled = true
 port = 0
 [output]
-directory = "{os.path.join(workdir, name + "-frames")}"
+directory = "{frames or os.path.join(workdir, name + "-frames")}"
 {extra.format(snapshot=self.snapshot)}
 ''')
         self.start()
@@ -892,6 +892,48 @@ class AbuseTest(DaemonTest):
         open(snapshot_dir, "w").close()  # a file where the directory should be
         self.assertEqual(d.stop(), 1)
         self.assertIn("event=snapshot_failed", d.log_text())
+
+
+    def test_case12_a_full_disk_fails_the_write_not_the_daemon(self):
+        from pymodbus.client import ModbusTcpClient
+        full = tempfile.mkdtemp(prefix="nephele-full-")
+        self.addCleanup(os.rmdir, full)
+        if subprocess.run(["mount", "-t", "tmpfs", "-o", "size=256k", "tmpfs", full],
+                          capture_output=True).returncode != 0:
+            self.skipTest("cannot mount a small tmpfs here (the render command test injects "
+                          "the failure with a file-size limit instead)")
+        self.addCleanup(subprocess.run, ["umount", "-l", full])
+        frames = os.path.join(full, "frames")
+        # Keys after [output]'s directory stay in that table.
+        d = self.daemon(view_size=(512, 384), frames=frames, extra='format = "jpeg"')
+        os.mkdir(frames)
+        filler = os.open(os.path.join(full, "filler"), os.O_WRONLY | os.O_CREAT)
+        try:  # fill the disk
+            while os.write(filler, b"\0" * 4096):
+                pass
+        except OSError:
+            pass
+        os.close(filler)
+        mb = ModbusTcpClient("127.0.0.1", port=d.modbus_port, timeout=10, retries=0)
+        self.assertTrue(mb.connect())
+        c = d.client()
+        errors = c.ok({"cmd": "stats"})["errors"]
+        self.assertFalse(mb.write_coil(0, True, slave=1).isError())
+        wait_until(lambda: "event=render_trigger_failed" in d.log_text(), "the failure logged")
+        self.assertEqual(os.listdir(frames), [])  # no empty or partial file
+        self.assertGreater(c.ok({"cmd": "stats"})["errors"], errors)
+        # Room again: the next trigger writes a whole JPEG.
+        os.remove(os.path.join(full, "filler"))
+        self.assertFalse(mb.write_coil(0, True, slave=1).isError())
+        wait_until(lambda: os.listdir(frames), "the image")
+        wait_until(lambda: not mb.read_coils(0, 1, slave=1).bits[0], "the coil to clear")
+        names = os.listdir(frames)
+        self.assertEqual(len(names), 1)
+        self.assertTrue(names[0].endswith(".jpg"))
+        with open(os.path.join(frames, names[0]), "rb") as f:
+            data = f.read()
+        self.assertEqual((data[:2], data[-2:]), (b"\xff\xd8", b"\xff\xd9"))  # SOI ... EOI
+        mb.close()
 
 
 if __name__ == "__main__":
