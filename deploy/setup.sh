@@ -11,7 +11,7 @@ packages=(
   libtomlplusplus-dev nlohmann-json3-dev libcli11-dev libspdlog-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libxxhash-dev libasio-dev
-  python3-pymodbus python3-serial-asyncio python3-numpy mbpoll
+  libmodbus-dev python3-pymodbus python3-serial-asyncio python3-numpy mbpoll
 )
 
 missing=()
