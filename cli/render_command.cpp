@@ -35,6 +35,9 @@ std::string applyOverrides(const RenderCommandOptions& o, SceneFile& file) {
   if (o.time && !file.dynamics.automata.empty() && *o.time > Limits::kMaxAutomatonTime)
     return "command line: --time " + std::to_string(*o.time) +
            " is out of range with automaton clouds (allowed: 0 to 86400 s)";
+  if (o.time)
+    if (std::string e = automatonWorkError(file.dynamics.automata, *o.time); !e.empty())
+      return "command line: --time: " + e;
   // The names were checked against the same lists when the flags were parsed.
   if (o.texture)
     file.render.texture_evaluation =

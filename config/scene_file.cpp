@@ -413,6 +413,8 @@ void readScene(const toml::table& root, const std::string& file, SceneFile& out)
     t.failAt("time", formatNumber(scene.time_s) + " is out of range with automaton clouds " +
                          "(allowed: 0 to " + formatNumber(Limits::kMaxAutomatonTime) +
                          " s; every automaton step is simulated)");
+  if (std::string e = automatonWorkError(dynamics.automata, scene.time_s); !e.empty())
+    t.failAt(t.has("time") ? "time" : "automaton", e);
   std::vector<TableReader> targets = t.tables("target");
   for (std::size_t i = 0; i < targets.size(); ++i) {
     Target& target = scene.targets.emplace_back();

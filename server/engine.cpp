@@ -23,8 +23,7 @@ using nlohmann::json;
 using Outcome = std::variant<json, ProtocolError>;
 
 constexpr int kProtocolVersion = 1;
-constexpr int kMaxCatchUpTicks = 100;                   // after a stall, ticks made up in one go
-constexpr double kMaxAutomatonStepsPerRequest = 20000;  // bounds one request's simulation work
+constexpr int kMaxCatchUpTicks = 100;  // after a stall, ticks made up in one go
 constexpr std::size_t kMaxClouds = 4096;
 constexpr std::size_t kRenderHistory = 1024;  // renders kept for p50/p99
 constexpr std::size_t kEncoderQueue = 16;
@@ -470,16 +469,8 @@ std::optional<ProtocolError> Engine::checkAdvance(double dt_s) const {
   // error reply and changes nothing.
   if (std::string e = state_->world->advanceError(dt_s); !e.empty())
     return ProtocolError{ErrorCode::kLimit, e};
-  double steps = 0.0;
-  for (const AutomatonCloudSpec& a : state_->world->dynamics().automata)
-    steps += dt_s / a.step_interval_s;
-  if (steps > kMaxAutomatonStepsPerRequest) {
-    std::ostringstream m;
-    m << "dt: " << dt_s << " s would run " << std::llround(steps)
-      << " automaton steps (allowed: at most " << kMaxAutomatonStepsPerRequest
-      << " per request; advance in smaller pieces)";
-    return ProtocolError{ErrorCode::kLimit, m.str()};
-  }
+  if (std::string e = automatonAdvanceError(state_->world->dynamics().automata, dt_s); !e.empty())
+    return ProtocolError{ErrorCode::kLimit, e};
   return std::nullopt;
 }
 

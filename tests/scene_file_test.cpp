@@ -356,6 +356,23 @@ volume_step = 2.0
   EXPECT_EQ(f.render.volume_step, 2.0);
 }
 
+// Issue 12, case 3: automaton work and memory are bounded before anything is built.
+TEST(SceneFile, AutomatonWorkBeyondItsBoundsIsRefusedUpFront) {
+  // 2^24 cells: 1.3e8 lattice points at two samples per cell, 16 times the bound.
+  EXPECT_THAT(parseError("time = 60.0\n[[automaton]]\ncells = [256, 256, 256]\n"),
+              HasSubstr("density lattice points"));
+  // A step every millisecond for a day: 8.6e7 steps.
+  EXPECT_THAT(parseError("time = 86400.0\n[[automaton]]\nstep_interval = 0.001\n"),
+              HasSubstr("steps (allowed: at most 1e+07"));
+  // Many cells for many steps: 128 x 128 x 64 cells at one sample for 86400 / 0.5 steps.
+  EXPECT_THAT(parseError("time = 86400.0\n[[automaton]]\ncells = [128, 128, 64]\n"
+                         "samples_per_cell = 1\nstep_interval = 0.5\n"),
+              HasSubstr("cell-steps"));
+  // Within the bounds: the 20^3 preset's cloud for a whole day (3.5e8 cell-steps).
+  SceneFile f;
+  EXPECT_EQ(parseError("time = 86400.0\n[[automaton]]\n", f), "");
+}
+
 TEST(SceneFile, BadWindDevelopmentAndAutomataAreRejected) {
   EXPECT_THAT(parseError("[[automaton]]\ncells = [0, 5, 5]\n"),
               HasSubstr("automaton[0].cells: 0 is out of range (allowed: 1 to 1024)"));

@@ -54,6 +54,17 @@ struct Limits {
   static constexpr int kMaxAutomata = 256;
   static constexpr int kMaxCellsPerAxis = 1024;
   static constexpr long long kMaxCells = 1LL << 24;
+  // Work and memory, summed over a scene's automata and checked before any is built
+  // (automatonWorkError; docs/RELIABILITY.md). Lattice points (cells x samples_per_cell^3)
+  // dominate memory and start-up time: 2^24 of them measured 1.1 GB and 37 s on the machines
+  // of ../shared/PLATFORM.md, so the bound is half that. A step costs about 1 us plus 6 ns
+  // per cell.
+  static constexpr long long kMaxLatticePoints = 1LL << 23;
+  static constexpr double kMaxAutomatonSteps = 1.0e7;  // warm-up and steps to the time
+  static constexpr double kMaxCellSteps = 4.0e9;       // cells x steps, ~25 s
+  // One daemon request (tick, set_time advance) runs at most this much automaton work.
+  static constexpr double kMaxStepsPerAdvance = 2.0e4;
+  static constexpr double kMaxCellStepsPerAdvance = 5.0e8;
   static constexpr Range kCellSize{0.01, 1.0e4};
   static constexpr Range kStepInterval{1.0e-3, 3600.0};
   static constexpr int kMaxWarmupSteps = 100000;

@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <sstream>
 
 #include "world/check.h"
+#include "world/limits.h"
 
 namespace nephele {
 namespace {
@@ -76,6 +78,56 @@ double AutomatonCloudView::exactDensity(glm::dvec3 world) const {
 double AutomatonCloudView::phaseValue(double cos_theta) const {
   return phase == PhaseFunction::kRayleigh ? rayleighPhase(cos_theta)
                                            : cornetteShanksPhase(cos_theta, phase_g);
+}
+
+namespace {
+
+std::string formatCount(double x) {
+  std::ostringstream out;
+  out << std::setprecision(3) << x;
+  return out.str();
+}
+
+}  // namespace
+
+std::string automatonWorkError(const std::vector<AutomatonCloudSpec>& automata, double time_s) {
+  double points = 0.0, cell_steps = 0.0;
+  for (const AutomatonCloudSpec& a : automata) {
+    const double cells = double(a.cells.cells());
+    points += cells * std::pow(double(a.samples_per_cell), 3.0);
+    const double steps = a.warmup_steps + std::floor(std::max(time_s, 0.0) / a.step_interval_s) + 1;
+    if (steps > Limits::kMaxAutomatonSteps)
+      return "automaton " + a.name + ": reaching time " + formatCount(time_s) + " s takes " +
+             formatCount(steps) + " steps (allowed: at most " +
+             formatCount(Limits::kMaxAutomatonSteps) + "; lengthen step_interval or start earlier)";
+    cell_steps += cells * steps;
+  }
+  if (points > double(Limits::kMaxLatticePoints))
+    return "automata: " + formatCount(points) +
+           " density lattice points (cells x samples_per_cell^3, summed) (allowed: at most " +
+           formatCount(double(Limits::kMaxLatticePoints)) +
+           "; use fewer or larger cells or fewer samples per cell)";
+  if (cell_steps > Limits::kMaxCellSteps)
+    return "automata: reaching time " + formatCount(time_s) + " s takes " +
+           formatCount(cell_steps) + " cell-steps (cells x steps, summed) (allowed: at most " +
+           formatCount(Limits::kMaxCellSteps) + ")";
+  return "";
+}
+
+std::string automatonAdvanceError(const std::vector<AutomatonCloudSpec>& automata, double dt_s) {
+  double steps = 0.0, cell_steps = 0.0;
+  for (const AutomatonCloudSpec& a : automata) {
+    const double n = std::ceil(dt_s / a.step_interval_s);
+    steps += n;
+    cell_steps += n * double(a.cells.cells());
+  }
+  if (steps > Limits::kMaxStepsPerAdvance || cell_steps > Limits::kMaxCellStepsPerAdvance)
+    return "dt: " + formatCount(dt_s) + " s would run " + formatCount(steps) +
+           " automaton steps over " + formatCount(cell_steps) +
+           " cells (allowed per request: at most " + formatCount(Limits::kMaxStepsPerAdvance) +
+           " steps and " + formatCount(Limits::kMaxCellStepsPerAdvance) +
+           " cell-steps; advance in smaller pieces)";
+  return "";
 }
 
 AutomatonCloud::AutomatonCloud(const AutomatonCloudSpec& spec, const WindProfile& wind,

@@ -50,6 +50,12 @@ struct AutomatonCloudSpec {
 // Empty when usable, else what is wrong and what is allowed.
 std::string automatonCloudError(const AutomatonCloudSpec& spec);
 
+// Empty when building `automata` and running them to `time_s` stays within the work and
+// memory bounds of world/limits.h, else which bound is passed and by how much.
+std::string automatonWorkError(const std::vector<AutomatonCloudSpec>& automata, double time_s);
+// The same for one advance of `dt_s` by the daemon.
+std::string automatonAdvanceError(const std::vector<AutomatonCloudSpec>& automata, double dt_s);
+
 // What a render needs of one automaton state.
 struct AutomatonKeyframe {
   std::uint64_t step = 0;
