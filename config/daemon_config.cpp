@@ -25,7 +25,7 @@ void readView(TableReader& t, const Camera& scene_camera, ViewConfig& view) {
   t.allow({"name", "position", "heading", "pitch", "roll", "vfov", "width", "height", "format",
            "coverage"});
   view.camera = scene_camera;
-  t.string("name", view.name);
+  t.name("name", view.name);
   Camera& c = view.camera;
   config_detail::readCameraKeys(t, c);
   t.integer("width", c.width, 1, Limits::kMaxImageSide);

@@ -185,7 +185,7 @@ void readShading(TableReader& t, ShadingParams& shading) {
 void readLayer(TableReader& t, CloudLayer& layer, LayerDevelopment& develop) {
   t.allow({"name", "altitude", "colour", "threshold", "transition", "ambient", "texture_fraction",
            "specular", "shininess", "drift", "seed", "texture", "develop"});
-  t.string("name", layer.name);
+  t.name("name", layer.name);
   t.number("altitude", layer.altitude_m, 0.0, Limits::kMaxAltitude);
   t.vector("colour", layer.colour, Limits::kColour);
   t.number("threshold", layer.threshold, Limits::kLayerThreshold);
@@ -261,7 +261,7 @@ void readCloud(TableReader& t, std::uint64_t seed, EllipsoidCloud& cloud,
   t.allow({"name", "colour", "threshold", "limb_threshold", "transition", "ambient",
            "texture_fraction", "specular", "shininess", "seed", "texture", "cumulus", "ellipsoid",
            "develop"});
-  t.string("name", cloud.name);
+  t.name("name", cloud.name);
   t.vector("colour", cloud.colour, Limits::kColour);
   t.number("threshold", cloud.threshold_centre, Limits::kCloudThreshold);
   t.number("limb_threshold", cloud.threshold_limb, Limits::kCloudThreshold);
@@ -299,7 +299,7 @@ void readAutomaton(TableReader& t, std::uint64_t seed, AutomatonCloudSpec& a) {
   t.allow({"name", "cells", "cell_size", "position", "seed", "step_interval", "warmup_steps",
            "humidity", "activation", "extinction", "colour", "ambient", "phase", "phase_u",
            "samples_per_cell", "shape", "develop"});
-  t.string("name", a.name);
+  t.name("name", a.name);
   int cells[3] = {a.cells.nx, a.cells.ny, a.cells.nz};
   t.integers3("cells", cells, 1, Limits::kMaxCellsPerAxis);
   a.cells = {cells[0], cells[1], cells[2]};
@@ -334,7 +334,7 @@ void readAutomaton(TableReader& t, std::uint64_t seed, AutomatonCloudSpec& a) {
 
 void readTarget(TableReader& t, const std::string& scene_path, Target& target) {
   t.allow({"name", "shape", "centre", "heading", "pitch", "roll", "size", "colour", "mesh"});
-  t.string("name", target.name);
+  t.name("name", target.name);
   target.shape = TargetShape(t.choice("shape", {"box", "ellipsoid", "mesh"}, int(target.shape)));
   t.vector("centre", target.centre, -Limits::kMaxCoordinate, Limits::kMaxCoordinate);
   readOrientation(t, target.orientation);

@@ -100,6 +100,16 @@ class TableReader {
     out = node->value<std::string>().value();
   }
 
+  // A name, by the one name rule (world/limits.h).
+  void name(std::string_view key, std::string& out) {
+    const toml::node* node = take(key);
+    if (!node) return;
+    if (!node->is_string()) fail(*node, key, "must be a string of " + std::string(kNameRule));
+    std::string value = node->value<std::string>().value();
+    if (std::string e = nameError(value); !e.empty()) fail(*node, key, e);
+    out = std::move(value);
+  }
+
   template <int N>
   void vector(std::string_view key, glm::vec<N, double>& out, Range range) {
     vector(key, out, range.lo, range.hi);

@@ -33,11 +33,16 @@ std::string encodeWithOiio(const char* extension, const oiio::ImageSpec& spec,
   const std::string name = std::string("frame") + extension;
   auto writer = oiio::ImageOutput::create(name);
   if (!writer) return "no encoder for " + name + ": " + oiio::geterror();
-  if (!writer->set_ioproxy(&proxy) || !writer->open(name, spec))
+  oiio::ImageSpec file_spec = spec;
+  // OpenImageIO 2.4's TIFF writer cannot put its Exif directory through an I/O proxy (the
+  // file comes out truncated); the image needs none.
+  file_spec.attribute("tiff:write_exif", 0);
+  if (!writer->set_ioproxy(&proxy) || !writer->open(name, file_spec))
     return "cannot encode " + name + ": " + writer->geterror();
   const bool written = writer->write_image(pixel_type, first_row, x_stride, y_stride);
   const std::string write_error = written ? "" : writer->geterror();
-  if (!writer->close() || !written)
+  // Some writers report a failure only through their error text.
+  if (!writer->close() || !written || writer->has_error())
     return "encoding " + name + " failed: " + (written ? writer->geterror() : write_error);
   return "";
 }

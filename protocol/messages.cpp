@@ -72,19 +72,13 @@ class FieldReader {
     return v->get<bool>();
   }
 
-  // A name: 1 to kMaxNameLength characters of letters, digits, '_', '-', '.', '/'.
+  // A name, by the one name rule (world/limits.h).
   std::optional<std::string> name(const char* key) {
     const json* v = take(key);
     if (!v) return std::nullopt;
-    const char* allowed =
-        "a string of 1 to 64 letters, digits, '_', '-', '.' or '/', not starting with '.'";
-    if (!v->is_string()) fail(key, std::string("must be ") + allowed);
+    if (!v->is_string()) fail(key, "must be a string of " + std::string(kNameRule));
     const std::string s = v->get<std::string>();
-    bool ok = !s.empty() && s.size() <= ProtocolLimits::kMaxNameLength && s[0] != '.';
-    for (char c : s)
-      ok = ok && (std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.' ||
-                  c == '/');
-    if (!ok) fail(key, std::string("is not allowed (allowed: ") + allowed + ")");
+    if (std::string e = nameError(s); !e.empty()) fail(key, e);
     return s;
   }
 
@@ -321,7 +315,6 @@ Command readCommand(const std::string& cmd, FieldReader& r) {
   }
   if (cmd == "snapshot" || cmd == "restore") {
     const std::string name = r.requiredName("name");
-    if (name.find('/') != std::string::npos) r.fail("name", "must not contain '/'");
     r.finish("cmd, id, name");
     if (cmd == "snapshot") return Snapshot{name};
     return Restore{name};

@@ -18,7 +18,6 @@ namespace nephele {
 struct ProtocolLimits {
   static constexpr std::size_t kMaxRequestBytes = 64 * 1024;  // one request line, newline included
   static constexpr int kMaxJsonDepth = 16;                    // nesting of arrays and objects
-  static constexpr std::size_t kMaxNameLength = 64;           // view, cloud and snapshot names
   static constexpr double kMaxSubscriptionHz = 60.0;
   static constexpr double kMaxTimeScale = 1000.0;
   static constexpr int kWeatherLayers = 3;  // CIGI cloud layers 1 to 3

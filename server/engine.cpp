@@ -13,6 +13,7 @@
 #include "renderer/gl/gl_platform.h"
 #include "renderer/gl/gl_renderer.h"
 #include "world/counter_random.h"
+#include "world/limits.h"
 #include "world/world.h"
 
 namespace nephele {
@@ -645,8 +646,10 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
   }
   if (const auto* c = std::get_if<AddCloud>(&command)) {
     const auto name = c->cloud.find("name");
-    if (name == c->cloud.end() || !name->is_string() || name->get<std::string>().empty())
+    if (name == c->cloud.end() || !name->is_string())
       return badField("cloud.name: is missing (a unique name, to change or remove the cloud by)");
+    if (std::string e = nameError(name->get<std::string>()); !e.empty())
+      return badField("cloud.name: " + e);
     EllipsoidCloud cloud;
     const std::string cloud_name = name->get<std::string>();
     if (std::string e = parseCloudJson(
@@ -818,7 +821,9 @@ void Engine::renderFrame(const ViewConfig& view, bool linear, Frame& frame) {
 
 std::optional<ProtocolError> Engine::setWeather(int layer, const WeatherLayer& weather) {
   State& s = *state_;
-  const std::string prefix = "weather" + std::to_string(layer);
+  // The daemon's own names hold a '/', which no user name may (world/limits.h): set_weather
+  // replaces exactly what it made before.
+  const std::string prefix = "weather/" + std::to_string(layer);
   const ViewConfig& anchor = *s.view(config_.modbus_view);
   const WeatherClouds add = weatherClouds(
       weather, prefix, glm::dvec2(anchor.camera.position),

@@ -3,6 +3,9 @@
 // the Modbus register map and the World all read their edges from here, so that a value one
 // of them accepts is never refused by another (docs/ACCURACY.md lists how each edge is
 // tested).
+#include <string>
+#include <string_view>
+
 namespace nephele {
 
 // A closed interval [lo, hi].
@@ -69,6 +72,28 @@ struct Limits {
   static constexpr Range kStepInterval{1.0e-3, 3600.0};
   static constexpr int kMaxWarmupSteps = 100000;
   static constexpr int kMaxSamplesPerCell = 8;
+
+  // Names of views, clouds, layers, automata, targets and snapshots.
+  static constexpr std::size_t kMaxNameLength = 64;
 };
+
+// The one name rule, for every name a user gives (scene files, daemon configs, requests):
+// 1 to 64 ASCII letters, digits, '_', '-' or '.', not starting with '.'. A name is thus
+// also a safe file name. '/' is kept for names the daemon makes itself (a weather layer's
+// clouds are "weather/1/heap3"), so no user name can collide with them.
+inline constexpr std::string_view kNameRule =
+    "1 to 64 ASCII letters, digits, '_', '-' or '.', not starting with '.'";
+inline std::string nameError(std::string_view name) {
+  bool ok = !name.empty() && name.size() <= Limits::kMaxNameLength && name[0] != '.';
+  for (char c : name)
+    ok = ok && ((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                c == '_' || c == '-' || c == '.');
+  if (ok) return {};
+  std::string shown;
+  for (char c : name.substr(0, 80))
+    shown += (c >= 0x20 && c < 0x7f && c != '"' && c != '\\') ? std::string(1, c) : "?";
+  return "\"" + shown + (name.size() > 80 ? "...\"" : "\"") +
+         " is not a name (allowed: " + std::string(kNameRule) + ")";
+}
 
 }  // namespace nephele

@@ -936,5 +936,33 @@ class AbuseTest(DaemonTest):
         mb.close()
 
 
+    def test_case13_one_name_rule_and_weather_in_its_own_namespace(self):
+        d = self.daemon()
+        c = d.client()
+        before = c.ok({"cmd": "hash"})["hash"]
+        cumulus = {"base": [0, 0, 900], "width": 500}
+        bad = ["two words", "line\nbreak", "x" * 1000, "h\u00e9llo", "weather/1/heap0",
+               ".hidden", "", "a/b"]
+        for name in bad:
+            with self.subTest(name=name[:20]):
+                error = c.error({"cmd": "add_cloud", "cloud": {"name": name, "cumulus": cumulus}})
+                self.assertEqual(error["code"], "bad_field")
+                self.assertIn("is not a name", error["message"])
+                for cmd in ({"cmd": "remove_cloud", "name": name},
+                            {"cmd": "get_view", "view": name},
+                            {"cmd": "snapshot", "name": name}):
+                    self.assertEqual(c.error(cmd)["code"], "bad_field", cmd)
+        self.assertEqual(c.ok({"cmd": "hash"})["hash"], before)
+        # A user's cloud whose name resembles the weather's survives set_weather, and what is
+        # added can be removed.
+        for name in ("weather1", "weather-1", "weather.1"):
+            c.ok({"cmd": "add_cloud", "cloud": {"name": name, "cumulus": cumulus}})
+        c.ok({"cmd": "set_weather", "layer": 1, "type": 7, "base": 1200, "thickness": 800,
+              "coverage": 30})
+        c.ok({"cmd": "set_weather", "layer": 1, "type": 0})
+        for name in ("weather1", "weather-1", "weather.1"):
+            c.ok({"cmd": "remove_cloud", "name": name})
+
+
 if __name__ == "__main__":
     unittest.main()
