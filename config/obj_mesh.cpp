@@ -1,5 +1,7 @@
 #include "config/obj_mesh.h"
 
+#include "config/table_reader.h"
+
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -63,11 +65,9 @@ std::string parseObjText(const std::string& text, const std::string& source_name
 }
 
 std::string loadObjMesh(const std::string& path, TriangleMesh& out) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return "cannot read mesh file '" + path + "': " + std::strerror(errno);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parseObjText(text.str(), path, out);
+  std::string text;
+  if (std::string e = config_detail::readTextFile(path, "mesh file", text); !e.empty()) return e;
+  return parseObjText(text, path, out);
 }
 
 }  // namespace nephele

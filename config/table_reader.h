@@ -3,6 +3,10 @@
 // Every error names the file, the line, the key and what is allowed.
 #include <toml++/toml.h>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <cerrno>
 #include <cmath>
 #include <cstdint>
@@ -252,14 +256,97 @@ class TableReader {
 };
 
 // Reads a whole file into `text`; on failure returns "cannot read WHAT 'path': reason".
+// TOML (1.0) allows characters beyond ASCII only inside strings and comments. toml++ 3.3,
+// the version Debian 12 ships, reaches a __builtin_unreachable (undefined behaviour) when
+// classifying some of them elsewhere, so such text is refused here, before it is parsed.
+// Returns "" or "LINE: what is wrong".
+inline std::string tomlAsciiError(std::string_view text) {
+  enum class In { kCode, kComment, kBasic, kLiteral, kMultiBasic, kMultiLiteral } in = In::kCode;
+  int line = 1;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    const std::string_view rest = text.substr(i);
+    if (c == '\n') {
+      ++line;
+      if (in == In::kComment || in == In::kBasic || in == In::kLiteral) in = In::kCode;
+      continue;
+    }
+    switch (in) {
+      case In::kCode:
+        if (static_cast<unsigned char>(c) >= 0x80)
+          return std::to_string(line) +
+                 ": a character beyond ASCII outside a string or comment (allowed there: "
+                 "ASCII only)";
+        if (c == '#') in = In::kComment;
+        if (rest.starts_with("\"\"\"")) {
+          in = In::kMultiBasic;
+          i += 2;
+        } else if (rest.starts_with("'''")) {
+          in = In::kMultiLiteral;
+          i += 2;
+        } else if (c == '"') {
+          in = In::kBasic;
+        } else if (c == '\'') {
+          in = In::kLiteral;
+        }
+        break;
+      case In::kComment:
+        break;
+      case In::kBasic:
+        if (c == '\\')
+          ++i;
+        else if (c == '"')
+          in = In::kCode;
+        break;
+      case In::kLiteral:
+        if (c == '\'') in = In::kCode;
+        break;
+      case In::kMultiBasic:
+        if (c == '\\')
+          ++i;
+        else if (rest.starts_with("\"\"\""))
+          in = In::kCode, i += 2;
+        break;
+      case In::kMultiLiteral:
+        if (rest.starts_with("'''")) in = In::kCode, i += 2;
+        break;
+    }
+  }
+  return "";
+}
+
+// Reads a whole text file: only a regular file (a directory, FIFO or device is refused,
+// never waited on) of at most Limits::kMaxTextFileBytes.
 inline std::string readTextFile(const std::string& path, const char* what, std::string& text) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return std::string("cannot read ") + what + " '" + path + "': " + std::strerror(errno);
-  std::ostringstream contents;
-  contents << in.rdbuf();
-  if (in.bad())
-    return std::string("cannot read ") + what + " '" + path + "': " + std::strerror(errno);
-  text = contents.str();
+  auto failure = [&](const std::string& why) {
+    return std::string("cannot read ") + what + " '" + path + "': " + why;
+  };
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) return failure(std::strerror(errno));
+  struct stat st {};
+  std::string error;
+  if (::fstat(fd, &st) != 0)
+    error = std::strerror(errno);
+  else if (!S_ISREG(st.st_mode))
+    error = "not a regular file";
+  else if (std::uint64_t(st.st_size) > Limits::kMaxTextFileBytes)
+    error = std::to_string(st.st_size) + " bytes (allowed: at most " +
+            std::to_string(Limits::kMaxTextFileBytes) + ")";
+  std::string contents;
+  if (error.empty()) {
+    contents.resize(std::size_t(st.st_size));
+    std::size_t got = 0;
+    while (got < contents.size()) {
+      const ssize_t n = ::read(fd, contents.data() + got, contents.size() - got);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) break;
+      got += std::size_t(n);
+    }
+    if (got != contents.size()) error = "the file changed size while it was read";
+  }
+  ::close(fd);
+  if (!error.empty()) return failure(error);
+  text = std::move(contents);
   return "";
 }
 

@@ -222,8 +222,9 @@ class Connection : public std::enable_shared_from_this<Connection> {
       }
     }
     // A request begun and not finished is held to the request timeout from its first byte
-    // (or from when the previous one was taken).
-    if (in_.empty() && !discarding_)
+    // (or from when the previous one was taken), but only while the daemon waits for it:
+    // not while reading is paused on the daemon's side.
+    if ((in_.empty() && !discarding_) || paused())
       line_started_.reset();
     else if (!line_started_)
       line_started_ = Clock::now();

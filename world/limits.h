@@ -73,6 +73,9 @@ struct Limits {
   static constexpr int kMaxWarmupSteps = 100000;
   static constexpr int kMaxSamplesPerCell = 8;
 
+  // A scene file, daemon config or mesh read whole.
+  static constexpr unsigned long long kMaxTextFileBytes = 64ull << 20;
+
   // Names of views, clouds, layers, automata, targets and snapshots.
   static constexpr std::size_t kMaxNameLength = 64;
 };

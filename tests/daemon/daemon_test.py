@@ -818,12 +818,14 @@ class AbuseTest(DaemonTest):
         mb = ModbusTcpClient("127.0.0.1", port=d.modbus_port, timeout=10, retries=0)
         self.assertTrue(mb.connect())
         # Twelve 16 MiB renders keep the world thread busy for seconds.
-        ids = [c.send({"cmd": "render", "view": "front", "channels": ["colour"]})
-               for _ in range(12)]
+        c.sock.sendall(b"".join(
+            (json.dumps({"id": i, "cmd": "render", "view": "front", "channels": ["colour"]})
+             + "\n").encode() for i in range(12)))
+        c.read()  # the first is done, so the other eleven are queued ahead of the write
         r = mb.write_registers(6, floats(123.0), slave=1)
         self.assertTrue(r.isError())
         self.assertEqual(r.exception_code, 6)
-        for _ in ids:
+        for _ in range(11):
             c.read()
         self.assertEqual(c.ok({"cmd": "get_view", "view": "front"})["heading"], heading)
         # An accepted write is answered once applied.
@@ -962,6 +964,96 @@ class AbuseTest(DaemonTest):
         c.ok({"cmd": "set_weather", "layer": 1, "type": 0})
         for name in ("weather1", "weather-1", "weather.1"):
             c.ok({"cmd": "remove_cloud", "name": name})
+
+
+    def test_live_fuzz_of_every_command_leaves_the_daemon_answering(self):
+        """Random mixes of valid and broken requests of every command over three connections,
+        restore of directories, FIFOs and sparse files included. NEPHELE_LIVE_FUZZ sets the
+        number of requests (default 1500, a few seconds)."""
+        import random
+        total = int(os.environ.get("NEPHELE_LIVE_FUZZ", "1500"))
+        d = self.daemon(socket_keys="max_pending_mb = 4", extra="[snapshot]\n"
+                        "path = \"{snapshot}\"\ninterval = 0\n")
+        snaps = os.path.dirname(d.snapshot)
+        os.makedirs(snaps, exist_ok=True)
+        os.mkdir(os.path.join(snaps, "dir.snap"))
+        os.mkfifo(os.path.join(snaps, "fifo.snap"))
+        with open(os.path.join(snaps, "sparse.snap"), "wb") as f:
+            f.truncate(1 << 30)
+        with open(os.path.join(snaps, "junk.snap"), "wb") as f:
+            f.write(b"NEPHSNAP" + bytes(range(256)) * 4)
+        rng = random.Random(12)
+        names = ["a", "b", "dir", "fifo", "sparse", "junk", "x" * 70, "a b", "../etc"]
+        values = [0, -1, 1e308, -1e308, 0.5, 12, 1e7, 3600.1, "x", None, True, [], {}, [1, 2, 3]]
+
+        def value():
+            return rng.choice(values + [rng.uniform(-1e4, 1e4), rng.randint(-5, 70000)])
+
+        def request():
+            cmd = rng.choice(["hello", "get_view", "set_view", "set_weather", "set_wind",
+                              "set_sun", "set_time", "add_cloud", "change_cloud",
+                              "remove_cloud", "tick", "render", "subscribe", "unsubscribe",
+                              "snapshot", "restore", "stats", "hash", "nonsense"])
+            r = {"cmd": cmd}
+            keys = {"get_view": ["view"], "set_view": ["view", "heading", "width", "height",
+                                                         "vfov", "position", "format"],
+                    "set_weather": ["layer", "type", "base", "thickness", "coverage", "wind"],
+                    "set_wind": ["velocity"], "set_sun": ["azimuth", "elevation"],
+                    "set_time": ["advance", "paused", "time_scale"],
+                    "change_cloud": ["name", "move", "threshold"], "remove_cloud": ["name"],
+                    "tick": ["dt"], "render": ["view", "format", "channels"],
+                    "subscribe": ["view", "rate"], "unsubscribe": ["subscription"],
+                    "snapshot": ["name"], "restore": ["name"]}.get(cmd, [])
+            for k in keys:
+                if rng.random() < 0.8:
+                    r[k] = value()
+            # Mostly sensible values, so that valid requests run too.
+            if "view" in r and rng.random() < 0.7:
+                r["view"] = rng.choice(["front", "left"])
+            if "name" in r and rng.random() < 0.8:
+                r["name"] = rng.choice(names)
+            if "layer" in r and rng.random() < 0.7:
+                r.update(layer=rng.randint(1, 3), type=rng.randint(0, 10), base=1500,
+                         thickness=500, coverage=rng.uniform(0, 100))
+            if "dt" in r and rng.random() < 0.7:
+                r["dt"] = rng.uniform(0, 2)
+            if cmd == "add_cloud":
+                r["cloud"] = {"name": rng.choice(names),
+                              "cumulus": {"base": [0, 0, 900], "width": rng.uniform(-10, 900)}}
+            if cmd == "set_view":
+                r.update(width=rng.randint(1, 96), height=rng.randint(1, 96))
+            if cmd == "subscribe":
+                r["rate"] = rng.choice([0.5, 60, 0, -1, "x"])
+            line = json.dumps(r)
+            if rng.random() < 0.1:  # broken bytes: truncation, garbage, BOM, NUL
+                line = rng.choice([line[:rng.randint(0, len(line))], "\ufeff" + line,
+                                   line + "\0", line + "}", "{" * 40, "[]"])
+            return line.encode("utf-8", "replace") + b"\n"
+
+        conns = [d.client() for _ in range(3)]
+        for c in conns:
+            c.sock.settimeout(TIMEOUT)
+        sent = 0
+        while sent < total:
+            for c in conns:
+                batch = b"".join(request() for _ in range(10))
+                c.sock.sendall(batch)
+                sent += 10
+            # Drain what has come back so far without waiting for every reply.
+            for c in conns:
+                c.sock.setblocking(False)
+                try:
+                    while c.sock.recv(1 << 20):
+                        pass
+                except (BlockingIOError, ConnectionResetError):
+                    pass
+                c.sock.setblocking(True)
+                c.sock.settimeout(TIMEOUT)
+        self.assertIsNone(d.proc.poll(), "the daemon died")
+        fresh = d.client()
+        fresh.ok({"cmd": "hello"})
+        fresh.ok({"cmd": "hash"})
+        self.assertEqual(d.stop(), 0, d.log_text()[-2000:])
 
 
 if __name__ == "__main__":

@@ -1,12 +1,13 @@
 // libFuzzer target for the bytes the daemon takes from the network: socket-protocol request
-// lines and Modbus register and coil writes. Built with clang by tests/CMakeLists.txt and
-// run briefly by ctest. The first input byte picks the decoder.
+// lines, Modbus TCP frames and Modbus register and coil writes. Built with clang by
+// tests/CMakeLists.txt and run briefly by ctest. The first input byte picks the decoder.
 #include <cstddef>
 #include <cstdint>
 #include <string_view>
 #include <vector>
 
 #include "protocol/messages.h"
+#include "protocol/modbus_frame.h"
 #include "protocol/register_map.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -14,6 +15,38 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (size < 1) return 0;
   const std::uint8_t selector = data[0];
   ++data, --size;
+  if (selector % 4 == 3) {
+    // A stream of Modbus TCP frames, framed the way the server frames them.
+    while (size >= ModbusFrame::kHeaderBytes) {
+      auto header = decodeMbapHeader(std::span<const std::uint8_t, ModbusFrame::kHeaderBytes>(
+          data, ModbusFrame::kHeaderBytes));
+      if (std::holds_alternative<std::string>(header)) return 0;  // the server closes
+      const MbapHeader& h = std::get<MbapHeader>(header);
+      if (size < ModbusFrame::kHeaderBytes + h.pduBytes()) return 0;
+      const auto request =
+          decodeModbusPdu(h, std::span(data + ModbusFrame::kHeaderBytes, h.pduBytes()));
+      std::vector<std::uint8_t> reply;
+      if (const auto* r = std::get_if<ModbusRequest>(&request)) {
+        const std::vector<std::uint16_t> registers(std::size_t(r->count), 0x1234);
+        const std::vector<std::uint8_t> bits(std::size_t(r->count), 1);
+        reply = r->function == ModbusFunction::kReadHoldingRegisters ||
+                        r->function == ModbusFunction::kReadInputRegisters
+                    ? encodeReadRegisters(*r, registers)
+                : r->function == ModbusFunction::kReadCoils ||
+                        r->function == ModbusFunction::kReadDiscreteInputs
+                    ? encodeReadBits(*r, bits)
+                    : encodeWriteReply(*r);
+      } else {
+        reply = encodeModbusException(h, std::get<ModbusException>(request));
+      }
+      // Every reply is one well-formed ADU no longer than the protocol allows.
+      if (reply.size() < ModbusFrame::kHeaderBytes + 2 || reply.size() > ModbusFrame::kMaxAduBytes)
+        __builtin_trap();
+      data += ModbusFrame::kHeaderBytes + h.pduBytes();
+      size -= ModbusFrame::kHeaderBytes + h.pduBytes();
+    }
+    return 0;
+  }
   if (selector % 3 == 0) {
     const auto result = parseRequest(std::string_view(reinterpret_cast<const char*>(data), size));
     // Every outcome must turn into a reply line.
