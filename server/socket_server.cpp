@@ -21,6 +21,7 @@ constexpr int kMaxRefusing = 64;  // over-limit connections being answered at on
 constexpr auto kRefusalWait = std::chrono::seconds(2);     // for an over-limit client's request
 constexpr auto kShutdownDrain = std::chrono::seconds(10);  // to finish writing at shutdown
 constexpr auto kSweepPeriod = std::chrono::milliseconds(250);
+constexpr std::size_t kMaxMetricsConnections = 16;
 
 Clock::duration seconds(double s) {
   return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
@@ -502,30 +503,54 @@ std::string MetricsServer::listen(const ListenConfig& where) {
   return "";
 }
 
+// One scrape: a request, a response, then the connection closes.
+struct MetricsExchange {
+  explicit MetricsExchange(tcp::socket s) : socket(std::move(s)), timer(socket.get_executor()) {}
+  void close() {
+    std::error_code ignored;
+    timer.cancel();
+    socket.close(ignored);
+  }
+  tcp::socket socket;
+  asio::steady_timer timer;
+  asio::streambuf request{8192};
+  std::string response;
+};
+
 void MetricsServer::accept() {
   acceptor_.async_accept([this](std::error_code ec, tcp::socket socket) {
     if (ec == asio::error::operation_aborted) return;
-    if (!ec) {
-      auto s = std::make_shared<tcp::socket>(std::move(socket));
-      auto request = std::make_shared<asio::streambuf>(8192);
+    std::erase_if(open_, [](const auto& weak) { return weak.expired(); });
+    if (!ec && open_.size() >= kMaxMetricsConnections) {
+      std::error_code ignored;
+      socket.close(ignored);  // a scraper needs one at a time; more are not scrapers
+    } else if (!ec) {
+      // One exchange per connection, the whole of it within the socket request timeout.
+      auto x = std::make_shared<MetricsExchange>(std::move(socket));
+      open_.push_back(x);
+      x->timer.expires_after(seconds(engine_.config().socket_timeouts.request_s));
+      x->timer.async_wait([x](std::error_code ec) {
+        std::error_code ignored;
+        if (!ec) x->socket.close(ignored);
+      });
       asio::async_read_until(
-          *s, *request, "\r\n\r\n", [this, s, request](std::error_code ec, std::size_t) {
-            if (ec) return;
+          x->socket, x->request, "\r\n\r\n", [this, x](std::error_code ec, std::size_t) {
+            if (ec) {
+              x->close();
+              return;
+            }
             std::string first_line;
-            std::istream in(request.get());
+            std::istream in(&x->request);
             std::getline(in, first_line);
             const bool metrics = first_line.rfind("GET /metrics ", 0) == 0;
             const std::string body = metrics ? engine_.prometheusText() : "not found\n";
-            auto response = std::make_shared<std::string>(
+            x->response =
                 std::string(metrics ? "HTTP/1.1 200 OK\r\n" : "HTTP/1.1 404 Not Found\r\n") +
                 "Content-Type: text/plain; version=0.0.4\r\n"
                 "Content-Length: " +
-                std::to_string(body.size()) + "\r\nConnection: close\r\n\r\n" + body);
-            asio::async_write(*s, asio::buffer(*response),
-                              [s, response](std::error_code, std::size_t) {
-                                std::error_code ignored;
-                                s->close(ignored);
-                              });
+                std::to_string(body.size()) + "\r\nConnection: close\r\n\r\n" + body;
+            asio::async_write(x->socket, asio::buffer(x->response),
+                              [x](std::error_code, std::size_t) { x->close(); });
           });
     }
     accept();
@@ -535,6 +560,9 @@ void MetricsServer::accept() {
 void MetricsServer::close() {
   std::error_code ec;
   acceptor_.close(ec);
+  for (auto& weak : open_)
+    if (auto x = weak.lock()) x->close();
+  open_.clear();
 }
 
 }  // namespace nephele

@@ -9,6 +9,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "server/engine.h"
 
@@ -43,7 +44,10 @@ class SocketServer {
   std::map<std::int64_t, std::shared_ptr<Connection>> connections_;
 };
 
-// GET /metrics in the Prometheus text format; anything else is 404.
+struct MetricsExchange;
+
+// GET /metrics in the Prometheus text format; anything else is 404. A scrape must be done
+// within the socket request timeout; at most 16 are served at once.
 class MetricsServer {
  public:
   MetricsServer(asio::io_context& io, Engine& engine);
@@ -58,6 +62,7 @@ class MetricsServer {
   Engine& engine_;
   asio::ip::tcp::acceptor acceptor_;
   int port_ = 0;
+  std::vector<std::weak_ptr<MetricsExchange>> open_;
 };
 
 // Opens `acceptor` on `where`; returns the error, naming the address, on failure.

@@ -20,6 +20,9 @@ TEST(DaemonConfig, DefaultsAndTheExample) {
   ASSERT_EQ(c.views.size(), 1u);
   EXPECT_EQ(c.views[0].camera.width, 1280);  // the scene's camera
   EXPECT_EQ(c.modbus_view, c.views[0].name);
+  EXPECT_EQ(c.socket_timeouts.request_s, 10.0);
+  EXPECT_EQ(c.socket_timeouts.idle_s, 300.0);
+  EXPECT_EQ(c.modbus_timeouts.request_s, 2.0);
 
   DaemonConfig example;
   ASSERT_EQ(loadDaemonConfig(std::string(NEPHELE_SOURCE_DIR) + "/deploy/nephele.toml", example),
@@ -58,6 +61,10 @@ TEST(DaemonConfig, ErrorsNameTheKey) {
       {kScene + "[socket]\nport = 70000\n", "socket.port"},
       {kScene + "[socket]\nmystery = 1\n", "socket.mystery: unknown key"},
       {kScene + "[output]\nformat = \"raw\"\n", "output.format"},
+      {kScene + "[socket]\nrequest_timeout = 0\n", "socket.request_timeout"},
+      {kScene + "[modbus]\nidle_timeout = -1\n", "modbus.idle_timeout"},
+      {kScene + "[[view]]\nname = \"front view\"\n", "is not a name"},
+      {"scene = \"/tmp\"\n", "not a regular file"},
   };
   for (const Case& c : cases) {
     DaemonConfig out;

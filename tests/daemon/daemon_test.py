@@ -734,6 +734,11 @@ class AbuseTest(DaemonTest):
         self.assertEqual(modbus_reply(mb)[0], 9)
         for s in idle_mb + [mb, drip]:
             s.close()
+        # Metrics: a scrape that never finishes its request is closed by the same timeout.
+        m = socket.create_connection(("127.0.0.1", d.metrics_port))
+        m.sendall(b"GET /metr")
+        self.assertTrue(closed_by_peer(m, 10))
+        m.close()
 
     def test_case05_unread_image_replies_stay_within_the_pending_limit(self):
         d = self.daemon(socket_keys="max_pending_mb = 1", view_size=(512, 512))
