@@ -6,6 +6,7 @@
 #include <chrono>
 #include <deque>
 #include <optional>
+#include <utility>
 
 namespace nephele {
 
@@ -90,6 +91,7 @@ class Connection : public std::enable_shared_from_this<Connection> {
     finishing_ = why;
     std::error_code ec;
     socket_.shutdown(tcp::socket::shutdown_receive, ec);
+    if (std::string_view(why) == "shutdown") answerUnread();
     if (out_.empty()) {
       close(why);
       return;
@@ -229,6 +231,22 @@ class Connection : public std::enable_shared_from_this<Connection> {
       line_started_.reset();
     else if (!line_started_)
       line_started_ = Clock::now();
+  }
+
+  // At shutdown: whole requests read but not yet handed on (reading was paused) are answered
+  // too, so that every request sent gets its answer.
+  void answerUnread() {
+    for (std::size_t newline; (newline = in_.find('\n')) != std::string::npos;
+         in_.erase(0, newline + 1)) {
+      if (std::exchange(discarding_, false)) continue;
+      line_.assign(in_, 0, newline);
+      if (line_.find_first_not_of(" \t\r") == std::string::npos) continue;
+      auto parsed = parseRequest(line_);
+      const nlohmann::json id = std::holds_alternative<BadRequest>(parsed)
+                                    ? std::get<BadRequest>(parsed).id
+                                    : std::get<Request>(parsed).id;
+      sendError(id, {ErrorCode::kFailed, "the daemon is shutting down"});
+    }
   }
 
   void handleLine() {
