@@ -142,9 +142,10 @@ class Connection : public std::enable_shared_from_this<Connection> {
     if (closed_ || finishing_) return nullptr;
     const Timeouts& t = engine_.config().socket_timeouts;
     if (line_started_ && now - *line_started_ > seconds(t.request_s)) return "request_timeout";
-    if (t.idle_s > 0.0 && now - last_activity_ > seconds(t.idle_s) &&
-        (in_flight_ == 0 || !out_.empty()) && engine_.subscriptionsOf(id_) == 0)
-      return out_.empty() ? "idle_timeout" : "write_timeout";
+    if (t.idle_s > 0.0 && now - last_activity_ > seconds(t.idle_s)) {
+      if (!out_.empty()) return "write_timeout";  // nothing read of its output, subscribed or not
+      if (in_flight_ == 0 && engine_.subscriptionsOf(id_) == 0) return "idle_timeout";
+    }
     return nullptr;
   }
 
