@@ -53,6 +53,14 @@ struct Limits {
   static constexpr Range kThickness{1.0, 15000.0};
   static constexpr Range kCoveragePercent{0.0, 100.0};
 
+  // Gardner's clusters (world/formations/cluster.h).
+  static constexpr Range kClusterSpacing{1.0, 1.0e5};
+  static constexpr Range kClusterBoundary{1.0, 1.0e6};
+  static constexpr Range kSizeVariation{0.0, 0.9};
+  static constexpr Range kPositionVariation{0.0, 1.0};
+  static constexpr Range kHeadingVariation{0.0, 180.0};
+  static constexpr Range kVerticalScale{0.01, 100.0};
+
   // Automaton clouds (Dobashi; Shen).
   static constexpr int kMaxAutomata = 256;
   static constexpr int kMaxCellsPerAxis = 1024;
