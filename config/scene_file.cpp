@@ -19,6 +19,7 @@
 #include "config/obj_mesh.h"
 #include "config/table_reader.h"
 #include "world/counter_random.h"
+#include "world/formations/cluster.h"
 
 namespace nephele {
 void config_detail::readCameraKeys(TableReader& t, Camera& camera) {
@@ -256,11 +257,47 @@ void readCumulus(TableReader& t, std::uint64_t seed, std::vector<Ellipsoid>& out
   out = cumulusEllipsoids(count, base, width, seed);
 }
 
+// Gardner's cluster (world/formations/cluster.h); [[cloud.cluster.terrain]] ellipsoids raise
+// it and are not drawn.
+void readCluster(TableReader& t, std::uint64_t seed, std::vector<Ellipsoid>& out) {
+  t.allow({"radii", "heading", "pitch", "roll", "centre", "boundary", "boundary_heading", "spacing",
+           "altitude", "size_variation", "position_variation", "heading_variation",
+           "vertical_scale", "seed", "terrain"});
+  ClusterSpec c;
+  c.seed = seed;
+  if (!t.has("radii")) t.failHere("missing key radii (the template ellipsoid's semi-axes)");
+  t.vector("radii", c.element.radii, Limits::kMinRadius, Limits::kMaxRadius);
+  readOrientation(t, c.element.orientation);
+  t.vector("centre", c.centre, -Limits::kMaxCoordinate, Limits::kMaxCoordinate);
+  t.vector("boundary", c.boundary_radii, Limits::kClusterBoundary);
+  t.number("boundary_heading", c.boundary_heading_deg, -Limits::kMaxHeading, Limits::kMaxHeading);
+  t.vector("spacing", c.spacing, Limits::kClusterSpacing);
+  t.number("altitude", c.altitude_m, 0.0, Limits::kMaxAltitude);
+  t.number("size_variation", c.size_variation, Limits::kSizeVariation);
+  t.number("position_variation", c.position_variation, Limits::kPositionVariation);
+  t.number("heading_variation", c.heading_variation_deg, Limits::kHeadingVariation);
+  t.number("vertical_scale", c.vertical_scale, Limits::kVerticalScale);
+  t.seed("seed", c.seed);
+  std::vector<TableReader> terrain_tables = t.tables("terrain");
+  if (terrain_tables.size() > std::size_t(Limits::kMaxEllipsoidsPerCloud))
+    t.failAt("terrain",
+             "more than " + std::to_string(Limits::kMaxEllipsoidsPerCloud) + " terrain ellipsoids");
+  std::vector<Ellipsoid> terrain;
+  for (TableReader& e : terrain_tables) readEllipsoid(e, terrain.emplace_back());
+  if (std::string e = clusterError(c); !e.empty()) t.failHere(e);
+  t.finish();
+  out = clusterEllipsoids(c, terrain);
+  if (out.empty())
+    t.failHere(
+        "has no ellipsoids inside its boundary (allowed: a boundary wider "
+        "than the spacing)");
+}
+
 void readCloud(TableReader& t, std::uint64_t seed, EllipsoidCloud& cloud,
                CloudDevelopment& develop) {
   t.allow({"name", "colour", "threshold", "limb_threshold", "transition", "ambient",
-           "texture_fraction", "specular", "shininess", "seed", "texture", "cumulus", "ellipsoid",
-           "develop"});
+           "texture_fraction", "specular", "shininess", "seed", "texture", "cumulus", "cluster",
+           "ellipsoid", "develop"});
   t.name("name", cloud.name);
   t.vector("colour", cloud.colour, Limits::kColour);
   t.number("threshold", cloud.threshold_centre, Limits::kCloudThreshold);
@@ -272,13 +309,20 @@ void readCloud(TableReader& t, std::uint64_t seed, EllipsoidCloud& cloud,
   if (auto texture = t.table("texture")) readSolidTexture(*texture, cloud.texture);
   if (auto cumulus = t.table("cumulus"))
     readCumulus(*cumulus, cloud.texture.seed, cloud.ellipsoids);
+  if (auto cluster = t.table("cluster")) {
+    if (!cloud.ellipsoids.empty())
+      cluster->failHere("a cloud takes [cumulus] or [cluster], not both");
+    readCluster(*cluster, cloud.texture.seed, cloud.ellipsoids);
+  }
   std::vector<TableReader> ellipsoids = t.tables("ellipsoid");
   if (cloud.ellipsoids.size() + ellipsoids.size() > std::size_t(Limits::kMaxEllipsoidsPerCloud))
     t.failAt("ellipsoid", "more than " + std::to_string(Limits::kMaxEllipsoidsPerCloud) +
                               " ellipsoids in one cloud");
   for (TableReader& e : ellipsoids) readEllipsoid(e, cloud.ellipsoids.emplace_back());
   if (cloud.ellipsoids.empty())
-    t.failHere("has no ellipsoids (add [[cloud.ellipsoid]] tables or a [cloud.cumulus] table)");
+    t.failHere(
+        "has no ellipsoids (add [[cloud.ellipsoid]] tables, a [cloud.cumulus] or a [cloud.cluster] "
+        "table)");
   if (auto d = t.table("develop"))
     readDevelop(*d,
                 {{"threshold", &develop.threshold_centre},

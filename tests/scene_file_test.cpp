@@ -5,6 +5,8 @@
 
 #include <filesystem>
 
+#include "world/formations/cluster.h"
+
 namespace nephele {
 namespace {
 
@@ -387,6 +389,40 @@ TEST(SceneFile, AutomatonWorkBeyondItsBoundsIsRefusedUpFront) {
   // Within the bounds: the 20^3 preset's cloud for a whole day (3.5e8 cell-steps).
   SceneFile f;
   EXPECT_EQ(parseError("time = 86400.0\n[[automaton]]\n", f), "");
+}
+
+TEST(SceneFile, ReadsAGardnerClusterWithTerrain) {
+  SceneFile f;
+  ASSERT_EQ(parseError("[[cloud]]\nname = \"field\"\nseed = 9\n[cloud.cluster]\n"
+                       "radii = [300.0, 300.0, 200.0]\nboundary = [2000.0, 1000.0]\n"
+                       "spacing = [500.0, 500.0]\naltitude = 1200.0\nvertical_scale = 2.0\n"
+                       "[[cloud.cluster.terrain]]\nradii = [800.0, 800.0, 600.0]\n"
+                       "centre = [0.0, 0.0, 0.0]\n",
+                       f),
+            "");
+  ASSERT_EQ(f.scene.clouds.size(), 1u);
+  ClusterSpec spec;
+  spec.element.radii = {300.0, 300.0, 200.0};
+  spec.boundary_radii = {2000.0, 1000.0};
+  spec.spacing = {500.0, 500.0};
+  spec.altitude_m = 1200.0;
+  spec.vertical_scale = 2.0;
+  spec.seed = 9;
+  Ellipsoid dome;
+  dome.radii = {800.0, 800.0, 600.0};
+  dome.centre = {0.0, 0.0, 0.0};
+  const std::vector<Ellipsoid> expected = clusterEllipsoids(spec, {dome});
+  const std::vector<Ellipsoid>& read = f.scene.clouds[0].ellipsoids;
+  ASSERT_EQ(read.size(), expected.size());
+  for (std::size_t i = 0; i < read.size(); ++i) EXPECT_EQ(read[i].centre, expected[i].centre);
+  EXPECT_THAT(parseError("[[cloud]]\n[cloud.cluster]\nradii = [1.0, 1.0, 1.0]\n"
+                         "spacing = [-5.0, 10.0]\n"),
+              HasSubstr("cloud[0].cluster.spacing"));
+  EXPECT_THAT(parseError("[[cloud]]\n[cloud.cluster]\nradii = [1.0, 1.0, 1.0]\n"
+                         "spacing = [1.0, 1.0]\nboundary = [500.0, 500.0]\n"),
+              HasSubstr("lattice cells (allowed: at most 4096"));
+  EXPECT_THAT(parseError("[[cloud]]\n[cloud.cumulus]\n[cloud.cluster]\nradii = [1.0, 1.0, 1.0]\n"),
+              HasSubstr("not both"));
 }
 
 TEST(SceneFile, BadWindDevelopmentAndAutomataAreRejected) {
