@@ -391,8 +391,7 @@ void Engine::run(std::promise<std::string>& started) {
     return;
   }
   s.next_tick = Clock::now();
-  s.next_snapshot = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                       std::chrono::duration<double>(config_.snapshot_interval_s));
+  s.next_snapshot = Clock::now() + secondsToDuration(config_.snapshot_interval_s);
   publish();
   started.set_value("");
 
@@ -429,9 +428,7 @@ void Engine::run(std::promise<std::string>& started) {
     if (config_.snapshot_interval_s > 0.0 && !config_.snapshot_path.empty() &&
         Clock::now() >= s.next_snapshot) {
       saveSnapshot(config_.snapshot_path, "periodic");
-      s.next_snapshot =
-          Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                             std::chrono::duration<double>(config_.snapshot_interval_s));
+      s.next_snapshot = Clock::now() + secondsToDuration(config_.snapshot_interval_s);
     }
     publish();
   }
@@ -490,8 +487,7 @@ void Engine::realtimeTicks() {
   if (config_.mode != TickMode::kRealtime || s.paused) return;
   const auto now = Clock::now();
   if (now < s.next_tick) return;
-  const auto period = std::chrono::duration_cast<Clock::duration>(
-      std::chrono::duration<double>(1.0 / config_.tick_rate_hz));
+  const auto period = secondsToDuration(1.0 / config_.tick_rate_hz);
   int due = 1 + int((now - s.next_tick) / period);
   if (due > kMaxCatchUpTicks) {  // a long stall: drop the backlog rather than race to catch up
     spdlog::warn("event=ticks_skipped count={}", due - kMaxCatchUpTicks);
@@ -743,8 +739,7 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
     sub.client = job.client;
     sub.view = c->view;
     sub.image = c->image.value_or(v->image);
-    sub.period = std::chrono::duration_cast<Clock::duration>(
-        std::chrono::duration<double>(1.0 / c->rate_hz));
+    sub.period = secondsToDuration(1.0 / c->rate_hz);
     sub.next_due = Clock::now();
     sub.sink = job.frames;
     sub.gone = std::make_shared<std::atomic<bool>>(false);

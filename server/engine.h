@@ -48,6 +48,12 @@ using FrameSink = std::function<bool(SharedReply)>;
 // Receives the outcome of a Modbus write or render trigger.
 using DoneSink = std::function<void(std::optional<ProtocolError>)>;
 
+// A configured number of seconds as a steady-clock duration.
+inline std::chrono::steady_clock::duration secondsToDuration(double s) {
+  return std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+      std::chrono::duration<double>(s));
+}
+
 // Decides, once, between the world thread applying a batch and its submitter withdrawing it.
 class BatchTicket {
  public:

@@ -19,11 +19,6 @@ namespace {
 
 constexpr int kPollMs = 100;  // how often waiting threads look at their flags and deadlines
 
-std::chrono::steady_clock::duration seconds(double s) {
-  return std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-      std::chrono::duration<double>(s));
-}
-
 // Writes all of `bytes`; false if the peer is gone or does not read within the send timeout.
 bool sendAll(int fd, const std::vector<std::uint8_t>& bytes) {
   std::size_t sent = 0;
@@ -113,7 +108,7 @@ void ModbusServer::acceptLoop() {
       // been idle (between frames) for at least the request timeout.
       const Clock::rep now = Clock::now().time_since_epoch().count();
       ClientState* idlest = nullptr;
-      Clock::rep longest = seconds(config.modbus_timeouts.request_s).count();
+      Clock::rep longest = secondsToDuration(config.modbus_timeouts.request_s).count();
       for (Client& c : clients_) {
         ClientState& s = *c.state;
         if (s.evict || s.mid_request) continue;
@@ -146,7 +141,7 @@ void ModbusServer::serveClient(int fd, const std::string& peer, ClientState& sta
   spdlog::info("event=modbus_connected peer={}", peer);
   const Timeouts& timeouts = engine_.config().modbus_timeouts;
   // A client that does not read its replies is dropped rather than blocking this thread.
-  const auto send_timeout = seconds(timeouts.request_s);
+  const auto send_timeout = secondsToDuration(timeouts.request_s);
   timeval tv{};
   tv.tv_sec = std::chrono::duration_cast<std::chrono::seconds>(send_timeout).count();
   tv.tv_usec =
@@ -165,11 +160,12 @@ void ModbusServer::serveClient(int fd, const std::string& peer, ClientState& sta
       break;
     }
     const auto now = Clock::now();
-    if (have > 0 && now - started > seconds(timeouts.request_s)) {
+    if (have > 0 && now - started > secondsToDuration(timeouts.request_s)) {
       why = "request_timeout";
       break;
     }
-    if (have == 0 && timeouts.idle_s > 0.0 && now - last_activity > seconds(timeouts.idle_s)) {
+    if (have == 0 && timeouts.idle_s > 0.0 &&
+        now - last_activity > secondsToDuration(timeouts.idle_s)) {
       why = "idle_timeout";
       break;
     }
@@ -237,7 +233,7 @@ std::optional<ProtocolError> ModbusServer::runBatch(std::vector<Command> command
   if (!engine_.submitBatch(std::move(commands), render, ticket,
                            [outcome](std::optional<ProtocolError> e) { outcome->set_value(e); }))
     return ProtocolError{ErrorCode::kBusy, "the request queue is full; nothing was changed"};
-  if (result.wait_for(seconds(engine_.config().modbus_timeouts.request_s)) !=
+  if (result.wait_for(secondsToDuration(engine_.config().modbus_timeouts.request_s)) !=
           std::future_status::ready &&
       ticket->withdraw()) {
     if (render) engine_.clearRenderTrigger();

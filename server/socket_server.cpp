@@ -24,10 +24,6 @@ constexpr auto kShutdownDrain = std::chrono::seconds(10);  // to finish writing 
 constexpr auto kSweepPeriod = std::chrono::milliseconds(250);
 constexpr std::size_t kMaxMetricsConnections = 16;
 
-Clock::duration seconds(double s) {
-  return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
-}
-
 // Compares a presented token with the configured one in time that depends only on the
 // configured token's length, so that timing tells a guesser nothing about a prefix.
 bool tokenMatches(std::string_view presented, std::string_view expected) {
@@ -141,8 +137,9 @@ class Connection : public std::enable_shared_from_this<Connection> {
   const char* overdue(Clock::time_point now) const {
     if (closed_ || finishing_) return nullptr;
     const Timeouts& t = engine_.config().socket_timeouts;
-    if (line_started_ && now - *line_started_ > seconds(t.request_s)) return "request_timeout";
-    if (t.idle_s > 0.0 && now - last_activity_ > seconds(t.idle_s)) {
+    if (line_started_ && now - *line_started_ > secondsToDuration(t.request_s))
+      return "request_timeout";
+    if (t.idle_s > 0.0 && now - last_activity_ > secondsToDuration(t.idle_s)) {
       if (!out_.empty()) return "write_timeout";  // nothing read of its output, subscribed or not
       if (in_flight_ == 0 && engine_.subscriptionsOf(id_) == 0) return "idle_timeout";
     }
@@ -214,17 +211,8 @@ class Connection : public std::enable_shared_from_this<Connection> {
                                            " bytes (allowed: less); it was skipped"});
       discarding_ = true;
     }
-    if (discarding_) {
-      const std::size_t newline = in_.find('\n');
-      if (newline == std::string::npos) {
-        in_.clear();
-      } else {
-        in_.erase(0, newline + 1);
-        discarding_ = false;
-        processInput();
-        return;
-      }
-    }
+    // The rest of an over-long line is dropped as it comes; the loop above skips its end.
+    if (discarding_ && in_.find('\n') == std::string::npos) in_.clear();
     // A request begun and not finished is held to the request timeout from its first byte
     // (or from when the previous one was taken), but only while the daemon waits for it:
     // not while reading is paused on the daemon's side.
@@ -473,7 +461,7 @@ void SocketServer::accept() {
       // connections never starve a working one.
       const auto now = Clock::now();
       std::shared_ptr<Connection> idlest;
-      Clock::duration longest = seconds(engine_.config().socket_timeouts.request_s);
+      Clock::duration longest = secondsToDuration(engine_.config().socket_timeouts.request_s);
       for (auto& [id, c] : connections_)
         if (auto idle = c->idleFor(now); idle && *idle >= longest) {
           longest = *idle;
@@ -547,7 +535,7 @@ void MetricsServer::accept() {
       // One exchange per connection, the whole of it within the socket request timeout.
       auto x = std::make_shared<MetricsExchange>(std::move(socket));
       open_.push_back(x);
-      x->timer.expires_after(seconds(engine_.config().socket_timeouts.request_s));
+      x->timer.expires_after(secondsToDuration(engine_.config().socket_timeouts.request_s));
       x->timer.async_wait([x](std::error_code ec) {
         std::error_code ignored;
         if (!ec) x->socket.close(ignored);
