@@ -20,6 +20,7 @@
 #include "config/table_reader.h"
 #include "world/counter_random.h"
 #include "world/formations/cluster.h"
+#include "world/formations/weather.h"
 
 namespace nephele {
 void config_detail::readCameraKeys(TableReader& t, Camera& camera) {
@@ -117,14 +118,14 @@ void readGardnerParams(TableReader& t, GardnerTextureParams& g, double min_frequ
 }
 
 void readTexture(TableReader& t, LayerTextureSpec& texture) {
-  t.allow({"source", "terms", "fx1", "fy1", "t0", "phases", "tile_size", "size_log2", "roughness",
-           "cells", "octaves", "persistence"});
+  t.allow({"source", "terms", "fx1", "fy1", "t0", "phases", "rotation", "tile_size", "size_log2",
+           "roughness", "cells", "octaves", "persistence"});
   texture.source = TextureSource(
       t.choice("source", {"gardner", "perlin", "diamond-square"}, int(texture.source)));
   const std::string source(textureSourceName(texture.source));
   const bool gardner = texture.source == TextureSource::kGardner;
   const bool perlin = texture.source == TextureSource::kPerlin;
-  for (const char* key : {"terms", "fx1", "fy1", "t0", "phases"})
+  for (const char* key : {"terms", "fx1", "fy1", "t0", "phases", "rotation"})
     if (!gardner) t.forbid(key, "applies to source \"gardner\" only, not \"" + source + "\"");
   for (const char* key : {"tile_size", "size_log2"})
     if (gardner) t.forbid(key, "applies to sources \"perlin\" and \"diamond-square\" only");
@@ -134,6 +135,7 @@ void readTexture(TableReader& t, LayerTextureSpec& texture) {
     t.forbid("roughness", "applies to source \"diamond-square\" only, not \"" + source + "\"");
 
   readGardnerParams(t, texture.gardner, 1.0e-7);
+  t.number("rotation", texture.gardner.rotation_deg, Limits::kTermRotation);
   NoiseTableParams& n = texture.table;
   t.vector("tile_size", n.tile_size_m, 1.0, 1.0e7);
   t.integer("size_log2", n.size_log2, 4, 12);
@@ -216,7 +218,7 @@ void readSolidTexture(TableReader& t, SolidTextureSpec& texture) {
   texture.source =
       SolidTextureSource(t.choice("source", {"gardner", "perlin"}, int(texture.source)));
   const bool gardner = texture.source == SolidTextureSource::kGardner;
-  for (const char* key : {"terms", "fx1", "fy1", "t0", "phases"})
+  for (const char* key : {"terms", "fx1", "fy1", "t0", "phases", "rotation"})
     if (!gardner) t.forbid(key, "applies to source \"gardner\" only, not \"perlin\"");
   for (const char* key : {"period", "size_log2", "cells", "octaves", "persistence"})
     if (gardner) t.forbid(key, "applies to source \"perlin\" only, not \"gardner\"");
@@ -404,10 +406,26 @@ void readTarget(TableReader& t, const std::string& scene_path, Target& target) {
   t.finish();
 }
 
+// A [[weather]] layer as a host sends it (MODEL.md section 10): the same mapping as set_weather.
+WeatherLayer readWeather(TableReader& t) {
+  t.allow({"type", "base", "thickness", "coverage"});
+  std::vector<std::string> names;
+  for (int i = 0; i < kCloudTypeCount; ++i) names.emplace_back(cloudTypeName(CloudType(i)));
+  WeatherLayer w;
+  w.type = CloudType(t.choice("type", names, int(CloudType::kStratus)));
+  t.number("base", w.base_m, 0.0, Limits::kMaxBase);
+  t.number("thickness", w.thickness_m, Limits::kThickness);
+  double percent = 100.0 * w.coverage;
+  t.number("coverage", percent, Limits::kCoveragePercent);
+  w.coverage = percent / 100.0;
+  t.finish();
+  return w;
+}
+
 void readScene(const toml::table& root, const std::string& file, SceneFile& out) {
   TableReader t(root, "", file);
   t.allow({"seed", "time", "image", "camera", "sun", "sky", "fog", "render", "wind", "layer",
-           "cloud", "automaton", "target"});
+           "cloud", "automaton", "target", "weather"});
   Scene& scene = out.scene;
   t.seed("seed", scene.seed);
   t.number("time", scene.time_s, 0.0, Limits::kMaxTime);
@@ -436,6 +454,17 @@ void readScene(const toml::table& root, const std::string& file, SceneFile& out)
                        "altitude (remove one of them)");
     readLayer(layers[i], layer, dynamics.layers.emplace_back());
     if (layer.name.empty()) layer.name = "layer" + std::to_string(i);
+  }
+  std::vector<TableReader> weather = t.tables("weather");
+  for (std::size_t i = 0; i < weather.size(); ++i) {
+    const WeatherLayer w = readWeather(weather[i]);
+    const WeatherClouds add =
+        weatherClouds(w, "weather/" + std::to_string(i + 1), weatherSeed(scene.seed, int(i + 1)));
+    for (const CloudLayer& l : add.layers) {
+      scene.layers.push_back(l);
+      dynamics.layers.emplace_back();
+    }
+    scene.fields.insert(scene.fields.end(), add.fields.begin(), add.fields.end());
   }
   std::vector<TableReader> clouds = t.tables("cloud");
   for (std::size_t i = 0; i < clouds.size(); ++i) {

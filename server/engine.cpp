@@ -617,7 +617,8 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
     return json{{"layer", c->layer},
                 {"type", cloudTypeName(c->weather.type)},
                 {"layers", world.base().layers.size()},
-                {"clouds", world.base().clouds.size()}};
+                {"clouds", world.base().clouds.size()},
+                {"fields", world.base().fields.size()}};
   }
   if (const auto* c = std::get_if<SetWind>(&command)) {
     std::string error = world.edit([&](Scene&, WorldDynamics& d) {
@@ -819,23 +820,18 @@ std::optional<ProtocolError> Engine::setWeather(int layer, const WeatherLayer& w
   // The daemon's own names hold a '/', which no user name may (world/limits.h): set_weather
   // replaces exactly what it made before.
   const std::string prefix = "weather/" + std::to_string(layer);
-  const ViewConfig& anchor = *s.view(config_.modbus_view);
-  const WeatherClouds add = weatherClouds(
-      weather, prefix, glm::dvec2(anchor.camera.position),
-      hashCounters(config_.scene.scene.seed, 0x57656174686572ull, std::uint64_t(layer)));
+  const WeatherClouds add =
+      weatherClouds(weather, prefix, weatherSeed(config_.scene.scene.seed, layer));
   std::string error = s.world->edit([&](Scene& now, WorldDynamics& d) -> std::string {
-    eraseWithDevelopment(now.layers, d.layers,
-                         [&](const CloudLayer& l) { return l.name == prefix; });
-    eraseWithDevelopment(now.clouds, d.clouds, [&](const EllipsoidCloud& c) {
-      return c.name.rfind(prefix + "/", 0) == 0;
-    });
+    auto made = [&](const std::string& name) {
+      return name == prefix || name.rfind(prefix + "/", 0) == 0;
+    };
+    eraseWithDevelopment(now.layers, d.layers, [&](const CloudLayer& l) { return made(l.name); });
+    std::erase_if(now.fields, [&](const CloudField& f) { return made(f.name); });
+    now.fields.insert(now.fields.end(), add.fields.begin(), add.fields.end());
     for (const CloudLayer& l : add.layers) {
       now.layers.push_back(l);
       if (!d.layers.empty()) d.layers.emplace_back();
-    }
-    for (const EllipsoidCloud& c : add.clouds) {
-      now.clouds.push_back(c);
-      if (!d.clouds.empty()) d.clouds.emplace_back();
     }
     if (weather.wind)
       setWindSample(d.wind, weather.base_m + 0.5 * weather.thickness_m, *weather.wind);
@@ -844,10 +840,10 @@ std::optional<ProtocolError> Engine::setWeather(int layer, const WeatherLayer& w
   if (!error.empty()) return ProtocolError{ErrorCode::kFailed, error};
   s.weather[std::size_t(layer - 1)] = weather;
   spdlog::info(
-      "event=weather layer={} type={} base={} thickness={} coverage={:.2f} layers={} "
-      "heaps={}",
+      "event=weather layer={} type={} base={} thickness={} coverage={:.2f} planes={} "
+      "fields={}",
       layer, cloudTypeName(weather.type), weather.base_m, weather.thickness_m, weather.coverage,
-      add.layers.size(), add.clouds.size());
+      add.layers.size(), add.fields.size());
   return std::nullopt;
 }
 

@@ -30,7 +30,7 @@ TEST(SceneFile, EveryPresetLoads) {
     SceneFile file;
     EXPECT_EQ(loadSceneFile(entry.path().string(), file), "") << entry.path();
     EXPECT_FALSE(file.scene.layers.empty() && file.scene.clouds.empty() &&
-                 file.dynamics.automata.empty())
+                 file.scene.fields.empty() && file.dynamics.automata.empty())
         << entry.path();
     ++count;
   }
@@ -131,8 +131,8 @@ TEST(SceneFile, WrongTypeIsRejected) {
 
 TEST(SceneFile, OutOfRangeNamesTheAllowedRange) {
   const std::string e = parseError("[[layer]]\n\nthreshold = 1.5\n");
-  EXPECT_THAT(e,
-              HasSubstr("test.toml:3: layer[0].threshold: 1.5 is out of range (allowed: 0 to 1)"));
+  EXPECT_THAT(
+      e, HasSubstr("test.toml:3: layer[0].threshold: 1.5 is out of range (allowed: -10 to 1)"));
   EXPECT_THAT(parseError("[image]\nwidth = 0\n"), HasSubstr("allowed: 1 to 16384"));
   EXPECT_THAT(parseError("[[layer]]\n[layer.texture]\nterms = 9\n"), HasSubstr("allowed: 1 to 8"));
   EXPECT_THAT(parseError("[camera]\nposition = [0, 0, -1]\n"), HasSubstr("below the ground"));

@@ -34,13 +34,15 @@ struct Limits {
   static constexpr double kMaxAutomatonTime = 86400.0;
 
   // Appearance (Gardner eq. 8, 9 and 11).
-  static constexpr Range kLayerThreshold{0.0, 1.0};   // T1 of a sky plane
+  // T1 of a sky plane; below 0 makes even T = 0 partly opaque (full cover, section 9).
+  static constexpr Range kLayerThreshold{-10.0, 1.0};
   static constexpr Range kCloudThreshold{-2.0, 2.0};  // T1 and T2 of an ellipsoid cloud
   static constexpr Range kTransition{0.0, 10.0};      // D; 0 is a hard threshold
   static constexpr Range kFraction{0.0, 1.0};         // a, t, s of eq. 8; probabilities
   static constexpr Range kShininess{1.0, 1000.0};
   static constexpr Range kColour{0.0, 100.0};         // linear RGB; above 1 for bright HDR suns
   static constexpr Range kContrastOffset{0.0, 10.0};  // Gardner's T0
+  static constexpr Range kTermRotation{0.0, 90.0};    // lattice-breaking angle, degrees
 
   // Ellipsoids and targets, metres: zero, negative and NaN are rejected.
   static constexpr double kMinRadius = 1.0e-3, kMaxRadius = 1.0e5;

@@ -8,6 +8,7 @@
 #include <glm/glm.hpp>
 
 #include "world/automaton/automaton_cloud.h"
+#include "world/formations/cloud_field.h"
 #include "world/formations/ellipsoid_cloud.h"
 #include "world/frames.h"
 #include "world/shading.h"
@@ -37,9 +38,16 @@ struct Scene {
   std::optional<Fog> fog;
   std::vector<CloudLayer> layers;
   std::vector<EllipsoidCloud> clouds;
+  // Fields of heaps that exist everywhere; a render sees the heaps around its camera
+  // (withFieldClouds).
+  std::vector<CloudField> fields;
   std::vector<Target> targets;
   // Automaton clouds as the World hands them to a render (scene files alone hold none).
   std::vector<AutomatonCloudView> automata;
 };
+
+// `scene` with its fields' heaps around its camera added to its clouds (MODEL.md section 10);
+// what every renderer draws.
+Scene withFieldClouds(const Scene& scene);
 
 }  // namespace nephele

@@ -136,6 +136,8 @@ void World::foldDrift(Scene& scene, const WorldDynamics& dynamics, double sign) 
   for (CloudLayer& layer : scene.layers)
     layer.texture.drift_offset_m += sign * layer.texture.drift_velocity * t;
   if (dynamics.wind.empty()) return;
+  for (CloudField& field : scene.fields)
+    field.drift_m += sign * dynamics.wind.at(fieldAltitude(field)) * t;
   for (EllipsoidCloud& cloud : scene.clouds) {
     const glm::dvec3 drift(sign * dynamics.wind.at(cloudAltitude(cloud)) * t, 0.0);
     for (Ellipsoid& e : cloud.ellipsoids) e.centre += drift;
@@ -184,6 +186,8 @@ Scene World::scene() const {
     cloud.threshold_limb = d.threshold_limb.at(t, cloud.threshold_limb);
     cloud.transition = d.transition.at(t, cloud.transition);
   }
+  if (!dynamics_.wind.empty())
+    for (CloudField& field : s.fields) field.drift_m += dynamics_.wind.at(fieldAltitude(field)) * t;
   if (!dynamics_.wind.empty())
     for (EllipsoidCloud& cloud : s.clouds) {
       const glm::dvec3 drift(dynamics_.wind.at(cloudAltitude(cloud)) * t, 0.0);

@@ -24,7 +24,7 @@ namespace {
 static_assert(std::endian::native == std::endian::little, "snapshots assume a little-endian host");
 
 constexpr char kMagic[8] = {'N', 'E', 'P', 'H', 'S', 'N', 'A', 'P'};
-constexpr std::uint32_t kFormatVersion = 2;
+constexpr std::uint32_t kFormatVersion = 3;
 constexpr std::size_t kHeaderBytes = sizeof kMagic + 4 + 8 + 8;
 
 class Writer {
@@ -144,6 +144,7 @@ void io(A& a, ShadingParams& s) {
 template <class A>
 void io(A& a, GardnerTextureParams& g) {
   io(a, g.terms), io(a, g.fx1), io(a, g.fy1), io(a, g.t0), io(a, g.seeded_phases), io(a, g.seed);
+  io(a, g.rotation_deg);
   if (g.terms < 1 || g.terms > GardnerTextureParams::kMaxTerms)
     a.fail("texture terms out of range");
 }
@@ -197,9 +198,19 @@ void io(A& a, Target& t) {
   if (A::kReading) t.mesh = std::make_shared<const TriangleMesh>(std::move(mesh));
 }
 template <class A>
+void io(A& a, CloudField& f) {
+  io(a, f.name);
+  ioEnum(a, f.type, kCloudTypeCount);
+  io(a, f.base_m), io(a, f.thickness_m), io(a, f.coverage), io(a, f.seed), io(a, f.drift_m);
+  if (f.type != CloudType::kCumulus && f.type != CloudType::kCumulonimbus)
+    a.fail("field " + f.name + ": not a convective cloud type");
+  const WeatherLayer w{f.type, f.base_m, f.thickness_m, f.coverage, {}};
+  if (std::string e = weatherLayerError(w); !e.empty()) a.fail("field " + f.name + ": " + e);
+}
+template <class A>
 void io(A& a, Scene& s) {
   io(a, s.seed), io(a, s.camera), io(a, s.sun), io(a, s.sky), io(a, s.fog);
-  io(a, s.layers, 64), io(a, s.clouds, 64), io(a, s.targets, 64);
+  io(a, s.layers, 64), io(a, s.clouds, 64), io(a, s.targets, 64), io(a, s.fields, 64);
 }
 template <class A>
 void io(A& a, Schedule& s) {

@@ -55,7 +55,7 @@ std::string textureKey(const LayerTextureSpec& spec, const RenderSettings& setti
   if (spec.source == TextureSource::kGardner) {
     const GardnerTextureParams& g = spec.gardner;
     key << g.terms << '/' << g.fx1 << '/' << g.fy1 << '/' << g.t0 << '/' << g.seeded_phases << '/'
-        << settings.bake_texels_per_cycle;
+        << g.rotation_deg << '/' << settings.bake_texels_per_cycle;
   } else {
     const NoiseTableParams& t = spec.table;
     key << t.tile_size_m.x << '/' << t.tile_size_m.y << '/' << t.size_log2 << '/' << t.roughness
@@ -311,8 +311,9 @@ void GlRenderer::setSlotUniforms(GLuint p, int slot, const LayerSlot& entry, con
   // The precision rule of MODEL.md section 2: the texture's local origin is the point under the
   // camera, reduced modulo the period in double; the shader only sees offsets from it.
   const glm::dvec2 period = texture.period();
+  const glm::dvec2 camera_xy(camera.position.x, camera.position.y);
   const glm::dvec2 origin_uv =
-      texture.periodicCoordinate({camera.position.x, camera.position.y}, scene.time_s);
+      texture.periodic() ? texture.periodicCoordinate(camera_xy, scene.time_s) : glm::dvec2(0.0);
   const glm::vec2 origin_f(origin_uv), inv_period(1.0 / period);
   gl_.ProgramUniform2fv(p, location("u_origin", slot), 1, &origin_f.x);
   gl_.ProgramUniform2fv(p, location("u_inv_period", slot), 1, &inv_period.x);
@@ -320,19 +321,31 @@ void GlRenderer::setSlotUniforms(GLuint p, int slot, const LayerSlot& entry, con
   if (const GardnerTexture* g = texture.gardner()) {
     gl_.ProgramUniform1f(p, location("u_terms", slot), float(g->terms()));
     if (entry.kind == LayerKind::kProceduralGardner) {
-      const glm::dvec2 origin = origin_uv * period;  // metres inside one period
+      // Metres inside one period; a rotated texture has none, so its phases at the point under
+      // the camera are taken from the whole drifted position, in double, term by term.
+      const glm::dvec2 origin =
+          texture.periodic() ? origin_uv * period : camera_xy - texture.driftOffset(scene.time_s);
+      gl_.ProgramUniform1i(p, location("u_components", slot), g->components());
       for (int j = 0; j < g->terms(); ++j) {
-        const int k = 8 * slot + j;
-        auto set = [&](const char* name, double v) {
+        auto set = [&](const char* name, int k, double v) {
           gl_.ProgramUniform1f(p, location(name, k), float(v));
         };
-        set("u_fx", g->frequencyX(j));
-        set("u_fy", g->frequencyY(j));
-        set("u_amplitude", g->amplitude(j));
-        set("u_phase_x", wrapPeriodic(g->frequencyX(j) * origin.x + g->phaseX(j), kTwoPi));
-        set("u_phase_y", wrapPeriodic(g->frequencyY(j) * origin.y + g->phaseY(j), kTwoPi));
-        set("u_half_phase_x", wrapPeriodic(0.5 * g->frequencyX(j) * origin.x, kTwoPi));
-        set("u_half_phase_y", wrapPeriodic(0.5 * g->frequencyY(j) * origin.y, kTwoPi));
+        set("u_fx", 8 * slot + j, g->frequencyX(j));
+        set("u_fy", 8 * slot + j, g->frequencyY(j));
+        set("u_amplitude", 8 * slot + j, g->componentAmplitude(j));
+        for (int c = 0; c < g->components(); ++c) {
+          const int k = 16 * slot + 2 * j + c;
+          const glm::dvec2 a = g->axisX(j, c), b = g->axisY(j, c);
+          const glm::dvec2 q1(a.x * origin.x + a.y * origin.y, a.x * origin.y - a.y * origin.x);
+          const glm::dvec2 q2(b.x * origin.x + b.y * origin.y, b.x * origin.y - b.y * origin.x);
+          set("u_phase_x", k, wrapPeriodic(g->frequencyX(j) * q1.x + g->phaseX(j, c), kTwoPi));
+          set("u_phase_y", k, wrapPeriodic(g->frequencyY(j) * q2.y + g->phaseY(j, c), kTwoPi));
+          set("u_half_phase_x", k, wrapPeriodic(0.5 * g->frequencyX(j) * q2.x, kTwoPi));
+          set("u_half_phase_y", k, wrapPeriodic(0.5 * g->frequencyY(j) * q1.y, kTwoPi));
+          const glm::vec2 axis_x(a), axis_y(b);
+          gl_.ProgramUniform2fv(p, location("u_axis_x", k), 1, &axis_x.x);
+          gl_.ProgramUniform2fv(p, location("u_axis_y", k), 1, &axis_y.x);
+        }
       }
       gl_.ProgramUniform1f(p, location("u_t0", slot), float(g->params().t0));
       gl_.ProgramUniform1f(p, location("u_k", slot), float(g->normalisation()));
@@ -438,6 +451,8 @@ void GlRenderer::drawSkyGroup(const Scene& scene, const RenderSettings& settings
 
 void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
                            TargetFormat format) {
+  // Fields of heaps become the clouds around this camera (MODEL.md section 10).
+  if (!scene.fields.empty()) return drawFrame(withFieldClouds(scene), settings, format);
   const Camera& camera = scene.camera;
   prepareTarget(camera.width, camera.height, format);
   stats_ = {};
@@ -462,8 +477,10 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
   for (const CloudLayer& layer : scene.layers) {
     if (layer.altitude_m == z) continue;  // seen edge-on: covers no pixel
     CachedTexture& texture = cachedTexture(layer.texture, settings);
+    // A rotated Gardner texture never repeats, so no periodic table can hold it.
     const LayerKind kind = !texture.source->gardner() ? LayerKind::kTable
-                           : settings.texture_evaluation == TextureEvaluation::kProcedural
+                           : settings.texture_evaluation == TextureEvaluation::kProcedural ||
+                                   !texture.source->periodic()
                                ? LayerKind::kProceduralGardner
                                : LayerKind::kBakedGardner;
     (layer.altitude_m > z ? above : below).push_back({&layer, &texture, kind});

@@ -183,35 +183,48 @@ float tableValue(sampler2D table, int i, LayerHit hit) {
 }
 
 #ifdef PROCEDURAL
-// Per-term constants, slot i's term j at [8 i + j]; the local origin's phases are reduced
-// modulo 2 pi on the CPU in double.
+// Per-term constants, slot i's term j at [8 i + j], and per component (two per term when the
+// texture is rotated, GardnerTexture::components) at [16 i + 2 j + c]; the local origin's
+// phases are reduced modulo 2 pi on the CPU in double.
 uniform float u_fx[kSlots * 8];
 uniform float u_fy[kSlots * 8];
-uniform float u_amplitude[kSlots * 8];
-uniform float u_phase_x[kSlots * 8];       // FX(j) * origin.x + phx(j), mod 2 pi
-uniform float u_phase_y[kSlots * 8];       // FY(j) * origin.y + phy(j), mod 2 pi
-uniform float u_half_phase_x[kSlots * 8];  // 0.5 FX(j) * origin.x, mod 2 pi
-uniform float u_half_phase_y[kSlots * 8];  // 0.5 FY(j) * origin.y, mod 2 pi
+uniform float u_amplitude[kSlots * 8];      // of one component
+uniform int u_components[kSlots];
+uniform float u_phase_x[kSlots * 16];       // FX(j) * origin.x + phx(j), mod 2 pi
+uniform float u_phase_y[kSlots * 16];       // FY(j) * origin.y + phy(j), mod 2 pi
+uniform float u_half_phase_x[kSlots * 16];  // 0.5 FX(j) * origin.x, mod 2 pi
+uniform float u_half_phase_y[kSlots * 16];  // 0.5 FY(j) * origin.y, mod 2 pi
+uniform vec2 u_axis_x[kSlots * 16];         // the component's X axis in SX (cos, sin)
+uniform vec2 u_axis_y[kSlots * 16];         // and in SY; (1, 0) for Gardner's lattice
 uniform float u_t0[kSlots];
 uniform float u_k[kSlots];
 const float kHalfPi = 1.5707963267948966;
 
-void addTerm(int j, vec2 p, inout float sx, inout float sy) {
-  float px = kHalfPi * sin(0.5 * u_fy[j] * p.y + u_half_phase_y[j]);
-  float py = kHalfPi * sin(0.5 * u_fx[j] * p.x + u_half_phase_x[j]);
-  sx += u_amplitude[j] * sin(u_fx[j] * p.x + u_phase_x[j] + px);
-  sy += u_amplitude[j] * sin(u_fy[j] * p.y + u_phase_y[j] + py);
+// Term j of slot i into SX and SY (GardnerTexture::addTerm), each component in its own axes;
+// the origin's phases above were taken in the same axes.
+void addTerm(int i, int j, vec2 p, inout float sx, inout float sy) {
+  int t = 8 * i + j;
+  for (int c = 0; c < u_components[i]; ++c) {
+    int k = 16 * i + 2 * j + c;
+    vec2 a = u_axis_x[k], b = u_axis_y[k];
+    vec2 q1 = vec2(a.x * p.x + a.y * p.y, a.x * p.y - a.y * p.x);
+    vec2 q2 = vec2(b.x * p.x + b.y * p.y, b.x * p.y - b.y * p.x);
+    float px = kHalfPi * sin(0.5 * u_fy[t] * q1.y + u_half_phase_y[k]);
+    float py = kHalfPi * sin(0.5 * u_fx[t] * q2.x + u_half_phase_x[k]);
+    sx += u_amplitude[t] * sin(u_fx[t] * q1.x + u_phase_x[k] + px);
+    sy += u_amplitude[t] * sin(u_fy[t] * q2.y + u_phase_y[k] + py);
+  }
 }
 
 float proceduralValue(int i, LayerHit hit) {
   float count = termCount(i, hit);
   int whole = int(count);
   float sx = u_t0[i], sy = u_t0[i];
-  for (int j = 0; j < whole; ++j) addTerm(8 * i + j, hit.p, sx, sy);
+  for (int j = 0; j < whole; ++j) addTerm(i, j, hit.p, sx, sy);
   float t = u_k[i] * max(sx, 0.0) * max(sy, 0.0);
   float fraction = count - float(whole);
   if (fraction > 0.0) {
-    addTerm(8 * i + whole, hit.p, sx, sy);
+    addTerm(i, whole, hit.p, sx, sy);
     t = mix(t, u_k[i] * max(sx, 0.0) * max(sy, 0.0), fraction);
   }
   return t;

@@ -206,7 +206,8 @@ FloatImage renderReference(const Scene& scene, const ReferenceSettings& settings
   const Camera& camera = scene.camera;
   FloatImage image{camera.width, camera.height,
                    std::vector<float>(std::size_t(camera.width) * camera.height * 4)};
-  const ReferenceTracer tracer(scene);
+  const Scene with_fields = scene.fields.empty() ? Scene{} : withFieldClouds(scene);
+  const ReferenceTracer tracer(scene.fields.empty() ? scene : with_fields);
   const ViewBasis basis = viewBasis(camera);
   const int n = std::max(1, settings.samples_per_axis);
 

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <numbers>
 
 #include "world/counter_random.h"
 #include "world/textures/layer_texture.h"
@@ -11,135 +10,140 @@
 namespace nephele {
 namespace {
 
-// How a stratiform type looks as a Gardner sky plane: base frequencies (radians per metre),
-// term count, contrast offset T0, transition D, colour and shading.
-struct PlaneLook {
+// How a genus is drawn (MODEL.md section 10): Gardner sky-plane texture (base frequencies in
+// radians per metre, term count, contrast offset T0, lattice-breaking rotation), its
+// transition D and shading, how many planes stand through the layer's thickness, and whether
+// the genus is convective (a field of heaps, this plane only as the deck under them).
+struct GenusLook {
   double fx1, fy1;
   int terms;
-  double t0, transition, grey, ambient, texture_fraction;
+  double t0, rotation_deg, transition, grey, ambient, texture_fraction;
+  int planes;
+  bool heaps;
 };
 
-// Indexed by CloudType; the convective types (cumulus, cumulonimbus) are drawn as heaps.
-constexpr std::array<PlaneLook, kCloudTypeCount> kPlaneLooks{{
-    {0, 0, 0, 0, 0, 0, 0, 0},                            // none
-    {3.0e-3, 3.0e-3, 6, 0.5, 0.20, 0.92, 0.60, 0.50},    // altocumulus: mid-level cells
-    {1.0e-3, 0.8e-3, 5, 2.0, 0.30, 0.75, 0.65, 0.35},    // altostratus: grey sheet
-    {8.0e-3, 8.0e-3, 6, 0.5, 0.30, 1.00, 0.70, 0.50},    // cirrocumulus: small ripples
-    {0.3e-3, 0.3e-3, 4, 1.0, 0.80, 1.00, 0.75, 0.30},    // cirrostratus: thin veil
-    {0.5e-3, 0.25e-3, 7, 0.25, 0.50, 1.00, 0.70, 0.60},  // cirrus: streaks
-    {0, 0, 0, 0, 0, 0, 0, 0},                            // cumulonimbus (heaps)
-    {0, 0, 0, 0, 0, 0, 0, 0},                            // cumulus (heaps)
-    {3.0e-3, 2.5e-3, 5, 3.0, 0.05, 0.45, 0.70, 0.40},    // nimbostratus: dark, uniform
-    {2.0e-3, 1.6e-3, 6, 0.8, 0.15, 0.80, 0.60, 0.55},    // stratocumulus: large lumps
-    {4.0e-3, 3.0e-3, 5, 2.0, 0.22, 0.78, 0.65, 0.45},    // stratus: low grey deck
+// Indexed by CloudType.
+constexpr std::array<GenusLook, kCloudTypeCount> kLooks{{
+    {0, 0, 1, 0, 0, 0, 0, 0, 0, 0, false},                              // none
+    {3.0e-3, 3.0e-3, 6, 0.5, 90.0, 0.12, 0.95, 0.55, 0.50, 1, false},   // altocumulus: cells
+    {1.2e-3, 1.2e-3, 5, 2.0, 90.0, 0.50, 0.72, 0.70, 0.35, 2, false},   // altostratus: sheet
+    {8.0e-3, 6.5e-3, 6, 0.5, 90.0, 0.15, 1.00, 0.70, 0.50, 1, false},   // cirrocumulus: ripples
+    {1.0e-3, 1.0e-3, 4, 2.0, 90.0, 1.20, 1.00, 0.80, 0.30, 1, false},   // cirrostratus: veil
+    {1.0e-3, 0.35e-3, 5, 0.2, 30.0, 0.50, 1.00, 0.75, 0.60, 1, false},  // cirrus: streaks
+    {1.0e-3, 1.0e-3, 4, 2.0, 90.0, 0.80, 0.42, 0.80, 0.30, 1, true},    // cumulonimbus: deck
+    {2.0e-3, 1.6e-3, 6, 0.6, 90.0, 0.12, 0.82, 0.55, 0.55, 1, true},    // cumulus: Sc deck
+    {1.0e-3, 1.0e-3, 4, 2.0, 90.0, 0.80, 0.42, 0.80, 0.30, 3, false},   // nimbostratus: deck
+    {2.0e-3, 1.6e-3, 6, 0.6, 90.0, 0.12, 0.82, 0.55, 0.55, 1, false},   // stratocumulus: lumps
+    {1.5e-3, 1.5e-3, 4, 2.5, 90.0, 0.60, 0.66, 0.75, 0.30, 2, false},   // stratus: grey sheet
 }};
 
-constexpr std::array<std::string_view, kCloudTypeCount> kNames{
-    "none",         "altocumulus", "altostratus",  "cirrocumulus",  "cirrostratus", "cirrus",
-    "cumulonimbus", "cumulus",     "nimbostratus", "stratocumulus", "stratus"};
-
-// Texture values on a grid over one period, sorted.
+// Texture values at seeded points spread over 24 x 24 texture periods (the texture has no
+// period once rotated), sorted.
 std::vector<double> sortedSamples(const LayerTextureSpec& spec) {
-  constexpr int kGrid = 96;  // samples per period axis
-  const LayerTexture texture(spec);
-  const glm::dvec2 period = texture.period();
+  constexpr int kSamples = 16384;
+  constexpr double kSpan = 24.0;  // periods
+  LayerTextureSpec still = spec;
+  still.drift_velocity = still.drift_offset_m = glm::dvec2(0.0);
+  const LayerTexture texture(still);
+  const glm::dvec2 span = kSpan * texture.period();
   std::vector<double> values;
-  values.reserve(kGrid * kGrid);
-  for (int j = 0; j < kGrid; ++j)
-    for (int i = 0; i < kGrid; ++i)
-      values.push_back(
-          texture.value({(i + 0.5) / kGrid * period.x, (j + 0.5) / kGrid * period.y}, 0.0));
+  values.reserve(kSamples);
+  for (int k = 0; k < kSamples; ++k) {
+    const glm::dvec2 u(unitFromBits(hashCounters(0x436f76ull, std::uint64_t(k), 0)),
+                       unitFromBits(hashCounters(0x436f76ull, std::uint64_t(k), 1)));
+    values.push_back(texture.value(u * span, 0.0));
+  }
   std::sort(values.begin(), values.end());
   return values;
 }
 
-double positiveFraction(const LayerTextureSpec& spec) {
-  const std::vector<double> values = sortedSamples(spec);
-  const auto zeros = std::upper_bound(values.begin(), values.end(), 0.0) - values.begin();
-  return 1.0 - double(zeros) / double(values.size());
+double positiveFraction(const std::vector<double>& sorted) {
+  const auto zeros = std::upper_bound(sorted.begin(), sorted.end(), 0.0) - sorted.begin();
+  return 1.0 - double(zeros) / double(sorted.size());
 }
 
-bool isConvective(CloudType type) {
-  return type == CloudType::kCumulus || type == CloudType::kCumulonimbus;
-}
-
-CloudLayer planeLayer(const WeatherLayer& w, const std::string& name, std::uint64_t seed) {
-  const PlaneLook& look = kPlaneLooks[std::size_t(w.type)];
+// The planes of a stratiform layer, or the deck under heaps, covering `coverage`.
+std::vector<CloudLayer> planes(const WeatherLayer& w, const GenusLook& look, double coverage,
+                               const std::string& prefix, std::uint64_t seed) {
   CloudLayer layer;
-  layer.name = name;
-  layer.altitude_m = w.base_m;  // the plane is the cloud base, which is what is seen from below
   layer.colour = glm::dvec3(look.grey);
   layer.transition = look.transition;
   layer.shading.ambient = look.ambient;
   layer.shading.texture_fraction = look.texture_fraction;
-  layer.texture.source = TextureSource::kGardner;
-  layer.texture.gardner.fx1 = look.fx1;
-  layer.texture.gardner.fy1 = look.fy1;
-  layer.texture.gardner.terms = look.terms;
-  layer.texture.gardner.t0 = look.t0;
-  layer.texture.seed = seed;
-  // Gardner's T is zero wherever a sum of sines is negative, which caps the coverage any T1
-  // can give; raise T0 (fewer zeros, less contrast) until the asked coverage is within reach.
+  LayerTextureSpec& t = layer.texture;
+  t.source = TextureSource::kGardner;
+  t.gardner.fx1 = look.fx1;
+  t.gardner.fy1 = look.fy1;
+  t.gardner.terms = look.terms;
+  t.gardner.t0 = look.t0;
+  t.gardner.rotation_deg = look.rotation_deg;
+  t.seed = seed;
+  // Gardner's T is zero wherever a sum of sines is negative, so no threshold separates
+  // coverages between the positive fraction and 1; raise T0 (less contrast) until the asked
+  // coverage is below the positive fraction.
   constexpr double kMaxT0 = 8.0;
-  while (w.coverage < 1.0 && layer.texture.gardner.t0 < kMaxT0 &&
-         positiveFraction(layer.texture) < w.coverage + 0.02)
-    layer.texture.gardner.t0 += 0.25;
-  layer.threshold = thresholdForCoverage(layer.texture, w.coverage);
-  return layer;
-}
-
-// Heaps over a disc around `centre`, as many as cover `coverage` of it (at most kMaxHeaps),
-// each as wide as about 1.2 times the layer's thickness.
-std::vector<EllipsoidCloud> heapField(const WeatherLayer& w, const std::string& prefix,
-                                      glm::dvec2 centre, std::uint64_t seed) {
-  const bool cb = w.type == CloudType::kCumulonimbus;
-  const double width = std::clamp(1.2 * w.thickness_m, 200.0, 8000.0);
-  const double radius = WeatherLimits::kFieldRadius;
-  const double footprint = 0.25 * width * width;  // (w/2)^2; the disc areas' pi cancels
-  const int count = w.coverage <= 0.0
-                        ? 0
-                        : std::clamp(int(std::lround(w.coverage * radius * radius / footprint)), 1,
-                                     WeatherLimits::kMaxHeaps);
-  std::vector<EllipsoidCloud> out;
-  for (int i = 0; i < count; ++i) {
-    // Uniform over the disc: radius from the square root of a uniform draw.
-    const double r = radius * std::sqrt(unitFromBits(hashCounters(seed, 1, std::uint64_t(i))));
-    const double a = 2.0 * std::numbers::pi * unitFromBits(hashCounters(seed, 2, std::uint64_t(i)));
-    const glm::dvec3 base(centre + r * glm::dvec2(std::cos(a), std::sin(a)), w.base_m);
-    EllipsoidCloud cloud;
-    cloud.name = prefix + "/heap" + std::to_string(i);
-    cloud.colour = glm::dvec3(cb ? 0.7 : 1.0);
-    cloud.texture.seed = hashCounters(seed, 3, std::uint64_t(i));
-    cloud.ellipsoids = cumulusEllipsoids(cb ? 48 : 27, base, width, cloud.texture.seed);
-    out.push_back(std::move(cloud));
+  while (coverage < 1.0 && t.gardner.t0 < kMaxT0 &&
+         positiveFraction(sortedSamples(t)) < coverage + 0.02)
+    t.gardner.t0 += 0.25;
+  const int count = look.planes;
+  layer.threshold = thresholdForCoverage(t, layer.transition, count, coverage);
+  std::vector<CloudLayer> out;
+  for (int k = 0; k < count; ++k) {
+    CloudLayer plane = layer;
+    plane.name = k == 0 ? prefix : prefix + "/" + std::to_string(k);
+    plane.altitude_m = w.base_m + (count == 1 ? 0.0 : w.thickness_m * k / (count - 1));
+    out.push_back(plane);
   }
   return out;
 }
 
 }  // namespace
 
-std::string_view cloudTypeName(CloudType type) {
-  const int i = int(type);
-  return i >= 0 && i < kCloudTypeCount ? kNames[std::size_t(i)] : "unknown";
-}
-
-WeatherClouds weatherClouds(const WeatherLayer& weather, const std::string& prefix,
-                            glm::dvec2 field_centre, std::uint64_t seed) {
+WeatherClouds weatherClouds(const WeatherLayer& w, const std::string& prefix, std::uint64_t seed) {
   WeatherClouds out;
-  if (weather.type == CloudType::kNone || weather.coverage <= 0.0) return out;
-  if (isConvective(weather.type))
-    out.clouds = heapField(weather, prefix, field_centre, seed);
-  else
-    out.layers.push_back(planeLayer(weather, prefix, seed));
+  if (w.type == CloudType::kNone || !(w.coverage > 0.0) || !weatherLayerError(w).empty())
+    return out;
+  const GenusLook& look = kLooks[std::size_t(w.type)];
+  const double coverage = std::min(w.coverage, 1.0);
+  if (!look.heaps) {
+    out.layers = planes(w, look, coverage, prefix, seed);
+    return out;
+  }
+  // Heaps cover up to CloudField::kMaxFieldCoverage; a deck independent of them covers the
+  // rest, so that together 1 - (1 - heaps) (1 - deck) is the coverage asked.
+  CloudField field;
+  field.name = prefix + "/heaps";
+  field.type = w.type;
+  field.base_m = w.base_m;
+  field.thickness_m = w.thickness_m;
+  field.coverage = std::min(coverage, CloudField::kMaxFieldCoverage);
+  field.seed = hashCounters(seed, 0x48656170ull);
+  out.fields.push_back(field);
+  if (coverage > field.coverage) {
+    const double deck = coverage >= 1.0 ? 1.0 : 1.0 - (1.0 - coverage) / (1.0 - field.coverage);
+    out.layers = planes(w, look, deck, prefix + "/deck", seed);
+  }
   return out;
 }
 
-double thresholdForCoverage(const LayerTextureSpec& spec, double coverage) {
+std::uint64_t weatherSeed(std::uint64_t scene_seed, int layer) {
+  return hashCounters(scene_seed, 0x57656174686572ull, std::uint64_t(layer));
+}
+
+double thresholdForCoverage(const LayerTextureSpec& spec, double transition, int planes,
+                            double coverage) {
   const std::vector<double> values = sortedSamples(spec);
+  // Through k identical planes of opacity a each, 1 - (1 - a)^k >= 1/2 where
+  // a >= 1 - 2^(-1/k); eq. 9 gives a = (T - T1) / D, so T >= T1 + a D.
+  const double level = 1.0 - std::pow(0.5, 1.0 / std::max(planes, 1));
+  const double shift = level * transition;
   const double c = std::clamp(coverage, 0.0, 1.0);
-  if (c >= 1.0) return values.front() - 1e-3;
-  if (c <= 0.0) return values.back() + 1e-3;
-  return values[std::size_t(std::floor((1.0 - c) * double(values.size())))];
+  // D = 0 is a hard threshold: opaque where T > T1.
+  const double margin = 1e-6 + 1e-3 * transition;
+  // A full cover is drawn opaque (a = 1 on every plane), not merely at opacity 1/2.
+  if (c >= 1.0) return values.front() - transition - margin;
+  if (c <= 0.0) return values.back() - shift + margin;
+  return values[std::size_t(std::floor((1.0 - c) * double(values.size())))] - shift;
 }
 
 }  // namespace nephele

@@ -31,11 +31,32 @@ GardnerTexture::GardnerTexture(const GardnerTextureParams& params) : params_(par
     c_[i] = c;
     amplitude_sum += c;
     c *= kAmplitudeRatio;
-    if (params_.seeded_phases) {
-      phx_[i] = 2.0 * kPi * unitFromBits(hashCounters(params_.seed, 0x47617264ull, i, 0));
-      phy_[i] = 2.0 * kPi * unitFromBits(hashCounters(params_.seed, 0x47617264ull, i, 1));
+    for (int k = 0; k < 2; ++k) {
+      if (params_.seeded_phases && (k == 0 || !periodic())) {
+        phx_[i][k] = 2.0 * kPi * unitFromBits(hashCounters(params_.seed, 0x47617264ull, i, 2 * k));
+        phy_[i][k] =
+            2.0 * kPi * unitFromBits(hashCounters(params_.seed, 0x47617264ull, i, 2 * k + 1));
+      }
+      ax_[i][k] = ay_[i][k] = {1.0, 0.0};
+    }
+    if (!periodic()) {
+      // Each component of SX and of SY turns by its own angle r (2u - 1), r = rotation_deg.
+      const double r = params_.rotation_deg * kPi / 180.0;
+      auto axis = [&](std::uint64_t which) {
+        const double u = unitFromBits(hashCounters(params_.seed, 0x526f7461ull, i, which));
+        const double angle = r * (2.0 * u - 1.0);
+        return glm::dvec2(std::cos(angle), std::sin(angle));
+      };
+      for (int k = 0; k < 2; ++k) {
+        ax_[i][k] = axis(2 * k);
+        ay_[i][k] = axis(2 * k + 1);
+      }
     }
   }
+  // Two components of C / sqrt 2 keep each term's power; their sum can reach sqrt 2 C, which
+  // k then allows for so that T stays within [0, 1].
+  component_scale_ = periodic() ? 1.0 : 1.0 / std::sqrt(2.0);
+  if (!periodic()) amplitude_sum *= std::sqrt(2.0);
   const double denom = amplitude_sum + params_.t0;
   k_ = 1.0 / (denom * denom);
 }
@@ -54,15 +75,27 @@ double GardnerTexture::solid(glm::dvec3 p, double term_count) const {
 
 void GardnerTexture::addTerm(int i, glm::dvec3 p, bool solid, double& sx, double& sy) const {
   // Planar phases, plus the Z term for solid textures (MODEL.md section 2).
-  double px = 0.5 * kPi * std::sin(0.5 * fy_[i] * p.y);
-  double py = 0.5 * kPi * std::sin(0.5 * fx_[i] * p.x);
-  if (solid) {
-    const double pz = kPi * std::sin(0.5 * fx_[i] * p.z);
-    px += pz;
-    py += pz;
+  if (solid || periodic()) {
+    double px = 0.5 * kPi * std::sin(0.5 * fy_[i] * p.y);
+    double py = 0.5 * kPi * std::sin(0.5 * fx_[i] * p.x);
+    if (solid) {
+      const double pz = kPi * std::sin(0.5 * fx_[i] * p.z);
+      px += pz;
+      py += pz;
+    }
+    sx += c_[i] * std::sin(fx_[i] * p.x + px + phx_[i][0]);
+    sy += c_[i] * std::sin(fy_[i] * p.y + py + phy_[i][0]);
+    return;
   }
-  sx += c_[i] * std::sin(fx_[i] * p.x + px + phx_[i]);
-  sy += c_[i] * std::sin(fy_[i] * p.y + py + phy_[i]);
+  // Lattice breaking: each component reads (x, y) in its own rotated axes.
+  for (int k = 0; k < 2; ++k) {
+    const glm::dvec2 a = ax_[i][k], b = ay_[i][k];
+    const double x1 = a.x * p.x + a.y * p.y, y1 = a.x * p.y - a.y * p.x;
+    const double x2 = b.x * p.x + b.y * p.y, y2 = b.x * p.y - b.y * p.x;
+    const double c = c_[i] * component_scale_;
+    sx += c * std::sin(fx_[i] * x1 + 0.5 * kPi * std::sin(0.5 * fy_[i] * y1) + phx_[i][k]);
+    sy += c * std::sin(fy_[i] * y2 + 0.5 * kPi * std::sin(0.5 * fx_[i] * x2) + phy_[i][k]);
+  }
 }
 
 double GardnerTexture::evaluate(glm::dvec3 p, bool solid, double term_count) const {

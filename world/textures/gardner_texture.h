@@ -15,6 +15,13 @@ struct GardnerTextureParams {
   double t0 = 0.0;            // contrast offset, >= 0
   bool seeded_phases = true;  // add a seed-derived constant phase per term
   std::uint64_t seed = 0;
+  // Lattice breaking (MODEL.md section 2). 0 is Gardner's texture exactly. Otherwise each
+  // planar term of SX and of SY is two components of amplitude C(i) / sqrt 2 (the same power),
+  // each in its own axes, turned by a seed-derived angle uniform in [-rotation_deg,
+  // rotation_deg], and with its own phases: the octaves and their powers stay Gardner's, but no
+  // single lattice carries much of the power, and the sum never repeats. Solid textures
+  // ignore it.
+  double rotation_deg = 0.0;
 };
 
 // How terms above the local sampling frequency are removed (MODEL.md section 2).
@@ -33,12 +40,23 @@ class GardnerTexture {
   double frequencyX(int i) const { return fx_[i]; }  // i is 0-based
   double frequencyY(int i) const { return fy_[i]; }
   double amplitude(int i) const { return c_[i]; }
-  double phaseX(int i) const { return phx_[i]; }  // seed-derived constant phase, radians
-  double phaseY(int i) const { return phy_[i]; }
+  // Seed-derived constant phases, radians, of term i's component c (0 unless rotated).
+  double phaseX(int i, int c = 0) const { return phx_[i][c]; }
+  double phaseY(int i, int c = 0) const { return phy_[i][c]; }
   double normalisation() const { return k_; }  // k = 1 / (sum C + T0)^2
+  // Components per term: 1 for Gardner's lattice, 2 when rotated; each has amplitude
+  // amplitude(i) / sqrt(components()).
+  int components() const { return periodic() ? 1 : 2; }
+  double componentAmplitude(int i) const { return c_[i] * component_scale_; }
+  // Unit X axis of component c of term i in SX and in SY (the Y axis is that turned 90
+  // degrees anticlockwise); (1, 0) when rotation_deg is 0.
+  glm::dvec2 axisX(int i, int c) const { return ax_[i][c]; }
+  glm::dvec2 axisY(int i, int c) const { return ay_[i][c]; }
+  // False when the terms are rotated: the planar texture then never repeats.
+  bool periodic() const { return params_.rotation_deg == 0.0; }
 
   // Repeat lengths in metres: 4 pi / FX1 and 4 pi / FY1 (the phase terms run at half the
-  // base frequency).
+  // base frequency). For a rotated texture, the scale the term filter measures footprints in.
   glm::dvec2 period() const;
 
   // T at a planar point, drift already removed, with `term_count` terms in [0, n]; a
@@ -60,8 +78,11 @@ class GardnerTexture {
   double fx_[GardnerTextureParams::kMaxTerms]{};
   double fy_[GardnerTextureParams::kMaxTerms]{};
   double c_[GardnerTextureParams::kMaxTerms]{};
-  double phx_[GardnerTextureParams::kMaxTerms]{};
-  double phy_[GardnerTextureParams::kMaxTerms]{};
+  double phx_[GardnerTextureParams::kMaxTerms][2]{};
+  double phy_[GardnerTextureParams::kMaxTerms][2]{};
+  glm::dvec2 ax_[GardnerTextureParams::kMaxTerms][2];
+  glm::dvec2 ay_[GardnerTextureParams::kMaxTerms][2];
+  double component_scale_ = 1.0;
   double k_ = 1.0;
 };
 

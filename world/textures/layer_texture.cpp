@@ -40,6 +40,8 @@ glm::dvec2 LayerTexture::period() const {
 }
 
 glm::dvec2 LayerTexture::driftOffset(double time_s) const {
+  // Without a period there is nothing to wrap by; double keeps a drift of 10^7 m to 2 nm.
+  if (!periodic()) return spec_.drift_offset_m + spec_.drift_velocity * time_s;
   const glm::dvec2 p = period();
   // Reduce time modulo the time one period takes to pass, so velocity * time stays exact
   // after hours of drift.
@@ -59,6 +61,7 @@ glm::dvec2 LayerTexture::periodicCoordinate(glm::dvec2 world_xy, double time_s) 
 }
 
 double LayerTexture::value(glm::dvec2 world_xy, double time_s) const {
+  if (!periodic()) return gardner_->planar(world_xy - driftOffset(time_s));
   const glm::dvec2 uv = periodicCoordinate(world_xy, time_s);
   if (gardner_) return gardner_->planar(uv * period());
   return table_->sampleBilinear(uv);

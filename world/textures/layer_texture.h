@@ -41,11 +41,15 @@ class LayerTexture {
   explicit LayerTexture(const LayerTextureSpec& spec);
 
   const LayerTextureSpec& spec() const { return spec_; }
-  // Repeat lengths in metres.
+  // Repeat lengths in metres (for a rotated Gardner texture, which never repeats, its scale).
   glm::dvec2 period() const;
-  // Drift offset at time t in double, wrapped into [0, period) (MODEL.md section 2).
+  // False for a Gardner texture whose terms are rotated (GardnerTextureParams::rotation_deg).
+  bool periodic() const { return !gardner_ || gardner_->periodic(); }
+  // Drift offset at time t in double, wrapped into [0, period) when the texture is periodic
+  // (MODEL.md section 2).
   glm::dvec2 driftOffset(double time_s) const;
-  // Position inside one period, in periods [0, 1), of world point p at time t.
+  // Position inside one period, in periods [0, 1), of world point p at time t (periodic
+  // textures only).
   glm::dvec2 periodicCoordinate(glm::dvec2 world_xy, double time_s) const;
   // T with every term (the reference's evaluation).
   double value(glm::dvec2 world_xy, double time_s) const;

@@ -1,0 +1,393 @@
+#include "world/formations/cloud_field.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <list>
+#include <map>
+#include <mutex>
+#include <numbers>
+#include <sstream>
+#include <tuple>
+
+#include "world/counter_random.h"
+#include "world/formations/cluster.h"
+#include "world/limits.h"
+#include "world/scene.h"
+#include "world/textures/solid_texture.h"
+
+namespace nephele {
+namespace {
+
+constexpr std::array<std::string_view, kCloudTypeCount> kNames{
+    "none",         "altocumulus", "altostratus",  "cirrocumulus",  "cirrostratus", "cirrus",
+    "cumulonimbus", "cumulus",     "nimbostratus", "stratocumulus", "stratus"};
+
+// Purposes of the counter-based draws (hashCounters' third key).
+enum Draw : std::uint64_t { kCount = 1, kX, kY, kSize, kHeight, kShape };
+
+// A heap's look (Gardner eq. 8 and 11). T1 well below zero makes the middle of every ellipsoid
+// opaque whatever the texture; T2 above one makes the limb clear; D sets how soft the edge is.
+// With these the opacity-1/2 outline seen straight down lies at rho^2 = (It - T1 - D/2) /
+// (T2 - T1) of the ellipsoid's projected radius.
+struct HeapLook {
+  double colour, ambient, texture_fraction, t1, t2, d;
+};
+constexpr HeapLook kCumulusLook{1.0, 0.38, 0.45, -0.6, 1.0, 0.3};
+constexpr HeapLook kCumulonimbusLook{0.9, 0.3, 0.4, -0.6, 1.0, 0.3};
+
+bool isCb(const CloudField& f) {
+  return f.type == CloudType::kCumulonimbus;
+}
+const HeapLook& lookOf(const CloudField& f) {
+  return isCb(f) ? kCumulonimbusLook : kCumulusLook;
+}
+
+// Typical horizontal radius of a heap's base ellipsoid, metres: heaps are about as wide as
+// they are tall (cumulus) or, for a cumulonimbus, its anvil spreads to twice its height.
+double heapRadius(const CloudField& f) {
+  return (isCb(f) ? 1.0 : 0.9) * f.thickness_m;
+}
+constexpr double kSizeVariation = 0.3;  // radius times 1 + v (2u - 1)
+
+// Beyond this many heap radii from the eye a heap keeps only the ellipsoids that set its
+// outline (its base, and a cumulonimbus's anvil); nearer, every lobe.
+constexpr double kDetailRadii = 12.0;
+
+// The ellipsoids of one heap standing on `base` (the middle of its flat bottom).
+std::vector<Ellipsoid> heapEllipsoids(const CloudField& f, glm::dvec3 base, double size,
+                                      double height, std::uint64_t seed, bool detailed) {
+  const double r = heapRadius(f) * size;
+  const double h = f.thickness_m * height;
+  std::vector<Ellipsoid> out;
+  // The flat base: wide, a third of the height, its bottom on the cloud base.
+  Ellipsoid bottom;
+  const double squash = 0.8 + 0.2 * unitFromBits(hashCounters(seed, kShape));
+  bottom.radii = {r, r * squash, (isCb(f) ? 0.12 : 0.3) * h};
+  bottom.centre = base + glm::dvec3(0.0, 0.0, bottom.radii.z);
+  bottom.orientation.heading_deg = 360.0 * unitFromBits(hashCounters(seed, kShape, 1));
+  if (!isCb(f)) out.push_back(bottom);
+  // Gardner's towers: lobes on a jittered lattice raised by a dummy dome under the middle.
+  Ellipsoid dome;
+  dome.radii = {0.45 * r, 0.45 * r, (isCb(f) ? 0.75 : 0.55) * h};
+  dome.centre = base;
+  ClusterSpec lobes;
+  lobes.element.radii = {0.38 * r, 0.38 * r, 0.3 * h};
+  if (isCb(f)) lobes.element.radii = {0.22 * r, 0.22 * r, 0.16 * h};
+  lobes.centre = glm::dvec2(base);
+  lobes.boundary_radii = glm::dvec2(0.42 * r);
+  lobes.spacing = glm::dvec2(0.3 * r);
+  lobes.altitude_m = base.z + (isCb(f) ? 0.1 : 0.25) * h;
+  lobes.size_variation = 0.25;
+  lobes.position_variation = 0.4;
+  lobes.heading_variation_deg = 90.0;
+  lobes.seed = hashCounters(seed, kShape, 2);
+  if (detailed || isCb(f)) {
+    std::vector<Ellipsoid> tower = clusterEllipsoids(lobes, {dome});
+    if (!detailed) tower.resize(std::min<std::size_t>(tower.size(), 1));
+    out.insert(out.end(), tower.begin(), tower.end());
+  }
+  if (isCb(f)) {
+    // The anvil: a second, flat cluster over a wide plateau at nine tenths of the height, so
+    // that it spreads level and droops a little at its edge ([G]: a base and a cap).
+    Ellipsoid plateau;
+    plateau.radii = {3.0 * r, 3.0 * r, 0.88 * h};
+    plateau.centre = base;
+    ClusterSpec cap;
+    cap.element.radii = {0.45 * r, 0.45 * r, 0.05 * h};
+    cap.centre = glm::dvec2(base);
+    cap.boundary_radii = glm::dvec2(0.7 * r);
+    cap.spacing = glm::dvec2(0.35 * r);  // the anvil sets the outline: kept at every distance
+    cap.altitude_m = base.z;
+    cap.size_variation = 0.2;
+    cap.position_variation = 0.3;
+    cap.heading_variation_deg = 90.0;
+    cap.seed = hashCounters(seed, kShape, 3);
+    const std::vector<Ellipsoid> anvil = clusterEllipsoids(cap, {plateau});
+    out.insert(out.end(), anvil.begin(), anvil.end());
+    bottom.radii.x *= 0.6, bottom.radii.y *= 0.6;
+    out.push_back(bottom);
+  }
+  return out;
+}
+
+EllipsoidCloud heapCloud(const CloudField& f, std::string name) {
+  const HeapLook& look = lookOf(f);
+  EllipsoidCloud cloud;
+  cloud.name = std::move(name);
+  cloud.colour = glm::dvec3(look.colour);
+  cloud.threshold_centre = look.t1;
+  cloud.threshold_limb = look.t2;
+  cloud.transition = look.d;
+  cloud.shading.ambient = look.ambient;
+  cloud.shading.texture_fraction = look.texture_fraction;
+  // One texture for the whole field (the renderer caches textures by their parameters); it is
+  // solid, so every heap shows a different part of it.
+  cloud.texture.seed = hashCounters(f.seed, 0x54657874ull);
+  cloud.texture.gardner.fx1 = cloud.texture.gardner.fy1 = 6.0 / heapRadius(f);
+  return cloud;
+}
+
+// Opacity of one cloud along the vertical ray through `xy` seen from far above: SPEC section
+// 4 in its orthographic limit, where the limb function of a vertical ray is the ray
+// quadratic's discriminant over its value through the centre.
+double nadirOpacity(const EllipsoidCloud& cloud, const SolidTexture& texture, glm::dvec2 xy) {
+  double transmittance = 1.0;
+  for (const Ellipsoid& e : cloud.ellipsoids) {
+    const glm::dmat3 w = worldToUnitSphere(e);
+    const glm::dmat3 m = glm::transpose(w) * w;
+    const glm::dvec2 d = xy - glm::dvec2(e.centre);
+    // Q(s) = a s^2 + b s + c along Z through xy, s measured from the centre's altitude.
+    const double a = m[2][2];
+    const double b = 2.0 * (m[0][2] * d.x + m[1][2] * d.y);
+    const double c = m[0][0] * d.x * d.x + 2.0 * m[0][1] * d.x * d.y + m[1][1] * d.y * d.y - 1.0;
+    const double delta = b * b - 4.0 * a * c;
+    if (delta <= 0.0) continue;
+    const double g = std::clamp(delta / (4.0 * a), 0.0, 1.0);
+    const double top = (-b + std::sqrt(delta)) / (2.0 * a);
+    const double it = texture.value(glm::dvec3(xy, e.centre.z + top) - cloud.drift_m);
+    const double excess =
+        it - cloud.threshold_centre - (cloud.threshold_limb - cloud.threshold_centre) * (1.0 - g);
+    const double tr = cloud.transition <= 0.0
+                          ? (excess <= 0.0 ? 1.0 : 0.0)
+                          : std::clamp(1.0 - excess / cloud.transition, 0.0, 1.0);
+    transmittance *= tr;
+  }
+  return 1.0 - transmittance;
+}
+
+// Mean area seen straight down with opacity >= 1/2 of one heap of size factor 1, in units of
+// heapRadius^2, measured on a few sample heaps (the shape is scale-free but for the texture,
+// which scales with the heap too). Computed once per type.
+double unitFootprint(CloudType type) {
+  auto measure = [](CloudType t) {
+    CloudField f;
+    f.type = t;
+    f.thickness_m = t == CloudType::kCumulonimbus ? 9000.0 : 1500.0;
+    const double r = heapRadius(f);
+    const SolidTexture texture(heapCloud(f, "").texture);
+    constexpr int kHeaps = 8, kGrid = 48;
+    double area = 0.0;
+    for (int k = 0; k < kHeaps; ++k) {
+      EllipsoidCloud cloud = heapCloud(f, "");
+      cloud.ellipsoids = heapEllipsoids(f, {0.0, 0.0, 1000.0}, 1.0, 1.0, hashCounters(77, k), true);
+      const double half = 2.5 * r, cell = 2.0 * half / kGrid;
+      int inside = 0;
+      for (int y = 0; y < kGrid; ++y)
+        for (int x = 0; x < kGrid; ++x)
+          inside += nadirOpacity(cloud, texture,
+                                 {-half + (x + 0.5) * cell, -half + (y + 0.5) * cell}) >= 0.5;
+      area += inside * cell * cell / (r * r);
+    }
+    return area / kHeaps;
+  };
+  static const double cumulus = measure(CloudType::kCumulus);
+  static const double cumulonimbus = measure(CloudType::kCumulonimbus);
+  return type == CloudType::kCumulonimbus ? cumulonimbus : cumulus;
+}
+
+// Heaps per square metre giving the field's coverage (Boolean model), with sizes 1 + v (2u - 1)
+// so that the mean squared size is 1 + v^2 / 3.
+double heapDensity(const CloudField& f) {
+  const double c = std::clamp(f.coverage, 0.0, CloudField::kMaxFieldCoverage);
+  const double r = heapRadius(f);
+  const double mean_area =
+      unitFootprint(f.type) * r * r * (1.0 + kSizeVariation * kSizeVariation / 3.0);
+  return -std::log1p(-c) / mean_area;
+}
+
+// Poisson count with mean `mean` from one uniform draw (inverse CDF; exact for means up to a
+// few hundred, which tiles stay well below).
+int poisson(double mean, double u) {
+  double p = std::exp(-mean), cumulative = p;
+  int k = 0;
+  while (u > cumulative && k < 10000) {
+    ++k;
+    p *= mean / k;
+    cumulative += p;
+    if (p < 1e-300 && cumulative < u) break;
+  }
+  return k;
+}
+
+struct TileKey {
+  std::string field;
+  std::int64_t i, j;
+  bool detailed;
+  auto operator<=>(const TileKey&) const = default;
+};
+
+// Tiles already built (they are pure functions of their key), most recent first; bounded.
+class TileCache {
+ public:
+  template <class Make>
+  std::shared_ptr<const EllipsoidCloud> get(const TileKey& key, Make make) {
+    {
+      std::lock_guard lock(mutex_);
+      if (auto it = index_.find(key); it != index_.end()) {
+        order_.splice(order_.begin(), order_, it->second);
+        return it->second->second;
+      }
+    }
+    auto made = std::make_shared<const EllipsoidCloud>(make());
+    std::lock_guard lock(mutex_);
+    if (index_.count(key)) return made;
+    order_.emplace_front(key, made);
+    index_[key] = order_.begin();
+    if (order_.size() > kCapacity) {
+      index_.erase(order_.back().first);
+      order_.pop_back();
+    }
+    return made;
+  }
+
+ private:
+  static constexpr std::size_t kCapacity = 8192;
+  std::mutex mutex_;
+  std::list<std::pair<TileKey, std::shared_ptr<const EllipsoidCloud>>> order_;
+  std::map<TileKey, decltype(order_)::iterator> index_;
+};
+
+std::string fieldKey(const CloudField& f) {
+  std::ostringstream key;
+  key.precision(17);
+  key << f.name << '/' << int(f.type) << '/' << f.base_m << '/' << f.thickness_m << '/'
+      << f.coverage << '/' << f.seed;
+  return key.str();
+}
+
+EllipsoidCloud makeTile(const CloudField& f, std::int64_t i, std::int64_t j, bool detailed) {
+  const double size = fieldTileSize(f);
+  const std::uint64_t tile_seed = hashCounters(f.seed, std::uint64_t(i), std::uint64_t(j));
+  const int count =
+      poisson(heapDensity(f) * size * size, unitFromBits(hashCounters(tile_seed, kCount)));
+  EllipsoidCloud cloud = heapCloud(f, f.name + "/" + std::to_string(i) + "," + std::to_string(j));
+  for (int k = 0; k < count; ++k) {
+    auto u = [&](Draw d) { return unitFromBits(hashCounters(tile_seed, d, std::uint64_t(k))); };
+    const glm::dvec3 base((double(i) + u(kX)) * size, (double(j) + u(kY)) * size, f.base_m);
+    const double s = 1.0 + kSizeVariation * (2.0 * u(kSize) - 1.0);
+    const double h = 0.8 + 0.4 * u(kHeight);
+    const std::vector<Ellipsoid> heap =
+        heapEllipsoids(f, base, s, h, hashCounters(tile_seed, kShape, std::uint64_t(k)), detailed);
+    if (cloud.ellipsoids.size() + heap.size() > std::size_t(Limits::kMaxEllipsoidsPerCloud)) break;
+    cloud.ellipsoids.insert(cloud.ellipsoids.end(), heap.begin(), heap.end());
+  }
+  return cloud;
+}
+
+TileCache& tileCache() {
+  static TileCache cache;
+  return cache;
+}
+
+}  // namespace
+
+std::string_view cloudTypeName(CloudType type) {
+  const int i = int(type);
+  return i >= 0 && i < kCloudTypeCount ? kNames[std::size_t(i)] : "unknown";
+}
+
+std::optional<CloudType> cloudTypeFromName(std::string_view name) {
+  for (int i = 0; i < kCloudTypeCount; ++i)
+    if (kNames[std::size_t(i)] == name) return CloudType(i);
+  return std::nullopt;
+}
+
+std::string weatherLayerError(const WeatherLayer& w) {
+  std::ostringstream out;
+  auto outside = [&](const char* name, double value, Range range) {
+    if (std::isfinite(value) && range.contains(value)) return false;
+    out << name << ": " << value << " is out of range (allowed: " << range.lo << " to " << range.hi
+        << ")";
+    return true;
+  };
+  if (int(w.type) < 0 || int(w.type) >= kCloudTypeCount) {
+    out << "type: " << int(w.type) << " is not a CIGI cloud type (allowed: 0 none, 1 to 10)";
+    return out.str();
+  }
+  if (outside("base", w.base_m, {0.0, Limits::kMaxBase}) ||
+      outside("thickness", w.thickness_m, Limits::kThickness) ||
+      outside("coverage", w.coverage, Limits::kFraction))
+    return out.str();
+  if (w.wind && (outside("wind x", w.wind->x, {-Limits::kMaxWind, Limits::kMaxWind}) ||
+                 outside("wind y", w.wind->y, {-Limits::kMaxWind, Limits::kMaxWind})))
+    return out.str();
+  return "";
+}
+
+double fieldTileSize(const CloudField& f) {
+  return 4.0 * heapRadius(f);
+}
+
+std::vector<EllipsoidCloud> tileClouds(const CloudField& f, std::int64_t i, std::int64_t j) {
+  std::vector<EllipsoidCloud> out;
+  EllipsoidCloud cloud = makeTile(f, i, j, true);
+  if (!cloud.ellipsoids.empty()) out.push_back(std::move(cloud));
+  return out;
+}
+
+std::vector<EllipsoidCloud> fieldClouds(const CloudField& f, const Camera& camera) {
+  std::vector<EllipsoidCloud> out;
+  if (!(f.coverage > 0.0)) return out;
+  const double size = fieldTileSize(f);
+  // The eye in the field's own frame (the field has drifted by drift_m).
+  const glm::dvec2 eye = glm::dvec2(camera.position) - f.drift_m;
+  // From high up the view reaches further: the range grows with the height above the heaps.
+  const double range = CloudField::kRangeM + 2.0 * std::abs(camera.position.z - f.base_m);
+  const ViewBasis basis = viewBasis(camera);
+  const double top = f.base_m + (isCb(f) ? 1.3 : 1.2) * f.thickness_m;
+  // A tile is kept when its box (grown by the largest heap that can reach out of it) is not
+  // wholly behind one of the view's four side planes.
+  const double reach = 3.0 * heapRadius(f) * (1.0 + kSizeVariation);
+  const double tan_v = std::tan(glm::radians(camera.vfov_deg) / 2.0);
+  const double tan_h = tan_v * camera.width / std::max(camera.height, 1);
+  const glm::dvec3 normals[4] = {glm::normalize(basis.forward * tan_h + basis.right),
+                                 glm::normalize(basis.forward * tan_h - basis.right),
+                                 glm::normalize(basis.forward * tan_v + basis.up),
+                                 glm::normalize(basis.forward * tan_v - basis.up)};
+  const std::string key = fieldKey(f);
+  const auto lo = glm::floor((eye - range) / size), hi = glm::floor((eye + range) / size);
+  for (double jy = lo.y; jy <= hi.y; ++jy)
+    for (double ix = lo.x; ix <= hi.x; ++ix) {
+      const glm::dvec2 min_xy = glm::dvec2(ix, jy) * size - reach;
+      const glm::dvec2 max_xy = glm::dvec2(ix + 1.0, jy + 1.0) * size + reach;
+      const glm::dvec2 nearest = glm::clamp(eye, min_xy, max_xy);
+      const double distance = glm::length(nearest - eye);
+      if (distance > range) continue;
+      bool outside = false;
+      for (const glm::dvec3& n : normals) {
+        bool any_inside = false;
+        for (int corner = 0; corner < 8 && !any_inside; ++corner) {
+          const glm::dvec3 p((corner & 1) ? max_xy.x : min_xy.x, (corner & 2) ? max_xy.y : min_xy.y,
+                             (corner & 4) ? top : f.base_m);
+          any_inside = glm::dot(p - glm::dvec3(eye, camera.position.z), n) >= 0.0;
+        }
+        if (!any_inside) outside = true;
+      }
+      if (outside) continue;
+      const std::int64_t i = std::int64_t(ix), j = std::int64_t(jy);
+      const bool detailed = distance < kDetailRadii * heapRadius(f);
+      const auto tile =
+          tileCache().get({key, i, j, detailed}, [&] { return makeTile(f, i, j, detailed); });
+      if (tile->ellipsoids.empty()) continue;
+      EllipsoidCloud cloud = *tile;
+      const glm::dvec3 drift(f.drift_m, 0.0);
+      for (Ellipsoid& e : cloud.ellipsoids) e.centre += drift;
+      cloud.drift_m = drift;
+      out.push_back(std::move(cloud));
+    }
+  return out;
+}
+
+Scene withFieldClouds(const Scene& scene) {
+  Scene out = scene;
+  for (const CloudField& field : scene.fields) {
+    std::vector<EllipsoidCloud> heaps = fieldClouds(field, scene.camera);
+    out.clouds.insert(out.clouds.end(), std::make_move_iterator(heaps.begin()),
+                      std::make_move_iterator(heaps.end()));
+  }
+  out.fields.clear();
+  return out;
+}
+
+}  // namespace nephele

@@ -1,0 +1,86 @@
+#pragma once
+// Weather as host simulators describe it (CIGI Weather Control: per layer a cloud type, base,
+// thickness, coverage and wind), and the convective part of it: a field of cumulus or
+// cumulonimbus heaps that exists everywhere, generated per ground tile around whichever view
+// is rendered (MODEL.md section 10). A tile's heaps depend only on (field seed, tile index),
+// so the sky is the same whatever order tiles are visited in and whichever view asks.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "world/formations/ellipsoid_cloud.h"
+#include "world/frames.h"
+
+namespace nephele {
+
+// The cloud-type enumeration of CIGI Weather Control packets, in its numbering.
+enum class CloudType : int {
+  kNone = 0,
+  kAltocumulus = 1,
+  kAltostratus = 2,
+  kCirrocumulus = 3,
+  kCirrostratus = 4,
+  kCirrus = 5,
+  kCumulonimbus = 6,
+  kCumulus = 7,
+  kNimbostratus = 8,
+  kStratocumulus = 9,
+  kStratus = 10,
+};
+inline constexpr int kCloudTypeCount = 11;
+std::string_view cloudTypeName(CloudType type);
+// The type named `name` (as cloudTypeName spells it), or nullopt.
+std::optional<CloudType> cloudTypeFromName(std::string_view name);
+
+struct WeatherLayer {
+  CloudType type = CloudType::kNone;
+  double base_m = 1000.0;          // cloud base above the ground
+  double thickness_m = 500.0;      // base to top
+  double coverage = 0.5;           // cloud fraction (SPEC section 9), 0..1
+  std::optional<glm::dvec2> wind;  // east, north m/s at this layer; unset keeps the world's
+};
+
+// Empty when the layer can be drawn, else what is wrong and what is allowed (ranges in
+// world/limits.h).
+std::string weatherLayerError(const WeatherLayer& layer);
+
+// Heaps of one convective layer, everywhere.
+struct CloudField {
+  std::string name;
+  CloudType type = CloudType::kCumulus;  // cumulus or cumulonimbus
+  double base_m = 1000.0;
+  double thickness_m = 1500.0;
+  double coverage = 0.3;  // the heaps' own cloud fraction, 0..kMaxFieldCoverage
+  std::uint64_t seed = 1;
+  glm::dvec2 drift_m{0.0, 0.0};  // how far the field has moved with the wind since time 0
+
+  // Heaps are a Boolean model (Poisson centres, random sizes): the fraction they cover is
+  // 1 - exp(-density * mean footprint) for any coverage up to 1, but above this their
+  // overlaps merge into one mass; weather layers asking for more add a deck (weather.h).
+  static constexpr double kMaxFieldCoverage = 0.6;
+  // Heaps are generated in tiles within this horizontal distance of the eye, plus twice the
+  // eye's height above the field.
+  static constexpr double kRangeM = 40000.0;
+};
+
+// Size of one heap's tile, metres (a few heaps per tile at any coverage).
+double fieldTileSize(const CloudField& field);
+
+// The heaps of tile (i, j), tile (0, 0) starting at the field's origin (before drift): a pure
+// function of (field, i, j). Names are `<field name>/<i>,<j>/<k>`.
+std::vector<EllipsoidCloud> tileClouds(const CloudField& field, std::int64_t i, std::int64_t j);
+
+// The altitude whose wind carries the field: the middle of its heaps.
+inline double fieldAltitude(const CloudField& field) {
+  return field.base_m + 0.5 * field.thickness_m;
+}
+
+// The heaps of every tile within CloudField::kRangeM of the camera whose bounds meet its
+// view, drifted into place.
+std::vector<EllipsoidCloud> fieldClouds(const CloudField& field, const Camera& camera);
+
+}  // namespace nephele
