@@ -7,6 +7,8 @@
 
 #include <complex>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <numbers>
 
 #include "gl_test_fixture.h"
@@ -231,6 +233,83 @@ TEST_F(WeatherRenderTest, NoGenusRepeatsAtHalfCover) {
     EXPECT_LT(peak, bound) << cloudTypeName(type);
     if (peak >= bound)
       writeFailureImages(image, image, "repeat_" + std::string(cloudTypeName(type)));
+  }
+}
+
+// Tiles are pure functions of (field, tile index): built in any order, or reached from any
+// view, they hold the same heaps; and a field 100 km away is the same field.
+TEST(CloudField, TilesDoNotDependOnVisitingOrder) {
+  CloudField f;
+  f.name = "f";
+  f.coverage = 0.4;
+  f.seed = 21;
+  std::vector<std::vector<EllipsoidCloud>> forward, backward;
+  for (int k = 0; k < 6; ++k) forward.push_back(tileClouds(f, k - 3, 40 + k));
+  for (int k = 5; k >= 0; --k) backward.insert(backward.begin(), tileClouds(f, k - 3, 40 + k));
+  int heaps = 0;
+  for (int k = 0; k < 6; ++k) {
+    ASSERT_EQ(forward[k].size(), backward[k].size());
+    for (std::size_t c = 0; c < forward[k].size(); ++c) {
+      ASSERT_EQ(forward[k][c].ellipsoids.size(), backward[k][c].ellipsoids.size());
+      heaps += int(forward[k][c].ellipsoids.size());
+      for (std::size_t e = 0; e < forward[k][c].ellipsoids.size(); ++e)
+        EXPECT_EQ(forward[k][c].ellipsoids[e].centre, backward[k][c].ellipsoids[e].centre);
+    }
+  }
+  EXPECT_GT(heaps, 0);
+  // Two cameras far apart looking at the same ground see the same tile.
+  Camera a, b;
+  a.position = {0.0, 0.0, 30000.0};
+  a.orientation = {0.0, -90.0, 0.0};
+  b = a;
+  b.position = {20000.0, 0.0, 30000.0};
+  b.orientation = {270.0, -50.0, 0.0};
+  auto tileNamed = [](const std::vector<EllipsoidCloud>& clouds, const std::string& name) {
+    for (const EllipsoidCloud& c : clouds)
+      if (c.name == name) return c.ellipsoids;
+    return std::vector<Ellipsoid>{};
+  };
+  const auto from_a = tileNamed(fieldClouds(f, a), "f/0,0");
+  const auto from_b = tileNamed(fieldClouds(f, b), "f/0,0");
+  ASSERT_FALSE(from_a.empty());
+  ASSERT_EQ(from_a.size(), from_b.size());
+  for (std::size_t e = 0; e < from_a.size(); ++e) EXPECT_EQ(from_a[e].centre, from_b[e].centre);
+  // Far from the origin the field is as dense as near it: heaps exist around every view.
+  Camera far = a;
+  far.position = {150000.0, -120000.0, 30000.0};
+  std::size_t near_count = 0, far_count = 0;
+  for (const EllipsoidCloud& c : fieldClouds(f, a)) near_count += c.ellipsoids.size();
+  for (const EllipsoidCloud& c : fieldClouds(f, far)) far_count += c.ellipsoids.size();
+  EXPECT_GT(far_count, near_count / 2);
+  EXPECT_LT(far_count, near_count * 2);
+}
+
+TEST(Weather, InvalidLayersAreRefusedWithTheAllowedRange) {
+  EXPECT_NE(weatherLayerError({CloudType(11), 1000.0, 500.0, 0.5, {}}).find("allowed: 0 none"),
+            std::string::npos);
+  EXPECT_NE(weatherLayerError({CloudType::kCumulus, 1000.0, -5.0, 0.5, {}}).find("thickness"),
+            std::string::npos);
+  EXPECT_NE(weatherLayerError({CloudType::kCumulus, 1000.0, 500.0, 1.5, {}}).find("coverage"),
+            std::string::npos);
+  EXPECT_NE(weatherLayerError({CloudType::kStratus, -1.0, 500.0, 0.5, {}}).find("base"),
+            std::string::npos);
+  EXPECT_EQ(weatherLayerError({CloudType::kStratus, 100.0, 500.0, 0.5, {}}), "");
+  // Nothing is drawn for a layer that is refused.
+  const WeatherClouds none = weatherClouds({CloudType::kCumulus, 1000.0, 500.0, 1.5, {}}, "w", 1);
+  EXPECT_TRUE(none.layers.empty() && none.fields.empty());
+  // Scene files name the key and the allowed values, and load nothing.
+  for (const char* bad :
+       {"type = \"cumulous\"", "coverage = 150", "thickness = -3", "base = 1e9"}) {
+    const std::filesystem::path path =
+        std::filesystem::temp_directory_path() / "nephele_weather_test.toml";
+    {
+      std::ofstream out(path);
+      out << "[[weather]]\n" << bad << "\n";
+    }
+    SceneFile file;
+    const std::string error = loadSceneFile(path.string(), file);
+    EXPECT_NE(error.find("weather[0]"), std::string::npos) << bad << ": " << error;
+    EXPECT_NE(error.find("allowed"), std::string::npos) << bad << ": " << error;
   }
 }
 
