@@ -3,6 +3,8 @@
 // the Modbus register map and the World all read their edges from here, so that a value one
 // of them accepts is never refused by another (docs/ACCURACY.md lists how each edge is
 // tested).
+#include <cmath>
+#include <ostream>
 #include <string>
 #include <string_view>
 
@@ -14,6 +16,15 @@ struct Range {
   double hi;
   constexpr bool contains(double x) const { return x >= lo && x <= hi; }
 };
+
+// Writes "name: value is out of range (allowed: lo to hi)" to `out` and returns true when
+// `value` is not finite or outside `range`; the one wording of a range error in world/.
+inline bool outOfRange(std::ostream& out, const char* name, double value, Range range) {
+  if (std::isfinite(value) && range.contains(value)) return false;
+  out << name << ": " << value << " is out of range (allowed: " << range.lo << " to " << range.hi
+      << ")";
+  return true;
+}
 
 struct Limits {
   // Camera and image.

@@ -296,10 +296,7 @@ std::optional<CloudType> cloudTypeFromName(std::string_view name) {
 std::string weatherLayerError(const WeatherLayer& w) {
   std::ostringstream out;
   auto outside = [&](const char* name, double value, Range range) {
-    if (std::isfinite(value) && range.contains(value)) return false;
-    out << name << ": " << value << " is out of range (allowed: " << range.lo << " to " << range.hi
-        << ")";
-    return true;
+    return outOfRange(out, name, value, range);
   };
   if (int(w.type) < 0 || int(w.type) >= kCloudTypeCount) {
     out << "type: " << int(w.type) << " is not a CIGI cloud type (allowed: 0 none, 1 to 10)";

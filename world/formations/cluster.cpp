@@ -20,10 +20,7 @@ long long halfCells(double radius, double spacing) {
 std::string clusterError(const ClusterSpec& s) {
   std::ostringstream out;
   auto outside = [&](const char* name, double value, Range range) {
-    if (std::isfinite(value) && range.contains(value)) return false;
-    out << name << ": " << value << " is out of range (allowed: " << range.lo << " to " << range.hi
-        << ")";
-    return true;
+    return outOfRange(out, name, value, range);
   };
   if (std::string e = ellipsoidError(s.element); !e.empty()) return "element: " + e;
   if (outside("spacing x", s.spacing.x, Limits::kClusterSpacing) ||
