@@ -51,7 +51,7 @@ double heapRadius(const CloudField& f) {
 constexpr double kSizeVariation = 0.3;  // radius times 1 + v (2u - 1)
 
 // Beyond this many heap radii from the eye a heap keeps only the ellipsoids that set its
-// outline (its base, and a cumulonimbus's anvil); nearer, every lobe.
+// outline (its base, and a cumulonimbus's anvil with one lobe of its tower); nearer, every lobe.
 constexpr double kDetailRadii = 12.0;
 
 // The ellipsoids of one heap standing on `base` (the middle of its flat bottom).
@@ -181,9 +181,13 @@ double unitFootprint(CloudType type) {
     }
     return area / kHeaps;
   };
+  // Each measured on first use only: a sky of cumulus never pays for the cumulonimbus.
+  if (type == CloudType::kCumulonimbus) {
+    static const double cumulonimbus = measure(CloudType::kCumulonimbus);
+    return cumulonimbus;
+  }
   static const double cumulus = measure(CloudType::kCumulus);
-  static const double cumulonimbus = measure(CloudType::kCumulonimbus);
-  return type == CloudType::kCumulonimbus ? cumulonimbus : cumulus;
+  return cumulus;
 }
 
 // Heaps per square metre giving the field's coverage (Boolean model), with sizes 1 + v (2u - 1)

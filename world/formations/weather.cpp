@@ -62,6 +62,22 @@ double positiveFraction(const std::vector<double>& sorted) {
   return 1.0 - double(zeros) / double(sorted.size());
 }
 
+// thresholdForCoverage on the texture's sorted samples.
+double thresholdFromSamples(const std::vector<double>& values, double transition, int planes,
+                            double coverage) {
+  // Through k identical planes of opacity a each, 1 - (1 - a)^k >= 1/2 where
+  // a >= 1 - 2^(-1/k); eq. 9 gives a = (T - T1) / D, so T >= T1 + a D.
+  const double level = 1.0 - std::pow(0.5, 1.0 / std::max(planes, 1));
+  const double shift = level * transition;
+  const double c = std::clamp(coverage, 0.0, 1.0);
+  // D = 0 is a hard threshold: opaque where T > T1.
+  const double margin = 1e-6 + 1e-3 * transition;
+  // A full cover is drawn opaque (a = 1 on every plane), not merely at opacity 1/2.
+  if (c >= 1.0) return values.front() - transition - margin;
+  if (c <= 0.0) return values.back() - shift + margin;
+  return values[std::size_t(std::floor((1.0 - c) * double(values.size())))] - shift;
+}
+
 // The planes of a stratiform layer, or the deck under heaps, covering `coverage`.
 std::vector<CloudLayer> planes(const WeatherLayer& w, const GenusLook& look, double coverage,
                                const std::string& prefix, std::uint64_t seed) {
@@ -82,11 +98,13 @@ std::vector<CloudLayer> planes(const WeatherLayer& w, const GenusLook& look, dou
   // coverages between the positive fraction and 1; raise T0 (less contrast) until the asked
   // coverage is below the positive fraction.
   constexpr double kMaxT0 = 8.0;
-  while (coverage < 1.0 && t.gardner.t0 < kMaxT0 &&
-         positiveFraction(sortedSamples(t)) < coverage + 0.02)
+  std::vector<double> samples = sortedSamples(t);
+  while (coverage < 1.0 && t.gardner.t0 < kMaxT0 && positiveFraction(samples) < coverage + 0.02) {
     t.gardner.t0 += 0.25;
+    samples = sortedSamples(t);
+  }
   const int count = look.planes;
-  layer.threshold = thresholdForCoverage(t, layer.transition, count, coverage);
+  layer.threshold = thresholdFromSamples(samples, layer.transition, count, coverage);
   std::vector<CloudLayer> out;
   for (int k = 0; k < count; ++k) {
     CloudLayer plane = layer;
@@ -132,18 +150,7 @@ std::uint64_t weatherSeed(std::uint64_t scene_seed, int layer) {
 
 double thresholdForCoverage(const LayerTextureSpec& spec, double transition, int planes,
                             double coverage) {
-  const std::vector<double> values = sortedSamples(spec);
-  // Through k identical planes of opacity a each, 1 - (1 - a)^k >= 1/2 where
-  // a >= 1 - 2^(-1/k); eq. 9 gives a = (T - T1) / D, so T >= T1 + a D.
-  const double level = 1.0 - std::pow(0.5, 1.0 / std::max(planes, 1));
-  const double shift = level * transition;
-  const double c = std::clamp(coverage, 0.0, 1.0);
-  // D = 0 is a hard threshold: opaque where T > T1.
-  const double margin = 1e-6 + 1e-3 * transition;
-  // A full cover is drawn opaque (a = 1 on every plane), not merely at opacity 1/2.
-  if (c >= 1.0) return values.front() - transition - margin;
-  if (c <= 0.0) return values.back() - shift + margin;
-  return values[std::size_t(std::floor((1.0 - c) * double(values.size())))] - shift;
+  return thresholdFromSamples(sortedSamples(spec), transition, planes, coverage);
 }
 
 }  // namespace nephele
