@@ -36,7 +36,12 @@ struct Setting {
   std::string knob;   // empty for the defaults
   std::string value;  // the knob's value, as a scene file or flag spells it
   std::function<void(RenderSettings&)> edit = [](RenderSettings&) {};
-  int samples_per_cell = 0;  // automaton lattice resolution; 0 keeps the scene's
+  // A knob of the scene rather than of the renderer (the automaton lattice, the layers'
+  // lattice breaking); null for none.
+  std::function<void(SceneFile&)> scene_edit;
+  // The knob changes the model itself (not how closely it is drawn): its error is measured
+  // against the reference image of the edited scene.
+  bool changes_model = false;
 
   std::string name() const { return knob.empty() ? "defaults" : knob + "=" + value; }
 };
@@ -54,6 +59,8 @@ struct Point {
   ImageError error;
   bool same_image = false;  // draws exactly what the defaults draw: its time is noise
   bool front = false;
+  // Takes no part in the front: the defaults timed again, or another model (another sky).
+  bool apart() const { return same_image || setting.changes_model; }
 };
 
 struct SceneResult {
@@ -75,21 +82,30 @@ std::string withKnob(double value) {
 std::vector<Setting> settingsFor(const SceneFile& file) {
   std::vector<Setting> out{{}};
   auto add = [&](std::string knob, std::string value, std::function<void(RenderSettings&)> edit) {
-    out.push_back({std::move(knob), std::move(value), std::move(edit)});
+    out.push_back({std::move(knob), std::move(value), std::move(edit), {}, false});
   };
-  const bool layers = !file.scene.layers.empty(), clouds = !file.scene.clouds.empty();
-  if (layers || clouds) {
+  // Rotated layer textures are always evaluated per pixel (no periodic table holds them), so
+  // the bake knobs act only on layers without rotation.
+  const bool layers = !file.scene.layers.empty();
+  const bool baked_layers =
+      std::any_of(file.scene.layers.begin(), file.scene.layers.end(),
+                  [](const CloudLayer& l) { return l.texture.gardner.rotation_deg == 0.0; });
+  const bool clouds = !file.scene.clouds.empty() || !file.scene.fields.empty();
+  if (baked_layers || clouds) {
     add("texture", "baked",
         [](RenderSettings& s) { s.texture_evaluation = TextureEvaluation::kBaked; });
     add("texture", "procedural",
         [](RenderSettings& s) { s.texture_evaluation = TextureEvaluation::kProcedural; });
+  }
+  if (layers || clouds) {
     add("term_filter", "cut", [](RenderSettings& s) { s.term_filter = TermFilter::kCut; });
     add("term_filter", "none", [](RenderSettings& s) { s.term_filter = TermFilter::kNone; });
   }
-  if (layers) {
+  if (baked_layers)
     for (int tpc : {2, 4, 16, 32})
       add("bake_texels_per_cycle", std::to_string(tpc),
           [tpc](RenderSettings& s) { s.bake_texels_per_cycle = tpc; });
+  if (layers) {
     add("sky_passes", "multipass", [](RenderSettings& s) { s.sky_passes = SkyPasses::kMultipass; });
   }
   if (clouds) {
@@ -117,10 +133,24 @@ std::vector<Setting> settingsFor(const SceneFile& file) {
   if (!file.dynamics.automata.empty()) {
     for (double step : {0.5, 2.0, 4.0})
       add("volume_step", withKnob(step), [step](RenderSettings& s) { s.volume_step = step; });
-    for (int samples : {1, 3}) {
-      out.push_back({"samples_per_cell", std::to_string(samples), [](RenderSettings&) {}, samples});
-    }
+    for (int samples : {1, 3})
+      out.push_back({"samples_per_cell", std::to_string(samples), [](RenderSettings&) {},
+                     [samples](SceneFile& f) {
+                       for (AutomatonCloudSpec& a : f.dynamics.automata)
+                         a.samples_per_cell = samples;
+                     }});
   }
+  // Lattice breaking (MODEL.md section 2) on layers that have it: 0 is Gardner's periodic
+  // texture, which the renderer can bake; rotated terms are evaluated per pixel.
+  if (std::any_of(file.scene.layers.begin(), file.scene.layers.end(),
+                  [](const CloudLayer& l) { return l.texture.gardner.rotation_deg > 0.0; }))
+    for (double degrees : {0.0, 15.0})
+      out.push_back({"rotation", withKnob(degrees), [](RenderSettings&) {},
+                     [degrees](SceneFile& f) {
+                       for (CloudLayer& l : f.scene.layers)
+                         l.texture.gardner.rotation_deg = degrees;
+                     },
+                     true});
   return out;
 }
 
@@ -161,6 +191,8 @@ constexpr SceneEntry kScenes[] = {
     {"automaton", "automaton_cloud", "one automaton cloud of 20x20x20 cells"},
     {"harbour", "harbour", "Shen's harbour: 20 automaton clouds, sea fog"},
     {"inside", "inside_cloud", "a camera inside the edge of a cloud lobe"},
+    {"altocumulus", "genus_altocumulus", "altocumulus from the weather mapping, from the ground"},
+    {"cumulus_field", "genus_cumulus", "a cumulus field from the weather mapping, from the ground"},
 };
 
 // "cirrus, stratus, ...": the names --scenes allows.
@@ -183,11 +215,11 @@ std::string loadScenes(std::vector<BenchScene>& out) {
 
 // Pareto front over (time, colour RMSE): no other point is as fast and as accurate and
 // better in one of them. A setting that draws the defaults' image exactly is the defaults
-// timed again, so it takes no part.
+// timed again, and one that changes the model draws another sky, so neither takes part.
 void markFront(std::vector<Point>& points) {
   for (Point& p : points) {
-    p.front = !p.same_image && std::none_of(points.begin(), points.end(), [&](const Point& q) {
-      return !q.same_image && q.ms <= p.ms && q.error.rms <= p.error.rms &&
+    p.front = !p.apart() && std::none_of(points.begin(), points.end(), [&](const Point& q) {
+      return !q.apart() && q.ms <= p.ms && q.error.rms <= p.error.rms &&
              (q.ms < p.ms || q.error.rms < p.error.rms);
     });
   }
@@ -199,7 +231,7 @@ std::string defaultStatus(const std::vector<Point>& points) {
   const Point& d = points.front();
   if (d.front) return "on the front";
   for (const Point& q : points) {
-    if (q.same_image) continue;
+    if (q.apart()) continue;
     const bool much_faster = q.ms < 0.9 * d.ms && q.error.rms <= d.error.rms;
     const bool much_better = q.error.rms < 0.9 * d.error.rms && q.ms <= d.ms;
     if (much_faster || much_better) return "dominated by " + q.setting.name();
@@ -222,14 +254,15 @@ void printScene(const SceneResult& r, int width, int height, int samples) {
   for (const Point& p : r.points) {
     const ImageError& e = p.error;
     std::printf("%s %-46s %9.2f %7.1f %8s %8.5f %7.4f %8s %8.5f %7.4f%s\n",
-                p.front        ? "*"
-                : p.same_image ? "="
-                               : " ",
+                p.front                   ? "*"
+                : p.same_image            ? "="
+                : p.setting.changes_model ? "m"
+                                          : " ",
                 p.setting.name().c_str(), p.ms, p.floor_multiple, fixed(e.psnr_db, 1).c_str(),
                 e.rms, e.max_abs, fixed(e.coverage_psnr, 1).c_str(), e.coverage_rms, e.coverage_max,
                 e.non_finite ? "  NON-FINITE" : "");
   }
-  std::printf("  defaults: %s   (* front, = same image as the defaults)\n",
+  std::printf("  defaults: %s   (* front, = same image as the defaults, m another model)\n",
               r.default_status.c_str());
   std::fflush(stdout);
 }
@@ -264,9 +297,10 @@ void writeMarkdown(const std::filesystem::path& path, const std::vector<SceneRes
           << " | " << fixed(e.rms, 5) << " | " << fixed(e.max_abs, 4) << " | "
           << fixed(e.coverage_psnr, 1) << " | " << fixed(e.coverage_rms, 5) << " | "
           << fixed(e.coverage_max, 4) << " | "
-          << (p.front        ? "yes"
-              : p.same_image ? "same image"
-                             : "")
+          << (p.front                   ? "yes"
+              : p.same_image            ? "same image"
+              : p.setting.changes_model ? "another model"
+                                        : "")
           << " |\n";
     }
     out << "\n";
@@ -428,16 +462,21 @@ int runBenchCommand(const BenchCommandOptions& o) {
     for (std::size_t k = 0; k < settings.size(); ++k) {
       const Setting& setting = settings[k];
       setting.edit(renders[k]);
-      if (setting.samples_per_cell > 0) {
+      if (setting.scene_edit) {
         SceneFile file = bench_scene.file;
-        for (AutomatonCloudSpec& a : file.dynamics.automata)
-          a.samples_per_cell = setting.samples_per_cell;
+        setting.scene_edit(file);
         edited[k] = sceneAtTime(file);
       }
       Point point;
       point.setting = setting;
       const FloatImage image = renderer.renderFloat(edited[k], renders[k]);
-      point.error = compareImages(image, reference);
+      if (setting.changes_model) {
+        if (tty)
+          std::fprintf(stderr, "\r%s: reference for %s", tag.c_str(), setting.name().c_str());
+        point.error = compareImages(image, renderReference(edited[k], {samples, 0}));
+      } else {
+        point.error = compareImages(image, reference);
+      }
       if (k == 0)
         defaults_image = image;
       else

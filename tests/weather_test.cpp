@@ -24,27 +24,6 @@ constexpr CloudType kGenera[] = {CloudType::kAltocumulus,   CloudType::kAltostra
                                  CloudType::kCumulus,       CloudType::kNimbostratus,
                                  CloudType::kStratocumulus, CloudType::kStratus};
 
-// A base and thickness typical of each genus (WMO cloud atlas bands), metres.
-WeatherLayer typical(CloudType type, double coverage) {
-  switch (type) {
-    case CloudType::kCirrus:
-    case CloudType::kCirrocumulus:
-    case CloudType::kCirrostratus:
-      return {type, 8000.0, 600.0, coverage, {}};
-    case CloudType::kAltocumulus:
-    case CloudType::kAltostratus:
-      return {type, 4000.0, 700.0, coverage, {}};
-    case CloudType::kNimbostratus:
-      return {type, 900.0, 2500.0, coverage, {}};
-    case CloudType::kCumulonimbus:
-      return {type, 900.0, 9000.0, coverage, {}};
-    case CloudType::kCumulus:
-      return {type, 1200.0, 1200.0, coverage, {}};
-    default:
-      return {type, 700.0, 500.0, coverage, {}};
-  }
-}
-
 Scene weatherScene(const WeatherLayer& w, std::uint64_t seed) {
   Scene scene;
   const WeatherClouds add = weatherClouds(w, "w", seed);
@@ -206,7 +185,7 @@ TEST_F(WeatherRenderTest, EveryGenusDrawsTheCoverageAsked) {
     std::printf("%-14s", std::string(cloudTypeName(type)).c_str());
     double previous = 0.0;
     for (double c : {0.1, 0.3, 0.5, 0.7, 0.9, 1.0}) {
-      const double drawn = drawnFraction(typical(type, c), 11);
+      const double drawn = drawnFraction(typicalWeatherLayer(type, c), 11);
       std::printf(" %6.3f", drawn);
       std::fflush(stdout);
       EXPECT_NEAR(drawn, c, 0.05) << cloudTypeName(type) << " at " << c;
@@ -219,7 +198,7 @@ TEST_F(WeatherRenderTest, EveryGenusDrawsTheCoverageAsked) {
 
 TEST_F(WeatherRenderTest, NoGenusRepeatsAtHalfCover) {
   for (CloudType type : kGenera) {
-    const WeatherLayer w = typical(type, 0.5);
+    const WeatherLayer w = typicalWeatherLayer(type, 0.5);
     Scene scene = weatherScene(w, 11);
     // Several texture periods (or heap tiles) across, so a lattice would show as a peak.
     scene.camera = nadir(w, {3000.0, -2000.0}, 5.0 * featureScale(scene), 256);

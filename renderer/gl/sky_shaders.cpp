@@ -231,7 +231,9 @@ float proceduralValue(int i, LayerHit hit) {
 }
 #endif
 
-// Slot i's surface "over" what lies behind it.
+// Slot i's surface under what lies in front of it: layers are composited nearest first, so
+// `colour` holds the premultiplied sum of the surfaces in front and `transmittance` what they
+// let through ("over" summed front to back, the same sum as back to front).
 void composite(int i, vec3 r, LayerHit hit, float it, inout vec3 colour,
                inout float transmittance) {
   float tr = translucence(it - u_threshold[i], u_transition[i]);  // Gardner eq. 9
@@ -248,7 +250,7 @@ void composite(int i, vec3 r, LayerHit hit, float it, inout vec3 colour,
 #ifdef FOG
   surface = applyFog(surface, normalize(r), hit.distance);
 #endif
-  colour = mix(colour, surface, 1.0 - tr);
+  colour += transmittance * (1.0 - tr) * surface;
   transmittance *= tr;
 }
 )";
@@ -267,8 +269,11 @@ std::string slotStatement(int slot, LayerKind kind) {
       value = "proceduralValue(" + i + ", hit)";
       break;
   }
-  return "    { LayerHit hit = hitLayer(" + i + ", r); if (inFront(hit.distance)) composite(" + i +
-         ", r, hit, " + value + ", colour, transmittance); }\n";
+  // Behind a surface that is opaque to within 1/1024 nothing more is evaluated (what the
+  // layers there could add is below half an 8-bit step): a full deck costs its nearest plane.
+  return "    if (transmittance > kClear) { LayerHit hit = hitLayer(" + i +
+         ", r); if (inFront(hit.distance)) composite(" + i + ", r, hit, " + value +
+         ", colour, transmittance); }\n";
 }
 
 }  // namespace
@@ -317,27 +322,34 @@ std::string skyFragmentSource(const SkyPassLayout& layout) {
     for (int i = 0; i < layout.slots(); ++i)
       s += "uniform sampler2D u_table" + std::to_string(i) + ";\n";
 
+  s += "const float kClear = 1.0 / 1024.0;\n";
   s += "void main() {\n  vec3 r = viewRay();\n";
-  s += layout.background ? "  vec3 colour = background(r);\n" : "  vec3 colour = vec3(0.0);\n";
   if (layout.targets) {
     // Layers behind a target are hidden; the target replaces the background.
     s += "  float target_distance = targetDistance();\n";
-    if (layout.background) s += "  if (target_distance < kFar) colour = targetColour();\n";
     s += "#define inFront(d) ((d) < target_distance)\n";
   } else {
     s += "#define inFront(d) true\n";
   }
-  s += "  float transmittance = 1.0;\n";
-  int slot = 0;
-  if (!layout.above.empty()) {
+  s += "  vec3 colour = vec3(0.0);\n  float transmittance = 1.0;\n";
+  // Slots are listed farthest first on each side: emitted in reverse, nearest first.
+  const int above = int(layout.above.size());
+  if (above > 0) {
     s += "  if (r.z > 0.0) {\n";
-    for (LayerKind kind : layout.above) s += slotStatement(slot++, kind);
+    for (int slot = above - 1; slot >= 0; --slot)
+      s += slotStatement(slot, layout.above[std::size_t(slot)]);
     s += "  }\n";
   }
   if (!layout.below.empty()) {
     s += "  if (r.z < 0.0) {\n";
-    for (LayerKind kind : layout.below) s += slotStatement(slot++, kind);
+    for (int k = int(layout.below.size()) - 1; k >= 0; --k)
+      s += slotStatement(above + k, layout.below[std::size_t(k)]);
     s += "  }\n";
+  }
+  if (layout.background) {
+    s += "  vec3 behind = background(r);\n";
+    if (layout.targets) s += "  if (target_distance < kFar) behind = targetColour();\n";
+    s += "  colour += transmittance * behind;\n";
   }
   s += "  o_colour = vec4(colour, 1.0 - transmittance);\n}\n";
   return s;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <list>
 #include <map>
 #include <mutex>
@@ -51,7 +52,8 @@ double heapRadius(const CloudField& f) {
 constexpr double kSizeVariation = 0.3;  // radius times 1 + v (2u - 1)
 
 // Beyond this many heap radii from the eye a heap keeps only the ellipsoids that set its
-// outline (its base, and a cumulonimbus's anvil with one lobe of its tower); nearer, every lobe.
+// outline (its base, one mound standing for its lobes, a cumulonimbus's anvil); nearer, every
+// lobe.
 constexpr double kDetailRadii = 12.0;
 
 // The ellipsoids of one heap standing on `base` (the middle of its flat bottom).
@@ -82,11 +84,22 @@ std::vector<Ellipsoid> heapEllipsoids(const CloudField& f, glm::dvec3 base, doub
   lobes.position_variation = 0.4;
   lobes.heading_variation_deg = 90.0;
   lobes.seed = hashCounters(seed, kShape, 2);
-  if (detailed || isCb(f)) {
-    std::vector<Ellipsoid> tower = clusterEllipsoids(lobes, {dome});
-    if (!detailed) tower.resize(std::min<std::size_t>(tower.size(), 1));
-    out.insert(out.end(), tower.begin(), tower.end());
+  std::vector<Ellipsoid> tower = clusterEllipsoids(lobes, {dome});
+  if (!detailed && !tower.empty()) {
+    // Far away the lobes merge into one mound: an ellipsoid filling the box that holds them
+    // (four fifths of its half-extents, so that it covers about what they cover).
+    glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-lo);
+    for (const Ellipsoid& e : tower) {
+      const double reach = std::max({e.radii.x, e.radii.y});
+      lo = glm::min(lo, e.centre - glm::dvec3(reach, reach, e.radii.z));
+      hi = glm::max(hi, e.centre + glm::dvec3(reach, reach, e.radii.z));
+    }
+    Ellipsoid mound;
+    mound.centre = 0.5 * (lo + hi);
+    mound.radii = 0.4 * (hi - lo);
+    tower = {mound};
   }
+  out.insert(out.end(), tower.begin(), tower.end());
   if (isCb(f)) {
     // The anvil: a second, flat cluster over a wide plateau at nine tenths of the height, so
     // that it spreads level and droops a little at its edge ([G]: a base and a cap).

@@ -148,6 +148,26 @@ std::uint64_t weatherSeed(std::uint64_t scene_seed, int layer) {
   return hashCounters(scene_seed, 0x57656174686572ull, std::uint64_t(layer));
 }
 
+WeatherLayer typicalWeatherLayer(CloudType type, double coverage) {
+  switch (type) {
+    case CloudType::kCirrus:
+    case CloudType::kCirrocumulus:
+    case CloudType::kCirrostratus:
+      return {type, 8000.0, 600.0, coverage, {}};
+    case CloudType::kAltocumulus:
+    case CloudType::kAltostratus:
+      return {type, 4000.0, 700.0, coverage, {}};
+    case CloudType::kNimbostratus:
+      return {type, 900.0, 2500.0, coverage, {}};
+    case CloudType::kCumulonimbus:
+      return {type, 900.0, 9000.0, coverage, {}};
+    case CloudType::kCumulus:
+      return {type, 1200.0, 1200.0, coverage, {}};
+    default:  // stratocumulus, stratus
+      return {type, 700.0, 500.0, coverage, {}};
+  }
+}
+
 double thresholdForCoverage(const LayerTextureSpec& spec, double transition, int planes,
                             double coverage) {
   return thresholdFromSamples(sortedSamples(spec), transition, planes, coverage);

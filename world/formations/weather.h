@@ -24,6 +24,10 @@ WeatherClouds weatherClouds(const WeatherLayer& weather, const std::string& pref
 // from set_weather, Modbus or a scene file draws the same sky.
 std::uint64_t weatherSeed(std::uint64_t scene_seed, int layer);
 
+// A layer of `type` at a base and thickness typical of its genus (the WMO cloud atlas's
+// altitude bands for mid-latitudes), with the given coverage.
+WeatherLayer typicalWeatherLayer(CloudType type, double coverage);
+
 // Gardner's T1 for a layer texture such that, seen straight down through `planes` identical
 // planes with transition D, a fraction `coverage` of the ground has opacity >= 1/2 (SPEC
 // section 9). Estimated from the texture's values at 16384 seeded points spread over many

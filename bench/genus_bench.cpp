@@ -1,0 +1,331 @@
+// Genus benchmark (issue 13): the frame time of every genus preset, and of the cloudscape,
+// from below, inside and above the layer, still and flying, as multiples of the platform
+// floor timed in the same run. A program that prints figures, not a test: these machines
+// are shared and noisy, and multiples of the floor move much less than milliseconds.
+//
+//   genus_bench [--sizes 640x480,1280x1024] [--repeats N] [--presets genus_cumulus,...]
+//
+// "still" is the median of N frames of one view after a warm-up frame. "flying" is a view
+// moving east at 250 m/s rendered at 30 Hz for N frames from a fresh renderer cache: the
+// median and the slowest frame, so the cost of generating new heap tiles shows.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "bench/bench_common.h"
+#include "config/scene_file.h"
+#include "image/image.h"
+#include "renderer/gl/gl_renderer.h"
+#include "world/formations/cloud_field.h"
+#include "world/formations/weather.h"
+
+namespace {
+
+using namespace nephele;
+using Clock = std::chrono::steady_clock;
+
+struct View {
+  const char* name;
+  Camera camera;
+};
+
+// The preset's own view (from the ground), one inside the highest formation and one 1.5 km
+// above its top. A formation is a field of heaps or the planes of one weather layer (named
+// "weather/N" and "weather/N/k", spread through its thickness).
+std::vector<View> viewsOf(const SceneFile& file) {
+  std::vector<View> views{{"below", file.scene.camera}};
+  double base = 0.0, top = 0.0;
+  std::string top_layer;
+  for (const CloudLayer& layer : file.scene.layers)
+    if (layer.altitude_m > top) top = base = layer.altitude_m, top_layer = layer.name;
+  const std::string group = top_layer.substr(0, top_layer.find('/', top_layer.find('/') + 1));
+  for (const CloudLayer& layer : file.scene.layers)
+    if (layer.name.starts_with(group)) base = std::min(base, layer.altitude_m);
+  for (const CloudField& field : file.scene.fields)
+    if (field.base_m + field.thickness_m > top)
+      base = field.base_m, top = field.base_m + field.thickness_m;
+  Camera inside = file.scene.camera;
+  inside.position.z = 0.5 * (base + top);
+  inside.orientation.pitch_deg = 0.0;
+  views.push_back({"inside", inside});
+  Camera above = file.scene.camera;
+  above.position.z = top + 1500.0;
+  above.orientation.pitch_deg = -20.0;
+  views.push_back({"above", above});
+  return views;
+}
+
+// The connected regions (4-neighbour) of pixels whose coverage exceeds one half, leaving out
+// those that touch the border (a cloud cut by the frame has no whole outline); each as its
+// pixel indices.
+std::vector<std::vector<int>> cloudRegions(const FloatImage& image) {
+  const int w = image.width, h = image.height;
+  std::vector<int> label(std::size_t(w) * h, -1);
+  std::vector<std::vector<int>> out;
+  for (int start = 0; start < w * h; ++start) {
+    if (label[start] != -1 || image.rgba[4 * std::size_t(start) + 3] <= 0.5f) continue;
+    std::vector<int> region{start}, stack{start};
+    label[start] = int(out.size());
+    bool border = false;
+    while (!stack.empty()) {
+      const int p = stack.back();
+      stack.pop_back();
+      const int x = p % w, y = p / w;
+      border = border || x == 0 || y == 0 || x == w - 1 || y == h - 1;
+      for (const auto& [dx, dy] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
+        const int nx = x + dx, ny = y + dy;
+        if (nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
+        const int q = ny * w + nx;
+        if (label[q] != -1 || image.rgba[4 * std::size_t(q) + 3] <= 0.5f) continue;
+        label[q] = label[start];
+        region.push_back(q);
+        stack.push_back(q);
+      }
+    }
+    out.push_back(border ? std::vector<int>{} : std::move(region));
+  }
+  std::erase_if(out, [](const std::vector<int>& r) { return r.size() < 64; });
+  return out;
+}
+
+struct BodyFigure {
+  int inner = 0, opaque = 0;  // pixels in the inner half, and of those with coverage > 0.95
+  double luminance = 0.0;     // mean linear luminance over the inner half
+  glm::dvec2 centroid{0.0};   // pixels
+};
+
+// The region's inner half is its outline shrunk to half its size about its centroid: pixel p
+// is in it when centroid + 2 (p - centroid) lies in the region.
+BodyFigure bodyFigure(const FloatImage& image, const std::vector<int>& region) {
+  const int w = image.width, h = image.height;
+  std::vector<char> in(std::size_t(w) * h, 0);
+  BodyFigure f;
+  for (int p : region) {
+    in[p] = 1;
+    f.centroid += glm::dvec2(p % w, p / w);
+  }
+  f.centroid /= double(region.size());
+  for (int p : region) {
+    const glm::dvec2 q = f.centroid + 2.0 * (glm::dvec2(p % w, p / w) - f.centroid);
+    const int qx = int(std::lround(q.x)), qy = int(std::lround(q.y));
+    if (qx < 0 || qy < 0 || qx >= w || qy >= h || !in[qy * w + qx]) continue;
+    const float* c = &image.rgba[4 * std::size_t(p)];
+    ++f.inner;
+    f.opaque += c[3] > 0.95f;
+    f.luminance += 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+  }
+  f.luminance /= std::max(f.inner, 1);
+  return f;
+}
+
+// Cumulus body figures (issue 13): the heaps of a few tiles near the origin, each seen
+// straight down from far above (near-orthographic) and straight up from the ground under its
+// middle; per heap the fraction of its inner half that is opaque (coverage > 0.95), and the
+// luminance of its underside against that of its sunlit top.
+void printBodyFigures(GlRenderer& renderer, const SceneFile& file) {
+  if (file.scene.fields.empty()) return;
+  const CloudField& field = file.scene.fields.front();
+  const double tile = fieldTileSize(field);
+  int inner = 0, opaque = 0, heaps = 0;
+  double top_sum = 0.0, under_sum = 0.0, worst = 1.0;
+  for (std::int64_t i = -1; i <= 1; ++i)
+    for (std::int64_t j = -1; j <= 1; ++j) {
+      Scene scene = file.scene;
+      scene.fields.clear();
+      scene.layers.clear();
+      scene.clouds = tileClouds(field, i, j);
+      if (scene.clouds.empty()) continue;
+      // Straight down onto the tile and a margin around it.
+      const double span = 2.0 * tile, vfov = 4.0;
+      const glm::dvec2 middle = (glm::dvec2(i, j) + 0.5) * tile;
+      Camera& c = scene.camera;
+      c.position = glm::dvec3(middle, field.base_m + 1.3 * field.thickness_m +
+                                          0.5 * span / std::tan(glm::radians(vfov / 2.0)));
+      c.orientation = {0.0, -90.0, 0.0};
+      c.vfov_deg = vfov;
+      c.width = c.height = 384;
+      const FloatImage top = renderer.renderFloat(scene, file.render);
+      for (const std::vector<int>& region : cloudRegions(top)) {
+        const BodyFigure above = bodyFigure(top, region);
+        // Image x runs east, rows run south from the top.
+        const glm::dvec2 xy = middle + span * glm::dvec2((above.centroid.x + 0.5) / c.width - 0.5,
+                                                         0.5 - (above.centroid.y + 0.5) / c.height);
+        Scene up = scene;
+        up.camera.position = glm::dvec3(xy, 2.0);
+        up.camera.orientation = {0.0, 90.0, 0.0};
+        up.camera.vfov_deg = 120.0;
+        up.camera.width = up.camera.height = 256;
+        const FloatImage below = renderer.renderFloat(up, file.render);
+        // The heap overhead: the region holding the image centre.
+        const std::vector<std::vector<int>> regions = cloudRegions(below);
+        const int centre = (up.camera.height / 2) * up.camera.width + up.camera.width / 2;
+        const auto hit = std::find_if(regions.begin(), regions.end(), [&](const auto& r) {
+          return std::find(r.begin(), r.end(), centre) != r.end();
+        });
+        if (hit == regions.end()) continue;
+        const BodyFigure under = bodyFigure(below, *hit);
+        ++heaps;
+        inner += above.inner + under.inner;
+        opaque += above.opaque + under.opaque;
+        worst = std::min({worst, double(above.opaque) / std::max(above.inner, 1),
+                          double(under.opaque) / std::max(under.inner, 1)});
+        top_sum += above.luminance;
+        under_sum += under.luminance;
+      }
+    }
+  if (heaps == 0) return;
+  std::printf(
+      "  body: %d heaps; inner half opaque (coverage > 0.95): %.3f of pixels (worst heap view "
+      "%.3f); luminance underside %.3f, sunlit top %.3f, ratio %.2f\n",
+      heaps, double(opaque) / std::max(inner, 1), worst, under_sum / heaps, top_sum / heaps,
+      under_sum / std::max(top_sum, 1e-9));
+}
+
+// Fraction of the sky hemisphere seen from the ground whose coverage exceeds one half, from
+// the five upper faces of a cube map (each pixel weighted by its solid angle, proportional to
+// (1 + u^2 + v^2)^-3/2 on a face at unit distance), averaged over four places 20 km apart.
+double hemisphereFraction(GlRenderer& renderer, const Scene& weather,
+                          const RenderSettings& render) {
+  constexpr int kFace = 128;
+  double cloudy = 0.0, total = 0.0;
+  for (int place = 0; place < 4; ++place) {
+    Scene scene = weather;
+    scene.camera.position = {20000.0 * (place % 2), 20000.0 * (place / 2), 2.0};
+    scene.camera.vfov_deg = 90.0;
+    scene.camera.width = scene.camera.height = kFace;
+    for (int face = 0; face < 5; ++face) {
+      scene.camera.orientation =
+          face == 4 ? Orientation{0.0, 90.0, 0.0} : Orientation{90.0 * face, 0.0, 0.0};
+      const FloatImage image = renderer.renderFloat(scene, render);
+      for (int y = 0; y < kFace; ++y) {
+        const double v = 1.0 - 2.0 * (y + 0.5) / kFace;
+        if (face < 4 && v <= 0.0) continue;  // below the horizon
+        for (int x = 0; x < kFace; ++x) {
+          const double u = 2.0 * (x + 0.5) / kFace - 1.0;
+          const double w = std::pow(1.0 + u * u + v * v, -1.5);
+          total += w;
+          cloudy += image.pixel(x, y)[3] > 0.5f ? w : 0.0;
+        }
+      }
+    }
+  }
+  return cloudy / total;
+}
+
+std::size_t ellipsoidCount(const Scene& scene) {
+  std::size_t n = 0;
+  for (const EllipsoidCloud& c : withFieldClouds(scene).clouds) n += c.ellipsoids.size();
+  return n;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app("Nephele genus benchmark: frame times of the genus presets in floor multiples");
+  std::string presets_dir = NEPHELE_SOURCE_DIR "/config/scenes";
+  int repeats = 9;
+  std::vector<std::string> sizes{"640x480", "1280x1024"}, names;
+  app.add_option("--repeats", repeats, "Frames per still median and per flight")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  app.add_option("--sizes", sizes, "Image sizes WxH")->delimiter(',');
+  app.add_option("--dir", presets_dir, "Directory of scene files")->capture_default_str();
+  app.add_option("--presets", names, "Only these presets (default: genus_* and cloudscape)")
+      ->delimiter(',');
+  bool hemisphere = false;
+  app.add_flag("--hemisphere", hemisphere,
+               "Instead: the fraction of the sky dome covered, seen from the ground, for every "
+               "genus at coverage 0.1 to 0.9");
+  CLI11_PARSE(app, argc, argv);
+
+  std::vector<std::filesystem::path> files;
+  for (const auto& path : bench::presetFiles(presets_dir)) {
+    const std::string stem = path.stem().string();
+    const bool wanted = names.empty() ? stem.starts_with("genus_") || stem == "cloudscape"
+                                      : std::find(names.begin(), names.end(), stem) != names.end();
+    if (wanted) files.push_back(path);
+  }
+  const auto platform = bench::openPlatform();
+  if (!platform) return 1;
+  if (hemisphere) {
+    // Every genus at its typical altitude (weather.h), seen from the ground.
+    GlRenderer renderer(*platform);
+    std::printf(
+        "hemisphere fraction from the ground (cloud fraction asked -> fraction of the sky "
+        "dome with coverage > 0.5)\n%-14s",
+        "genus");
+    const double asked[] = {0.1, 0.3, 0.5, 0.7, 0.9};
+    for (double c : asked) std::printf(" %7.1f", c);
+    std::printf("\n");
+    for (int type = 1; type < kCloudTypeCount; ++type) {
+      std::printf("%-14s", std::string(cloudTypeName(CloudType(type))).c_str());
+      for (double c : asked) {
+        Scene scene;
+        const WeatherClouds add =
+            weatherClouds(typicalWeatherLayer(CloudType(type), c), "weather/1", 7);
+        scene.layers = add.layers;
+        scene.fields = add.fields;
+        std::printf(" %7.3f", hemisphereFraction(renderer, scene, RenderSettings{}));
+        std::fflush(stdout);
+      }
+      std::printf("\n");
+    }
+    return 0;
+  }
+  std::printf("GL: %s, %s; render + readback into an 8-bit target\n",
+              std::string(platform->backendName()).c_str(), platform->renderer().c_str());
+  std::printf("%-22s %-7s %-10s %8s %9s %7s %10s %7s %10s %7s %10s\n", "preset", "view", "size",
+              "floor ms", "still ms", "xfloor", "flying ms", "xfloor", "slowest ms", "xfloor",
+              "ellipsoids");
+
+  for (const auto& path : files) {
+    SceneFile file;
+    if (std::string e = loadSceneFile(path.string(), file); !e.empty()) {
+      std::fprintf(stderr, "%s\n", e.c_str());
+      return 1;
+    }
+    for (const std::string& size : sizes) {
+      int width = 0, height = 0;
+      if (std::sscanf(size.c_str(), "%dx%d", &width, &height) != 2 || width < 1 || height < 1) {
+        std::fprintf(stderr, "--sizes: '%s' is not WxH\n", size.c_str());
+        return 2;
+      }
+      for (const View& view : viewsOf(file)) {
+        Scene scene = file.scene;
+        scene.camera = view.camera;
+        scene.camera.width = width, scene.camera.height = height;
+        // A fresh renderer per case: heap tiles and bakes left by the previous case would
+        // make the first frames of this one look cheaper than a new view's are.
+        GlRenderer renderer(*platform);
+        const double floor =
+            medianMilliseconds(repeats, [&] { renderer.renderFloor(width, height); });
+        const double still =
+            medianMilliseconds(repeats, [&] { renderer.renderSrgb8(scene, file.render); });
+        GlRenderer flyer(*platform);
+        std::vector<double> ms;
+        Scene moving = scene;
+        for (int frame = 0; frame < repeats; ++frame) {
+          moving.camera.position.x = scene.camera.position.x + 250.0 / 30.0 * frame + 50000.0;
+          const auto start = Clock::now();
+          flyer.renderSrgb8(moving, file.render);
+          ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
+        }
+        const double slowest = *std::max_element(ms.begin(), ms.end());
+        std::sort(ms.begin(), ms.end());
+        const double flying = ms[ms.size() / 2];
+        std::printf("%-22s %-7s %-10s %8.2f %9.2f %7.1f %10.2f %7.1f %10.2f %7.1f %10zu\n",
+                    path.stem().c_str(), view.name, size.c_str(), floor, still, still / floor,
+                    flying, flying / floor, slowest, slowest / floor, ellipsoidCount(scene));
+        std::fflush(stdout);
+      }
+    }
+    GlRenderer renderer(*platform);
+    printBodyFigures(renderer, file);
+  }
+  return 0;
+}
