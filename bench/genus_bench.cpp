@@ -36,7 +36,8 @@ struct View {
 
 // The preset's own view (from the ground), one inside the highest formation and one 1.5 km
 // above its top. A formation is a field of heaps or the planes of one weather layer (named
-// "weather/N" and "weather/N/k", spread through its thickness).
+// "weather/N" and "weather/N/k", spread through its thickness); a genus drawn as one plane
+// has no inside, and its "inside" view is that plane seen edge on.
 std::vector<View> viewsOf(const SceneFile& file) {
   std::vector<View> views{{"below", file.scene.camera}};
   double base = 0.0, top = 0.0;

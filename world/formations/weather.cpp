@@ -13,28 +13,31 @@ namespace {
 // How a genus is drawn (MODEL.md section 10): Gardner sky-plane texture (base frequencies in
 // radians per metre, term count, contrast offset T0, lattice-breaking rotation), its
 // transition D and shading, how many planes stand through the layer's thickness, and whether
-// the genus is convective (a field of heaps, this plane only as the deck under them).
+// the genus is convective (a field of heaps, this plane only as the deck under them). A veil
+// stays translucent at full cover (opacity just above 1/2 where it is thinnest) where a deck
+// turns opaque.
 struct GenusLook {
   double fx1, fy1;
   int terms;
   double t0, rotation_deg, transition, grey, ambient, texture_fraction;
   int planes;
   bool heaps;
+  bool veil = false;
 };
 
 // Indexed by CloudType.
 constexpr std::array<GenusLook, kCloudTypeCount> kLooks{{
-    {0, 0, 1, 0, 0, 0, 0, 0, 0, 0, false},                              // none
-    {3.0e-3, 3.0e-3, 6, 0.5, 90.0, 0.12, 0.95, 0.55, 0.50, 1, false},   // altocumulus: cells
-    {1.2e-3, 1.2e-3, 5, 2.0, 90.0, 0.50, 0.72, 0.70, 0.35, 2, false},   // altostratus: sheet
-    {8.0e-3, 6.5e-3, 6, 0.5, 90.0, 0.15, 1.00, 0.70, 0.50, 1, false},   // cirrocumulus: ripples
-    {1.0e-3, 1.0e-3, 4, 2.0, 90.0, 1.20, 1.00, 0.80, 0.30, 1, false},   // cirrostratus: veil
-    {1.0e-3, 0.35e-3, 5, 0.2, 30.0, 0.50, 1.00, 0.75, 0.60, 1, false},  // cirrus: streaks
-    {1.0e-3, 1.0e-3, 4, 2.0, 90.0, 0.80, 0.42, 0.80, 0.30, 1, true},    // cumulonimbus: deck
-    {2.0e-3, 1.6e-3, 6, 0.6, 90.0, 0.12, 0.82, 0.55, 0.55, 1, true},    // cumulus: Sc deck
-    {1.0e-3, 1.0e-3, 4, 2.0, 90.0, 0.80, 0.42, 0.80, 0.30, 3, false},   // nimbostratus: deck
-    {2.0e-3, 1.6e-3, 6, 0.6, 90.0, 0.12, 0.82, 0.55, 0.55, 1, false},   // stratocumulus: lumps
-    {1.5e-3, 1.5e-3, 4, 2.5, 90.0, 0.60, 0.66, 0.75, 0.30, 2, false},   // stratus: grey sheet
+    {0, 0, 1, 0, 0, 0, 0, 0, 0, 0, false},                             // none
+    {3.0e-3, 3.0e-3, 6, 0.5, 90.0, 0.12, 0.95, 0.55, 0.50, 1, false},  // altocumulus: cells
+    {1.2e-3, 1.2e-3, 5, 2.0, 90.0, 0.50, 0.72, 0.70, 0.35, 2, false},  // altostratus: sheet
+    {8.0e-3, 6.5e-3, 6, 0.5, 90.0, 0.15, 1.00, 0.70, 0.50, 1, false},  // cirrocumulus: ripples
+    {1.0e-3, 1.0e-3, 4, 2.0, 90.0, 3.00, 1.00, 0.80, 0.30, 1, false, true},  // cirrostratus
+    {1.0e-3, 0.35e-3, 5, 0.2, 30.0, 0.50, 1.00, 0.75, 0.60, 1, false},       // cirrus: streaks
+    {1.0e-3, 1.0e-3, 4, 2.0, 90.0, 0.80, 0.42, 0.80, 0.30, 1, true},         // cumulonimbus: deck
+    {2.0e-3, 1.6e-3, 6, 0.6, 90.0, 0.12, 0.82, 0.55, 0.55, 1, true},         // cumulus: Sc deck
+    {1.0e-3, 1.0e-3, 4, 2.0, 90.0, 0.80, 0.42, 0.80, 0.30, 3, false},        // nimbostratus: deck
+    {2.0e-3, 1.6e-3, 6, 0.6, 90.0, 0.12, 0.82, 0.55, 0.55, 1, false},        // stratocumulus: lumps
+    {1.5e-3, 1.5e-3, 4, 2.5, 90.0, 0.60, 0.66, 0.75, 0.30, 2, false},        // stratus: grey sheet
 }};
 
 // Texture values at seeded points spread over 24 x 24 texture periods (the texture has no
@@ -64,7 +67,7 @@ double positiveFraction(const std::vector<double>& sorted) {
 
 // thresholdForCoverage on the texture's sorted samples.
 double thresholdFromSamples(const std::vector<double>& values, double transition, int planes,
-                            double coverage) {
+                            double coverage, bool veil = false) {
   // Through k identical planes of opacity a each, 1 - (1 - a)^k >= 1/2 where
   // a >= 1 - 2^(-1/k); eq. 9 gives a = (T - T1) / D, so T >= T1 + a D.
   const double level = 1.0 - std::pow(0.5, 1.0 / std::max(planes, 1));
@@ -72,8 +75,9 @@ double thresholdFromSamples(const std::vector<double>& values, double transition
   const double c = std::clamp(coverage, 0.0, 1.0);
   // D = 0 is a hard threshold: opaque where T > T1.
   const double margin = 1e-6 + 1e-3 * transition;
-  // A full cover is drawn opaque (a = 1 on every plane), not merely at opacity 1/2.
-  if (c >= 1.0) return values.front() - transition - margin;
+  // A full cover is drawn opaque (a = 1 on every plane), not merely at opacity 1/2; a veil
+  // just above opacity 1/2 where it is thinnest.
+  if (c >= 1.0) return values.front() - (veil ? level + 0.05 : 1.0) * transition - margin;
   if (c <= 0.0) return values.back() - shift + margin;
   return values[std::size_t(std::floor((1.0 - c) * double(values.size())))] - shift;
 }
@@ -104,7 +108,7 @@ std::vector<CloudLayer> planes(const WeatherLayer& w, const GenusLook& look, dou
     samples = sortedSamples(t);
   }
   const int count = look.planes;
-  layer.threshold = thresholdFromSamples(samples, layer.transition, count, coverage);
+  layer.threshold = thresholdFromSamples(samples, layer.transition, count, coverage, look.veil);
   std::vector<CloudLayer> out;
   for (int k = 0; k < count; ++k) {
     CloudLayer plane = layer;
