@@ -100,9 +100,7 @@ void renderTable(const std::string& presets, const std::string& size, int repeat
       std::fprintf(stderr, "%s\n", e.c_str());
       return;
     }
-    if (std::sscanf(size.c_str(), "%dx%d", &file.scene.camera.width, &file.scene.camera.height) !=
-        2)
-      return;
+    if (!bench::parseSize(size, file.scene.camera)) return;
     FloatImage reference;
     for (const Case& c : cases) {
       SceneFile edited = file;

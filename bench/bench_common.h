@@ -47,6 +47,17 @@ inline double medianFrameMilliseconds(GlRenderer& renderer, const Scene& scene,
   });
 }
 
+// Sets the camera's image size from "WxH"; false, after saying why, when it is not one.
+inline bool parseSize(const std::string& size, Camera& camera) {
+  int width = 0, height = 0;
+  if (std::sscanf(size.c_str(), "%dx%d", &width, &height) != 2 || width < 1 || height < 1) {
+    std::fprintf(stderr, "size '%s' is not WxH with both sides at least 1\n", size.c_str());
+    return false;
+  }
+  camera.width = width, camera.height = height;
+  return true;
+}
+
 // The scene files (*.toml) in `directory`, sorted by name.
 inline std::vector<std::filesystem::path> presetFiles(const std::string& directory) {
   std::vector<std::filesystem::path> files;

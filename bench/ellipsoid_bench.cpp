@@ -68,10 +68,6 @@ std::vector<Knob> knobs() {
   };
 }
 
-bool parseSize(const std::string& size, Camera& camera) {
-  return std::sscanf(size.c_str(), "%dx%d", &camera.width, &camera.height) == 2;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -110,7 +106,7 @@ int main(int argc, char** argv) {
       Scene scene = cumulus.scene;
       EllipsoidCloud& cloud = scene.clouds.at(0);
       cloud.ellipsoids = cumulusEllipsoids(count, {0.0, 0.0, 800.0}, 2000.0, 27);
-      if (!parseSize(size, scene.camera)) return 2;
+      if (!bench::parseSize(size, scene.camera)) return 2;
       RenderSettings multipass;
       multipass.ellipsoid_passes = EllipsoidPasses::kMultipass;
       const double fused_ms = bench::medianFrameMilliseconds(renderer, scene, {}, repeats, false);

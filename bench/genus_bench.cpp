@@ -291,11 +291,9 @@ int main(int argc, char** argv) {
       return 1;
     }
     for (const std::string& size : sizes) {
-      int width = 0, height = 0;
-      if (std::sscanf(size.c_str(), "%dx%d", &width, &height) != 2 || width < 1 || height < 1) {
-        std::fprintf(stderr, "--sizes: '%s' is not WxH\n", size.c_str());
-        return 2;
-      }
+      Camera sized;
+      if (!bench::parseSize(size, sized)) return 2;
+      const int width = sized.width, height = sized.height;
       for (const View& view : viewsOf(file)) {
         Scene scene = file.scene;
         scene.camera = view.camera;

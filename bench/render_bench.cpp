@@ -86,10 +86,7 @@ int main(int argc, char** argv) {
     }
     for (const std::string& size : sizes) {
       Scene scene = file.scene;
-      if (std::sscanf(size.c_str(), "%dx%d", &scene.camera.width, &scene.camera.height) != 2) {
-        std::fprintf(stderr, "bad size '%s' (expected WxH)\n", size.c_str());
-        return 2;
-      }
+      if (!bench::parseSize(size, scene.camera)) return 2;
       const auto ref_start = Clock::now();
       const FloatImage reference = renderReference(scene, {samples, 0});
       const double ref_ms =
