@@ -23,6 +23,7 @@
 #include "renderer/gl/gl_renderer.h"
 #include "world/formations/cloud_field.h"
 #include "world/formations/weather.h"
+#include "world/world.h"
 
 namespace {
 
@@ -218,6 +219,52 @@ double hemisphereFraction(GlRenderer& renderer, const Scene& weather,
   return cloudy / total;
 }
 
+// Automaton clouds' underside against their sunlit top (MODEL.md section 6, sky light): each
+// automaton of the harbour preset seen straight up from the ground under its middle and
+// straight down from 2 km above it; mean luminance over the inner half of its outline.
+void printAutomatonFigures(GlRenderer& renderer) {
+  SceneFile file;
+  if (std::string e = loadSceneFile(NEPHELE_SOURCE_DIR "/config/scenes/harbour.toml", file);
+      !e.empty()) {
+    std::fprintf(stderr, "%s\n", e.c_str());
+    return;
+  }
+  file.scene.fog.reset();  // the sea fog lies below the clouds; it would grey the view down
+  const Scene world = World(file.scene, file.dynamics).scene();
+  double under_sum = 0.0, top_sum = 0.0;
+  int clouds = 0;
+  for (const AutomatonCloudView& cloud : world.automata) {
+    const glm::dvec3 middle = 0.5 * (cloud.lowerBound() + cloud.upperBound());
+    Scene only = world;
+    only.automata = {cloud};
+    double luminance[2] = {0.0, 0.0};
+    bool seen = true;
+    for (int side = 0; side < 2 && seen; ++side) {
+      only.camera.position = glm::dvec3(glm::dvec2(middle), side == 0 ? 2.0 : middle.z + 2000.0);
+      only.camera.orientation = {0.0, side == 0 ? 90.0 : -90.0, 0.0};
+      only.camera.vfov_deg = 60.0;
+      only.camera.width = only.camera.height = 128;
+      const FloatImage image = renderer.renderFloat(only, file.render);
+      const std::vector<std::vector<int>> regions = cloudRegions(image);
+      const int centre = 64 * 128 + 64;
+      const auto hit = std::find_if(regions.begin(), regions.end(), [&](const auto& r) {
+        return std::find(r.begin(), r.end(), centre) != r.end();
+      });
+      seen = hit != regions.end();
+      if (seen) luminance[side] = bodyFigure(image, *hit).luminance;
+    }
+    if (!seen) continue;
+    ++clouds;
+    under_sum += luminance[0];
+    top_sum += luminance[1];
+  }
+  if (clouds == 0) return;
+  std::printf(
+      "automaton clouds (harbour, %d whole): luminance underside %.3f, sunlit top %.3f, "
+      "ratio %.2f\n",
+      clouds, under_sum / clouds, top_sum / clouds, under_sum / std::max(top_sum, 1e-9));
+}
+
 std::size_t ellipsoidCount(const Scene& scene) {
   std::size_t n = 0;
   for (const EllipsoidCloud& c : withFieldClouds(scene).clouds) n += c.ellipsoids.size();
@@ -236,7 +283,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--sizes", sizes, "Image sizes WxH")->delimiter(',');
   app.add_option("--dir", presets_dir, "Directory of scene files")->capture_default_str();
-  app.add_option("--presets", names, "Only these presets (default: genus_* and cloudscape)")
+  app.add_option("--presets", names,
+                 "Only these presets (default: genus_* and cloudscape; harbour adds the "
+                 "automaton figures)")
       ->delimiter(',');
   bool hemisphere = false;
   app.add_flag("--hemisphere", hemisphere,
@@ -325,6 +374,10 @@ int main(int argc, char** argv) {
     }
     GlRenderer renderer(*platform);
     printBodyFigures(renderer, file);
+  }
+  if (names.empty() || std::find(names.begin(), names.end(), "harbour") != names.end()) {
+    GlRenderer renderer(*platform);
+    printAutomatonFigures(renderer);
   }
   return 0;
 }

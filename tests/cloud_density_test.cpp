@@ -134,6 +134,35 @@ TEST(SweepSunlight, StaysInRangeForAnySunAndExtremeDensity) {
   }
 }
 
+TEST(SweepSkylight, EachSampleSeesTheExactColumnAboveIt) {
+  // Density varying sample to sample (thin and thick): each sample's skylight is the two-stream
+  // transmittance of the trapezoid sum of Ex rho up its column, plus half a segment falling to
+  // 0 above the top sample; it falls with depth and never reaches 0.
+  for (const float scale : {0.5f, 200.0f}) {
+    DensityLattice l = uniformLattice({5, 4, 40}, 20.0, 0.0f);
+    for (std::size_t i = 0; i < l.density.size(); ++i)
+      l.density[i] = scale * float((i * 7919) % 101) / 100.0f;
+    sweepSkylight(l);
+    ASSERT_EQ(l.skylight.size(), l.density.size());
+    for (int y = 0; y < 4; ++y)
+      for (int x = 0; x < 5; ++x) {
+        double tau = kCloudExtinctionPerMetre * 0.5 * l.density[l.index(x, y, 39)] * 10.0;
+        for (int z = 39; z >= 0; --z) {
+          if (z < 39)
+            tau += kCloudExtinctionPerMetre * 0.5 *
+                   (l.density[l.index(x, y, z)] + l.density[l.index(x, y, z + 1)]) * 20.0;
+          const double got = l.skylight[l.index(x, y, z)];
+          ASSERT_GT(got, 0.0);
+          ASSERT_LE(got, 1.0);
+          EXPECT_NEAR(got, 1.0 / (1.0 + 0.75 * 0.15 * tau), 1e-6) << x << "," << y << "," << z;
+          if (z < 39) {
+            EXPECT_LE(got, l.skylight[l.index(x, y, z + 1)]);
+          }
+        }
+      }
+  }
+}
+
 // 2 pi times the integral over cos theta in [-1, 1] (Simpson).
 template <class F>
 double sphereIntegral(F phase) {

@@ -12,10 +12,12 @@ namespace nephele {
 namespace {
 
 constexpr int kVolumeTextureUnit = 13;
+constexpr int kSkyTextureUnit = 8;
 constexpr int kMaxMarchSteps = 2048;
 
 const char* kVolumePass = R"(
 layout(binding = 13) uniform sampler3D u_volume;  // rho and sunlight of both keyframes
+layout(binding = 8) uniform sampler3D u_sky;      // skylight of both keyframes
 uniform vec3 u_box_min;         // camera-relative box where the density can be non-zero
 uniform vec3 u_box_max;
 uniform vec3 u_lattice_origin;  // camera-relative position of lattice sample (0, 0, 0)
@@ -29,9 +31,12 @@ uniform float u_ambient;
 uniform vec3 u_to_sun;
 uniform float u_phase_g;
 
-vec2 densityAndSunlight(vec3 p) {
-  vec4 v = texture(u_volume, ((p - u_lattice_origin) * u_inv_spacing + 0.5) * u_inv_dims);
-  return mix(v.xy, v.zw, u_blend);
+// Density, sunlight and skylight (MODEL.md section 6) at camera-relative p.
+vec3 densityAndLight(vec3 p) {
+  vec3 t = ((p - u_lattice_origin) * u_inv_spacing + 0.5) * u_inv_dims;
+  vec4 v = texture(u_volume, t);
+  vec2 sky = texture(u_sky, t).rg;
+  return vec3(mix(v.xy, v.zw, u_blend), mix(sky.r, sky.g, u_blend));
 }
 
 float phase(float c) {
@@ -61,13 +66,13 @@ void main() {
   float scattering = phase(dot(u_to_sun, d));
   vec3 radiance = vec3(0.0);
   float transmittance = 1.0;
-  vec2 a = densityAndSunlight(enter * d);
+  vec3 a = densityAndLight(enter * d);
   for (int i = 1; i <= steps && transmittance > 1e-3; ++i) {
-    vec2 b = densityAndSunlight((enter + float(i) * ds) * d);
+    vec3 b = densityAndLight((enter + float(i) * ds) * d);
     // Exact attenuation over the step for density linear along it (MODEL.md section 6), with the source
     // held at the mean of the step's ends, as the reference does.
     float segment = exp(-u_extinction * 0.5 * (a.x + b.x) * ds);
-    float source = scattering * 0.5 * (a.y + b.y) + u_ambient;
+    float source = scattering * 0.5 * (a.y + b.y) + u_ambient * 0.5 * (a.z + b.z);
     radiance += transmittance * (1.0 - segment) * source * u_light;
     transmittance *= segment;
     a = b;
@@ -143,23 +148,32 @@ AutomatonRenderer::Volume& AutomatonRenderer::volume(const Scene& scene, std::si
   const DensityLattice& a = cloud.from->lattice;
   const DensityLattice& b = cloud.to->lattice;
   NEPHELE_CHECK(a.dims == b.dims, "keyframes on different lattices");
-  std::vector<float> texels(a.density.size() * 4);
+  std::vector<float> texels(a.density.size() * 4), sky(a.density.size() * 2);
   for (std::size_t i = 0; i < a.density.size(); ++i) {
     texels[4 * i + 0] = a.density[i];
     texels[4 * i + 1] = a.sunlight[i];
     texels[4 * i + 2] = b.density[i];
     texels[4 * i + 3] = b.sunlight[i];
+    sky[2 * i + 0] = a.skylight[i];
+    sky[2 * i + 1] = b.skylight[i];
   }
   if (!v.texture || !v.from || v.from->lattice.dims != a.dims) {
-    v.texture = createTexture(gl_, GL_TEXTURE_3D);
-    gl_.TextureStorage3D(v.texture.get(), 1, GL_RGBA32F, a.dims.x, a.dims.y, a.dims.z);
-    gl_.TextureParameteri(v.texture.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    gl_.TextureParameteri(v.texture.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    for (GLenum wrap : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R})
-      gl_.TextureParameteri(v.texture.get(), wrap, GL_CLAMP_TO_EDGE);
+    auto make = [&](GLenum format) {
+      GlObject texture = createTexture(gl_, GL_TEXTURE_3D);
+      gl_.TextureStorage3D(texture.get(), 1, format, a.dims.x, a.dims.y, a.dims.z);
+      gl_.TextureParameteri(texture.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+      gl_.TextureParameteri(texture.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+      for (GLenum wrap : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R})
+        gl_.TextureParameteri(texture.get(), wrap, GL_CLAMP_TO_EDGE);
+      return texture;
+    };
+    v.texture = make(GL_RGBA32F);
+    v.sky = make(GL_RG32F);
   }
   gl_.TextureSubImage3D(v.texture.get(), 0, 0, 0, 0, a.dims.x, a.dims.y, a.dims.z, GL_RGBA,
                         GL_FLOAT, texels.data());
+  gl_.TextureSubImage3D(v.sky.get(), 0, 0, 0, 0, a.dims.x, a.dims.y, a.dims.z, GL_RG, GL_FLOAT,
+                        sky.data());
   v.from = cloud.from;
   v.to = cloud.to;
   ++uploads_;
@@ -203,6 +217,7 @@ void AutomatonRenderer::drawCloud(const Scene& scene, std::size_t index,
   set("u_ambient", cloud.ambient);
   set("u_phase_g", cloud.phase_g);
   gl_.BindTextureUnit(kVolumeTextureUnit, v.texture.get());
+  gl_.BindTextureUnit(kSkyTextureUnit, v.sky.get());
   gl_.ProgramUniform2fv(p, gl_.GetUniformLocation(p, "u_polygon"), GLsizei(polygon.size()),
                         &polygon[0].x);
   gl_.Enable(GL_BLEND);

@@ -34,7 +34,8 @@ class AutomatonRenderer {
  private:
   struct Volume {
     std::shared_ptr<const AutomatonKeyframe> from, to;  // kept alive: compared by identity
-    GlObject texture;
+    GlObject texture;                                   // density and sunlight of both keyframes
+    GlObject sky;                                       // skylight of both keyframes
     bool used = false;
   };
 

@@ -132,7 +132,8 @@ class ReferenceTracer {
 
   // An automaton cloud along the ray, as one surface at the ray's entry into its box: MODEL.md
   // section 6's single scattering with the exact metaball density, marched in steps of l/8 with the
-  // exact exponential per step; sunlight marched towards the sun in steps of l/4 the same way.
+  // exact exponential per step; sunlight marched towards the sun, and sky light straight up, in
+  // steps of l/4 the same way.
   std::optional<Surface> volumeSurface(const AutomatonCloudView& cloud, glm::dvec3 direction,
                                        double nearest_opaque) const {
     const glm::dvec3 eye = scene_.camera.position;
@@ -147,41 +148,47 @@ class ReferenceTracer {
     const double phase = cloud.phaseValue(glm::dot(sun_, direction));
     glm::dvec3 radiance(0.0);
     double transmittance = 1.0;
-    auto sample = [&](double s, double& rho, double& sunlight) {
+    // Density, and the light reaching the point: sun (times the phase function) and sky.
+    auto sample = [&](double s, double& rho, double& lit) {
       const glm::dvec3 p = eye + s * direction;
       rho = cloud.exactDensity(p);
-      sunlight = rho > 0.0 ? sunTransmittance(cloud, p) : 0.0;
+      lit = rho > 0.0 ? phase * std::exp(-opticalDepthTowards(cloud, p, sun_)) +
+                            cloud.ambient *
+                                diffuseTransmittance(opticalDepthTowards(cloud, p, {0.0, 0.0, 1.0}))
+                      : 0.0;
     };
-    double rho_a, sun_a;
-    sample(enter, rho_a, sun_a);
+    double rho_a, lit_a;
+    sample(enter, rho_a, lit_a);
     for (int i = 1; i <= steps && transmittance > 1e-7; ++i) {
-      double rho_b, sun_b;
-      sample(enter + i * ds, rho_b, sun_b);
+      double rho_b, lit_b;
+      sample(enter + i * ds, rho_b, lit_b);
       const double segment = segmentTransmittance(rho_a, rho_b, ds);
       // Source constant over the step (the mean of its ends); exact attenuation within it.
-      const double source = phase * 0.5 * (sun_a + sun_b) + cloud.ambient;
+      const double source = 0.5 * (lit_a + lit_b);
       radiance += transmittance * (1.0 - segment) * source * light;
       transmittance *= segment;
       rho_a = rho_b;
-      sun_a = sun_b;
+      lit_a = lit_b;
     }
     const double alpha = 1.0 - transmittance;
     if (alpha <= 0.0) return std::nullopt;
     return Surface{enter, withFog(radiance / alpha, direction, enter), alpha};
   }
 
-  double sunTransmittance(const AutomatonCloudView& cloud, glm::dvec3 p) const {
-    const double leave = boxSpan(cloud.lowerBound(), cloud.upperBound(), p, sun_).second;
-    if (!(leave > 0.0)) return 1.0;
+  // Optical depth from p out of the cloud's box along the unit direction `towards`.
+  double opticalDepthTowards(const AutomatonCloudView& cloud, glm::dvec3 p,
+                             glm::dvec3 towards) const {
+    const double leave = boxSpan(cloud.lowerBound(), cloud.upperBound(), p, towards).second;
+    if (!(leave > 0.0)) return 0.0;
     const int steps = int(std::ceil(leave / (cloud.cell_size_m / 4.0)));
     const double ds = leave / steps;
     double tau = 0.0, rho_a = cloud.exactDensity(p);
     for (int i = 1; i <= steps; ++i) {
-      const double rho_b = cloud.exactDensity(p + (i * ds) * sun_);
+      const double rho_b = cloud.exactDensity(p + (i * ds) * towards);
       tau += kCloudExtinctionPerMetre * 0.5 * (rho_a + rho_b) * ds;
       rho_a = rho_b;
     }
-    return std::exp(-tau);
+    return tau;
   }
 
   glm::dvec3 withFog(glm::dvec3 colour, glm::dvec3 direction, double distance) const {

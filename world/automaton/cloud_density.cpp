@@ -120,6 +120,7 @@ DensityLattice densityLattice(const std::vector<float>& means, GridSize size, do
     lattice.occupied_lo = glm::max(lo - 1, glm::ivec3(0));
     lattice.occupied_hi = glm::min(hi + 1, lattice.dims - 1);
   }
+  sweepSkylight(lattice);
   return lattice;
 }
 
@@ -174,6 +175,24 @@ void sweepSunlight(DensityLattice& lattice, glm::dvec3 to_sun, double extinction
             t_up * segmentTransmittance(lattice.density[here], rho_up, length, extinction_per_m));
       }
   }
+}
+
+void sweepSkylight(DensityLattice& lattice, double extinction_per_m) {
+  lattice.skylight.assign(lattice.density.size(), 1.0f);
+  const glm::ivec3 dims = lattice.dims;
+  for (int y = 0; y < dims.y; ++y)
+    for (int x = 0; x < dims.x; ++x) {
+      // Down the column from the top sample, above which the density has fallen to 0 within
+      // half a spacing (as in sweepSunlight); the optical depth summed exactly in double.
+      double tau = 0.0, rho_above = 0.0, step = 0.5 * lattice.spacing;
+      for (int z = dims.z - 1; z >= 0; --z) {
+        const double rho = lattice.density[lattice.index(x, y, z)];
+        tau += extinction_per_m * 0.5 * (rho + rho_above) * step;
+        lattice.skylight[lattice.index(x, y, z)] = float(diffuseTransmittance(tau));
+        rho_above = rho;
+        step = lattice.spacing;
+      }
+    }
 }
 
 double rayleighPhase(double cos_theta) {

@@ -14,6 +14,15 @@ namespace nephele {
 inline constexpr double kCloudExtinctionPerMetre =
     16.33e-3;                                        // Ex for density 1 (MODEL.md section 6)
 inline constexpr double kMetaballRadiusCells = 2.0;  // R = 2 l (MODEL.md section 6 default)
+// Asymmetry of cloud droplets' scattering for diffuse light (MODEL.md section 6, sky light).
+inline constexpr double kDiffuseAsymmetry = 0.85;
+
+// The share of diffuse light a non-absorbing cloud layer of optical depth tau lets through
+// (two-stream: 1 / (1 + 3/4 (1 - g) tau); MODEL.md section 6, sky light). 1 at tau = 0,
+// falling as 1 / tau, never to 0.
+inline double diffuseTransmittance(double tau) {
+  return 1.0 / (1.0 + 0.75 * (1.0 - kDiffuseAsymmetry) * tau);
+}
 
 // The metaball field f(r) = -4/9 a^6 + 17/9 a^4 - 22/9 a^2 + 1, a = r / R; 0 beyond R.
 double metaballField(double r, double radius);
@@ -35,6 +44,7 @@ struct DensityLattice {
   glm::dvec3 origin{0.0};       // grid-frame position of sample (0, 0, 0)
   std::vector<float> density;   // x fastest
   std::vector<float> sunlight;  // transmittance towards the sun, exp(-tau)
+  std::vector<float> skylight;  // share of the sky light reaching the sample (sweepSkylight)
   // Samples bounding every non-zero density sample, widened by one: the trilinear density is
   // 0 outside them (lo > hi when the cloud is empty).
   glm::ivec3 occupied_lo{0}, occupied_hi{-1};
@@ -48,7 +58,8 @@ struct DensityLattice {
   double densityAt(glm::dvec3 x) const;
 };
 
-// The exact metaball density at every lattice sample: q splatted through a fixed kernel table.
+// The exact metaball density at every lattice sample: q splatted through a fixed kernel table,
+// with its skylight (sweepSkylight); sunlight is left at 1 for sweepSunlight.
 DensityLattice densityLattice(const std::vector<float>& means, GridSize size, double cell_size,
                               int samples_per_cell);
 
@@ -57,6 +68,10 @@ DensityLattice densityLattice(const std::vector<float>& means, GridSize size, do
 // of the segment between them, with the density linear along it. O(samples).
 void sweepSunlight(DensityLattice& lattice, glm::dvec3 to_sun,
                    double extinction_per_m = kCloudExtinctionPerMetre);
+// Fills `lattice.skylight`: how much of the sky light reaches each sample through the cloud
+// straight above it, diffuseTransmittance of that column's optical depth (MODEL.md section 6,
+// sky light). A vertical column needs no interpolation: exact at every sample.
+void sweepSkylight(DensityLattice& lattice, double extinction_per_m = kCloudExtinctionPerMetre);
 
 // Transmittance of a segment whose density runs linearly from rho_a to rho_b: exact, and
 // stays in [0, 1] however thick the segment.
