@@ -75,7 +75,7 @@ std::vector<Ellipsoid> heapEllipsoids(const CloudField& f, glm::dvec3 base, doub
   dome.centre = base;
   ClusterSpec lobes;
   lobes.element.radii = {0.38 * r, 0.38 * r, 0.3 * h};
-  if (isCb(f)) lobes.element.radii = {0.22 * r, 0.22 * r, 0.16 * h};
+  if (isCb(f)) lobes.element.radii = {0.28 * r, 0.28 * r, 0.18 * h};
   lobes.centre = glm::dvec2(base);
   lobes.boundary_radii = glm::dvec2(0.42 * r);
   lobes.spacing = glm::dvec2(0.3 * r);
@@ -107,7 +107,7 @@ std::vector<Ellipsoid> heapEllipsoids(const CloudField& f, glm::dvec3 base, doub
     plateau.radii = {3.0 * r, 3.0 * r, 0.88 * h};
     plateau.centre = base;
     ClusterSpec cap;
-    cap.element.radii = {0.45 * r, 0.45 * r, 0.05 * h};
+    cap.element.radii = {0.5 * r, 0.5 * r, 0.07 * h};
     cap.centre = glm::dvec2(base);
     cap.boundary_radii = glm::dvec2(0.7 * r);
     cap.spacing = glm::dvec2(0.35 * r);  // the anvil sets the outline: kept at every distance
@@ -118,6 +118,12 @@ std::vector<Ellipsoid> heapEllipsoids(const CloudField& f, glm::dvec3 base, doub
     cap.seed = hashCounters(seed, kShape, 3);
     const std::vector<Ellipsoid> anvil = clusterEllipsoids(cap, {plateau});
     out.insert(out.end(), anvil.begin(), anvil.end());
+    // The trunk: one tall ellipsoid from the base to the anvil, so that the tower stands
+    // unbroken behind its lobes.
+    Ellipsoid trunk;
+    trunk.radii = {0.3 * r, 0.3 * r * squash, 0.45 * h};
+    trunk.centre = base + glm::dvec3(0.0, 0.0, trunk.radii.z);
+    out.push_back(trunk);
     bottom.radii.x *= 0.6, bottom.radii.y *= 0.6;
     out.push_back(bottom);
   }
