@@ -51,6 +51,7 @@ std::vector<View> viewsOf(const SceneFile& file) {
   for (const CloudField& field : file.scene.fields)
     if (field.base_m + field.thickness_m > top)
       base = field.base_m, top = field.base_m + field.thickness_m;
+  if (top <= 0.0) return views;  // no weather layer or field: only the preset's own view
   Camera inside = file.scene.camera;
   inside.position.z = 0.5 * (base + top);
   inside.orientation.pitch_deg = 0.0;
@@ -343,8 +344,10 @@ int main(int argc, char** argv) {
       Camera sized;
       if (!bench::parseSize(size, sized)) return 2;
       const int width = sized.width, height = sized.height;
+      // The world at the preset's time: automaton clouds are grown by the World.
+      const Scene at_time = World(file.scene, file.dynamics).scene();
       for (const View& view : viewsOf(file)) {
-        Scene scene = file.scene;
+        Scene scene = at_time;
         scene.camera = view.camera;
         scene.camera.width = width, scene.camera.height = height;
         // A fresh renderer per case: heap tiles and bakes left by the previous case would
