@@ -175,9 +175,9 @@ double nadirOpacity(const EllipsoidCloud& cloud, const SolidTexture& texture, gl
   return 1.0 - transmittance;
 }
 
-// Mean area seen straight down with opacity >= 1/2 of one heap of size factor 1, in units of
-// heapRadius^2, measured on a few sample heaps (the shape is scale-free but for the texture,
-// which scales with the heap too). Computed once per type.
+// Mean area seen straight down with opacity >= 1/2 of one heap, in units of heapRadius^2,
+// measured on 16 heaps whose sizes and heights are drawn as the tiles draw theirs (the shape
+// is scale-free but for the texture, which scales with the field). Computed once per type.
 double unitFootprint(CloudType type) {
   auto measure = [](CloudType t) {
     CloudField f;
@@ -185,12 +185,17 @@ double unitFootprint(CloudType type) {
     f.thickness_m = t == CloudType::kCumulonimbus ? 9000.0 : 1500.0;
     const double r = heapRadius(f);
     const SolidTexture texture(heapCloud(f, "").texture);
-    constexpr int kHeaps = 8, kGrid = 48;
+    constexpr int kHeaps = 16, kGrid = 48;
     double area = 0.0;
     for (int k = 0; k < kHeaps; ++k) {
+      // Sizes and heights drawn as the tiles draw them (makeTile).
+      auto u = [&](Draw d) { return unitFromBits(hashCounters(77, d, std::uint64_t(k))); };
+      const double size = 1.0 + kSizeVariation * (2.0 * u(kSize) - 1.0);
+      const double height = 0.8 + 0.4 * u(kHeight);
       EllipsoidCloud cloud = heapCloud(f, "");
-      cloud.ellipsoids = heapEllipsoids(f, {0.0, 0.0, 1000.0}, 1.0, 1.0, hashCounters(77, k), true);
-      const double half = 2.5 * r, cell = 2.0 * half / kGrid;
+      cloud.ellipsoids =
+          heapEllipsoids(f, {0.0, 0.0, 1000.0}, size, height, hashCounters(77, k), true);
+      const double half = 2.5 * r * size, cell = 2.0 * half / kGrid;
       int inside = 0;
       for (int y = 0; y < kGrid; ++y)
         for (int x = 0; x < kGrid; ++x)
@@ -209,13 +214,12 @@ double unitFootprint(CloudType type) {
   return cumulus;
 }
 
-// Heaps per square metre giving the field's coverage (Boolean model), with sizes 1 + v (2u - 1)
-// so that the mean squared size is 1 + v^2 / 3.
+// Heaps per square metre giving the field's coverage (Boolean model: 1 - exp(-density * mean
+// footprint)).
 double heapDensity(const CloudField& f) {
   const double c = std::clamp(f.coverage, 0.0, CloudField::kMaxFieldCoverage);
   const double r = heapRadius(f);
-  const double mean_area =
-      unitFootprint(f.type) * r * r * (1.0 + kSizeVariation * kSizeVariation / 3.0);
+  const double mean_area = unitFootprint(f.type) * r * r;
   return -std::log1p(-c) / mean_area;
 }
 
