@@ -113,6 +113,8 @@ std::vector<CloudLayer> planes(const WeatherLayer& w, const GenusLook& look, dou
   for (int k = 0; k < count; ++k) {
     CloudLayer plane = layer;
     plane.name = k == 0 ? prefix : prefix + "/" + std::to_string(k);
+    // A stack brightens upwards: the genus's grey at the base, white at the sunlit top.
+    if (count > 1) plane.colour = glm::dvec3(look.grey + (1.0 - look.grey) * k / (count - 1));
     plane.altitude_m = w.base_m + (count == 1 ? 0.0 : w.thickness_m * k / (count - 1));
     out.push_back(plane);
   }
