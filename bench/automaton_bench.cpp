@@ -96,10 +96,7 @@ void renderTable(const std::string& presets, const std::string& size, int repeat
                         {"3 samples per cell", 3, 1.0}};
   for (const char* name : {"automaton_cloud", "harbour"}) {
     SceneFile file;
-    if (std::string e = loadSceneFile(presets + "/" + name + ".toml", file); !e.empty()) {
-      std::fprintf(stderr, "%s\n", e.c_str());
-      return;
-    }
+    if (!bench::loadPreset(presets + "/" + name + ".toml", file)) return;
     if (!bench::parseSize(size, file.scene.camera)) return;
     FloatImage reference;
     for (const Case& c : cases) {

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "config/scene_file.h"
 #include "renderer/frame_timing.h"
 #include "renderer/gl/gl_renderer.h"
 
@@ -56,6 +57,13 @@ inline bool parseSize(const std::string& size, Camera& camera) {
   }
   camera.width = width, camera.height = height;
   return true;
+}
+
+// Reads the scene file at `path`; false, after printing the error, when it cannot be used.
+inline bool loadPreset(const std::string& path, SceneFile& file) {
+  const std::string error = loadSceneFile(path, file);
+  if (!error.empty()) std::fprintf(stderr, "%s\n", error.c_str());
+  return error.empty();
 }
 
 // The scene files (*.toml) in `directory`, sorted by name.

@@ -94,10 +94,7 @@ int main(int argc, char** argv) {
   GlRenderer renderer(*platform);
 
   SceneFile cumulus;
-  if (std::string e = loadSceneFile(presets + "/cumulus.toml", cumulus); !e.empty()) {
-    std::fprintf(stderr, "%s\n", e.c_str());
-    return 1;
-  }
+  if (!bench::loadPreset(presets + "/cumulus.toml", cumulus)) return 1;
   // Scaling: the cumulus preset's cloud rebuilt with N lobes (the same 2 km heap, denser).
   std::printf("\nscaling (cumulus preset, default knobs; multipass beside it)\n");
   std::printf("%-10s %-10s %12s %14s\n", "ellipsoids", "size", "fused ms", "multipass ms");
@@ -123,10 +120,7 @@ int main(int argc, char** argv) {
   const std::vector<std::filesystem::path> files = bench::presetFiles(presets);
   for (const auto& path : files) {
     SceneFile file;
-    if (std::string e = loadSceneFile(path.string(), file); !e.empty()) {
-      std::fprintf(stderr, "%s\n", e.c_str());
-      return 1;
-    }
+    if (!bench::loadPreset(path.string(), file)) return 1;
     if (file.scene.clouds.empty()) continue;
     const Scene& scene = file.scene;
     const FloatImage reference = renderReference(scene, {samples, 0});

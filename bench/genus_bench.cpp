@@ -225,11 +225,7 @@ double hemisphereFraction(GlRenderer& renderer, const Scene& weather,
 // straight down from 2 km above it; mean luminance over the inner half of its outline.
 void printAutomatonFigures(GlRenderer& renderer) {
   SceneFile file;
-  if (std::string e = loadSceneFile(NEPHELE_SOURCE_DIR "/config/scenes/harbour.toml", file);
-      !e.empty()) {
-    std::fprintf(stderr, "%s\n", e.c_str());
-    return;
-  }
+  if (!bench::loadPreset(NEPHELE_SOURCE_DIR "/config/scenes/harbour.toml", file)) return;
   file.scene.fog.reset();  // the sea fog lies below the clouds; it would grey the view down
   const Scene world = World(file.scene, file.dynamics).scene();
   double under_sum = 0.0, top_sum = 0.0;
@@ -336,10 +332,7 @@ int main(int argc, char** argv) {
 
   for (const auto& path : files) {
     SceneFile file;
-    if (std::string e = loadSceneFile(path.string(), file); !e.empty()) {
-      std::fprintf(stderr, "%s\n", e.c_str());
-      return 1;
-    }
+    if (!bench::loadPreset(path.string(), file)) return 1;
     for (const std::string& size : sizes) {
       Camera sized;
       if (!bench::parseSize(size, sized)) return 2;

@@ -80,10 +80,7 @@ int main(int argc, char** argv) {
 
   for (const auto& path : files) {
     SceneFile file;
-    if (std::string e = loadSceneFile(path.string(), file); !e.empty()) {
-      std::fprintf(stderr, "%s\n", e.c_str());
-      return 1;
-    }
+    if (!bench::loadPreset(path.string(), file)) return 1;
     for (const std::string& size : sizes) {
       Scene scene = file.scene;
       if (!bench::parseSize(size, scene.camera)) return 2;
