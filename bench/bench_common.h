@@ -69,8 +69,12 @@ inline bool loadPreset(const std::string& path, SceneFile& file) {
 // The scene files (*.toml) in `directory`, sorted by name.
 inline std::vector<std::filesystem::path> presetFiles(const std::string& directory) {
   std::vector<std::filesystem::path> files;
-  for (const auto& entry : std::filesystem::directory_iterator(directory))
+  std::error_code error;
+  for (const auto& entry : std::filesystem::directory_iterator(directory, error))
     if (entry.path().extension() == ".toml") files.push_back(entry.path());
+  if (error)
+    std::fprintf(stderr, "%s: cannot read the directory (%s)\n", directory.c_str(),
+                 error.message().c_str());
   std::sort(files.begin(), files.end());
   return files;
 }
