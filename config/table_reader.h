@@ -278,6 +278,12 @@ inline std::string tomlAsciiError(std::string_view text) {
                  ": a character beyond ASCII outside a string or comment (allowed there: "
                  "ASCII only)";
         if (c == '#') in = In::kComment;
+        // A quote opens a string only where a key or value may start; elsewhere (straight
+        // after a bare word or number) toml++ reads it as part of a malformed token, reading
+        // ahead to the next whitespace, so what follows stays code here too.
+        if ((c == '"' || c == '\'') && i > 0 &&
+            std::string_view(" \t\r\n=[,{.").find(text[i - 1]) == std::string_view::npos)
+          break;
         if (rest.starts_with("\"\"\"")) {
           in = In::kMultiBasic;
           i += 2;

@@ -167,6 +167,13 @@ TEST(SceneFile, NonAsciiOutsideStringsAndCommentsIsRefused) {
   EXPECT_THAT(error, HasSubstr("is not a name"));
   EXPECT_THAT(parseError("seed = 1\nx = '''\n\xc3\xa9'''\ny = \"\"\"\xc3\xa9\"\"\"\n"),
               Not(HasSubstr("beyond ASCII")));
+  // A quote straight after a number or bare word opens no string: toml++ reads it as part of
+  // the malformed token, up to the next whitespace (config_fuzz's later finds).
+  EXPECT_THAT(parseError("boundary = [35\"\"\"3fff\xef\xbb\xb7"
+                         "f\n"),
+              HasSubstr(":1: a character beyond ASCII"));
+  EXPECT_THAT(parseError("x = [0.0, -7seed0EEE'EEE\xc5\xba.0]\n"),
+              HasSubstr(":1: a character beyond ASCII"));
 }
 
 TEST(SceneFile, SyntaxErrorNamesTheLine) {
