@@ -51,6 +51,16 @@ double heapRadius(const CloudField& f) {
 }
 constexpr double kSizeVariation = 0.3;  // radius times 1 + v (2u - 1)
 
+// Size and height factors of heap k among those drawn from `seed` (a tile's, or the footprint
+// measurement's): size 1 +- kSizeVariation, height 0.8 to 1.2 of the layer's thickness.
+struct HeapScale {
+  double size, height;
+};
+HeapScale heapScale(std::uint64_t seed, std::uint64_t k) {
+  auto u = [&](Draw d) { return unitFromBits(hashCounters(seed, d, k)); };
+  return {1.0 + kSizeVariation * (2.0 * u(kSize) - 1.0), 0.8 + 0.4 * u(kHeight)};
+}
+
 // Beyond this many heap radii from the eye a heap keeps only the ellipsoids that set its
 // outline (its base, one mound standing for its lobes, a cumulonimbus's anvil); nearer, every
 // lobe.
@@ -189,13 +199,11 @@ double unitFootprint(CloudType type) {
     double area = 0.0;
     for (int k = 0; k < kHeaps; ++k) {
       // Sizes and heights drawn as the tiles draw them (makeTile).
-      auto u = [&](Draw d) { return unitFromBits(hashCounters(77, d, std::uint64_t(k))); };
-      const double size = 1.0 + kSizeVariation * (2.0 * u(kSize) - 1.0);
-      const double height = 0.8 + 0.4 * u(kHeight);
+      const HeapScale scale = heapScale(77, std::uint64_t(k));
       EllipsoidCloud cloud = heapCloud(f, "");
-      cloud.ellipsoids =
-          heapEllipsoids(f, {0.0, 0.0, 1000.0}, size, height, hashCounters(77, k), true);
-      const double half = 2.5 * r * size, cell = 2.0 * half / kGrid;
+      cloud.ellipsoids = heapEllipsoids(f, {0.0, 0.0, 1000.0}, scale.size, scale.height,
+                                        hashCounters(77, k), true);
+      const double half = 2.5 * r * scale.size, cell = 2.0 * half / kGrid;
       int inside = 0;
       for (int y = 0; y < kGrid; ++y)
         for (int x = 0; x < kGrid; ++x)
@@ -292,10 +300,10 @@ EllipsoidCloud makeTile(const CloudField& f, std::int64_t i, std::int64_t j, boo
   for (int k = 0; k < count; ++k) {
     auto u = [&](Draw d) { return unitFromBits(hashCounters(tile_seed, d, std::uint64_t(k))); };
     const glm::dvec3 base((double(i) + u(kX)) * size, (double(j) + u(kY)) * size, f.base_m);
-    const double s = 1.0 + kSizeVariation * (2.0 * u(kSize) - 1.0);
-    const double h = 0.8 + 0.4 * u(kHeight);
+    const HeapScale scale = heapScale(tile_seed, std::uint64_t(k));
     const std::vector<Ellipsoid> heap =
-        heapEllipsoids(f, base, s, h, hashCounters(tile_seed, kShape, std::uint64_t(k)), detailed);
+        heapEllipsoids(f, base, scale.size, scale.height,
+                       hashCounters(tile_seed, kShape, std::uint64_t(k)), detailed);
     if (cloud.ellipsoids.size() + heap.size() > std::size_t(Limits::kMaxEllipsoidsPerCloud)) break;
     cloud.ellipsoids.insert(cloud.ellipsoids.end(), heap.begin(), heap.end());
   }
