@@ -437,12 +437,13 @@ void SocketServer::sweep() {
   });
   sweep_timer_.expires_after(kSweepPeriod);
   sweep_timer_.async_wait([this](std::error_code ec) {
-    if (!ec) sweep();
+    if (!ec && !closed_) sweep();
   });
 }
 
 void SocketServer::accept() {
   acceptor_.async_accept([this](std::error_code ec, tcp::socket socket) {
+    if (closed_) return;  // accepted just before close(): the socket closes with this handler
     if (ec) {
       if (ec != asio::error::operation_aborted) {
         spdlog::warn("event=accept_failed error=\"{}\"", ec.message());
@@ -492,6 +493,7 @@ void SocketServer::accept() {
 }
 
 void SocketServer::close() {
+  closed_ = true;
   std::error_code ec;
   acceptor_.close(ec);
   sweep_timer_.cancel();
@@ -526,7 +528,7 @@ struct MetricsExchange {
 
 void MetricsServer::accept() {
   acceptor_.async_accept([this](std::error_code ec, tcp::socket socket) {
-    if (ec == asio::error::operation_aborted) return;
+    if (ec == asio::error::operation_aborted || closed_) return;
     std::erase_if(open_, [](const auto& weak) { return weak.expired(); });
     if (!ec && open_.size() >= kMaxMetricsConnections) {
       std::error_code ignored;
@@ -565,6 +567,7 @@ void MetricsServer::accept() {
 }
 
 void MetricsServer::close() {
+  closed_ = true;
   std::error_code ec;
   acceptor_.close(ec);
   for (auto& weak : open_)

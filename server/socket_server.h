@@ -39,6 +39,9 @@ class SocketServer {
   std::shared_ptr<std::atomic<int>> refusing_;  // over-limit connections being answered
   int port_ = 0;
   std::int64_t next_id_ = 1;
+  // Set by close(): a sweep or accept whose handler was already queued when close() cancelled
+  // it must not start another (the io thread would never run out of work).
+  bool closed_ = false;
   // Owned here while open (a connection that has paused reading has no pending operation
   // to keep it alive); closed ones are dropped by the sweep.
   std::map<std::int64_t, std::shared_ptr<Connection>> connections_;
@@ -63,6 +66,7 @@ class MetricsServer {
   asio::ip::tcp::acceptor acceptor_;
   int port_ = 0;
   std::vector<std::weak_ptr<MetricsExchange>> open_;
+  bool closed_ = false;  // as SocketServer::closed_
 };
 
 // Opens `acceptor` on `where`; returns the error, naming the address, on failure.
