@@ -84,12 +84,14 @@ std::vector<Setting> settingsFor(const SceneFile& file) {
   auto add = [&](std::string knob, std::string value, std::function<void(RenderSettings&)> edit) {
     out.push_back({std::move(knob), std::move(value), std::move(edit), {}, false});
   };
-  // Rotated layer textures are always evaluated per pixel (no periodic table holds them), so
-  // the bake knobs act only on layers without rotation.
+  // Rotated or jittered layer textures are always evaluated per pixel (no periodic table holds
+  // them), so the bake knobs act only on layers with Gardner's lattice.
   const bool layers = !file.scene.layers.empty();
+  auto periodic = [](const CloudLayer& l) {
+    return l.texture.gardner.rotation_deg == 0.0 && l.texture.gardner.jitter_octaves == 0.0;
+  };
   const bool baked_layers =
-      std::any_of(file.scene.layers.begin(), file.scene.layers.end(),
-                  [](const CloudLayer& l) { return l.texture.gardner.rotation_deg == 0.0; });
+      std::any_of(file.scene.layers.begin(), file.scene.layers.end(), periodic);
   const bool clouds = !file.scene.clouds.empty() || !file.scene.fields.empty();
   if (baked_layers || clouds) {
     add("texture", "baked",
@@ -140,17 +142,24 @@ std::vector<Setting> settingsFor(const SceneFile& file) {
                          a.samples_per_cell = samples;
                      }});
   }
-  // Lattice breaking (MODEL.md section 2) on layers that have it: 0 is Gardner's periodic
-  // texture, which the renderer can bake; rotated terms are evaluated per pixel.
-  if (std::any_of(file.scene.layers.begin(), file.scene.layers.end(),
-                  [](const CloudLayer& l) { return l.texture.gardner.rotation_deg > 0.0; }))
-    for (double degrees : {0.0, 15.0})
-      out.push_back({"rotation", withKnob(degrees), [](RenderSettings&) {},
-                     [degrees](SceneFile& f) {
-                       for (CloudLayer& l : f.scene.layers)
-                         l.texture.gardner.rotation_deg = degrees;
+  // Lattice breaking (MODEL.md section 2) on layers that have it: "off" is Gardner's periodic
+  // texture, which the renderer can bake; rotated or jittered terms are evaluated per pixel.
+  if (!std::all_of(file.scene.layers.begin(), file.scene.layers.end(), periodic)) {
+    auto model = [&](std::string knob, std::string value, double rotation, double jitter) {
+      out.push_back({std::move(knob), std::move(value), [](RenderSettings&) {},
+                     [rotation, jitter](SceneFile& f) {
+                       for (CloudLayer& l : f.scene.layers) {
+                         GardnerTextureParams& g = l.texture.gardner;
+                         if (rotation >= 0.0) g.rotation_deg = rotation;
+                         if (jitter >= 0.0) g.jitter_octaves = jitter;
+                       }
                      },
                      true});
+    };
+    model("lattice_breaking", "off", 0.0, 0.0);
+    model("rotation", "15", 15.0, -1.0);
+    for (double octaves : {0.0, 1.0}) model("jitter", withKnob(octaves), -1.0, octaves);
+  }
   return out;
 }
 

@@ -118,14 +118,14 @@ void readGardnerParams(TableReader& t, GardnerTextureParams& g, double min_frequ
 }
 
 void readTexture(TableReader& t, LayerTextureSpec& texture) {
-  t.allow({"source", "terms", "fx1", "fy1", "t0", "phases", "rotation", "tile_size", "size_log2",
-           "roughness", "cells", "octaves", "persistence"});
+  t.allow({"source", "terms", "fx1", "fy1", "t0", "phases", "rotation", "jitter", "tile_size",
+           "size_log2", "roughness", "cells", "octaves", "persistence"});
   texture.source = TextureSource(
       t.choice("source", {"gardner", "perlin", "diamond-square"}, int(texture.source)));
   const std::string source(textureSourceName(texture.source));
   const bool gardner = texture.source == TextureSource::kGardner;
   const bool perlin = texture.source == TextureSource::kPerlin;
-  for (const char* key : {"terms", "fx1", "fy1", "t0", "phases", "rotation"})
+  for (const char* key : {"terms", "fx1", "fy1", "t0", "phases", "rotation", "jitter"})
     if (!gardner) t.forbid(key, "applies to source \"gardner\" only, not \"" + source + "\"");
   for (const char* key : {"tile_size", "size_log2"})
     if (gardner) t.forbid(key, "applies to sources \"perlin\" and \"diamond-square\" only");
@@ -136,6 +136,7 @@ void readTexture(TableReader& t, LayerTextureSpec& texture) {
 
   readGardnerParams(t, texture.gardner, 1.0e-7);
   t.number("rotation", texture.gardner.rotation_deg, Limits::kTermRotation);
+  t.number("jitter", texture.gardner.jitter_octaves, Limits::kTermJitter);
   NoiseTableParams& n = texture.table;
   t.vector("tile_size", n.tile_size_m, 1.0, 1.0e7);
   t.integer("size_log2", n.size_log2, 4, 12);

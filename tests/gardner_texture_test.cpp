@@ -62,6 +62,70 @@ TEST(GardnerTexture, StaysWithinZeroAndOne) {
     }
 }
 
+// Lattice breaking (MODEL.md section 2) written out: n = 4 components for terms 1 and 2, 2 for
+// the others, each turned by at most `rotation_deg`, scaled by 2^(+-jitter), of amplitude
+// C / sqrt n; k = 1 / (sum sqrt(n) C + T0)^2.
+TEST(GardnerTexture, LatticeBreakingFollowsTheModel) {
+  GardnerTextureParams p = params(5, 0.4);
+  p.rotation_deg = 30.0;
+  p.jitter_octaves = 0.5;
+  const GardnerTexture g(p);
+  ASSERT_FALSE(g.periodic());
+  auto components = [](int i) { return i < 2 ? 4 : 2; };
+  double sum_c = 0.0;
+  for (int i = 0; i < p.terms; ++i) {
+    ASSERT_EQ(g.components(i), components(i));
+    sum_c += std::sqrt(components(i)) * g.amplitude(i);
+  }
+  const double k = 1.0 / ((sum_c + p.t0) * (sum_c + p.t0));
+  EXPECT_DOUBLE_EQ(g.normalisation(), k);
+  bool scaled_up = false, scaled_down = false;
+  for (int i = 0; i < p.terms; ++i)
+    for (int c = 0; c < components(i); ++c)
+      for (const glm::dvec2 a : {g.axisX(i, c), g.axisY(i, c)}) {
+        const double length = glm::length(a), angle = std::atan2(a.y, a.x) * 180.0 / kPi;
+        EXPECT_GE(length, std::exp2(-0.5) - 1e-12);
+        EXPECT_LE(length, std::exp2(0.5) + 1e-12);
+        EXPECT_LE(std::abs(angle), 30.0 + 1e-9);
+        scaled_up |= length > 1.1, scaled_down |= length < 0.9;
+      }
+  EXPECT_TRUE(scaled_up && scaled_down) << "the seeded scales spread both ways";
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<double> coordinate(-1e5, 1e5);
+  double mismatch = 0.0;
+  for (int n = 0; n < 500; ++n) {
+    const glm::dvec2 q(coordinate(rng), coordinate(rng));
+    double sx = p.t0, sy = p.t0;
+    for (int i = 0; i < p.terms; ++i)
+      for (int c = 0; c < components(i); ++c) {
+        const glm::dvec2 a = g.axisX(i, c), b = g.axisY(i, c);
+        const double x1 = a.x * q.x + a.y * q.y, y1 = a.x * q.y - a.y * q.x;
+        const double x2 = b.x * q.x + b.y * q.y, y2 = b.x * q.y - b.y * q.x;
+        const double fx = g.frequencyX(i), fy = g.frequencyY(i);
+        const double ci = g.amplitude(i) / std::sqrt(components(i));
+        sx += ci * std::sin(fx * x1 + kPi / 2 * std::sin(0.5 * fy * y1) + g.phaseX(i, c));
+        sy += ci * std::sin(fy * y2 + kPi / 2 * std::sin(0.5 * fx * x2) + g.phaseY(i, c));
+      }
+    const double expected = k * std::max(sx, 0.0) * std::max(sy, 0.0);
+    const double t = g.planar(q);
+    ASSERT_GE(t, 0.0);
+    ASSERT_LE(t, 1.0);
+    mismatch = std::max(mismatch, std::abs(t - expected));
+  }
+  EXPECT_LT(mismatch, 1e-12);
+  // Jitter alone breaks the lattice too: the texture no longer repeats with Gardner's period.
+  GardnerTextureParams jittered = params(5, 0.4);
+  jittered.jitter_octaves = 0.5;
+  const GardnerTexture j(jittered);
+  EXPECT_FALSE(j.periodic());
+  double moved = 0.0;
+  for (int n = 0; n < 50; ++n) {
+    const glm::dvec2 q(coordinate(rng), coordinate(rng));
+    moved = std::max(moved, std::abs(j.planar(q) - j.planar(q + j.period())));
+  }
+  EXPECT_GT(moved, 0.01);
+}
+
 TEST(GardnerTexture, FrequencyAndAmplitudeRelations) {
   const GardnerTexture g(params(8, 0.4));
   double sum = 0.0;

@@ -82,6 +82,22 @@ void expectPointSampledEqual(GlRenderer& renderer, const Scene& scene, const std
   EXPECT_LE(worst, 2e-3f) << name;
 }
 
+// Lattice breaking (rotated, jittered components; MODEL.md section 2) as the weather mapping
+// draws altocumulus: exact against the one-sample reference. The renderer's texture state
+// follows the jitter: after the same layer without it, the jittered one is drawn right again.
+TEST_F(GlRenderTest, LatticeBreakingEqualsOneSampleReference) {
+  SceneFile file = preset("genus_altocumulus");
+  ASSERT_FALSE(file.scene.layers.empty());
+  ASSERT_GT(file.scene.layers[0].texture.gardner.jitter_octaves, 0.0);
+  ASSERT_GT(file.scene.layers[0].texture.gardner.rotation_deg, 0.0);
+  file.scene.camera.orientation.pitch_deg = 50.0;
+  expectPointSampledEqual(*renderer_, file.scene, "point_lattice_breaking");
+  SceneFile plain = file;
+  for (CloudLayer& l : plain.scene.layers) l.texture.gardner.jitter_octaves = 0.0;
+  expectPointSampledEqual(*renderer_, plain.scene, "point_rotation_only");
+  expectPointSampledEqual(*renderer_, file.scene, "point_lattice_breaking_again");
+}
+
 // A deck below the camera and a layer above it, seen from between them: exact against the
 // one-sample reference, and filtered against the 4x4 reference. Seen from above at a slant,
 // the deck's full plaid is resolved by the 4x4 reference only partly where GL drops its

@@ -135,6 +135,10 @@ TEST(SceneFile, OutOfRangeNamesTheAllowedRange) {
       e, HasSubstr("test.toml:3: layer[0].threshold: 1.5 is out of range (allowed: -10 to 1)"));
   EXPECT_THAT(parseError("[image]\nwidth = 0\n"), HasSubstr("allowed: 1 to 16384"));
   EXPECT_THAT(parseError("[[layer]]\n[layer.texture]\nterms = 9\n"), HasSubstr("allowed: 1 to 8"));
+  EXPECT_THAT(parseError("[[layer]]\n[layer.texture]\njitter = 1.5\n"),
+              HasSubstr("layer[0].texture.jitter: 1.5 is out of range (allowed: 0 to 1)"));
+  EXPECT_THAT(parseError("[[layer]]\n[layer.texture]\nsource = \"perlin\"\njitter = 0.5\n"),
+              HasSubstr("applies to source \"gardner\" only"));
   EXPECT_THAT(parseError("[camera]\nposition = [0, 0, -1]\n"), HasSubstr("below the ground"));
 }
 

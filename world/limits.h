@@ -54,6 +54,7 @@ struct Limits {
   static constexpr Range kColour{0.0, 100.0};         // linear RGB; above 1 for bright HDR suns
   static constexpr Range kContrastOffset{0.0, 10.0};  // Gardner's T0
   static constexpr Range kTermRotation{0.0, 90.0};    // lattice-breaking angle, degrees
+  static constexpr Range kTermJitter{0.0, 1.0};       // lattice-breaking scale spread, octaves
 
   // Ellipsoids and targets, metres: zero, negative and NaN are rejected.
   static constexpr double kMinRadius = 1.0e-3, kMaxRadius = 1.0e5;

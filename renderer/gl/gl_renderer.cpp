@@ -55,7 +55,7 @@ std::string textureKey(const LayerTextureSpec& spec, const RenderSettings& setti
   if (spec.source == TextureSource::kGardner) {
     const GardnerTextureParams& g = spec.gardner;
     key << g.terms << '/' << g.fx1 << '/' << g.fy1 << '/' << g.t0 << '/' << g.seeded_phases << '/'
-        << g.rotation_deg << '/' << settings.bake_texels_per_cycle;
+        << g.rotation_deg << '/' << g.jitter_octaves << '/' << settings.bake_texels_per_cycle;
   } else {
     const NoiseTableParams& t = spec.table;
     key << t.tile_size_m.x << '/' << t.tile_size_m.y << '/' << t.size_log2 << '/' << t.roughness
@@ -325,7 +325,6 @@ void GlRenderer::setSlotUniforms(GLuint p, int slot, const LayerSlot& entry, con
       // the camera are taken from the whole drifted position, in double, term by term.
       const glm::dvec2 origin =
           texture.periodic() ? origin_uv * period : camera_xy - texture.driftOffset(scene.time_s);
-      gl_.ProgramUniform1i(p, location("u_components", slot), g->components());
       for (int j = 0; j < g->terms(); ++j) {
         auto set = [&](const char* name, int k, double v) {
           gl_.ProgramUniform1f(p, location(name, k), float(v));
@@ -333,8 +332,9 @@ void GlRenderer::setSlotUniforms(GLuint p, int slot, const LayerSlot& entry, con
         set("u_fx", 8 * slot + j, g->frequencyX(j));
         set("u_fy", 8 * slot + j, g->frequencyY(j));
         set("u_amplitude", 8 * slot + j, g->componentAmplitude(j));
-        for (int c = 0; c < g->components(); ++c) {
-          const int k = 16 * slot + 2 * j + c;
+        gl_.ProgramUniform1i(p, location("u_components", 8 * slot + j), g->components(j));
+        for (int c = 0; c < g->components(j); ++c) {
+          const int k = GardnerTextureParams::kComponents * (8 * slot + j) + c;
           const glm::dvec2 a = g->axisX(j, c), b = g->axisY(j, c);
           const glm::dvec2 q1(a.x * origin.x + a.y * origin.y, a.x * origin.y - a.y * origin.x);
           const glm::dvec2 q2(b.x * origin.x + b.y * origin.y, b.x * origin.y - b.y * origin.x);

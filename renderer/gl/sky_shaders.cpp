@@ -1,5 +1,7 @@
 #include "renderer/gl/sky_shaders.h"
 
+#include "world/textures/gardner_texture.h"
+
 namespace nephele {
 namespace {
 
@@ -183,19 +185,22 @@ float tableValue(sampler2D table, int i, LayerHit hit) {
 }
 
 #ifdef PROCEDURAL
-// Per-term constants, slot i's term j at [8 i + j], and per component (two per term when the
-// texture is rotated, GardnerTexture::components) at [16 i + 2 j + c]; the local origin's
-// phases are reduced modulo 2 pi on the CPU in double.
+// Per-term constants, slot i's term j at [8 i + j], and per component (u_components of them,
+// at most kComponents, once the lattice is broken: GardnerTexture::components) at
+// [kComponents (8 i + j) + c]; the local origin's phases are reduced modulo 2 pi on the CPU
+// in double.
 uniform float u_fx[kSlots * 8];
 uniform float u_fy[kSlots * 8];
 uniform float u_amplitude[kSlots * 8];      // of one component
-uniform int u_components[kSlots];
-uniform float u_phase_x[kSlots * 16];       // FX(j) * origin.x + phx(j), mod 2 pi
-uniform float u_phase_y[kSlots * 16];       // FY(j) * origin.y + phy(j), mod 2 pi
-uniform float u_half_phase_x[kSlots * 16];  // 0.5 FX(j) * origin.x, mod 2 pi
-uniform float u_half_phase_y[kSlots * 16];  // 0.5 FY(j) * origin.y, mod 2 pi
-uniform vec2 u_axis_x[kSlots * 16];         // the component's X axis in SX (cos, sin)
-uniform vec2 u_axis_y[kSlots * 16];         // and in SY; (1, 0) for Gardner's lattice
+uniform int u_components[kSlots * 8];       // of each term
+uniform float u_phase_x[kSlots * 8 * kComponents];       // FX(j) * origin.x + phx(j), mod 2 pi
+uniform float u_phase_y[kSlots * 8 * kComponents];       // FY(j) * origin.y + phy(j), mod 2 pi
+uniform float u_half_phase_x[kSlots * 8 * kComponents];  // 0.5 FX(j) * origin.x, mod 2 pi
+uniform float u_half_phase_y[kSlots * 8 * kComponents];  // 0.5 FY(j) * origin.y, mod 2 pi
+// The component's X axis in SX and in SY, (cos, sin) times its scale; (1, 0) for Gardner's
+// lattice.
+uniform vec2 u_axis_x[kSlots * 8 * kComponents];
+uniform vec2 u_axis_y[kSlots * 8 * kComponents];
 uniform float u_t0[kSlots];
 uniform float u_k[kSlots];
 const float kHalfPi = 1.5707963267948966;
@@ -204,8 +209,8 @@ const float kHalfPi = 1.5707963267948966;
 // the origin's phases above were taken in the same axes.
 void addTerm(int i, int j, vec2 p, inout float sx, inout float sy) {
   int t = 8 * i + j;
-  for (int c = 0; c < u_components[i]; ++c) {
-    int k = 16 * i + 2 * j + c;
+  for (int c = 0; c < u_components[t]; ++c) {
+    int k = kComponents * (8 * i + j) + c;
     vec2 a = u_axis_x[k], b = u_axis_y[k];
     vec2 q1 = vec2(a.x * p.x + a.y * p.y, a.x * p.y - a.y * p.x);
     vec2 q2 = vec2(b.x * p.x + b.y * p.y, b.x * p.y - b.y * p.x);
@@ -315,6 +320,7 @@ std::string skyFragmentSource(const SkyPassLayout& layout) {
     for (LayerKind kind : *side)
       (kind == LayerKind::kProceduralGardner ? procedural : sampled) = true;
   if (procedural) s += "#define PROCEDURAL\n";
+  s += "const int kComponents = " + std::to_string(GardnerTextureParams::kComponents) + ";\n";
   s += kCommon;
   if (layout.slots() > 0) s += kLayers;
   // One sampler uniform per slot: llvmpipe samples a sampler-array element far more slowly.

@@ -29,9 +29,11 @@ GardnerTexture::GardnerTexture(const GardnerTextureParams& params) : params_(par
     fx_[i] = params_.fx1 * std::ldexp(1.0, i);  // FX(i+1) = 2 FX(i)
     fy_[i] = params_.fy1 * std::ldexp(1.0, i);
     c_[i] = c;
-    amplitude_sum += c;
+    // n components of C / sqrt n keep the term's power; their sum can reach sqrt n C, which
+    // k allows for so that T stays within [0, 1].
+    amplitude_sum += c * std::sqrt(double(components(i)));
     c *= kAmplitudeRatio;
-    for (int k = 0; k < 2; ++k) {
+    for (int k = 0; k < GardnerTextureParams::kComponents; ++k) {
       if (params_.seeded_phases && (k == 0 || !periodic())) {
         phx_[i][k] = 2.0 * kPi * unitFromBits(hashCounters(params_.seed, 0x47617264ull, i, 2 * k));
         phy_[i][k] =
@@ -40,23 +42,23 @@ GardnerTexture::GardnerTexture(const GardnerTextureParams& params) : params_(par
       ax_[i][k] = ay_[i][k] = {1.0, 0.0};
     }
     if (!periodic()) {
-      // Each component of SX and of SY turns by its own angle r (2u - 1), r = rotation_deg.
+      // Each component of SX and of SY turns by its own angle r (2u - 1), r = rotation_deg,
+      // and scales by its own factor 2^(j (2v - 1)), j = jitter_octaves: the axis vector
+      // carries both, so that every evaluator (here and the GL sky shader) applies them alike.
       const double r = params_.rotation_deg * kPi / 180.0;
+      const double j = params_.jitter_octaves;
       auto axis = [&](std::uint64_t which) {
         const double u = unitFromBits(hashCounters(params_.seed, 0x526f7461ull, i, which));
+        const double v = unitFromBits(hashCounters(params_.seed, 0x4a697474ull, i, which));
         const double angle = r * (2.0 * u - 1.0);
-        return glm::dvec2(std::cos(angle), std::sin(angle));
+        return std::exp2(j * (2.0 * v - 1.0)) * glm::dvec2(std::cos(angle), std::sin(angle));
       };
-      for (int k = 0; k < 2; ++k) {
+      for (int k = 0; k < components(i); ++k) {
         ax_[i][k] = axis(2 * k);
         ay_[i][k] = axis(2 * k + 1);
       }
     }
   }
-  // Two components of C / sqrt 2 keep each term's power; their sum can reach sqrt 2 C, which
-  // k then allows for so that T stays within [0, 1].
-  component_scale_ = periodic() ? 1.0 : 1.0 / std::sqrt(2.0);
-  if (!periodic()) amplitude_sum *= std::sqrt(2.0);
   const double denom = amplitude_sum + params_.t0;
   k_ = 1.0 / (denom * denom);
 }
@@ -88,11 +90,11 @@ void GardnerTexture::addTerm(int i, glm::dvec3 p, bool solid, double& sx, double
     return;
   }
   // Lattice breaking: each component reads (x, y) in its own rotated axes.
-  for (int k = 0; k < 2; ++k) {
+  for (int k = 0; k < components(i); ++k) {
     const glm::dvec2 a = ax_[i][k], b = ay_[i][k];
     const double x1 = a.x * p.x + a.y * p.y, y1 = a.x * p.y - a.y * p.x;
     const double x2 = b.x * p.x + b.y * p.y, y2 = b.x * p.y - b.y * p.x;
-    const double c = c_[i] * component_scale_;
+    const double c = componentAmplitude(i);
     sx += c * std::sin(fx_[i] * x1 + 0.5 * kPi * std::sin(0.5 * fy_[i] * y1) + phx_[i][k]);
     sy += c * std::sin(fy_[i] * y2 + 0.5 * kPi * std::sin(0.5 * fx_[i] * x2) + phy_[i][k]);
   }

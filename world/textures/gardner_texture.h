@@ -1,5 +1,6 @@
 #pragma once
 // Gardner's sum-of-sines texture (MODEL.md section 2), evaluated in double.
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -9,19 +10,26 @@ namespace nephele {
 
 struct GardnerTextureParams {
   static constexpr int kMaxTerms = 8;
+  // Components per term once rotated or jittered (MODEL.md section 2): four for the two
+  // lowest terms, which carry most of the power, two for the others.
+  static constexpr int kComponents = 4;
+  static constexpr int kSplitTerms = 2;
   int terms = 5;              // n, 1..8
   double fx1 = 2.0e-3;        // base frequency along X, radians per metre
   double fy1 = 2.0e-3;        // base frequency along Y, radians per metre
   double t0 = 0.0;            // contrast offset, >= 0
   bool seeded_phases = true;  // add a seed-derived constant phase per term
   std::uint64_t seed = 0;
-  // Lattice breaking (MODEL.md section 2). 0 is Gardner's texture exactly. Otherwise each
-  // planar term of SX and of SY is two components of amplitude C(i) / sqrt 2 (the same power),
-  // each in its own axes, turned by a seed-derived angle uniform in [-rotation_deg,
-  // rotation_deg], and with its own phases: the octaves and their powers stay Gardner's, but no
-  // single lattice carries much of the power, and the sum never repeats. Solid textures
-  // ignore it.
+  // Lattice breaking (MODEL.md section 2); both 0 is Gardner's texture exactly. Otherwise each
+  // planar term of SX and of SY is n components of amplitude C(i) / sqrt n (the same power;
+  // n above), each in its own axes, turned by a seed-derived angle uniform in [-rotation_deg,
+  // rotation_deg], scaled by a seed-derived factor 2^(j (2v - 1)), j = jitter_octaves, and
+  // with its own phases: the octaves and their powers stay Gardner's, spread over the band
+  // around each octave, no single lattice carries much of the power, and the sum never
+  // repeats. The scale spread matters where the rotation must stay small (cirrus streaks keep
+  // a direction). Solid textures ignore both.
   double rotation_deg = 0.0;
+  double jitter_octaves = 0.0;
 };
 
 // How terms above the local sampling frequency are removed (MODEL.md section 2).
@@ -44,16 +52,20 @@ class GardnerTexture {
   double phaseX(int i, int c = 0) const { return phx_[i][c]; }
   double phaseY(int i, int c = 0) const { return phy_[i][c]; }
   double normalisation() const { return k_; }  // k = 1 / (sum C + T0)^2
-  // Components per term: 1 for Gardner's lattice, 2 when rotated; each has amplitude
-  // amplitude(i) / sqrt(components()).
-  int components() const { return periodic() ? 1 : 2; }
-  double componentAmplitude(int i) const { return c_[i] * component_scale_; }
-  // Unit X axis of component c of term i in SX and in SY (the Y axis is that turned 90
-  // degrees anticlockwise); (1, 0) when rotation_deg is 0.
+  // Components of term i: 1 for Gardner's lattice, else 4 for the two lowest terms and 2 for
+  // the others; each has amplitude amplitude(i) / sqrt(components(i)).
+  int components(int i) const {
+    if (periodic()) return 1;
+    return i < GardnerTextureParams::kSplitTerms ? GardnerTextureParams::kComponents : 2;
+  }
+  double componentAmplitude(int i) const { return c_[i] / std::sqrt(double(components(i))); }
+  // X axis of component c of term i in SX and in SY (the Y axis is that turned 90 degrees
+  // anticlockwise), of length the component's frequency factor (1 without jitter_octaves);
+  // (1, 0) for Gardner's lattice.
   glm::dvec2 axisX(int i, int c) const { return ax_[i][c]; }
   glm::dvec2 axisY(int i, int c) const { return ay_[i][c]; }
-  // False when the terms are rotated: the planar texture then never repeats.
-  bool periodic() const { return params_.rotation_deg == 0.0; }
+  // False when the terms are rotated or jittered: the planar texture then never repeats.
+  bool periodic() const { return params_.rotation_deg == 0.0 && params_.jitter_octaves == 0.0; }
 
   // Repeat lengths in metres: 4 pi / FX1 and 4 pi / FY1 (the phase terms run at half the
   // base frequency). For a rotated texture, the scale the term filter measures footprints in.
@@ -78,11 +90,10 @@ class GardnerTexture {
   double fx_[GardnerTextureParams::kMaxTerms]{};
   double fy_[GardnerTextureParams::kMaxTerms]{};
   double c_[GardnerTextureParams::kMaxTerms]{};
-  double phx_[GardnerTextureParams::kMaxTerms][2]{};
-  double phy_[GardnerTextureParams::kMaxTerms][2]{};
-  glm::dvec2 ax_[GardnerTextureParams::kMaxTerms][2];
-  glm::dvec2 ay_[GardnerTextureParams::kMaxTerms][2];
-  double component_scale_ = 1.0;
+  double phx_[GardnerTextureParams::kMaxTerms][GardnerTextureParams::kComponents]{};
+  double phy_[GardnerTextureParams::kMaxTerms][GardnerTextureParams::kComponents]{};
+  glm::dvec2 ax_[GardnerTextureParams::kMaxTerms][GardnerTextureParams::kComponents];
+  glm::dvec2 ay_[GardnerTextureParams::kMaxTerms][GardnerTextureParams::kComponents];
   double k_ = 1.0;
 };
 
