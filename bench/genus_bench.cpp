@@ -19,6 +19,7 @@
 
 #include "bench/bench_common.h"
 #include "config/scene_file.h"
+#include "image/cloud_statistics.h"
 #include "image/image.h"
 #include "renderer/gl/gl_renderer.h"
 #include "world/formations/cloud_field.h"
@@ -63,38 +64,8 @@ std::vector<View> viewsOf(const SceneFile& file) {
   return views;
 }
 
-// The connected regions (4-neighbour) of pixels whose coverage exceeds one half, leaving out
-// those that touch the border (a cloud cut by the frame has no whole outline); each as its
-// pixel indices.
-std::vector<std::vector<int>> cloudRegions(const FloatImage& image) {
-  const int w = image.width, h = image.height;
-  std::vector<int> label(std::size_t(w) * h, -1);
-  std::vector<std::vector<int>> out;
-  for (int start = 0; start < w * h; ++start) {
-    if (label[start] != -1 || image.rgba[4 * std::size_t(start) + 3] <= 0.5f) continue;
-    std::vector<int> region{start}, stack{start};
-    label[start] = int(out.size());
-    bool border = false;
-    while (!stack.empty()) {
-      const int p = stack.back();
-      stack.pop_back();
-      const int x = p % w, y = p / w;
-      border = border || x == 0 || y == 0 || x == w - 1 || y == h - 1;
-      for (const auto& [dx, dy] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
-        const int nx = x + dx, ny = y + dy;
-        if (nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
-        const int q = ny * w + nx;
-        if (label[q] != -1 || image.rgba[4 * std::size_t(q) + 3] <= 0.5f) continue;
-        label[q] = label[start];
-        region.push_back(q);
-        stack.push_back(q);
-      }
-    }
-    out.push_back(border ? std::vector<int>{} : std::move(region));
-  }
-  std::erase_if(out, [](const std::vector<int>& r) { return r.size() < 64; });
-  return out;
-}
+// Clouds smaller than this many pixels are left out of the body figures.
+constexpr int kMinCloudPixels = 64;
 
 struct BodyFigure {
   int inner = 0, opaque = 0;  // pixels in the inner half, and of those with coverage > 0.95
@@ -153,8 +124,8 @@ void printBodyFigures(GlRenderer& renderer, const SceneFile& file) {
       c.vfov_deg = vfov;
       c.width = c.height = 384;
       const FloatImage top = renderer.renderFloat(scene, file.render);
-      for (const std::vector<int>& region : cloudRegions(top)) {
-        const BodyFigure above = bodyFigure(top, region);
+      for (const CloudRegion& region : cloudRegions(top, kMinCloudPixels)) {
+        const BodyFigure above = bodyFigure(top, region.pixels);
         // Image x runs east, rows run south from the top.
         const glm::dvec2 xy = middle + span * glm::dvec2((above.centroid.x + 0.5) / c.width - 0.5,
                                                          0.5 - (above.centroid.y + 0.5) / c.height);
@@ -165,13 +136,13 @@ void printBodyFigures(GlRenderer& renderer, const SceneFile& file) {
         up.camera.width = up.camera.height = 256;
         const FloatImage below = renderer.renderFloat(up, file.render);
         // The heap overhead: the region holding the image centre.
-        const std::vector<std::vector<int>> regions = cloudRegions(below);
+        const std::vector<CloudRegion> regions = cloudRegions(below, kMinCloudPixels);
         const int centre = (up.camera.height / 2) * up.camera.width + up.camera.width / 2;
-        const auto hit = std::find_if(regions.begin(), regions.end(), [&](const auto& r) {
-          return std::find(r.begin(), r.end(), centre) != r.end();
+        const auto hit = std::find_if(regions.begin(), regions.end(), [&](const CloudRegion& r) {
+          return std::find(r.pixels.begin(), r.pixels.end(), centre) != r.pixels.end();
         });
         if (hit == regions.end()) continue;
-        const BodyFigure under = bodyFigure(below, *hit);
+        const BodyFigure under = bodyFigure(below, hit->pixels);
         ++heaps;
         inner += above.inner + under.inner;
         opaque += above.opaque + under.opaque;
@@ -242,13 +213,13 @@ void printAutomatonFigures(GlRenderer& renderer) {
       only.camera.vfov_deg = 60.0;
       only.camera.width = only.camera.height = 128;
       const FloatImage image = renderer.renderFloat(only, file.render);
-      const std::vector<std::vector<int>> regions = cloudRegions(image);
+      const std::vector<CloudRegion> regions = cloudRegions(image, kMinCloudPixels);
       const int centre = 64 * 128 + 64;
-      const auto hit = std::find_if(regions.begin(), regions.end(), [&](const auto& r) {
-        return std::find(r.begin(), r.end(), centre) != r.end();
+      const auto hit = std::find_if(regions.begin(), regions.end(), [&](const CloudRegion& r) {
+        return std::find(r.pixels.begin(), r.pixels.end(), centre) != r.pixels.end();
       });
       seen = hit != regions.end();
-      if (seen) luminance[side] = bodyFigure(image, *hit).luminance;
+      if (seen) luminance[side] = bodyFigure(image, hit->pixels).luminance;
     }
     if (!seen) continue;
     ++clouds;

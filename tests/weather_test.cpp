@@ -12,6 +12,7 @@
 #include <numbers>
 
 #include "gl_test_fixture.h"
+#include "image/cloud_statistics.h"
 #include "world/counter_random.h"
 #include "world/formations/cloud_field.h"
 
@@ -61,46 +62,6 @@ std::vector<double> coverageMask(const FloatImage& image) {
   std::vector<double> mask(std::size_t(image.width) * image.height);
   for (std::size_t i = 0; i < mask.size(); ++i) mask[i] = image.rgba[4 * i + 3] >= 0.5f ? 1.0 : 0.0;
   return mask;
-}
-
-// In-place radix-2 FFT.
-void fft(std::vector<std::complex<double>>& a, bool inverse) {
-  const std::size_t n = a.size();
-  for (std::size_t i = 1, j = 0; i < n; ++i) {
-    std::size_t bit = n >> 1;
-    for (; j & bit; bit >>= 1) j ^= bit;
-    j ^= bit;
-    if (i < j) std::swap(a[i], a[j]);
-  }
-  for (std::size_t len = 2; len <= n; len <<= 1) {
-    const double angle = 2.0 * std::numbers::pi / double(len) * (inverse ? 1.0 : -1.0);
-    const std::complex<double> w_len(std::cos(angle), std::sin(angle));
-    for (std::size_t i = 0; i < n; i += len) {
-      std::complex<double> w(1.0);
-      for (std::size_t k = 0; k < len / 2; ++k, w *= w_len) {
-        const auto u = a[i + k], v = a[i + k + len / 2] * w;
-        a[i + k] = u + v;
-        a[i + k + len / 2] = u - v;
-      }
-    }
-  }
-  if (inverse)
-    for (auto& x : a) x /= double(n);
-}
-
-// 2D transform of an n x n grid (rows then columns).
-void fft2(std::vector<std::complex<double>>& g, int n, bool inverse) {
-  std::vector<std::complex<double>> line(static_cast<std::size_t>(n));
-  for (int y = 0; y < n; ++y) {
-    std::copy_n(g.begin() + std::ptrdiff_t(y) * n, n, line.begin());
-    fft(line, inverse);
-    std::copy(line.begin(), line.end(), g.begin() + std::ptrdiff_t(y) * n);
-  }
-  for (int x = 0; x < n; ++x) {
-    for (int y = 0; y < n; ++y) line[std::size_t(y)] = g[std::size_t(y) * n + x];
-    fft(line, inverse);
-    for (int y = 0; y < n; ++y) g[std::size_t(y) * n + x] = line[std::size_t(y)];
-  }
 }
 
 // The highest secondary peak of the normalised autocorrelation of an s x s mask (s a power of

@@ -1,0 +1,170 @@
+#include "image/cloud_statistics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <utility>
+
+namespace nephele {
+
+void fft(std::vector<std::complex<double>>& a, bool inverse) {
+  const std::size_t n = a.size();
+  for (std::size_t i = 1, j = 0; i < n; ++i) {  // bit-reversal permutation
+    std::size_t bit = n >> 1;
+    for (; j & bit; bit >>= 1) j ^= bit;
+    j ^= bit;
+    if (i < j) std::swap(a[i], a[j]);
+  }
+  for (std::size_t len = 2; len <= n; len <<= 1) {
+    const double angle = 2.0 * std::numbers::pi / double(len) * (inverse ? 1.0 : -1.0);
+    const std::complex<double> w_len(std::cos(angle), std::sin(angle));
+    for (std::size_t i = 0; i < n; i += len) {
+      std::complex<double> w(1.0);
+      for (std::size_t k = 0; k < len / 2; ++k, w *= w_len) {
+        const auto u = a[i + k], v = a[i + k + len / 2] * w;
+        a[i + k] = u + v;
+        a[i + k + len / 2] = u - v;
+      }
+    }
+  }
+  if (inverse)
+    for (auto& x : a) x /= double(n);
+}
+
+void fft2(std::vector<std::complex<double>>& g, int n, bool inverse) {
+  std::vector<std::complex<double>> line(static_cast<std::size_t>(n));
+  for (int y = 0; y < n; ++y) {
+    std::copy_n(g.begin() + std::ptrdiff_t(y) * n, n, line.begin());
+    fft(line, inverse);
+    std::copy(line.begin(), line.end(), g.begin() + std::ptrdiff_t(y) * n);
+  }
+  for (int x = 0; x < n; ++x) {
+    for (int y = 0; y < n; ++y) line[std::size_t(y)] = g[std::size_t(y) * n + x];
+    fft(line, inverse);
+    for (int y = 0; y < n; ++y) g[std::size_t(y) * n + x] = line[std::size_t(y)];
+  }
+}
+
+std::vector<CloudRegion> cloudRegions(const FloatImage& image, int min_pixels) {
+  const int w = image.width, h = image.height;
+  auto cloud = [&](int p) { return image.rgba[4 * std::size_t(p) + 3] > 0.5f; };
+  std::vector<char> seen(std::size_t(w) * h, 0);
+  std::vector<CloudRegion> out;
+  for (int start = 0; start < w * h; ++start) {
+    if (seen[start] || !cloud(start)) continue;
+    CloudRegion region;
+    std::vector<int> stack{start};
+    seen[start] = 1;
+    bool border = false;
+    while (!stack.empty()) {
+      const int p = stack.back();
+      stack.pop_back();
+      region.pixels.push_back(p);
+      const int x = p % w, y = p / w;
+      border = border || x == 0 || y == 0 || x == w - 1 || y == h - 1;
+      for (const auto& [dx, dy] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
+        const int nx = x + dx, ny = y + dy;
+        const int q = ny * w + nx;
+        if (nx < 0 || ny < 0 || nx >= w || ny >= h || !cloud(q)) {
+          ++region.perimeter;  // an edge to clear sky (or the frame)
+          continue;
+        }
+        if (seen[q]) continue;
+        seen[q] = 1;
+        stack.push_back(q);
+      }
+    }
+    if (!border && int(region.pixels.size()) >= min_pixels) out.push_back(std::move(region));
+  }
+  return out;
+}
+
+LineFit fitLine(const std::vector<double>& x, const std::vector<double>& y) {
+  LineFit fit;
+  fit.points = int(std::min(x.size(), y.size()));
+  if (fit.points < 2) return fit;
+  double mx = 0.0, my = 0.0;
+  for (int i = 0; i < fit.points; ++i) mx += x[i], my += y[i];
+  mx /= fit.points, my /= fit.points;
+  double sxy = 0.0, sxx = 0.0;
+  for (int i = 0; i < fit.points; ++i) {
+    sxy += (x[i] - mx) * (y[i] - my);
+    sxx += (x[i] - mx) * (x[i] - mx);
+  }
+  fit.slope = sxx > 0.0 ? sxy / sxx : 0.0;
+  fit.intercept = my - fit.slope * mx;
+  return fit;
+}
+
+Fitted perimeterAreaDimension(const std::vector<CloudRegion>& clouds, int min_pixels) {
+  std::vector<double> log_area, log_perimeter;
+  for (const CloudRegion& c : clouds)
+    if (int(c.pixels.size()) >= min_pixels) {
+      log_area.push_back(std::log(double(c.pixels.size())));
+      log_perimeter.push_back(std::log(double(c.perimeter)));
+    }
+  const LineFit fit = fitLine(log_area, log_perimeter);
+  return {2.0 * fit.slope, fit.points};
+}
+
+Fitted sizeDistributionExponent(const std::vector<CloudRegion>& clouds, int min_pixels) {
+  constexpr double kBinsPerDecade = 4.0;
+  std::map<int, int> bins;  // bin index -> clouds
+  for (const CloudRegion& c : clouds)
+    if (int(c.pixels.size()) >= min_pixels)
+      ++bins[int(std::floor(kBinsPerDecade * std::log10(double(c.pixels.size()))))];
+  std::vector<double> log_size, log_density;
+  for (const auto& [bin, count] : bins) {
+    const double lower = std::pow(10.0, bin / kBinsPerDecade);
+    const double upper = std::pow(10.0, (bin + 1) / kBinsPerDecade);
+    log_size.push_back(std::log(std::sqrt(lower * upper)));
+    log_density.push_back(std::log(count / (upper - lower)));  // clouds per pixel of area
+  }
+  const LineFit fit = fitLine(log_size, log_density);
+  return {-fit.slope, fit.points};
+}
+
+Fitted transectSpectrumSlope(const std::vector<double>& field, int w, double longest_px,
+                             double shortest_px) {
+  std::vector<double> power(std::size_t(w / 2 + 1), 0.0);
+  std::vector<std::complex<double>> line(static_cast<std::size_t>(w));
+  for (int pass = 0; pass < 2; ++pass)  // rows, then columns
+    for (int r = 0; r < w; ++r) {
+      double mean = 0.0;
+      for (int i = 0; i < w; ++i)
+        mean += field[pass == 0 ? std::size_t(r) * w + i : std::size_t(i) * w + r];
+      mean /= w;
+      for (int i = 0; i < w; ++i) {
+        const double hann = 0.5 - 0.5 * std::cos(2.0 * std::numbers::pi * i / w);
+        const double v = field[pass == 0 ? std::size_t(r) * w + i : std::size_t(i) * w + r];
+        line[std::size_t(i)] = hann * (v - mean);
+      }
+      fft(line, false);
+      for (int k = 1; k <= w / 2; ++k) power[std::size_t(k)] += std::norm(line[std::size_t(k)]);
+    }
+  // Logarithmic bins, eight per octave, of wavenumbers k (cycles per transect) whose
+  // wavelengths w / k lie between the two limits.
+  const double k_low = std::max(1.0, w / longest_px), k_high = std::min(w / 2.0, w / shortest_px);
+  struct Bin {
+    double power = 0.0, log_k = 0.0;
+    int count = 0;
+  };
+  std::map<int, Bin> bins;
+  for (int k = int(std::ceil(k_low)); k <= int(std::floor(k_high)); ++k) {
+    Bin& bin = bins[int(std::floor(8.0 * std::log2(double(k))))];
+    bin.power += power[std::size_t(k)];
+    bin.log_k += std::log(double(k));
+    ++bin.count;
+  }
+  std::vector<double> log_k, log_power;
+  for (const auto& [index, bin] : bins) {
+    if (bin.power <= 0.0) continue;
+    log_k.push_back(bin.log_k / bin.count);
+    log_power.push_back(std::log(bin.power / bin.count));
+  }
+  const LineFit fit = fitLine(log_k, log_power);
+  return {fit.slope, fit.points};
+}
+
+}  // namespace nephele

@@ -1,0 +1,57 @@
+#pragma once
+// Statistics of rendered cloud fields, for the benchmarks and tests that compare them with
+// observed clouds (docs/ACCURACY.md, "Realism"): cloud outlines on the coverage channel,
+// their perimeter-area dimension and size distribution, and the spectrum of the radiance.
+#include <complex>
+#include <vector>
+
+#include "image/image.h"
+
+namespace nephele {
+
+// In-place radix-2 FFT (size a power of two); the inverse divides by the size.
+void fft(std::vector<std::complex<double>>& a, bool inverse);
+// 2D transform of an n x n grid stored row by row (rows, then columns).
+void fft2(std::vector<std::complex<double>>& g, int n, bool inverse);
+
+// One cloud: a 4-connected region of pixels whose coverage exceeds one half.
+struct CloudRegion {
+  std::vector<int> pixels;  // indices y * width + x
+  int perimeter = 0;        // pixel edges between the region and what is not cloud
+};
+
+// The clouds of an image that do not touch its border (a cloud cut by the frame has no whole
+// outline) and hold at least `min_pixels` pixels.
+std::vector<CloudRegion> cloudRegions(const FloatImage& image, int min_pixels);
+
+// Slope and intercept of the least-squares line y = slope x + intercept.
+struct LineFit {
+  double slope = 0.0, intercept = 0.0;
+  int points = 0;
+};
+LineFit fitLine(const std::vector<double>& x, const std::vector<double>& y);
+
+// A fitted figure and the number of points (clouds or bins) it rests on.
+struct Fitted {
+  double value = 0.0;
+  int points = 0;
+};
+
+// Perimeter-area dimension D (Lovejoy 1982): perimeter ~ area^(D / 2) over the clouds of at
+// least `min_pixels`, fitted on log perimeter against log area. A raster outline counts pixel
+// edges, which makes D = 1 for squares and biases it upwards for clouds a few pixels across.
+Fitted perimeterAreaDimension(const std::vector<CloudRegion>& clouds, int min_pixels);
+
+// Exponent a of the cloud size distribution n(A) ~ A^-a (clouds per unit of area), fitted on
+// logarithmic bins of area (four per decade) from `min_pixels` up, bins with clouds only.
+Fitted sizeDistributionExponent(const std::vector<CloudRegion>& clouds, int min_pixels);
+
+// Slope of the one-dimensional power spectrum of a w x w field (w a power of two), averaged
+// over its rows and its columns (as transects of satellite images are analysed; Cahalan and
+// Snider 1989), each transect with its mean removed and a Hann window, fitted on log power
+// against log wavenumber on logarithmic bins between the wavelengths `longest_px` and
+// `shortest_px`.
+Fitted transectSpectrumSlope(const std::vector<double>& field, int w, double longest_px,
+                             double shortest_px);
+
+}  // namespace nephele
