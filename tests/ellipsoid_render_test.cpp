@@ -108,6 +108,41 @@ TEST_F(EllipsoidRenderTest, SingleEllipsoidPointSampledMatchesReference) {
   expectClose(gl, reference, 45.0, 1.0, "single_point_sampled");
 }
 
+// Clouds all around the camera, some straddling the edges of the view: the renderer leaves
+// out whole clouds outside the frustum (MODEL.md section 7, "culling") and must not lose a
+// visible one, so the image equals the one-sample reference, which culls nothing. The
+// clouds at 52.5 degrees either side have their centres outside the view and an edge in it.
+TEST_F(EllipsoidRenderTest, CullingKeepsEveryVisibleCloud) {
+  // Pitched up so that the horizon, which GL antialiases analytically, is out of view.
+  Scene scene = cloudScene({}, lookingNorth({0.0, 0.0, 1000.0}, 35.0));
+  const EllipsoidCloud model = scene.clouds[0];
+  scene.clouds.clear();
+  for (int k = 0; k < 48; ++k) {
+    const double azimuth = glm::radians(7.5 * k), distance = 2500.0 + 150.0 * (k % 4);
+    EllipsoidCloud cloud = model;
+    cloud.name = std::to_string(k);
+    cloud.transition = 0.3;
+    cloud.ellipsoids = {
+        {{450.0, 300.0, 250.0},
+         {distance * std::sin(azimuth), distance * std::cos(azimuth), 1000.0 + 0.7 * distance},
+         {10.0 * k, 0.0, 0.0}}};
+    scene.clouds.push_back(cloud);
+  }
+  RenderSettings settings;
+  settings.texture_evaluation = TextureEvaluation::kProcedural;
+  settings.term_filter = TermFilter::kNone;
+  const FloatImage gl = renderer_->renderFloat(scene, settings);
+  const FrameStats stats = renderer_->lastFrameStats();
+  EXPECT_GE(stats.ellipsoids_culled, 28) << "most of the ring is outside the view";
+  EXPECT_GE(stats.ellipsoids_drawn, 10);
+  const FloatImage reference = renderReference(scene, {1, 0});
+  int large = 0;
+  for (std::size_t i = 0; i < gl.rgba.size(); ++i)
+    if (i % 4 != 3) large += std::abs(gl.rgba[i] - reference.rgba[i]) > 2e-3f;
+  EXPECT_LE(large, 40) << "of " << gl.rgba.size() / 4 * 3 << " channels";
+  expectClose(gl, reference, 45.0, 1.0, "culling_ring");
+}
+
 // The camera inside an ellipsoid, an ellipsoid behind it, one straddling the near plane and
 // a 1000:1 flat one: finite, in range, and close to the reference.
 TEST_F(EllipsoidRenderTest, HardViewsMatchReference) {

@@ -42,6 +42,19 @@ ViewBasis viewBasis(const Camera& camera) {
   return basis;
 }
 
+bool sphereMayBeInView(const ViewBasis& basis, glm::dvec3 eye, glm::dvec3 centre, double radius) {
+  const glm::dvec3 d = centre - eye;
+  if (glm::dot(d, basis.forward) < -radius) return false;  // behind the eye
+  // Each side plane holds the eye and an edge of the image: for the right edge its inward
+  // normal is forward * tan - right, normalised (and likewise for the others).
+  const double th = basis.tan_half_vfov, tw = th * basis.aspect;
+  const glm::dvec3 normals[] = {basis.forward * tw - basis.right, basis.forward * tw + basis.right,
+                                basis.forward * th - basis.up, basis.forward * th + basis.up};
+  for (const glm::dvec3& n : normals)
+    if (glm::dot(d, n) < -radius * glm::length(n)) return false;
+  return true;
+}
+
 glm::dvec3 rayDirection(const ViewBasis& basis, const Camera& camera, double x, double y) {
   const double u = (2.0 * x / camera.width - 1.0) * basis.tan_half_vfov * basis.aspect;
   const double v = (1.0 - 2.0 * y / camera.height) * basis.tan_half_vfov;

@@ -324,22 +324,6 @@ void EllipsoidRenderer::drawCloud(const Scene& scene, std::size_t index,
 
 namespace {
 
-// The bounding sphere of a cloud: the centre of its ellipsoids' bounding box, and the
-// largest distance from it to a centre plus that ellipsoid's longest semi-axis.
-void boundingSphere(const EllipsoidCloud& cloud, glm::dvec3& centre, double& radius) {
-  glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-lo);
-  for (const Ellipsoid& e : cloud.ellipsoids) {
-    const double r = std::max({e.radii.x, e.radii.y, e.radii.z});
-    lo = glm::min(lo, e.centre - r);
-    hi = glm::max(hi, e.centre + r);
-  }
-  centre = 0.5 * (lo + hi);
-  radius = 0.0;
-  for (const Ellipsoid& e : cloud.ellipsoids)
-    radius = std::max(radius,
-                      glm::length(e.centre - centre) + std::max({e.radii.x, e.radii.y, e.radii.z}));
-}
-
 // Everything an impostor's picture depends on besides the eye.
 std::string impostorKey(const Scene& scene, const EllipsoidCloud& cloud,
                         const RenderSettings& settings) {
@@ -368,9 +352,7 @@ bool EllipsoidRenderer::drawImpostor(const Scene& scene, std::size_t index,
                                      bool targets_drawn, const AltitudeBand& band) {
   const EllipsoidCloud& cloud = scene.clouds[index];
   const Camera& camera = scene.camera;
-  glm::dvec3 centre;
-  double radius;
-  boundingSphere(cloud, centre, radius);
+  const auto [centre, radius] = boundingSphere(cloud);
   const double distance = glm::length(centre - camera.position);
   // Only far clouds: the sphere well away from the eye and small on screen.
   const double pixels_per_radian = camera.height / glm::radians(camera.vfov_deg);

@@ -519,11 +519,21 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
       clouds.push_back({automaton, index, piece.band, distance,
                         pieces.size() == 1 ? AltitudeBand{} : piece.window});
   };
+  // A cloud wholly outside the view frustum is left out before any of its ellipsoids is
+  // looked at (the eye inside one is the veil's business, drawn below).
+  const ViewBasis basis = viewBasis(camera);
   for (std::size_t i = 0; i < scene.clouds.size(); ++i) {
+    const EllipsoidCloud& cloud = scene.clouds[i];
+    if (cloud.ellipsoids.empty()) continue;
+    if (const BoundingSphere s = boundingSphere(cloud);
+        !sphereMayBeInView(basis, camera.position, s.centre, s.radius)) {
+      stats_.ellipsoids_culled += int(cloud.ellipsoids.size());
+      continue;
+    }
     glm::dvec3 centre(0.0);
-    for (const Ellipsoid& e : scene.clouds[i].ellipsoids) centre += e.centre;
-    centre /= double(scene.clouds[i].ellipsoids.size());
-    const auto [z_lo, z_hi] = cloudVerticalExtent(scene.clouds[i]);
+    for (const Ellipsoid& e : cloud.ellipsoids) centre += e.centre;
+    centre /= double(cloud.ellipsoids.size());
+    const auto [z_lo, z_hi] = cloudVerticalExtent(cloud);
     addCloud(false, i, centre, z_lo, z_hi);
   }
   for (std::size_t i = 0; i < scene.automata.size(); ++i) {

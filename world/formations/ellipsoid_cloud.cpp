@@ -15,6 +15,21 @@ double smoothstep(double edge0, double edge1, double x) {
 }
 }  // namespace
 
+BoundingSphere boundingSphere(const EllipsoidCloud& cloud) {
+  glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-lo);
+  for (const Ellipsoid& e : cloud.ellipsoids) {
+    const double r = std::max({e.radii.x, e.radii.y, e.radii.z});
+    lo = glm::min(lo, e.centre - r);
+    hi = glm::max(hi, e.centre + r);
+  }
+  BoundingSphere s;
+  s.centre = 0.5 * (lo + hi);
+  for (const Ellipsoid& e : cloud.ellipsoids)
+    s.radius = std::max(
+        s.radius, glm::length(e.centre - s.centre) + std::max({e.radii.x, e.radii.y, e.radii.z}));
+  return s;
+}
+
 std::pair<double, double> cloudVerticalExtent(const EllipsoidCloud& cloud) {
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (const Ellipsoid& e : cloud.ellipsoids) {

@@ -30,6 +30,14 @@ struct EllipsoidCloud {
   glm::dvec3 drift_m{0.0};
 };
 
+// A sphere holding every ellipsoid of the cloud: the middle of their bounding box, and the
+// largest distance from it to a centre plus that ellipsoid's longest semi-axis.
+struct BoundingSphere {
+  glm::dvec3 centre{0.0};
+  double radius = 0.0;
+};
+BoundingSphere boundingSphere(const EllipsoidCloud& cloud);
+
 // The lowest and highest altitudes its ellipsoids reach.
 std::pair<double, double> cloudVerticalExtent(const EllipsoidCloud& cloud);
 // The middle of that extent: the altitude whose wind carries the cloud.
