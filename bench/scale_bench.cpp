@@ -86,8 +86,8 @@ int main(int argc, char** argv) {
     Scene seen = world;
     const ViewBasis basis = viewBasis(camera);
     std::erase_if(seen.clouds, [&](const EllipsoidCloud& c) {
-      const BoundingSphere s = boundingSphere(c);
-      return !sphereMayBeInView(basis, camera.position, s.centre, s.radius);
+      const BoundingBox box = boundingBox(c);
+      return !boxMayBeInView(basis, camera.position, box.lo, box.hi);
     });
     GlRenderer renderer(*platform);
     const RenderSettings settings;

@@ -22,6 +22,7 @@ constexpr int kMaxRefusing = 64;  // over-limit connections being answered at on
 constexpr auto kRefusalWait = std::chrono::seconds(2);     // for an over-limit client's request
 constexpr auto kShutdownDrain = std::chrono::seconds(10);  // to finish writing at shutdown
 constexpr auto kSweepPeriod = std::chrono::milliseconds(250);
+constexpr auto kAcceptRetry = std::chrono::milliseconds(100);  // after a failed accept
 constexpr std::size_t kMaxMetricsConnections = 16;
 
 // Compares a presented token with the configured one in time that depends only on the
@@ -416,6 +417,7 @@ SocketServer::SocketServer(asio::io_context& io, Engine& engine)
       engine_(engine),
       acceptor_(io),
       sweep_timer_(io),
+      accept_timer_(io),
       refusing_(std::make_shared<std::atomic<int>>(0)) {}
 
 SocketServer::~SocketServer() = default;
@@ -446,8 +448,13 @@ void SocketServer::accept() {
     if (closed_) return;  // accepted just before close(): the socket closes with this handler
     if (ec) {
       if (ec != asio::error::operation_aborted) {
+        // Out of file descriptors, say: the listening socket stays readable, so accepting
+        // again at once would spin; try again after a pause.
         spdlog::warn("event=accept_failed error=\"{}\"", ec.message());
-        accept();
+        accept_timer_.expires_after(kAcceptRetry);
+        accept_timer_.async_wait([this](std::error_code e) {
+          if (!e && !closed_) accept();
+        });
       }
       return;
     }
@@ -497,13 +504,14 @@ void SocketServer::close() {
   std::error_code ec;
   acceptor_.close(ec);
   sweep_timer_.cancel();
+  accept_timer_.cancel();
   // Replies already posted are written out (within kShutdownDrain) before each closes.
   for (auto& [id, c] : connections_) c->finish("shutdown", kShutdownDrain);
   connections_.clear();
 }
 
 MetricsServer::MetricsServer(asio::io_context& io, Engine& engine)
-    : io_(io), engine_(engine), acceptor_(io) {}
+    : io_(io), engine_(engine), acceptor_(io), accept_timer_(io) {}
 
 std::string MetricsServer::listen(const ListenConfig& where) {
   if (std::string e = openAcceptor(acceptor_, where, "metrics"); !e.empty()) return e;
@@ -529,6 +537,14 @@ struct MetricsExchange {
 void MetricsServer::accept() {
   acceptor_.async_accept([this](std::error_code ec, tcp::socket socket) {
     if (ec == asio::error::operation_aborted || closed_) return;
+    if (ec) {  // as SocketServer::accept: a pause, not a spin
+      spdlog::warn("event=metrics_accept_failed error=\"{}\"", ec.message());
+      accept_timer_.expires_after(kAcceptRetry);
+      accept_timer_.async_wait([this](std::error_code e) {
+        if (!e && !closed_) accept();
+      });
+      return;
+    }
     std::erase_if(open_, [](const auto& weak) { return weak.expired(); });
     if (!ec && open_.size() >= kMaxMetricsConnections) {
       std::error_code ignored;
@@ -570,6 +586,7 @@ void MetricsServer::close() {
   closed_ = true;
   std::error_code ec;
   acceptor_.close(ec);
+  accept_timer_.cancel();
   for (auto& weak : open_)
     if (auto x = weak.lock()) x->close();
   open_.clear();

@@ -36,6 +36,7 @@ class SocketServer {
   Engine& engine_;
   asio::ip::tcp::acceptor acceptor_;
   asio::steady_timer sweep_timer_;
+  asio::steady_timer accept_timer_;             // retries accepting after an error
   std::shared_ptr<std::atomic<int>> refusing_;  // over-limit connections being answered
   int port_ = 0;
   std::int64_t next_id_ = 1;
@@ -66,7 +67,8 @@ class MetricsServer {
   asio::ip::tcp::acceptor acceptor_;
   int port_ = 0;
   std::vector<std::weak_ptr<MetricsExchange>> open_;
-  bool closed_ = false;  // as SocketServer::closed_
+  asio::steady_timer accept_timer_;  // retries accepting after an error
+  bool closed_ = false;              // as SocketServer::closed_
 };
 
 // Opens `acceptor` on `where`; returns the error, naming the address, on failure.

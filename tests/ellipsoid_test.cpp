@@ -246,9 +246,10 @@ TEST(InCloudModel, ContinuousAcrossTheSurface) {
   cloud.ellipsoids = {tilted()};
   const SolidTexture texture(cloud.texture);
   const Sun sun;
-  const Veil far = inCloudVeil({cloud}, {&texture}, {0.0, 0.0, 0.0}, sun);
+  auto only = [&](std::size_t) -> const SolidTexture& { return texture; };
+  const Veil far = inCloudVeil({cloud}, only, {0.0, 0.0, 0.0}, sun);
   EXPECT_EQ(far.opacity, 0.0);
-  const Veil inside = inCloudVeil({cloud}, {&texture}, tilted().centre, sun);
+  const Veil inside = inCloudVeil({cloud}, only, tilted().centre, sun);
   EXPECT_EQ(inside.opacity, 1.0);
   EXPECT_GT(inside.colour.x, 0.0);
 }

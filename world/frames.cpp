@@ -42,16 +42,18 @@ ViewBasis viewBasis(const Camera& camera) {
   return basis;
 }
 
-bool sphereMayBeInView(const ViewBasis& basis, glm::dvec3 eye, glm::dvec3 centre, double radius) {
-  const glm::dvec3 d = centre - eye;
-  if (glm::dot(d, basis.forward) < -radius) return false;  // behind the eye
-  // Each side plane holds the eye and an edge of the image: for the right edge its inward
-  // normal is forward * tan - right, normalised (and likewise for the others).
+bool boxMayBeInView(const ViewBasis& basis, glm::dvec3 eye, glm::dvec3 lo, glm::dvec3 hi) {
+  const glm::dvec3 centre = 0.5 * (lo + hi) - eye, half = 0.5 * (hi - lo);
+  // Each plane holds the eye; n is its inward normal. The box is beyond it when even its
+  // corner farthest along n is: n . centre + sum |n_i| half_i < 0. The side planes hold the
+  // eye and an image edge: for the right edge n = forward tan(half width) - right, and
+  // likewise for the others.
   const double th = basis.tan_half_vfov, tw = th * basis.aspect;
-  const glm::dvec3 normals[] = {basis.forward * tw - basis.right, basis.forward * tw + basis.right,
-                                basis.forward * th - basis.up, basis.forward * th + basis.up};
+  const glm::dvec3 normals[] = {basis.forward, basis.forward * tw - basis.right,
+                                basis.forward * tw + basis.right, basis.forward * th - basis.up,
+                                basis.forward * th + basis.up};
   for (const glm::dvec3& n : normals)
-    if (glm::dot(d, n) < -radius * glm::length(n)) return false;
+    if (glm::dot(n, centre) + glm::dot(glm::abs(n), half) < 0.0) return false;
   return true;
 }
 

@@ -34,9 +34,10 @@ struct ViewBasis {
 
 ViewBasis viewBasis(const Camera& camera);
 
-// False only when a sphere lies wholly outside the camera's view frustum (beyond one of its
-// four side planes or behind the eye); conservative near the frustum's edges and corners.
-bool sphereMayBeInView(const ViewBasis& basis, glm::dvec3 eye, glm::dvec3 centre, double radius);
+// False only when the axis-aligned box [lo, hi] lies wholly outside the camera's view frustum
+// (beyond one of its four side planes or behind the eye); conservative near the frustum's
+// edges and corners.
+bool boxMayBeInView(const ViewBasis& basis, glm::dvec3 eye, glm::dvec3 lo, glm::dvec3 hi);
 
 // Unnormalised ray direction through image position (x, y) in pixels (pixel centres at +0.5).
 glm::dvec3 rayDirection(const ViewBasis& basis, const Camera& camera, double x, double y);

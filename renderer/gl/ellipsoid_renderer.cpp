@@ -715,10 +715,12 @@ void EllipsoidRenderer::renderAtlasBatch(const Scene& scene, const EllipsoidClou
 
 void EllipsoidRenderer::drawVeil(const Scene& scene, const RenderSettings& settings) {
   if (scene.clouds.empty()) return;
-  std::vector<const SolidTexture*> textures;
-  for (const EllipsoidCloud& cloud : scene.clouds)
-    textures.push_back(cachedTexture(cloud.texture, settings).source.get());
-  const Veil veil = inCloudVeil(scene.clouds, textures, scene.camera.position, scene.sun);
+  const Veil veil = inCloudVeil(
+      scene.clouds,
+      [&](std::size_t c) -> const SolidTexture& {
+        return *cachedTexture(scene.clouds[c].texture, settings).source;
+      },
+      scene.camera.position, scene.sun);
   if (veil.opacity <= 0.0) return;
   EllipsoidPassLayout layout;
   layout.program = EllipsoidProgram::kVeil;

@@ -519,14 +519,14 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
       clouds.push_back({automaton, index, piece.band, distance,
                         pieces.size() == 1 ? AltitudeBand{} : piece.window});
   };
-  // A cloud wholly outside the view frustum is left out before any of its ellipsoids is
-  // looked at (the eye inside one is the veil's business, drawn below).
+  // A cloud whose bounding box is wholly outside the view frustum is left out before any of
+  // its ellipsoids is projected (the eye inside one is the veil's business, drawn below).
   const ViewBasis basis = viewBasis(camera);
   for (std::size_t i = 0; i < scene.clouds.size(); ++i) {
     const EllipsoidCloud& cloud = scene.clouds[i];
     if (cloud.ellipsoids.empty()) continue;
-    if (const BoundingSphere s = boundingSphere(cloud);
-        !sphereMayBeInView(basis, camera.position, s.centre, s.radius)) {
+    if (const BoundingBox box = boundingBox(cloud);
+        !boxMayBeInView(basis, camera.position, box.lo, box.hi)) {
       stats_.ellipsoids_culled += int(cloud.ellipsoids.size());
       continue;
     }

@@ -64,7 +64,9 @@ class ReferenceTracer {
         if (fade > 0.0) ellipsoids_.push_back({view, c, fade});
       }
     }
-    veil_ = inCloudVeil(scene.clouds, solid_pointers, scene.camera.position, scene.sun);
+    veil_ = inCloudVeil(
+        scene.clouds, [&](std::size_t c) -> const SolidTexture& { return *solid_pointers[c]; },
+        scene.camera.position, scene.sun);
   }
 
   // Colour and coverage along one ray (unit direction).

@@ -990,6 +990,45 @@ class AbuseTest(DaemonTest):
         for name in ("weather1", "weather-1", "weather.1"):
             c.ok({"cmd": "remove_cloud", "name": name})
 
+    def test_case14_out_of_descriptors_the_daemon_waits_instead_of_spinning(self):
+        """With the file-descriptor limit reached, accepting fails while connections wait in
+        the backlog; the daemon must pause between attempts (not burn a core) and serve
+        newcomers once descriptors are free."""
+        import resource
+
+        def cpu_seconds(pid):
+            with open(f"/proc/{pid}/stat") as f:
+                fields = f.read().rsplit(")", 1)[1].split()
+            return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+        d = self.daemon()
+        first = d.client()
+        first.ok({"cmd": "hello"})
+        open_fds = len(os.listdir(f"/proc/{d.proc.pid}/fd"))
+        soft, hard = resource.prlimit(d.proc.pid, resource.RLIMIT_NOFILE)
+        resource.prlimit(d.proc.pid, resource.RLIMIT_NOFILE, (open_fds + 2, hard))
+        waiting = [socket.create_connection(("127.0.0.1", d.port)) for _ in range(6)]
+        time.sleep(0.5)  # the free descriptors are taken; the rest wait in the backlog
+        before = cpu_seconds(d.proc.pid)
+        time.sleep(2.0)
+        used = cpu_seconds(d.proc.pid) - before
+        self.assertLess(used, 0.5, f"the daemon used {used:.2f} s of CPU in 2 s while out of "
+                        "descriptors")
+        self.assertIn("accept_failed", d.log_text())
+        for s in waiting:
+            s.close()
+        first.close()
+        resource.prlimit(d.proc.pid, resource.RLIMIT_NOFILE, (soft, hard))
+        deadline = time.time() + 20
+        while True:  # the closed backlog entries are accepted and dropped first
+            try:
+                d.client().ok({"cmd": "hello"})
+                break
+            except (OSError, AssertionError):
+                if time.time() > deadline:
+                    raise
+                time.sleep(0.2)
+
 
     def test_live_fuzz_of_every_command_leaves_the_daemon_answering(self):
         """Random mixes of valid and broken requests of every command over three connections,

@@ -15,15 +15,21 @@ double smoothstep(double edge0, double edge1, double x) {
 }
 }  // namespace
 
-BoundingSphere boundingSphere(const EllipsoidCloud& cloud) {
-  glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-lo);
+BoundingBox boundingBox(const EllipsoidCloud& cloud) {
+  BoundingBox box{glm::dvec3(std::numeric_limits<double>::infinity()),
+                  glm::dvec3(-std::numeric_limits<double>::infinity())};
   for (const Ellipsoid& e : cloud.ellipsoids) {
     const double r = std::max({e.radii.x, e.radii.y, e.radii.z});
-    lo = glm::min(lo, e.centre - r);
-    hi = glm::max(hi, e.centre + r);
+    box.lo = glm::min(box.lo, e.centre - r);
+    box.hi = glm::max(box.hi, e.centre + r);
   }
+  return box;
+}
+
+BoundingSphere boundingSphere(const EllipsoidCloud& cloud) {
+  const BoundingBox box = boundingBox(cloud);
   BoundingSphere s;
-  s.centre = 0.5 * (lo + hi);
+  s.centre = 0.5 * (box.lo + box.hi);
   for (const Ellipsoid& e : cloud.ellipsoids)
     s.radius = std::max(
         s.radius, glm::length(e.centre - s.centre) + std::max({e.radii.x, e.radii.y, e.radii.z}));
@@ -93,7 +99,8 @@ double veilOpacity(double eye_radius) {
 }
 
 Veil inCloudVeil(const std::vector<EllipsoidCloud>& clouds,
-                 const std::vector<const SolidTexture*>& textures, glm::dvec3 eye, const Sun& sun) {
+                 const std::function<const SolidTexture&(std::size_t)>& texture, glm::dvec3 eye,
+                 const Sun& sun) {
   double transmittance = 1.0, weight = 0.0;
   glm::dvec3 weighted(0.0);
   const double lit_from_above = std::max(0.0, sunDirection(sun).z);
@@ -101,11 +108,16 @@ Veil inCloudVeil(const std::vector<EllipsoidCloud>& clouds,
     const EllipsoidCloud& cloud = clouds[c];
     double cloud_transmittance = 1.0;
     for (const Ellipsoid& e : cloud.ellipsoids) {
-      const glm::dvec3 o = worldToUnitSphere(e) * (eye - e.centre);
+      // Outside the ball of (1 + band) times the longest semi-axis the unit-sphere radius
+      // exceeds 1 + band, where the veil is 0.
+      const double reach = (1.0 + kInCloudBand) * std::max({e.radii.x, e.radii.y, e.radii.z});
+      const glm::dvec3 d = eye - e.centre;
+      if (glm::dot(d, d) > reach * reach) continue;
+      const glm::dvec3 o = worldToUnitSphere(e) * d;
       cloud_transmittance *= 1.0 - veilOpacity(glm::length(o));
     }
     if (cloud_transmittance == 1.0) continue;
-    const double it = textures[c]->value(eye - clouds[c].drift_m);
+    const double it = texture(c).value(eye - clouds[c].drift_m);
     const double intensity = gardnerIntensity(cloud.shading, lit_from_above, 0.0, it);
     const double opacity = 1.0 - cloud_transmittance;
     weighted += opacity * intensity * cloud.colour * sun.colour;

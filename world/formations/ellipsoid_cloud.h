@@ -3,6 +3,7 @@
 // one texture and one set of thresholds (MODEL.md sections 4 and 5), and the in-cloud fog a
 // camera sees when it flies into one.
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -30,8 +31,14 @@ struct EllipsoidCloud {
   glm::dvec3 drift_m{0.0};
 };
 
-// A sphere holding every ellipsoid of the cloud: the middle of their bounding box, and the
-// largest distance from it to a centre plus that ellipsoid's longest semi-axis.
+// An axis-aligned box holding every ellipsoid of the cloud (each taken as the ball of its
+// longest semi-axis); one pass over the ellipsoids.
+struct BoundingBox {
+  glm::dvec3 lo{0.0}, hi{0.0};
+};
+BoundingBox boundingBox(const EllipsoidCloud& cloud);
+// A sphere holding every ellipsoid of the cloud: the middle of that box, and the largest
+// distance from it to a centre plus that ellipsoid's longest semi-axis.
 struct BoundingSphere {
   glm::dvec3 centre{0.0};
   double radius = 0.0;
@@ -73,8 +80,12 @@ struct Veil {
   glm::dvec3 colour{0.0};
   double opacity = 0.0;
 };
-// `textures[i]` is cloud i's texture (the caller keeps them built).
+// `texture(i)` is cloud i's texture, asked for only when the eye is within the veil band of
+// one of its ellipsoids (the caller keeps it built). Ellipsoids farther from the eye than
+// (1 + kInCloudBand) times their longest semi-axis are passed over without a transform, so a
+// world of many clouds costs a distance test per ellipsoid.
 Veil inCloudVeil(const std::vector<EllipsoidCloud>& clouds,
-                 const std::vector<const SolidTexture*>& textures, glm::dvec3 eye, const Sun& sun);
+                 const std::function<const SolidTexture&(std::size_t)>& texture, glm::dvec3 eye,
+                 const Sun& sun);
 
 }  // namespace nephele
