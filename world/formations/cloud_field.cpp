@@ -13,6 +13,7 @@
 
 #include "world/counter_random.h"
 #include "world/formations/cluster.h"
+#include "world/frames.h"
 #include "world/limits.h"
 #include "world/scene.h"
 #include "world/textures/solid_texture.h"
@@ -369,14 +370,9 @@ std::vector<EllipsoidCloud> fieldClouds(const CloudField& f, const Camera& camer
   const ViewBasis basis = viewBasis(camera);
   const double top = f.base_m + (isCb(f) ? 1.3 : 1.2) * f.thickness_m;
   // A tile is kept when its box (grown by the largest heap that can reach out of it) is not
-  // wholly behind one of the view's four side planes.
+  // wholly outside the view frustum (the renderer's test for clouds).
   const double reach = 3.0 * heapRadius(f) * (1.0 + kSizeVariation);
-  const double tan_v = std::tan(glm::radians(camera.vfov_deg) / 2.0);
-  const double tan_h = tan_v * camera.width / std::max(camera.height, 1);
-  const glm::dvec3 normals[4] = {glm::normalize(basis.forward * tan_h + basis.right),
-                                 glm::normalize(basis.forward * tan_h - basis.right),
-                                 glm::normalize(basis.forward * tan_v + basis.up),
-                                 glm::normalize(basis.forward * tan_v - basis.up)};
+  const glm::dvec3 eye3(eye, camera.position.z);
   const std::string key = fieldKey(f);
   const auto lo = glm::floor((eye - range) / size), hi = glm::floor((eye + range) / size);
   for (double jy = lo.y; jy <= hi.y; ++jy)
@@ -386,17 +382,8 @@ std::vector<EllipsoidCloud> fieldClouds(const CloudField& f, const Camera& camer
       const glm::dvec2 nearest = glm::clamp(eye, min_xy, max_xy);
       const double distance = glm::length(nearest - eye);
       if (distance > range) continue;
-      bool outside = false;
-      for (const glm::dvec3& n : normals) {
-        bool any_inside = false;
-        for (int corner = 0; corner < 8 && !any_inside; ++corner) {
-          const glm::dvec3 p((corner & 1) ? max_xy.x : min_xy.x, (corner & 2) ? max_xy.y : min_xy.y,
-                             (corner & 4) ? top : f.base_m);
-          any_inside = glm::dot(p - glm::dvec3(eye, camera.position.z), n) >= 0.0;
-        }
-        if (!any_inside) outside = true;
-      }
-      if (outside) continue;
+      if (!boxMayBeInView(basis, eye3, glm::dvec3(min_xy, f.base_m), glm::dvec3(max_xy, top)))
+        continue;
       const std::int64_t i = std::int64_t(ix), j = std::int64_t(jy);
       const bool detailed = distance < kDetailRadii * heapRadius(f);
       const auto tile =
