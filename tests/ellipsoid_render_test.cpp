@@ -27,6 +27,17 @@ class EllipsoidRenderTest : public GlRenderTest {
     return scene;
   }
 
+  // The GL image against the one-sample reference: at most `max_channels` colour channels
+  // differ by more than 2e-3 (float against double), and 45 dB overall.
+  static void expectPointSampledClose(const FloatImage& gl, const FloatImage& reference,
+                                      int max_channels, const std::string& name) {
+    int large = 0;
+    for (std::size_t i = 0; i < gl.rgba.size(); ++i)
+      if (i % 4 != 3) large += std::abs(gl.rgba[i] - reference.rgba[i]) > 2e-3f;
+    EXPECT_LE(large, max_channels) << name << ": of " << gl.rgba.size() / 4 * 3 << " channels";
+    expectClose(gl, reference, 45.0, 1.0, name);
+  }
+
   static Camera lookingNorth(glm::dvec3 position, double pitch = 0.0) {
     Camera camera;
     camera.position = position;
@@ -100,12 +111,7 @@ TEST_F(EllipsoidRenderTest, SingleEllipsoidPointSampledMatchesReference) {
   settings.texture_evaluation = TextureEvaluation::kProcedural;
   settings.term_filter = TermFilter::kNone;
   const FloatImage gl = renderer_->renderFloat(scene, settings);
-  const FloatImage reference = renderReference(scene, {1, 0});
-  int large = 0;
-  for (std::size_t i = 0; i < gl.rgba.size(); ++i)
-    if (i % 4 != 3) large += std::abs(gl.rgba[i] - reference.rgba[i]) > 2e-3f;
-  EXPECT_LE(large, 12) << "of " << gl.rgba.size() / 4 * 3 << " channels";
-  expectClose(gl, reference, 45.0, 1.0, "single_point_sampled");
+  expectPointSampledClose(gl, renderReference(scene, {1, 0}), 12, "single_point_sampled");
 }
 
 // Clouds all around the camera, some straddling the edges of the view: the renderer leaves
@@ -135,12 +141,7 @@ TEST_F(EllipsoidRenderTest, CullingKeepsEveryVisibleCloud) {
   const FrameStats stats = renderer_->lastFrameStats();
   EXPECT_GE(stats.ellipsoids_culled, 28) << "most of the ring is outside the view";
   EXPECT_GE(stats.ellipsoids_drawn, 10);
-  const FloatImage reference = renderReference(scene, {1, 0});
-  int large = 0;
-  for (std::size_t i = 0; i < gl.rgba.size(); ++i)
-    if (i % 4 != 3) large += std::abs(gl.rgba[i] - reference.rgba[i]) > 2e-3f;
-  EXPECT_LE(large, 40) << "of " << gl.rgba.size() / 4 * 3 << " channels";
-  expectClose(gl, reference, 45.0, 1.0, "culling_ring");
+  expectPointSampledClose(gl, renderReference(scene, {1, 0}), 40, "culling_ring");
 }
 
 // The camera inside an ellipsoid, an ellipsoid behind it, one straddling the near plane and

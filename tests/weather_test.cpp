@@ -9,7 +9,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <numbers>
 
 #include "gl_test_fixture.h"
 #include "image/cloud_statistics.h"
