@@ -115,14 +115,10 @@ void printBodyFigures(GlRenderer& renderer, const SceneFile& file) {
       scene.clouds = tileClouds(field, i, j);
       if (scene.clouds.empty()) continue;
       // Straight down onto the tile and a margin around it.
-      const double span = 2.0 * tile, vfov = 4.0;
+      const double span = 2.0 * tile;
       const glm::dvec2 middle = (glm::dvec2(i, j) + 0.5) * tile;
       Camera& c = scene.camera;
-      c.position = glm::dvec3(middle, field.base_m + 1.3 * field.thickness_m +
-                                          0.5 * span / std::tan(glm::radians(vfov / 2.0)));
-      c.orientation = {0.0, -90.0, 0.0};
-      c.vfov_deg = vfov;
-      c.width = c.height = 384;
+      c = nadirCamera(middle, field.base_m, field.thickness_m, span, 384);
       const FloatImage top = renderer.renderFloat(scene, file.render);
       for (const CloudRegion& region : cloudRegions(top, kMinCloudPixels)) {
         const BodyFigure above = bodyFigure(top, region.pixels);

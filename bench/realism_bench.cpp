@@ -41,13 +41,7 @@ Figures measure(GlRenderer& renderer, CloudType type, double coverage, double sp
   const WeatherClouds clouds = weatherClouds(w, "weather/1", 7);
   scene.layers = clouds.layers;
   scene.fields = clouds.fields;
-  Camera& c = scene.camera;
-  c.vfov_deg = 4.0;  // near-orthographic, as the coverage test's nadir views
-  c.position = glm::dvec3(
-      3000.0, -2000.0,
-      w.base_m + 1.3 * w.thickness_m + 0.5 * span_m / std::tan(glm::radians(c.vfov_deg / 2.0)));
-  c.orientation = {0.0, -90.0, 0.0};
-  c.width = c.height = pixels;
+  scene.camera = nadirCamera({3000.0, -2000.0}, w.base_m, w.thickness_m, span_m, pixels);
   Figures f;
   FloatImage image;
   f.ms = medianMilliseconds(1, [&] { image = renderer.renderFloat(scene, {}); });

@@ -34,14 +34,7 @@ Scene weatherScene(const WeatherLayer& w, std::uint64_t seed) {
 
 // Straight down from far above the layer onto a square `span` metres wide centred at `xy`.
 Camera nadir(const WeatherLayer& w, glm::dvec2 xy, double span, int pixels) {
-  Camera c;
-  const double vfov = 4.0;  // near-orthographic: heap tops magnified by under 1 %
-  const double height = 0.5 * span / std::tan(glm::radians(vfov / 2.0));
-  c.position = glm::dvec3(xy, w.base_m + 1.3 * w.thickness_m + height);
-  c.orientation = {0.0, -90.0, 0.0};
-  c.vfov_deg = vfov;
-  c.width = c.height = pixels;
-  return c;
+  return nadirCamera(xy, w.base_m, w.thickness_m, span, pixels);
 }
 
 // The horizontal extent of a genus's largest feature, metres: the nominal texture period or

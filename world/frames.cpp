@@ -42,6 +42,16 @@ ViewBasis viewBasis(const Camera& camera) {
   return basis;
 }
 
+Camera nadirCamera(glm::dvec2 xy, double base_m, double thickness_m, double span_m, int pixels) {
+  Camera c;
+  c.vfov_deg = 4.0;
+  const double height = 0.5 * span_m / std::tan(radians(c.vfov_deg) * 0.5);
+  c.position = glm::dvec3(xy, base_m + 1.3 * thickness_m + height);
+  c.orientation = {0.0, -90.0, 0.0};
+  c.width = c.height = pixels;
+  return c;
+}
+
 bool boxMayBeInView(const ViewBasis& basis, glm::dvec3 eye, glm::dvec3 lo, glm::dvec3 hi) {
   const glm::dvec3 centre = 0.5 * (lo + hi) - eye, half = 0.5 * (hi - lo);
   // Each plane holds the eye; n is its inward normal. The box is beyond it when even its

@@ -34,6 +34,12 @@ struct ViewBasis {
 
 ViewBasis viewBasis(const Camera& camera);
 
+// Straight down onto a square `span_m` metres wide centred at `xy`, from above clouds whose
+// base is `base_m` and thickness `thickness_m` (heaps reach 1.3 times it): a 4 degree view
+// (near-orthographic: heap tops magnified by under 1 %), `pixels` a side. The view the
+// coverage, repetition and realism figures are measured in (SPEC section 9).
+Camera nadirCamera(glm::dvec2 xy, double base_m, double thickness_m, double span_m, int pixels);
+
 // False only when the axis-aligned box [lo, hi] lies wholly outside the camera's view frustum
 // (beyond one of its four side planes or behind the eye); conservative near the frustum's
 // edges and corners.
