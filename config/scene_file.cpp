@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -407,9 +408,44 @@ void readTarget(TableReader& t, const std::string& scene_path, Target& target) {
   t.finish();
 }
 
+// The keys a [[macrocluster]] adds to a weather layer (MODEL.md section 11): the region it
+// fills, its cluster grid and variation, and a front's side.
+void readMacrocluster(TableReader& t, WeatherLayer& w) {
+  Region& r = w.region;
+  if (!t.has("size"))
+    t.failAt("size", "is missing ([across, along] metres, each " +
+                         formatNumber(Limits::kRegionSize.lo) + " to " +
+                         formatNumber(Limits::kRegionSize.hi) + ")");
+  t.vector("centre", r.centre, -Limits::kMaxCoordinate, Limits::kMaxCoordinate);
+  glm::dvec2 size(0.0);
+  t.vector("size", size, Limits::kRegionSize);
+  r.half_size = 0.5 * size;
+  t.number("heading", r.heading_deg, -Limits::kMaxHeading, Limits::kMaxHeading);
+  t.number("edge", r.edge_m, Limits::kRegionBand);
+  const bool transition = t.has("transition");
+  r.side = std::array{0, -1, 1}[std::size_t(t.choice("front", {"none", "left", "right"}, 0))];
+  t.number("transition", r.transition_m, Limits::kRegionBand);
+  if (transition && r.side == 0)
+    t.failAt("transition",
+             "applies to one side of a front only (set front = \"left\" or \"right\")");
+  const bool heaps = w.type == CloudType::kCumulus || w.type == CloudType::kCumulonimbus;
+  for (const char* key : {"spacing", "variation"})
+    if (t.has(key) && !heaps)
+      t.failAt(key, "applies to heaps only (type cumulus or cumulonimbus), not " +
+                        std::string(cloudTypeName(w.type)));
+  t.number("spacing", w.clusters.spacing_m, Limits::kClusterSpacing);
+  t.number("variation", w.clusters.amount, Limits::kClusterVariation);
+  if (w.clusters.amount > 0.0 && w.clusters.spacing_m == 0.0)
+    t.failAt("variation", "needs spacing, the distance between the clusters it varies");
+}
+
 // A [[weather]] layer as a host sends it (MODEL.md section 10): the same mapping as set_weather.
-WeatherLayer readWeather(TableReader& t) {
-  t.allow({"type", "base", "thickness", "coverage"});
+// A [[macrocluster]] is a weather layer filling a region (`macro`).
+WeatherLayer readWeather(TableReader& t, bool macro = false) {
+  t.allow(macro ? std::vector<std::string>{"type", "base", "thickness", "coverage", "seed",
+                                           "centre", "size", "heading", "edge", "front",
+                                           "transition", "spacing", "variation"}
+                : std::vector<std::string>{"type", "base", "thickness", "coverage"});
   std::vector<std::string> names;
   for (int i = 0; i < kCloudTypeCount; ++i) names.emplace_back(cloudTypeName(CloudType(i)));
   WeatherLayer w;
@@ -419,6 +455,7 @@ WeatherLayer readWeather(TableReader& t) {
   double percent = 100.0 * w.coverage;
   t.number("coverage", percent, Limits::kCoveragePercent);
   w.coverage = percent / 100.0;
+  if (macro) readMacrocluster(t, w);
   t.finish();
   return w;
 }
@@ -426,7 +463,7 @@ WeatherLayer readWeather(TableReader& t) {
 void readScene(const toml::table& root, const std::string& file, SceneFile& out) {
   TableReader t(root, "", file);
   t.allow({"seed", "time", "image", "camera", "sun", "sky", "fog", "render", "wind", "layer",
-           "cloud", "automaton", "target", "weather"});
+           "cloud", "automaton", "target", "weather", "macrocluster"});
   Scene& scene = out.scene;
   t.seed("seed", scene.seed);
   t.number("time", scene.time_s, 0.0, Limits::kMaxTime);
@@ -456,16 +493,23 @@ void readScene(const toml::table& root, const std::string& file, SceneFile& out)
     readLayer(layers[i], layer, dynamics.layers.emplace_back());
     if (layer.name.empty()) layer.name = "layer" + std::to_string(i);
   }
-  std::vector<TableReader> weather = t.tables("weather");
-  for (std::size_t i = 0; i < weather.size(); ++i) {
-    const WeatherLayer w = readWeather(weather[i]);
-    const WeatherClouds add =
-        weatherClouds(w, "weather/" + std::to_string(i + 1), weatherSeed(scene.seed, int(i + 1)));
+  auto addWeather = [&](const WeatherLayer& w, const std::string& prefix, std::uint64_t seed) {
+    const WeatherClouds add = weatherClouds(w, prefix, seed);
     for (const CloudLayer& l : add.layers) {
       scene.layers.push_back(l);
       dynamics.layers.emplace_back();
     }
     scene.fields.insert(scene.fields.end(), add.fields.begin(), add.fields.end());
+  };
+  std::vector<TableReader> weather = t.tables("weather");
+  for (std::size_t i = 0; i < weather.size(); ++i)
+    addWeather(readWeather(weather[i]), "weather/" + std::to_string(i + 1),
+               weatherSeed(scene.seed, int(i + 1)));
+  std::vector<TableReader> macro = t.tables("macrocluster");
+  for (std::size_t i = 0; i < macro.size(); ++i) {
+    std::uint64_t seed = hashCounters(scene.seed, 0x4d6163726full, i);
+    macro[i].seed("seed", seed);
+    addWeather(readWeather(macro[i], true), "macrocluster/" + std::to_string(i + 1), seed);
   }
   std::vector<TableReader> clouds = t.tables("cloud");
   for (std::size_t i = 0; i < clouds.size(); ++i) {

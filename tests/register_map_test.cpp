@@ -24,7 +24,7 @@ HoldingRegisters sample() {
   s.heading = 90.0;
   s.width = 640;
   s.height = 480;
-  s.layers[1] = {CloudType::kCumulus, 1200.0, 800.0, 0.4, {}};
+  s.layers[1] = {CloudType::kCumulus, 1200.0, 800.0, 0.4, {}, {}, {}};
   return encodeHolding(s);
 }
 

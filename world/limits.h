@@ -67,6 +67,11 @@ struct Limits {
   static constexpr Range kThickness{1.0, 15000.0};
   static constexpr Range kCoveragePercent{0.0, 100.0};
 
+  // Macroclusters and fronts (world/formations/region.h), metres.
+  static constexpr Range kRegionSize{1.0, 2.0e7};      // full extent along each axis
+  static constexpr Range kRegionBand{0.0, 1.0e7};      // edge and front transition widths
+  static constexpr Range kClusterVariation{0.0, 1.0};  // per-cluster spread of cover, height
+
   // Gardner's clusters (world/formations/cluster.h).
   static constexpr Range kClusterSpacing{1.0, 1.0e5};
   static constexpr Range kClusterBoundary{1.0, 1.0e6};

@@ -10,6 +10,7 @@
 #include "world/automaton/automaton_cloud.h"
 #include "world/formations/cloud_field.h"
 #include "world/formations/ellipsoid_cloud.h"
+#include "world/formations/region.h"
 #include "world/frames.h"
 #include "world/shading.h"
 #include "world/sky.h"
@@ -27,7 +28,16 @@ struct CloudLayer {
   double transition = 0.3;           // D, >= 0
   ShadingParams shading;
   LayerTextureSpec texture;
+  Region region;  // where the layer lies (MODEL.md section 11); it drifts with the texture
 };
+
+// The layer's region weight at world point `xy` at time t: the region moves with the layer's
+// drift, unwrapped (the texture's own offset may be reduced modulo its period).
+inline double layerRegionWeight(const CloudLayer& layer, glm::dvec2 xy, double time_s) {
+  if (layer.region.everywhere()) return 1.0;
+  const LayerTextureSpec& t = layer.texture;
+  return regionWeight(layer.region, xy - t.drift_offset_m - t.drift_velocity * time_s);
+}
 
 struct Scene {
   std::uint64_t seed = 1;

@@ -24,7 +24,7 @@ namespace {
 static_assert(std::endian::native == std::endian::little, "snapshots assume a little-endian host");
 
 constexpr char kMagic[8] = {'N', 'E', 'P', 'H', 'S', 'N', 'A', 'P'};
-constexpr std::uint32_t kFormatVersion = 4;
+constexpr std::uint32_t kFormatVersion = 5;
 constexpr std::size_t kHeaderBytes = sizeof kMagic + 4 + 8 + 8;
 
 class Writer {
@@ -157,9 +157,19 @@ void io(A& a, LayerTextureSpec& t) {
   io(a, n.persistence), io(a, t.seed), io(a, t.drift_velocity), io(a, t.drift_offset_m);
 }
 template <class A>
+void io(A& a, Region& r) {
+  io(a, r.centre), io(a, r.half_size), io(a, r.heading_deg), io(a, r.edge_m), io(a, r.side);
+  io(a, r.transition_m);
+}
+template <class A>
+void io(A& a, ClusterVariation& v) {
+  io(a, v.spacing_m), io(a, v.amount);
+}
+template <class A>
 void io(A& a, CloudLayer& l) {
   io(a, l.name), io(a, l.altitude_m), io(a, l.colour), io(a, l.threshold), io(a, l.transition);
-  io(a, l.shading), io(a, l.texture);
+  io(a, l.shading), io(a, l.texture), io(a, l.region);
+  if (std::string e = regionError(l.region); !e.empty()) a.fail("layer " + l.name + ": " + e);
 }
 template <class A>
 void io(A& a, SolidTextureSpec& t) {
@@ -202,9 +212,10 @@ void io(A& a, CloudField& f) {
   io(a, f.name);
   ioEnum(a, f.type, kCloudTypeCount);
   io(a, f.base_m), io(a, f.thickness_m), io(a, f.coverage), io(a, f.seed), io(a, f.drift_m);
+  io(a, f.region), io(a, f.clusters);
   if (f.type != CloudType::kCumulus && f.type != CloudType::kCumulonimbus)
     a.fail("field " + f.name + ": not a convective cloud type");
-  const WeatherLayer w{f.type, f.base_m, f.thickness_m, f.coverage, {}};
+  const WeatherLayer w{f.type, f.base_m, f.thickness_m, f.coverage, {}, f.region, f.clusters};
   if (std::string e = weatherLayerError(w); !e.empty()) a.fail("field " + f.name + ": " + e);
 }
 template <class A>

@@ -307,6 +307,20 @@ void GlRenderer::setSlotUniforms(GLuint p, int slot, const LayerSlot& entry, con
   gl_.ProgramUniform4fv(p, location("u_shading", slot), 1, &shading.x);
   gl_.ProgramUniform1f(p, location("u_threshold", slot), float(layer.threshold));
   gl_.ProgramUniform1f(p, location("u_transition", slot), float(layer.transition));
+  if (GLint where = location("u_region", slot); where >= 0) {
+    // The region's centre, drifted with the layer, from the camera in double.
+    const Region& r = layer.region;
+    const LayerTextureSpec& t = layer.texture;
+    const glm::dvec2 centre =
+        r.centre + t.drift_offset_m + t.drift_velocity * scene.time_s - glm::dvec2(camera.position);
+    const double h = glm::radians(r.heading_deg);
+    const glm::vec4 frame(centre.x, centre.y, std::cos(h), std::sin(h));
+    auto finite = [](double half) { return float(std::min(half, 1.0e30)); };
+    const glm::vec4 size(finite(r.half_size.x), finite(r.half_size.y), r.edge_m, r.transition_m);
+    gl_.ProgramUniform4fv(p, where, 1, &frame.x);
+    gl_.ProgramUniform4fv(p, location("u_region_size", slot), 1, &size.x);
+    gl_.ProgramUniform1f(p, location("u_region_side", slot), float(r.side));
+  }
 
   // The precision rule of MODEL.md section 2: the texture's local origin is the point under the
   // camera, reduced modulo the period in double; the shader only sees offsets from it.
@@ -394,7 +408,10 @@ void GlRenderer::drawSkyGroup(const Scene& scene, const RenderSettings& settings
   base.fog = scene.fog.has_value();
   base.term_filter = settings.term_filter;
   base.targets = targets;
-  for (const CloudLayer& layer : scene.layers) base.specular |= layer.shading.specular > 0.0;
+  for (const CloudLayer& layer : scene.layers) {
+    base.specular |= layer.shading.specular > 0.0;
+    base.regions |= !layer.region.everywhere();
+  }
   const bool fused = settings.sky_passes == SkyPasses::kFused &&
                      int(std::max(above.size(), below.size())) <= kMaxLayerSlots;
 

@@ -137,6 +137,11 @@ uniform float u_transition[kSlots]; // D
 uniform vec2 u_origin[kSlots];      // texture coordinate under the camera, periods, in [0, 1)
 uniform vec2 u_inv_period[kSlots];  // periods per metre
 uniform float u_terms[kSlots];      // n
+#ifdef REGIONS
+uniform vec4 u_region[kSlots];       // centre from the camera (m), cos and sin of heading
+uniform vec4 u_region_size[kSlots];  // half sizes (m, 1e30 unbounded), edge, front transition
+uniform float u_region_side[kSlots]; // front side -1 or 1, 0 for none
+#endif
 uniform vec3 u_to_sun;
 
 struct LayerHit {
@@ -236,12 +241,32 @@ float proceduralValue(int i, LayerHit hit) {
 }
 #endif
 
+// T1 of slot i at `p` (metres from the camera): raised towards 1 as the weight of the layer's
+// region falls (world/formations/region.h, MODEL.md section 11).
+#ifdef REGIONS
+float regionRamp(float x, float width) {
+  float u = clamp(x / max(width, 1.0e-3), 0.0, 1.0);
+  return u * u * (3.0 - 2.0 * u);
+}
+float layerThreshold(int i, vec2 p) {
+  vec2 d = p - u_region[i].xy;
+  vec2 q = vec2(d.x * u_region[i].z - d.y * u_region[i].w, d.x * u_region[i].w + d.y * u_region[i].z);
+  vec4 size = u_region_size[i];
+  float w = regionRamp(size.x - abs(q.x), size.z) * regionRamp(size.y - abs(q.y), size.z);
+  if (u_region_side[i] != 0.0) w *= regionRamp(u_region_side[i] * q.x + 0.5 * size.w, size.w);
+  float t1 = u_threshold[i];
+  return t1 >= 1.0 ? t1 : t1 + (1.0 - w) * (1.0 - t1);
+}
+#else
+float layerThreshold(int i, vec2 p) { return u_threshold[i]; }
+#endif
+
 // Slot i's surface under what lies in front of it: layers are composited nearest first, so
 // `colour` holds the premultiplied sum of the surfaces in front and `transmittance` what they
 // let through ("over" summed front to back, the same sum as back to front).
 void composite(int i, vec3 r, LayerHit hit, float it, inout vec3 colour,
                inout float transmittance) {
-  float tr = translucence(it - u_threshold[i], u_transition[i]);  // Gardner eq. 9
+  float tr = translucence(it - layerThreshold(i, hit.p), u_transition[i]);  // Gardner eq. 9
   vec3 normal = vec3(0.0, 0.0, u_height[i] > 0.0 ? -1.0 : 1.0);  // turned towards the viewer
   float n_dot_l = dot(normal, u_to_sun);
   float highlight = 0.0;
@@ -293,6 +318,7 @@ std::string SkyPassLayout::key() const {
   k += fog ? 'f' : '-';
   k += specular ? 's' : '-';
   k += targets ? 't' : '-';
+  k += regions ? 'r' : '-';
   return k;
 }
 
@@ -313,6 +339,7 @@ std::string skyFragmentSource(const SkyPassLayout& layout) {
   if (layout.background) s += "#define BACKGROUND\n";
   if (layout.specular) s += "#define SPECULAR\n";
   if (layout.targets) s += "#define TARGETS\n";
+  if (layout.regions) s += "#define REGIONS\n";
   if (layout.term_filter == TermFilter::kCut) s += "#define FILTER_CUT\n";
   if (layout.term_filter == TermFilter::kNone) s += "#define FILTER_NONE\n";
   bool procedural = false, sampled = false;

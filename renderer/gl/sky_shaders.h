@@ -25,6 +25,7 @@ struct SkyPassLayout {
   bool fog = false;
   bool specular = false;
   bool targets = false;  // opaque targets were drawn first (their colour and distance)
+  bool regions = false;  // some layer lies in a bounded region (region.h)
 
   int slots() const { return int(above.size() + below.size()); }
   std::string key() const;

@@ -115,7 +115,9 @@ class ReferenceTracer {
                        double s) const {
     const glm::dvec3 p = scene_.camera.position + s * direction;
     const double t = texture.value({p.x, p.y}, scene_.time_s);
-    const double tr = skyPlaneTranslucence(t, layer.threshold, layer.transition);
+    const double t1 =
+        regionThreshold(layer.threshold, layerRegionWeight(layer, {p.x, p.y}, scene_.time_s));
+    const double tr = skyPlaneTranslucence(t, t1, layer.transition);
     const double intensity = gardnerIntensity(layer.shading, t, {0.0, 0.0, 1.0}, sun_, -direction);
     return {s, withFog(intensity * layer.colour * scene_.sun.colour, direction, s), 1.0 - tr};
   }

@@ -26,7 +26,7 @@ constexpr std::array<std::string_view, kCloudTypeCount> kNames{
     "cumulonimbus", "cumulus",     "nimbostratus", "stratocumulus", "stratus"};
 
 // Purposes of the counter-based draws (hashCounters' third key).
-enum Draw : std::uint64_t { kCount = 1, kX, kY, kSize, kHeight, kShape };
+enum Draw : std::uint64_t { kCount = 1, kX, kY, kSize, kHeight, kShape, kKeep, kCover, kRise };
 
 // A heap's look (Gardner eq. 8 and 11). T1 well below zero makes the middle of every ellipsoid
 // opaque whatever the texture; T2 above one makes the limb clear; D sets how soft the edge is.
@@ -223,10 +223,21 @@ double unitFootprint(CloudType type) {
   return cumulus;
 }
 
-// Heaps per square metre giving the field's coverage (Boolean model: 1 - exp(-density * mean
-// footprint)).
-double heapDensity(const CloudField& f) {
-  const double c = std::clamp(f.coverage, 0.0, CloudField::kMaxFieldCoverage);
+// The cover heaps are drawn for at `xy` (field frame): the field's coverage times the region's
+// weight and the cluster's cover factor there, at most kMaxFieldCoverage.
+double localCoverage(const CloudField& f, glm::dvec2 xy) {
+  const double c =
+      f.coverage * regionWeight(f.region, xy) * clusterFactor(f.clusters, f.seed, kCover, xy);
+  return std::clamp(c, 0.0, CloudField::kMaxFieldCoverage);
+}
+// The most any point asks for.
+double peakCoverage(const CloudField& f) {
+  return std::clamp(f.coverage * (1.0 + (f.clusters.none() ? 0.0 : f.clusters.amount)), 0.0,
+                    CloudField::kMaxFieldCoverage);
+}
+
+// Heaps per square metre giving cover c (Boolean model: 1 - exp(-density * mean footprint)).
+double heapDensity(const CloudField& f, double c) {
   const double r = heapRadius(f);
   const double mean_area = unitFootprint(f.type) * r * r;
   return -std::log1p(-c) / mean_area;
@@ -289,19 +300,33 @@ std::string fieldKey(const CloudField& f) {
   key.precision(17);
   key << f.name << '/' << int(f.type) << '/' << f.base_m << '/' << f.thickness_m << '/'
       << f.coverage << '/' << f.seed;
+  const Region& r = f.region;
+  if (!r.everywhere())
+    key << "/r" << r.centre.x << ',' << r.centre.y << ',' << r.half_size.x << ',' << r.half_size.y
+        << ',' << r.heading_deg << ',' << r.edge_m << ',' << r.side << ',' << r.transition_m;
+  if (!f.clusters.none()) key << "/v" << f.clusters.spacing_m << ',' << f.clusters.amount;
   return key.str();
 }
 
 EllipsoidCloud makeTile(const CloudField& f, std::int64_t i, std::int64_t j, bool detailed) {
   const double size = fieldTileSize(f);
   const std::uint64_t tile_seed = hashCounters(f.seed, std::uint64_t(i), std::uint64_t(j));
+  // Heaps are drawn for the highest cover anywhere, and each is kept with the ratio of the
+  // density its place asks for to that (thinning a Poisson process gives a Poisson process of
+  // the thinned density), so cover follows the region and the clusters without seams.
+  const double peak = peakCoverage(f);
+  const double peak_density = heapDensity(f, peak);
   const int count =
-      poisson(heapDensity(f) * size * size, unitFromBits(hashCounters(tile_seed, kCount)));
+      poisson(peak_density * size * size, unitFromBits(hashCounters(tile_seed, kCount)));
   EllipsoidCloud cloud = heapCloud(f, f.name + "/" + std::to_string(i) + "," + std::to_string(j));
+  const bool uniform = f.region.everywhere() && f.clusters.none();
   for (int k = 0; k < count; ++k) {
     auto u = [&](Draw d) { return unitFromBits(hashCounters(tile_seed, d, std::uint64_t(k))); };
     const glm::dvec3 base((double(i) + u(kX)) * size, (double(j) + u(kY)) * size, f.base_m);
-    const HeapScale scale = heapScale(tile_seed, std::uint64_t(k));
+    if (!uniform && !(u(kKeep) < heapDensity(f, localCoverage(f, glm::dvec2(base))) / peak_density))
+      continue;
+    HeapScale scale = heapScale(tile_seed, std::uint64_t(k));
+    scale.height *= clusterFactor(f.clusters, f.seed, kRise, glm::dvec2(base));
     const std::vector<Ellipsoid> heap =
         heapEllipsoids(f, base, scale.size, scale.height,
                        hashCounters(tile_seed, kShape, std::uint64_t(k)), detailed);
@@ -345,7 +370,8 @@ std::string weatherLayerError(const WeatherLayer& w) {
   if (w.wind && (outside("wind x", w.wind->x, {-Limits::kMaxWind, Limits::kMaxWind}) ||
                  outside("wind y", w.wind->y, {-Limits::kMaxWind, Limits::kMaxWind})))
     return out.str();
-  return "";
+  if (std::string error = regionError(w.region); !error.empty()) return error;
+  return clusterVariationError(w.clusters);
 }
 
 double fieldTileSize(const CloudField& f) {
@@ -361,14 +387,15 @@ std::vector<EllipsoidCloud> tileClouds(const CloudField& f, std::int64_t i, std:
 
 std::vector<EllipsoidCloud> fieldClouds(const CloudField& f, const Camera& camera) {
   std::vector<EllipsoidCloud> out;
-  if (!(f.coverage > 0.0)) return out;
+  if (!(peakCoverage(f) > 0.0)) return out;
   const double size = fieldTileSize(f);
   // The eye in the field's own frame (the field has drifted by drift_m).
   const glm::dvec2 eye = glm::dvec2(camera.position) - f.drift_m;
   // From high up the view reaches further: the range grows with the height above the heaps.
   const double range = CloudField::kRangeM + 2.0 * std::abs(camera.position.z - f.base_m);
   const ViewBasis basis = viewBasis(camera);
-  const double top = f.base_m + (isCb(f) ? 1.3 : 1.2) * f.thickness_m;
+  const double rise = f.clusters.none() ? 1.0 : 1.0 + f.clusters.amount;
+  const double top = f.base_m + (isCb(f) ? 1.3 : 1.2) * f.thickness_m * rise;
   // A tile is kept when its box (grown by the largest heap that can reach out of it) is not
   // wholly outside the view frustum (the renderer's test for clouds).
   const double reach = 3.0 * heapRadius(f) * (1.0 + kSizeVariation);
@@ -382,6 +409,10 @@ std::vector<EllipsoidCloud> fieldClouds(const CloudField& f, const Camera& camer
       const glm::dvec2 nearest = glm::clamp(eye, min_xy, max_xy);
       const double distance = glm::length(nearest - eye);
       if (distance > range) continue;
+      // Tiles where the region leaves no cover are never built.
+      if (regionExcludesDisc(f.region, glm::dvec2(ix + 0.5, jy + 0.5) * size,
+                             std::sqrt(0.5) * size))
+        continue;
       if (!boxMayBeInView(basis, eye3, glm::dvec3(min_xy, f.base_m), glm::dvec3(max_xy, top)))
         continue;
       const std::int64_t i = std::int64_t(ix), j = std::int64_t(jy);

@@ -13,6 +13,7 @@
 #include <glm/glm.hpp>
 
 #include "world/formations/ellipsoid_cloud.h"
+#include "world/formations/region.h"
 #include "world/frames.h"
 
 namespace nephele {
@@ -42,6 +43,8 @@ struct WeatherLayer {
   double thickness_m = 500.0;      // base to top
   double coverage = 0.5;           // cloud fraction (SPEC section 9), 0..1
   std::optional<glm::dvec2> wind;  // east, north m/s at this layer; unset keeps the world's
+  Region region;                   // where the layer lies; the default is everywhere
+  ClusterVariation clusters;       // heaps only: Gardner's macrocluster variation
 };
 
 // Empty when the layer can be drawn, else what is wrong and what is allowed (ranges in
@@ -57,6 +60,10 @@ struct CloudField {
   double coverage = 0.3;  // the heaps' own cloud fraction, 0..kMaxFieldCoverage
   std::uint64_t seed = 1;
   glm::dvec2 drift_m{0.0, 0.0};  // how far the field has moved with the wind since time 0
+  // Where the heaps stand, in the field's own frame (it drifts with them), and how their
+  // cover and height vary from cluster to cluster (MODEL.md section 11).
+  Region region;
+  ClusterVariation clusters;
 
   // Heaps are a Boolean model (Poisson centres, random sizes): the fraction they cover is
   // 1 - exp(-density * mean footprint) for any coverage up to 1, but above this their

@@ -116,6 +116,7 @@ std::vector<CloudLayer> planes(const WeatherLayer& w, const GenusLook& look, dou
   }
   const int count = look.planes;
   layer.threshold = thresholdFromSamples(samples, layer.transition, count, coverage, look.veil);
+  layer.region = w.region;
   std::vector<CloudLayer> out;
   for (int k = 0; k < count; ++k) {
     CloudLayer plane = layer;
@@ -149,6 +150,8 @@ WeatherClouds weatherClouds(const WeatherLayer& w, const std::string& prefix, st
   field.thickness_m = w.thickness_m;
   field.coverage = std::min(coverage, CloudField::kMaxFieldCoverage);
   field.seed = hashCounters(seed, 0x48656170ull);
+  field.region = w.region;
+  field.clusters = w.clusters;
   out.fields.push_back(field);
   if (coverage > field.coverage) {
     const double deck = coverage >= 1.0 ? 1.0 : 1.0 - (1.0 - coverage) / (1.0 - field.coverage);
@@ -166,18 +169,18 @@ WeatherLayer typicalWeatherLayer(CloudType type, double coverage) {
     case CloudType::kCirrus:
     case CloudType::kCirrocumulus:
     case CloudType::kCirrostratus:
-      return {type, 8000.0, 600.0, coverage, {}};
+      return {type, 8000.0, 600.0, coverage, {}, {}, {}};
     case CloudType::kAltocumulus:
     case CloudType::kAltostratus:
-      return {type, 4000.0, 700.0, coverage, {}};
+      return {type, 4000.0, 700.0, coverage, {}, {}, {}};
     case CloudType::kNimbostratus:
-      return {type, 900.0, 2500.0, coverage, {}};
+      return {type, 900.0, 2500.0, coverage, {}, {}, {}};
     case CloudType::kCumulonimbus:
-      return {type, 900.0, 9000.0, coverage, {}};
+      return {type, 900.0, 9000.0, coverage, {}, {}, {}};
     case CloudType::kCumulus:
-      return {type, 1200.0, 1200.0, coverage, {}};
+      return {type, 1200.0, 1200.0, coverage, {}, {}, {}};
     default:  // stratocumulus, stratus
-      return {type, 700.0, 500.0, coverage, {}};
+      return {type, 700.0, 500.0, coverage, {}, {}, {}};
   }
 }
 

@@ -1,0 +1,72 @@
+#pragma once
+// Where a weather layer lies (MODEL.md section 11, "Macroclusters and fronts"): a rectangle
+// of any size and heading whose cover fades out over a band inside its edge, optionally cut
+// by a front along its middle into one side, the two sides blending across a transition band.
+// A layer with the default region covers the whole plane. Pure functions of position, so
+// every renderer, every tile and every thread sees the same boundary.
+#include <cstdint>
+#include <limits>
+#include <string>
+
+#include <glm/glm.hpp>
+
+namespace nephele {
+
+struct Region {
+  static constexpr double kUnbounded = std::numeric_limits<double>::infinity();
+  glm::dvec2 centre{0.0, 0.0};  // east, north, m
+  // Half the rectangle's extent along its across-front (x) and along-front (y) axes, m.
+  glm::dvec2 half_size{kUnbounded, kUnbounded};
+  double heading_deg = 0.0;   // of the y axis (the front line), clockwise from north
+  double edge_m = 0.0;        // cover fades from full to none over this band inside the edge
+  int side = 0;               // 0 the whole rectangle; -1 left of the front line, +1 right
+  double transition_m = 0.0;  // band across the front line over which the sides blend
+
+  bool operator==(const Region&) const = default;
+  bool everywhere() const { return *this == Region{}; }
+};
+
+// Bands narrower than this count as this wide (a step, without dividing by zero).
+inline constexpr double kRegionMinBand = 1.0e-3;
+
+// The region's coordinates of world point `xy`: x across the front line (positive to the
+// right of the heading), y along it.
+glm::dvec2 regionLocal(const Region& region, glm::dvec2 xy);
+
+// How much of the layer's cover is present at `xy`, 0..1: smoothstep ramps over the edge band
+// on each axis times, for one side of a front, a smoothstep across the transition band.
+double regionWeight(const Region& region, glm::dvec2 xy);
+
+// True when regionWeight is 0 everywhere within `radius` of `xy` (conservative: false when
+// unsure), so that tiles and clouds there need not be built.
+bool regionExcludesDisc(const Region& region, glm::dvec2 xy, double radius);
+
+// A sky plane's T1 where the region's weight is w (MODEL.md section 11): raised towards 1,
+// above every value of T, as w falls to 0, so cover thins out and breaks up into the
+// texture's highest peaks before it ends, as a layer's edge does.
+inline double regionThreshold(double t1, double weight) {
+  return t1 >= 1.0 ? t1 : t1 + (1.0 - weight) * (1.0 - t1);
+}
+
+// Empty when usable, else what is wrong and what is allowed (ranges in world/limits.h).
+std::string regionError(const Region& region);
+
+// Gardner's macrocluster variation (MODEL.md section 11): inside a region, clusters on a grid
+// of this spacing each draw their own cover and vertical development, as factors
+// 1 + amount u with u in [-1, 1]; between the grid's points the factors blend smoothly, so
+// there is no seam. Spacing 0 or amount 0: every cluster alike.
+struct ClusterVariation {
+  double spacing_m = 0.0;
+  double amount = 0.0;
+  bool operator==(const ClusterVariation&) const = default;
+  bool none() const { return !(spacing_m > 0.0 && amount > 0.0); }
+};
+
+// The factor 1 + amount u of draw `purpose` at `xy`: u is a counter-based draw of (seed,
+// purpose, grid point) at each grid point, blended with smoothstep weights between the four
+// around `xy`. 1 when the variation is none.
+double clusterFactor(const ClusterVariation& variation, std::uint64_t seed, std::uint64_t purpose,
+                     glm::dvec2 xy);
+std::string clusterVariationError(const ClusterVariation& variation);
+
+}  // namespace nephele
