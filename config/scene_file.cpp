@@ -413,30 +413,26 @@ void readTarget(TableReader& t, const std::string& scene_path, Target& target) {
 void readMacrocluster(TableReader& t, WeatherLayer& w) {
   Region& r = w.region;
   if (!t.has("size"))
-    t.failAt("size", "is missing ([across, along] metres, each " +
-                         formatNumber(Limits::kRegionSize.lo) + " to " +
-                         formatNumber(Limits::kRegionSize.hi) + ")");
+    t.failHere("size is missing ([across, along] metres, each " +
+               formatNumber(Limits::kRegionSize.lo) + " to " +
+               formatNumber(Limits::kRegionSize.hi) + ")");
   t.vector("centre", r.centre, -Limits::kMaxCoordinate, Limits::kMaxCoordinate);
   glm::dvec2 size(0.0);
   t.vector("size", size, Limits::kRegionSize);
   r.half_size = 0.5 * size;
   t.number("heading", r.heading_deg, -Limits::kMaxHeading, Limits::kMaxHeading);
   t.number("edge", r.edge_m, Limits::kRegionBand);
-  const bool transition = t.has("transition");
   r.side = std::array{0, -1, 1}[std::size_t(t.choice("front", {"none", "left", "right"}, 0))];
   t.number("transition", r.transition_m, Limits::kRegionBand);
-  if (transition && r.side == 0)
-    t.failAt("transition",
-             "applies to one side of a front only (set front = \"left\" or \"right\")");
-  const bool heaps = w.type == CloudType::kCumulus || w.type == CloudType::kCumulonimbus;
-  for (const char* key : {"spacing", "variation"})
-    if (t.has(key) && !heaps)
-      t.failAt(key, "applies to heaps only (type cumulus or cumulonimbus), not " +
-                        std::string(cloudTypeName(w.type)));
   t.number("spacing", w.clusters.spacing_m, Limits::kClusterSpacing);
   t.number("variation", w.clusters.amount, Limits::kClusterVariation);
-  if (w.clusters.amount > 0.0 && w.clusters.spacing_m == 0.0)
-    t.failAt("variation", "needs spacing, the distance between the clusters it varies");
+  // The rules between keys are the world's, shared with set_weather; the error points at the
+  // key it names.
+  if (std::string e = weatherLayerError(w); !e.empty()) {
+    const std::string key = e.substr(0, e.find(':'));
+    if (t.has(key) && e.size() > key.size() + 2) t.failAt(key, e.substr(key.size() + 2));
+    t.failHere(e);
+  }
 }
 
 // A [[weather]] layer as a host sends it (MODEL.md section 10): the same mapping as set_weather.

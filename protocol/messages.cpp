@@ -212,6 +212,25 @@ WeatherLayer readWeather(FieldReader& r) {
   w.wind = r.vector<2>("wind", -Limits::kMaxWind, Limits::kMaxWind);
   if (w.wind && glm::length(*w.wind) > Limits::kMaxWind)
     r.fail("wind", "speed is above " + formatNumber(Limits::kMaxWind) + " m/s");
+  // A macrocluster or one side of a front (MODEL.md section 11): the keys of a scene file's
+  // [[macrocluster]]; without `size` the layer is unbounded.
+  Region& region = w.region;
+  const double c = Limits::kMaxCoordinate;
+  region.centre = r.vector<2>("centre", -c, c).value_or(region.centre);
+  if (auto size = r.vector<2>("size", Limits::kRegionSize.lo, Limits::kRegionSize.hi))
+    region.half_size = 0.5 * *size;
+  region.heading_deg = r.number("heading", -Limits::kMaxHeading, Limits::kMaxHeading).value_or(0.0);
+  region.edge_m = r.number("edge", Limits::kRegionBand).value_or(0.0);
+  if (auto front = r.string("front", 8)) {
+    if (*front != "none" && *front != "left" && *front != "right")
+      r.fail("front", "\"" + *front + "\" is not allowed (allowed: none, left, right)");
+    region.side = *front == "left" ? -1 : *front == "right" ? 1 : 0;
+  }
+  region.transition_m = r.number("transition", Limits::kRegionBand).value_or(0.0);
+  w.clusters.spacing_m = r.number("spacing", Limits::kClusterSpacing).value_or(0.0);
+  w.clusters.amount = r.number("variation", Limits::kClusterVariation).value_or(0.0);
+  // The rules between keys are the world's, shared with scene files.
+  if (std::string e = weatherLayerError(w); !e.empty()) throw FieldError{ErrorCode::kBadField, e};
   return w;
 }
 
@@ -243,7 +262,9 @@ Command readCommand(const std::string& cmd, FieldReader& r) {
              "altostratus, 3 cirrocumulus, 4 cirrostratus, 5 cirrus, 6 cumulonimbus, 7 "
              "cumulus, 8 nimbostratus, 9 stratocumulus, 10 stratus)");
     c.weather = readWeather(r);
-    r.finish("cmd, id, layer, type, base, thickness, coverage, wind");
+    r.finish(
+        "cmd, id, layer, type, base, thickness, coverage, wind, centre, size, heading, edge, "
+        "front, transition, spacing, variation");
     return c;
   }
   if (cmd == "set_wind") {

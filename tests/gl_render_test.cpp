@@ -98,6 +98,33 @@ TEST_F(GlRenderTest, LatticeBreakingEqualsOneSampleReference) {
   expectPointSampledEqual(*renderer_, file.scene, "point_lattice_breaking_again");
 }
 
+// A layer bounded by a region (a turned rectangle with an edge band, one side of a front;
+// MODEL.md section 11), drifted for ten minutes: exact against the one-sample reference, and
+// the region really removes cover (less than half the unbounded layer's).
+TEST_F(GlRenderTest, RegionBoundedLayerEqualsOneSampleReference) {
+  SceneFile file = preset("stratus");
+  file.scene.camera.orientation.pitch_deg = 60.0;
+  file.scene.time_s = 600.0;
+  CloudLayer& layer = file.scene.layers[0];
+  layer.texture.drift_velocity = {12.0, -5.0};
+  const FloatImage unbounded = renderer_->renderFloat(file.scene, pointSampled());
+  Region& r = layer.region;
+  const glm::dvec2 ahead = glm::dvec2(file.scene.camera.position) + glm::dvec2(0.0, 1500.0);
+  r.centre = ahead - layer.texture.drift_velocity * file.scene.time_s;  // there at 600 s
+  r.half_size = {1800.0, 1200.0};
+  r.heading_deg = 30.0;
+  r.edge_m = 400.0;
+  r.side = 1;
+  r.transition_m = 600.0;
+  expectPointSampledEqual(*renderer_, file.scene, "point_region");
+  const FloatImage bounded = renderer_->renderFloat(file.scene, pointSampled());
+  double before = 0.0, after = 0.0;
+  for (std::size_t i = 3; i < bounded.rgba.size(); i += 4)
+    before += unbounded.rgba[i], after += bounded.rgba[i];
+  EXPECT_GT(after, 0.02 * before);
+  EXPECT_LT(after, 0.5 * before);
+}
+
 // A deck below the camera and a layer above it, seen from between them: exact against the
 // one-sample reference, and filtered against the 4x4 reference. Seen from above at a slant,
 // the deck's full plaid is resolved by the 4x4 reference only partly where GL drops its

@@ -45,6 +45,18 @@ TEST(Messages, ParsesEveryCommandWithItsFields) {
   EXPECT_EQ(w.weather.base_m, 1200.0);
   EXPECT_EQ(w.weather.coverage, 0.75);
   EXPECT_EQ(*w.weather.wind, glm::dvec2(3, -4));
+  EXPECT_TRUE(w.weather.region.everywhere());
+  // One message covers a 300 km macrocluster on one side of a front.
+  const auto m = std::get<command::SetWeather>(
+      parsed(R"({"cmd":"set_weather","layer":1,"type":7,"coverage":40,"centre":[1e4,-2e4],)"
+             R"("size":[3e5,2e5],"heading":45,"edge":1e4,"front":"right","transition":2e4,)"
+             R"("spacing":25000,"variation":0.6})")
+          .command);
+  EXPECT_EQ(m.weather.region.half_size, glm::dvec2(1.5e5, 1e5));
+  EXPECT_EQ(m.weather.region.centre, glm::dvec2(1e4, -2e4));
+  EXPECT_EQ(m.weather.region.side, 1);
+  EXPECT_EQ(m.weather.region.transition_m, 2e4);
+  EXPECT_EQ(m.weather.clusters.amount, 0.6);
 
   EXPECT_EQ(std::get<command::Tick>(parsed(R"({"cmd":"tick","dt":0.02})").command).dt, 0.02);
   EXPECT_EQ(
@@ -88,6 +100,13 @@ TEST(Messages, ErrorsNameTheFieldAndWhatIsAllowed) {
       {R"({"cmd":"set_weather","layer":1})", ErrorCode::kBadField, "1 altocumulus"},
       {R"({"cmd":"set_weather","layer":1,"type":3,"wind":[150,150]})", ErrorCode::kBadField,
        "200 m/s"},
+      {R"({"cmd":"set_weather","layer":1,"type":7,"size":[0,1e5]})", ErrorCode::kBadField, "size"},
+      {R"({"cmd":"set_weather","layer":1,"type":7,"transition":500})", ErrorCode::kBadField,
+       "front left or right"},
+      {R"({"cmd":"set_weather","layer":1,"type":10,"spacing":1e4,"variation":0.5})",
+       ErrorCode::kBadField, "heaps only"},
+      {R"({"cmd":"set_weather","layer":1,"type":7,"front":"north"})", ErrorCode::kBadField,
+       "none, left, right"},
       {R"({"cmd":"render","view":"a","channels":["colour","colour"]})", ErrorCode::kBadField,
        "repeated"},
       {R"({"cmd":"render","view":"a","channels":["depth"]})", ErrorCode::kBadField, "depth"},

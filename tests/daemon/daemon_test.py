@@ -316,6 +316,16 @@ class SocketProtocolTest(DaemonTest):
         cumulus = c.ok({"cmd": "set_weather", "layer": 2, "type": 7, "base": 1200,
                         "thickness": 900, "coverage": 10, "wind": [8, 2]})
         self.assertEqual((cumulus["fields"], cumulus["layers"]), (1, 2))  # heaps, no deck
+        # One message: a 300 km cluster field on one side of a front, the deck on the other.
+        front = {"centre": [0, 0], "size": [300000, 300000], "heading": 45, "transition": 20000}
+        h_before = c.ok({"cmd": "hash"})["hash"]
+        self.assertEqual(c.error(dict(front, cmd="set_weather", layer=3, type=8,
+                                      variation=0.5))["code"], "bad_field")
+        self.assertEqual(c.ok({"cmd": "hash"})["hash"], h_before)  # refused: nothing changed
+        c.ok(dict(front, cmd="set_weather", layer=1, type=8, coverage=90, front="right"))
+        c.ok(dict(front, cmd="set_weather", layer=3, type=7, coverage=40, front="left",
+                  spacing=25000, variation=0.6))
+        c.ok({"cmd": "set_weather", "layer": 3, "type": 0})
         c.ok({"cmd": "set_weather", "layer": 1, "type": 0})  # none removes the layer
         self.assertEqual(c.ok({"cmd": "set_weather", "layer": 3, "type": 5})["layers"], 0 + 1)
         c.ok({"cmd": "add_cloud", "cloud": {"name": "extra",

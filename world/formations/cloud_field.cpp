@@ -223,13 +223,6 @@ double unitFootprint(CloudType type) {
   return cumulus;
 }
 
-// The cover heaps are drawn for at `xy` (field frame): the field's coverage times the region's
-// weight and the cluster's cover factor there, at most kMaxFieldCoverage.
-double localCoverage(const CloudField& f, glm::dvec2 xy) {
-  const double c =
-      f.coverage * regionWeight(f.region, xy) * clusterFactor(f.clusters, f.seed, kCover, xy);
-  return std::clamp(c, 0.0, CloudField::kMaxFieldCoverage);
-}
 // The most any point asks for.
 double peakCoverage(const CloudField& f) {
   return std::clamp(f.coverage * (1.0 + (f.clusters.none() ? 0.0 : f.clusters.amount)), 0.0,
@@ -323,7 +316,8 @@ EllipsoidCloud makeTile(const CloudField& f, std::int64_t i, std::int64_t j, boo
   for (int k = 0; k < count; ++k) {
     auto u = [&](Draw d) { return unitFromBits(hashCounters(tile_seed, d, std::uint64_t(k))); };
     const glm::dvec3 base((double(i) + u(kX)) * size, (double(j) + u(kY)) * size, f.base_m);
-    if (!uniform && !(u(kKeep) < heapDensity(f, localCoverage(f, glm::dvec2(base))) / peak_density))
+    if (!uniform &&
+        !(u(kKeep) < heapDensity(f, fieldCoverageAt(f, glm::dvec2(base))) / peak_density))
       continue;
     HeapScale scale = heapScale(tile_seed, std::uint64_t(k));
     scale.height *= clusterFactor(f.clusters, f.seed, kRise, glm::dvec2(base));
@@ -371,7 +365,22 @@ std::string weatherLayerError(const WeatherLayer& w) {
                  outside("wind y", w.wind->y, {-Limits::kMaxWind, Limits::kMaxWind})))
     return out.str();
   if (std::string error = regionError(w.region); !error.empty()) return error;
-  return clusterVariationError(w.clusters);
+  if (std::string error = clusterVariationError(w.clusters); !error.empty()) return error;
+  if (w.region.transition_m > 0.0 && w.region.side == 0)
+    return "transition: applies to one side of a front only (front left or right)";
+  const bool heaps = w.type == CloudType::kCumulus || w.type == CloudType::kCumulonimbus;
+  if ((w.clusters.spacing_m > 0.0 || w.clusters.amount > 0.0) && !heaps)
+    return "variation: applies to heaps only (type cumulus or cumulonimbus), not " +
+           std::string(cloudTypeName(w.type));
+  if (w.clusters.amount > 0.0 && !(w.clusters.spacing_m > 0.0))
+    return "variation: needs spacing, the distance between the clusters it varies";
+  return "";
+}
+
+double fieldCoverageAt(const CloudField& f, glm::dvec2 xy) {
+  const double c =
+      f.coverage * regionWeight(f.region, xy) * clusterFactor(f.clusters, f.seed, kCover, xy);
+  return std::clamp(c, 0.0, CloudField::kMaxFieldCoverage);
 }
 
 double fieldTileSize(const CloudField& f) {

@@ -74,6 +74,10 @@ struct CloudField {
   static constexpr double kRangeM = 40000.0;
 };
 
+// The cover the field's heaps are drawn for at `xy` (field frame, before drift): its coverage
+// times its region's weight and its cluster's cover factor there, at most kMaxFieldCoverage.
+double fieldCoverageAt(const CloudField& field, glm::dvec2 xy);
+
 // Size of one heap's tile, metres (a few heaps per tile at any coverage).
 double fieldTileSize(const CloudField& field);
 
