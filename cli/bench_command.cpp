@@ -132,6 +132,11 @@ std::vector<Setting> settingsFor(const SceneFile& file) {
       add("impostor_tolerance", withKnob(px),
           [px](RenderSettings& s) { s.impostor_tolerance_px = px; });
   }
+  // Heaps beyond the range drawn as a far deck (MODEL.md section 11), against the reference's
+  // heaps out to the automatic range.
+  if (!file.scene.fields.empty())
+    for (double m : {5000.0, 15000.0})
+      add("heap_range", withKnob(m), [m](RenderSettings& s) { s.heap_range_m = m; });
   if (!file.dynamics.automata.empty()) {
     for (double step : {0.5, 2.0, 4.0})
       add("volume_step", withKnob(step), [step](RenderSettings& s) { s.volume_step = step; });

@@ -56,6 +56,7 @@ std::string applyOverrides(const RenderCommandOptions& o, SceneFile& file) {
   if (o.tessellation) r.tessellation = *o.tessellation;
   if (o.impostor_tolerance) r.impostor_tolerance_px = *o.impostor_tolerance;
   if (o.volume_step) r.volume_step = *o.volume_step;
+  if (o.heap_range) r.heap_range_m = file.reference.heap_range_m = *o.heap_range;
   if (o.samples) file.reference.samples_per_axis = *o.samples;
   std::string error = validateCamera(camera);
   if (error.empty()) error = validateRenderSettings(r);
@@ -143,6 +144,9 @@ void addRenderCommand(CLI::App& app, RenderCommandOptions& o) {
                   "Multipass ellipsoid mesh: 0 adaptive, or N slices by N stacks (3..256)");
   cmd->add_option("--impostor-tolerance", o.impostor_tolerance,
                   "Reuse far-cloud impostors while they move less than this many pixels (0 off)");
+  cmd->add_option("--heap-range", o.heap_range,
+                  "Cloud fields: heaps as ellipsoids to this distance (m), a far deck beyond; "
+                  "0 is 40 km plus twice the height");
   cmd->add_option("--volume-step", o.volume_step,
                   "Automaton clouds: view march step in lattice spacings (0.25..8)");
   cmd->add_option("--samples", o.samples, "Reference supersampling per pixel axis")

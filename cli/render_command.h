@@ -25,6 +25,7 @@ struct RenderCommandOptions {
   std::optional<std::string> ellipsoid_passes, ellipsoid_order, limb, tile_format;
   std::optional<int> tile_resolution, tessellation;
   std::optional<double> impostor_tolerance;
+  std::optional<double> heap_range;
   std::optional<double> volume_step;
   std::optional<int> samples;
   bool stats = false;

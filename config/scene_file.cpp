@@ -83,7 +83,7 @@ void readFog(TableReader& t, Fog& fog) {
 void readRender(TableReader& t, SceneFile& out) {
   t.allow({"texture", "term_filter", "sky_passes", "bake_texels_per_cycle", "reference_samples",
            "ellipsoid_passes", "ellipsoid_order", "limb", "tile_resolution", "tile_format",
-           "tessellation", "impostor_tolerance", "volume_step"});
+           "tessellation", "impostor_tolerance", "volume_step", "heap_range"});
   out.render.texture_evaluation = TextureEvaluation(
       t.choice("texture", kTextureEvaluationNames, int(out.render.texture_evaluation)));
   out.render.term_filter =
@@ -105,6 +105,8 @@ void readRender(TableReader& t, SceneFile& out) {
     t.failAt(error.substr(0, error.find(':')), error.substr(error.find(':') + 2));
   t.number("impostor_tolerance", r.impostor_tolerance_px, 0.0, 100.0);
   t.number("volume_step", r.volume_step, 0.25, 8.0);
+  t.number("heap_range", r.heap_range_m, Limits::kHeapRange);
+  out.reference.heap_range_m = r.heap_range_m;  // both renderers draw the same heaps
   t.finish();
 }
 
@@ -643,6 +645,8 @@ std::string validateRenderSettings(const RenderSettings& r) {
   if (!(r.impostor_tolerance_px >= 0.0 && r.impostor_tolerance_px <= 100.0))
     return "impostor_tolerance: " + formatNumber(r.impostor_tolerance_px) +
            " is out of range (allowed: 0 to 100 pixels)";
+  if (std::ostringstream out; outOfRange(out, "heap_range", r.heap_range_m, Limits::kHeapRange))
+    return out.str() + " metres; 0 is 40 km plus twice the height";
   if (!(r.volume_step >= 0.25 && r.volume_step <= 8.0))
     return "volume_step: " + formatNumber(r.volume_step) +
            " is out of range (allowed: 0.25 to 8 lattice spacings)";

@@ -52,4 +52,22 @@ FloatImage differenceImage(const FloatImage& actual, const FloatImage& expected,
   return out;
 }
 
+ProfileError rowProfileError(const FloatImage& a, const FloatImage& b, int band) {
+  NEPHELE_CHECK(a.width == b.width && a.height == b.height && band >= 1, "sizes differ");
+  ProfileError out;
+  for (int y0 = 0; y0 + band <= a.height; y0 += band) {
+    double cover = 0.0, luminance = 0.0;
+    for (int y = y0; y < y0 + band; ++y)
+      for (int x = 0; x < a.width; ++x) {
+        const std::size_t i = 4 * (std::size_t(y) * a.width + x);
+        cover += a.rgba[i + 3] - b.rgba[i + 3];
+        for (int c = 0; c < 3; ++c) luminance += (a.rgba[i + c] - b.rgba[i + c]) / 3.0;
+      }
+    const double n = double(band) * a.width;
+    out.cover = std::max(out.cover, std::abs(cover) / n);
+    out.luminance = std::max(out.luminance, std::abs(luminance) / n);
+  }
+  return out;
+}
+
 }  // namespace nephele

@@ -17,6 +17,15 @@ struct ImageError {
 
 ImageError compareImages(const FloatImage& actual, const FloatImage& expected);
 
+// An impostor cannot match what it stands for pixel by pixel, only its amount and brightness
+// at each distance: the largest difference, over bands of `band` image rows (on level ground
+// a row is a line of equal distance), of the mean coverage and of the mean linear luminance
+// (the mean of R, G and B).
+struct ProfileError {
+  double cover = 0.0, luminance = 0.0;
+};
+ProfileError rowProfileError(const FloatImage& actual, const FloatImage& expected, int band = 8);
+
 // |actual - expected| per channel, scaled by `gain`, as a float image for inspection.
 FloatImage differenceImage(const FloatImage& actual, const FloatImage& expected, float gain);
 

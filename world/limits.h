@@ -71,6 +71,7 @@ struct Limits {
   static constexpr Range kRegionSize{1.0, 2.0e7};      // full extent along each axis
   static constexpr Range kRegionBand{0.0, 1.0e7};      // edge and front transition widths
   static constexpr Range kClusterVariation{0.0, 1.0};  // per-cluster spread of cover, height
+  static constexpr Range kHeapRange{0.0, 1.0e6};       // heaps as ellipsoids this far; 0 automatic
 
   // Gardner's clusters (world/formations/cluster.h).
   static constexpr Range kClusterSpacing{1.0, 1.0e5};

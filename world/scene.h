@@ -29,14 +29,28 @@ struct CloudLayer {
   ShadingParams shading;
   LayerTextureSpec texture;
   Region region;  // where the layer lies (MODEL.md section 11); it drifts with the texture
+  // A far deck standing for heaps (withFieldClouds) is absent within this horizontal distance
+  // of the camera, where the heaps themselves are drawn, and fades in over the next band.
+  double hole_radius_m = 0.0, hole_band_m = 0.0;
+  FarCover far;  // a far deck's cover against view elevation (region.h)
 };
 
-// The layer's region weight at world point `xy` at time t: the region moves with the layer's
-// drift, unwrapped (the texture's own offset may be reduced modulo its period).
-inline double layerRegionWeight(const CloudLayer& layer, glm::dvec2 xy, double time_s) {
-  if (layer.region.everywhere()) return 1.0;
-  const LayerTextureSpec& t = layer.texture;
-  return regionWeight(layer.region, xy - t.drift_offset_m - t.drift_velocity * time_s);
+// The layer's weight at world point `xy` at time t seen from `eye` (MODEL.md section 11): its
+// region's, which moves with the layer's drift (unwrapped: the texture's own offset may be
+// reduced modulo its period), times its hole's.
+inline double layerRegionWeight(const CloudLayer& layer, glm::dvec2 xy, double time_s,
+                                glm::dvec2 eye) {
+  double w = 1.0;
+  if (!layer.region.everywhere()) {
+    const LayerTextureSpec& t = layer.texture;
+    w = regionWeight(layer.region, xy - t.drift_offset_m - t.drift_velocity * time_s);
+  }
+  if (layer.hole_radius_m > 0.0)
+    w *= holeRamp(glm::length(xy - eye) - layer.hole_radius_m, layer.hole_band_m);
+  return w;
+}
+inline bool layerHasRegion(const CloudLayer& layer) {
+  return !layer.region.everywhere() || layer.hole_radius_m > 0.0 || layer.far.side_ratio > 0.0;
 }
 
 struct Scene {
@@ -56,8 +70,9 @@ struct Scene {
   std::vector<AutomatonCloudView> automata;
 };
 
-// `scene` with its fields' heaps around its camera added to its clouds (MODEL.md section 10);
-// what every renderer draws.
-Scene withFieldClouds(const Scene& scene);
+// `scene` with its fields' heaps within heapRange(heap_range_m) of its camera added to its
+// clouds, and, where the view reaches beyond that, a far deck standing for the rest
+// (MODEL.md sections 10 and 11); what every renderer draws.
+Scene withFieldClouds(const Scene& scene, double heap_range_m = 0.0);
 
 }  // namespace nephele

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace nephele {
 namespace {
@@ -33,6 +34,12 @@ double gardnerIntensity(const ShadingParams& shading, double texture_value, glm:
     highlight = std::pow(std::max(0.0, glm::dot(reflected, to_viewer)), shading.shininess);
   }
   return gardnerIntensity(shading, diffuse, highlight, texture_value);
+}
+
+double sphereDiffuse(double cos_alpha) {
+  const double alpha = std::acos(std::clamp(cos_alpha, -1.0, 1.0));
+  return (2.0 / 3.0) * (std::sin(alpha) + (std::numbers::pi - alpha) * cos_alpha) /
+         std::numbers::pi;
 }
 
 double skyPlaneTranslucence(double texture_value, double threshold, double transition) {

@@ -20,6 +20,11 @@ double gardnerIntensity(const ShadingParams& shading, double diffuse, double hig
 double gardnerIntensity(const ShadingParams& shading, double texture_value, glm::dvec3 normal,
                         glm::dvec3 to_sun, glm::dvec3 to_viewer);
 
+// The mean of max(0, N.L) over the visible disc of a Lambertian sphere at phase angle alpha
+// (the angle between the directions to the sun and to the viewer): 2/3 (sin alpha +
+// (pi - alpha) cos alpha) / pi. A far deck standing for heaps is lit so (MODEL.md section 11).
+double sphereDiffuse(double cos_alpha);
+
 // Gardner eq. 9: translucence of a sky plane for texture value It, threshold T1 and
 // transition width D. D = 0 is a hard threshold.
 double skyPlaneTranslucence(double texture_value, double threshold, double transition);

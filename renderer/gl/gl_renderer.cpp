@@ -320,6 +320,14 @@ void GlRenderer::setSlotUniforms(GLuint p, int slot, const LayerSlot& entry, con
     gl_.ProgramUniform4fv(p, where, 1, &frame.x);
     gl_.ProgramUniform4fv(p, location("u_region_size", slot), 1, &size.x);
     gl_.ProgramUniform1f(p, location("u_region_side", slot), float(r.side));
+    const glm::vec2 hole(layer.hole_radius_m, layer.hole_band_m);
+    gl_.ProgramUniform2fv(p, location("u_hole", slot), 1, &hole.x);
+    const glm::vec2 far(layer.far.coverage, layer.far.side_ratio);
+    gl_.ProgramUniform2fv(p, location("u_far", slot), 1, &far.x);
+    float table[FarCover::kSteps + 1];
+    for (int k = 0; k <= FarCover::kSteps; ++k) table[k] = float(layer.far.threshold[k]);
+    gl_.ProgramUniform1fv(p, location("u_far_threshold", (FarCover::kSteps + 1) * slot),
+                          FarCover::kSteps + 1, table);
   }
 
   // The precision rule of MODEL.md section 2: the texture's local origin is the point under the
@@ -410,7 +418,7 @@ void GlRenderer::drawSkyGroup(const Scene& scene, const RenderSettings& settings
   base.targets = targets;
   for (const CloudLayer& layer : scene.layers) {
     base.specular |= layer.shading.specular > 0.0;
-    base.regions |= !layer.region.everywhere();
+    base.regions |= layerHasRegion(layer);
   }
   const bool fused = settings.sky_passes == SkyPasses::kFused &&
                      int(std::max(above.size(), below.size())) <= kMaxLayerSlots;
@@ -469,7 +477,8 @@ void GlRenderer::drawSkyGroup(const Scene& scene, const RenderSettings& settings
 void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
                            TargetFormat format) {
   // Fields of heaps become the clouds around this camera (MODEL.md section 10).
-  if (!scene.fields.empty()) return drawFrame(withFieldClouds(scene), settings, format);
+  if (!scene.fields.empty())
+    return drawFrame(withFieldClouds(scene, settings.heap_range_m), settings, format);
   const Camera& camera = scene.camera;
   prepareTarget(camera.width, camera.height, format);
   stats_ = {};

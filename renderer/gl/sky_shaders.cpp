@@ -141,6 +141,9 @@ uniform float u_terms[kSlots];      // n
 uniform vec4 u_region[kSlots];       // centre from the camera (m), cos and sin of heading
 uniform vec4 u_region_size[kSlots];  // half sizes (m, 1e30 unbounded), edge, front transition
 uniform float u_region_side[kSlots]; // front side -1 or 1, 0 for none
+uniform vec2 u_hole[kSlots];         // a far deck's hole around the camera and its band, m
+uniform vec2 u_far[kSlots];          // a far deck's coverage and side ratio (0 none)
+uniform float u_far_threshold[kSlots * 17];  // its T1 at cover 0, 1/16, ..., 1
 #endif
 uniform vec3 u_to_sun;
 
@@ -248,17 +251,31 @@ float regionRamp(float x, float width) {
   float u = clamp(x / max(width, 1.0e-3), 0.0, 1.0);
   return u * u * (3.0 - 2.0 * u);
 }
-float layerThreshold(int i, vec2 p) {
+// A far deck stands for rounded heaps: the mean of max(0, N.L) over a Lambertian sphere's
+// visible disc at phase angle alpha, 2/3 (sin alpha + (pi - alpha) cos alpha) / pi.
+float sphereDiffuse(float cos_alpha) {
+  float alpha = acos(clamp(cos_alpha, -1.0, 1.0));
+  return (2.0 / 3.0) * (sin(alpha) + (3.14159265 - alpha) * cos(alpha)) / 3.14159265;
+}
+float layerThreshold(int i, vec3 r, vec2 p) {
+  float t1 = u_threshold[i];
+  if (u_far[i].y > 0.0) {
+    float cot_e = length(r.xy) / max(abs(r.z), 1e-9 * length(r));
+    float cover = 1.0 - pow(1.0 - min(u_far[i].x, 1.0), 1.0 + u_far[i].y * cot_e);
+    float x = clamp(cover, 0.0, 1.0) * 16.0;
+    int k = min(int(x), 15);
+    t1 = mix(u_far_threshold[17 * i + k], u_far_threshold[17 * i + k + 1], x - float(k));
+  }
   vec2 d = p - u_region[i].xy;
   vec2 q = vec2(d.x * u_region[i].z - d.y * u_region[i].w, d.x * u_region[i].w + d.y * u_region[i].z);
   vec4 size = u_region_size[i];
   float w = regionRamp(size.x - abs(q.x), size.z) * regionRamp(size.y - abs(q.y), size.z);
   if (u_region_side[i] != 0.0) w *= regionRamp(u_region_side[i] * q.x + 0.5 * size.w, size.w);
-  float t1 = u_threshold[i];
+  if (u_hole[i].x > 0.0) w *= regionRamp(length(p) - u_hole[i].x, u_hole[i].y);
   return t1 >= 1.0 ? t1 : t1 + (1.0 - w) * (1.0 - t1);
 }
 #else
-float layerThreshold(int i, vec2 p) { return u_threshold[i]; }
+float layerThreshold(int i, vec3 r, vec2 p) { return u_threshold[i]; }
 #endif
 
 // Slot i's surface under what lies in front of it: layers are composited nearest first, so
@@ -266,7 +283,7 @@ float layerThreshold(int i, vec2 p) { return u_threshold[i]; }
 // let through ("over" summed front to back, the same sum as back to front).
 void composite(int i, vec3 r, LayerHit hit, float it, inout vec3 colour,
                inout float transmittance) {
-  float tr = translucence(it - layerThreshold(i, hit.p), u_transition[i]);  // Gardner eq. 9
+  float tr = translucence(it - layerThreshold(i, r, hit.p), u_transition[i]);  // Gardner eq. 9
   vec3 normal = vec3(0.0, 0.0, u_height[i] > 0.0 ? -1.0 : 1.0);  // turned towards the viewer
   float n_dot_l = dot(normal, u_to_sun);
   float highlight = 0.0;
@@ -276,7 +293,11 @@ void composite(int i, vec3 r, LayerHit hit, float it, inout vec3 colour,
     highlight = pow(max(dot(reflected, -normalize(r)), 0.0), u_shading[i].w);
   }
 #endif
-  vec3 surface = gardnerIntensity(u_shading[i], max(n_dot_l, 0.0), highlight, it) * u_colour[i];
+  float diffuse = max(n_dot_l, 0.0);
+#ifdef REGIONS
+  if (u_far[i].y > 0.0) diffuse = sphereDiffuse(dot(u_to_sun, -normalize(r)));
+#endif
+  vec3 surface = gardnerIntensity(u_shading[i], diffuse, highlight, it) * u_colour[i];
 #ifdef FOG
   surface = applyFog(surface, normalize(r), hit.distance);
 #endif

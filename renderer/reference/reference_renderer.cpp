@@ -115,10 +115,15 @@ class ReferenceTracer {
                        double s) const {
     const glm::dvec3 p = scene_.camera.position + s * direction;
     const double t = texture.value({p.x, p.y}, scene_.time_s);
-    const double t1 =
-        regionThreshold(layer.threshold, layerRegionWeight(layer, {p.x, p.y}, scene_.time_s));
+    const double base =
+        layer.far.side_ratio > 0.0 ? farThreshold(layer.far, direction) : layer.threshold;
+    const double t1 = regionThreshold(base, layerRegionWeight(layer, {p.x, p.y}, scene_.time_s,
+                                                              glm::dvec2(scene_.camera.position)));
     const double tr = skyPlaneTranslucence(t, t1, layer.transition);
-    const double intensity = gardnerIntensity(layer.shading, t, {0.0, 0.0, 1.0}, sun_, -direction);
+    const double intensity =
+        layer.far.side_ratio > 0.0
+            ? gardnerIntensity(layer.shading, sphereDiffuse(glm::dot(sun_, -direction)), 0.0, t)
+            : gardnerIntensity(layer.shading, t, {0.0, 0.0, 1.0}, sun_, -direction);
     return {s, withFog(intensity * layer.colour * scene_.sun.colour, direction, s), 1.0 - tr};
   }
 
@@ -217,7 +222,8 @@ FloatImage renderReference(const Scene& scene, const ReferenceSettings& settings
   const Camera& camera = scene.camera;
   FloatImage image{camera.width, camera.height,
                    std::vector<float>(std::size_t(camera.width) * camera.height * 4)};
-  const Scene with_fields = scene.fields.empty() ? Scene{} : withFieldClouds(scene);
+  const Scene with_fields =
+      scene.fields.empty() ? Scene{} : withFieldClouds(scene, settings.heap_range_m);
   const ReferenceTracer tracer(scene.fields.empty() ? scene : with_fields);
   const ViewBasis basis = viewBasis(camera);
   const int n = std::max(1, settings.samples_per_axis);

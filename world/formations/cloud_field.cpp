@@ -13,6 +13,7 @@
 
 #include "world/counter_random.h"
 #include "world/formations/cluster.h"
+#include "world/formations/weather.h"
 #include "world/frames.h"
 #include "world/limits.h"
 #include "world/scene.h"
@@ -158,24 +159,26 @@ EllipsoidCloud heapCloud(const CloudField& f, std::string name) {
   return cloud;
 }
 
-// Opacity of one cloud along the vertical ray through `xy` seen from far above: SPEC section
-// 4 in its orthographic limit, where the limb function of a vertical ray is the ray
-// quadratic's discriminant over its value through the centre.
-double nadirOpacity(const EllipsoidCloud& cloud, const SolidTexture& texture, glm::dvec2 xy) {
+// Opacity of one cloud along the line through `point` seen from far away looking along unit
+// `view`: SPEC section 4 in its orthographic limit, where the limb function g of a ray is the
+// depth of the ray quadratic's minimum below zero (its discriminant over 4a), and the texture
+// is read where the ray enters.
+double orthographicOpacity(const EllipsoidCloud& cloud, const SolidTexture& texture,
+                           glm::dvec3 point, glm::dvec3 view) {
   double transmittance = 1.0;
   for (const Ellipsoid& e : cloud.ellipsoids) {
     const glm::dmat3 w = worldToUnitSphere(e);
     const glm::dmat3 m = glm::transpose(w) * w;
-    const glm::dvec2 d = xy - glm::dvec2(e.centre);
-    // Q(s) = a s^2 + b s + c along Z through xy, s measured from the centre's altitude.
-    const double a = m[2][2];
-    const double b = 2.0 * (m[0][2] * d.x + m[1][2] * d.y);
-    const double c = m[0][0] * d.x * d.x + 2.0 * m[0][1] * d.x * d.y + m[1][1] * d.y * d.y - 1.0;
+    const glm::dvec3 d = point - e.centre;
+    // Q(s) = a s^2 + b s + c at point + s view.
+    const double a = glm::dot(view, m * view);
+    const double b = 2.0 * glm::dot(view, m * d);
+    const double c = glm::dot(d, m * d) - 1.0;
     const double delta = b * b - 4.0 * a * c;
     if (delta <= 0.0) continue;
     const double g = std::clamp(delta / (4.0 * a), 0.0, 1.0);
-    const double top = (-b + std::sqrt(delta)) / (2.0 * a);
-    const double it = texture.value(glm::dvec3(xy, e.centre.z + top) - cloud.drift_m);
+    const double enter = (-b - std::sqrt(delta)) / (2.0 * a);
+    const double it = texture.value(point + enter * view - cloud.drift_m);
     const double excess =
         it - cloud.threshold_centre - (cloud.threshold_limb - cloud.threshold_centre) * (1.0 - g);
     const double tr = cloud.transition <= 0.0
@@ -186,11 +189,12 @@ double nadirOpacity(const EllipsoidCloud& cloud, const SolidTexture& texture, gl
   return 1.0 - transmittance;
 }
 
-// Mean area seen straight down with opacity >= 1/2 of one heap, in units of heapRadius^2,
-// measured on 16 heaps whose sizes and heights are drawn as the tiles draw theirs (the shape
-// is scale-free but for the texture, which scales with the field). Computed once per type.
-double unitFootprint(CloudType type) {
-  auto measure = [](CloudType t) {
+// Mean area seen straight down (`side` false) or from the side, horizontally, (`side` true)
+// with opacity >= 1/2 of one heap, in units of heapRadius^2, measured on 16 heaps whose sizes
+// and heights are drawn as the tiles draw theirs (the shape is scale-free but for the texture,
+// which scales with the field). Computed once per type and view.
+double unitArea(CloudType type, bool side) {
+  auto measure = [side](CloudType t) {
     CloudField f;
     f.type = t;
     f.thickness_m = t == CloudType::kCumulonimbus ? 9000.0 : 1500.0;
@@ -204,23 +208,47 @@ double unitFootprint(CloudType type) {
       EllipsoidCloud cloud = heapCloud(f, "");
       cloud.ellipsoids = heapEllipsoids(f, {0.0, 0.0, 1000.0}, scale.size, scale.height,
                                         hashCounters(77, k), true);
+      // A square around the heap: across it (x) and down through it (y) or along its height.
       const double half = 2.5 * r * scale.size, cell = 2.0 * half / kGrid;
+      const double height = 2.0 * f.thickness_m * scale.height, step_up = height / kGrid;
       int inside = 0;
       for (int y = 0; y < kGrid; ++y)
-        for (int x = 0; x < kGrid; ++x)
-          inside += nadirOpacity(cloud, texture,
-                                 {-half + (x + 0.5) * cell, -half + (y + 0.5) * cell}) >= 0.5;
+        for (int x = 0; x < kGrid; ++x) {
+          const double across = -half + (x + 0.5) * cell;
+          inside +=
+              side ? orthographicOpacity(cloud, texture,
+                                         {across, -10.0 * r, 1000.0 + (y + 0.5) * step_up},
+                                         {0.0, 1.0, 0.0}) >= 0.5
+                   : orthographicOpacity(cloud, texture, {across, -half + (y + 0.5) * cell, 1.0e5},
+                                         {0.0, 0.0, -1.0}) >= 0.5;
+        }
+      if (side) {
+        area += inside * cell * step_up / (r * r);
+        continue;
+      }
       area += inside * cell * cell / (r * r);
     }
     return area / kHeaps;
   };
-  // Each measured on first use only: a sky of cumulus never pays for the cumulonimbus.
+  // Each measured on first use only: a sky of cumulus never pays for the cumulonimbus, and a
+  // view that shows no far deck never measures a side.
   if (type == CloudType::kCumulonimbus) {
+    if (side) {
+      static const double cumulonimbus_side = measure(CloudType::kCumulonimbus);
+      return cumulonimbus_side;
+    }
     static const double cumulonimbus = measure(CloudType::kCumulonimbus);
     return cumulonimbus;
   }
+  if (side) {
+    static const double cumulus_side = measure(CloudType::kCumulus);
+    return cumulus_side;
+  }
   static const double cumulus = measure(CloudType::kCumulus);
   return cumulus;
+}
+double unitFootprint(CloudType type) {
+  return unitArea(type, false);
 }
 
 // The most any point asks for.
@@ -394,14 +422,20 @@ std::vector<EllipsoidCloud> tileClouds(const CloudField& f, std::int64_t i, std:
   return out;
 }
 
-std::vector<EllipsoidCloud> fieldClouds(const CloudField& f, const Camera& camera) {
+double heapRange(const CloudField& f, const Camera& camera, double heap_range_m) {
+  if (heap_range_m > 0.0) return heap_range_m;
+  // From high up the view reaches further: the range grows with the height above the heaps.
+  return CloudField::kRangeM + 2.0 * std::abs(camera.position.z - f.base_m);
+}
+
+std::vector<EllipsoidCloud> fieldClouds(const CloudField& f, const Camera& camera,
+                                        double heap_range_m) {
   std::vector<EllipsoidCloud> out;
   if (!(peakCoverage(f) > 0.0)) return out;
   const double size = fieldTileSize(f);
   // The eye in the field's own frame (the field has drifted by drift_m).
   const glm::dvec2 eye = glm::dvec2(camera.position) - f.drift_m;
-  // From high up the view reaches further: the range grows with the height above the heaps.
-  const double range = CloudField::kRangeM + 2.0 * std::abs(camera.position.z - f.base_m);
+  const double range = heapRange(f, camera, heap_range_m);
   const ViewBasis basis = viewBasis(camera);
   const double rise = f.clusters.none() ? 1.0 : 1.0 + f.clusters.amount;
   const double top = f.base_m + (isCb(f) ? 1.3 : 1.2) * f.thickness_m * rise;
@@ -417,7 +451,7 @@ std::vector<EllipsoidCloud> fieldClouds(const CloudField& f, const Camera& camer
       const glm::dvec2 max_xy = glm::dvec2(ix + 1.0, jy + 1.0) * size + reach;
       const glm::dvec2 nearest = glm::clamp(eye, min_xy, max_xy);
       const double distance = glm::length(nearest - eye);
-      if (distance > range) continue;
+      if (glm::length(glm::dvec2(ix + 0.5, jy + 0.5) * size - eye) > range) continue;
       // Tiles where the region leaves no cover are never built.
       if (regionExcludesDisc(f.region, glm::dvec2(ix + 0.5, jy + 0.5) * size,
                              std::sqrt(0.5) * size))
@@ -438,12 +472,86 @@ std::vector<EllipsoidCloud> fieldClouds(const CloudField& f, const Camera& camer
   return out;
 }
 
-Scene withFieldClouds(const Scene& scene) {
+namespace {
+
+// True when the camera sees the plane Z = altitude further than `range` horizontally from
+// itself: some corner ray of the view meets it beyond that, or runs parallel to or away from
+// it (the plane's horizon is then in view). The view's footprint on the plane is the convex
+// hull of the corner rays' hits, so its farthest point is a corner.
+bool planeSeenBeyond(const Camera& camera, double altitude, double range) {
+  const ViewBasis b = viewBasis(camera);
+  const double dz = altitude - camera.position.z;
+  for (double sx : {-1.0, 1.0})
+    for (double sy : {-1.0, 1.0}) {
+      const glm::dvec3 d =
+          b.forward + sx * b.tan_half_vfov * b.aspect * b.right + sy * b.tan_half_vfov * b.up;
+      if (!(d.z * dz > 0.0)) return true;
+      if ((dz / d.z) * glm::length(glm::dvec2(d)) > range) return true;
+    }
+  return false;
+}
+
+// The far deck standing for a field's heaps beyond `range` (MODEL.md section 11): a sky plane
+// of the stratocumulus look at the heaps' middle, drawn for the field's coverage in its
+// region, lit like the heaps, drifting with them, with a hole of `range` around the camera.
+// Its threshold is calibrated once per field (a few milliseconds).
+CloudLayer farDeck(const CloudField& f, double range) {
+  static std::mutex mutex;
+  static std::map<std::string, CloudLayer> decks;
+  const std::string key = fieldKey(f);
+  CloudLayer deck;
+  {
+    std::lock_guard lock(mutex);
+    auto it = decks.find(key);
+    if (it == decks.end()) {
+      const WeatherLayer w{CloudType::kStratocumulus,
+                           std::min(fieldAltitude(f), Limits::kMaxBase),
+                           f.thickness_m,
+                           std::min(f.coverage, CloudField::kMaxFieldCoverage),
+                           {},
+                           f.region,
+                           {}};
+      const std::vector<CloudLayer> layers =
+          weatherClouds(w, f.name + "/far", hashCounters(f.seed, 0x466172ull)).layers;
+      if (decks.size() > 256) decks.clear();
+      CloudLayer deck = layers.empty() ? CloudLayer{} : layers.front();
+      // Gardner's periodic lattice, which the renderer bakes: a far deck is seen at a grazing
+      // angle, where its period foreshortens below the heaps' own spacing.
+      deck.texture.gardner.rotation_deg = deck.texture.gardner.jitter_octaves = 0.0;
+      // Its cover rises towards the horizon as the heaps' sides fill the gaps: the ratio of a
+      // heap's side silhouette to its footprint, both measured (unitArea).
+      deck.far.coverage = w.coverage;
+      deck.far.side_ratio = unitArea(f.type, true) / unitArea(f.type, false);
+      calibrateFarCover(deck.texture, deck.transition, deck.far);
+      deck.threshold = deck.far.threshold[0];  // unused while far.side_ratio > 0
+      it = decks.emplace(key, deck).first;
+    }
+    deck = it->second;
+  }
+  const HeapLook& look = lookOf(f);
+  deck.colour = glm::dvec3(look.colour);
+  deck.shading.ambient = look.ambient;
+  deck.shading.texture_fraction = look.texture_fraction;
+  deck.texture.drift_offset_m = f.drift_m;
+  // Heaps stand in the tiles whose middle is within the range, so their density falls from
+  // full to none over a tile either side of it; the deck rises over the same band.
+  const double tile = fieldTileSize(f);
+  deck.hole_radius_m = std::max(range - 0.5 * tile, kRegionMinBand);
+  deck.hole_band_m = tile;
+  return deck;
+}
+
+}  // namespace
+
+Scene withFieldClouds(const Scene& scene, double heap_range_m) {
   Scene out = scene;
   for (const CloudField& field : scene.fields) {
-    std::vector<EllipsoidCloud> heaps = fieldClouds(field, scene.camera);
+    std::vector<EllipsoidCloud> heaps = fieldClouds(field, scene.camera, heap_range_m);
     out.clouds.insert(out.clouds.end(), std::make_move_iterator(heaps.begin()),
                       std::make_move_iterator(heaps.end()));
+    const double range = heapRange(field, scene.camera, heap_range_m);
+    if (field.coverage > 0.0 && planeSeenBeyond(scene.camera, fieldAltitude(field), range))
+      out.layers.push_back(farDeck(field, range));
   }
   out.fields.clear();
   return out;

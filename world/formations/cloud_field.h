@@ -90,8 +90,13 @@ inline double fieldAltitude(const CloudField& field) {
   return field.base_m + 0.5 * field.thickness_m;
 }
 
-// The heaps of every tile within CloudField::kRangeM of the camera whose bounds meet its
-// view, drifted into place.
-std::vector<EllipsoidCloud> fieldClouds(const CloudField& field, const Camera& camera);
+// How far from the camera heaps are drawn as ellipsoids: `heap_range_m` when positive, else
+// CloudField::kRangeM plus twice the camera's height above the field's base.
+double heapRange(const CloudField& field, const Camera& camera, double heap_range_m = 0.0);
+
+// The heaps of every tile within heapRange of the camera whose bounds meet its view, drifted
+// into place.
+std::vector<EllipsoidCloud> fieldClouds(const CloudField& field, const Camera& camera,
+                                        double heap_range_m = 0.0);
 
 }  // namespace nephele

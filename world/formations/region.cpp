@@ -11,10 +11,8 @@
 namespace nephele {
 namespace {
 
-// Smoothstep of x / width clamped to [0, 1]: 0 at or below 0, 1 at or above `width`.
 double ramp(double x, double width) {
-  const double u = std::clamp(x / std::max(width, kRegionMinBand), 0.0, 1.0);
-  return u * u * (3.0 - 2.0 * u);
+  return holeRamp(x, width);
 }
 
 }  // namespace
@@ -61,6 +59,17 @@ std::string regionError(const Region& r) {
     return out.str();
   if (r.side < -1 || r.side > 1) return "side: " + std::to_string(r.side) + " (allowed: -1, 0, 1)";
   return "";
+}
+
+double farApparentCover(const FarCover& far, glm::dvec3 ray) {
+  const double cot = glm::length(glm::dvec2(ray)) / std::max(std::abs(ray.z), 1e-9);
+  return 1.0 - std::pow(1.0 - std::min(far.coverage, 1.0), 1.0 + far.side_ratio * cot);
+}
+
+double farThreshold(const FarCover& far, glm::dvec3 ray) {
+  const double x = std::clamp(farApparentCover(far, ray), 0.0, 1.0) * FarCover::kSteps;
+  const int k = std::min(int(x), FarCover::kSteps - 1);
+  return far.threshold[k] + (x - k) * (far.threshold[k + 1] - far.threshold[k]);
 }
 
 double clusterFactor(const ClusterVariation& v, std::uint64_t seed, std::uint64_t purpose,

@@ -41,6 +41,13 @@ double regionWeight(const Region& region, glm::dvec2 xy);
 // unsure), so that tiles and clouds there need not be built.
 bool regionExcludesDisc(const Region& region, glm::dvec2 xy, double radius);
 
+// Smoothstep of x / width clamped to [0, 1] (width at least kRegionMinBand): every band of a
+// region, and a far deck's hole, ramps this way.
+inline double holeRamp(double x, double width) {
+  const double u = std::min(std::max(x / std::max(width, kRegionMinBand), 0.0), 1.0);
+  return u * u * (3.0 - 2.0 * u);
+}
+
 // A sky plane's T1 where the region's weight is w (MODEL.md section 11): raised towards 1,
 // above every value of T, as w falls to 0, so cover thins out and breaks up into the
 // texture's highest peaks before it ends, as a layer's edge does.
@@ -50,6 +57,23 @@ inline double regionThreshold(double t1, double weight) {
 
 // Empty when usable, else what is wrong and what is allowed (ranges in world/limits.h).
 std::string regionError(const Region& region);
+
+// The cover a far deck stands for (MODEL.md section 11): heaps covering `coverage` of the
+// ground seen straight down hide more of it seen obliquely, their sides filling the gaps.
+// Along a ray at elevation angle e the apparent cover is 1 - (1 - coverage)^(1 + k cot e), k
+// the ratio of a heap's side silhouette to its footprint (a Boolean model whose shapes are
+// seen from the side over a path cot e times as long). T1 for a cover c is interpolated in a
+// table of T1 at c = 0, 1/16, ..., 1 calibrated on the deck's texture. side_ratio 0: none.
+struct FarCover {
+  static constexpr int kSteps = 16;
+  double coverage = 0.0;
+  double side_ratio = 0.0;
+  double threshold[kSteps + 1]{};
+};
+// Apparent cover along view ray `ray` (any length, ray.z != 0).
+double farApparentCover(const FarCover& far, glm::dvec3 ray);
+// T1 for that cover.
+double farThreshold(const FarCover& far, glm::dvec3 ray);
 
 // Gardner's macrocluster variation (MODEL.md section 11): inside a region, clusters on a grid
 // of this spacing each draw their own cover and vertical development, as factors

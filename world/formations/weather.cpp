@@ -189,4 +189,10 @@ double thresholdForCoverage(const LayerTextureSpec& spec, double transition, int
   return thresholdFromSamples(sortedSamples(spec), transition, planes, coverage);
 }
 
+void calibrateFarCover(const LayerTextureSpec& spec, double transition, FarCover& far) {
+  const std::vector<double> samples = sortedSamples(spec);
+  for (int k = 0; k <= FarCover::kSteps; ++k)
+    far.threshold[k] = thresholdFromSamples(samples, transition, 1, double(k) / FarCover::kSteps);
+}
+
 }  // namespace nephele

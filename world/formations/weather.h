@@ -34,5 +34,7 @@ WeatherLayer typicalWeatherLayer(CloudType type, double coverage);
 // texture periods.
 double thresholdForCoverage(const LayerTextureSpec& texture, double transition, int planes,
                             double coverage);
+// Fills far.threshold with thresholdForCoverage of one plane at c = 0, 1/16, ..., 1.
+void calibrateFarCover(const LayerTextureSpec& texture, double transition, FarCover& far);
 
 }  // namespace nephele
