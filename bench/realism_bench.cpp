@@ -35,9 +35,10 @@ struct Figures {
 };
 
 Figures measure(GlRenderer& renderer, CloudType type, double coverage, double span_m, int pixels,
-                double shortest_m) {
+                double shortest_m, const ClusterVariation& clusters) {
   Scene scene;
-  const WeatherLayer w = typicalWeatherLayer(type, coverage);
+  WeatherLayer w = typicalWeatherLayer(type, coverage);
+  if (type == CloudType::kCumulus || type == CloudType::kCumulonimbus) w.clusters = clusters;
   const WeatherClouds clouds = weatherClouds(w, "weather/1", 7);
   scene.layers = clouds.layers;
   scene.fields = clouds.fields;
@@ -87,6 +88,12 @@ int main(int argc, char** argv) {
       ->delimiter(',')
       ->check(CLI::Range(0.01, 0.99));
   app.add_option("--genera", genera, "Only these genera (default: all ten)")->delimiter(',');
+  ClusterVariation clusters;
+  app.add_option("--spacing", clusters.spacing_m,
+                 "Heaps: Gardner's cluster grid, metres (MODEL.md section 11; 0 none)")
+      ->check(CLI::Range(0.0, 1.0e5));
+  app.add_option("--variation", clusters.amount, "Heaps: cluster variation, 0..1")
+      ->check(CLI::Range(0.0, 1.0));
   CLI11_PARSE(app, argc, argv);
   std::vector<CloudType> types;
   for (int t = 1; t < kCloudTypeCount; ++t) {
@@ -111,7 +118,7 @@ int main(int argc, char** argv) {
               "s", "a", "bins(a)", "ms");
   for (CloudType type : types)
     for (double coverage : coverages) {
-      const Figures f = measure(renderer, type, coverage, span_m, pixels, shortest_m);
+      const Figures f = measure(renderer, type, coverage, span_m, pixels, shortest_m, clusters);
       auto value = [](const Fitted& x) { return x.points >= 3 ? x.value : NAN; };
       std::printf("%-14s %6.2f %6.3f %7d %7.3f %7.3f %7.3f %8d %8.0f\n",
                   std::string(cloudTypeName(type)).c_str(), coverage, f.fraction, f.clouds,

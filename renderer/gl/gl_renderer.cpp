@@ -49,9 +49,9 @@ int layerTermsAtMost(const CloudLayer& layer, const LayerTexture& texture, const
 std::string textureKey(const LayerTextureSpec& spec, const RenderSettings& settings) {
   std::ostringstream key;
   key.precision(17);
-  key << int(spec.source) << '/' << spec.seed << '/' << spec.drift_velocity.x << '/'
-      << spec.drift_velocity.y << '/' << spec.drift_offset_m.x << '/' << spec.drift_offset_m.y
-      << '/';
+  // Drift is left out: it only moves the texture's origin, which the uniforms carry from each
+  // layer's own spec (a far deck's offset changes every frame).
+  key << int(spec.source) << '/' << spec.seed << '/';
   if (spec.source == TextureSource::kGardner) {
     const GardnerTextureParams& g = spec.gardner;
     key << g.terms << '/' << g.fx1 << '/' << g.fy1 << '/' << g.t0 << '/' << g.seeded_phases << '/'
@@ -335,7 +335,8 @@ void GlRenderer::setSlotUniforms(GLuint p, int slot, const LayerSlot& entry, con
   const glm::dvec2 period = texture.period();
   const glm::dvec2 camera_xy(camera.position.x, camera.position.y);
   const glm::dvec2 origin_uv =
-      texture.periodic() ? texture.periodicCoordinate(camera_xy, scene.time_s) : glm::dvec2(0.0);
+      texture.periodic() ? texture.periodicCoordinate(camera_xy, scene.time_s, layer.texture)
+                         : glm::dvec2(0.0);
   const glm::vec2 origin_f(origin_uv), inv_period(1.0 / period);
   gl_.ProgramUniform2fv(p, location("u_origin", slot), 1, &origin_f.x);
   gl_.ProgramUniform2fv(p, location("u_inv_period", slot), 1, &inv_period.x);
@@ -345,8 +346,9 @@ void GlRenderer::setSlotUniforms(GLuint p, int slot, const LayerSlot& entry, con
     if (entry.kind == LayerKind::kProceduralGardner) {
       // Metres inside one period; a rotated texture has none, so its phases at the point under
       // the camera are taken from the whole drifted position, in double, term by term.
-      const glm::dvec2 origin =
-          texture.periodic() ? origin_uv * period : camera_xy - texture.driftOffset(scene.time_s);
+      const glm::dvec2 origin = texture.periodic()
+                                    ? origin_uv * period
+                                    : camera_xy - texture.driftOffset(scene.time_s, layer.texture);
       for (int j = 0; j < g->terms(); ++j) {
         auto set = [&](const char* name, int k, double v) {
           gl_.ProgramUniform1f(p, location(name, k), float(v));

@@ -285,7 +285,9 @@ struct TileKey {
   auto operator<=>(const TileKey&) const = default;
 };
 
-// Tiles already built (they are pure functions of their key), most recent first; bounded.
+// Tiles already built (they are pure functions of their key), most recent first; bounded by
+// the ellipsoids they hold (about 10 MiB), many times what one view within the heap range
+// needs, so a long flight's memory levels off (docs/ACCURACY.md, "Long flights").
 class TileCache {
  public:
   template <class Make>
@@ -302,7 +304,9 @@ class TileCache {
     if (index_.count(key)) return made;
     order_.emplace_front(key, made);
     index_[key] = order_.begin();
-    if (order_.size() > kCapacity) {
+    held_ += cost(*made);
+    while (held_ > kCapacity && order_.size() > 1) {
+      held_ -= cost(*order_.back().second);
       index_.erase(order_.back().first);
       order_.pop_back();
     }
@@ -310,7 +314,11 @@ class TileCache {
   }
 
  private:
-  static constexpr std::size_t kCapacity = 8192;
+  // In ellipsoids of 72 bytes; a tile, even an empty one, costs about eight more (its key,
+  // name and texture).
+  static constexpr std::size_t kCapacity = 1 << 17;
+  static std::size_t cost(const EllipsoidCloud& tile) { return tile.ellipsoids.size() + 8; }
+  std::size_t held_ = 0;
   std::mutex mutex_;
   std::list<std::pair<TileKey, std::shared_ptr<const EllipsoidCloud>>> order_;
   std::map<TileKey, decltype(order_)::iterator> index_;
@@ -492,7 +500,8 @@ bool planeSeenBeyond(const Camera& camera, double altitude, double range) {
 }
 
 // The far deck standing for a field's heaps beyond `range` (MODEL.md section 11): a sky plane
-// of the stratocumulus look at the heaps' middle, drawn for the field's coverage in its
+// of the stratocumulus look a metre under the heaps' base (so that no heap spans it and the
+// renderer need not draw the heaps once per side of it), drawn for the field's coverage in its
 // region, lit like the heaps, drifting with them, with a hole of `range` around the camera.
 // Its threshold is calibrated once per field (a few milliseconds).
 CloudLayer farDeck(const CloudField& f, double range) {
@@ -505,7 +514,7 @@ CloudLayer farDeck(const CloudField& f, double range) {
     auto it = decks.find(key);
     if (it == decks.end()) {
       const WeatherLayer w{CloudType::kStratocumulus,
-                           std::min(fieldAltitude(f), Limits::kMaxBase),
+                           std::max(f.base_m - 1.0, 0.0),
                            f.thickness_m,
                            std::min(f.coverage, CloudField::kMaxFieldCoverage),
                            {},
@@ -550,7 +559,7 @@ Scene withFieldClouds(const Scene& scene, double heap_range_m) {
     out.clouds.insert(out.clouds.end(), std::make_move_iterator(heaps.begin()),
                       std::make_move_iterator(heaps.end()));
     const double range = heapRange(field, scene.camera, heap_range_m);
-    if (field.coverage > 0.0 && planeSeenBeyond(scene.camera, fieldAltitude(field), range))
+    if (field.coverage > 0.0 && planeSeenBeyond(scene.camera, field.base_m, range))
       out.layers.push_back(farDeck(field, range));
   }
   out.fields.clear();

@@ -40,8 +40,13 @@ glm::dvec2 LayerTexture::period() const {
 }
 
 glm::dvec2 LayerTexture::driftOffset(double time_s) const {
+  return driftOffset(time_s, spec_);
+}
+
+glm::dvec2 LayerTexture::driftOffset(double time_s, const LayerTextureSpec& motion) const {
+  const glm::dvec2 velocity = motion.drift_velocity, offset = motion.drift_offset_m;
   // Without a period there is nothing to wrap by; double keeps a drift of 10^7 m to 2 nm.
-  if (!periodic()) return spec_.drift_offset_m + spec_.drift_velocity * time_s;
+  if (!periodic()) return offset + velocity * time_s;
   const glm::dvec2 p = period();
   // Reduce time modulo the time one period takes to pass, so velocity * time stays exact
   // after hours of drift.
@@ -50,13 +55,18 @@ glm::dvec2 LayerTexture::driftOffset(double time_s) const {
     const double time_per_period = period_m / std::abs(velocity);
     return wrapPeriodic(velocity * wrapPeriodic(time_s, time_per_period), period_m);
   };
-  return {wrapPeriodic(axis(spec_.drift_velocity.x, p.x) + spec_.drift_offset_m.x, p.x),
-          wrapPeriodic(axis(spec_.drift_velocity.y, p.y) + spec_.drift_offset_m.y, p.y)};
+  return {wrapPeriodic(axis(velocity.x, p.x) + offset.x, p.x),
+          wrapPeriodic(axis(velocity.y, p.y) + offset.y, p.y)};
 }
 
 glm::dvec2 LayerTexture::periodicCoordinate(glm::dvec2 world_xy, double time_s) const {
+  return periodicCoordinate(world_xy, time_s, spec_);
+}
+
+glm::dvec2 LayerTexture::periodicCoordinate(glm::dvec2 world_xy, double time_s,
+                                            const LayerTextureSpec& motion) const {
   const glm::dvec2 p = period();
-  const glm::dvec2 shifted = world_xy - driftOffset(time_s);
+  const glm::dvec2 shifted = world_xy - driftOffset(time_s, motion);
   return {wrapPeriodic(shifted.x, p.x) / p.x, wrapPeriodic(shifted.y, p.y) / p.y};
 }
 

@@ -51,6 +51,11 @@ class LayerTexture {
   // Position inside one period, in periods [0, 1), of world point p at time t (periodic
   // textures only).
   glm::dvec2 periodicCoordinate(glm::dvec2 world_xy, double time_s) const;
+  // The same with the drift (velocity and offset) of `motion`: a renderer keeps one texture
+  // for every layer that differs from it only in drift.
+  glm::dvec2 driftOffset(double time_s, const LayerTextureSpec& motion) const;
+  glm::dvec2 periodicCoordinate(glm::dvec2 world_xy, double time_s,
+                                const LayerTextureSpec& motion) const;
   // T with every term (the reference's evaluation).
   double value(glm::dvec2 world_xy, double time_s) const;
 
