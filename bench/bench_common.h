@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <string>
 #include <vector>
@@ -64,6 +65,14 @@ inline bool loadPreset(const std::string& path, SceneFile& file) {
   const std::string error = loadSceneFile(path, file);
   if (!error.empty()) std::fprintf(stderr, "%s\n", error.c_str());
   return error.empty();
+}
+
+// Resident memory of this process, MiB (Linux /proc/self/statm).
+inline double residentMiB() {
+  std::ifstream statm("/proc/self/statm");
+  double pages = 0.0, resident = 0.0;
+  statm >> pages >> resident;
+  return resident * 4096.0 / (1024.0 * 1024.0);
 }
 
 // The scene files (*.toml) in `directory`, sorted by name.

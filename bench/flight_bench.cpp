@@ -12,7 +12,6 @@
 // it never fails on its figures.
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -26,13 +25,6 @@
 using namespace nephele;
 
 namespace {
-
-double residentMiB() {
-  std::ifstream statm("/proc/self/statm");
-  double pages = 0.0, resident = 0.0;
-  statm >> pages >> resident;
-  return resident * 4096.0 / (1024.0 * 1024.0);
-}
 
 struct Means {
   double cover = 0.0, luminance = 0.0;
@@ -112,7 +104,7 @@ int main(int argc, char** argv) {
   const double floor =
       medianMilliseconds(5, [&] { renderer.renderFloor(camera.width, camera.height); });
   renderer.renderFloat(place(0.0), settings);  // shaders, textures, the heaps' footprints
-  const double start_mib = residentMiB();
+  const double start_mib = bench::residentMiB();
   std::printf("flight: %.1f h at %.0f m/s from x = %.0f km, %s, floor %.2f ms\n", hours, speed,
               start_x / 1000.0, size.c_str(), floor);
   std::printf("%8s %10s %9s %8s %7s %10s %9s %9s %9s %9s\n", "time s", "x km", "first ms", "ms",
@@ -144,11 +136,11 @@ int main(int argc, char** argv) {
     worst_luminance = std::max(worst_luminance, d_lum);
     worst_pixel = std::max(worst_pixel, e.max_abs);
     total_ms += ms;
-    peak_mib = std::max(peak_mib, residentMiB());
+    peak_mib = std::max(peak_mib, bench::residentMiB());
     if (samples % 10 == 0)
       std::printf("%8.0f %10.1f %9.1f %8.1f %7.1f %10d %9.4f %9.4f %9.3f %9.1f\n", t,
                   a.camera.position.x / 1000.0, first_ms, ms, ms / floor, drawn, d_cover, d_lum,
-                  e.max_abs, residentMiB());
+                  e.max_abs, bench::residentMiB());
     std::fflush(stdout);
   }
   std::printf(
@@ -157,7 +149,8 @@ int main(int argc, char** argv) {
       "luminance by %.4f, one pixel by %.3f (sRGB); memory %.1f MiB after the first "
       "frame, peak %.1f, end %.1f\n",
       samples, total_ms / samples, total_ms / samples / floor, total_first_ms / samples,
-      worst_cover, worst_at, worst_luminance, worst_pixel, start_mib, peak_mib, residentMiB());
+      worst_cover, worst_at, worst_luminance, worst_pixel, start_mib, peak_mib,
+      bench::residentMiB());
 
   // Precision: GL against the double-precision reference, near the origin and far from it.
   Camera small = camera;

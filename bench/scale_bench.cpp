@@ -9,7 +9,6 @@
 // reference with the automatic range. A benchmark: it never fails on its figures.
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <string>
 #include <vector>
 
@@ -26,14 +25,6 @@
 using namespace nephele;
 
 namespace {
-
-// Resident memory of this process, MiB (Linux /proc).
-double residentMiB() {
-  std::ifstream statm("/proc/self/statm");
-  double pages = 0.0, resident = 0.0;
-  statm >> pages >> resident;
-  return resident * 4096.0 / (1024.0 * 1024.0);
-}
 
 // The horizon part: see the file comment.
 void horizon(GlPlatform& platform, const std::vector<std::string>& sizes, int repeats,
@@ -59,7 +50,7 @@ void horizon(GlPlatform& platform, const std::vector<std::string>& sizes, int re
   Camera small = camera;
   small.width = 256, small.height = 192;
   scene.camera = small;
-  const double before = residentMiB();
+  const double before = bench::residentMiB();
   const FloatImage reference = renderReference(scene, {});
   std::printf("reference 256x192 4x4, automatic range (%.0f km)\n",
               heapRange(scene.fields[0], small) / 1000.0);
@@ -86,7 +77,8 @@ void horizon(GlPlatform& platform, const std::vector<std::string>& sizes, int re
       std::fflush(stdout);
     }
   }
-  std::printf("resident memory grew %.1f MiB over the horizon runs\n", residentMiB() - before);
+  std::printf("resident memory grew %.1f MiB over the horizon runs\n",
+              bench::residentMiB() - before);
 }
 
 }  // namespace
@@ -123,7 +115,7 @@ int main(int argc, char** argv) {
     if (horizon_part) horizon(*platform, sizes, repeats, ranges_km);
     return 0;
   }
-  const double before_mib = residentMiB();
+  const double before_mib = bench::residentMiB();
   Scene world;
   world.sun.elevation_deg = 50.0;
   const int per_side = int(side_km * 1000.0 / spacing_m);
@@ -140,7 +132,7 @@ int main(int argc, char** argv) {
     }
   std::size_t total = 0;
   for (const EllipsoidCloud& c : world.clouds) total += c.ellipsoids.size();
-  const double world_mib = residentMiB() - before_mib;
+  const double world_mib = bench::residentMiB() - before_mib;
   std::printf("world: %zu clouds, %zu ellipsoids over %.0f km x %.0f km; %.1f MiB resident\n",
               world.clouds.size(), total, side_km, side_km, world_mib);
   std::printf("%-10s %9s %9s %9s %8s %9s %9s %7s %9s\n", "size", "in view", "floor ms", "world ms",

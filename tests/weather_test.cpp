@@ -216,17 +216,21 @@ TEST(CloudField, TilesDoNotDependOnVisitingOrder) {
 }
 
 TEST(Weather, InvalidLayersAreRefusedWithTheAllowedRange) {
-  EXPECT_NE(weatherLayerError({CloudType(11), 1000.0, 500.0, 0.5, {}, {}, {}}).find("allowed: 0 none"),
-            std::string::npos);
-  EXPECT_NE(weatherLayerError({CloudType::kCumulus, 1000.0, -5.0, 0.5, {}, {}, {}}).find("thickness"),
-            std::string::npos);
-  EXPECT_NE(weatherLayerError({CloudType::kCumulus, 1000.0, 500.0, 1.5, {}, {}, {}}).find("coverage"),
-            std::string::npos);
+  EXPECT_NE(
+      weatherLayerError({CloudType(11), 1000.0, 500.0, 0.5, {}, {}, {}}).find("allowed: 0 none"),
+      std::string::npos);
+  EXPECT_NE(
+      weatherLayerError({CloudType::kCumulus, 1000.0, -5.0, 0.5, {}, {}, {}}).find("thickness"),
+      std::string::npos);
+  EXPECT_NE(
+      weatherLayerError({CloudType::kCumulus, 1000.0, 500.0, 1.5, {}, {}, {}}).find("coverage"),
+      std::string::npos);
   EXPECT_NE(weatherLayerError({CloudType::kStratus, -1.0, 500.0, 0.5, {}, {}, {}}).find("base"),
             std::string::npos);
   EXPECT_EQ(weatherLayerError({CloudType::kStratus, 100.0, 500.0, 0.5, {}, {}, {}}), "");
   // Nothing is drawn for a layer that is refused.
-  const WeatherClouds none = weatherClouds({CloudType::kCumulus, 1000.0, 500.0, 1.5, {}, {}, {}}, "w", 1);
+  const WeatherClouds none =
+      weatherClouds({CloudType::kCumulus, 1000.0, 500.0, 1.5, {}, {}, {}}, "w", 1);
   EXPECT_TRUE(none.layers.empty() && none.fields.empty());
   // Scene files name the key and the allowed values, and load nothing.
   for (const char* bad :
