@@ -46,7 +46,7 @@ inline double layerRegionWeight(const CloudLayer& layer, glm::dvec2 xy, double t
     w = regionWeight(layer.region, xy - t.drift_offset_m - t.drift_velocity * time_s);
   }
   if (layer.hole_radius_m > 0.0)
-    w *= holeRamp(glm::length(xy - eye) - layer.hole_radius_m, layer.hole_band_m);
+    w *= bandRamp(glm::length(xy - eye) - layer.hole_radius_m, layer.hole_band_m);
   return w;
 }
 inline bool layerHasRegion(const CloudLayer& layer) {

@@ -222,11 +222,7 @@ double unitArea(CloudType type, bool side) {
                    : orthographicOpacity(cloud, texture, {across, -half + (y + 0.5) * cell, 1.0e5},
                                          {0.0, 0.0, -1.0}) >= 0.5;
         }
-      if (side) {
-        area += inside * cell * step_up / (r * r);
-        continue;
-      }
-      area += inside * cell * cell / (r * r);
+      area += inside * cell * (side ? step_up : cell) / (r * r);
     }
     return area / kHeaps;
   };

@@ -9,13 +9,6 @@
 #include "world/limits.h"
 
 namespace nephele {
-namespace {
-
-double ramp(double x, double width) {
-  return holeRamp(x, width);
-}
-
-}  // namespace
 
 glm::dvec2 regionLocal(const Region& r, glm::dvec2 xy) {
   const double h = r.heading_deg * std::numbers::pi / 180.0;
@@ -27,10 +20,10 @@ glm::dvec2 regionLocal(const Region& r, glm::dvec2 xy) {
 double regionWeight(const Region& r, glm::dvec2 xy) {
   if (r.everywhere()) return 1.0;
   const glm::dvec2 p = regionLocal(r, xy);
-  double w =
-      ramp(r.half_size.x - std::abs(p.x), r.edge_m) * ramp(r.half_size.y - std::abs(p.y), r.edge_m);
+  double w = bandRamp(r.half_size.x - std::abs(p.x), r.edge_m) *
+             bandRamp(r.half_size.y - std::abs(p.y), r.edge_m);
   // The front: weight 1/2 on the line, rising to 1 half a band into the region's side.
-  if (r.side != 0) w *= ramp(r.side * p.x + 0.5 * r.transition_m, r.transition_m);
+  if (r.side != 0) w *= bandRamp(r.side * p.x + 0.5 * r.transition_m, r.transition_m);
   return w;
 }
 

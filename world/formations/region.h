@@ -43,7 +43,7 @@ bool regionExcludesDisc(const Region& region, glm::dvec2 xy, double radius);
 
 // Smoothstep of x / width clamped to [0, 1] (width at least kRegionMinBand): every band of a
 // region, and a far deck's hole, ramps this way.
-inline double holeRamp(double x, double width) {
+inline double bandRamp(double x, double width) {
   const double u = std::min(std::max(x / std::max(width, kRegionMinBand), 0.0), 1.0);
   return u * u * (3.0 - 2.0 * u);
 }
