@@ -7,8 +7,7 @@
 #include <cmath>
 
 #include "config/scene_file.h"
-#include "renderer/gl/gl_renderer.h"
-#include "renderer/reference/reference_renderer.h"
+#include "renderer/renderer.h"
 #include "world/check.h"
 #include "world/world.h"
 
@@ -83,6 +82,23 @@ World worldAtTime(const SceneFile& file) {
   return world;
 }
 
+ChannelSet parseChannelList(const std::string& list, std::string& error) {
+  ChannelSet set;
+  std::size_t start = 0;
+  while (start <= list.size()) {
+    const std::size_t comma = std::min(list.find(',', start), list.size());
+    const std::string name = list.substr(start, comma - start);
+    const auto channel = channelFromName(name);
+    if (!channel) {
+      error = "unknown channel '" + name + "' (allowed: " + channelNames() + ")";
+      return {};
+    }
+    set.add(*channel);
+    start = comma + 1;
+  }
+  return set;
+}
+
 GlBackend backendFromName(const std::string& name) {
   if (name == "egl") return GlBackend::kEgl;
   if (name == "osmesa") return GlBackend::kOsmesa;
@@ -101,6 +117,9 @@ void addRenderCommand(CLI::App& app, RenderCommandOptions& o) {
   cmd->add_option("--renderer", o.renderer, "gl, or the CPU reference (slow, exact)")
       ->check(CLI::IsMember({"gl", "reference"}))
       ->capture_default_str();
+  cmd->add_option("--channels", o.channels,
+                  "EXR output: channels to write, comma-separated, from " + channelNames() +
+                      " (default colour,coverage)");
   cmd->add_option("--width", o.width, "Image width in pixels")
       ->check(CLI::Range(1, Limits::kMaxImageSide));
   cmd->add_option("--height", o.height, "Image height in pixels")
@@ -179,27 +198,39 @@ int runRenderCommand(const RenderCommandOptions& o) {
     spdlog::error("{}", error);
     return 2;
   }
-  // The GL and its target first: a size the platform cannot allocate is refused before the
-  // world is simulated or anything is drawn.
-  std::unique_ptr<GlPlatform> platform;
-  std::unique_ptr<GlRenderer> renderer;
-  if (o.renderer != "reference") {
-    std::string platform_error;
-    platform = createGlPlatform(backendFromName(o.gl_backend), platform_error);
-    if (!platform) {
-      spdlog::error("{}", platform_error);
-      return 1;
-    }
-    spdlog::info("OpenGL: {} ({}), GL_RENDERER {}", platform->backendName(), platform->version(),
-                 platform->renderer());
-    renderer = std::make_unique<GlRenderer>(*platform);
-    const Camera& camera = file.scene.camera;
-    if (std::string e =
-            renderer->reserveTarget(camera.width, camera.height, isFloatFormat(*format));
-        !e.empty()) {
-      spdlog::error("--width/--height: {}", e);
+  FrameRequest request;
+  if (!o.channels.empty()) {
+    std::string channel_error;
+    request.channels = parseChannelList(o.channels, channel_error);
+    if (!channel_error.empty()) {
+      spdlog::error("--channels: {}", channel_error);
       return 2;
     }
+    if (!isFloatFormat(*format)) {
+      spdlog::error("--channels: '{}' is an 8-bit format holding colour only; write an .exr",
+                    o.output_path);
+      return 2;
+    }
+  }
+  // The renderer and its target first: a size the platform cannot allocate is refused before
+  // the world is simulated or anything is drawn.
+  RendererOptions options;
+  options.kind = o.renderer == "reference" ? RendererKind::kReference : RendererKind::kGl;
+  options.gl_backend = backendFromName(o.gl_backend);
+  options.render = file.render;
+  options.reference = file.reference;
+  std::string renderer_error;
+  const std::unique_ptr<Renderer> renderer = createRenderer(options, renderer_error);
+  if (!renderer) {
+    spdlog::error("{}", renderer_error);
+    return 1;
+  }
+  spdlog::info("renderer: {}", renderer->description());
+  const Camera& camera = file.scene.camera;
+  if (std::string e = renderer->reserve(camera.width, camera.height, isFloatFormat(*format));
+      !e.empty()) {
+    spdlog::error("--width/--height: {}", e);
+    return 2;
   }
   const auto start = Clock::now();
   const World world = worldAtTime(file);
@@ -212,35 +243,26 @@ int runRenderCommand(const RenderCommandOptions& o) {
       o.scene_path, scene.time_s, scene.camera.width, scene.camera.height, scene.layers.size(),
       scene.clouds.size(), ellipsoids, scene.automata.size(), scene.targets.size(),
       scene.fog ? ", fog" : "");
-
+  renderer->setProgress([&](double done) {
+    const double seconds = millisecondsSince(start) / 1000.0;
+    if (seconds >= 2.0)  // only long renders need a progress line
+      spdlog::info("render: {:.0f} % after {:.1f} s", 100.0 * done, seconds);
+  });
   std::string error;
-  if (o.renderer == "reference") {
-    const FloatImage image = renderReference(scene, file.reference, [&](double done) {
-      const double seconds = millisecondsSince(start) / 1000.0;
-      if (seconds >= 2.0)  // only long renders need a progress line
-        spdlog::info("reference render: {:.0f} % after {:.1f} s", 100.0 * done, seconds);
-    });
-    spdlog::info("reference render: {:.0f} ms ({}x{} samples per pixel)", millisecondsSince(start),
-                 file.reference.samples_per_axis, file.reference.samples_per_axis);
-    error = writeImageFile(o.output_path, image, o.encode);
+  const auto render_start = Clock::now();
+  if (isFloatFormat(*format)) {
+    const Frame frame = renderer->render(scene, request);
+    spdlog::info("render: {:.1f} ms", millisecondsSince(render_start));
+    error = writeFrameExr(o.output_path, frame, o.encode);
   } else {
-    GlRenderer& gl = *renderer;
-    const auto render_start = Clock::now();
-    if (isFloatFormat(*format)) {
-      const FloatImage image = gl.renderFloat(scene, file.render);
-      spdlog::info("render: {:.1f} ms", millisecondsSince(render_start));
-      error = writeImageFile(o.output_path, image, o.encode);
-    } else {
-      const Srgb8Image image = gl.renderSrgb8(scene, file.render);
-      spdlog::info("render: {:.1f} ms", millisecondsSince(render_start));
-      error = writeImageFile(o.output_path, image, o.encode);
-    }
-    if (o.stats)
-      std::printf("stats: %s automaton_steps=%llu relights=%llu\n",
-                  gl.lastFrameStats().line().c_str(),
-                  static_cast<unsigned long long>(world.automatonStepsRun()),
-                  static_cast<unsigned long long>(world.relightsRun()));
+    const Srgb8Image image = renderer->renderSrgb8(scene);
+    spdlog::info("render: {:.1f} ms", millisecondsSince(render_start));
+    error = writeImageFile(o.output_path, image, o.encode);
   }
+  if (o.stats)
+    std::printf("stats: %s automaton_steps=%llu relights=%llu\n", renderer->statsLine().c_str(),
+                static_cast<unsigned long long>(world.automatonStepsRun()),
+                static_cast<unsigned long long>(world.relightsRun()));
   if (!error.empty()) {
     spdlog::error("{}", error);
     return 1;

@@ -8,6 +8,7 @@
 
 #include "config/scene_file.h"
 #include "image/image_encoding.h"
+#include "renderer/frame.h"
 #include "renderer/gl/gl_platform.h"
 #include "world/world.h"
 
@@ -18,6 +19,7 @@ struct RenderCommandOptions {
   std::string output_path;
   std::string gl_backend = "auto";
   std::string renderer = "gl";  // or "reference"
+  std::string channels;         // comma-separated channel names (renderer/frame.h); EXR only
   std::optional<int> width, height;
   std::optional<std::vector<double>> position;
   std::optional<double> heading, pitch, roll, vfov, time;
@@ -42,6 +44,9 @@ World worldAtTime(const SceneFile& file);
 // The --gl values, and the back end each names (checked when the flag was parsed).
 inline const std::vector<std::string> kGlBackendNames{"auto", "egl", "osmesa"};
 GlBackend backendFromName(const std::string& name);
+// Channel names separated by commas into a set; `error` names an unknown one and lists the
+// allowed.
+ChannelSet parseChannelList(const std::string& list, std::string& error);
 
 // Runs the command; returns the process exit code (0 ok, 2 bad input, 1 failure).
 int runRenderCommand(const RenderCommandOptions& options);

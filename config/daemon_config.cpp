@@ -147,13 +147,8 @@ std::string parseDaemonConfig(std::string_view text, const std::string& source_n
   DaemonConfig parsed;
   parsed.config_path = source_name;
   try {
-    if (std::string e = config_detail::tomlAsciiError(text); !e.empty())
-      return source_name + ":" + e;
-    const toml::table root = toml::parse(text, source_name);
+    const toml::table root = config_detail::parseToml(text, source_name);
     readDaemon(root, source_name, parsed);
-  } catch (const toml::parse_error& e) {
-    return source_name + ":" + std::to_string(e.source().begin.line) +
-           ": not valid TOML: " + std::string(e.description());
   } catch (const SceneError& e) {
     return e.message;
   }

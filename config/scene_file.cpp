@@ -610,13 +610,8 @@ int nameIndex(const std::vector<std::string>& names, std::string_view name) {
 std::string parseSceneText(std::string_view text, const std::string& source_name, SceneFile& out) {
   SceneFile parsed;
   try {
-    if (std::string e = config_detail::tomlAsciiError(text); !e.empty())
-      return source_name + ":" + e;
-    const toml::table root = toml::parse(text, source_name);
+    const toml::table root = config_detail::parseToml(text, source_name);
     readScene(root, source_name, parsed);
-  } catch (const toml::parse_error& e) {
-    return source_name + ":" + std::to_string(e.source().begin.line) +
-           ": not valid TOML: " + std::string(e.description());
   } catch (const SceneError& e) {
     return e.message;
   }

@@ -10,6 +10,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <limits>
@@ -151,6 +152,27 @@ class TableReader {
     for (const toml::node& v : *array) out.push_back(v.value<std::string>().value());
   }
 
+  // A range to draw from: a number (fixed) or [low, high], each in `range`, low <= high.
+  void span(std::string_view key, double& lo, double& hi, Range range) {
+    const toml::node* node = take(key);
+    if (!node) return;
+    if (node->is_number()) {
+      lo = hi = toNumber(*node, key, range.lo, range.hi);
+      return;
+    }
+    const toml::array* array = node->as_array();
+    if (!array || array->size() != 2)
+      fail(*node, key,
+           "must be a number or an array [low, high] (each " + formatNumber(range.lo) + " to " +
+               formatNumber(range.hi) + ")");
+    const double a = toNumber(*array->get(0), key, range.lo, range.hi);
+    const double b = toNumber(*array->get(1), key, range.lo, range.hi);
+    if (a > b)
+      fail(*node, key,
+           "the low end " + formatNumber(a) + " is above the high end " + formatNumber(b));
+    lo = a, hi = b;
+  }
+
   // Three integers, each in [lo, hi].
   void integers3(std::string_view key, int (&out)[3], int lo, int hi) {
     const toml::node* node = take(key);
@@ -255,45 +277,112 @@ class TableReader {
   std::vector<std::string> allowed_;
 };
 
-// Reads a whole file into `text`; on failure returns "cannot read WHAT 'path': reason".
-// TOML (1.0) allows characters beyond ASCII only inside strings and comments. toml++ 3.3,
-// the version Debian 12 ships, reaches a __builtin_unreachable (undefined behaviour) when
-// classifying some of them elsewhere, so such text is refused here, before it is parsed.
-// Returns "" or "LINE: what is wrong".
-inline std::string tomlAsciiError(std::string_view text) {
-  enum class In { kCode, kComment, kBasic, kLiteral, kMultiBasic, kMultiLiteral } in = In::kCode;
+// toml++ 3.3, the version Debian 12 ships, reaches a __builtin_unreachable (undefined
+// behaviour) when it asks whether a character in U+00A1-U+0499, U+2C5E-U+2FFF, U+3001-U+3057 or
+// U+FB26-U+FEFE is whitespace: a gap in its generated table. It asks that of every character
+// it meets outside strings and comments (also while reading ahead through a malformed token,
+// quotes included), and inside a multi-line basic string of the first character after a
+// line-ending backslash. parseToml below keeps every such character from reaching those
+// questions, with the parser itself, not a second grammar, deciding what is inside a string:
+//   1. Text that is all ASCII is parsed directly.
+//   2. Otherwise a copy with each character beyond ASCII replaced by '@' is parsed. '@' is
+//      valid TOML only inside strings and comments, so if the copy parses, every such
+//      character of the original lies inside a string or a comment, and the document is
+//      valid TOML. If the copy fails, its error is the original's, reported with the
+//      character it names.
+//   3. In the now valid document, a character of the gap straight after a line-ending
+//      backslash (and the whitespace it skips) is refused: write it as \uXXXX there.
+//   4. The original is parsed.
+// Throws SceneError ("FILE:LINE: what is wrong"); returns the parsed table.
+inline toml::table parseToml(std::string_view text, const std::string& file) {
+  auto fail = [&](int line, const std::string& what) {
+    throw SceneError{file + ":" + std::to_string(line) + ": " + what};
+  };
+  auto invalid = [&](const toml::parse_error& e) {
+    fail(int(e.source().begin.line), "not valid TOML: " + std::string(e.description()));
+  };
+  // Decodes one UTF-8 sequence at text[i]; 0 and length 1 for a malformed one, which is left
+  // for toml++ to report.
+  auto decode = [&](std::size_t i, std::size_t& length) -> char32_t {
+    const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(text[k]); };
+    const unsigned char b0 = byte(i);
+    length = b0 >= 0xF0 ? 4 : b0 >= 0xE0 ? 3 : b0 >= 0xC0 ? 2 : 1;
+    if (length == 1 || i + length > text.size()) return length = 1, 0;
+    char32_t c = b0 & (0x7F >> length);
+    for (std::size_t k = 1; k < length; ++k) {
+      if ((byte(i + k) & 0xC0) != 0x80) return length = 1, 0;
+      c = (c << 6) | (byte(i + k) & 0x3F);
+    }
+    return c;
+  };
+  auto inGap = [](char32_t c) {
+    return (c >= 0xA1 && c <= 0x499) || (c >= 0x2C5E && c <= 0x2FFF) ||
+           (c >= 0x3001 && c <= 0x3057) || (c >= 0xFB26 && c <= 0xFEFE);
+  };
+  auto hex = [](char32_t c) {
+    char buffer[16];
+    std::snprintf(buffer, sizeof buffer, "U+%04X", unsigned(c));
+    return std::string(buffer);
+  };
+
+  std::string ascii;                                       // step 2's copy, one byte per character
+  std::vector<std::pair<std::size_t, char32_t>> replaced;  // (offset in ascii, character)
+  ascii.reserve(text.size());
+  for (std::size_t i = 0; i < text.size();) {
+    std::size_t length = 1;
+    const char32_t c = static_cast<unsigned char>(text[i]) < 0x80 ? 0 : decode(i, length);
+    if (c == 0) {
+      ascii += text[i];
+    } else {
+      replaced.emplace_back(ascii.size(), c);
+      ascii += '@';
+    }
+    i += length;
+  }
+  if (replaced.empty()) {
+    try {
+      return toml::parse(text, file);
+    } catch (const toml::parse_error& e) {
+      invalid(e);
+    }
+  }
+
+  try {
+    (void)toml::parse(ascii, file);
+  } catch (const toml::parse_error& e) {
+    // toml++ names the character it stopped at by line and column (1-based, one per byte in
+    // the copy); if that is a replaced one, name it.
+    std::size_t offset = 0;
+    for (std::size_t line = 1; line < e.source().begin.line && offset < ascii.size(); ++offset)
+      if (ascii[offset] == '\n') ++line;
+    offset += e.source().begin.column - 1;
+    for (const auto& [at, c] : replaced)
+      if (at == offset)
+        fail(int(e.source().begin.line),
+             "the character " + hex(c) +
+                 " is outside a string or comment (TOML allows only ASCII there)");
+    invalid(e);
+  }
+
+  // Step 3: a small scanner is enough now, the document being valid TOML.
   int line = 1;
-  for (std::size_t i = 0; i < text.size(); ++i) {
-    const char c = text[i];
-    const std::string_view rest = text.substr(i);
+  enum class In { kCode, kComment, kBasic, kLiteral, kMultiBasic, kMultiLiteral } in = In::kCode;
+  for (std::size_t i = 0; i < ascii.size(); ++i) {
+    const char c = ascii[i];
+    const std::string_view rest = std::string_view(ascii).substr(i);
     if (c == '\n') {
       ++line;
-      if (in == In::kComment || in == In::kBasic || in == In::kLiteral) in = In::kCode;
+      if (in == In::kComment) in = In::kCode;
       continue;
     }
     switch (in) {
       case In::kCode:
-        if (static_cast<unsigned char>(c) >= 0x80)
-          return std::to_string(line) +
-                 ": a character beyond ASCII outside a string or comment (allowed there: "
-                 "ASCII only)";
         if (c == '#') in = In::kComment;
-        // A quote opens a string only where a key or value may start; elsewhere (straight
-        // after a bare word or number) toml++ reads it as part of a malformed token, reading
-        // ahead to the next whitespace, so what follows stays code here too.
-        if ((c == '"' || c == '\'') && i > 0 &&
-            std::string_view(" \t\r\n=[,{.").find(text[i - 1]) == std::string_view::npos)
-          break;
-        if (rest.starts_with("\"\"\"")) {
-          in = In::kMultiBasic;
+        if (rest.starts_with("\"\"\"") || rest.starts_with("'''")) {
+          in = c == '"' ? In::kMultiBasic : In::kMultiLiteral;
           i += 2;
-        } else if (rest.starts_with("'''")) {
-          in = In::kMultiLiteral;
-          i += 2;
-        } else if (c == '"') {
-          in = In::kBasic;
-        } else if (c == '\'') {
-          in = In::kLiteral;
+        } else if (c == '"' || c == '\'') {
+          in = c == '"' ? In::kBasic : In::kLiteral;
         }
         break;
       case In::kComment:
@@ -308,20 +397,46 @@ inline std::string tomlAsciiError(std::string_view text) {
         if (c == '\'') in = In::kCode;
         break;
       case In::kMultiBasic:
-        if (c == '\\')
+        if (c == '\\' && i + 1 < ascii.size() &&
+            std::string_view(" \t\r\n").find(ascii[i + 1]) != std::string_view::npos) {
+          std::size_t k = i + 1;
+          for (; k < ascii.size() &&
+                 std::string_view(" \t\r\n").find(ascii[k]) != std::string_view::npos;
+               ++k)
+            if (ascii[k] == '\n') ++line;
+          for (const auto& [at, cp] : replaced)
+            if (at == k && inGap(cp))
+              fail(line, "the character " + hex(cp) +
+                             " straight after a line-ending backslash cannot be read by this "
+                             "build's TOML parser (toml++ 3.3); write it as \\u" +
+                             hex(cp).substr(2) + " there");
+          i = k - 1;
+        } else if (c == '\\') {
           ++i;
-        else if (rest.starts_with("\"\"\""))
+        } else if (rest.starts_with("\"\"\"")) {
+          // Up to two more quotes may close the string: """"" ends with the content "".
+          while (i + 3 < ascii.size() && ascii[i + 3] == '"') ++i;
           in = In::kCode, i += 2;
+        }
         break;
       case In::kMultiLiteral:
-        if (rest.starts_with("'''")) in = In::kCode, i += 2;
+        if (rest.starts_with("'''")) {
+          while (i + 3 < ascii.size() && ascii[i + 3] == '\'') ++i;
+          in = In::kCode, i += 2;
+        }
         break;
     }
   }
-  return "";
+  try {
+    return toml::parse(text, file);
+  } catch (const toml::parse_error& e) {
+    invalid(e);
+  }
+  return {};
 }
 
-// Reads a whole text file: only a regular file (a directory, FIFO or device is refused,
+// Reads a whole text file into `text`; on failure returns "cannot read WHAT 'path': reason".
+// Only a regular file (a directory, FIFO or device is refused,
 // never waited on) of at most Limits::kMaxTextFileBytes.
 inline std::string readTextFile(const std::string& path, const char* what, std::string& text) {
   auto failure = [&](const std::string& why) {

@@ -6,6 +6,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cstdio>
 #include <cstring>
@@ -88,9 +89,30 @@ std::optional<ImageFileFormat> imageFileFormatForPath(std::string_view path) {
 }
 
 Srgb8Image toSrgb8(const FloatImage& image) {
+  // The byte of each linear value through a table of the 255 thresholds between bytes: the
+  // same rounding as toByte(srgbEncode(v)), found by binary search instead of a pow.
+  static const std::array<float, 255> thresholds = [] {
+    std::array<float, 255> t{};
+    for (int b = 0; b < 255; ++b) {
+      // Smallest linear value encoding to byte b + 1 (bisection on the monotone encoder).
+      double lo = 0.0, hi = 1.0;
+      for (int k = 0; k < 60; ++k) {
+        const double mid = 0.5 * (lo + hi);
+        (toByte(srgbEncode(mid)) > b ? hi : lo) = mid;
+      }
+      t[b] = float(hi);
+    }
+    return t;
+  }();
   Srgb8Image out{image.width, image.height, false, std::vector<std::uint8_t>(image.rgba.size())};
   for (std::size_t i = 0; i < image.rgba.size(); i += 4) {
-    for (int c = 0; c < 3; ++c) out.rgba[i + c] = toByte(srgbEncode(image.rgba[i + c]));
+    for (int c = 0; c < 3; ++c) {
+      const float v = image.rgba[i + c];
+      out.rgba[i + c] = std::uint8_t(
+          v >= thresholds[0]
+              ? std::upper_bound(thresholds.begin(), thresholds.end(), v) - thresholds.begin()
+              : 0);
+    }
     out.rgba[i + 3] = toByte(image.rgba[i + 3]);
   }
   return out;
@@ -195,6 +217,45 @@ std::vector<std::uint8_t> packRaw(const Srgb8Image& image, bool colour, bool cov
     }
   }
   return out;
+}
+
+std::string writeMaskPng(const std::string& path, int width, int height,
+                         const std::vector<std::uint16_t>& values, const EncodeOptions& options) {
+  oiio::ImageSpec spec(width, height, 1, oiio::TypeDesc::UINT16);
+  spec.attribute("png:compressionLevel", std::clamp(options.png_compression, 0, 9));
+  return writeWithOiio(path, ImageFileFormat::kPng, spec, oiio::TypeDesc::UINT16, values.data(),
+                       sizeof(std::uint16_t), std::ptrdiff_t(width) * sizeof(std::uint16_t));
+}
+
+std::string writeExrPlanes(const std::string& path, int width, int height,
+                           const std::vector<ExrPlane>& planes,
+                           const std::vector<ImageAttribute>& attributes,
+                           const EncodeOptions& options) {
+  const int n = int(planes.size());
+  if (n == 0) return "cannot write '" + path + "': no channel to write";
+  oiio::ImageSpec spec(width, height, n, oiio::TypeDesc::FLOAT);
+  spec.channelnames.clear();
+  for (int c = 0; c < n; ++c) {
+    const std::string& name = planes[c].name;
+    const bool colour = name == "R" || name == "G" || name == "B" || name == "A";
+    spec.channelnames.push_back(name);
+    spec.channelformats.push_back(colour && options.exr_half ? oiio::TypeDesc::HALF
+                                                             : oiio::TypeDesc::FLOAT);
+    if (name == "A") spec.alpha_channel = c;
+  }
+  spec.attribute("compression", options.exr_compression);
+  spec.attribute("oiio:ColorSpace", "Linear");
+  for (const ImageAttribute& a : attributes) {
+    if (a.text.empty())
+      spec.attribute(a.name, float(a.number));
+    else
+      spec.attribute(a.name, a.text);
+  }
+  std::vector<float> pixels(std::size_t(width) * height * n);
+  for (std::size_t i = 0; i < std::size_t(width) * height; ++i)
+    for (int c = 0; c < n; ++c) pixels[i * n + c] = planes[c].data[i * planes[c].stride];
+  return writeWithOiio(path, ImageFileFormat::kExr, spec, oiio::TypeDesc::FLOAT, pixels.data(),
+                       n * sizeof(float), std::ptrdiff_t(width) * n * sizeof(float));
 }
 
 }  // namespace nephele

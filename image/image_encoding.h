@@ -33,6 +33,30 @@ std::string writeImageFile(const std::string& path, const FloatImage& image,
 std::string writeImageFile(const std::string& path, const Srgb8Image& image,
                            const EncodeOptions& options = {});
 
+// One 16-bit grey PNG (instance masks: the value is an id), rows top-down.
+std::string writeMaskPng(const std::string& path, int width, int height,
+                         const std::vector<std::uint16_t>& values,
+                         const EncodeOptions& options = {});
+
+// Named float planes as one EXR: `stride` floats between a plane's pixels, rows top-down.
+// Colour-like planes (R, G, B, A) follow options.exr_half; every other plane is 32-bit float,
+// since half floats cannot hold distances (65504 at most, 4 m steps at 5 km). `attributes`
+// become EXR header attributes (float when numeric).
+struct ExrPlane {
+  std::string name;
+  const float* data;
+  std::ptrdiff_t stride = 1;
+};
+struct ImageAttribute {
+  std::string name;
+  double number = 0.0;
+  std::string text;  // used when not empty
+};
+std::string writeExrPlanes(const std::string& path, int width, int height,
+                           const std::vector<ExrPlane>& planes,
+                           const std::vector<ImageAttribute>& attributes,
+                           const EncodeOptions& options = {});
+
 // In-memory images for the socket protocol. `colour` selects RGB and `coverage` the alpha;
 // each returns an empty string on success, else what went wrong. PNG takes any selection,
 // JPEG colour only; EXR is linear float (half unless options say otherwise).

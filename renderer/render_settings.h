@@ -66,6 +66,11 @@ struct RenderSettings {
   // Automaton clouds: the view march's step in lattice spacings (the lattice holds
   // samples_per_cell samples per cell edge). Larger steps are faster and blur thin edges.
   double volume_step = 1.0;
+
+  // Cloud depth (renderer/frame.h) is traced on the CPU, one ray per block of
+  // channel_divisor x channel_divisor pixels copied to the block: cost falls with its square,
+  // error grows at cloud edges.
+  int channel_divisor = 1;
 };
 
 // The CPU reference (MODEL.md section 7).
@@ -73,6 +78,7 @@ struct ReferenceSettings {
   int samples_per_axis = 4;   // supersampling grid per pixel
   int threads = 0;            // 0: one per hardware thread
   double heap_range_m = 0.0;  // as RenderSettings::heap_range_m
+  int label_divisor = 1;      // depth, cloud depth, object id: one centre ray per N x N block
 };
 
 }  // namespace nephele

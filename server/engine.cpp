@@ -299,7 +299,7 @@ void Engine::noteError(ErrorCode code) {
 }
 
 // A rendered view, before encoding.
-struct Frame {
+struct ViewFrame {
   Srgb8Image srgb;
   FloatImage linear;  // for EXR
   nlohmann::json meta;
@@ -308,7 +308,7 @@ struct Frame {
 namespace {
 
 // Encodes `frame` as `image` asks; on failure returns the error.
-std::variant<std::vector<std::uint8_t>, std::string> encodeFrame(const Frame& frame,
+std::variant<std::vector<std::uint8_t>, std::string> encodeFrame(const ViewFrame& frame,
                                                                  const ImageRequest& image,
                                                                  const EncodeOptions& options) {
   std::vector<std::uint8_t> bytes;
@@ -332,7 +332,7 @@ std::variant<std::vector<std::uint8_t>, std::string> encodeFrame(const Frame& fr
   return bytes;
 }
 
-json imageMeta(const Frame& frame, const ImageRequest& image) {
+json imageMeta(const ViewFrame& frame, const ImageRequest& image) {
   json meta = frame.meta;
   meta["format"] = imageFormatName(image.format);
   meta["channels"] = channelNames(image);
@@ -703,7 +703,7 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
     const ViewConfig* v = s.view(c->view);
     if (!v) return notFoundView(c->view);
     const ImageRequest image = c->image.value_or(v->image);
-    auto frame = std::make_shared<Frame>();
+    auto frame = std::make_shared<ViewFrame>();
     renderFrame(*v, image.format == ImageFormat::kExr, *frame);
     json meta = imageMeta(*frame, image);
     if (image.format == ImageFormat::kRaw) {
@@ -794,7 +794,7 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
   return ProtocolError{ErrorCode::kUnknownCommand, "unhandled command"};
 }
 
-void Engine::renderFrame(const ViewConfig& view, bool linear, Frame& frame) {
+void Engine::renderFrame(const ViewConfig& view, bool linear, ViewFrame& frame) {
   State& s = *state_;
   Scene scene = s.world->scene();
   scene.camera = view.camera;
@@ -865,7 +865,7 @@ void Engine::deliverFrames(bool only_due, const std::string& view_name) {
   for (auto& [name, subs] : by_view) {
     const ViewConfig* view = s.view(name);
     if (!view) continue;
-    std::shared_ptr<Frame> frames[2];  // 8-bit and linear
+    std::shared_ptr<ViewFrame> frames[2];  // 8-bit and linear
     std::vector<std::pair<ImageRequest, std::vector<Subscription*>>> groups;
     for (Subscription* sub : subs) {
       auto it = std::find_if(groups.begin(), groups.end(), [&](const auto& g) {
@@ -879,9 +879,9 @@ void Engine::deliverFrames(bool only_due, const std::string& view_name) {
     }
     for (auto& [image, members] : groups) {
       const bool linear = image.format == ImageFormat::kExr;
-      std::shared_ptr<Frame>& frame = frames[linear ? 1 : 0];
+      std::shared_ptr<ViewFrame>& frame = frames[linear ? 1 : 0];
       if (!frame) {
-        frame = std::make_shared<Frame>();
+        frame = std::make_shared<ViewFrame>();
         renderFrame(*view, linear, *frame);
       }
       std::vector<Subscription> sinks;  // copies: the encoder may run after a change
@@ -911,7 +911,7 @@ void Engine::renderTrigger() {
   State& s = *state_;
   const ViewConfig& view = *s.view(config_.modbus_view);
   const bool linear = config_.output_format == ImageFormat::kExr;
-  auto frame = std::make_shared<Frame>();
+  auto frame = std::make_shared<ViewFrame>();
   renderFrame(view, linear, *frame);
   const std::string extension = config_.output_format == ImageFormat::kPng    ? ".png"
                                 : config_.output_format == ImageFormat::kJpeg ? ".jpg"

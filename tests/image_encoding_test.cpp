@@ -109,4 +109,18 @@ TEST_F(ImageEncodingTest, FailuresLeaveNoFile) {
 }
 
 }  // namespace
+// toSrgb8 finds bytes in a table of thresholds; it must round as the formula does.
+TEST(ImageEncoding, TableSrgbEqualsTheFormula) {
+  FloatImage image{1000, 1, std::vector<float>(4000, 0.0f)};
+  for (int i = 0; i < 1000; ++i)
+    image.rgba[i * 4] = i < 990 ? float(std::pow(i / 989.0, 2.2)) * 1.01f : float(i - 995) * 0.5f;
+  image.rgba[4 * 999 + 1] = std::nanf("");
+  const Srgb8Image bytes = toSrgb8(image);
+  int differing = 0;
+  for (int i = 0; i < 1000; ++i)
+    for (int c = 0; c < 3; ++c)
+      differing += bytes.rgba[i * 4 + c] != toByte(srgbEncode(image.rgba[i * 4 + c]));
+  EXPECT_EQ(differing, 0);
+}
+
 }  // namespace nephele

@@ -65,6 +65,7 @@ using GlDepthMaskProc = void(APIENTRYP)(GLboolean flag);
   X(GlDrawArraysProc, DrawArrays)                                        \
   X(PFNGLPIXELSTOREIPROC, PixelStorei)                                   \
   X(PFNGLREADPIXELSPROC, ReadPixels)                                     \
+  X(PFNGLGETTEXTUREIMAGEPROC, GetTextureImage)                           \
   X(PFNGLFINISHPROC, Finish)                                             \
   X(GlDrawElementsProc, DrawElements)                                    \
   X(GlColorMaskProc, ColorMask)                                          \

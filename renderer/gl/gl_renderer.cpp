@@ -3,12 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <numbers>
 #include <sstream>
 #include <vector>
 
 #include "renderer/gl/sky_shaders.h"
 #include "renderer/gl/view_uniforms.h"
+#include "renderer/reference/reference_renderer.h"
 #include "world/check.h"
 #include "world/textures/layer_texture.h"
 #include "world/textures/texture_table.h"
@@ -175,6 +177,55 @@ FloatImage GlRenderer::renderFloat(const Scene& scene, const RenderSettings& set
     std::swap_ranges(image.rgba.begin() + y * row, image.rgba.begin() + (y + 1) * row,
                      image.rgba.begin() + (h - 1 - y) * row);
   return image;
+}
+
+Frame GlRenderer::renderFrame(const Scene& scene, const RenderSettings& settings,
+                              const FrameRequest& request) {
+  const Camera& camera = scene.camera;
+  const int w = camera.width, h = camera.height;
+  const std::size_t pixels = std::size_t(w) * h;
+  const ChannelSet& asked = request.channels;
+  Frame frame;
+  frame.info = frameInfo(camera, scene.time_s, request.tick);
+  frame.channels = asked;
+  const bool composite = asked.has(Channel::kColour) || asked.has(Channel::kCoverage) ||
+                         asked.has(Channel::kVisibility);
+  if (composite) frame.colour = renderFloat(scene, settings);
+  if (asked.has(Channel::kVisibility)) {
+    frame.visibility.resize(pixels);
+    for (std::size_t i = 0; i < pixels; ++i)
+      frame.visibility[i] = 1.0f - frame.colour.rgba[i * 4 + 3];
+  }
+  if (asked.has(Channel::kDepth) || asked.has(Channel::kObjectId)) {
+    // The composite pass drew the targets already; otherwise they are drawn alone.
+    std::vector<float> distance, id;
+    if (!scene.targets.empty() && (composite || targets_.draw(scene)))
+      targets_.read(&distance, &id);
+    const ViewBasis basis = viewBasis(camera);
+    if (asked.has(Channel::kDepth)) frame.depth.resize(pixels);
+    if (asked.has(Channel::kObjectId)) frame.object_id.resize(pixels);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const glm::dvec3 d = glm::normalize(rayDirection(basis, camera, x + 0.5, y + 0.5));
+        const double ground =
+            d.z < 0.0 ? camera.position.z / -d.z : std::numeric_limits<double>::infinity();
+        const std::size_t gl = std::size_t(h - 1 - y) * w + x;  // GL rows run bottom-up
+        const bool target = !distance.empty() && distance[gl] < 1e29f && distance[gl] < ground;
+        const std::size_t i = std::size_t(y) * w + x;
+        if (!frame.depth.empty()) frame.depth[i] = target ? distance[gl] : float(ground);
+        if (!frame.object_id.empty()) frame.object_id[i] = target ? id[gl] : 0.0f;
+      }
+  }
+  if (asked.has(Channel::kCloudDepth)) {
+    ReferenceSettings trace;
+    trace.samples_per_axis = 1;
+    trace.heap_range_m = settings.heap_range_m;
+    trace.label_divisor = settings.channel_divisor;
+    frame.cloud_depth =
+        renderReferenceFrame(scene, trace, {ChannelSet{Channel::kCloudDepth}, request.tick})
+            .cloud_depth;
+  }
+  return frame;
 }
 
 Srgb8Image GlRenderer::renderSrgb8(const Scene& scene, const RenderSettings& settings) {

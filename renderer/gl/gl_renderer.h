@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "image/image.h"
+#include "renderer/frame.h"
 #include "renderer/gl/automaton_renderer.h"
 #include "renderer/gl/ellipsoid_renderer.h"
 #include "renderer/gl/frame_stats.h"
@@ -29,6 +30,11 @@ class GlRenderer {
 
   // Linear float RGB plus coverage (for EXR and for measuring error).
   FloatImage renderFloat(const Scene& scene, const RenderSettings& settings);
+  // The channels `request` asks for (renderer/frame.h): colour, coverage and visibility from
+  // the composited frame, depth and object id from the target pass and the ground plane, cloud
+  // depth traced on the CPU (RenderSettings::channel_divisor).
+  Frame renderFrame(const Scene& scene, const RenderSettings& settings,
+                    const FrameRequest& request);
   // sRGB-encoded bytes, rows bottom-up as GL reads them (PNG, JPEG, TIFF).
   Srgb8Image renderSrgb8(const Scene& scene, const RenderSettings& settings);
 

@@ -36,6 +36,8 @@ void main() {
 
 const char* kFragment = R"(
 layout(location = 1) out float o_distance;
+layout(location = 2) out float o_id;
+uniform float u_id;             // 1 + the target's index
 uniform vec3 u_albedo;          // colour times sun colour
 uniform vec3 u_to_sun;
 uniform int u_smooth;           // 1: analytic ellipsoid normals, 0: facet normals
@@ -51,6 +53,7 @@ void main() {
   float distance = length(v_position);
   o_colour = vec4(applyFog(colour, v_position / distance, distance), 1.0);
   o_distance = distance;
+  o_id = u_id;
 }
 )";
 
@@ -73,20 +76,23 @@ void TargetRenderer::prepare(int width, int height) {
   framebuffer_ = createFramebuffer(gl_);
   colour_ = createTexture(gl_, GL_TEXTURE_2D);
   distance_ = createTexture(gl_, GL_TEXTURE_2D);
+  id_ = createTexture(gl_, GL_TEXTURE_2D);
   depth_ = createRenderbuffer(gl_);
   gl_.TextureStorage2D(colour_.get(), 1, GL_RGBA16F, width, height);
   gl_.TextureStorage2D(distance_.get(), 1, GL_R32F, width, height);
+  gl_.TextureStorage2D(id_.get(), 1, GL_R32F, width, height);
   gl_.NamedRenderbufferStorage(depth_.get(), GL_DEPTH_COMPONENT32F, width, height);
-  for (GLuint t : {colour_.get(), distance_.get()}) {
+  for (GLuint t : {colour_.get(), distance_.get(), id_.get()}) {
     gl_.TextureParameteri(t, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     gl_.TextureParameteri(t, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
   }
   const GLuint f = framebuffer_.get();
   gl_.NamedFramebufferTexture(f, GL_COLOR_ATTACHMENT0, colour_.get(), 0);
   gl_.NamedFramebufferTexture(f, GL_COLOR_ATTACHMENT1, distance_.get(), 0);
+  gl_.NamedFramebufferTexture(f, GL_COLOR_ATTACHMENT2, id_.get(), 0);
   gl_.NamedFramebufferRenderbuffer(f, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_.get());
-  const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-  gl_.NamedFramebufferDrawBuffers(f, 2, buffers);
+  const GLenum buffers[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
+  gl_.NamedFramebufferDrawBuffers(f, 3, buffers);
   const GLenum status = gl_.CheckNamedFramebufferStatus(f, GL_FRAMEBUFFER);
   NEPHELE_CHECK(status == GL_FRAMEBUFFER_COMPLETE, "target framebuffer 0x" << std::hex << status);
   width_ = width;
@@ -124,6 +130,7 @@ bool TargetRenderer::draw(const Scene& scene) {
   const float nearest_depth = 0.0f;
   gl_.ClearNamedFramebufferfv(f, GL_COLOR, 0, clear_colour);
   gl_.ClearNamedFramebufferfv(f, GL_COLOR, 1, far_distance);
+  gl_.ClearNamedFramebufferfv(f, GL_COLOR, 2, clear_colour);
   gl_.ClearNamedFramebufferfv(f, GL_DEPTH, 0, &nearest_depth);
   gl_.BindFramebuffer(GL_FRAMEBUFFER, f);
   gl_.Viewport(0, 0, camera.width, camera.height);
@@ -140,8 +147,10 @@ bool TargetRenderer::draw(const Scene& scene) {
   setUniform3(gl_, p, "u_clip_y", basis.up / basis.tan_half_vfov);
   setUniform3(gl_, p, "u_clip_w", basis.forward);
   setUniform3(gl_, p, "u_to_sun", sunDirection(scene.sun));
-  for (const Target& target : scene.targets) {
+  for (std::size_t t = 0; t < scene.targets.size(); ++t) {
+    const Target& target = scene.targets[t];
     if (target.shape == TargetShape::kMesh && !target.mesh) continue;
+    gl_.ProgramUniform1f(p, gl_.GetUniformLocation(p, "u_id"), float(t + 1));
     const glm::dmat3 rotation = bodyToWorld(target.orientation);
     const glm::mat3 model(
         rotation * glm::dmat3(target.size.x, 0, 0, 0, target.size.y, 0, 0, 0, target.size.z));
@@ -164,6 +173,16 @@ bool TargetRenderer::draw(const Scene& scene) {
   gl_.BindTextureUnit(kTargetColourUnit, colour_.get());
   gl_.BindTextureUnit(kTargetDistanceUnit, distance_.get());
   return true;
+}
+
+void TargetRenderer::read(std::vector<float>* distance, std::vector<float>* id) const {
+  const GLsizei bytes = GLsizei(std::size_t(width_) * height_ * sizeof(float));
+  gl_.PixelStorei(GL_PACK_ALIGNMENT, 4);
+  for (auto [plane, texture] : {std::pair{distance, distance_.get()}, std::pair{id, id_.get()}}) {
+    if (!plane) continue;
+    plane->resize(std::size_t(width_) * height_);
+    gl_.GetTextureImage(texture, 0, GL_RED, GL_FLOAT, bytes, plane->data());
+  }
 }
 
 }  // namespace nephele

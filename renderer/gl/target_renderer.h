@@ -3,6 +3,7 @@
 // and distance textures, which every later pass reads per pixel, so clouds hide targets and
 // targets hide clouds pixel by pixel.
 #include <map>
+#include <vector>
 
 #include "renderer/gl/gl_objects.h"
 #include "world/scene.h"
@@ -18,6 +19,9 @@ class TargetRenderer {
   // unit view ray (1e30 where none) to the view chunk's texture units. A scene without
   // targets draws nothing and returns false.
   bool draw(const Scene& scene);
+  // After draw: the distance along each pixel's unit view ray to the nearest target (1e30 where
+  // none) and 1 + that target's index (0 where none), rows bottom-up as GL stores them.
+  void read(std::vector<float>* distance, std::vector<float>* id) const;
 
  private:
   void prepare(int width, int height);
@@ -25,7 +29,7 @@ class TargetRenderer {
   GLuint program();
 
   const GlApi& gl_;
-  GlObject framebuffer_, colour_, distance_, depth_;
+  GlObject framebuffer_, colour_, distance_, id_, depth_;
   int width_ = 0, height_ = 0;
   GlObject program_;
   std::map<const void*, IndexedMesh> meshes_;  // by shape tag or TriangleMesh

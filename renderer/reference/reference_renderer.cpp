@@ -40,6 +40,17 @@ struct Surface {
   double distance;
   glm::dvec3 colour;
   double alpha;  // 1 - TR
+  // Where the surface's own opacity is reached: its distance, except for a volume, whose
+  // march puts it where the volume's transmittance first falls to 1/2 (or, for a thinner
+  // volume, to half its own opacity).
+  double half_distance;
+};
+
+// What one ray's centre sample shows besides colour (renderer/frame.h).
+struct RayLabels {
+  double depth = kInfinity;
+  double cloud_depth = kInfinity;
+  int object_id = 0;
 };
 
 struct EllipsoidEntry {
@@ -69,15 +80,21 @@ class ReferenceTracer {
         scene.camera.position, scene.sun);
   }
 
-  // Colour and coverage along one ray (unit direction).
-  glm::dvec4 trace(glm::dvec3 direction, std::vector<Surface>& surfaces) const {
+  // Colour and coverage along one ray (unit direction); the ray's labels if asked.
+  // Surfaces beyond `max_distance` are left out.
+  glm::dvec4 trace(glm::dvec3 direction, std::vector<Surface>& surfaces,
+                   RayLabels* labels = nullptr, double max_distance = kInfinity) const {
     const glm::dvec3 eye = scene_.camera.position;
-    double nearest_opaque = direction.z < 0.0 ? eye.z / -direction.z : kInfinity;
+    double nearest_opaque =
+        std::min(direction.z < 0.0 ? eye.z / -direction.z : kInfinity, max_distance);
     glm::dvec3 colour = skyBackground(scene_.sky, direction);
-    for (const Target& target : scene_.targets) {
+    int object_id = 0;
+    for (std::size_t t = 0; t < scene_.targets.size(); ++t) {
+      const Target& target = scene_.targets[t];
       const auto hit = intersectTarget(target, eye, direction);
       if (!hit || hit->distance >= nearest_opaque) continue;
       nearest_opaque = hit->distance;
+      object_id = int(t) + 1;
       colour = targetRadiance(target, hit->normal, sun_, -direction, scene_.sun);
     }
     colour = withFog(colour, direction, nearest_opaque);
@@ -107,6 +124,18 @@ class ReferenceTracer {
     // The in-cloud veil sits at the eye, in front of everything.
     colour = veil_.opacity * veil_.colour + (1.0 - veil_.opacity) * colour;
     translucence_product *= 1.0 - veil_.opacity;
+    if (labels) {
+      labels->depth = nearest_opaque;
+      labels->object_id = object_id;
+      labels->cloud_depth = kInfinity;
+      // Front to back: the first surface after which the cloud opacity is 1/2 or more.
+      double transmittance = 1.0 - veil_.opacity;
+      if (transmittance <= 0.5) labels->cloud_depth = 0.0;
+      for (auto s = surfaces.rbegin(); s != surfaces.rend() && transmittance > 0.5; ++s) {
+        transmittance *= 1.0 - s->alpha;
+        if (transmittance <= 0.5) labels->cloud_depth = s->half_distance;
+      }
+    }
     return {colour, 1.0 - translucence_product};
   }
 
@@ -124,7 +153,7 @@ class ReferenceTracer {
         layer.far.side_ratio > 0.0
             ? gardnerIntensity(layer.shading, sphereDiffuse(glm::dot(sun_, -direction)), 0.0, t)
             : gardnerIntensity(layer.shading, t, {0.0, 0.0, 1.0}, sun_, -direction);
-    return {s, withFog(intensity * layer.colour * scene_.sun.colour, direction, s), 1.0 - tr};
+    return {s, withFog(intensity * layer.colour * scene_.sun.colour, direction, s), 1.0 - tr, s};
   }
 
   Surface ellipsoidSurface(const EllipsoidEntry& entry, glm::dvec3 direction, double s) const {
@@ -136,7 +165,7 @@ class ReferenceTracer {
     const double intensity =
         gardnerIntensity(cloud.shading, t, entry.view.normalAt(direction, s), sun_, -direction);
     return {s, withFog(intensity * cloud.colour * scene_.sun.colour, direction, s),
-            (1.0 - tr) * entry.fade};
+            (1.0 - tr) * entry.fade, s};
   }
 
   // An automaton cloud along the ray, as one surface at the ray's entry into its box: MODEL.md
@@ -168,10 +197,13 @@ class ReferenceTracer {
     };
     double rho_a, lit_a;
     sample(enter, rho_a, lit_a);
+    thread_local std::vector<std::pair<double, double>> profile;  // (distance, transmittance)
+    profile.clear();
     for (int i = 1; i <= steps && transmittance > 1e-7; ++i) {
       double rho_b, lit_b;
       sample(enter + i * ds, rho_b, lit_b);
       const double segment = segmentTransmittance(rho_a, rho_b, ds);
+      profile.emplace_back(enter + i * ds, transmittance * segment);
       // Source constant over the step (the mean of its ends); exact attenuation within it.
       const double source = 0.5 * (lit_a + lit_b);
       radiance += transmittance * (1.0 - segment) * source * light;
@@ -181,7 +213,13 @@ class ReferenceTracer {
     }
     const double alpha = 1.0 - transmittance;
     if (alpha <= 0.0) return std::nullopt;
-    return Surface{enter, withFog(radiance / alpha, direction, enter), alpha};
+    double half = enter;
+    for (const auto& [s, t] : profile)
+      if (1.0 - t >= std::min(0.5, 0.5 * alpha)) {
+        half = s;
+        break;
+      }
+    return Surface{enter, withFog(radiance / alpha, direction, enter), alpha, half};
   }
 
   // Optical depth from p out of the cloud's box along the unit direction `towards`.
@@ -217,37 +255,69 @@ class ReferenceTracer {
 
 }  // namespace
 
-FloatImage renderReference(const Scene& scene, const ReferenceSettings& settings,
+Frame renderReferenceFrame(const Scene& scene, const ReferenceSettings& settings,
+                           const FrameRequest& request,
                            const std::function<void(double)>& progress) {
   const Camera& camera = scene.camera;
-  FloatImage image{camera.width, camera.height,
-                   std::vector<float>(std::size_t(camera.width) * camera.height * 4)};
+  const std::size_t pixels = std::size_t(camera.width) * camera.height;
+  const ChannelSet& asked = request.channels;
+  Frame frame;
+  frame.info = frameInfo(camera, scene.time_s, request.tick);
+  frame.channels = asked;
+  const bool colour = asked.has(Channel::kColour) || asked.has(Channel::kCoverage) ||
+                      asked.has(Channel::kVisibility);
+  const bool labels = asked.has(Channel::kDepth) || asked.has(Channel::kCloudDepth) ||
+                      asked.has(Channel::kObjectId);
+  if (colour) frame.colour = {camera.width, camera.height, std::vector<float>(pixels * 4)};
+  if (asked.has(Channel::kDepth)) frame.depth.resize(pixels);
+  if (asked.has(Channel::kCloudDepth)) frame.cloud_depth.resize(pixels);
+  if (asked.has(Channel::kObjectId)) frame.object_id.resize(pixels);
+
   const Scene with_fields =
       scene.fields.empty() ? Scene{} : withFieldClouds(scene, settings.heap_range_m);
   const ReferenceTracer tracer(scene.fields.empty() ? scene : with_fields);
   const ViewBasis basis = viewBasis(camera);
   const int n = std::max(1, settings.samples_per_axis);
+  const int divisor = std::max(1, settings.label_divisor);
 
   std::atomic<int> next_row{0};
   auto work = [&](bool report) {
     std::vector<Surface> hits;
     int reported_tenths = 0;
     for (int y; (y = next_row.fetch_add(1)) < camera.height;) {
+      if (!colour && y % divisor != 0) continue;
       if (report && progress && y * 10 / camera.height > reported_tenths) {
         reported_tenths = y * 10 / camera.height;
         progress(double(y) / camera.height);
       }
       for (int x = 0; x < camera.width; ++x) {
-        glm::dvec4 sum(0.0);
-        for (int sy = 0; sy < n; ++sy)
-          for (int sx = 0; sx < n; ++sx) {
-            const glm::dvec3 d =
-                glm::normalize(rayDirection(basis, camera, x + (sx + 0.5) / n, y + (sy + 0.5) / n));
-            sum += tracer.trace(d, hits);
-          }
-        const glm::dvec4 mean = sum / double(n * n);
-        float* out = image.pixel(x, y);
-        for (int c = 0; c < 4; ++c) out[c] = float(mean[c]);
+        const std::size_t i = std::size_t(y) * camera.width + x;
+        if (colour) {
+          glm::dvec4 sum(0.0);
+          for (int sy = 0; sy < n; ++sy)
+            for (int sx = 0; sx < n; ++sx) {
+              const glm::dvec3 d = glm::normalize(
+                  rayDirection(basis, camera, x + (sx + 0.5) / n, y + (sy + 0.5) / n));
+              sum += tracer.trace(d, hits);
+            }
+          const glm::dvec4 mean = sum / double(n * n);
+          for (int c = 0; c < 4; ++c) frame.colour.rgba[i * 4 + c] = float(mean[c]);
+        }
+        if (labels && x % divisor == 0 && y % divisor == 0) {
+          // Labels come from the pixel's centre ray, as a rasteriser samples them, or from
+          // the centre ray of a divisor x divisor block, copied to the block.
+          RayLabels ray;
+          tracer.trace(
+              glm::normalize(rayDirection(basis, camera, x + 0.5 * divisor, y + 0.5 * divisor)),
+              hits, &ray);
+          for (int by = y; by < std::min(y + divisor, camera.height); ++by)
+            for (int bx = x; bx < std::min(x + divisor, camera.width); ++bx) {
+              const std::size_t i = std::size_t(by) * camera.width + bx;
+              if (!frame.depth.empty()) frame.depth[i] = float(ray.depth);
+              if (!frame.cloud_depth.empty()) frame.cloud_depth[i] = float(ray.cloud_depth);
+              if (!frame.object_id.empty()) frame.object_id[i] = float(ray.object_id);
+            }
+        }
       }
     }
   };
@@ -256,8 +326,36 @@ FloatImage renderReference(const Scene& scene, const ReferenceSettings& settings
   std::vector<std::jthread> pool;
   for (int i = 1; i < threads; ++i) pool.emplace_back(work, false);
   work(true);
-  pool.clear();  // join before the image is handed out
-  return image;
+  pool.clear();  // join before the frame is handed out
+  if (asked.has(Channel::kVisibility)) {
+    frame.visibility.resize(pixels);
+    for (std::size_t i = 0; i < pixels; ++i)
+      frame.visibility[i] = 1.0f - frame.colour.rgba[i * 4 + 3];
+  }
+  return frame;
+}
+
+struct CloudProbe::State {
+  Scene scene;
+  ReferenceTracer tracer;
+  State(Scene s) : scene(std::move(s)), tracer(scene) {}
+};
+
+CloudProbe::CloudProbe(const Scene& scene, double heap_range_m)
+    : state_(std::make_unique<State>(scene.fields.empty() ? scene
+                                                          : withFieldClouds(scene, heap_range_m))) {
+  state_->scene.targets.clear();
+}
+CloudProbe::~CloudProbe() = default;
+
+double CloudProbe::transmittance(glm::dvec3 direction, double distance) const {
+  std::vector<Surface> surfaces;
+  return 1.0 - state_->tracer.trace(glm::normalize(direction), surfaces, nullptr, distance).w;
+}
+
+FloatImage renderReference(const Scene& scene, const ReferenceSettings& settings,
+                           const std::function<void(double)>& progress) {
+  return renderReferenceFrame(scene, settings, {}, progress).colour;
 }
 
 }  // namespace nephele

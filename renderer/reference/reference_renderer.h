@@ -3,8 +3,10 @@
 // texture term, exact ray-ellipsoid hits and limb function, per-pixel depth order,
 // supersampled. Slow and simple enough to trust.
 #include <functional>
+#include <memory>
 
 #include "image/image.h"
+#include "renderer/frame.h"
 #include "renderer/render_settings.h"
 #include "world/scene.h"
 
@@ -14,5 +16,26 @@ namespace nephele {
 // about every tenth of the image.
 FloatImage renderReference(const Scene& scene, const ReferenceSettings& settings = {},
                            const std::function<void(double)>& progress = {});
+
+// Every channel of renderer/frame.h that `request` asks for. Colour and coverage (and
+// visibility, 1 - coverage) are supersampled; depth, cloud depth and object id come from each
+// pixel's centre ray, where a rasteriser samples them.
+Frame renderReferenceFrame(const Scene& scene, const ReferenceSettings& settings,
+                           const FrameRequest& request,
+                           const std::function<void(double)>& progress = {});
+
+// Cloud transmittance along rays from the scene's camera up to a distance, as the reference
+// composites it: how the dataset generator places targets behind cloud or in the clear. The
+// scene's clouds (and its fields' heaps) are prepared once; its targets are ignored.
+class CloudProbe {
+ public:
+  explicit CloudProbe(const Scene& scene, double heap_range_m = 0.0);
+  ~CloudProbe();
+  double transmittance(glm::dvec3 direction, double distance) const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
 
 }  // namespace nephele

@@ -1,0 +1,139 @@
+#pragma once
+// A rendered frame: named channels, each computed only when asked for, and the camera and
+// clock it was rendered from (docs/DATASETS.md, "Channels").
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "image/image.h"
+#include "world/frames.h"
+
+namespace nephele {
+
+enum class Channel : std::uint8_t {
+  kColour,      // linear RGB (sRGB when encoded to 8 bits)
+  kCoverage,    // cloud opacity 1 - prod(1 - alpha): clouds only, never targets or ground
+  kDepth,       // metres along the ray to the first opaque surface (ground, target); inf: sky
+  kCloudDepth,  // metres along the ray where cloud opacity, front to back, first reaches 1/2
+  kObjectId,    // 1 + the index of the target covering the pixel, clouds ignored; 0: none
+  kVisibility,  // transmittance of the clouds in front of the first opaque surface
+};
+
+struct ChannelInfo {
+  Channel channel;
+  const char* name;  // as the CLI, the protocol and EXR layers spell it
+};
+inline constexpr std::array<ChannelInfo, 6> kChannels{{
+    {Channel::kColour, "colour"},
+    {Channel::kCoverage, "coverage"},
+    {Channel::kDepth, "depth"},
+    {Channel::kCloudDepth, "cloud_depth"},
+    {Channel::kObjectId, "object_id"},
+    {Channel::kVisibility, "visibility"},
+}};
+
+inline const char* channelName(Channel c) {
+  return kChannels[std::size_t(c)].name;
+}
+inline std::optional<Channel> channelFromName(std::string_view name) {
+  for (const ChannelInfo& info : kChannels)
+    if (name == info.name) return info.channel;
+  return std::nullopt;
+}
+inline std::string channelNames() {
+  std::string out;
+  for (const ChannelInfo& info : kChannels)
+    out += (out.empty() ? "" : ", ") + std::string(info.name);
+  return out;
+}
+
+// A set of channels.
+class ChannelSet {
+ public:
+  ChannelSet() = default;
+  ChannelSet(std::initializer_list<Channel> channels) {
+    for (Channel c : channels) add(c);
+  }
+  static ChannelSet all() { return ChannelSet(0x3F); }
+  void add(Channel c) { bits_ |= 1u << unsigned(c); }
+  bool has(Channel c) const { return bits_ & (1u << unsigned(c)); }
+  bool empty() const { return bits_ == 0; }
+  bool operator==(const ChannelSet&) const = default;
+
+ private:
+  explicit ChannelSet(unsigned bits) : bits_(bits) {}
+  unsigned bits_ = 0;
+};
+
+// Where a frame was seen from: the pose, the pinhole intrinsics and the clock.
+struct FrameInfo {
+  glm::dvec3 position{0.0};
+  Orientation orientation;
+  double vfov_deg = 60.0;
+  int width = 0, height = 0;
+  // Pinhole intrinsics in pixels, origin at the top-left corner of the top-left pixel, x right,
+  // y down: a point at camera coordinates (right, down, forward) = (X, Y, Z) images at
+  // (fx X / Z + cx, fy Y / Z + cy). Square pixels: fx = fy.
+  double focal_px = 0.0;
+  double cx = 0.0, cy = 0.0;
+  double time_s = 0.0;
+  std::uint64_t tick = 0;
+};
+
+inline FrameInfo frameInfo(const Camera& camera, double time_s, std::uint64_t tick = 0) {
+  FrameInfo info;
+  info.position = camera.position;
+  info.orientation = camera.orientation;
+  info.vfov_deg = camera.vfov_deg;
+  info.width = camera.width;
+  info.height = camera.height;
+  info.focal_px = 0.5 * camera.height / std::tan(0.5 * glm::radians(camera.vfov_deg));
+  info.cx = 0.5 * camera.width;
+  info.cy = 0.5 * camera.height;
+  info.time_s = time_s;
+  info.tick = tick;
+  return info;
+}
+
+// One frame. Rows run top to bottom; planes hold one float per pixel and are empty unless
+// their channel was asked for.
+struct Frame {
+  FrameInfo info;
+  ChannelSet channels;
+  FloatImage colour;  // RGB and coverage as alpha: present for colour or coverage
+  std::vector<float> depth, cloud_depth, object_id, visibility;
+
+  int width() const { return info.width; }
+  int height() const { return info.height; }
+  // The single-float plane of a channel (coverage is copied out of colour's alpha).
+  std::vector<float> plane(Channel c) const {
+    switch (c) {
+      case Channel::kDepth:
+        return depth;
+      case Channel::kCloudDepth:
+        return cloud_depth;
+      case Channel::kObjectId:
+        return object_id;
+      case Channel::kVisibility:
+        return visibility;
+      case Channel::kCoverage:
+      case Channel::kColour: {
+        std::vector<float> alpha(colour.rgba.size() / 4);
+        for (std::size_t i = 0; i < alpha.size(); ++i) alpha[i] = colour.rgba[i * 4 + 3];
+        return alpha;
+      }
+    }
+    return {};
+  }
+};
+
+// What a render is asked for beyond the scene.
+struct FrameRequest {
+  ChannelSet channels{Channel::kColour, Channel::kCoverage};
+  std::uint64_t tick = 0;
+};
+
+}  // namespace nephele

@@ -1,0 +1,97 @@
+#include "renderer/renderer.h"
+
+#include "renderer/gl/gl_renderer.h"
+#include "renderer/reference/reference_renderer.h"
+
+namespace nephele {
+namespace {
+
+class GlBackendRenderer final : public Renderer {
+ public:
+  GlBackendRenderer(std::unique_ptr<GlPlatform> platform, const RenderSettings& settings)
+      : platform_(std::move(platform)), gl_(*platform_), settings_(settings) {}
+  Frame render(const Scene& scene, const FrameRequest& request) override {
+    return gl_.renderFrame(scene, settings_, request);
+  }
+  Srgb8Image renderSrgb8(const Scene& scene) override { return gl_.renderSrgb8(scene, settings_); }
+  std::string reserve(int width, int height, bool linear) override {
+    return gl_.reserveTarget(width, height, linear);
+  }
+  std::string statsLine() const override { return gl_.lastFrameStats().line(); }
+  std::string description() const override {
+    return "gl: " + std::string(platform_->backendName()) + ", OpenGL " + platform_->version() +
+           ", GL_RENDERER " + platform_->renderer();
+  }
+
+ private:
+  std::unique_ptr<GlPlatform> platform_;
+  GlRenderer gl_;
+  RenderSettings settings_;
+};
+
+class ReferenceBackendRenderer final : public Renderer {
+ public:
+  explicit ReferenceBackendRenderer(const ReferenceSettings& settings) : settings_(settings) {}
+  Frame render(const Scene& scene, const FrameRequest& request) override {
+    return renderReferenceFrame(scene, settings_, request, progress_);
+  }
+  Srgb8Image renderSrgb8(const Scene& scene) override {
+    return toSrgb8(renderReferenceFrame(scene, settings_, {}, progress_).colour);
+  }
+  std::string reserve(int, int, bool) override { return ""; }
+  std::string description() const override {
+    const std::string n = std::to_string(settings_.samples_per_axis);
+    return "reference: " + n + "x" + n + " samples per pixel";
+  }
+
+ private:
+  ReferenceSettings settings_;
+};
+
+}  // namespace
+
+std::unique_ptr<Renderer> createRenderer(const RendererOptions& options, std::string& error) {
+  if (options.kind == RendererKind::kReference)
+    return std::make_unique<ReferenceBackendRenderer>(options.reference);
+  std::unique_ptr<GlPlatform> platform = createGlPlatform(options.gl_backend, error);
+  if (!platform) return nullptr;
+  return std::make_unique<GlBackendRenderer>(std::move(platform), options.render);
+}
+
+std::vector<ImageAttribute> frameAttributes(const FrameInfo& info) {
+  return {
+      {"nephele:position_x", info.position.x, ""},
+      {"nephele:position_y", info.position.y, ""},
+      {"nephele:position_z", info.position.z, ""},
+      {"nephele:heading_deg", info.orientation.heading_deg, ""},
+      {"nephele:pitch_deg", info.orientation.pitch_deg, ""},
+      {"nephele:roll_deg", info.orientation.roll_deg, ""},
+      {"nephele:vfov_deg", info.vfov_deg, ""},
+      {"nephele:focal_px", info.focal_px, ""},
+      {"nephele:cx", info.cx, ""},
+      {"nephele:cy", info.cy, ""},
+      {"nephele:time_s", info.time_s, ""},
+      {"nephele:tick", 0.0, std::to_string(info.tick)},
+  };
+}
+
+std::string writeFrameExr(const std::string& path, const Frame& frame,
+                          const EncodeOptions& options) {
+  std::vector<ExrPlane> planes;
+  const ChannelSet& c = frame.channels;
+  const float* rgba = frame.colour.rgba.data();
+  if (c.has(Channel::kColour))
+    for (int k = 0; k < 3; ++k) planes.push_back({std::string(1, "RGB"[k]), rgba + k, 4});
+  if (c.has(Channel::kCoverage)) planes.push_back({"A", rgba + 3, 4});
+  const std::pair<Channel, const std::vector<float>*> singles[] = {
+      {Channel::kDepth, &frame.depth},
+      {Channel::kCloudDepth, &frame.cloud_depth},
+      {Channel::kObjectId, &frame.object_id},
+      {Channel::kVisibility, &frame.visibility}};
+  for (const auto& [channel, plane] : singles)
+    if (c.has(channel)) planes.push_back({channelName(channel), plane->data(), 1});
+  return writeExrPlanes(path, frame.width(), frame.height(), planes, frameAttributes(frame.info),
+                        options);
+}
+
+}  // namespace nephele
