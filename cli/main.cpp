@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/bench_command.h"
+#include "cli/dataset_command.h"
 #include "cli/render_command.h"
 #include "server/serve_command.h"
 
@@ -24,11 +25,14 @@ int main(int argc, char** argv) {
   nephele::addServeCommand(app, serve);
   nephele::BenchCommandOptions bench;
   nephele::addBenchCommand(app, bench);
+  nephele::DatasetCommandOptions dataset;
+  nephele::addDatasetCommand(app, dataset);
 
   CLI11_PARSE(app, argc, argv);
   spdlog::set_level(spdlog::level::from_str(log_level));
   if (app.got_subcommand("render")) return nephele::runRenderCommand(render);
   if (app.got_subcommand("serve")) return nephele::runServeCommand(serve);
   if (app.got_subcommand("bench")) return nephele::runBenchCommand(bench);
+  if (app.got_subcommand("dataset")) return nephele::runDatasetCommand(dataset);
   return 2;
 }

@@ -219,12 +219,24 @@ std::vector<std::uint8_t> packRaw(const Srgb8Image& image, bool colour, bool cov
   return out;
 }
 
-std::string writeMaskPng(const std::string& path, int width, int height,
-                         const std::vector<std::uint16_t>& values, const EncodeOptions& options) {
+oiio::ImageSpec maskSpec(int width, int height, const EncodeOptions& options) {
   oiio::ImageSpec spec(width, height, 1, oiio::TypeDesc::UINT16);
   spec.attribute("png:compressionLevel", std::clamp(options.png_compression, 0, 9));
-  return writeWithOiio(path, ImageFileFormat::kPng, spec, oiio::TypeDesc::UINT16, values.data(),
-                       sizeof(std::uint16_t), std::ptrdiff_t(width) * sizeof(std::uint16_t));
+  return spec;
+}
+
+std::string encodeMaskPng(int width, int height, const std::vector<std::uint16_t>& values,
+                          const EncodeOptions& options, std::vector<std::uint8_t>& out) {
+  return encodeWithOiio(".png", maskSpec(width, height, options), oiio::TypeDesc::UINT16,
+                        values.data(), sizeof(std::uint16_t),
+                        std::ptrdiff_t(width) * sizeof(std::uint16_t), out);
+}
+
+std::string writeMaskPng(const std::string& path, int width, int height,
+                         const std::vector<std::uint16_t>& values, const EncodeOptions& options) {
+  return writeWithOiio(path, ImageFileFormat::kPng, maskSpec(width, height, options),
+                       oiio::TypeDesc::UINT16, values.data(), sizeof(std::uint16_t),
+                       std::ptrdiff_t(width) * sizeof(std::uint16_t));
 }
 
 std::string writeExrPlanes(const std::string& path, int width, int height,

@@ -33,7 +33,10 @@ std::string writeImageFile(const std::string& path, const FloatImage& image,
 std::string writeImageFile(const std::string& path, const Srgb8Image& image,
                            const EncodeOptions& options = {});
 
-// One 16-bit grey PNG (instance masks: the value is an id), rows top-down.
+// One 16-bit grey PNG (instance masks: the value is an id), rows top-down; in memory or as a
+// file.
+std::string encodeMaskPng(int width, int height, const std::vector<std::uint16_t>& values,
+                          const EncodeOptions& options, std::vector<std::uint8_t>& out);
 std::string writeMaskPng(const std::string& path, int width, int height,
                          const std::vector<std::uint16_t>& values,
                          const EncodeOptions& options = {});

@@ -1,5 +1,8 @@
 #include "renderer/renderer.h"
 
+#include <algorithm>
+#include <ctime>
+
 #include "renderer/gl/gl_renderer.h"
 #include "renderer/reference/reference_renderer.h"
 
@@ -59,7 +62,15 @@ std::unique_ptr<Renderer> createRenderer(const RendererOptions& options, std::st
 }
 
 std::vector<ImageAttribute> frameAttributes(const FrameInfo& info) {
+  // DateTime is the simulation clock counted from the Unix epoch, not the wall clock: a frame
+  // rendered twice is the same file.
+  const std::time_t seconds = std::time_t(std::clamp(info.time_s, 0.0, 1e11));
+  std::tm utc{};
+  gmtime_r(&seconds, &utc);
+  char date[32];
+  std::strftime(date, sizeof date, "%Y:%m:%d %H:%M:%S", &utc);
   return {
+      {"DateTime", 0.0, date},
       {"nephele:position_x", info.position.x, ""},
       {"nephele:position_y", info.position.y, ""},
       {"nephele:position_z", info.position.z, ""},

@@ -73,6 +73,13 @@ struct Limits {
   static constexpr Range kClusterVariation{0.0, 1.0};  // per-cluster spread of cover, height
   static constexpr Range kHeapRange{0.0, 1.0e6};       // heaps as ellipsoids this far; 0 automatic
 
+  // Datasets (dataset/dataset.h).
+  static constexpr int kMaxSamples = 100000000;
+  static constexpr Range kLayersPerSample{0.0, 4.0};
+  static constexpr Range kTargetsPerClass{0.0, 64.0};
+  static constexpr int kMaxTargetClasses = 256;
+  static constexpr Range kTargetDistance{1.0, 1.0e6};
+
   // Gardner's clusters (world/formations/cluster.h).
   static constexpr Range kClusterSpacing{1.0, 1.0e5};
   static constexpr Range kClusterBoundary{1.0, 1.0e6};

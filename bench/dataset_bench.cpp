@@ -1,0 +1,145 @@
+// Dataset throughput and where the time goes (issue: 20 samples per second at 640x480 with
+// PNG, labels and masks, for layers and cumulus with two targets, on 2 cores with software
+// GL). Per sample of a description: drawing the sky and placing the targets (CPU), rendering
+// colour, object ids and visibility (GL), labelling, sRGB conversion and PNG encoding of the
+// image, and the 16-bit mask's PNG; every stage timed alone, in memory (no disk), plus the
+// platform floor at the same size. `nephele dataset` runs the three groups (drawing,
+// rendering, labelling with encoding) on three threads: its rate is bounded by the slowest.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "bench_common.h"
+#include "config/dataset_file.h"
+#include "image/image_encoding.h"
+#include "renderer/gl/gl_renderer.h"
+
+using namespace nephele;
+using namespace nephele::bench;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app("Dataset throughput: samples per second and time per stage");
+  std::vector<std::string> specs{NEPHELE_SOURCE_DIR "/bench/datasets/layers_and_cumulus.toml",
+                                 NEPHELE_SOURCE_DIR "/bench/datasets/layers.toml"};
+  int samples = 12;
+  app.add_option("specs", specs, "Dataset descriptions")->capture_default_str();
+  app.add_option("--samples", samples, "Samples timed per description")->check(CLI::Range(1, 1000));
+  CLI11_PARSE(app, argc, argv);
+
+  const auto platform = openPlatform();
+  if (!platform) return 1;
+  GlRenderer gl(*platform);
+  for (const std::string& path : specs) {
+    DatasetSpec spec;
+    if (std::string e = loadDatasetFile(path, spec); !e.empty()) {
+      std::fprintf(stderr, "%s\n", e.c_str());
+      return 1;
+    }
+    const double floor_ms = medianMilliseconds(7, [&] { gl.renderFloor(spec.width, spec.height); });
+    RenderSettings settings;
+    settings.heap_range_m = spec.heap_range_m;
+    const FrameRequest request{{Channel::kColour, Channel::kObjectId, Channel::kVisibility}};
+    gl.renderFrame(drawSample(spec, 0).scene, settings, request);  // warm-up: shaders, tables
+    double draw = 0, heaps = 0, render = 0, label = 0, srgb = 0, png = 0, mask = 0;
+    int targets = 0, visible = 0;
+    for (int i = 0; i < samples; ++i) {
+      auto t = Clock::now();
+      const SampleScene sample = drawSample(spec, i);
+      draw += msSince(t);
+      t = Clock::now();
+      // The heaps around the camera, which the render builds first (tiles of ellipsoids).
+      const Scene with_heaps = withFieldClouds(sample.scene, spec.heap_range_m);
+      heaps += msSince(t);
+      t = Clock::now();
+      const Frame frame = gl.renderFrame(with_heaps, settings, request);
+      render += msSince(t);
+      t = Clock::now();
+      const std::vector<TargetLabel> labels = labelTargets(frame, sample.target_class);
+      const std::string json = sampleLabelsJson(labels, spec.width, spec.height).dump() +
+                               yoloText(labels, spec.width, spec.height);
+      const std::vector<std::uint16_t> ids = instanceMask(frame);
+      label += msSince(t);
+      t = Clock::now();
+      const Srgb8Image bytes = toSrgb8(frame.colour);
+      srgb += msSince(t);
+      t = Clock::now();
+      std::vector<std::uint8_t> encoded;
+      encodeImage(ImageFileFormat::kPng, bytes, true, false, EncodeOptions{1}, encoded);
+      png += msSince(t);
+      t = Clock::now();
+      encodeMaskPng(spec.width, spec.height, ids, EncodeOptions{1}, encoded);
+      mask += msSince(t);
+      targets += int(labels.size());
+      for (const TargetLabel& l : labels) visible += l.visible_px > 0;
+    }
+    const double n = samples;
+    const double serial = (draw + heaps + render + label + srgb + png + mask) / n;
+    const double pipelined =
+        std::max({draw / n, (heaps + render) / n, (label + srgb + png + mask) / n});
+    std::printf("%s: %dx%d, %d samples, %.1f targets per sample (%.0f %% visible)\n", path.c_str(),
+                spec.width, spec.height, samples, targets / n,
+                targets ? 100.0 * visible / targets : 0.0);
+    std::printf("  floor (one constant pass + readback): %.2f ms\n", floor_ms);
+    std::printf(
+        "  per sample: draw %.1f ms, heaps %.1f ms, GL render %.1f ms (%.0f x floor), "
+        "labels %.1f ms, sRGB %.1f ms, PNG %.1f ms, mask PNG %.1f ms\n",
+        draw / n, heaps / n, render / n, render / n / floor_ms, label / n, srgb / n, png / n,
+        mask / n);
+    std::printf(
+        "  one thread: %.1f samples/s; three overlapped stages on 2 cores: at most %.1f "
+        "samples/s (bounded by the slowest stage)\n",
+        1e3 / serial, 1e3 / pipelined);
+  }
+
+  // The label knob: cloud depth traced once per N x N pixels, against every pixel traced, on
+  // the first samples of the first description (error: pixels whose cloud depth changes
+  // between finite and infinite, and the mean relative change where both are finite).
+  DatasetSpec spec;
+  loadDatasetFile(specs.front(), spec);
+  std::printf("cloud_depth channel_divisor (%s, %d samples):\n", specs.front().c_str(),
+              std::min(samples, 4));
+  std::vector<std::vector<float>> exact;
+  for (int divisor : {1, 2, 4, 8}) {
+    RenderSettings settings;
+    settings.heap_range_m = spec.heap_range_m;
+    settings.channel_divisor = divisor;
+    double ms = 0.0, flipped = 0.0, relative = 0.0;
+    std::size_t pixels = 0, finite = 0;
+    for (int i = 0; i < std::min(samples, 4); ++i) {
+      const Scene scene = drawSample(spec, i).scene;
+      const auto t = Clock::now();
+      const Frame frame = gl.renderFrame(scene, settings, {ChannelSet{Channel::kCloudDepth}});
+      ms += msSince(t);
+      if (divisor == 1) exact.push_back(frame.cloud_depth);
+      const std::vector<float>& e = exact[std::size_t(i)];
+      for (std::size_t p = 0; p < e.size(); ++p) {
+        const float a = frame.cloud_depth[p], b = e[p];
+        ++pixels;
+        if (std::isinf(a) != std::isinf(b)) {
+          ++flipped;
+        } else if (!std::isinf(b)) {
+          ++finite;
+          relative += std::abs(a - b) / b;
+        }
+      }
+    }
+    std::printf(
+        "  %d: %.1f ms per frame, %.2f %% of pixels cloud/clear flipped, mean relative "
+        "depth error %.4f\n",
+        divisor, ms / std::min(samples, 4), 100.0 * flipped / pixels,
+        finite ? relative / finite : 0.0);
+  }
+  return 0;
+}

@@ -1,0 +1,412 @@
+#include "cli/dataset_command.h"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <condition_variable>
+#include <cstdio>
+#include <cstdlib>
+#include <deque>
+#include <filesystem>
+#include <fstream>
+#include <future>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include <unistd.h>
+
+#include "cli/render_command.h"
+#include "config/dataset_file.h"
+#include "config/table_reader.h"
+#include "dataset/dataset.h"
+#include "renderer/renderer.h"
+#include "world/counter_random.h"
+#include "world/file_output.h"
+
+namespace nephele {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using Clock = std::chrono::steady_clock;
+
+std::string sampleName(int index) {
+  char name[32];
+  std::snprintf(name, sizeof name, "%06d", index);
+  return name;
+}
+
+std::string writeText(const fs::path& path, const std::string& text) {
+  return writeFileAtomically(path.string(),
+                             {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()},
+                             "dataset file");
+}
+
+// 64-bit FNV-1a of the description's text: a run resumed or sharded into a directory must
+// come from the same description.
+std::uint64_t textHash(const std::string& text) {
+  std::uint64_t h = 0xcbf29ce484222325ull;
+  for (unsigned char c : text) h = (h ^ c) * 0x100000001b3ull;
+  return h;
+}
+
+// "I/N" or, with --shards N, I from the environment of a Kubernetes Indexed Job or a Slurm
+// array task.
+std::string shardOf(const DatasetCommandOptions& o, int& index, int& count) {
+  index = 0, count = 1;
+  if (!o.shard.empty()) {
+    char slash = 0;
+    std::istringstream in(o.shard);
+    if (!(in >> index >> slash >> count) || slash != '/' || !in.eof() || count < 1 || index < 0 ||
+        index >= count)
+      return "--shard: '" + o.shard + "' is not I/N with 0 <= I < N";
+    return "";
+  }
+  if (!o.shards) return "";
+  count = *o.shards;
+  for (const char* variable : {"JOB_COMPLETION_INDEX", "SLURM_ARRAY_TASK_ID"}) {
+    const char* value = std::getenv(variable);
+    if (!value) continue;
+    char* end = nullptr;
+    const long i = std::strtol(value, &end, 10);
+    long base = 0;
+    if (std::string(variable) == "SLURM_ARRAY_TASK_ID")
+      if (const char* min = std::getenv("SLURM_ARRAY_TASK_MIN"))
+        base = std::strtol(min, nullptr, 10);
+    if (*value == 0 || *end != 0 || i - base < 0 || i - base >= count)
+      return std::string("--shards ") + std::to_string(count) + ": " + variable + "='" + value +
+             "' is not a shard index 0 to " + std::to_string(count - 1);
+    index = int(i - base);
+    return "";
+  }
+  return "--shards: neither JOB_COMPLETION_INDEX (Kubernetes Indexed Job) nor "
+         "SLURM_ARRAY_TASK_ID (Slurm array) is set; use --shard I/N";
+}
+
+// A rendered sample on its way to the encoder thread.
+struct Rendered {
+  int index;
+  SampleScene sample;
+  Frame frame;
+};
+
+// Labels, masks, images and the record of one sample; the record last, so that a sample
+// whose record exists is complete (--resume).
+std::string writeSample(const DatasetSpec& spec, const fs::path& dir, const Rendered& r,
+                        const EncodeOptions& encode) {
+  const std::string name = sampleName(r.index);
+  const int w = r.frame.width(), h = r.frame.height();
+  const std::vector<TargetLabel> labels = labelTargets(r.frame, r.sample.target_class);
+  json record = r.sample.record;
+  record["file_name"] = "images/" + name + ".png";
+  record["camera"] = record["camera"];  // as drawn; the frame's own info is the same camera
+  record["labels"] = sampleLabelsJson(labels, w, h);
+  std::string e =
+      writeImageFile((dir / "images" / (name + ".png")).string(), r.frame.colour, encode);
+  if (e.empty() && spec.write_masks)
+    e = writeMaskPng((dir / "masks" / (name + ".png")).string(), w, h, instanceMask(r.frame),
+                     encode);
+  if (e.empty()) e = writeText(dir / "labels" / (name + ".txt"), yoloText(labels, w, h));
+  if (e.empty() && (spec.write_depth || spec.write_coverage)) {
+    Frame planes = r.frame;
+    planes.channels = {};
+    if (spec.write_depth)
+      for (Channel c : {Channel::kDepth, Channel::kCloudDepth, Channel::kObjectId})
+        planes.channels.add(c);
+    if (spec.write_coverage)
+      for (Channel c : {Channel::kCoverage, Channel::kVisibility}) planes.channels.add(c);
+    EncodeOptions exr = encode;
+    exr.exr_compression = "zip";
+    e = writeFrameExr((dir / "exr" / (name + ".exr")).string(), planes, exr);
+  }
+  if (e.empty()) e = writeText(dir / "records" / (name + ".json"), record.dump() + "\n");
+  return e;
+}
+
+// annotations.json (COCO), manifest.jsonl and classes.txt from every sample's record.
+std::string merge(const DatasetSpec& spec, const fs::path& dir) {
+  std::vector<json> records;
+  records.reserve(std::size_t(spec.samples));
+  int missing = 0, first_missing = -1;
+  for (int i = 0; i < spec.samples; ++i) {
+    std::ifstream in(dir / "records" / (sampleName(i) + ".json"));
+    if (!in) {
+      if (missing++ == 0) first_missing = i;
+      continue;
+    }
+    json record;
+    try {
+      in >> record;
+    } catch (const json::exception& e) {
+      return "records/" + sampleName(i) + ".json: " + e.what();
+    }
+    records.push_back(std::move(record));
+  }
+  if (missing)
+    return std::to_string(missing) + " of " + std::to_string(spec.samples) +
+           " samples are not written yet (the first is " + std::to_string(first_missing) +
+           "): run the missing shards, or this command with --resume";
+  std::string manifest, classes;
+  for (const json& r : records) {
+    json line = r;
+    for (json& l : line["labels"]) l.erase("segmentation");  // in annotations.json
+    manifest += line.dump() + "\n";
+  }
+  for (const TargetClass& c : spec.targets) classes += c.name + "\n";
+  std::string e = writeText(dir / "annotations.json", cocoFile(spec, records).dump() + "\n");
+  if (e.empty()) e = writeText(dir / "manifest.jsonl", manifest);
+  if (e.empty()) e = writeText(dir / "classes.txt", classes);
+  return e;
+}
+
+}  // namespace
+
+void addDatasetCommand(CLI::App& app, DatasetCommandOptions& o) {
+  CLI::App* cmd = app.add_subcommand(
+      "dataset", "Render a labelled cloud-clutter dataset (COCO, YOLO, masks; docs/DATASETS.md)");
+  cmd->add_option("spec", o.spec_path, "Dataset description (TOML)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("-o,--output", o.output_dir, "Output directory")->required();
+  cmd->add_flag("--resume", o.resume, "Skip samples already written (their record exists)");
+  cmd->add_option("--shard", o.shard, "Render only samples with index mod N = I, given as I/N");
+  cmd->add_option("--shards", o.shards,
+                  "N shards, this one's index from JOB_COMPLETION_INDEX (Kubernetes Indexed "
+                  "Job) or SLURM_ARRAY_TASK_ID (Slurm array)")
+      ->check(CLI::Range(1, 1 << 20));
+  cmd->add_flag("--merge", o.merge_only,
+                "Only build annotations.json, manifest.jsonl and classes.txt from the records "
+                "every shard wrote");
+  cmd->add_option("--only", o.only, "Render only these sample indices (reproduce a sample)");
+  cmd->add_option("--renderer", o.renderer, "gl, or the CPU reference (slow, exact)")
+      ->check(CLI::IsMember({"gl", "reference"}))
+      ->capture_default_str();
+  cmd->add_option("--gl", o.gl_backend, "OpenGL back end")
+      ->check(CLI::IsMember(kGlBackendNames))
+      ->capture_default_str();
+  cmd->add_option("--channel-divisor", o.channel_divisor,
+                  "Cloud depth (depth = true): one traced ray per N x N pixels")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
+  cmd->add_option("--png-compression", o.encode.png_compression, "PNG zlib level")
+      ->check(CLI::Range(0, 9))
+      ->capture_default_str();
+}
+
+int runDatasetCommand(const DatasetCommandOptions& o) {
+  // Everything that can be wrong with the request is found before any file is written.
+  DatasetSpec spec;
+  if (std::string e = loadDatasetFile(o.spec_path, spec); !e.empty()) {
+    spdlog::error("{}", e);
+    return 2;
+  }
+  int shard = 0, shards = 1;
+  if (std::string e = shardOf(o, shard, shards); !e.empty()) {
+    spdlog::error("{}", e);
+    return 2;
+  }
+  for (int i : o.only)
+    if (i < 0 || i >= spec.samples) {
+      spdlog::error("--only: {} is not a sample index (allowed: 0 to {})", i, spec.samples - 1);
+      return 2;
+    }
+  std::string spec_text;
+  config_detail::readTextFile(o.spec_path, "dataset description", spec_text);
+  const fs::path dir(o.output_dir);
+  const json header = {{"description", o.spec_path},
+                       {"description_hash", std::to_string(textHash(spec_text))},
+                       {"samples", spec.samples},
+                       {"width", spec.width},
+                       {"height", spec.height}};
+  std::error_code ec;
+  if (fs::exists(dir / "dataset.json")) {
+    std::ifstream in(dir / "dataset.json");
+    json existing;
+    try {
+      in >> existing;
+    } catch (const json::exception&) {
+    }
+    if (existing.value("description_hash", "") != header["description_hash"]) {
+      spdlog::error("{}: holds a dataset from another description; use an empty directory",
+                    o.output_dir);
+      return 2;
+    }
+  }
+  if (o.merge_only) {
+    if (std::string e = merge(spec, dir); !e.empty()) {
+      spdlog::error("{}", e);
+      return 1;
+    }
+    spdlog::info("merged {} samples into {}/annotations.json", spec.samples, o.output_dir);
+    return 0;
+  }
+  for (const char* sub : {"images", "masks", "labels", "exr", "records"}) {
+    if ((std::string(sub) == "masks" && !spec.write_masks) ||
+        (std::string(sub) == "exr" && !spec.write_depth && !spec.write_coverage))
+      continue;
+    fs::create_directories(dir / sub, ec);
+    if (ec) {
+      spdlog::error("cannot create '{}': {}", (dir / sub).string(), ec.message());
+      return 1;
+    }
+  }
+  // Shards start together on shared storage: each writes the header under its own name and
+  // renames it into place (the same bytes whoever wins).
+  const fs::path own = dir / ("dataset.json." + std::to_string(::getpid()));
+  if (std::string e = writeText(own, header.dump(2) + "\n"); !e.empty()) {
+    spdlog::error("{}", e);
+    return 1;
+  }
+  fs::rename(own, dir / "dataset.json", ec);
+  if (ec) {
+    spdlog::error("cannot write '{}': {}", (dir / "dataset.json").string(), ec.message());
+    return 1;
+  }
+
+  RendererOptions options;
+  options.kind = o.renderer == "reference" ? RendererKind::kReference : RendererKind::kGl;
+  options.gl_backend = backendFromName(o.gl_backend);
+  options.render.channel_divisor = o.channel_divisor;
+  options.render.heap_range_m = options.reference.heap_range_m = spec.heap_range_m;
+  options.reference.label_divisor = o.channel_divisor;
+  std::string error;
+  const std::unique_ptr<Renderer> renderer = createRenderer(options, error);
+  if (!renderer) {
+    spdlog::error("{}", error);
+    return 1;
+  }
+  if (std::string e = renderer->reserve(spec.width, spec.height, true); !e.empty()) {
+    spdlog::error("dataset.width/height: {}", e);
+    return 2;
+  }
+  spdlog::info("renderer: {}", renderer->description());
+
+  std::vector<int> todo;
+  if (!o.only.empty()) {
+    todo = o.only;
+  } else {
+    for (int i = shard; i < spec.samples; i += shards)
+      if (!o.resume || !fs::exists(dir / "records" / (sampleName(i) + ".json"))) todo.push_back(i);
+  }
+  // A run killed while writing leaves files named *.partial, never a final name: this run's
+  // samples' are removed (other shards' may be in progress).
+  for (int i : todo)
+    for (const char* file :
+         {"images/%s.png", "masks/%s.png", "labels/%s.txt", "exr/%s.exr", "records/%s.json"}) {
+      char name[64];
+      std::snprintf(name, sizeof name, file, sampleName(i).c_str());
+      fs::remove(dir / (std::string(name) + ".partial"), ec);
+    }
+  const int skipped =
+      o.only.empty() ? (spec.samples - shard + shards - 1) / shards - int(todo.size()) : 0;
+  spdlog::info(
+      "dataset: {} samples to render{}{}", todo.size(),
+      shards > 1 ? " (shard " + std::to_string(shard) + "/" + std::to_string(shards) + ")" : "",
+      skipped > 0 ? ", " + std::to_string(skipped) + " already written" : "");
+
+  FrameRequest request;
+  request.channels = {Channel::kColour, Channel::kObjectId, Channel::kVisibility};
+  if (spec.write_depth)
+    for (Channel c : {Channel::kDepth, Channel::kCloudDepth}) request.channels.add(c);
+  if (spec.write_coverage) request.channels.add(Channel::kCoverage);
+
+  // Rendering (this thread, which holds the GL context) and encoding (one worker) overlap;
+  // at most two rendered samples wait.
+  std::mutex mutex;
+  std::condition_variable changed;
+  std::deque<Rendered> queue;
+  bool done = false;
+  std::string write_error;
+  int written = 0;
+  double draw_s = 0.0, render_s = 0.0, write_s = 0.0;
+  std::jthread encoder([&] {
+    for (;;) {
+      std::unique_lock lock(mutex);
+      changed.wait(lock, [&] { return !queue.empty() || done; });
+      if (queue.empty()) return;
+      Rendered r = std::move(queue.front());
+      queue.pop_front();
+      changed.notify_all();
+      lock.unlock();
+      const auto start = Clock::now();
+      std::string e = writeSample(spec, dir, r, o.encode);
+      lock.lock();
+      write_s += std::chrono::duration<double>(Clock::now() - start).count();
+      if (!e.empty() && write_error.empty()) write_error = e;
+      ++written;
+      changed.notify_all();
+    }
+  });
+
+  const auto start = Clock::now();
+  auto last_report = start;
+  // The next sample's scene is drawn on another thread while this one renders.
+  auto drawAsync = [&](std::size_t n) {
+    return std::async(std::launch::async, [&spec, index = todo[n]] {
+      const auto t0 = Clock::now();
+      SampleScene sample = drawSample(spec, index);
+      return std::pair{std::move(sample), std::chrono::duration<double>(Clock::now() - t0).count()};
+    });
+  };
+  std::future<std::pair<SampleScene, double>> next;
+  if (!todo.empty()) next = drawAsync(0);
+  for (std::size_t n = 0; n < todo.size(); ++n) {
+    const auto t0 = Clock::now();
+    auto [sample, draw_seconds] = next.get();
+    if (n + 1 < todo.size()) next = drawAsync(n + 1);
+    Rendered r{todo[n], std::move(sample), {}};
+    const auto t1 = Clock::now();
+    r.frame = renderer->render(r.sample.scene, request);
+    const auto t2 = Clock::now();
+    spdlog::debug(
+        "sample {}: drawn in {:.1f} ms (waited {:.1f} ms), rendered in {:.1f} ms: {}", r.index,
+        1e3 * draw_seconds, std::chrono::duration<double, std::milli>(t1 - t0).count(),
+        std::chrono::duration<double, std::milli>(t2 - t1).count(), renderer->statsLine());
+    draw_s += draw_seconds;
+    render_s += std::chrono::duration<double>(t2 - t1).count();
+    std::unique_lock lock(mutex);
+    changed.wait(lock, [&] { return queue.size() < 2 || !write_error.empty(); });
+    if (!write_error.empty()) break;
+    queue.push_back(std::move(r));
+    changed.notify_all();
+    const double elapsed = std::chrono::duration<double>(t2 - start).count();
+    if (std::chrono::duration<double>(t2 - last_report).count() >= 2.0) {
+      last_report = t2;
+      const double rate = written / elapsed;
+      spdlog::info("dataset: {}/{} samples, {:.1f} samples/s, {:.0f} s left", written, todo.size(),
+                   rate, rate > 0 ? (todo.size() - written) / rate : 0.0);
+    }
+  }
+  {
+    std::unique_lock lock(mutex);
+    done = true;
+    changed.notify_all();
+  }
+  encoder.join();
+  if (!write_error.empty()) {
+    spdlog::error("{}", write_error);
+    return 1;
+  }
+  const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+  spdlog::info(
+      "dataset: {} samples in {:.1f} s, {:.1f} samples/s (per sample: drawing {:.1f} ms, "
+      "rendering {:.1f} ms, labelling and writing {:.1f} ms; the three overlap on their own "
+      "threads)",
+      todo.size(), elapsed, todo.empty() ? 0.0 : todo.size() / elapsed,
+      todo.empty() ? 0.0 : 1e3 * draw_s / todo.size(),
+      todo.empty() ? 0.0 : 1e3 * render_s / todo.size(),
+      todo.empty() ? 0.0 : 1e3 * write_s / todo.size());
+  if (shards == 1 && o.only.empty()) {
+    if (std::string e = merge(spec, dir); !e.empty()) {
+      spdlog::error("{}", e);
+      return 1;
+    }
+    spdlog::info("wrote {}/annotations.json, manifest.jsonl, classes.txt", o.output_dir);
+  } else if (shards > 1) {
+    spdlog::info("shard {}/{} done; when every shard is, run with --merge", shard, shards);
+  }
+  return 0;
+}
+
+}  // namespace nephele

@@ -1,0 +1,153 @@
+#include "config/dataset_file.h"
+
+#include <filesystem>
+#include <memory>
+
+#include "config/obj_mesh.h"
+#include "config/table_reader.h"
+
+namespace nephele {
+namespace {
+
+using config_detail::SceneError;
+using config_detail::TableReader;
+
+void readSpan(TableReader& t, std::string_view key, Span& s, Range range) {
+  t.span(key, s.lo, s.hi, range);
+}
+
+std::vector<std::string> cloudTypeNames() {
+  std::vector<std::string> names;
+  for (int i = 1; i < kCloudTypeCount; ++i) names.emplace_back(cloudTypeName(CloudType(i)));
+  return names;
+}
+
+void readDataset(TableReader& t, DatasetSpec& spec) {
+  t.allow({"seed", "samples", "width", "height", "band", "masks", "depth", "coverage",
+           "occluded_fraction", "heap_range"});
+  t.seed("seed", spec.seed);
+  t.integer("samples", spec.samples, 1, Limits::kMaxSamples);
+  t.integer("width", spec.width, 1, Limits::kMaxImageSide);
+  t.integer("height", spec.height, 1, Limits::kMaxImageSide);
+  t.choice("band", {"visible"}, 0);
+  t.boolean("masks", spec.write_masks);
+  t.boolean("depth", spec.write_depth);
+  t.boolean("coverage", spec.write_coverage);
+  t.number("occluded_fraction", spec.occluded_fraction, Limits::kFraction);
+  t.number("heap_range", spec.heap_range_m, Limits::kHeapRange);
+  t.finish();
+}
+
+void readSky(TableReader& t, DatasetSpec& spec) {
+  t.allow({"genera", "layers", "coverage", "base", "thickness"});
+  if (t.has("genera")) {
+    std::vector<std::string> names;
+    t.strings("genera", names, kCloudTypeCount);
+    const std::vector<std::string> allowed = cloudTypeNames();
+    spec.genera.clear();
+    for (const std::string& name : names) {
+      const int i = nameIndex(allowed, name);
+      if (i < 0)
+        t.failAt("genera", "\"" + name + "\" is not a genus (allowed: " +
+                               config_detail::joinKeys(allowed) + ")");
+      spec.genera.push_back(CloudType(i + 1));
+    }
+  }
+  readSpan(t, "layers", spec.layers, Limits::kLayersPerSample);
+  readSpan(t, "coverage", spec.coverage, Limits::kFraction);
+  readSpan(t, "base", spec.base, {0.0, Limits::kMaxBase});
+  readSpan(t, "thickness", spec.thickness, Limits::kThickness);
+  t.finish();
+}
+
+void readTargetClass(TableReader& t, const std::string& file, TargetClass& c) {
+  t.allow(
+      {"name", "shape", "mesh", "size", "colour", "count", "distance", "heading", "pitch", "roll"});
+  if (!t.has("name")) t.failHere("name is missing (the category's name)");
+  t.name("name", c.name);
+  c.shape = TargetShape(t.choice("shape", {"box", "ellipsoid", "mesh"}, int(c.shape)));
+  if (c.shape == TargetShape::kMesh) c.size = glm::dvec3(1.0);
+  t.vector("size", c.size, Limits::kMinRadius, Limits::kMaxRadius);
+  t.vector("colour", c.colour, Limits::kColour);
+  readSpan(t, "count", c.count, Limits::kTargetsPerClass);
+  readSpan(t, "distance", c.distance, Limits::kTargetDistance);
+  readSpan(t, "heading", c.heading, {-Limits::kMaxHeading, Limits::kMaxHeading});
+  readSpan(t, "pitch", c.pitch, {-Limits::kMaxPitch, Limits::kMaxPitch});
+  readSpan(t, "roll", c.roll, {-Limits::kMaxRoll, Limits::kMaxRoll});
+  t.string("mesh", c.mesh_path);
+  if (c.shape == TargetShape::kMesh) {
+    if (c.mesh_path.empty()) t.failAt("shape", "shape \"mesh\" needs a mesh = \"file.obj\" key");
+    const std::filesystem::path path(c.mesh_path);
+    const std::filesystem::path resolved =
+        path.is_absolute() ? path : std::filesystem::path(file).parent_path() / path;
+    auto mesh = std::make_shared<TriangleMesh>();
+    if (std::string error = loadObjMesh(resolved.string(), *mesh); !error.empty())
+      t.failAt("mesh", error);
+    c.mesh = std::move(mesh);
+  } else if (!c.mesh_path.empty()) {
+    t.failAt("mesh", "applies to shape \"mesh\" only");
+  }
+  t.finish();
+}
+
+}  // namespace
+
+std::string parseDatasetText(std::string_view text, const std::string& source_name,
+                             DatasetSpec& out) {
+  DatasetSpec spec;
+  try {
+    const toml::table root = config_detail::parseToml(text, source_name);
+    TableReader t(root, "", source_name);
+    t.allow({"dataset", "sky", "sun", "fog", "camera", "target"});
+    if (auto d = t.table("dataset")) readDataset(*d, spec);
+    if (auto sky = t.table("sky")) readSky(*sky, spec);
+    if (auto sun = t.table("sun")) {
+      sun->allow({"azimuth", "elevation"});
+      readSpan(*sun, "azimuth", spec.sun_azimuth, {-Limits::kMaxHeading, Limits::kMaxHeading});
+      readSpan(*sun, "elevation", spec.sun_elevation, {-Limits::kMaxPitch, Limits::kMaxPitch});
+      sun->finish();
+    }
+    if (auto fog = t.table("fog")) {
+      fog->allow({"probability", "top", "visibility"});
+      fog->number("probability", spec.fog_probability, Limits::kFraction);
+      readSpan(*fog, "top", spec.fog_top, {0.0, Limits::kMaxAltitude});
+      readSpan(*fog, "visibility", spec.fog_visibility, {1.0, 1.0e7});
+      fog->finish();
+    }
+    if (auto camera = t.table("camera")) {
+      camera->allow({"altitude", "heading", "pitch", "roll", "vfov"});
+      readSpan(*camera, "altitude", spec.altitude, {0.0, Limits::kMaxAltitude});
+      readSpan(*camera, "heading", spec.heading, {-Limits::kMaxHeading, Limits::kMaxHeading});
+      readSpan(*camera, "pitch", spec.pitch, {-Limits::kMaxPitch, Limits::kMaxPitch});
+      readSpan(*camera, "roll", spec.roll, {-Limits::kMaxRoll, Limits::kMaxRoll});
+      readSpan(*camera, "vfov", spec.vfov, {Limits::kMinVfov, Limits::kMaxVfov});
+      camera->finish();
+    }
+    std::vector<TableReader> targets = t.tables("target");
+    if (targets.size() > std::size_t(Limits::kMaxTargetClasses))
+      t.failAt("target",
+               "at most " + std::to_string(Limits::kMaxTargetClasses) + " [[target]] categories");
+    for (TableReader& target : targets)
+      readTargetClass(target, source_name, spec.targets.emplace_back());
+    for (std::size_t i = 0; i < spec.targets.size(); ++i)
+      for (std::size_t j = 0; j < i; ++j)
+        if (spec.targets[i].name == spec.targets[j].name)
+          t.failAt("target",
+                   "two [[target]] categories are named \"" + spec.targets[i].name + "\"");
+    t.finish();
+  } catch (const SceneError& e) {
+    return e.message;
+  }
+  if (std::string e = datasetSpecError(spec); !e.empty()) return source_name + ": " + e;
+  out = std::move(spec);
+  return "";
+}
+
+std::string loadDatasetFile(const std::string& path, DatasetSpec& out) {
+  std::string text;
+  if (std::string e = config_detail::readTextFile(path, "dataset description", text); !e.empty())
+    return e;
+  return parseDatasetText(text, path, out);
+}
+
+}  // namespace nephele

@@ -1,0 +1,343 @@
+#include "dataset/dataset.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <optional>
+
+#include "renderer/reference/reference_renderer.h"
+#include "world/counter_random.h"
+#include "world/formations/weather.h"
+#include "world/limits.h"
+
+namespace nephele {
+namespace {
+
+using nlohmann::json;
+
+// Independent streams of one sample's draws: changing how many targets a sample has never
+// moves its sky, and the reverse.
+enum Stream : std::uint64_t { kSky = 1, kSun, kFog, kCamera, kTargets };
+
+// Draws from (key, counter): the n-th number of a stream is a pure function of both.
+class Draws {
+ public:
+  explicit Draws(std::uint64_t key) : key_(key) {}
+  double unit() { return unitFromBits(hashCounters(key_, n_++)); }
+  double in(Span s) { return s.lo + (s.hi - s.lo) * unit(); }
+  int integer(Span s) {  // uniform over the integers lo..hi
+    const int lo = int(std::lround(s.lo)), hi = int(std::lround(s.hi));
+    return std::min(hi, lo + int(std::floor(unit() * (hi - lo + 1))));
+  }
+
+ private:
+  std::uint64_t key_;
+  std::uint64_t n_ = 0;
+};
+
+const char* shapeName(TargetShape shape) {
+  return shape == TargetShape::kBox         ? "box"
+         : shape == TargetShape::kEllipsoid ? "ellipsoid"
+                                            : "mesh";
+}
+
+json vec3(glm::dvec3 v) {
+  return json::array({v.x, v.y, v.z});
+}
+
+json frameInfoJson(const FrameInfo& info) {
+  return {{"position", vec3(info.position)},
+          {"heading_deg", info.orientation.heading_deg},
+          {"pitch_deg", info.orientation.pitch_deg},
+          {"roll_deg", info.orientation.roll_deg},
+          {"vfov_deg", info.vfov_deg},
+          {"focal_px", info.focal_px},
+          {"principal_point", json::array({info.cx, info.cy})},
+          {"time_s", info.time_s},
+          {"tick", info.tick}};
+}
+
+std::string spanError(const char* name, Span s) {
+  if (!(s.lo <= s.hi)) return std::string(name) + ": the range's low end is above its high end";
+  return "";
+}
+
+}  // namespace
+
+std::string datasetSpecError(const DatasetSpec& spec) {
+  if (spec.genera.empty() && spec.layers.hi > 0.0)
+    return "sky.genera: empty, yet sky.layers asks for layers";
+  using Named = std::pair<const char*, Span>;
+  const Named spans[] = {{"sky.layers", spec.layers},
+                         {"sky.coverage", spec.coverage},
+                         {"sky.base", spec.base},
+                         {"sky.thickness", spec.thickness},
+                         {"sun.azimuth", spec.sun_azimuth},
+                         {"sun.elevation", spec.sun_elevation},
+                         {"fog.top", spec.fog_top},
+                         {"fog.visibility", spec.fog_visibility},
+                         {"camera.altitude", spec.altitude},
+                         {"camera.heading", spec.heading},
+                         {"camera.pitch", spec.pitch},
+                         {"camera.roll", spec.roll},
+                         {"camera.vfov", spec.vfov}};
+  for (const auto& [name, s] : spans)
+    if (std::string e = spanError(name, s); !e.empty()) return e;
+  for (const TargetClass& c : spec.targets) {
+    const Named target_spans[] = {{"count", c.count},
+                                  {"distance", c.distance},
+                                  {"heading", c.heading},
+                                  {"pitch", c.pitch},
+                                  {"roll", c.roll}};
+    for (const auto& [name, s] : target_spans)
+      if (std::string e = spanError(name, s); !e.empty()) return "target " + c.name + "." + e;
+  }
+  return "";
+}
+
+SampleScene drawSample(const DatasetSpec& spec, int index) {
+  const std::uint64_t seed = hashCounters(spec.seed, 0x53616d706c65ull, std::uint64_t(index));
+  auto stream = [&](Stream s) { return Draws(hashCounters(seed, s)); };
+  SampleScene out;
+  Scene& scene = out.scene;
+  scene.seed = seed;
+  json& record = out.record;
+  record["index"] = index;
+  record["seed"] = std::to_string(seed);
+
+  Draws sky = stream(kSky);
+  const int layers = spec.genera.empty() ? 0 : sky.integer(spec.layers);
+  record["layers"] = json::array();
+  for (int k = 0; k < layers; ++k) {
+    WeatherLayer w;
+    w.type = spec.genera[std::min(spec.genera.size() - 1,
+                                  std::size_t(sky.unit() * double(spec.genera.size())))];
+    w.coverage = sky.in(spec.coverage);
+    w.base_m = sky.in(spec.base);
+    w.thickness_m = sky.in(spec.thickness);
+    const std::uint64_t layer_seed = weatherSeed(seed, k + 1);
+    const WeatherClouds add = weatherClouds(w, "layer" + std::to_string(k + 1), layer_seed);
+    scene.layers.insert(scene.layers.end(), add.layers.begin(), add.layers.end());
+    scene.fields.insert(scene.fields.end(), add.fields.begin(), add.fields.end());
+    record["layers"].push_back({{"genus", std::string(cloudTypeName(w.type))},
+                                {"coverage", w.coverage},
+                                {"base_m", w.base_m},
+                                {"thickness_m", w.thickness_m},
+                                {"seed", std::to_string(layer_seed)}});
+  }
+
+  Draws sun = stream(kSun);
+  scene.sun.azimuth_deg = sun.in(spec.sun_azimuth);
+  scene.sun.elevation_deg = sun.in(spec.sun_elevation);
+  record["sun"] = {{"azimuth_deg", scene.sun.azimuth_deg},
+                   {"elevation_deg", scene.sun.elevation_deg}};
+
+  Draws fog = stream(kFog);
+  if (fog.unit() < spec.fog_probability) {
+    Fog& f = scene.fog.emplace();
+    f.top_m = fog.in(spec.fog_top);
+    f.visibility_m = fog.in(spec.fog_visibility);
+    record["fog"] = {{"top_m", f.top_m}, {"visibility_m", f.visibility_m}};
+  } else {
+    record["fog"] = nullptr;
+  }
+
+  Draws cam = stream(kCamera);
+  Camera& camera = scene.camera;
+  camera.width = spec.width;
+  camera.height = spec.height;
+  camera.position = {0.0, 0.0, cam.in(spec.altitude)};
+  camera.orientation = {cam.in(spec.heading), cam.in(spec.pitch), cam.in(spec.roll)};
+  camera.vfov_deg = cam.in(spec.vfov);
+  record["camera"] = frameInfoJson(frameInfo(camera, 0.0));
+
+  // Targets: a pixel and a distance per instance; those meant to be behind cloud (or in the
+  // clear) try up to kPlacementAttempts placements for one whose centre ray says so.
+  constexpr int kPlacementAttempts = 64;
+  Draws draw = stream(kTargets);
+  std::optional<CloudProbe> probe;
+  const ViewBasis basis = viewBasis(camera);
+  record["targets"] = json::array();
+  for (std::size_t c = 0; c < spec.targets.size(); ++c) {
+    const TargetClass& cls = spec.targets[c];
+    const int count = draw.integer(cls.count);
+    for (int i = 0; i < count; ++i) {
+      const bool behind = draw.unit() < spec.occluded_fraction;
+      Target target;
+      target.name = cls.name + std::to_string(i + 1);
+      target.shape = cls.shape;
+      target.mesh = cls.mesh;
+      target.size = cls.size;
+      target.colour = cls.colour;
+      target.orientation = {draw.in(cls.heading), draw.in(cls.pitch), draw.in(cls.roll)};
+      double transmittance = 1.0;
+      bool met = false;
+      for (int attempt = 0; attempt < kPlacementAttempts && !met; ++attempt) {
+        const double px = draw.in({0.1 * spec.width, 0.9 * spec.width});
+        const double py = draw.in({0.1 * spec.height, 0.9 * spec.height});
+        const double distance = draw.in(cls.distance);
+        const glm::dvec3 d = glm::normalize(rayDirection(basis, camera, px, py));
+        const glm::dvec3 centre = camera.position + distance * d;
+        if (centre.z < 0.0 && attempt + 1 < kPlacementAttempts) continue;  // below the ground
+        target.centre = centre;
+        if (scene.layers.empty() && scene.fields.empty()) {
+          transmittance = 1.0;
+        } else {
+          if (!probe) probe.emplace(scene, spec.heap_range_m);
+          transmittance = probe->transmittance(d, distance);
+        }
+        met = behind ? transmittance < 0.9 : transmittance > 0.99;
+      }
+      scene.targets.push_back(target);
+      out.target_class.push_back(int(c));
+      record["targets"].push_back({{"category", cls.name},
+                                   {"shape", shapeName(cls.shape)},
+                                   {"mesh", cls.mesh_path},
+                                   {"centre", vec3(target.centre)},
+                                   {"heading_deg", target.orientation.heading_deg},
+                                   {"pitch_deg", target.orientation.pitch_deg},
+                                   {"roll_deg", target.orientation.roll_deg},
+                                   {"size", vec3(target.size)},
+                                   {"placed", behind ? "behind cloud" : "clear"},
+                                   {"placement_met", met},
+                                   {"centre_transmittance", transmittance}});
+    }
+  }
+  return out;
+}
+
+std::vector<TargetLabel> labelTargets(const Frame& frame, const std::vector<int>& target_class) {
+  const int w = frame.width(), h = frame.height();
+  std::vector<TargetLabel> labels(target_class.size());
+  std::vector<double> transmittance(labels.size(), 0.0);
+  struct Extent {
+    int x0 = 1 << 30, y0 = 1 << 30, x1 = -1, y1 = -1;
+    void add(int x, int y) {
+      x0 = std::min(x0, x), y0 = std::min(y0, y), x1 = std::max(x1, x), y1 = std::max(y1, y);
+    }
+    void to(double (&box)[4]) const {
+      if (x1 < 0) return;
+      box[0] = x0, box[1] = y0, box[2] = x1 - x0 + 1, box[3] = y1 - y0 + 1;
+    }
+  };
+  std::vector<Extent> full(labels.size()), visible(labels.size());
+  for (std::size_t k = 0; k < labels.size(); ++k) {
+    labels[k].target = int(k);
+    labels[k].category = target_class[k];
+  }
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = std::size_t(y) * w + x;
+      const int id = int(frame.object_id[i]);
+      if (id <= 0 || id > int(labels.size())) continue;
+      TargetLabel& l = labels[id - 1];
+      const double t = frame.visibility[i];
+      ++l.silhouette_px;
+      transmittance[id - 1] += t;
+      full[id - 1].add(x, y);
+      if (t >= 0.5) {
+        ++l.visible_px;
+        visible[id - 1].add(x, y);
+      }
+    }
+  for (std::size_t k = 0; k < labels.size(); ++k) {
+    TargetLabel& l = labels[k];
+    if (l.silhouette_px > 0) l.visibility = transmittance[k] / l.silhouette_px;
+    full[k].to(l.box_full);
+    visible[k].to(l.box);
+    if (l.visible_px == 0) continue;
+    // COCO's uncompressed RLE runs down the columns, starting with a run of zeros.
+    bool inside = false;
+    std::uint32_t run = 0;
+    for (int x = 0; x < w; ++x)
+      for (int y = 0; y < h; ++y) {
+        const std::size_t i = std::size_t(y) * w + x;
+        const bool on = int(frame.object_id[i]) == int(k) + 1 && frame.visibility[i] >= 0.5f;
+        if (on != inside) {
+          l.rle.push_back(run);
+          run = 0;
+          inside = on;
+        }
+        ++run;
+      }
+    l.rle.push_back(run);
+  }
+  return labels;
+}
+
+std::vector<std::uint16_t> instanceMask(const Frame& frame) {
+  std::vector<std::uint16_t> mask(frame.object_id.size(), 0);
+  for (std::size_t i = 0; i < mask.size(); ++i)
+    if (frame.object_id[i] > 0.0f && frame.visibility[i] >= 0.5f)
+      mask[i] = std::uint16_t(frame.object_id[i]);
+  return mask;
+}
+
+json sampleLabelsJson(const std::vector<TargetLabel>& labels, int width, int height) {
+  json out = json::array();
+  for (const TargetLabel& l : labels) {
+    json a = {
+        {"target", l.target},
+        {"category", l.category},
+        {"bbox", json::array({l.box[0], l.box[1], l.box[2], l.box[3]})},
+        {"bbox_full", json::array({l.box_full[0], l.box_full[1], l.box_full[2], l.box_full[3]})},
+        {"area", l.visible_px},
+        {"area_full", l.silhouette_px},
+        {"visibility", l.visibility},
+        {"occluded_fraction",
+         l.silhouette_px ? 1.0 - double(l.visible_px) / l.silhouette_px : 1.0}};
+    if (l.visible_px > 0) a["segmentation"] = {{"size", {height, width}}, {"counts", l.rle}};
+    out.push_back(std::move(a));
+  }
+  return out;
+}
+
+std::string yoloText(const std::vector<TargetLabel>& labels, int width, int height) {
+  std::string out;
+  char line[128];
+  for (const TargetLabel& l : labels) {
+    if (l.visible_px == 0) continue;
+    std::snprintf(line, sizeof line, "%d %.6f %.6f %.6f %.6f\n", l.category,
+                  (l.box[0] + 0.5 * l.box[2]) / width, (l.box[1] + 0.5 * l.box[3]) / height,
+                  l.box[2] / width, l.box[3] / height);
+    out += line;
+  }
+  return out;
+}
+
+json cocoFile(const DatasetSpec& spec, const std::vector<json>& samples) {
+  json coco;
+  coco["info"] = {{"description", "Nephele cloud-clutter dataset"},
+                  {"version", "1"},
+                  {"seed", std::to_string(spec.seed)}};
+  coco["licenses"] = json::array();
+  coco["categories"] = json::array();
+  for (std::size_t c = 0; c < spec.targets.size(); ++c)
+    coco["categories"].push_back(
+        {{"id", c + 1}, {"name", spec.targets[c].name}, {"supercategory", "target"}});
+  coco["images"] = json::array();
+  coco["annotations"] = json::array();
+  int annotation_id = 0;
+  for (const json& s : samples) {
+    const int image_id = s["index"].get<int>() + 1;
+    coco["images"].push_back({{"id", image_id},
+                              {"file_name", s["file_name"]},
+                              {"width", spec.width},
+                              {"height", spec.height},
+                              {"camera", s["camera"]}});
+    for (const json& l : s["labels"]) {
+      if (l["area"].get<int>() == 0) continue;  // hidden: in the manifest, not in COCO
+      json a = l;
+      a.erase("target");
+      a.erase("category");
+      a["id"] = ++annotation_id;
+      a["image_id"] = image_id;
+      a["category_id"] = l["category"].get<int>() + 1;
+      a["iscrowd"] = 0;
+      coco["annotations"].push_back(std::move(a));
+    }
+  }
+  return coco;
+}
+
+}  // namespace nephele

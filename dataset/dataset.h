@@ -1,0 +1,103 @@
+#pragma once
+// Labelled cloud-clutter datasets (docs/DATASETS.md): a description of ranges, one scene per
+// sample drawn from them by counter-based randomness keyed by (dataset seed, sample index),
+// and the labels of a rendered sample. No files, no GL: the dataset command does those.
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "renderer/frame.h"
+#include "world/formations/cloud_field.h"
+#include "world/scene.h"
+
+namespace nephele {
+
+// A closed interval each sample draws uniformly from; lo == hi is a fixed value.
+struct Span {
+  double lo = 0.0, hi = 0.0;
+};
+
+// One category of target and how its instances are placed.
+struct TargetClass {
+  std::string name;  // the COCO category name
+  TargetShape shape = TargetShape::kBox;
+  std::shared_ptr<const TriangleMesh> mesh;  // shape mesh
+  std::string mesh_path;                     // as written, for the manifest
+  glm::dvec3 size{10.0, 10.0, 3.0};          // as Target::size
+  glm::dvec3 colour{0.35, 0.35, 0.38};
+  Span count{1.0, 1.0};  // instances per sample (integers)
+  Span distance{300.0, 3000.0};
+  Span heading{0.0, 360.0}, pitch{0.0, 0.0}, roll{0.0, 0.0};
+};
+
+struct DatasetSpec {
+  std::uint64_t seed = 1;
+  int samples = 100;
+  int width = 640, height = 480;
+  // What each sample writes besides its PNG, YOLO text and record (docs/DATASETS.md).
+  bool write_masks = true;
+  bool write_depth = false;     // depth, cloud depth and object id as an EXR
+  bool write_coverage = false;  // coverage and visibility as an EXR
+  // Heaps drawn as ellipsoids out to this distance and as a far deck beyond (MODEL.md section
+  // 11, RenderSettings::heap_range_m); 0 is automatic (40 km plus twice the height).
+  double heap_range_m = 0.0;
+
+  // Sky: each sample has `layers` weather layers, each of a genus drawn from `genera`.
+  std::vector<CloudType> genera{CloudType::kCumulus};
+  Span layers{1.0, 1.0};
+  Span coverage{0.2, 0.6};
+  Span base{600.0, 2000.0};
+  Span thickness{300.0, 1500.0};
+  Span sun_azimuth{0.0, 360.0}, sun_elevation{15.0, 70.0};
+  double fog_probability = 0.0;
+  Span fog_top{50.0, 300.0}, fog_visibility{2000.0, 20000.0};
+
+  // Camera at (0, 0, altitude).
+  Span altitude{300.0, 3000.0};
+  Span heading{0.0, 360.0}, pitch{-5.0, 10.0}, roll{0.0, 0.0}, vfov{30.0, 60.0};
+
+  std::vector<TargetClass> targets;
+  // The share of targets placed behind cloud (centre ray's cloud transmittance below 0.9);
+  // the others are placed in the clear (above 0.99) where the sky allows.
+  double occluded_fraction = 0.5;
+};
+
+// The same checks the dataset file reader applies after its per-key ranges: empty when the
+// description can be drawn, else what is wrong.
+std::string datasetSpecError(const DatasetSpec& spec);
+
+// One sample's scene and the record of every draw (for the manifest).
+struct SampleScene {
+  Scene scene;
+  std::vector<int> target_class;  // per scene target: index into spec.targets
+  nlohmann::json record;          // index, seed, sky, sun, fog, camera, targets
+};
+SampleScene drawSample(const DatasetSpec& spec, int index);
+
+// Labels of one rendered sample. `frame` holds object_id and visibility.
+struct TargetLabel {
+  int target = 0;                  // index into the scene's targets
+  int category = 0;                // index into spec.targets
+  int silhouette_px = 0;           // pixels where the target is the first opaque surface
+  int visible_px = 0;              // of those, pixels with cloud transmittance >= 1/2
+  double visibility = 0.0;         // mean transmittance over the silhouette
+  double box_full[4]{};            // x, y, width, height of the silhouette, pixels
+  double box[4]{};                 // of the visible part
+  std::vector<std::uint32_t> rle;  // COCO uncompressed RLE of the visible part, column-major
+};
+std::vector<TargetLabel> labelTargets(const Frame& frame, const std::vector<int>& target_class);
+
+// The visible-part mask of every target: 1 + target index where visible, 0 elsewhere.
+std::vector<std::uint16_t> instanceMask(const Frame& frame);
+
+// One sample's COCO image entry and annotations (ids filled in when merged), YOLO lines.
+nlohmann::json sampleLabelsJson(const std::vector<TargetLabel>& labels, int width, int height);
+std::string yoloText(const std::vector<TargetLabel>& labels, int width, int height);
+
+// The COCO file of a dataset from its sample records in index order.
+nlohmann::json cocoFile(const DatasetSpec& spec, const std::vector<nlohmann::json>& samples);
+
+}  // namespace nephele
