@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <optional>
 
+#include "protocol/messages.h"
 #include "renderer/reference/reference_renderer.h"
 #include "world/counter_random.h"
 #include "world/formations/weather.h"
@@ -43,18 +44,6 @@ const char* shapeName(TargetShape shape) {
 
 json vec3(glm::dvec3 v) {
   return json::array({v.x, v.y, v.z});
-}
-
-json frameInfoJson(const FrameInfo& info) {
-  return {{"position", vec3(info.position)},
-          {"heading_deg", info.orientation.heading_deg},
-          {"pitch_deg", info.orientation.pitch_deg},
-          {"roll_deg", info.orientation.roll_deg},
-          {"vfov_deg", info.vfov_deg},
-          {"focal_px", info.focal_px},
-          {"principal_point", json::array({info.cx, info.cy})},
-          {"time_s", info.time_s},
-          {"tick", info.tick}};
 }
 
 std::string spanError(const char* name, Span s) {
@@ -149,7 +138,7 @@ SampleScene drawSample(const DatasetSpec& spec, int index) {
   camera.position = {0.0, 0.0, cam.in(spec.altitude)};
   camera.orientation = {cam.in(spec.heading), cam.in(spec.pitch), cam.in(spec.roll)};
   camera.vfov_deg = cam.in(spec.vfov);
-  record["camera"] = frameInfoJson(frameInfo(camera, 0.0));
+  record["camera"] = cameraJson(frameInfo(camera, 0.0));
 
   // Targets: a pixel and a distance per instance; those meant to be behind cloud (or in the
   // clear) try up to kPlacementAttempts placements for one whose centre ray says so.

@@ -239,13 +239,15 @@ std::string writeMaskPng(const std::string& path, int width, int height,
                        std::ptrdiff_t(width) * sizeof(std::uint16_t));
 }
 
-std::string writeExrPlanes(const std::string& path, int width, int height,
-                           const std::vector<ExrPlane>& planes,
-                           const std::vector<ImageAttribute>& attributes,
-                           const EncodeOptions& options) {
+namespace {
+
+// The spec and interleaved pixels of named planes (writeExrPlanes, encodeExrPlanes).
+std::string exrPlanes(int width, int height, const std::vector<ExrPlane>& planes,
+                      const std::vector<ImageAttribute>& attributes, const EncodeOptions& options,
+                      oiio::ImageSpec& spec, std::vector<float>& pixels) {
   const int n = int(planes.size());
-  if (n == 0) return "cannot write '" + path + "': no channel to write";
-  oiio::ImageSpec spec(width, height, n, oiio::TypeDesc::FLOAT);
+  if (n == 0) return "no channel to write";
+  spec = oiio::ImageSpec(width, height, n, oiio::TypeDesc::FLOAT);
   spec.channelnames.clear();
   for (int c = 0; c < n; ++c) {
     const std::string& name = planes[c].name;
@@ -263,11 +265,39 @@ std::string writeExrPlanes(const std::string& path, int width, int height,
     else
       spec.attribute(a.name, a.text);
   }
-  std::vector<float> pixels(std::size_t(width) * height * n);
+  pixels.assign(std::size_t(width) * height * n, 0.0f);
   for (std::size_t i = 0; i < std::size_t(width) * height; ++i)
     for (int c = 0; c < n; ++c) pixels[i * n + c] = planes[c].data[i * planes[c].stride];
+  return "";
+}
+
+}  // namespace
+
+std::string writeExrPlanes(const std::string& path, int width, int height,
+                           const std::vector<ExrPlane>& planes,
+                           const std::vector<ImageAttribute>& attributes,
+                           const EncodeOptions& options) {
+  oiio::ImageSpec spec;
+  std::vector<float> pixels;
+  if (std::string e = exrPlanes(width, height, planes, attributes, options, spec, pixels);
+      !e.empty())
+    return "cannot write '" + path + "': " + e;
+  const std::ptrdiff_t n = std::ptrdiff_t(planes.size());
   return writeWithOiio(path, ImageFileFormat::kExr, spec, oiio::TypeDesc::FLOAT, pixels.data(),
                        n * sizeof(float), std::ptrdiff_t(width) * n * sizeof(float));
+}
+
+std::string encodeExrPlanes(int width, int height, const std::vector<ExrPlane>& planes,
+                            const std::vector<ImageAttribute>& attributes,
+                            const EncodeOptions& options, std::vector<std::uint8_t>& out) {
+  oiio::ImageSpec spec;
+  std::vector<float> pixels;
+  if (std::string e = exrPlanes(width, height, planes, attributes, options, spec, pixels);
+      !e.empty())
+    return e;
+  const std::ptrdiff_t n = std::ptrdiff_t(planes.size());
+  return encodeWithOiio(".exr", spec, oiio::TypeDesc::FLOAT, pixels.data(), n * sizeof(float),
+                        std::ptrdiff_t(width) * n * sizeof(float), out);
 }
 
 }  // namespace nephele

@@ -59,6 +59,9 @@ std::string writeExrPlanes(const std::string& path, int width, int height,
                            const std::vector<ExrPlane>& planes,
                            const std::vector<ImageAttribute>& attributes,
                            const EncodeOptions& options = {});
+std::string encodeExrPlanes(int width, int height, const std::vector<ExrPlane>& planes,
+                            const std::vector<ImageAttribute>& attributes,
+                            const EncodeOptions& options, std::vector<std::uint8_t>& out);
 
 // In-memory images for the socket protocol. `colour` selects RGB and `coverage` the alpha;
 // each returns an empty string on success, else what went wrong. PNG takes any selection,

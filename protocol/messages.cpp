@@ -169,19 +169,32 @@ std::optional<ImageRequest> readImage(FieldReader& r) {
   image.format = readFormat(r, image.format);
   image.coverage = defaultCoverage(image.format);
   if (const json* channels = r.raw("channels")) {
-    const std::string allowed = " (allowed: a non-empty array of \"colour\" and \"coverage\")";
-    if (!channels->is_array() || channels->empty() || channels->size() > 2)
+    const std::string allowed = " (allowed: a non-empty array of " + channelNames() +
+                                "; depth, cloud_depth, object_id and visibility with raw or exr)";
+    if (!channels->is_array() || channels->empty() || channels->size() > kChannels.size())
       r.fail("channels", "must be an array of channel names" + allowed);
     image.colour = image.coverage = false;
+    ChannelSet seen;
     for (const json& c : *channels) {
       const std::string name = c.is_string() ? c.get<std::string>() : c.dump();
-      bool& flag = name == "colour" ? image.colour : image.coverage;
-      if (name == "depth")
-        r.fail("channels", "\"depth\" is not available from this renderer" + allowed);
-      if ((name != "colour" && name != "coverage") || flag)
+      const std::optional<Channel> channel = channelFromName(name);
+      if (!channel || seen.has(*channel))
         r.fail("channels", name + " is not allowed or repeated" + allowed);
-      flag = true;
+      seen.add(*channel);
+      image.order.push_back(*channel);
+      if (*channel == Channel::kColour)
+        image.colour = true;
+      else if (*channel == Channel::kCoverage)
+        image.coverage = true;
+      else
+        image.planes.add(*channel);
     }
+    if (image.floatPlanes() && image.format != ImageFormat::kRaw &&
+        image.format != ImageFormat::kExr)
+      r.fail("channels",
+             "depth, cloud_depth, object_id and visibility are float planes: "
+             "format raw or exr only (allowed with " +
+                 std::string(imageFormatName(image.format)) + ": colour, coverage)");
   }
   if (image.format == ImageFormat::kJpeg && image.coverage)
     r.fail("channels", "jpeg holds colour only (allowed with jpeg: [\"colour\"])");
@@ -515,9 +528,23 @@ std::string frameEventHeader(std::int64_t subscription, json image, std::size_t 
 
 json channelNames(const ImageRequest& image) {
   json out = json::array();
+  if (!image.order.empty()) {
+    for (Channel c : image.order) out.push_back(nephele::channelName(c));
+    return out;
+  }
   if (image.colour) out.push_back("colour");
   if (image.coverage) out.push_back("coverage");
   return out;
+}
+
+json cameraJson(const FrameInfo& info) {
+  return {{"position", {info.position.x, info.position.y, info.position.z}},
+          {"heading_deg", info.orientation.heading_deg},
+          {"pitch_deg", info.orientation.pitch_deg},
+          {"roll_deg", info.orientation.roll_deg},
+          {"vfov_deg", info.vfov_deg},
+          {"focal_px", info.focal_px},
+          {"principal_point", {info.cx, info.cy}}};
 }
 
 }  // namespace nephele

@@ -11,6 +11,8 @@
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
+#include "renderer/frame.h"
+
 #include "world/formations/weather.h"
 
 namespace nephele {
@@ -56,7 +58,17 @@ struct ImageRequest {
   ImageFormat format = ImageFormat::kRaw;
   bool colour = true;
   bool coverage = true;
+  // Ground-truth channels (depth, cloud_depth, object_id, visibility; renderer/frame.h), raw
+  // or EXR only. With any of them a raw image is float32 planes, one per channel in the
+  // order of `order`, colour as three linear planes.
+  ChannelSet planes;
+  std::vector<Channel> order;  // every asked channel as the request listed it
   int channelCount() const { return (colour ? 3 : 0) + (coverage ? 1 : 0); }
+  bool floatPlanes() const { return !planes.empty(); }
+  bool operator==(const ImageRequest& o) const {
+    return format == o.format && colour == o.colour && coverage == o.coverage &&
+           planes == o.planes && order == o.order;
+  }
 };
 
 // Fields of a view; unset ones stay as they are.
@@ -169,5 +181,8 @@ std::string frameEventHeader(std::int64_t subscription, nlohmann::json image,
 
 // Channel names of an image request, e.g. ["colour", "coverage"].
 nlohmann::json channelNames(const ImageRequest& image);
+// The camera a frame was seen from, as frame headers and dataset records carry it: position,
+// attitude, vertical field of view, focal length in pixels and principal point.
+nlohmann::json cameraJson(const FrameInfo& info);
 
 }  // namespace nephele

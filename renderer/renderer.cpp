@@ -86,23 +86,51 @@ std::vector<ImageAttribute> frameAttributes(const FrameInfo& info) {
   };
 }
 
+namespace {
+
+std::vector<ExrPlane> framePlanes(const Frame& frame, const std::vector<Channel>& order) {
+  std::vector<ExrPlane> planes;
+  const float* rgba = frame.colour.rgba.data();
+  for (Channel c : order) {
+    switch (c) {
+      case Channel::kColour:
+        for (int k = 0; k < 3; ++k) planes.push_back({std::string(1, "RGB"[k]), rgba + k, 4});
+        break;
+      case Channel::kCoverage:
+        planes.push_back({"A", rgba + 3, 4});
+        break;
+      case Channel::kDepth:
+        planes.push_back({channelName(c), frame.depth.data(), 1});
+        break;
+      case Channel::kCloudDepth:
+        planes.push_back({channelName(c), frame.cloud_depth.data(), 1});
+        break;
+      case Channel::kObjectId:
+        planes.push_back({channelName(c), frame.object_id.data(), 1});
+        break;
+      case Channel::kVisibility:
+        planes.push_back({channelName(c), frame.visibility.data(), 1});
+        break;
+    }
+  }
+  return planes;
+}
+
+}  // namespace
+
 std::string writeFrameExr(const std::string& path, const Frame& frame,
                           const EncodeOptions& options) {
-  std::vector<ExrPlane> planes;
-  const ChannelSet& c = frame.channels;
-  const float* rgba = frame.colour.rgba.data();
-  if (c.has(Channel::kColour))
-    for (int k = 0; k < 3; ++k) planes.push_back({std::string(1, "RGB"[k]), rgba + k, 4});
-  if (c.has(Channel::kCoverage)) planes.push_back({"A", rgba + 3, 4});
-  const std::pair<Channel, const std::vector<float>*> singles[] = {
-      {Channel::kDepth, &frame.depth},
-      {Channel::kCloudDepth, &frame.cloud_depth},
-      {Channel::kObjectId, &frame.object_id},
-      {Channel::kVisibility, &frame.visibility}};
-  for (const auto& [channel, plane] : singles)
-    if (c.has(channel)) planes.push_back({channelName(channel), plane->data(), 1});
-  return writeExrPlanes(path, frame.width(), frame.height(), planes, frameAttributes(frame.info),
-                        options);
+  std::vector<Channel> order;
+  for (const ChannelInfo& info : kChannels)
+    if (frame.channels.has(info.channel)) order.push_back(info.channel);
+  return writeExrPlanes(path, frame.width(), frame.height(), framePlanes(frame, order),
+                        frameAttributes(frame.info), options);
+}
+
+std::string encodeFrameExr(const Frame& frame, const std::vector<Channel>& order,
+                           const EncodeOptions& options, std::vector<std::uint8_t>& out) {
+  return encodeExrPlanes(frame.width(), frame.height(), framePlanes(frame, order),
+                         frameAttributes(frame.info), options, out);
 }
 
 }  // namespace nephele

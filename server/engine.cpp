@@ -12,6 +12,7 @@
 #include "image/image_encoding.h"
 #include "renderer/gl/gl_platform.h"
 #include "renderer/gl/gl_renderer.h"
+#include "renderer/renderer.h"
 #include "world/counter_random.h"
 #include "world/limits.h"
 #include "world/world.h"
@@ -302,6 +303,7 @@ void Engine::noteError(ErrorCode code) {
 struct ViewFrame {
   Srgb8Image srgb;
   FloatImage linear;  // for EXR
+  Frame planes;       // with ground-truth channels (ImageRequest::floatPlanes)
   nlohmann::json meta;
 };
 
@@ -313,6 +315,29 @@ std::variant<std::vector<std::uint8_t>, std::string> encodeFrame(const ViewFrame
                                                                  const EncodeOptions& options) {
   std::vector<std::uint8_t> bytes;
   std::string error;
+  if (image.floatPlanes()) {
+    const Frame& f = frame.planes;
+    if (image.format == ImageFormat::kExr) {
+      error = encodeFrameExr(f, image.order, options, bytes);
+      if (!error.empty()) return error;
+      return bytes;
+    }
+    // Raw: float32 planes, host byte order (little-endian on x86-64 and ARM), in the order asked.
+    const std::size_t pixels = std::size_t(f.width()) * f.height();
+    std::vector<float> planes;
+    planes.reserve(pixels * (image.order.size() + 2));
+    for (Channel c : image.order) {
+      if (c == Channel::kColour) {
+        for (int k = 0; k < 3; ++k)
+          for (std::size_t i = 0; i < pixels; ++i) planes.push_back(f.colour.rgba[i * 4 + k]);
+      } else {
+        const std::vector<float> plane = f.plane(c);
+        planes.insert(planes.end(), plane.begin(), plane.end());
+      }
+    }
+    const auto* raw = reinterpret_cast<const std::uint8_t*>(planes.data());
+    return std::vector<std::uint8_t>(raw, raw + planes.size() * sizeof(float));
+  }
   switch (image.format) {
     case ImageFormat::kRaw:
       return packRaw(frame.srgb, image.colour, image.coverage);
@@ -337,7 +362,9 @@ json imageMeta(const ViewFrame& frame, const ImageRequest& image) {
   meta["format"] = imageFormatName(image.format);
   meta["channels"] = channelNames(image);
   meta["rows"] = "top-down";
-  meta["encoding"] = image.format == ImageFormat::kExr ? "linear" : "srgb";
+  meta["encoding"] = image.format == ImageFormat::kExr ? "linear"
+                     : image.floatPlanes()             ? "float32-planes"
+                                                       : "srgb";
   return meta;
 }
 
@@ -704,9 +731,9 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
     if (!v) return notFoundView(c->view);
     const ImageRequest image = c->image.value_or(v->image);
     auto frame = std::make_shared<ViewFrame>();
-    renderFrame(*v, image.format == ImageFormat::kExr, *frame);
+    renderFrame(*v, image, *frame);
     json meta = imageMeta(*frame, image);
-    if (image.format == ImageFormat::kRaw) {
+    if (image.format == ImageFormat::kRaw && !image.floatPlanes()) {
       auto body = packRaw(frame->srgb, image.colour, image.coverage);
       std::string header = imageReplyHeader(job.request.id, std::move(meta), body.size());
       job.reply(makeReply(std::move(header),
@@ -794,15 +821,23 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
   return ProtocolError{ErrorCode::kUnknownCommand, "unhandled command"};
 }
 
-void Engine::renderFrame(const ViewConfig& view, bool linear, ViewFrame& frame) {
+void Engine::renderFrame(const ViewConfig& view, const ImageRequest& image, ViewFrame& frame) {
   State& s = *state_;
   Scene scene = s.world->scene();
   scene.camera = view.camera;
   const auto t0 = Clock::now();
-  if (linear)
+  if (image.floatPlanes()) {
+    FrameRequest request;
+    request.channels = image.planes;
+    if (image.colour) request.channels.add(Channel::kColour);
+    if (image.coverage) request.channels.add(Channel::kCoverage);
+    request.tick = std::uint64_t(s.ticks);
+    frame.planes = s.renderer->renderFrame(scene, config_.scene.render, request);
+  } else if (image.format == ImageFormat::kExr) {
     frame.linear = s.renderer->renderFloat(scene, config_.scene.render);
-  else
+  } else {
     frame.srgb = s.renderer->renderSrgb8(scene, config_.scene.render);
+  }
   s.last_render_ms = msSince(t0);
   s.render_ms.push_back(s.last_render_ms);
   if (s.render_ms.size() > kRenderHistory) s.render_ms.pop_front();
@@ -812,7 +847,9 @@ void Engine::renderFrame(const ViewConfig& view, bool linear, ViewFrame& frame) 
                 {"height", view.camera.height},
                 {"time", s.world->timeSeconds()},
                 {"tick", s.ticks},
-                {"frame", s.frames}};
+                {"frame", s.frames},
+                {"camera", cameraJson(frameInfo(view.camera, s.world->timeSeconds(),
+                                                std::uint64_t(s.ticks)))}};
 }
 
 std::optional<ProtocolError> Engine::setWeather(int layer, const WeatherLayer& weather) {
@@ -868,10 +905,8 @@ void Engine::deliverFrames(bool only_due, const std::string& view_name) {
     std::shared_ptr<ViewFrame> frames[2];  // 8-bit and linear
     std::vector<std::pair<ImageRequest, std::vector<Subscription*>>> groups;
     for (Subscription* sub : subs) {
-      auto it = std::find_if(groups.begin(), groups.end(), [&](const auto& g) {
-        return g.first.format == sub->image.format && g.first.colour == sub->image.colour &&
-               g.first.coverage == sub->image.coverage;
-      });
+      auto it = std::find_if(groups.begin(), groups.end(),
+                             [&](const auto& g) { return g.first == sub->image; });
       if (it == groups.end())
         groups.push_back({sub->image, {sub}});
       else
@@ -879,10 +914,11 @@ void Engine::deliverFrames(bool only_due, const std::string& view_name) {
     }
     for (auto& [image, members] : groups) {
       const bool linear = image.format == ImageFormat::kExr;
-      std::shared_ptr<ViewFrame>& frame = frames[linear ? 1 : 0];
+      std::shared_ptr<ViewFrame> planes;  // ground-truth channels: rendered for this group
+      std::shared_ptr<ViewFrame>& frame = image.floatPlanes() ? planes : frames[linear ? 1 : 0];
       if (!frame) {
         frame = std::make_shared<ViewFrame>();
-        renderFrame(*view, linear, *frame);
+        renderFrame(*view, image, *frame);
       }
       std::vector<Subscription> sinks;  // copies: the encoder may run after a change
       for (Subscription* sub : members) sinks.push_back(*sub);
@@ -899,7 +935,7 @@ void Engine::deliverFrames(bool only_due, const std::string& view_name) {
           if (!sub.sink(makeReply(frameEventHeader(sub.id, meta, bytes->size()), bytes)))
             sub.gone->store(true);
       };
-      if (image.format == ImageFormat::kRaw)
+      if (image.format == ImageFormat::kRaw && !image.floatPlanes())
         send();
       else if (!encoder_->post(send))
         frames_dropped += members.size();
@@ -912,7 +948,9 @@ void Engine::renderTrigger() {
   const ViewConfig& view = *s.view(config_.modbus_view);
   const bool linear = config_.output_format == ImageFormat::kExr;
   auto frame = std::make_shared<ViewFrame>();
-  renderFrame(view, linear, *frame);
+  ImageRequest image;
+  image.format = config_.output_format;
+  renderFrame(view, image, *frame);
   const std::string extension = config_.output_format == ImageFormat::kPng    ? ".png"
                                 : config_.output_format == ImageFormat::kJpeg ? ".jpg"
                                                                               : ".exr";

@@ -134,7 +134,7 @@ class Engine {
   std::optional<ProtocolError> checkAdvance(double dt_s) const;
   void advance(double dt_s);  // one tick
   // Renders a view (float for EXR, else 8-bit) and records its time.
-  void renderFrame(const ViewConfig& view, bool linear, struct ViewFrame& frame);
+  void renderFrame(const ViewConfig& view, const ImageRequest& image, struct ViewFrame& frame);
   void realtimeTicks();
   void deliverFrames(bool only_due, const std::string& view);
   void renderTrigger();

@@ -5,6 +5,7 @@ protocol, pymodbus and mbpoll. Readiness is the daemon's ready line, never a sle
 Run by ctest with NEPHELE_BINARY and NEPHELE_SOURCE_DIR set; /usr/bin/python3 (Debian's,
 which has pymodbus)."""
 import json
+import math
 import os
 import signal
 import socket
@@ -246,6 +247,27 @@ class SocketProtocolTest(DaemonTest):
         coverage = raw[3::4]
         self.assertGreater(max(coverage), 200)
         self.assertEqual(min(coverage), 0)
+        # Ground truth as float32 planes in the order asked, with the camera in the header:
+        # visibility is 1 - coverage, depth is finite only below the horizon (the ground).
+        meta, planes = c.ok({"cmd": "render", "view": "front",
+                             "channels": ["visibility", "depth", "coverage"]})
+        image = meta["image"]
+        self.assertEqual(image["encoding"], "float32-planes")
+        self.assertEqual(image["channels"], ["visibility", "depth", "coverage"])
+        self.assertAlmostEqual(image["camera"]["focal_px"],
+                               24 / math.tan(math.radians(view["vfov"] / 2)), places=6)
+        self.assertEqual(image["camera"]["principal_point"], [32.0, 24.0])
+        self.assertEqual(len(planes), 64 * 48 * 4 * 3)
+        n = 64 * 48
+        values = struct.unpack("<%df" % (3 * n), planes)
+        visibility, depth, cover = values[:n], values[n:2 * n], values[2 * n:]
+        self.assertTrue(all(abs(v + c - 1.0) < 1e-6 for v, c in zip(visibility, cover)))
+        self.assertTrue(all(math.isinf(d) or d > 0 for d in depth))
+        self.assertTrue(any(math.isinf(d) for d in depth[:64]))  # sky in the top row
+        _, exr = c.ok({"cmd": "render", "view": "front", "format": "exr",
+                       "channels": ["colour", "object_id"]})
+        self.assertEqual(exr[:4], b"\x76\x2f\x31\x01")
+        self.assertIn(b"object_id", exr[:2000])
 
     def test_set_view_changes_the_frame(self):
         d = self.daemon()
@@ -271,7 +293,10 @@ class SocketProtocolTest(DaemonTest):
             ({"cmd": "set_weather", "layer": 1, "type": 7, "coverage": -5}, "bad_field",
              "coverage"),
             ({"cmd": "render", "view": "front", "format": "gif"}, "bad_field", "raw, png"),
-            ({"cmd": "render", "view": "front", "channels": ["depth"]}, "bad_field", "depth"),
+            ({"cmd": "render", "view": "front", "format": "png", "channels": ["depth"]},
+             "bad_field", "format raw or exr only"),
+            ({"cmd": "render", "view": "front", "channels": ["height"]}, "bad_field",
+             "allowed: a non-empty array of colour, coverage, depth, cloud_depth"),
             ({"cmd": "render", "view": "front", "format": "jpeg", "channels": ["coverage"]},
              "bad_field", "jpeg"),
             ({"cmd": "tick", "dt": -1}, "bad_field", "dt"),
