@@ -161,20 +161,37 @@ SampleScene drawSample(const DatasetSpec& spec, int index) {
       target.orientation = {draw.in(cls.heading), draw.in(cls.pitch), draw.in(cls.roll)};
       double transmittance = 1.0;
       bool met = false;
+      const bool cloudy = !scene.layers.empty() || !scene.fields.empty();
+      auto transmittanceTo = [&](glm::dvec3 d, double distance) {
+        if (!cloudy) return 1.0;
+        if (!probe) probe.emplace(scene, spec.heap_range_m);
+        return probe->transmittance(d, distance);
+      };
       for (int attempt = 0; attempt < kPlacementAttempts && !met; ++attempt) {
+        const bool last = attempt + 1 == kPlacementAttempts;
         const double px = draw.in({0.1 * spec.width, 0.9 * spec.width});
         const double py = draw.in({0.1 * spec.height, 0.9 * spec.height});
-        const double distance = draw.in(cls.distance);
         const glm::dvec3 d = glm::normalize(rayDirection(basis, camera, px, py));
-        const glm::dvec3 centre = camera.position + distance * d;
-        if (centre.z < 0.0 && attempt + 1 < kPlacementAttempts) continue;  // below the ground
-        target.centre = centre;
-        if (scene.layers.empty() && scene.fields.empty()) {
-          transmittance = 1.0;
-        } else {
-          if (!probe) probe.emplace(scene, spec.heap_range_m);
-          transmittance = probe->transmittance(d, distance);
+        Span range = cls.distance;
+        if (behind && cloudy) {
+          // Behind cloud: only as far as the cloud along this ray allows. Transmittance falls
+          // with distance; the nearest distance where it is below 0.9 is found by bisection
+          // and the target drawn between it and the far end.
+          if (transmittanceTo(d, range.hi) >= 0.9 && !last) continue;
+          if (transmittanceTo(d, range.lo) >= 0.9) {
+            double lo = range.lo, hi = range.hi;
+            for (int k = 0; k < 12; ++k) {
+              const double mid = 0.5 * (lo + hi);
+              (transmittanceTo(d, mid) < 0.9 ? hi : lo) = mid;
+            }
+            range.lo = hi;
+          }
         }
+        const double distance = draw.in(range);
+        const glm::dvec3 centre = camera.position + distance * d;
+        if (centre.z < 0.0 && !last) continue;  // below the ground
+        target.centre = centre;
+        transmittance = transmittanceTo(d, distance);
         met = behind ? transmittance < 0.9 : transmittance > 0.99;
       }
       scene.targets.push_back(target);
