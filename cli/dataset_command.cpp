@@ -93,32 +93,48 @@ struct Rendered {
 
 // Labels, masks, images and the record of one sample; the record last, so that a sample
 // whose record exists is complete (--resume).
-std::string writeSample(const DatasetSpec& spec, const fs::path& dir, const Rendered& r,
-                        const EncodeOptions& encode) {
+std::string writeSample(const DatasetSpec& spec, const BandTable& band, const fs::path& dir,
+                        const Rendered& r, const EncodeOptions& encode) {
   const std::string name = sampleName(r.index);
   const int w = r.frame.width(), h = r.frame.height();
   const std::vector<TargetLabel> labels = labelTargets(r.frame, r.sample.target_class);
   json record = r.sample.record;
   record["file_name"] = "images/" + name + ".png";
-  record["camera"] = record["camera"];  // as drawn; the frame's own info is the same camera
   record["labels"] = sampleLabelsJson(labels, w, h);
-  std::string e =
-      writeImageFile((dir / "images" / (name + ".png")).string(), r.frame.colour, encode);
+  const std::string image = (dir / "images" / (name + ".png")).string();
+  std::string e;
+  std::vector<float> kelvin;
+  if (spec.band == Band::kLwir) {
+    // Brightness temperature, shown linearly from display_k.lo (black) to .hi (white).
+    kelvin.resize(r.frame.lwir.size());
+    Srgb8Image grey{w, h, false, std::vector<std::uint8_t>(kelvin.size() * 4, 255)};
+    for (std::size_t i = 0; i < kelvin.size(); ++i) {
+      kelvin[i] = float(band.temperature(r.frame.lwir[i]));
+      const std::uint8_t v =
+          toByte((kelvin[i] - spec.display_k.lo) / (spec.display_k.hi - spec.display_k.lo));
+      grey.rgba[i * 4] = grey.rgba[i * 4 + 1] = grey.rgba[i * 4 + 2] = v;
+    }
+    e = writeImageFile(image, grey, encode);
+  } else {
+    e = writeImageFile(image, r.frame.colour, encode);
+  }
   if (e.empty() && spec.write_masks)
     e = writeMaskPng((dir / "masks" / (name + ".png")).string(), w, h, instanceMask(r.frame),
                      encode);
   if (e.empty()) e = writeText(dir / "labels" / (name + ".txt"), yoloText(labels, w, h));
-  if (e.empty() && (spec.write_depth || spec.write_coverage)) {
-    Frame planes = r.frame;
-    planes.channels = {};
+  if (e.empty() && (spec.write_depth || spec.write_coverage || spec.band == Band::kLwir)) {
+    std::vector<Channel> order;
+    if (spec.band == Band::kLwir) order.push_back(Channel::kLwir);
     if (spec.write_depth)
-      for (Channel c : {Channel::kDepth, Channel::kCloudDepth, Channel::kObjectId})
-        planes.channels.add(c);
-    if (spec.write_coverage)
-      for (Channel c : {Channel::kCoverage, Channel::kVisibility}) planes.channels.add(c);
+      order.insert(order.end(), {Channel::kDepth, Channel::kCloudDepth, Channel::kObjectId});
+    if (spec.write_coverage) order.insert(order.end(), {Channel::kCoverage, Channel::kVisibility});
+    std::vector<ExrPlane> planes = exrPlanesOf(r.frame, order);
+    if (spec.band == Band::kLwir)
+      planes.insert(planes.begin() + 1, {"brightness_temperature", kelvin.data(), 1});
     EncodeOptions exr = encode;
     exr.exr_compression = "zip";
-    e = writeFrameExr((dir / "exr" / (name + ".exr")).string(), planes, exr);
+    e = writeExrPlanes((dir / "exr" / (name + ".exr")).string(), w, h, planes,
+                       frameAttributes(r.frame.info), exr);
   }
   if (e.empty()) e = writeText(dir / "records" / (name + ".json"), record.dump() + "\n");
   return e;
@@ -243,7 +259,8 @@ int runDatasetCommand(const DatasetCommandOptions& o) {
   }
   for (const char* sub : {"images", "masks", "labels", "exr", "records"}) {
     if ((std::string(sub) == "masks" && !spec.write_masks) ||
-        (std::string(sub) == "exr" && !spec.write_depth && !spec.write_coverage))
+        (std::string(sub) == "exr" && !spec.write_depth && !spec.write_coverage &&
+         spec.band != Band::kLwir))
       continue;
     fs::create_directories(dir / sub, ec);
     if (ec) {
@@ -306,13 +323,15 @@ int runDatasetCommand(const DatasetCommandOptions& o) {
       skipped > 0 ? ", " + std::to_string(skipped) + " already written" : "");
 
   FrameRequest request;
-  request.channels = {Channel::kColour, Channel::kObjectId, Channel::kVisibility};
+  request.channels = {spec.band == Band::kLwir ? Channel::kLwir : Channel::kColour,
+                      Channel::kObjectId, Channel::kVisibility};
   if (spec.write_depth)
     for (Channel c : {Channel::kDepth, Channel::kCloudDepth}) request.channels.add(c);
   if (spec.write_coverage) request.channels.add(Channel::kCoverage);
 
   // Rendering (this thread, which holds the GL context) and encoding (one worker) overlap;
   // at most two rendered samples wait.
+  const BandTable band(spec.infrared);
   std::mutex mutex;
   std::condition_variable changed;
   std::deque<Rendered> queue;
@@ -330,7 +349,7 @@ int runDatasetCommand(const DatasetCommandOptions& o) {
       changed.notify_all();
       lock.unlock();
       const auto start = Clock::now();
-      std::string e = writeSample(spec, dir, r, o.encode);
+      std::string e = writeSample(spec, band, dir, r, o.encode);
       lock.lock();
       write_s += std::chrono::duration<double>(Clock::now() - start).count();
       if (!e.empty() && write_error.empty()) write_error = e;
@@ -357,6 +376,7 @@ int runDatasetCommand(const DatasetCommandOptions& o) {
     if (n + 1 < todo.size()) next = drawAsync(n + 1);
     Rendered r{todo[n], std::move(sample), {}};
     const auto t1 = Clock::now();
+    request.infrared = r.sample.infrared;
     r.frame = renderer->render(r.sample.scene, request);
     const auto t2 = Clock::now();
     spdlog::debug(

@@ -29,12 +29,29 @@ void readDataset(TableReader& t, DatasetSpec& spec) {
   t.integer("samples", spec.samples, 1, Limits::kMaxSamples);
   t.integer("width", spec.width, 1, Limits::kMaxImageSide);
   t.integer("height", spec.height, 1, Limits::kMaxImageSide);
-  t.choice("band", {"visible"}, 0);
+  spec.band = Band(t.choice("band", {"visible", "lwir"}, int(spec.band)));
   t.boolean("masks", spec.write_masks);
   t.boolean("depth", spec.write_depth);
   t.boolean("coverage", spec.write_coverage);
   t.number("occluded_fraction", spec.occluded_fraction, Limits::kFraction);
   t.number("heap_range", spec.heap_range_m, Limits::kHeapRange);
+  t.finish();
+}
+
+void readInfrared(TableReader& t, DatasetSpec& spec) {
+  InfraredModel& m = spec.infrared;
+  t.allow({"band", "steps", "surface_air", "ground", "ground_emissivity", "sky_zenith_emissivity",
+           "display"});
+  t.span("band", m.band_lo_um, m.band_hi_um, {0.5, 100.0});
+  if (!(m.band_hi_um > m.band_lo_um)) t.failAt("band", "must be [low, high] with low < high");
+  t.integer("steps", m.band_steps, 1, 10000);
+  t.number("surface_air", m.surface_air_k, 150.0, 350.0);
+  t.number("ground", m.ground_k, 150.0, 400.0);
+  t.number("ground_emissivity", m.ground_emissivity, Limits::kFraction);
+  t.number("sky_zenith_emissivity", m.sky_zenith_emissivity, Limits::kFraction);
+  t.span("display", spec.display_k.lo, spec.display_k.hi, {1.0, 5000.0});
+  if (!(spec.display_k.hi > spec.display_k.lo))
+    t.failAt("display", "must be [black, white] kelvin with black < white");
   t.finish();
 }
 
@@ -61,8 +78,8 @@ void readSky(TableReader& t, DatasetSpec& spec) {
 }
 
 void readTargetClass(TableReader& t, const std::string& file, TargetClass& c) {
-  t.allow(
-      {"name", "shape", "mesh", "size", "colour", "count", "distance", "heading", "pitch", "roll"});
+  t.allow({"name", "shape", "mesh", "size", "colour", "count", "distance", "heading", "pitch",
+           "roll", "temperature"});
   if (!t.has("name")) t.failHere("name is missing (the category's name)");
   t.name("name", c.name);
   c.shape = TargetShape(t.choice("shape", {"box", "ellipsoid", "mesh"}, int(c.shape)));
@@ -74,6 +91,7 @@ void readTargetClass(TableReader& t, const std::string& file, TargetClass& c) {
   readSpan(t, "heading", c.heading, {-Limits::kMaxHeading, Limits::kMaxHeading});
   readSpan(t, "pitch", c.pitch, {-Limits::kMaxPitch, Limits::kMaxPitch});
   readSpan(t, "roll", c.roll, {-Limits::kMaxRoll, Limits::kMaxRoll});
+  readSpan(t, "temperature", c.temperature, {1.0, 5000.0});
   t.string("mesh", c.mesh_path);
   if (c.shape == TargetShape::kMesh) {
     if (c.mesh_path.empty()) t.failAt("shape", "shape \"mesh\" needs a mesh = \"file.obj\" key");
@@ -98,9 +116,10 @@ std::string parseDatasetText(std::string_view text, const std::string& source_na
   try {
     const toml::table root = config_detail::parseToml(text, source_name);
     TableReader t(root, "", source_name);
-    t.allow({"dataset", "sky", "sun", "fog", "camera", "target"});
+    t.allow({"dataset", "sky", "sun", "fog", "camera", "target", "infrared"});
     if (auto d = t.table("dataset")) readDataset(*d, spec);
     if (auto sky = t.table("sky")) readSky(*sky, spec);
+    if (auto infrared = t.table("infrared")) readInfrared(*infrared, spec);
     if (auto sun = t.table("sun")) {
       sun->allow({"azimuth", "elevation"});
       readSpan(*sun, "azimuth", spec.sun_azimuth, {-Limits::kMaxHeading, Limits::kMaxHeading});

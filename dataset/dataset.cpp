@@ -18,7 +18,7 @@ using nlohmann::json;
 
 // Independent streams of one sample's draws: changing how many targets a sample has never
 // moves its sky, and the reverse.
-enum Stream : std::uint64_t { kSky = 1, kSun, kFog, kCamera, kTargets };
+enum Stream : std::uint64_t { kSky = 1, kSun, kFog, kCamera, kTargets, kInfrared };
 
 // Draws from (key, counter): the n-th number of a stream is a pure function of both.
 class Draws {
@@ -93,6 +93,7 @@ SampleScene drawSample(const DatasetSpec& spec, int index) {
   json& record = out.record;
   record["index"] = index;
   record["seed"] = std::to_string(seed);
+  record["band"] = spec.band == Band::kLwir ? "lwir" : "visible";
 
   Draws sky = stream(kSky);
   const int layers = spec.genera.empty() ? 0 : sky.integer(spec.layers);
@@ -144,6 +145,8 @@ SampleScene drawSample(const DatasetSpec& spec, int index) {
   // clear) try up to kPlacementAttempts placements for one whose centre ray says so.
   constexpr int kPlacementAttempts = 64;
   Draws draw = stream(kTargets);
+  Draws heat = stream(kInfrared);  // its own stream: both bands place the same targets
+  out.infrared = spec.infrared;
   std::optional<CloudProbe> probe;
   const ViewBasis basis = viewBasis(camera);
   record["targets"] = json::array();
@@ -194,6 +197,8 @@ SampleScene drawSample(const DatasetSpec& spec, int index) {
         transmittance = transmittanceTo(d, distance);
         met = behind ? transmittance < 0.9 : transmittance > 0.99;
       }
+      const double temperature = heat.in(cls.temperature);
+      out.infrared.target_temperatures.push_back(temperature);
       scene.targets.push_back(target);
       out.target_class.push_back(int(c));
       record["targets"].push_back({{"category", cls.name},
@@ -206,7 +211,8 @@ SampleScene drawSample(const DatasetSpec& spec, int index) {
                                    {"size", vec3(target.size)},
                                    {"placed", behind ? "behind cloud" : "clear"},
                                    {"placement_met", met},
-                                   {"centre_transmittance", transmittance}});
+                                   {"centre_transmittance", transmittance},
+                                   {"temperature_k", temperature}});
     }
   }
   return out;

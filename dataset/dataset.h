@@ -31,12 +31,21 @@ struct TargetClass {
   Span count{1.0, 1.0};  // instances per sample (integers)
   Span distance{300.0, 3000.0};
   Span heading{0.0, 360.0}, pitch{0.0, 0.0}, roll{0.0, 0.0};
+  Span temperature{300.0, 300.0};  // kelvin, the infrared band's
 };
+
+enum class Band { kVisible, kLwir };
 
 struct DatasetSpec {
   std::uint64_t seed = 1;
   int samples = 100;
   int width = 640, height = 480;
+  // The visible band, or long-wave infrared (world/infrared.h): then images are brightness
+  // temperature mapped linearly from display_k.lo (black) to display_k.hi (white), and the
+  // EXR holds radiance and brightness temperature.
+  Band band = Band::kVisible;
+  InfraredModel infrared;
+  Span display_k{220.0, 320.0};
   // What each sample writes besides its PNG, YOLO text and record (docs/DATASETS.md).
   bool write_masks = true;
   bool write_depth = false;     // depth, cloud depth and object id as an EXR
@@ -72,6 +81,7 @@ std::string datasetSpecError(const DatasetSpec& spec);
 // One sample's scene and the record of every draw (for the manifest).
 struct SampleScene {
   Scene scene;
+  InfraredModel infrared;         // the spec's, with the targets' drawn temperatures
   std::vector<int> target_class;  // per scene target: index into spec.targets
   nlohmann::json record;          // index, seed, sky, sun, fog, camera, targets
 };

@@ -10,6 +10,7 @@
 
 #include "image/image.h"
 #include "world/frames.h"
+#include "world/infrared.h"
 
 namespace nephele {
 
@@ -20,19 +21,21 @@ enum class Channel : std::uint8_t {
   kCloudDepth,  // metres along the ray where cloud opacity, front to back, first reaches 1/2
   kObjectId,    // 1 + the index of the target covering the pixel, clouds ignored; 0: none
   kVisibility,  // transmittance of the clouds in front of the first opaque surface
+  kLwir,        // long-wave infrared band radiance, W m^-2 sr^-1 (world/infrared.h)
 };
 
 struct ChannelInfo {
   Channel channel;
   const char* name;  // as the CLI, the protocol and EXR layers spell it
 };
-inline constexpr std::array<ChannelInfo, 6> kChannels{{
+inline constexpr std::array<ChannelInfo, 7> kChannels{{
     {Channel::kColour, "colour"},
     {Channel::kCoverage, "coverage"},
     {Channel::kDepth, "depth"},
     {Channel::kCloudDepth, "cloud_depth"},
     {Channel::kObjectId, "object_id"},
     {Channel::kVisibility, "visibility"},
+    {Channel::kLwir, "lwir"},
 }};
 
 inline const char* channelName(Channel c) {
@@ -57,7 +60,7 @@ class ChannelSet {
   ChannelSet(std::initializer_list<Channel> channels) {
     for (Channel c : channels) add(c);
   }
-  static ChannelSet all() { return ChannelSet(0x3F); }
+  static ChannelSet all() { return ChannelSet((1u << kChannels.size()) - 1); }
   void add(Channel c) { bits_ |= 1u << unsigned(c); }
   bool has(Channel c) const { return bits_ & (1u << unsigned(c)); }
   bool empty() const { return bits_ == 0; }
@@ -104,11 +107,12 @@ struct Frame {
   FrameInfo info;
   ChannelSet channels;
   FloatImage colour;  // RGB and coverage as alpha: present for colour or coverage
-  std::vector<float> depth, cloud_depth, object_id, visibility;
+  std::vector<float> depth, cloud_depth, object_id, visibility, lwir;
 
   int width() const { return info.width; }
   int height() const { return info.height; }
-  // The single-float plane of a channel (coverage is copied out of colour's alpha).
+  // The single-float plane of a channel (coverage is copied out of colour's alpha); colour,
+  // three floats per pixel, has none: read `colour`.
   std::vector<float> plane(Channel c) const {
     switch (c) {
       case Channel::kDepth:
@@ -119,12 +123,15 @@ struct Frame {
         return object_id;
       case Channel::kVisibility:
         return visibility;
-      case Channel::kCoverage:
-      case Channel::kColour: {
+      case Channel::kLwir:
+        return lwir;
+      case Channel::kCoverage: {
         std::vector<float> alpha(colour.rgba.size() / 4);
         for (std::size_t i = 0; i < alpha.size(); ++i) alpha[i] = colour.rgba[i * 4 + 3];
         return alpha;
       }
+      case Channel::kColour:
+        break;
     }
     return {};
   }
@@ -132,8 +139,11 @@ struct Frame {
 
 // What a render is asked for beyond the scene.
 struct FrameRequest {
+  FrameRequest() = default;
+  FrameRequest(ChannelSet asked, std::uint64_t at_tick = 0) : channels(asked), tick(at_tick) {}
   ChannelSet channels{Channel::kColour, Channel::kCoverage};
   std::uint64_t tick = 0;
+  InfraredModel infrared;  // for lwir
 };
 
 }  // namespace nephele

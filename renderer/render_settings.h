@@ -67,9 +67,9 @@ struct RenderSettings {
   // samples_per_cell samples per cell edge). Larger steps are faster and blur thin edges.
   double volume_step = 1.0;
 
-  // Cloud depth (renderer/frame.h) is traced on the CPU, one ray per block of
-  // channel_divisor x channel_divisor pixels copied to the block: cost falls with its square,
-  // error grows at cloud edges.
+  // Cloud depth and the infrared band (renderer/frame.h) are traced on the CPU, one ray per
+  // block of channel_divisor x channel_divisor pixels copied to the block: cost falls with its
+  // square, error grows at cloud edges.
   int channel_divisor = 1;
 };
 

@@ -86,9 +86,7 @@ std::vector<ImageAttribute> frameAttributes(const FrameInfo& info) {
   };
 }
 
-namespace {
-
-std::vector<ExrPlane> framePlanes(const Frame& frame, const std::vector<Channel>& order) {
+std::vector<ExrPlane> exrPlanesOf(const Frame& frame, const std::vector<Channel>& order) {
   std::vector<ExrPlane> planes;
   const float* rgba = frame.colour.rgba.data();
   for (Channel c : order) {
@@ -111,25 +109,26 @@ std::vector<ExrPlane> framePlanes(const Frame& frame, const std::vector<Channel>
       case Channel::kVisibility:
         planes.push_back({channelName(c), frame.visibility.data(), 1});
         break;
+      case Channel::kLwir:
+        planes.push_back({channelName(c), frame.lwir.data(), 1});
+        break;
     }
   }
   return planes;
 }
-
-}  // namespace
 
 std::string writeFrameExr(const std::string& path, const Frame& frame,
                           const EncodeOptions& options) {
   std::vector<Channel> order;
   for (const ChannelInfo& info : kChannels)
     if (frame.channels.has(info.channel)) order.push_back(info.channel);
-  return writeExrPlanes(path, frame.width(), frame.height(), framePlanes(frame, order),
+  return writeExrPlanes(path, frame.width(), frame.height(), exrPlanesOf(frame, order),
                         frameAttributes(frame.info), options);
 }
 
 std::string encodeFrameExr(const Frame& frame, const std::vector<Channel>& order,
                            const EncodeOptions& options, std::vector<std::uint8_t>& out) {
-  return encodeExrPlanes(frame.width(), frame.height(), framePlanes(frame, order),
+  return encodeExrPlanes(frame.width(), frame.height(), exrPlanesOf(frame, order),
                          frameAttributes(frame.info), options, out);
 }
 

@@ -51,7 +51,9 @@ std::vector<ImageAttribute> frameAttributes(const FrameInfo& info);
 // cloud_depth, object_id, visibility; with frameAttributes.
 std::string writeFrameExr(const std::string& path, const Frame& frame,
                           const EncodeOptions& options = {});
-// The same in memory, the channels in `order` (colour as R, G, B).
+// The EXR layers of the channels in `order` (colour as R, G, B, coverage as A).
+std::vector<ExrPlane> exrPlanesOf(const Frame& frame, const std::vector<Channel>& order);
+// The same in memory, the channels in `order`.
 std::string encodeFrameExr(const Frame& frame, const std::vector<Channel>& order,
                            const EncodeOptions& options, std::vector<std::uint8_t>& out);
 

@@ -175,6 +175,60 @@ TEST_P(ChannelsTest, VisibilityBehindALayerIsItsTranslucence) {
   EXPECT_LE(sum / target_pixels, gl ? 0.015 : 1e-6);
 }
 
+// The infrared band (MODEL.md section 12): a target behind a translucent layer shows
+// alpha B(T_layer) + (1 - alpha) B(T_target), with alpha the layer's opacity at the crossing
+// and T_layer the ISA temperature of its altitude; the clear sky is colder at the zenith.
+TEST_P(ChannelsTest, LwirBehindALayerMixesTheLayerAndTheTarget) {
+  Scene scene = level();
+  scene.camera.orientation.pitch_deg = 20.0;
+  Target box;
+  box.centre = {0.0, 600.0, 330.0};
+  box.size = {150.0, 10.0, 120.0};
+  scene.targets.push_back(box);
+  CloudLayer layer;
+  layer.altitude_m = 250.0;
+  layer.threshold = 0.2;
+  layer.transition = 0.8;
+  layer.texture.gardner.fx1 = layer.texture.gardner.fy1 = 0.01;
+  scene.layers.push_back(layer);
+  const LayerTexture texture(layer.texture);
+  FrameRequest request(ChannelSet{Channel::kLwir, Channel::kObjectId});
+  request.infrared.target_temperatures = {330.0};
+  const InfraredModel& ir = request.infrared;
+  const auto renderer = makeRenderer(GetParam());
+  const Frame frame = renderer->render(scene, request);
+  const double target = bandRadiance(ir, 330.0);
+  const double cloud = bandRadiance(ir, airTemperature(ir, 250.0));
+  EXPECT_NEAR(airTemperature(ir, 250.0), 288.15 - 1.625, 1e-9);
+  int checked = 0;
+  for (int y = 0; y < 72; ++y)
+    for (int x = 0; x < 96; ++x) {
+      const std::size_t i = std::size_t(y) * 96 + x;
+      if (frame.object_id[i] != 1.0f) continue;
+      const glm::dvec3 d = centreRay(scene, x, y);
+      const double s = (layer.altitude_m - 100.0) / d.z;
+      const glm::dvec3 p = scene.camera.position + s * d;
+      const double alpha =
+          s < boxEntry(box.centre - box.size, box.centre + box.size, scene.camera.position, d)
+              ? 1.0 - skyPlaneTranslucence(texture.value({p.x, p.y}, 0.0), layer.threshold,
+                                           layer.transition)
+              : 0.0;
+      EXPECT_NEAR(frame.lwir[i], alpha * cloud + (1.0 - alpha) * target, 1e-4 * target);
+      ++checked;
+    }
+  EXPECT_GT(checked, 300);
+  // Sky: the top row looks 56 degrees up, the row at the horizon 0; each pixel is at most the
+  // air's radiance at the camera and the zenith is coldest.
+  Scene clear = level();
+  clear.camera.orientation.pitch_deg = 60.0;
+  const Frame sky = renderer->render(clear, FrameRequest(ChannelSet{Channel::kLwir}));
+  const double air = bandRadiance(ir, airTemperature(ir, 100.0));
+  for (int y = 1; y < 72; ++y) {
+    EXPECT_LT(sky.lwir[std::size_t(y - 1) * 96 + 48], sky.lwir[std::size_t(y) * 96 + 48]);
+    EXPECT_LT(sky.lwir[std::size_t(y) * 96 + 48], air);
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(BothBackEnds, ChannelsTest,
                          ::testing::Values(RendererKind::kGl, RendererKind::kReference),
                          [](const auto& info) {
@@ -212,7 +266,16 @@ TEST(ChannelsCompare, GlMatchesReferenceOnEveryChannel) {
   const auto reference = createRenderer(options, error);
   const Frame g = gl->render(scene, all), r = reference->render(scene, all);
   for (const ChannelInfo& info : kChannels) {
-    const std::vector<float> pg = g.plane(info.channel), pr = r.plane(info.channel);
+    // Colour is compared as its three planes in a row.
+    auto planeOf = [&](const Frame& f) {
+      if (info.channel != Channel::kColour) return f.plane(info.channel);
+      std::vector<float> rgb;
+      for (std::size_t i = 0; i < f.colour.rgba.size(); ++i)
+        if (i % 4 != 3) rgb.push_back(f.colour.rgba[i]);
+      return rgb;
+    };
+    const std::vector<float> pg = planeOf(g), pr = planeOf(r);
+    ASSERT_FALSE(pg.empty()) << info.name;
     ASSERT_EQ(pg.size(), pr.size()) << info.name;
     int differing = 0;
     for (std::size_t i = 0; i < pg.size(); ++i) {
@@ -227,6 +290,26 @@ TEST(ChannelsCompare, GlMatchesReferenceOnEveryChannel) {
     // cloud limbs and thresholds in half floats differ by a few hundredths there.
     std::printf("%-12s %4d of %zu pixels differ\n", info.name, differing, pg.size());
     EXPECT_LE(differing, int(pg.size() / 50)) << info.name;
+  }
+}
+
+// The band integral against Stefan-Boltzmann (sigma T^4 / pi over all wavelengths), and the
+// brightness temperature as its inverse.
+TEST(Infrared, BandRadianceIsPlanckIntegrated) {
+  InfraredModel wide;
+  wide.band_lo_um = 0.5;
+  wide.band_hi_um = 2000.0;
+  wide.band_steps = 200000;
+  const double sigma = 5.670374419e-8;
+  for (double t : {220.0, 288.15, 330.0})
+    EXPECT_NEAR(bandRadiance(wide, t), sigma * std::pow(t, 4) / M_PI,
+                2e-3 * sigma * std::pow(t, 4) / M_PI)
+        << t;
+  const InfraredModel band;
+  const BandTable table(band);
+  for (double t : {180.0, 250.0, 300.0, 350.0}) {
+    EXPECT_NEAR(brightnessTemperature(band, bandRadiance(band, t)), t, 1e-6);
+    EXPECT_NEAR(table.temperature(bandRadiance(band, t)), t, 1e-3);
   }
 }
 

@@ -216,14 +216,18 @@ Frame GlRenderer::renderFrame(const Scene& scene, const RenderSettings& settings
         if (!frame.object_id.empty()) frame.object_id[i] = target ? id[gl] : 0.0f;
       }
   }
-  if (asked.has(Channel::kCloudDepth)) {
+  if (asked.has(Channel::kCloudDepth) || asked.has(Channel::kLwir)) {
     ReferenceSettings trace;
     trace.samples_per_axis = 1;
     trace.heap_range_m = settings.heap_range_m;
     trace.label_divisor = settings.channel_divisor;
-    frame.cloud_depth =
-        renderReferenceFrame(scene, trace, {ChannelSet{Channel::kCloudDepth}, request.tick})
-            .cloud_depth;
+    FrameRequest traced = request;
+    traced.channels = {};
+    for (Channel c : {Channel::kCloudDepth, Channel::kLwir})
+      if (asked.has(c)) traced.channels.add(c);
+    Frame cpu = renderReferenceFrame(scene, trace, traced);
+    frame.cloud_depth = std::move(cpu.cloud_depth);
+    frame.lwir = std::move(cpu.lwir);
   }
   return frame;
 }

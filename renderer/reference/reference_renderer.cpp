@@ -51,6 +51,7 @@ struct RayLabels {
   double depth = kInfinity;
   double cloud_depth = kInfinity;
   int object_id = 0;
+  double lwir = 0.0;  // with an infrared model
 };
 
 struct EllipsoidEntry {
@@ -83,7 +84,8 @@ class ReferenceTracer {
   // Colour and coverage along one ray (unit direction); the ray's labels if asked.
   // Surfaces beyond `max_distance` are left out.
   glm::dvec4 trace(glm::dvec3 direction, std::vector<Surface>& surfaces,
-                   RayLabels* labels = nullptr, double max_distance = kInfinity) const {
+                   RayLabels* labels = nullptr, double max_distance = kInfinity,
+                   const InfraredModel* infrared = nullptr) const {
     const glm::dvec3 eye = scene_.camera.position;
     double nearest_opaque =
         std::min(direction.z < 0.0 ? eye.z / -direction.z : kInfinity, max_distance);
@@ -135,11 +137,38 @@ class ReferenceTracer {
         transmittance *= 1.0 - s->alpha;
         if (transmittance <= 0.5) labels->cloud_depth = s->half_distance;
       }
+      if (infrared)
+        labels->lwir = infraredRadiance(*infrared, direction, surfaces, object_id, nearest_opaque);
     }
     return {colour, 1.0 - translucence_product};
   }
 
  private:
+  // MODEL.md section 12: the opaque surface or clear sky behind, then every cloud surface back
+  // to front as a grey body at the air temperature of its altitude, emissivity its opacity.
+  double infraredRadiance(const InfraredModel& model, glm::dvec3 direction,
+                          const std::vector<Surface>& surfaces, int object_id,
+                          double nearest_opaque) const {
+    const glm::dvec3 eye = scene_.camera.position;
+    const double elevation = std::asin(std::clamp(direction.z, -1.0, 1.0));
+    double radiance;
+    if (object_id > 0) {
+      radiance = bandRadiance(model, targetTemperature(model, object_id - 1));
+    } else if (std::isfinite(nearest_opaque)) {  // the ground, reflecting the sky a little
+      radiance = model.ground_emissivity * bandRadiance(model, model.ground_k) +
+                 (1.0 - model.ground_emissivity) * clearSkyRadiance(model, -elevation, 0.0);
+    } else {
+      radiance = clearSkyRadiance(model, elevation, eye.z);
+    }
+    for (const Surface& s : surfaces) {  // back to front
+      const double z = eye.z + s.half_distance * direction.z;
+      radiance =
+          s.alpha * bandRadiance(model, airTemperature(model, z)) + (1.0 - s.alpha) * radiance;
+    }
+    return veil_.opacity * bandRadiance(model, airTemperature(model, eye.z)) +
+           (1.0 - veil_.opacity) * radiance;
+  }
+
   Surface layerSurface(const CloudLayer& layer, const LayerTexture& texture, glm::dvec3 direction,
                        double s) const {
     const glm::dvec3 p = scene_.camera.position + s * direction;
@@ -267,11 +296,13 @@ Frame renderReferenceFrame(const Scene& scene, const ReferenceSettings& settings
   const bool colour = asked.has(Channel::kColour) || asked.has(Channel::kCoverage) ||
                       asked.has(Channel::kVisibility);
   const bool labels = asked.has(Channel::kDepth) || asked.has(Channel::kCloudDepth) ||
-                      asked.has(Channel::kObjectId);
+                      asked.has(Channel::kObjectId) || asked.has(Channel::kLwir);
+  const InfraredModel* infrared = asked.has(Channel::kLwir) ? &request.infrared : nullptr;
   if (colour) frame.colour = {camera.width, camera.height, std::vector<float>(pixels * 4)};
   if (asked.has(Channel::kDepth)) frame.depth.resize(pixels);
   if (asked.has(Channel::kCloudDepth)) frame.cloud_depth.resize(pixels);
   if (asked.has(Channel::kObjectId)) frame.object_id.resize(pixels);
+  if (infrared) frame.lwir.resize(pixels);
 
   const Scene with_fields =
       scene.fields.empty() ? Scene{} : withFieldClouds(scene, settings.heap_range_m);
@@ -309,13 +340,14 @@ Frame renderReferenceFrame(const Scene& scene, const ReferenceSettings& settings
           RayLabels ray;
           tracer.trace(
               glm::normalize(rayDirection(basis, camera, x + 0.5 * divisor, y + 0.5 * divisor)),
-              hits, &ray);
+              hits, &ray, kInfinity, infrared);
           for (int by = y; by < std::min(y + divisor, camera.height); ++by)
             for (int bx = x; bx < std::min(x + divisor, camera.width); ++bx) {
               const std::size_t i = std::size_t(by) * camera.width + bx;
               if (!frame.depth.empty()) frame.depth[i] = float(ray.depth);
               if (!frame.cloud_depth.empty()) frame.cloud_depth[i] = float(ray.cloud_depth);
               if (!frame.object_id.empty()) frame.object_id[i] = float(ray.object_id);
+              if (!frame.lwir.empty()) frame.lwir[i] = float(ray.lwir);
             }
         }
       }
