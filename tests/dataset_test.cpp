@@ -70,6 +70,10 @@ TEST(Dataset, SampleDrawsArePureFunctionsOfSeedAndIndex) {
   more.targets.back().name = "crate2";
   EXPECT_EQ(drawSample(spec, 2).record["layers"], drawSample(more, 2).record["layers"]);
   EXPECT_EQ(drawSample(spec, 2).record["camera"], drawSample(more, 2).record["camera"]);
+  // The infrared band places the same targets.
+  DatasetSpec infrared = spec;
+  infrared.band = Band::kLwir;
+  EXPECT_EQ(drawSample(spec, 4).record["targets"], drawSample(infrared, 4).record["targets"]);
 }
 
 TEST(Dataset, BadDescriptionsNameFileLineAndKey) {
@@ -82,12 +86,16 @@ TEST(Dataset, BadDescriptionsNameFileLineAndKey) {
   EXPECT_THAT(parseError("[camera]\nvfov = [10, 200]\n"),
               HasSubstr("d.toml:2: camera.vfov: 200 is out of range (allowed: 0.01 to 179)"));
   EXPECT_THAT(parseError("[dataset]\nband = \"radar\"\n"),
-              HasSubstr("dataset.band: \"radar\" is not allowed (one of: visible)"));
+              HasSubstr("dataset.band: \"radar\" is not allowed (one of: visible, lwir)"));
   EXPECT_THAT(parseError("[[target]]\nshape = \"box\"\n"), HasSubstr("name is missing"));
   EXPECT_THAT(parseError("[[target]]\nname = \"a\"\nshape = \"mesh\"\n"),
               HasSubstr("needs a mesh = \"file.obj\" key"));
   EXPECT_THAT(parseError("[[target]]\nname = \"a\"\n[[target]]\nname = \"a\"\n"),
               HasSubstr("two [[target]] categories are named \"a\""));
+  EXPECT_THAT(parseError("[infrared]\ndisplay = [300, 300]\n"),
+              HasSubstr("d.toml:2: infrared.display: must be [black, white] kelvin"));
+  EXPECT_THAT(parseError("[[target]]\nname = \"a\"\ntemperature = [0, 300]\n"),
+              HasSubstr("target[0].temperature: 0 is out of range (allowed: 1 to 5000)"));
   EXPECT_THAT(parseError("[dataset]\nsampels = 3\n"),
               HasSubstr("d.toml:2: dataset.sampels: unknown key (allowed here: seed, samples"));
 }
