@@ -110,6 +110,12 @@ struct Frame {
   std::vector<float> depth, cloud_depth, object_id, visibility, lwir;
 
   int width() const { return info.width; }
+  // visibility = 1 - coverage, from colour's alpha (both back ends composite it there).
+  void visibilityFromCoverage() {
+    visibility.resize(colour.rgba.size() / 4);
+    for (std::size_t i = 0; i < visibility.size(); ++i)
+      visibility[i] = 1.0f - colour.rgba[i * 4 + 3];
+  }
   int height() const { return info.height; }
   // The single-float plane of a channel (coverage is copied out of colour's alpha); colour,
   // three floats per pixel, has none: read `colour`.

@@ -19,7 +19,19 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-class ChannelsTest : public ::testing::TestWithParam<RendererKind> {
+struct ChannelsTestScenes {
+  // Looking north, level, from 100 m up.
+  static Scene level(int width = 96, int height = 72) {
+    Scene scene;
+    scene.camera.position = {0.0, 0.0, 100.0};
+    scene.camera.vfov_deg = 40.0;
+    scene.camera.width = width;
+    scene.camera.height = height;
+    return scene;
+  }
+};
+
+class ChannelsTest : public ::testing::TestWithParam<RendererKind>, public ChannelsTestScenes {
  protected:
   static std::unique_ptr<Renderer> makeRenderer(RendererKind kind) {
     RendererOptions options;
@@ -29,16 +41,6 @@ class ChannelsTest : public ::testing::TestWithParam<RendererKind> {
     auto renderer = createRenderer(options, error);
     EXPECT_NE(renderer, nullptr) << error;
     return renderer;
-  }
-
-  // Looking north, level, from 100 m up.
-  static Scene level(int width = 96, int height = 72) {
-    Scene scene;
-    scene.camera.position = {0.0, 0.0, 100.0};
-    scene.camera.vfov_deg = 40.0;
-    scene.camera.width = width;
-    scene.camera.height = height;
-    return scene;
   }
 
   static glm::dvec3 centreRay(const Scene& scene, int x, int y) {
@@ -128,8 +130,9 @@ TEST_P(ChannelsTest, CloudDepthOfAnOpaqueSphereIsItsEntryDistance) {
   EXPECT_EQ(wrong, 0);
 }
 
-TEST_P(ChannelsTest, VisibilityBehindALayerIsItsTranslucence) {
-  Scene scene = level();
+// A wide box target behind a translucent layer at 250 m, seen from below.
+Scene targetBehindLayer() {
+  Scene scene = ChannelsTestScenes::level();
   scene.camera.orientation.pitch_deg = 20.0;
   Target box;
   box.centre = {0.0, 600.0, 330.0};
@@ -141,6 +144,13 @@ TEST_P(ChannelsTest, VisibilityBehindALayerIsItsTranslucence) {
   layer.transition = 0.8;  // translucent throughout
   layer.texture.gardner.fx1 = layer.texture.gardner.fy1 = 0.01;
   scene.layers.push_back(layer);
+  return scene;
+}
+
+TEST_P(ChannelsTest, VisibilityBehindALayerIsItsTranslucence) {
+  const Scene scene = targetBehindLayer();
+  const Target& box = scene.targets[0];
+  const CloudLayer& layer = scene.layers[0];
   const LayerTexture texture(layer.texture);
   const auto renderer = makeRenderer(GetParam());
   const Frame frame =
@@ -179,18 +189,9 @@ TEST_P(ChannelsTest, VisibilityBehindALayerIsItsTranslucence) {
 // alpha B(T_layer) + (1 - alpha) B(T_target), with alpha the layer's opacity at the crossing
 // and T_layer the ISA temperature of its altitude; the clear sky is colder at the zenith.
 TEST_P(ChannelsTest, LwirBehindALayerMixesTheLayerAndTheTarget) {
-  Scene scene = level();
-  scene.camera.orientation.pitch_deg = 20.0;
-  Target box;
-  box.centre = {0.0, 600.0, 330.0};
-  box.size = {150.0, 10.0, 120.0};
-  scene.targets.push_back(box);
-  CloudLayer layer;
-  layer.altitude_m = 250.0;
-  layer.threshold = 0.2;
-  layer.transition = 0.8;
-  layer.texture.gardner.fx1 = layer.texture.gardner.fy1 = 0.01;
-  scene.layers.push_back(layer);
+  const Scene scene = targetBehindLayer();
+  const Target& box = scene.targets[0];
+  const CloudLayer& layer = scene.layers[0];
   const LayerTexture texture(layer.texture);
   FrameRequest request(ChannelSet{Channel::kLwir, Channel::kObjectId});
   request.infrared.target_temperatures = {330.0};

@@ -191,11 +191,7 @@ Frame GlRenderer::renderFrame(const Scene& scene, const RenderSettings& settings
   const bool composite = asked.has(Channel::kColour) || asked.has(Channel::kCoverage) ||
                          asked.has(Channel::kVisibility);
   if (composite) frame.colour = renderFloat(scene, settings);
-  if (asked.has(Channel::kVisibility)) {
-    frame.visibility.resize(pixels);
-    for (std::size_t i = 0; i < pixels; ++i)
-      frame.visibility[i] = 1.0f - frame.colour.rgba[i * 4 + 3];
-  }
+  if (asked.has(Channel::kVisibility)) frame.visibilityFromCoverage();
   if (asked.has(Channel::kDepth) || asked.has(Channel::kObjectId)) {
     // The composite pass drew the targets already; otherwise they are drawn alone.
     std::vector<float> distance, id;

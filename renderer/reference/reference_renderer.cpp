@@ -359,11 +359,7 @@ Frame renderReferenceFrame(const Scene& scene, const ReferenceSettings& settings
   for (int i = 1; i < threads; ++i) pool.emplace_back(work, false);
   work(true);
   pool.clear();  // join before the frame is handed out
-  if (asked.has(Channel::kVisibility)) {
-    frame.visibility.resize(pixels);
-    for (std::size_t i = 0; i < pixels; ++i)
-      frame.visibility[i] = 1.0f - frame.colour.rgba[i * 4 + 3];
-  }
+  if (asked.has(Channel::kVisibility)) frame.visibilityFromCoverage();
   return frame;
 }
 
