@@ -140,38 +140,82 @@ std::string writeSample(const DatasetSpec& spec, const BandTable& band, const fs
   return e;
 }
 
-// annotations.json (COCO), manifest.jsonl and classes.txt from every sample's record.
-std::string merge(const DatasetSpec& spec, const fs::path& dir) {
-  std::vector<json> records;
-  records.reserve(std::size_t(spec.samples));
-  int missing = 0, first_missing = -1;
-  for (int i = 0; i < spec.samples; ++i) {
-    std::ifstream in(dir / "records" / (sampleName(i) + ".json"));
-    if (!in) {
-      if (missing++ == 0) first_missing = i;
-      continue;
-    }
-    json record;
-    try {
-      in >> record;
-    } catch (const json::exception& e) {
-      return "records/" + sampleName(i) + ".json: " + e.what();
-    }
-    records.push_back(std::move(record));
+// Streams text into `path` through a temporary beside it, renamed into place when complete.
+class StreamedFile {
+ public:
+  explicit StreamedFile(fs::path path) : path_(std::move(path)), out_(partial()) {}
+  ~StreamedFile() {  // abandoned (an unreadable record): no temporary is left behind
+    if (finished_) return;
+    out_.close();
+    std::error_code ec;
+    fs::remove(partial(), ec);
   }
+  std::ofstream& out() { return out_; }
+  std::string finish() {
+    finished_ = true;
+    out_.close();
+    std::error_code ec;
+    if (!out_) return "cannot write '" + partial().string() + "'";
+    fs::rename(partial(), path_, ec);
+    return ec ? "cannot move '" + partial().string() + "' into place: " + ec.message() : "";
+  }
+
+ private:
+  fs::path partial() const { return fs::path(path_.string() + ".partial"); }
+  fs::path path_;
+  std::ofstream out_;
+  bool finished_ = false;
+};
+
+// annotations.json (COCO), manifest.jsonl and classes.txt from every sample's record, streamed
+// record by record (two passes: annotations, then images), so that a merge of millions of
+// samples holds one record at a time. The text equals one nlohmann::json dump of the whole.
+std::string merge(const DatasetSpec& spec, const fs::path& dir) {
+  int missing = 0, first_missing = -1;
+  for (int i = 0; i < spec.samples; ++i)
+    if (!fs::exists(dir / "records" / (sampleName(i) + ".json")) && missing++ == 0)
+      first_missing = i;
   if (missing)
     return std::to_string(missing) + " of " + std::to_string(spec.samples) +
            " samples are not written yet (the first is " + std::to_string(first_missing) +
            "): run the missing shards, or this command with --resume";
-  std::string manifest, classes;
-  for (const json& r : records) {
-    json line = r;
-    for (json& l : line["labels"]) l.erase("segmentation");  // in annotations.json
-    manifest += line.dump() + "\n";
+  std::string error;
+  auto read = [&](int i, json& record) {
+    std::ifstream in(dir / "records" / (sampleName(i) + ".json"));
+    try {
+      in >> record;
+      return true;
+    } catch (const json::exception& e) {
+      error = "records/" + sampleName(i) + ".json: " + e.what();
+      return false;
+    }
+  };
+  StreamedFile coco(dir / "annotations.json"), manifest(dir / "manifest.jsonl");
+  std::ofstream& c = coco.out();
+  c << "{\"annotations\":[";
+  int next_id = 0;
+  bool first = true;
+  for (int i = 0; i < spec.samples; ++i) {
+    json record;
+    if (!read(i, record)) return error;
+    for (const json& a : cocoAnnotations(record, next_id)) {
+      c << (first ? "" : ",") << a.dump();
+      first = false;
+    }
+    for (json& l : record["labels"]) l.erase("segmentation");  // in annotations.json
+    manifest.out() << record.dump() << "\n";
   }
-  for (const TargetClass& c : spec.targets) classes += c.name + "\n";
-  std::string e = writeText(dir / "annotations.json", cocoFile(spec, records).dump() + "\n");
-  if (e.empty()) e = writeText(dir / "manifest.jsonl", manifest);
+  c << "],\"categories\":" << cocoCategories(spec).dump() << ",\"images\":[";
+  for (int i = 0; i < spec.samples; ++i) {
+    json record;
+    if (!read(i, record)) return error;
+    c << (i ? "," : "") << cocoImage(spec, record).dump();
+  }
+  c << "],\"info\":" << cocoInfo(spec).dump() << ",\"licenses\":[]}\n";
+  std::string classes;
+  for (const TargetClass& t : spec.targets) classes += t.name + "\n";
+  std::string e = coco.finish();
+  if (e.empty()) e = manifest.finish();
   if (e.empty()) e = writeText(dir / "classes.txt", classes);
   return e;
 }

@@ -317,39 +317,42 @@ std::string yoloText(const std::vector<TargetLabel>& labels, int width, int heig
   return out;
 }
 
-json cocoFile(const DatasetSpec& spec, const std::vector<json>& samples) {
-  json coco;
-  coco["info"] = {{"description", "Nephele cloud-clutter dataset"},
-                  {"version", "1"},
-                  {"seed", std::to_string(spec.seed)}};
-  coco["licenses"] = json::array();
-  coco["categories"] = json::array();
+json cocoInfo(const DatasetSpec& spec) {
+  return {{"description", "Nephele cloud-clutter dataset"},
+          {"version", "1"},
+          {"seed", std::to_string(spec.seed)}};
+}
+
+json cocoCategories(const DatasetSpec& spec) {
+  json categories = json::array();
   for (std::size_t c = 0; c < spec.targets.size(); ++c)
-    coco["categories"].push_back(
+    categories.push_back(
         {{"id", c + 1}, {"name", spec.targets[c].name}, {"supercategory", "target"}});
-  coco["images"] = json::array();
-  coco["annotations"] = json::array();
-  int annotation_id = 0;
-  for (const json& s : samples) {
-    const int image_id = s["index"].get<int>() + 1;
-    coco["images"].push_back({{"id", image_id},
-                              {"file_name", s["file_name"]},
-                              {"width", spec.width},
-                              {"height", spec.height},
-                              {"camera", s["camera"]}});
-    for (const json& l : s["labels"]) {
-      if (l["area"].get<int>() == 0) continue;  // hidden: in the manifest, not in COCO
-      json a = l;
-      a.erase("target");
-      a.erase("category");
-      a["id"] = ++annotation_id;
-      a["image_id"] = image_id;
-      a["category_id"] = l["category"].get<int>() + 1;
-      a["iscrowd"] = 0;
-      coco["annotations"].push_back(std::move(a));
-    }
+  return categories;
+}
+
+json cocoImage(const DatasetSpec& spec, const json& record) {
+  return {{"id", record["index"].get<int>() + 1},
+          {"file_name", record["file_name"]},
+          {"width", spec.width},
+          {"height", spec.height},
+          {"camera", record["camera"]}};
+}
+
+std::vector<json> cocoAnnotations(const json& record, int& next_id) {
+  std::vector<json> out;
+  for (const json& l : record["labels"]) {
+    if (l["area"].get<int>() == 0) continue;  // hidden: in the manifest, not in COCO
+    json a = l;
+    a.erase("target");
+    a.erase("category");
+    a["id"] = ++next_id;
+    a["image_id"] = record["index"].get<int>() + 1;
+    a["category_id"] = l["category"].get<int>() + 1;
+    a["iscrowd"] = 0;
+    out.push_back(std::move(a));
   }
-  return coco;
+  return out;
 }
 
 }  // namespace nephele

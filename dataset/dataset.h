@@ -107,7 +107,12 @@ std::vector<std::uint16_t> instanceMask(const Frame& frame);
 nlohmann::json sampleLabelsJson(const std::vector<TargetLabel>& labels, int width, int height);
 std::string yoloText(const std::vector<TargetLabel>& labels, int width, int height);
 
-// The COCO file of a dataset from its sample records in index order.
-nlohmann::json cocoFile(const DatasetSpec& spec, const std::vector<nlohmann::json>& samples);
+// Pieces of a dataset's COCO file, which the merge streams record by record: its info and
+// categories, one sample's image entry, and one sample's annotations (ids from `next_id` on;
+// targets with no visible pixel have none).
+nlohmann::json cocoInfo(const DatasetSpec& spec);
+nlohmann::json cocoCategories(const DatasetSpec& spec);
+nlohmann::json cocoImage(const DatasetSpec& spec, const nlohmann::json& record);
+std::vector<nlohmann::json> cocoAnnotations(const nlohmann::json& record, int& next_id);
 
 }  // namespace nephele
