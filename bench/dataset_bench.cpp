@@ -15,6 +15,7 @@
 #include "bench_common.h"
 #include "config/dataset_file.h"
 #include "image/image_encoding.h"
+#include "image/image_metrics.h"
 #include "renderer/gl/gl_renderer.h"
 #include "world/infrared.h"
 
@@ -117,30 +118,21 @@ int main(int argc, char** argv) {
     settings.heap_range_m = spec.heap_range_m;
     settings.channel_divisor = divisor;
     double ms = 0.0, flipped = 0.0, relative = 0.0;
-    std::size_t pixels = 0, finite = 0;
-    for (int i = 0; i < std::min(samples, 4); ++i) {
+    const int n = std::min(samples, 4);
+    for (int i = 0; i < n; ++i) {
       const Scene scene = drawSample(spec, i).scene;
       const auto t = Clock::now();
       const Frame frame = gl.renderFrame(scene, settings, {ChannelSet{Channel::kCloudDepth}});
       ms += msSince(t);
       if (divisor == 1) exact.push_back(frame.cloud_depth);
-      const std::vector<float>& e = exact[std::size_t(i)];
-      for (std::size_t p = 0; p < e.size(); ++p) {
-        const float a = frame.cloud_depth[p], b = e[p];
-        ++pixels;
-        if (std::isinf(a) != std::isinf(b)) {
-          ++flipped;
-        } else if (!std::isinf(b)) {
-          ++finite;
-          relative += std::abs(a - b) / b;
-        }
-      }
+      const PlaneError e = comparePlanes(frame.cloud_depth, exact[std::size_t(i)]);
+      flipped += e.flipped / n;
+      relative += e.mean_relative / n;
     }
     std::printf(
         "  %d: %.1f ms per frame, %.2f %% of pixels cloud/clear flipped, mean relative "
         "depth error %.4f\n",
-        divisor, ms / std::min(samples, 4), 100.0 * flipped / pixels,
-        finite ? relative / finite : 0.0);
+        divisor, ms / n, 100.0 * flipped, relative);
   }
 
   // The infrared knob: band_steps (midpoint rule over 8-12 um) against 4096 steps, as the

@@ -21,6 +21,7 @@
 #include "renderer/gl/gl_renderer.h"
 #include "renderer/reference/reference_renderer.h"
 #include "world/formations/ellipsoid_cloud.h"
+#include "world/infrared.h"
 
 namespace nephele {
 namespace {
@@ -321,6 +322,61 @@ void writeMarkdown(const std::filesystem::path& path, const std::vector<SceneRes
   }
 }
 
+// The label knob channel_divisor: cloud depth and the infrared band, traced on the CPU once
+// per N x N pixels, against N = 1 (renderer/render_settings.h).
+struct LabelPoint {
+  int divisor = 1;
+  double ms = 0.0;
+  PlaneError cloud_depth;
+  double lwir_kelvin = 0.0;  // mean |brightness temperature - exact|
+};
+struct LabelResult {
+  std::string name;
+  std::vector<LabelPoint> points;
+};
+
+LabelResult measureLabelKnob(GlRenderer& renderer, const BenchScene& bench_scene,
+                             const Scene& scene, const BandTable& band) {
+  LabelResult result{bench_scene.name, {}};
+  const FrameRequest request(ChannelSet{Channel::kCloudDepth, Channel::kLwir});
+  Frame exact;
+  std::vector<float> exact_kelvin;
+  for (int divisor : {1, 2, 4, 8}) {
+    RenderSettings settings = bench_scene.file.render;
+    settings.channel_divisor = divisor;
+    const auto start = Clock::now();
+    Frame frame = renderer.renderFrame(scene, settings, request);
+    LabelPoint point;
+    point.divisor = divisor;
+    point.ms = secondsSince(start) * 1e3;
+    std::vector<float> kelvin(frame.lwir.size());
+    for (std::size_t i = 0; i < kelvin.size(); ++i)
+      kelvin[i] = float(band.temperature(frame.lwir[i]));
+    if (divisor == 1) exact = frame, exact_kelvin = kelvin;
+    point.cloud_depth = comparePlanes(frame.cloud_depth, exact.cloud_depth);
+    point.lwir_kelvin = comparePlanes(kelvin, exact_kelvin).mean_abs;
+    result.points.push_back(point);
+  }
+  return result;
+}
+
+void writeLabelMarkdown(std::ofstream& out, const std::vector<LabelResult>& results) {
+  if (results.empty()) return;
+  out << "### Label channels: channel_divisor\n\n"
+      << "Cloud depth and lwir traced once per N x N pixels against N = 1: the share of pixels "
+         "whose cloud depth turns finite or infinite, the mean relative cloud-depth error where "
+         "both are finite, the mean brightness-temperature error, and the time of both "
+         "channels.\n\n"
+      << "| scene | N | ms | cloud/clear flipped | cloud depth rel. error | lwir K |\n"
+      << "| --- | --- | --- | --- | --- | --- |\n";
+  for (const LabelResult& r : results)
+    for (const LabelPoint& p : r.points)
+      out << "| " << r.name << " | " << p.divisor << " | " << fixed(p.ms, 1) << " | "
+          << fixed(100.0 * p.cloud_depth.flipped, 2) << " % | "
+          << fixed(p.cloud_depth.mean_relative, 4) << " | " << fixed(p.lwir_kelvin, 3) << " |\n";
+  out << "\n";
+}
+
 // Error against time, one panel per scene: x the frame time in multiples of the floor (log
 // scale), y the colour PSNR; the front joined by a line, the defaults ringed.
 void writePlot(const std::filesystem::path& path, const std::vector<SceneResult>& results) {
@@ -526,8 +582,31 @@ int runBenchCommand(const BenchCommandOptions& o) {
     spdlog::error("{}: {}", o.output_dir, ec.message());
     return 1;
   }
+  // The label knob, on every scene with clouds (after the sweep: its tracing would disturb no
+  // timing there).
+  std::vector<LabelResult> labels;
+  const BandTable band{InfraredModel{}};
+  for (const BenchScene& bench_scene : scenes) {
+    const Scene scene = sceneAtTime(bench_scene.file);
+    if (scene.layers.empty() && scene.clouds.empty() && scene.fields.empty() &&
+        scene.automata.empty())
+      continue;
+    labels.push_back(measureLabelKnob(renderer, bench_scene, scene, band));
+    std::fprintf(stderr, "%s: label channels\n", bench_scene.name.c_str());
+    for (const LabelPoint& p : labels.back().points)
+      std::printf(
+          "  channel_divisor=%d: %.1f ms, %.2f %% cloud/clear flipped, cloud depth %.4f "
+          "relative, lwir %.3f K\n",
+          p.divisor, p.ms, 100.0 * p.cloud_depth.flipped, p.cloud_depth.mean_relative,
+          p.lwir_kelvin);
+  }
+
   writeCsv(dir / "accuracy.csv", results);
   writeMarkdown(dir / "accuracy.md", results, header);
+  {
+    std::ofstream out(dir / "accuracy.md", std::ios::app);
+    writeLabelMarkdown(out, labels);
+  }
   writePlot(dir / "accuracy.svg", results);
   std::printf("\nwrote %s, %s and %s in %.0f s\n", (dir / "accuracy.csv").c_str(),
               (dir / "accuracy.md").c_str(), (dir / "accuracy.svg").c_str(), secondsSince(start));

@@ -70,4 +70,22 @@ ProfileError rowProfileError(const FloatImage& a, const FloatImage& b, int band)
   return out;
 }
 
+PlaneError comparePlanes(const std::vector<float>& actual, const std::vector<float>& expected) {
+  PlaneError e;
+  std::size_t flipped = 0, finite = 0;
+  for (std::size_t i = 0; i < std::min(actual.size(), expected.size()); ++i) {
+    const float a = actual[i], b = expected[i];
+    if (std::isinf(a) != std::isinf(b)) {
+      ++flipped;
+    } else if (!std::isinf(b)) {
+      ++finite;
+      e.mean_abs += std::abs(a - b);
+      e.mean_relative += b != 0.0f ? std::abs(a - b) / std::abs(b) : std::abs(a - b);
+    }
+  }
+  if (!expected.empty()) e.flipped = double(flipped) / double(expected.size());
+  if (finite) e.mean_abs /= double(finite), e.mean_relative /= double(finite);
+  return e;
+}
+
 }  // namespace nephele

@@ -27,6 +27,16 @@ struct ProfileError {
 ProfileError rowProfileError(const FloatImage& actual, const FloatImage& expected, int band = 8);
 
 // |actual - expected| per channel, scaled by `gain`, as a float image for inspection.
+// A label plane (one float per pixel; +inf meaning none, as cloud depth) against an exact
+// one: the fraction of pixels whose value turns finite or infinite, and the mean relative
+// and absolute differences where both are finite.
+struct PlaneError {
+  double flipped = 0.0;
+  double mean_relative = 0.0;
+  double mean_abs = 0.0;
+};
+PlaneError comparePlanes(const std::vector<float>& actual, const std::vector<float>& expected);
+
 FloatImage differenceImage(const FloatImage& actual, const FloatImage& expected, float gain);
 
 }  // namespace nephele
