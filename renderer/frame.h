@@ -152,4 +152,17 @@ struct FrameRequest {
   InfraredModel infrared;  // for lwir
 };
 
+// Colour, coverage and visibility all come from the composited colour image.
+inline bool compositeAsked(const ChannelSet& c) {
+  return c.has(Channel::kColour) || c.has(Channel::kCoverage) || c.has(Channel::kVisibility);
+}
+
+// A frame with the request's channels and the camera's info, its planes not yet filled.
+inline Frame frameFor(const Camera& camera, double time_s, const FrameRequest& request) {
+  Frame frame;
+  frame.info = frameInfo(camera, time_s, request.tick);
+  frame.channels = request.channels;
+  return frame;
+}
+
 }  // namespace nephele

@@ -185,11 +185,8 @@ Frame GlRenderer::renderFrame(const Scene& scene, const RenderSettings& settings
   const int w = camera.width, h = camera.height;
   const std::size_t pixels = std::size_t(w) * h;
   const ChannelSet& asked = request.channels;
-  Frame frame;
-  frame.info = frameInfo(camera, scene.time_s, request.tick);
-  frame.channels = asked;
-  const bool composite = asked.has(Channel::kColour) || asked.has(Channel::kCoverage) ||
-                         asked.has(Channel::kVisibility);
+  Frame frame = frameFor(camera, scene.time_s, request);
+  const bool composite = compositeAsked(asked);
   if (composite) frame.colour = renderFloat(scene, settings);
   if (asked.has(Channel::kVisibility)) frame.visibilityFromCoverage();
   if (asked.has(Channel::kDepth) || asked.has(Channel::kObjectId)) {

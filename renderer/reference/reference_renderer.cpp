@@ -290,11 +290,8 @@ Frame renderReferenceFrame(const Scene& scene, const ReferenceSettings& settings
   const Camera& camera = scene.camera;
   const std::size_t pixels = std::size_t(camera.width) * camera.height;
   const ChannelSet& asked = request.channels;
-  Frame frame;
-  frame.info = frameInfo(camera, scene.time_s, request.tick);
-  frame.channels = asked;
-  const bool colour = asked.has(Channel::kColour) || asked.has(Channel::kCoverage) ||
-                      asked.has(Channel::kVisibility);
+  Frame frame = frameFor(camera, scene.time_s, request);
+  const bool colour = compositeAsked(asked);
   const bool labels = asked.has(Channel::kDepth) || asked.has(Channel::kCloudDepth) ||
                       asked.has(Channel::kObjectId) || asked.has(Channel::kLwir);
   const InfraredModel* infrared = asked.has(Channel::kLwir) ? &request.infrared : nullptr;
