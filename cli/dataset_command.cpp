@@ -256,8 +256,11 @@ void addDatasetCommand(CLI::App& app, DatasetCommandOptions& o) {
 
 int runDatasetCommand(const DatasetCommandOptions& o) {
   // Everything that can be wrong with the request is found before any file is written.
+  // The text is read once: parsed here, and hashed below to tie the output to it.
+  std::string spec_text;
   DatasetSpec spec;
-  if (std::string e = loadDatasetFile(o.spec_path, spec); !e.empty()) {
+  if (std::string e = config_detail::readTextFile(o.spec_path, "dataset description", spec_text);
+      !e.empty() || !(e = parseDatasetText(spec_text, o.spec_path, spec)).empty()) {
     spdlog::error("{}", e);
     return 2;
   }
@@ -271,8 +274,6 @@ int runDatasetCommand(const DatasetCommandOptions& o) {
       spdlog::error("--only: {} is not a sample index (allowed: 0 to {})", i, spec.samples - 1);
       return 2;
     }
-  std::string spec_text;
-  config_detail::readTextFile(o.spec_path, "dataset description", spec_text);
   const fs::path dir(o.output_dir);
   const json header = {{"description", o.spec_path},
                        {"description_hash", std::to_string(textHash(spec_text))},

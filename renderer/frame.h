@@ -117,29 +117,34 @@ struct Frame {
       visibility[i] = 1.0f - colour.rgba[i * 4 + 3];
   }
   int height() const { return info.height; }
+  // The frame's own one-float-per-pixel plane of a channel; null for colour and coverage,
+  // which live in `colour` (RGB and alpha).
+  const std::vector<float>* ownPlane(Channel c) const {
+    switch (c) {
+      case Channel::kDepth:
+        return &depth;
+      case Channel::kCloudDepth:
+        return &cloud_depth;
+      case Channel::kObjectId:
+        return &object_id;
+      case Channel::kVisibility:
+        return &visibility;
+      case Channel::kLwir:
+        return &lwir;
+      case Channel::kColour:
+      case Channel::kCoverage:
+        break;
+    }
+    return nullptr;
+  }
   // The single-float plane of a channel (coverage is copied out of colour's alpha); colour,
   // three floats per pixel, has none: read `colour`.
   std::vector<float> plane(Channel c) const {
-    switch (c) {
-      case Channel::kDepth:
-        return depth;
-      case Channel::kCloudDepth:
-        return cloud_depth;
-      case Channel::kObjectId:
-        return object_id;
-      case Channel::kVisibility:
-        return visibility;
-      case Channel::kLwir:
-        return lwir;
-      case Channel::kCoverage: {
-        std::vector<float> alpha(colour.rgba.size() / 4);
-        for (std::size_t i = 0; i < alpha.size(); ++i) alpha[i] = colour.rgba[i * 4 + 3];
-        return alpha;
-      }
-      case Channel::kColour:
-        break;
-    }
-    return {};
+    if (const std::vector<float>* own = ownPlane(c)) return *own;
+    if (c != Channel::kCoverage) return {};
+    std::vector<float> alpha(colour.rgba.size() / 4);
+    for (std::size_t i = 0; i < alpha.size(); ++i) alpha[i] = colour.rgba[i * 4 + 3];
+    return alpha;
   }
 };
 

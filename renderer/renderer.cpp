@@ -90,29 +90,12 @@ std::vector<ExrPlane> exrPlanesOf(const Frame& frame, const std::vector<Channel>
   std::vector<ExrPlane> planes;
   const float* rgba = frame.colour.rgba.data();
   for (Channel c : order) {
-    switch (c) {
-      case Channel::kColour:
-        for (int k = 0; k < 3; ++k) planes.push_back({std::string(1, "RGB"[k]), rgba + k, 4});
-        break;
-      case Channel::kCoverage:
-        planes.push_back({"A", rgba + 3, 4});
-        break;
-      case Channel::kDepth:
-        planes.push_back({channelName(c), frame.depth.data(), 1});
-        break;
-      case Channel::kCloudDepth:
-        planes.push_back({channelName(c), frame.cloud_depth.data(), 1});
-        break;
-      case Channel::kObjectId:
-        planes.push_back({channelName(c), frame.object_id.data(), 1});
-        break;
-      case Channel::kVisibility:
-        planes.push_back({channelName(c), frame.visibility.data(), 1});
-        break;
-      case Channel::kLwir:
-        planes.push_back({channelName(c), frame.lwir.data(), 1});
-        break;
-    }
+    if (c == Channel::kColour)
+      for (int k = 0; k < 3; ++k) planes.push_back({std::string(1, "RGB"[k]), rgba + k, 4});
+    else if (c == Channel::kCoverage)
+      planes.push_back({"A", rgba + 3, 4});
+    else
+      planes.push_back({channelName(c), frame.ownPlane(c)->data(), 1});
   }
   return planes;
 }
