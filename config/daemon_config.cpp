@@ -45,7 +45,8 @@ void readView(TableReader& t, const Camera& scene_camera, ViewConfig& view) {
 
 void readDaemon(const toml::table& root, const std::string& file, DaemonConfig& out) {
   TableReader t(root, "", file);
-  t.allow({"scene", "world", "view", "socket", "modbus", "metrics", "snapshot", "output"});
+  t.allow({"scene", "world", "view", "socket", "modbus", "metrics", "snapshot", "output", "cigi",
+           "site", "entity_type"});
   if (!t.has("scene")) t.failHere("missing key scene (the scene file to load)");
   t.string("scene", out.scene_path);
   const std::filesystem::path scene(out.scene_path);
@@ -112,6 +113,42 @@ void readDaemon(const toml::table& root, const std::string& file, DaemonConfig& 
   else if (std::none_of(out.views.begin(), out.views.end(),
                         [&](const ViewConfig& v) { return v.name == out.modbus_view; }))
     t.failHere("modbus.view: \"" + out.modbus_view + "\" is not a view");
+  if (auto c = t.table("cigi")) {
+    c->allow({"enabled", "bind", "ig_port", "host_port", "views"});
+    c->boolean("enabled", out.cigi.enabled);
+    c->string("bind", out.cigi.bind);
+    c->integer("ig_port", out.cigi.ig_port, 0, 65535);
+    c->integer("host_port", out.cigi.host_port, 0, 65535);
+    if (c->has("views")) {
+      c->strings("views", out.cigi.views, DaemonLimits::kMaxViews);
+      for (const std::string& name : out.cigi.views)
+        if (std::none_of(out.views.begin(), out.views.end(),
+                         [&](const ViewConfig& v) { return v.name == name; }))
+          c->failAt("views", "\"" + name + "\" is not a [[view]]");
+    }
+    c->finish();
+  }
+  if (out.cigi.views.empty())
+    for (const ViewConfig& v : out.views) out.cigi.views.push_back(v.name);
+  if (auto s = t.table("site")) {
+    s->allow({"latitude", "longitude"});
+    s->number("latitude", out.site.latitude_deg, Limits::kLatitude);
+    s->number("longitude", out.site.longitude_deg, Limits::kLongitude);
+    s->finish();
+  }
+  for (TableReader& e : t.tables("entity_type")) {
+    EntityType& type = out.entity_types.emplace_back();
+    if (!e.has("id")) e.failHere("missing key id (the CIGI entity type, 0 to 65535)");
+    e.integer("id", type.id, 0, 65535);
+    readTarget(e, file, type.prototype, {"id"});
+    type.name = type.prototype.name;
+    if (type.name.empty()) e.failHere("missing key name (how requests name this type)");
+    for (std::size_t i = 0; i + 1 < out.entity_types.size(); ++i)
+      if (out.entity_types[i].id == type.id || out.entity_types[i].name == type.name)
+        e.failAt("id", "entity type " + std::to_string(type.id) + " \"" + type.name +
+                           "\" repeats an earlier id or name");
+    e.finish();
+  }
   if (auto m = t.table("metrics")) {
     m->allow({"enabled", "bind", "port"});
     m->boolean("enabled", out.metrics_enabled);

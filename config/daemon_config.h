@@ -35,6 +35,22 @@ struct Timeouts {
   double idle_s;     // a connection with nothing to do is closed after this; 0: never
 };
 
+// CIGI 3.3 over UDP (protocol/cigi.h, docs/CIGI.md): the host sends to `ig_port`; Start of
+// Frame goes back to the sender's address at `host_port`.
+struct CigiConfig {
+  bool enabled = false;
+  std::string bind = "127.0.0.1";
+  int ig_port = 8004;
+  int host_port = 8005;
+  std::vector<std::string> views;  // CIGI view id n is views[n]; default the config's views
+};
+
+// Where the database's origin lies on the Earth (for the sun from a date and time).
+struct Site {
+  double latitude_deg = 0.0;
+  double longitude_deg = 0.0;
+};
+
 struct DaemonConfig {
   std::string config_path;
   std::string scene_path;  // relative paths are relative to the config file
@@ -75,6 +91,10 @@ struct DaemonConfig {
     return snapshot_directory.empty() ? std::filesystem::path(snapshot_path).parent_path().string()
                                       : snapshot_directory;
   }
+
+  CigiConfig cigi;
+  Site site;
+  std::vector<EntityType> entity_types;  // [[entity_type]]: targets by CIGI type or name
 
   std::string output_directory = "frames";  // images written by the Modbus render coil
   ImageFormat output_format = ImageFormat::kPng;

@@ -75,7 +75,7 @@ void readSky(TableReader& t, Sky& sky) {
 void readFog(TableReader& t, Fog& fog) {
   t.allow({"top", "visibility", "colour"});
   t.number("top", fog.top_m, 0.0, Limits::kMaxAltitude);
-  t.number("visibility", fog.visibility_m, 1.0, 1.0e7);
+  t.number("visibility", fog.visibility_m, Limits::kFogVisibility);
   t.vector("colour", fog.colour, Limits::kColour);
   t.finish();
 }
@@ -382,8 +382,14 @@ void readAutomaton(TableReader& t, std::uint64_t seed, AutomatonCloudSpec& a) {
   t.finish();
 }
 
-void readTarget(TableReader& t, const std::string& scene_path, Target& target) {
-  t.allow({"name", "shape", "centre", "heading", "pitch", "roll", "size", "colour", "mesh"});
+}  // namespace
+
+void readTarget(TableReader& t, const std::string& scene_path, Target& target,
+                std::vector<std::string> extra_keys) {
+  std::vector<std::string> keys{"name", "shape", "centre", "heading", "pitch",
+                                "roll", "size",  "colour", "mesh"};
+  keys.insert(keys.end(), extra_keys.begin(), extra_keys.end());
+  t.allow(keys);
   t.name("name", target.name);
   target.shape = TargetShape(t.choice("shape", {"box", "ellipsoid", "mesh"}, int(target.shape)));
   t.vector("centre", target.centre, -Limits::kMaxCoordinate, Limits::kMaxCoordinate);
@@ -407,8 +413,10 @@ void readTarget(TableReader& t, const std::string& scene_path, Target& target) {
   } else if (!mesh_path.empty()) {
     t.failAt("mesh", "applies to shape \"mesh\" only");
   }
-  t.finish();
+  if (extra_keys.empty()) t.finish();
 }
+
+namespace {
 
 // The keys a [[macrocluster]] adds to a weather layer (MODEL.md section 11): the region it
 // fills, its cluster grid and variation, and a front's side.
@@ -598,6 +606,42 @@ std::string parseCloudJson(const nlohmann::json& cloud, std::uint64_t seed, Elli
     const std::size_t key = e.message.find(": ");
     return key == std::string::npos ? e.message : e.message.substr(key + 2);
   }
+  return "";
+}
+
+std::string parseTargetJson(const nlohmann::json& target, const std::vector<EntityType>& types,
+                            Target& out) {
+  toml::table table;
+  if (!target.is_object() || !fillTable(target, table))
+    return "target: must be an object without null values";
+  Target parsed;
+  if (const auto type = target.find("type"); type != target.end()) {
+    std::string names;
+    for (const EntityType& e : types) names += (names.empty() ? "" : ", ") + e.name;
+    const auto it = std::find_if(types.begin(), types.end(), [&](const EntityType& e) {
+      return type->is_string() && e.name == type->get<std::string>();
+    });
+    if (it == types.end())
+      return "target.type: " + type->dump() +
+             " is not an entity type of the daemon config (allowed: " +
+             (names.empty() ? std::string("none are configured") : names) + ")";
+    parsed = it->prototype;
+    table.erase("type");
+  }
+  try {
+    TableReader reader(table, "target", "request");
+    reader.forbid("mesh", "meshes come from the daemon config's [[entity_type]] (give \"type\")");
+    if (parsed.shape == TargetShape::kMesh) reader.forbid("shape", "the entity type fixes it");
+    readTarget(reader, "", parsed);
+    if (parsed.name.empty())
+      reader.failHere("name is missing (a unique name, to move or remove the target by)");
+    if (parsed.shape == TargetShape::kMesh && !parsed.mesh)
+      reader.failAt("shape", "shape \"mesh\" needs an [[entity_type]] with a mesh");
+  } catch (const SceneError& e) {
+    const std::size_t key = e.message.find(": ");
+    return key == std::string::npos ? e.message : e.message.substr(key + 2);
+  }
+  out = std::move(parsed);
   return "";
 }
 

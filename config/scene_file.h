@@ -44,6 +44,21 @@ std::string parseSceneText(std::string_view text, const std::string& source_name
 // the key and what is allowed.
 std::string parseCloudJson(const nlohmann::json& cloud, std::uint64_t seed, EllipsoidCloud& out);
 
+namespace config_detail {
+class TableReader;
+}
+// Reads a [[target]] table onto `target` (relative mesh paths are relative to `path`'s
+// directory). With `extra_keys` the caller reads those keys and finishes the table.
+void readTarget(config_detail::TableReader& t, const std::string& path, Target& target,
+                std::vector<std::string> extra_keys = {});
+
+// A target given as a JSON object with the keys of a scene file's [[target]] table (the socket
+// protocol's add_target), without `mesh`; `type` starts it from one of `types` (the daemon
+// config's [[entity_type]], which alone may name meshes). Errors name the key and what is
+// allowed.
+std::string parseTargetJson(const nlohmann::json& target, const std::vector<EntityType>& types,
+                            Target& out);
+
 // Checks the render knobs whose allowed values are not a plain range: "key: what is wrong
 // (allowed: ...)", or empty when valid.
 std::string validateRenderSettings(const RenderSettings& settings);

@@ -201,7 +201,7 @@ std::optional<ImageRequest> readImage(FieldReader& r) {
   return image;
 }
 
-ViewPatch readViewPatch(FieldReader& r) {
+ViewPatch readViewPatch(FieldReader& r, bool image = true) {
   ViewPatch p;
   p.position = r.vector<3>("position", -Limits::kMaxCoordinate, Limits::kMaxCoordinate);
   if (p.position && p.position->z < 0.0)
@@ -212,8 +212,33 @@ ViewPatch readViewPatch(FieldReader& r) {
   p.vfov = r.number("vfov", Limits::kMinVfov, Limits::kMaxVfov);
   if (auto w = r.integer("width", 1, Limits::kMaxImageSide)) p.width = int(*w);
   if (auto h = r.integer("height", 1, Limits::kMaxImageSide)) p.height = int(*h);
-  p.image = readImage(r);
+  if (image) p.image = readImage(r);
   return p;
+}
+
+constexpr const char* kCameraKeys = "position, heading, pitch, roll, vfov, width, height";
+
+// The views of a render: "view" (one name) or "views" (an array of names).
+std::vector<std::string> readViews(FieldReader& r) {
+  const std::string allowed = "\"view\": a name, or \"views\": an array of 1 to " +
+                              std::to_string(ProtocolLimits::kMaxViewsPerRender) +
+                              " distinct view names";
+  if (r.has("view") == r.has("views"))
+    r.fail("view", "give one of view and views (" + allowed + ")");
+  if (r.has("view")) return {r.requiredName("view")};
+  const json* views = r.raw("views");
+  if (!views->is_array() || views->empty() ||
+      views->size() > std::size_t(ProtocolLimits::kMaxViewsPerRender))
+    r.fail("views", "must be " + allowed);
+  std::vector<std::string> names;
+  for (const json& v : *views) {
+    const std::string name = v.is_string() ? v.get<std::string>() : v.dump();
+    if (std::string e = nameError(name); !e.empty()) r.fail("views", e);
+    if (std::find(names.begin(), names.end(), name) != names.end())
+      r.fail("views", "\"" + name + "\" is repeated (" + allowed + ")");
+    names.push_back(name);
+  }
+  return names;
 }
 
 WeatherLayer readWeather(FieldReader& r) {
@@ -290,14 +315,35 @@ Command readCommand(const std::string& cmd, FieldReader& r) {
   }
   if (cmd == "set_sun") {
     SetSun c{r.number("azimuth", -Limits::kMaxHeading, Limits::kMaxHeading),
-             r.number("elevation", -Limits::kMaxPitch, Limits::kMaxPitch)};
-    r.finish("cmd, id, azimuth, elevation");
+             r.number("elevation", -Limits::kMaxPitch, Limits::kMaxPitch), std::nullopt};
+    if (auto utc = r.string("utc", 64)) {
+      if (c.azimuth || c.elevation)
+        r.fail("utc", "give the sun by azimuth and elevation, or by utc, not both");
+      CivilTime t;
+      if (std::string e = parseUtc(*utc, t); !e.empty()) r.fail("utc", e);
+      c.utc = t;
+    }
+    r.finish("cmd, id, azimuth, elevation, utc");
+    return c;
+  }
+  if (cmd == "set_fog") {
+    SetFog c{r.boolean("enabled"), r.number("top", 0.0, Limits::kMaxAltitude),
+             r.number("visibility", Limits::kFogVisibility),
+             r.vector<3>("colour", Limits::kColour.lo, Limits::kColour.hi)};
+    if (c.enabled == false && (c.top || c.visibility || c.colour))
+      r.fail("enabled", "false removes the fog; give no top, visibility or colour with it");
+    r.finish("cmd, id, enabled, top, visibility, colour");
     return c;
   }
   if (cmd == "set_time") {
     SetTime c{r.number("time_scale", 0.0, ProtocolLimits::kMaxTimeScale), r.boolean("paused"),
-              r.number("advance", 0.0, Limits::kMaxAdvance)};
-    r.finish("cmd, id, time_scale, paused, advance");
+              r.number("advance", 0.0, Limits::kMaxAdvance), std::nullopt};
+    if (auto mode = r.string("mode", 16)) {
+      if (*mode != "realtime" && *mode != "lockstep")
+        r.fail("mode", "\"" + *mode + "\" is not allowed (allowed: realtime, lockstep)");
+      c.mode = *mode == "realtime" ? ClockMode::kRealtime : ClockMode::kLockstep;
+    }
+    r.finish("cmd, id, time_scale, paused, advance, mode");
     return c;
   }
   if (cmd == "add_cloud") {
@@ -323,14 +369,49 @@ Command readCommand(const std::string& cmd, FieldReader& r) {
     r.finish("cmd, id, name");
     return c;
   }
+  if (cmd == "add_target") {
+    const json* target = r.object("target");
+    if (!target)
+      r.fail("target",
+             "is missing (an object with the keys of a scene file's [[target]], or a type "
+             "named in the daemon config's [[entity_type]])");
+    AddTarget c{*target};
+    r.finish("cmd, id, target");
+    return c;
+  }
+  if (cmd == "move_target") {
+    MoveTarget c;
+    c.name = r.requiredName("name");
+    c.centre = r.vector<3>("centre", -Limits::kMaxCoordinate, Limits::kMaxCoordinate);
+    c.heading = r.number("heading", -Limits::kMaxHeading, Limits::kMaxHeading);
+    c.pitch = r.number("pitch", -Limits::kMaxPitch, Limits::kMaxPitch);
+    c.roll = r.number("roll", -Limits::kMaxRoll, Limits::kMaxRoll);
+    r.finish("cmd, id, name, centre, heading, pitch, roll");
+    return c;
+  }
+  if (cmd == "remove_target") {
+    RemoveTarget c{r.requiredName("name")};
+    r.finish("cmd, id, name");
+    return c;
+  }
+  if (cmd == "list_targets") {
+    r.finish("cmd, id");
+    return ListTargets{};
+  }
   if (cmd == "tick") {
     Tick c{r.requiredNumber("dt", 0.0, Limits::kMaxTick)};
     r.finish("cmd, id, dt");
     return c;
   }
   if (cmd == "render") {
-    Render c{r.requiredName("view"), readImage(r)};
-    r.finish("cmd, id, view, format, channels");
+    Render c{readViews(r), std::nullopt, readImage(r)};
+    if (const json* camera = r.object("camera")) {
+      if (c.views.size() != 1) r.fail("camera", "applies to a render of one view");
+      FieldReader cr(*camera, "camera");
+      c.camera = readViewPatch(cr, false);
+      cr.finish(kCameraKeys);
+    }
+    r.finish("cmd, id, view, views, camera, format, channels");
     return c;
   }
   if (cmd == "subscribe") {
@@ -428,9 +509,10 @@ std::string_view imageFormatName(ImageFormat format) {
 
 std::string_view commandName(const Command& command) {
   static constexpr std::string_view kNames[] = {
-      "hello",     "get_view",    "set_view",     "set_weather",  "set_wind", "set_sun",
-      "set_time",  "add_cloud",   "change_cloud", "remove_cloud", "tick",     "render",
-      "subscribe", "unsubscribe", "snapshot",     "restore",      "stats",    "hash"};
+      "hello",       "get_view",      "set_view",     "set_weather",  "set_wind",     "set_sun",
+      "set_fog",     "set_time",      "add_cloud",    "change_cloud", "remove_cloud", "add_target",
+      "move_target", "remove_target", "list_targets", "tick",         "render",       "subscribe",
+      "unsubscribe", "snapshot",      "restore",      "stats",        "hash"};
   static_assert(std::size(kNames) == std::variant_size_v<Command>);
   return kNames[command.index()];
 }

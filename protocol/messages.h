@@ -14,6 +14,7 @@
 #include "renderer/frame.h"
 
 #include "world/formations/weather.h"
+#include "world/solar.h"
 
 namespace nephele {
 
@@ -22,7 +23,9 @@ struct ProtocolLimits {
   static constexpr int kMaxJsonDepth = 16;                    // nesting of arrays and objects
   static constexpr double kMaxSubscriptionHz = 60.0;
   static constexpr double kMaxTimeScale = 1000.0;
-  static constexpr int kWeatherLayers = 3;  // CIGI cloud layers 1 to 3
+  static constexpr int kWeatherLayers = 3;       // CIGI cloud layers 1 to 3
+  static constexpr int kMaxViewsPerRender = 16;  // views captured from one tick by one render
+  static constexpr int kMaxTargets = 4096;       // targets in the world at once
 };
 
 enum class ErrorCode {
@@ -97,13 +100,24 @@ struct SetWeather {
 struct SetWind {
   glm::dvec2 velocity{0.0};  // east, north m/s, at every altitude
 };
+// The sun by direction, or by the date and time of day at the site's latitude and longitude
+// (world/solar.h), not both.
 struct SetSun {
   std::optional<double> azimuth, elevation;
+  std::optional<CivilTime> utc;
 };
+// Ground fog (McReynolds and Blythe): unset fields keep their value; `enabled` false removes it.
+struct SetFog {
+  std::optional<bool> enabled;
+  std::optional<double> top, visibility;
+  std::optional<glm::dvec3> colour;
+};
+enum class ClockMode { kRealtime, kLockstep };
 struct SetTime {
   std::optional<double> time_scale;  // simulated seconds per real second
   std::optional<bool> paused;
   std::optional<double> advance;  // seconds to move on at once
+  std::optional<ClockMode> mode;
 };
 struct AddCloud {
   nlohmann::json cloud;  // the keys of a scene file's [[cloud]] table
@@ -117,12 +131,28 @@ struct ChangeCloud {
 struct RemoveCloud {
   std::string name;
 };
+struct AddTarget {
+  nlohmann::json target;  // the keys of a scene file's [[target]] table, or `type` (config)
+};
+// A target's new pose: unset fields keep their value.
+struct MoveTarget {
+  std::string name;
+  std::optional<glm::dvec3> centre;
+  std::optional<double> heading, pitch, roll;
+};
+struct RemoveTarget {
+  std::string name;
+};
+struct ListTargets {};
 struct Tick {
   double dt = 0.0;
 };
+// Renders one view, or several from the same tick (one image reply each, in order). `camera`
+// overrides the one view's pose, field of view and size for this render alone.
 struct Render {
-  std::string view;
-  std::optional<ImageRequest> image;  // unset: the view's own
+  std::vector<std::string> views;
+  std::optional<ViewPatch> camera;
+  std::optional<ImageRequest> image;  // unset: each view's own
 };
 struct Subscribe {
   std::string view;
@@ -144,15 +174,16 @@ struct Hash {};
 
 using Command =
     std::variant<command::Hello, command::GetView, command::SetView, command::SetWeather,
-                 command::SetWind, command::SetSun, command::SetTime, command::AddCloud,
-                 command::ChangeCloud, command::RemoveCloud, command::Tick, command::Render,
-                 command::Subscribe, command::Unsubscribe, command::Snapshot, command::Restore,
-                 command::Stats, command::Hash>;
+                 command::SetWind, command::SetSun, command::SetFog, command::SetTime,
+                 command::AddCloud, command::ChangeCloud, command::RemoveCloud, command::AddTarget,
+                 command::MoveTarget, command::RemoveTarget, command::ListTargets, command::Tick,
+                 command::Render, command::Subscribe, command::Unsubscribe, command::Snapshot,
+                 command::Restore, command::Stats, command::Hash>;
 std::string_view commandName(const Command& command);
 inline constexpr std::string_view kCommandNames =
-    "hello, get_view, set_view, set_weather, set_wind, set_sun, set_time, add_cloud, "
-    "change_cloud, remove_cloud, tick, render, subscribe, unsubscribe, snapshot, restore, "
-    "stats, hash";
+    "hello, get_view, set_view, set_weather, set_wind, set_sun, set_fog, set_time, add_cloud, "
+    "change_cloud, remove_cloud, add_target, move_target, remove_target, list_targets, tick, "
+    "render, subscribe, unsubscribe, snapshot, restore, stats, hash";
 
 struct Request {
   nlohmann::json id;  // echoed in the reply: a number, a string or null

@@ -27,17 +27,31 @@
 namespace nephele {
 
 // A reply: one JSON line, and for images the bytes that follow it (shared, so that one
-// encoded frame goes to every subscriber without a copy).
+// encoded frame goes to every subscriber without a copy). `then` holds replies written right
+// after it, as one unit (the images of a render of several views).
 struct Reply {
   std::string header;
   std::shared_ptr<const std::vector<std::uint8_t>> body;
-  std::size_t size() const { return header.size() + (body ? body->size() : 0); }
+  std::vector<std::shared_ptr<const Reply>> then;
+  std::size_t size() const {
+    std::size_t n = header.size() + (body ? body->size() : 0);
+    for (const auto& r : then) n += r->size();
+    return n;
+  }
 };
 using SharedReply = std::shared_ptr<const Reply>;
 
 inline SharedReply makeReply(std::string header,
                              std::shared_ptr<const std::vector<std::uint8_t>> body = nullptr) {
   return std::make_shared<const Reply>(Reply{std::move(header), std::move(body)});
+}
+
+// Several replies written as one, in order.
+inline SharedReply chainReplies(std::vector<SharedReply> replies) {
+  if (replies.size() == 1) return replies.front();
+  Reply first = *replies.front();
+  first.then.assign(replies.begin() + 1, replies.end());
+  return std::make_shared<const Reply>(std::move(first));
 }
 
 // Receives a request's reply, once, on a daemon thread (not the caller's).
@@ -131,12 +145,27 @@ class Engine {
                                                                    Job& job);
   std::optional<ProtocolError> check(const Command& command) const;
   std::optional<ProtocolError> setWeather(int layer, const WeatherLayer& weather);
+  std::variant<nlohmann::json, ProtocolError> setSun(const command::SetSun& c);
+  std::variant<nlohmann::json, ProtocolError> setFog(const command::SetFog& c);
+  void setMode(TickMode mode);
+  std::optional<std::variant<nlohmann::json, ProtocolError>> renderRequest(const command::Render& c,
+                                                                           Job& job);
+  std::optional<ProtocolError> pixelLimit(const Camera& camera) const;
+  // Snapshots: the World's file and the daemon's state beside it (snapshots.cpp).
+  nlohmann::json daemonState() const;
+  std::string writeSnapshot(const std::string& path);
+  std::string restoreSnapshot(const std::string& path);
   std::optional<ProtocolError> checkAdvance(double dt_s) const;
   void advance(double dt_s);  // one tick
   // Renders a view (float for EXR, else 8-bit) and records its time.
   void renderFrame(const ViewConfig& view, const ImageRequest& image, struct ViewFrame& frame);
   void realtimeTicks();
-  void deliverFrames(bool only_due, const std::string& view);
+  enum class Delivery {
+    kDue,        // realtime: subscriptions whose period has come round
+    kEveryTick,  // lockstep: every subscription, once per tick
+    kView,       // the render coil: the subscribers of one view
+  };
+  void deliverFrames(Delivery which, const std::string& view);
   void renderTrigger();
   bool saveSnapshot(const std::string& path, const char* why);
   void countSubscriptions();  // refreshes subscribers_ from the world thread's list

@@ -303,8 +303,12 @@ class Connection : public std::enable_shared_from_this<Connection> {
   void write() {
     writing_ = true;
     const SharedReply& r = out_.front();
-    std::array<asio::const_buffer, 2> buffers{
-        asio::buffer(r->header), r->body ? asio::buffer(*r->body) : asio::const_buffer()};
+    std::vector<asio::const_buffer> buffers{asio::buffer(r->header)};
+    if (r->body) buffers.push_back(asio::buffer(*r->body));
+    for (const SharedReply& then : r->then) {
+      buffers.push_back(asio::buffer(then->header));
+      if (then->body) buffers.push_back(asio::buffer(*then->body));
+    }
     asio::async_write(socket_, buffers,
                       [self = shared_from_this()](std::error_code ec, std::size_t) {
                         const SharedReply& done = self->out_.front();

@@ -108,6 +108,14 @@ struct Limits {
   static constexpr int kMaxWarmupSteps = 100000;
   static constexpr int kMaxSamplesPerCell = 8;
 
+  // The site and the sun's date (world/solar.h). The low-precision solar coordinates hold to
+  // about 0.01 degree from 1901 to 2099 (NOAA's solar calculator notes).
+  static constexpr Range kLatitude{-90.0, 90.0};
+  static constexpr Range kLongitude{-180.0, 180.0};
+  static constexpr int kMinSolarYear = 1901, kMaxSolarYear = 2099;
+  // Ground fog (McReynolds and Blythe): top and meteorological visibility, metres.
+  static constexpr Range kFogVisibility{1.0, 1.0e7};
+
   // A scene file, daemon config or mesh read whole.
   static constexpr unsigned long long kMaxTextFileBytes = 64ull << 20;
 

@@ -35,6 +35,14 @@ struct Target {
   std::shared_ptr<const TriangleMesh> mesh;  // for kMesh
 };
 
+// A kind of target a host names by number (a CIGI entity type) or by name: shape, size, colour
+// and mesh, from the daemon config's [[entity_type]]. Placed targets start from it.
+struct EntityType {
+  int id = 0;
+  std::string name;
+  Target prototype;
+};
+
 // Targets are Lambertian with a fixed ambient share: colour * sun * (a + (1 - a) max(0, N.L)),
 // N turned towards the viewer.
 inline constexpr double kTargetAmbient = 0.3;

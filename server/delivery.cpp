@@ -1,0 +1,271 @@
+#include <spdlog/spdlog.h>
+
+#include <filesystem>
+#include <map>
+
+#include "renderer/renderer.h"
+#include "server/engine_state.h"
+
+// Frames: rendering a view, encoding off the world thread, render replies, subscriptions and
+// the Modbus render coil's files.
+namespace nephele {
+
+using namespace engine_detail;
+
+namespace engine_detail {
+
+// Encodes `frame` as `image` asks; on failure returns the error.
+std::variant<std::vector<std::uint8_t>, std::string> encodeFrame(const ViewFrame& frame,
+                                                                 const ImageRequest& image,
+                                                                 const EncodeOptions& options) {
+  std::vector<std::uint8_t> bytes;
+  std::string error;
+  if (image.floatPlanes()) {
+    const Frame& f = frame.planes;
+    if (image.format == ImageFormat::kExr) {
+      error = encodeFrameExr(f, image.order, options, bytes);
+      if (!error.empty()) return error;
+      return bytes;
+    }
+    // Raw: float32 planes, host byte order (little-endian on x86-64 and ARM), in the order asked.
+    const std::size_t pixels = std::size_t(f.width()) * f.height();
+    std::vector<float> planes;
+    planes.reserve(pixels * (image.order.size() + 2));
+    for (Channel c : image.order) {
+      if (c == Channel::kColour) {
+        for (int k = 0; k < 3; ++k)
+          for (std::size_t i = 0; i < pixels; ++i) planes.push_back(f.colour.rgba[i * 4 + k]);
+      } else {
+        const std::vector<float> plane = f.plane(c);
+        planes.insert(planes.end(), plane.begin(), plane.end());
+      }
+    }
+    const auto* raw = reinterpret_cast<const std::uint8_t*>(planes.data());
+    return std::vector<std::uint8_t>(raw, raw + planes.size() * sizeof(float));
+  }
+  switch (image.format) {
+    case ImageFormat::kRaw:
+      return packRaw(frame.srgb, image.colour, image.coverage);
+    case ImageFormat::kPng:
+      error = encodeImage(ImageFileFormat::kPng, frame.srgb, image.colour, image.coverage, options,
+                          bytes);
+      break;
+    case ImageFormat::kJpeg:
+      error = encodeImage(ImageFileFormat::kJpeg, frame.srgb, image.colour, image.coverage, options,
+                          bytes);
+      break;
+    case ImageFormat::kExr:
+      error = encodeImage(frame.linear, image.colour, image.coverage, options, bytes);
+      break;
+  }
+  if (!error.empty()) return error;
+  return bytes;
+}
+
+json imageMeta(const ViewFrame& frame, const ImageRequest& image) {
+  json meta = frame.meta;
+  meta["format"] = imageFormatName(image.format);
+  meta["channels"] = channelNames(image);
+  meta["rows"] = "top-down";
+  meta["encoding"] = image.format == ImageFormat::kExr ? "linear"
+                     : image.floatPlanes()             ? "float32-planes"
+                                                       : "srgb";
+  return meta;
+}
+
+}  // namespace engine_detail
+
+void Engine::renderFrame(const ViewConfig& view, const ImageRequest& image, ViewFrame& frame) {
+  State& s = *state_;
+  Scene scene = s.world->scene();
+  scene.camera = view.camera;
+  const auto t0 = Clock::now();
+  if (image.floatPlanes()) {
+    FrameRequest request;
+    request.channels = image.planes;
+    if (image.colour) request.channels.add(Channel::kColour);
+    if (image.coverage) request.channels.add(Channel::kCoverage);
+    request.tick = std::uint64_t(s.ticks);
+    frame.planes = s.renderer->renderFrame(scene, config_.scene.render, request);
+  } else if (image.format == ImageFormat::kExr) {
+    frame.linear = s.renderer->renderFloat(scene, config_.scene.render);
+  } else {
+    frame.srgb = s.renderer->renderSrgb8(scene, config_.scene.render);
+  }
+  s.last_render_ms = msSince(t0);
+  s.render_ms.push_back(s.last_render_ms);
+  if (s.render_ms.size() > kRenderHistory) s.render_ms.pop_front();
+  ++s.frames;
+  frame.meta = {{"view", view.name},
+                {"width", view.camera.width},
+                {"height", view.camera.height},
+                {"time", s.world->timeSeconds()},
+                {"tick", s.ticks},
+                {"frame", s.frames},
+                {"camera", cameraJson(frameInfo(view.camera, s.world->timeSeconds(),
+                                                std::uint64_t(s.ticks)))}};
+}
+
+std::optional<ProtocolError> Engine::pixelLimit(const Camera& camera) const {
+  const std::int64_t w = camera.width, h = camera.height;
+  if (w * h <= config_.max_image_pixels) return std::nullopt;
+  return ProtocolError{ErrorCode::kLimit, "width x height: " + std::to_string(w) + "x" +
+                                              std::to_string(h) + " is above the limit of " +
+                                              std::to_string(config_.max_image_pixels) + " pixels"};
+}
+
+std::optional<Outcome> Engine::renderRequest(const command::Render& c, Job& job) {
+  State& s = *state_;
+  std::vector<ViewConfig> views;
+  for (const std::string& name : c.views) {
+    const ViewConfig* v = s.view(name);
+    if (!v) return unknownView(s.views, name);
+    views.push_back(*v);
+  }
+  if (c.camera) {  // for this render alone: the view itself stays as it is
+    applyViewPatch(views.front(), *c.camera);
+    if (auto error = pixelLimit(views.front().camera)) return *error;
+  }
+  if (encoder_->depth() >= kEncoderQueue)
+    return ProtocolError{ErrorCode::kBusy, "the image encoder is busy; try again"};
+  // Every view is rendered before anything else runs on this thread: one tick, one world.
+  struct Part {
+    std::shared_ptr<ViewFrame> frame;
+    ImageRequest image;
+  };
+  std::vector<Part> parts;
+  bool all_raw = true;
+  for (const ViewConfig& v : views) {
+    Part part{std::make_shared<ViewFrame>(), c.image.value_or(v.image)};
+    renderFrame(v, part.image, *part.frame);
+    all_raw = all_raw && part.image.format == ImageFormat::kRaw && !part.image.floatPlanes();
+    parts.push_back(std::move(part));
+  }
+  auto send = [parts, id = job.request.id, reply = job.reply, options = config_.encode]() {
+    std::vector<SharedReply> replies;
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+      auto encoded = encodeFrame(*parts[i].frame, parts[i].image, options);
+      if (auto* e = std::get_if<std::string>(&encoded)) {
+        reply(makeReply(errorReply(id, {ErrorCode::kFailed, *e})));
+        return;
+      }
+      auto bytes = std::make_shared<const std::vector<std::uint8_t>>(
+          std::move(std::get<std::vector<std::uint8_t>>(encoded)));
+      json meta = imageMeta(*parts[i].frame, parts[i].image);
+      if (parts.size() > 1) {
+        meta["part"] = i;
+        meta["parts"] = parts.size();
+      }
+      replies.push_back(makeReply(imageReplyHeader(id, std::move(meta), bytes->size()), bytes));
+    }
+    reply(chainReplies(std::move(replies)));
+  };
+  if (all_raw)
+    send();  // nothing to encode: packing is a copy
+  else
+    encoder_->post(send);  // room was checked above, and only this thread posts
+  return std::nullopt;
+}
+
+void Engine::deliverFrames(Delivery which, const std::string& view_name) {
+  State& s = *state_;
+  if (std::erase_if(s.subscriptions, [](const Subscription& sub) { return sub.gone->load(); }))
+    countSubscriptions();
+  const auto now = Clock::now();
+  // Group the subscriptions that are due by view and by image request: one render per view
+  // (and per kind of pixel), one encoding per request.
+  std::map<std::string, std::vector<Subscription*>> by_view;
+  for (Subscription& sub : s.subscriptions) {
+    const bool due = which == Delivery::kDue         ? now >= sub.next_due
+                     : which == Delivery::kEveryTick ? sub.last_tick != s.ticks
+                                                     : sub.view == view_name;
+    if (!due) continue;
+    if (which == Delivery::kDue) {
+      sub.next_due += sub.period;
+      if (sub.next_due < now) sub.next_due = now + sub.period;  // a slow render: skip, never burst
+    }
+    sub.last_tick = s.ticks;
+    by_view[sub.view].push_back(&sub);
+  }
+  for (auto& [name, subs] : by_view) {
+    const ViewConfig* view = s.view(name);
+    if (!view) continue;
+    std::shared_ptr<ViewFrame> frames[2];  // 8-bit and linear
+    std::vector<std::pair<ImageRequest, std::vector<Subscription*>>> groups;
+    for (Subscription* sub : subs) {
+      auto it = std::find_if(groups.begin(), groups.end(),
+                             [&](const auto& g) { return g.first == sub->image; });
+      if (it == groups.end())
+        groups.push_back({sub->image, {sub}});
+      else
+        it->second.push_back(sub);
+    }
+    for (auto& [image, members] : groups) {
+      const bool linear = image.format == ImageFormat::kExr;
+      std::shared_ptr<ViewFrame> planes;  // ground-truth channels: rendered for this group
+      std::shared_ptr<ViewFrame>& frame = image.floatPlanes() ? planes : frames[linear ? 1 : 0];
+      if (!frame) {
+        frame = std::make_shared<ViewFrame>();
+        renderFrame(*view, image, *frame);
+      }
+      std::vector<Subscription> sinks;  // copies: the encoder may run after a change
+      for (Subscription* sub : members) sinks.push_back(*sub);
+      auto send = [frame, image = image, sinks, options = config_.encode]() {
+        auto encoded = encodeFrame(*frame, image, options);
+        if (auto* e = std::get_if<std::string>(&encoded)) {
+          spdlog::error("event=encode_failed error=\"{}\"", *e);
+          return;
+        }
+        auto bytes = std::make_shared<const std::vector<std::uint8_t>>(
+            std::move(std::get<std::vector<std::uint8_t>>(encoded)));
+        const json meta = imageMeta(*frame, image);
+        for (const Subscription& sub : sinks)
+          if (!sub.sink(makeReply(frameEventHeader(sub.id, meta, bytes->size()), bytes)))
+            sub.gone->store(true);
+      };
+      if (image.format == ImageFormat::kRaw && !image.floatPlanes())
+        send();
+      else if (!encoder_->post(send))
+        frames_dropped += members.size();
+    }
+  }
+}
+
+void Engine::renderTrigger() {
+  State& s = *state_;
+  const ViewConfig& view = *s.view(config_.modbus_view);
+  const bool linear = config_.output_format == ImageFormat::kExr;
+  auto frame = std::make_shared<ViewFrame>();
+  ImageRequest image;
+  image.format = config_.output_format;
+  renderFrame(view, image, *frame);
+  const std::string extension = config_.output_format == ImageFormat::kPng    ? ".png"
+                                : config_.output_format == ImageFormat::kJpeg ? ".jpg"
+                                                                              : ".exr";
+  // Named by the frame counter, which a snapshot restores; a name already taken (a restart
+  // without a snapshot) gets a suffix, so an earlier frame is never overwritten.
+  const std::filesystem::path directory(config_.output_directory);
+  const std::string stem = view.name + "_" + std::to_string(s.frames);
+  std::filesystem::path path = directory / (stem + extension);
+  for (int n = 1; std::filesystem::exists(path) && n < 1000000; ++n)
+    path = directory / (stem + "." + std::to_string(n) + extension);
+  // The caller checked that the encoder has room, and only this thread feeds it; the
+  // subscribers' frames come after.
+  encoder_->post([this, frame, linear, path, options = config_.encode]() {
+    std::error_code ec;
+    std::filesystem::create_directories(path.parent_path(), ec);
+    // writeImageFile picks the format from the extension and renames into place.
+    const std::string e = linear ? writeImageFile(path.string(), frame->linear, options)
+                                 : writeImageFile(path.string(), frame->srgb, options);
+    if (!e.empty()) {
+      spdlog::error("event=render_trigger_failed error=\"{}\"", e);
+      noteError(ErrorCode::kFailed);
+    } else {
+      spdlog::info("event=render_trigger path={}", path.string());
+    }
+    trigger_pending_ = false;
+  });
+  deliverFrames(Delivery::kView, view.name);
+}
+
+}  // namespace nephele

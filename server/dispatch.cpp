@@ -1,0 +1,314 @@
+#include <filesystem>
+
+#include "config/scene_file.h"
+#include "server/engine_state.h"
+#include "world/counter_random.h"
+#include "world/limits.h"
+
+// Requests: checked (check), then carried out on the world thread (apply), one handler per
+// command of protocol/messages.h.
+namespace nephele {
+
+using namespace engine_detail;
+
+namespace {
+
+// A name's 64-bit FNV-1a hash, for seeding clouds by name.
+std::uint64_t nameHash(const std::string& name) {
+  std::uint64_t h = 0xcbf29ce484222325ull;
+  for (unsigned char c : name) h = (h ^ c) * 0x100000001b3ull;
+  return h;
+}
+
+json targetJson(const Target& t, std::size_t object_id) {
+  static constexpr const char* kShapes[] = {"box", "ellipsoid", "mesh"};
+  return {{"name", t.name},
+          {"shape", kShapes[int(t.shape)]},
+          {"centre", {t.centre.x, t.centre.y, t.centre.z}},
+          {"heading", t.orientation.heading_deg},
+          {"pitch", t.orientation.pitch_deg},
+          {"roll", t.orientation.roll_deg},
+          {"size", {t.size.x, t.size.y, t.size.z}},
+          {"object_id", object_id}};
+}
+
+}  // namespace
+
+std::optional<ProtocolError> Engine::check(const Command& command) const {
+  const State& s = *state_;
+  if (const auto* c = std::get_if<command::SetView>(&command)) {
+    const ViewConfig* view = s.view(c->view);
+    if (!view) return unknownView(s.views, c->view);
+    ViewConfig changed = *view;
+    applyViewPatch(changed, c->patch);
+    if (auto error = pixelLimit(changed.camera)) return error;
+  }
+  if (const auto* c = std::get_if<command::Tick>(&command)) {
+    if (s.mode == TickMode::kRealtime)
+      return ProtocolError{ErrorCode::kFailed,
+                           "tick: the daemon runs in realtime mode, where it ticks itself (switch "
+                           "with set_time mode \"lockstep\", or use set_time advance)"};
+    return checkAdvance(c->dt);
+  }
+  if (const auto* c = std::get_if<command::SetTime>(&command); c && c->advance)
+    return checkAdvance(*c->advance);
+  return std::nullopt;
+}
+
+std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
+  State& s = *state_;
+  World& world = *s.world;
+  using namespace command;
+  auto notFoundView = [&](const std::string& name) -> Outcome {
+    return unknownView(s.views, name);
+  };
+  const ProtocolError noSnapshotDirectory{
+      ErrorCode::kFailed, "name: no snapshot directory is configured ([snapshot] directory)"};
+  auto snapshotPath = [&](const std::string& name) {
+    return (std::filesystem::path(config_.snapshotDirectory()) / (name + ".snap")).string();
+  };
+  // One handler per command: a command added to the protocol without one here does not
+  // compile.
+  const Overloaded handlers{
+
+      [&](const Hello& c) -> std::optional<Outcome> {
+        (void)c;  // the token is checked by the transport
+        json views = json::array();
+        for (const ViewConfig& v : s.views) views.push_back(v.name);
+        return json{{"server", "nephele"},          {"version", NEPHELE_VERSION},
+                    {"protocol", kProtocolVersion}, {"views", views},
+                    {"mode", modeName(s.mode)},     {"tick_rate", config_.tick_rate_hz}};
+      },
+      [&](const GetView& c) -> std::optional<Outcome> {
+        if (c.view.empty()) {
+          json all = json::array();
+          for (const ViewConfig& v : s.views) all.push_back(viewJson(v));
+          return json{{"views", all}};
+        }
+        const ViewConfig* v = s.view(c.view);
+        if (!v) return notFoundView(c.view);
+        return viewJson(*v);
+      },
+      [&](const SetView& c) -> std::optional<Outcome> {
+        ViewConfig* v = s.view(c.view);
+        if (!v) return notFoundView(c.view);
+        applyViewPatch(*v, c.patch);
+        return viewJson(*v);
+      },
+      [&](const SetWeather& c) -> std::optional<Outcome> {
+        if (auto error = setWeather(c.layer, c.weather)) return *error;
+        return json{{"layer", c.layer},
+                    {"type", cloudTypeName(c.weather.type)},
+                    {"layers", world.base().layers.size()},
+                    {"clouds", world.base().clouds.size()},
+                    {"fields", world.base().fields.size()}};
+      },
+      [&](const SetWind& c) -> std::optional<Outcome> {
+        std::string error = world.edit([&](Scene&, WorldDynamics& d) {
+          d.wind.samples = {{0.0, c.velocity}};
+          return std::string();
+        });
+        if (!error.empty()) return ProtocolError{ErrorCode::kFailed, error};
+        return json{{"velocity", {c.velocity.x, c.velocity.y}}};
+      },
+      [&](const SetSun& c) -> std::optional<Outcome> { return setSun(c); },
+      [&](const SetFog& c) -> std::optional<Outcome> { return setFog(c); },
+      [&](const SetTime& c) -> std::optional<Outcome> {
+        if (c.time_scale) s.time_scale = *c.time_scale;
+        if (c.paused) s.paused = *c.paused;
+        if (c.mode)
+          setMode(*c.mode == ClockMode::kLockstep ? TickMode::kLockstep : TickMode::kRealtime);
+        if (c.advance) advance(*c.advance);
+        return json{{"time", world.timeSeconds()},
+                    {"time_scale", s.time_scale},
+                    {"paused", s.paused},
+                    {"mode", modeName(s.mode)},
+                    {"ticks", s.ticks}};
+      },
+      [&](const AddCloud& c) -> std::optional<Outcome> {
+        const auto name = c.cloud.find("name");
+        if (name == c.cloud.end() || !name->is_string())
+          return badField(
+              "cloud.name: is missing (a unique name, to change or remove the cloud by)");
+        if (std::string e = nameError(name->get<std::string>()); !e.empty())
+          return badField("cloud.name: " + e);
+        EllipsoidCloud cloud;
+        const std::string cloud_name = name->get<std::string>();
+        if (std::string e = parseCloudJson(
+                c.cloud, hashCounters(config_.scene.scene.seed, nameHash(cloud_name)), cloud);
+            !e.empty())
+          return badField(e);
+        std::size_t ellipsoids = cloud.ellipsoids.size();
+        std::string error = world.edit([&](Scene& now, WorldDynamics& d) -> std::string {
+          if (now.clouds.size() >= kMaxClouds)
+            return "cloud: the world holds " + std::to_string(kMaxClouds) + " clouds already";
+          for (const EllipsoidCloud& other : now.clouds)
+            if (other.name == cloud.name) return "cloud.name: \"" + cloud.name + "\" is taken";
+          now.clouds.push_back(cloud);
+          if (!d.clouds.empty()) d.clouds.emplace_back();
+          return "";
+        });
+        if (!error.empty()) return badField(error);
+        return json{{"name", cloud.name}, {"ellipsoids", ellipsoids}};
+      },
+      [&](const ChangeCloud& c) -> std::optional<Outcome> {
+        std::string error = world.edit([&](Scene& now, WorldDynamics&) -> std::string {
+          for (EllipsoidCloud& cloud : now.clouds) {
+            if (cloud.name != c.name) continue;
+            if (c.move) {
+              for (Ellipsoid& e : cloud.ellipsoids) e.centre += *c.move;
+              cloud.drift_m += *c.move;  // the texture moves with the cloud
+            }
+            if (c.threshold) cloud.threshold_centre = *c.threshold;
+            if (c.limb_threshold) cloud.threshold_limb = *c.limb_threshold;
+            if (c.transition) cloud.transition = *c.transition;
+            if (c.colour) cloud.colour = *c.colour;
+            return "";
+          }
+          return "name: no cloud is called \"" + c.name + "\"";
+        });
+        if (!error.empty()) return ProtocolError{ErrorCode::kNotFound, error};
+        return json{{"name", c.name}};
+      },
+      [&](const RemoveCloud& c) -> std::optional<Outcome> {
+        std::string error = world.edit([&](Scene& now, WorldDynamics& d) -> std::string {
+          const std::size_t before = now.clouds.size();
+          eraseWithDevelopment(now.clouds, d.clouds,
+                               [&](const EllipsoidCloud& cloud) { return cloud.name == c.name; });
+          return now.clouds.size() == before ? "name: no cloud is called \"" + c.name + "\"" : "";
+        });
+        if (!error.empty()) return ProtocolError{ErrorCode::kNotFound, error};
+        return json{{"name", c.name}};
+      },
+      [&](const AddTarget& c) -> std::optional<Outcome> {
+        Target target;
+        if (std::string e = parseTargetJson(c.target, config_.entity_types, target); !e.empty())
+          return badField(e);
+        std::string error = world.edit([&](Scene& now, WorldDynamics&) -> std::string {
+          if (now.targets.size() >= std::size_t(ProtocolLimits::kMaxTargets))
+            return "target: the world holds " + std::to_string(ProtocolLimits::kMaxTargets) +
+                   " targets already";
+          for (const Target& other : now.targets)
+            if (other.name == target.name) return "target.name: \"" + target.name + "\" is taken";
+          now.targets.push_back(target);
+          return "";
+        });
+        if (!error.empty()) return badField(error);
+        return targetJson(target, world.base().targets.size());
+      },
+      [&](const MoveTarget& c) -> std::optional<Outcome> {
+        std::optional<json> moved;
+        world.edit([&](Scene& now, WorldDynamics&) -> std::string {
+          for (std::size_t i = 0; i < now.targets.size(); ++i) {
+            Target& t = now.targets[i];
+            if (t.name != c.name) continue;
+            if (c.centre) t.centre = *c.centre;
+            if (c.heading) t.orientation.heading_deg = *c.heading;
+            if (c.pitch) t.orientation.pitch_deg = *c.pitch;
+            if (c.roll) t.orientation.roll_deg = *c.roll;
+            moved = targetJson(t, i + 1);
+            return "";
+          }
+          return "not found";
+        });
+        if (!moved)
+          return ProtocolError{ErrorCode::kNotFound,
+                               "name: no target is called \"" + c.name + "\""};
+        return *moved;
+      },
+      [&](const RemoveTarget& c) -> std::optional<Outcome> {
+        std::string error = world.edit([&](Scene& now, WorldDynamics&) -> std::string {
+          const std::size_t before = now.targets.size();
+          std::erase_if(now.targets, [&](const Target& t) { return t.name == c.name; });
+          return now.targets.size() == before ? "name: no target is called \"" + c.name + "\"" : "";
+        });
+        if (!error.empty()) return ProtocolError{ErrorCode::kNotFound, error};
+        return json{{"name", c.name}};
+      },
+      [&](const ListTargets&) -> std::optional<Outcome> {
+        json all = json::array();
+        const std::vector<Target>& targets = world.base().targets;
+        for (std::size_t i = 0; i < targets.size(); ++i)
+          all.push_back(targetJson(targets[i], i + 1));
+        return json{{"targets", all}};
+      },
+      [&](const Tick& c) -> std::optional<Outcome> {
+        advance(c.dt);
+        return json{{"time", world.timeSeconds()}, {"ticks", s.ticks}};
+      },
+      [&](const Render& c) -> std::optional<Outcome> { return renderRequest(c, job); },
+      [&](const Subscribe& c) -> std::optional<Outcome> {
+        const ViewConfig* v = s.view(c.view);
+        if (!v) return notFoundView(c.view);
+        if (int(s.subscriptions.size()) >= config_.max_subscriptions)
+          return ProtocolError{ErrorCode::kLimit,
+                               "subscribe: the daemon serves " +
+                                   std::to_string(config_.max_subscriptions) +
+                                   " subscriptions already (the configured limit)"};
+        Subscription sub;
+        sub.id = s.next_subscription++;
+        sub.client = job.client;
+        sub.view = c.view;
+        sub.image = c.image.value_or(v->image);
+        sub.period = secondsToDuration(1.0 / c.rate_hz);
+        sub.next_due = Clock::now();
+        sub.sink = job.frames;
+        sub.gone = std::make_shared<std::atomic<bool>>(false);
+        s.subscriptions.push_back(sub);
+        countSubscriptions();
+        return json{{"subscription", sub.id},
+                    {"view", sub.view},
+                    {"rate", c.rate_hz},
+                    {"format", imageFormatName(sub.image.format)},
+                    {"channels", channelNames(sub.image)}};
+      },
+      [&](const Unsubscribe& c) -> std::optional<Outcome> {
+        const std::size_t before = s.subscriptions.size();
+        std::erase_if(s.subscriptions, [&](const Subscription& sub) {
+          return sub.id == c.subscription && sub.client == job.client;
+        });
+        countSubscriptions();
+        if (s.subscriptions.size() == before)
+          return ProtocolError{ErrorCode::kNotFound,
+                               "subscription: " + std::to_string(c.subscription) +
+                                   " is not one of this connection's subscriptions"};
+        return json{{"subscription", c.subscription}};
+      },
+      [&](const Snapshot& c) -> std::optional<Outcome> {
+        if (config_.snapshotDirectory().empty()) return noSnapshotDirectory;
+        std::error_code ec;
+        std::filesystem::create_directories(config_.snapshotDirectory(), ec);
+        if (std::string e = writeSnapshot(snapshotPath(c.name)); !e.empty())
+          return ProtocolError{ErrorCode::kFailed, e};
+        return json{
+            {"name", c.name}, {"time", world.timeSeconds()}, {"hash", hexHash(world.hash())}};
+      },
+      [&](const Restore& c) -> std::optional<Outcome> {
+        if (config_.snapshotDirectory().empty()) return noSnapshotDirectory;
+        const std::string path = snapshotPath(c.name);
+        if (!std::filesystem::exists(path))
+          return ProtocolError{ErrorCode::kNotFound, "name: no snapshot \"" + c.name + "\""};
+        if (std::string e = restoreSnapshot(path); !e.empty())
+          return ProtocolError{ErrorCode::kFailed, e};
+        return json{{"name", c.name},
+                    {"time", world.timeSeconds()},
+                    {"hash", hexHash(world.hash())},
+                    {"ticks", s.ticks},
+                    {"frames", s.frames}};
+      },
+      [&](const Stats&) -> std::optional<Outcome> {
+        publish();
+        std::lock_guard lock(published_mutex_);
+        return published_stats_;
+      },
+      [&](const Hash&) -> std::optional<Outcome> {
+        return json{{"hash", hexHash(world.hash())},
+                    {"time", world.timeSeconds()},
+                    {"time_ns", world.timeNs()},
+                    {"ticks", s.ticks}};
+      },
+  };
+  return std::visit(handlers, command);
+}
+
+}  // namespace nephele

@@ -1,0 +1,256 @@
+#pragma once
+// The world thread's state and work items, shared by the files that make up the Engine:
+// engine.cpp (thread, queue and time), dispatch.cpp (requests), delivery.cpp (rendering and
+// frame delivery), atmosphere.cpp (weather, fog, sun), snapshots.cpp and telemetry.cpp.
+// Transports include engine.h only.
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <thread>
+#include <variant>
+#include <vector>
+
+#include "image/image_encoding.h"
+#include "renderer/frame.h"
+#include "renderer/gl/gl_platform.h"
+#include "renderer/gl/gl_renderer.h"
+#include "server/engine.h"
+#include "world/solar.h"
+#include "world/world.h"
+
+namespace nephele {
+namespace engine_detail {
+
+using Clock = std::chrono::steady_clock;
+using nlohmann::json;
+using Outcome = std::variant<json, ProtocolError>;
+
+constexpr int kProtocolVersion = 1;
+constexpr int kMaxCatchUpTicks = 100;  // after a stall, ticks made up in one go
+constexpr std::size_t kMaxClouds = 4096;
+constexpr std::size_t kRenderHistory = 1024;  // renders kept for p50/p99
+constexpr std::size_t kEncoderQueue = 16;
+
+inline double msSince(Clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+}
+
+inline std::string hexHash(std::uint64_t h) {
+  char text[17];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h));
+  return text;
+}
+
+inline ProtocolError badField(std::string message) {
+  return {ErrorCode::kBadField, std::move(message)};
+}
+
+// What the last rendered frame did (renderer/gl/frame_stats.h).
+inline json frameStatsJson(const FrameStats& f) {
+  json out = json::object();
+  for (const auto& [name, value] : f.fields()) out[name] = value;
+  return out;
+}
+
+inline json viewJson(const ViewConfig& v) {
+  const Camera& c = v.camera;
+  return {{"name", v.name},
+          {"position", {c.position.x, c.position.y, c.position.z}},
+          {"heading", c.orientation.heading_deg},
+          {"pitch", c.orientation.pitch_deg},
+          {"roll", c.orientation.roll_deg},
+          {"vfov", c.vfov_deg},
+          {"width", c.width},
+          {"height", c.height},
+          {"format", imageFormatName(v.image.format)},
+          {"channels", channelNames(v.image)}};
+}
+
+inline const char* modeName(TickMode mode) {
+  return mode == TickMode::kRealtime ? "realtime" : "lockstep";
+}
+
+inline ProtocolError unknownView(const std::vector<ViewConfig>& views, const std::string& name) {
+  std::string names;
+  for (const ViewConfig& v : views) names += (names.empty() ? "" : ", ") + v.name;
+  return {ErrorCode::kNotFound, "view: \"" + name + "\" is not a view (allowed: " + names + ")"};
+}
+
+inline double percentile(std::vector<double> values, double p) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  return values[std::min(values.size() - 1, std::size_t(p * double(values.size())))];
+}
+
+// Removes the entries of `items` (and the matching development entries, if any) for which
+// `drop` holds.
+template <class T, class D, class Pred>
+inline void eraseWithDevelopment(std::vector<T>& items, std::vector<D>& development, Pred drop) {
+  std::vector<T> kept_items;
+  std::vector<D> kept_development;
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    if (drop(items[i])) continue;
+    kept_items.push_back(std::move(items[i]));
+    if (!development.empty()) kept_development.push_back(std::move(development[i]));
+  }
+  items = std::move(kept_items);
+  development = std::move(kept_development);
+}
+
+// A visitor of one lambda per alternative.
+template <class... F>
+struct Overloaded : F... {
+  using F::operator()...;
+};
+template <class... F>
+Overloaded(F...) -> Overloaded<F...>;
+
+// The fields a patch sets; the others stay.
+inline void applyViewPatch(ViewConfig& v, const ViewPatch& p) {
+  Camera& cam = v.camera;
+  if (p.position) cam.position = *p.position;
+  if (p.heading) cam.orientation.heading_deg = *p.heading;
+  if (p.pitch) cam.orientation.pitch_deg = *p.pitch;
+  if (p.roll) cam.orientation.roll_deg = *p.roll;
+  if (p.vfov) cam.vfov_deg = *p.vfov;
+  if (p.width) cam.width = *p.width;
+  if (p.height) cam.height = *p.height;
+  if (p.image) v.image = *p.image;
+}
+
+}  // namespace engine_detail
+
+using engine_detail::Clock;
+using engine_detail::kEncoderQueue;
+
+// One queued piece of work.
+struct Engine::Job {
+  enum class Kind { kRequest, kBatch } kind = Kind::kRequest;
+  Request request;
+  std::int64_t client = 0;
+  FrameSink frames;
+  ReplySink reply;
+  std::vector<Command> batch;
+  bool render = false;  // a batch with the render coil
+  std::shared_ptr<BatchTicket> ticket;
+  DoneSink done;
+};
+
+struct Engine::Subscription {
+  std::int64_t id = 0;
+  std::int64_t client = 0;
+  std::string view;
+  ImageRequest image;
+  Clock::duration period{};
+  Clock::time_point next_due;
+  std::uint64_t last_tick = UINT64_MAX;  // the tick of the last frame sent
+  FrameSink sink;
+  std::shared_ptr<std::atomic<bool>> gone;  // set when the sink reports its client gone
+};
+
+// A thread that encodes images off the world thread, from a bounded queue.
+class Engine::Encoder {
+ public:
+  Encoder() : thread_([this] { run(); }) {}
+  ~Encoder() {
+    {
+      std::lock_guard lock(mutex_);
+      stop_ = true;
+    }
+    cv_.notify_all();
+    thread_.join();
+  }
+  bool post(std::function<void()> job) {
+    {
+      std::lock_guard lock(mutex_);
+      if (jobs_.size() >= kEncoderQueue) return false;
+      jobs_.push_back(std::move(job));
+    }
+    cv_.notify_one();
+    return true;
+  }
+  std::size_t depth() const {
+    std::lock_guard lock(mutex_);
+    return jobs_.size();
+  }
+
+ private:
+  void run() {
+    for (;;) {
+      std::function<void()> job;
+      {
+        std::unique_lock lock(mutex_);
+        cv_.wait(lock, [&] { return stop_ || !jobs_.empty(); });
+        if (jobs_.empty()) return;  // stopping, and every queued image is out
+        job = std::move(jobs_.front());
+        jobs_.pop_front();
+      }
+      job();
+    }
+  }
+  mutable std::mutex mutex_;
+  std::condition_variable cv_;
+  std::deque<std::function<void()>> jobs_;
+  bool stop_ = false;
+  std::thread thread_;
+};
+
+// Everything the world thread owns.
+struct Engine::State {
+  std::unique_ptr<GlPlatform> platform;
+  std::unique_ptr<GlRenderer> renderer;
+  std::unique_ptr<World> world;
+  std::vector<ViewConfig> views;
+  std::array<WeatherLayer, ProtocolLimits::kWeatherLayers> weather;
+  TickMode mode = TickMode::kRealtime;  // switchable at run time (set_time mode)
+  double time_scale = 1.0;
+  bool paused = false;
+  std::optional<CivilTime> sun_utc;  // when the sun was last set from a date and time
+  std::uint64_t ticks = 0;
+  std::uint64_t frames = 0;
+  std::uint64_t requests = 0;
+  double last_render_ms = 0.0;
+  std::deque<double> render_ms;
+  std::deque<std::pair<Clock::time_point, std::uint64_t>> tick_history;  // one per second
+  std::vector<Subscription> subscriptions;
+  std::int64_t next_subscription = 1;
+  Clock::time_point next_tick;
+  Clock::time_point next_snapshot;
+  std::uint64_t next_cloud_seed = 0;
+
+  ViewConfig* view(const std::string& name) {
+    for (ViewConfig& v : views)
+      if (v.name == name) return &v;
+    return nullptr;
+  }
+  const ViewConfig* view(const std::string& name) const {
+    return const_cast<State*>(this)->view(name);
+  }
+};
+
+// A rendered view, before encoding.
+struct ViewFrame {
+  Srgb8Image srgb;
+  FloatImage linear;  // for EXR
+  Frame planes;       // with ground-truth channels (ImageRequest::floatPlanes)
+  nlohmann::json meta;
+};
+
+namespace engine_detail {
+// Encodes `frame` as `image` asks (delivery.cpp); on failure returns the error.
+std::variant<std::vector<std::uint8_t>, std::string> encodeFrame(const ViewFrame& frame,
+                                                                 const ImageRequest& image,
+                                                                 const EncodeOptions& options);
+// An image header's fields: the frame's view, pose, time and tick, and how it is encoded.
+json imageMeta(const ViewFrame& frame, const ImageRequest& image);
+}  // namespace engine_detail
+
+}  // namespace nephele

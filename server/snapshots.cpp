@@ -1,0 +1,180 @@
+#include <spdlog/spdlog.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "server/engine_state.h"
+#include "world/file_output.h"
+#include "world/limits.h"
+
+// Snapshots: the World saves its clouds, targets, sun, fog, wind and clock; beside it
+// (PATH.daemon.json) the daemon saves what the host set that the World does not hold: views,
+// the weather layers as asked, the sun's date, the clock's mode, scale and pause, and the
+// tick and frame counters. The views and weather are kept as the requests that set them, so
+// a restore reads them through the one request parser, with its checks.
+namespace nephele {
+
+using namespace engine_detail;
+
+namespace {
+
+constexpr int kDaemonStateVersion = 1;
+constexpr std::uintmax_t kMaxDaemonStateBytes = 4u << 20;
+
+std::string daemonStatePath(const std::string& snapshot) {
+  return snapshot + ".daemon.json";
+}
+
+// A set_weather request that sets `w` again.
+json weatherRequest(int layer, const WeatherLayer& w) {
+  json r{{"cmd", "set_weather"},       {"layer", layer},
+         {"type", int(w.type)},        {"base", w.base_m},
+         {"thickness", w.thickness_m}, {"coverage", 100.0 * w.coverage}};
+  if (w.wind) r["wind"] = {w.wind->x, w.wind->y};
+  const Region& g = w.region;
+  if (std::isfinite(g.half_size.x) && std::isfinite(g.half_size.y)) {
+    r["centre"] = {g.centre.x, g.centre.y};
+    r["size"] = {2.0 * g.half_size.x, 2.0 * g.half_size.y};
+    r["heading"] = g.heading_deg;
+    r["edge"] = g.edge_m;
+  }
+  if (g.side != 0) {
+    r["front"] = g.side < 0 ? "left" : "right";
+    r["transition"] = g.transition_m;
+  }
+  if (!w.clusters.none()) {
+    r["spacing"] = w.clusters.spacing_m;
+    r["variation"] = w.clusters.amount;
+  }
+  return r;
+}
+
+// A set_view request that sets every field of `v`.
+json viewRequest(const ViewConfig& v) {
+  json r = viewJson(v);
+  r.erase("name");
+  r["view"] = v.name;
+  r["cmd"] = "set_view";
+  return r;
+}
+
+}  // namespace
+
+json Engine::daemonState() const {
+  const State& s = *state_;
+  json requests = json::array();
+  for (const ViewConfig& v : s.views) requests.push_back(viewRequest(v));
+  for (int layer = 1; layer <= ProtocolLimits::kWeatherLayers; ++layer)
+    if (s.weather[std::size_t(layer - 1)].type != CloudType::kNone)
+      requests.push_back(weatherRequest(layer, s.weather[std::size_t(layer - 1)]));
+  json out{{"format", "nephele-daemon-state"},
+           {"version", kDaemonStateVersion},
+           {"ticks", s.ticks},
+           {"frames", s.frames},
+           {"mode", modeName(s.mode)},
+           {"time_scale", s.time_scale},
+           {"paused", s.paused},
+           {"requests", requests}};
+  if (s.sun_utc) out["sun_utc"] = formatUtc(*s.sun_utc);
+  return out;
+}
+
+std::string Engine::writeSnapshot(const std::string& path) {
+  if (std::string e = state_->world->saveSnapshot(path); !e.empty()) return e;
+  const std::string text = daemonState().dump(1) + "\n";
+  return writeFileAtomically(
+      daemonStatePath(path),
+      std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()), "daemon state");
+}
+
+std::string Engine::restoreSnapshot(const std::string& path) {
+  State& s = *state_;
+  // The daemon's part is read and checked first, so that a bad file changes nothing.
+  const std::string side = daemonStatePath(path);
+  std::optional<json> state;
+  std::vector<Command> requests;
+  std::optional<CivilTime> sun_utc;
+  if (std::filesystem::exists(side)) {
+    auto bad = [&](const std::string& what) { return side + ": " + what; };
+    std::error_code ec;
+    if (std::filesystem::file_size(side, ec) > kMaxDaemonStateBytes || ec)
+      return bad("larger than 4 MiB or unreadable");
+    std::ifstream in(side, std::ios::binary);
+    std::stringstream text;
+    text << in.rdbuf();
+    json j = json::parse(text.str(), nullptr, false);
+    if (j.is_discarded() || !j.is_object() || j.value("format", "") != "nephele-daemon-state")
+      return bad("not a daemon state file");
+    if (j.value("version", 0) != kDaemonStateVersion)
+      return bad("version " + j["version"].dump() + " is not " +
+                 std::to_string(kDaemonStateVersion));
+    for (const char* key : {"ticks", "frames"})
+      if (!j.contains(key) || !j[key].is_number_unsigned())
+        return bad(std::string(key) + ": missing");
+    if (!j.contains("time_scale") || !j["time_scale"].is_number() ||
+        !(j["time_scale"].get<double>() >= 0.0 &&
+          j["time_scale"].get<double>() <= ProtocolLimits::kMaxTimeScale))
+      return bad("time_scale: missing or out of range");
+    const std::string mode = j.value("mode", "");
+    if (mode != "realtime" && mode != "lockstep") return bad("mode: not realtime or lockstep");
+    if (!j.contains("paused") || !j["paused"].is_boolean()) return bad("paused: missing");
+    if (j.contains("sun_utc")) {
+      CivilTime t;
+      if (!j["sun_utc"].is_string()) return bad("sun_utc: not a string");
+      if (std::string e = parseUtc(j["sun_utc"].get<std::string>(), t); !e.empty())
+        return bad("sun_utc: " + e);
+      sun_utc = t;
+    }
+    if (!j.contains("requests") || !j["requests"].is_array()) return bad("requests: missing");
+    for (const json& r : j["requests"]) {
+      auto parsed = parseRequest(r.dump());
+      if (auto* b = std::get_if<BadRequest>(&parsed)) return bad(b->error.message);
+      Command c = std::get<Request>(parsed).command;
+      if (!std::holds_alternative<command::SetView>(c) &&
+          !std::holds_alternative<command::SetWeather>(c))
+        return bad("requests: only set_view and set_weather are restored");
+      requests.push_back(std::move(c));
+    }
+    state = std::move(j);
+  }
+  if (std::string e = s.world->restoreSnapshot(path); !e.empty()) return e;
+  if (!state) return "";  // a snapshot from before daemon state was saved: the world alone
+  s.ticks = (*state)["ticks"].get<std::uint64_t>();
+  s.frames = (*state)["frames"].get<std::uint64_t>();
+  s.time_scale = (*state)["time_scale"].get<double>();
+  s.paused = (*state)["paused"].get<bool>();
+  setMode((*state)["mode"] == "lockstep" ? TickMode::kLockstep : TickMode::kRealtime);
+  s.sun_utc = sun_utc;
+  s.weather = {};
+  for (const Command& c : requests) {
+    if (const auto* v = std::get_if<command::SetView>(&c)) {
+      ViewConfig* view = s.view(v->view);
+      if (!view) {  // the config no longer has it
+        spdlog::warn("event=restore_view_skipped view={}", v->view);
+        continue;
+      }
+      applyViewPatch(*view, v->patch);
+    } else if (const auto* w = std::get_if<command::SetWeather>(&c)) {
+      s.weather[std::size_t(w->layer - 1)] = w->weather;  // its clouds are in the world's part
+    }
+  }
+  return "";
+}
+
+bool Engine::saveSnapshot(const std::string& path, const char* why) {
+  const auto t0 = Clock::now();
+  std::error_code ec;
+  std::filesystem::create_directories(std::filesystem::path(path).parent_path(), ec);
+  if (std::string e = writeSnapshot(path); !e.empty()) {
+    spdlog::error("event=snapshot_failed reason={} error=\"{}\"", why, e);
+    noteError(ErrorCode::kFailed);
+    return false;
+  }
+  spdlog::info("event=snapshot reason={} path={} time={:.3f} hash={} ticks={} ms={:.1f}", why, path,
+               state_->world->timeSeconds(), hexHash(state_->world->hash()), state_->ticks,
+               msSince(t0));
+  return true;
+}
+
+}  // namespace nephele

@@ -1,0 +1,139 @@
+#include <sstream>
+
+#include "server/engine_state.h"
+
+// Telemetry: the stats reply, the Modbus readings and the Prometheus text.
+namespace nephele {
+
+using namespace engine_detail;
+
+void Engine::publish() {
+  State& s = *state_;
+  const auto now = Clock::now();
+  if (s.tick_history.empty() || now - s.tick_history.back().first >= std::chrono::seconds(1)) {
+    s.tick_history.push_back({now, s.ticks});
+    if (s.tick_history.size() > 6) s.tick_history.pop_front();
+  }
+  double ticks_per_second = 0.0;
+  if (s.tick_history.size() >= 2) {
+    const auto& [t0, n0] = s.tick_history.front();
+    const double seconds = std::chrono::duration<double>(now - t0).count();
+    if (seconds > 0.0) ticks_per_second = double(s.ticks - n0) / seconds;
+  }
+  std::size_t depth = 0;
+  {
+    std::lock_guard lock(queue_mutex_);
+    depth = queue_.size();
+  }
+  const std::vector<double> history(s.render_ms.begin(), s.render_ms.end());
+  const World& world = *s.world;
+  json stats = {
+      {"time", world.timeSeconds()},
+      {"ticks", s.ticks},
+      {"ticks_per_second", ticks_per_second},
+      {"mode", modeName(s.mode)},
+      {"paused", s.paused},
+      {"time_scale", s.time_scale},
+      {"frames", s.frames},
+      {"render_ms",
+       {{"last", s.last_render_ms},
+        {"p50", percentile(history, 0.5)},
+        {"p99", percentile(history, 0.99)},
+        {"samples", history.size()}}},
+      {"clients", {{"socket", socket_clients.load()}, {"modbus", modbus_clients.load()}}},
+      {"queue",
+       {{"depth", depth},
+        {"limit", config_.max_queue},
+        {"encoder", encoder_ ? encoder_->depth() : 0},
+        {"encoder_limit", kEncoderQueue}}},
+      {"subscriptions", s.subscriptions.size()},
+      {"frames_dropped", frames_dropped.load()},
+      {"requests", s.requests},
+      {"errors", errors_.load()},
+      {"automaton_steps", world.automatonStepsRun()},
+      {"relights", world.relightsRun()},
+      {"last_frame", frameStatsJson(s.renderer->lastFrameStats())},
+  };
+  {
+    std::lock_guard lock(published_mutex_);
+    published_stats_ = std::move(stats);
+  }
+  publishReadings();
+}
+
+void Engine::publishReadings() {
+  const State& s = *state_;
+  const World& world = *s.world;
+  ModbusSettings settings;
+  const ViewConfig& view = *s.view(config_.modbus_view);
+  settings.position = view.camera.position;
+  settings.heading = view.camera.orientation.heading_deg;
+  settings.pitch = view.camera.orientation.pitch_deg;
+  settings.roll = view.camera.orientation.roll_deg;
+  settings.vfov = view.camera.vfov_deg;
+  settings.width = view.camera.width;
+  settings.height = view.camera.height;
+  const WindProfile& wind = world.dynamics().wind;
+  settings.wind = wind.empty() ? glm::dvec2(0.0) : wind.samples.front().velocity;
+  settings.sun_azimuth = world.base().sun.azimuth_deg;
+  settings.sun_elevation = world.base().sun.elevation_deg;
+  settings.time_scale = s.time_scale;
+  settings.layers = s.weather;
+  ModbusStatus status;
+  status.status = s.mode == TickMode::kLockstep ? ModbusStatusCode::kLockstep
+                  : s.paused                    ? ModbusStatusCode::kPaused
+                                                : ModbusStatusCode::kRunning;
+  status.frames = std::uint32_t(s.frames);
+  status.render_ms = s.last_render_ms;
+  status.ticks = s.ticks;
+  status.time_s = world.timeSeconds();
+  std::lock_guard lock(published_mutex_);
+  published_settings_ = settings;
+  published_status_ = status;
+}
+
+ModbusSettings Engine::modbusSettings() const {
+  std::lock_guard lock(published_mutex_);
+  return published_settings_;
+}
+
+ModbusStatus Engine::modbusStatus() const {
+  std::lock_guard lock(published_mutex_);
+  ModbusStatus status = published_status_;
+  status.last_error = std::uint16_t(last_error_.load());
+  return status;
+}
+
+json Engine::stats() const {
+  std::lock_guard lock(published_mutex_);
+  return published_stats_;
+}
+
+std::string Engine::prometheusText() const {
+  const json st = stats();
+  std::ostringstream out;
+  auto metric = [&](const char* name, const char* type, const char* help, double value) {
+    out << "# HELP nephele_" << name << ' ' << help << "\n# TYPE nephele_" << name << ' ' << type
+        << "\nnephele_" << name << ' ' << value << '\n';
+  };
+  if (st.is_null()) return "";
+  metric("world_time_seconds", "gauge", "Simulation time.", st["time"].get<double>());
+  metric("ticks_total", "counter", "Ticks applied.", st["ticks"].get<double>());
+  metric("ticks_per_second", "gauge", "Ticks per second over the last 5 s.",
+         st["ticks_per_second"].get<double>());
+  metric("frames_total", "counter", "Frames rendered.", st["frames"].get<double>());
+  metric("render_ms_p50", "gauge", "Median render time (last 1024).",
+         st["render_ms"]["p50"].get<double>());
+  metric("render_ms_p99", "gauge", "99th percentile render time (last 1024).",
+         st["render_ms"]["p99"].get<double>());
+  metric("socket_clients", "gauge", "Socket clients.", st["clients"]["socket"].get<double>());
+  metric("modbus_clients", "gauge", "Modbus clients.", st["clients"]["modbus"].get<double>());
+  metric("queue_depth", "gauge", "Requests waiting.", st["queue"]["depth"].get<double>());
+  metric("subscriptions", "gauge", "Frame subscriptions.", st["subscriptions"].get<double>());
+  metric("frames_dropped_total", "counter", "Frames dropped for slow clients.",
+         st["frames_dropped"].get<double>());
+  metric("errors_total", "counter", "Error replies and failed work.", st["errors"].get<double>());
+  return out.str();
+}
+
+}  // namespace nephele
