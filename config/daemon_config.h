@@ -13,11 +13,6 @@
 
 namespace nephele {
 
-enum class TickMode {
-  kRealtime,  // the daemon advances the world tick_rate times per real second
-  kLockstep,  // the world advances only when the host sends tick requests
-};
-
 struct ViewConfig {
   std::string name;
   Camera camera;  // pose, field of view and size

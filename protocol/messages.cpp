@@ -341,7 +341,7 @@ Command readCommand(const std::string& cmd, FieldReader& r) {
     if (auto mode = r.string("mode", 16)) {
       if (*mode != "realtime" && *mode != "lockstep")
         r.fail("mode", "\"" + *mode + "\" is not allowed (allowed: realtime, lockstep)");
-      c.mode = *mode == "realtime" ? ClockMode::kRealtime : ClockMode::kLockstep;
+      c.mode = *mode == "realtime" ? TickMode::kRealtime : TickMode::kLockstep;
     }
     r.finish("cmd, id, time_scale, paused, advance, mode");
     return c;
@@ -375,7 +375,7 @@ Command readCommand(const std::string& cmd, FieldReader& r) {
       r.fail("target",
              "is missing (an object with the keys of a scene file's [[target]], or a type "
              "named in the daemon config's [[entity_type]])");
-    AddTarget c{*target};
+    AddTarget c{*target, false};
     r.finish("cmd, id, target");
     return c;
   }

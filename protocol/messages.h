@@ -74,6 +74,11 @@ struct ImageRequest {
   }
 };
 
+enum class TickMode {
+  kRealtime,  // the daemon advances the world tick_rate times per real second
+  kLockstep,  // the world advances only when the host sends tick requests
+};
+
 // Fields of a view; unset ones stay as they are.
 struct ViewPatch {
   std::optional<glm::dvec3> position;
@@ -112,12 +117,11 @@ struct SetFog {
   std::optional<double> top, visibility;
   std::optional<glm::dvec3> colour;
 };
-enum class ClockMode { kRealtime, kLockstep };
 struct SetTime {
   std::optional<double> time_scale;  // simulated seconds per real second
   std::optional<bool> paused;
   std::optional<double> advance;  // seconds to move on at once
-  std::optional<ClockMode> mode;
+  std::optional<TickMode> mode;
 };
 struct AddCloud {
   nlohmann::json cloud;  // the keys of a scene file's [[cloud]] table
@@ -133,6 +137,7 @@ struct RemoveCloud {
 };
 struct AddTarget {
   nlohmann::json target;  // the keys of a scene file's [[target]] table, or `type` (config)
+  bool replace = false;   // an existing target of that name is replaced (CIGI entities)
 };
 // A target's new pose: unset fields keep their value.
 struct MoveTarget {

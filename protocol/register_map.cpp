@@ -1,5 +1,6 @@
 #include "protocol/register_map.h"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <sstream>
@@ -34,6 +35,11 @@ constexpr FloatField kOtherFloats[] = {
     {M::kSunElevation, "sun elevation", -Limits::kMaxPitch, Limits::kMaxPitch},
     {M::kTimeScale, "time scale", 0.0, ProtocolLimits::kMaxTimeScale},
 };
+constexpr FloatField kAtmosphereFloats[] = {
+    {M::kFogTop, "fog top", 0.0, Limits::kMaxAltitude},
+    {M::kFogVisibility, "fog visibility", 0.0, Limits::kFogVisibility.hi},
+    {M::kSunTime, "sun time of day", 0.0, 86399.999},
+};
 constexpr FloatField kLayerFloats[] = {
     {M::kLayerBase, "base", 0.0, Limits::kMaxBase},
     {M::kLayerThickness, "thickness", Limits::kThickness.lo, Limits::kThickness.hi},
@@ -51,6 +57,8 @@ std::vector<int> floatAddresses() {
   std::vector<int> out;
   for (const FloatField& f : kViewFloats) out.push_back(f.address);
   for (const FloatField& f : kOtherFloats) out.push_back(f.address);
+  for (const FloatField& f : kAtmosphereFloats) out.push_back(f.address);
+  out.push_back(M::kSunDate);  // a uint32, written whole like a float
   for (int layer = 0; layer < ProtocolLimits::kWeatherLayers; ++layer)
     for (const FloatField& f : kLayerFloats)
       out.push_back(M::kLayerStart + layer * M::kLayerStride + f.address);
@@ -59,7 +67,8 @@ std::vector<int> floatAddresses() {
 
 bool isReserved(int address) {
   if (address > M::kTimeScale + 1 && address < M::kLayerStart) return true;
-  return address >= M::kLayerStart && (address - M::kLayerStart) % M::kLayerStride == 7;
+  return address >= M::kLayerStart && address < M::kFogTop &&
+         (address - M::kLayerStart) % M::kLayerStride == 7;
 }
 
 struct Written {
@@ -102,6 +111,15 @@ HoldingRegisters encodeHolding(const ModbusSettings& s) {
     putFloat(b + M::kLayerBase, w.base_m);
     putFloat(b + M::kLayerThickness, w.thickness_m);
     putFloat(b + M::kLayerCoverage, w.coverage * 100.0);
+  }
+  putFloat(&r[M::kFogTop], s.fog_top);
+  putFloat(&r[M::kFogVisibility], s.fog_visibility);
+  if (s.sun_utc) {
+    const CivilTime& t = *s.sun_utc;
+    const std::uint32_t date = std::uint32_t(t.year * 10000 + t.month * 100 + t.day);
+    r[M::kSunDate] = std::uint16_t(date >> 16);
+    r[M::kSunDate + 1] = std::uint16_t(date & 0xffffu);
+    putFloat(&r[M::kSunTime], t.hour * 3600.0 + t.minute * 60.0 + t.second);
   }
   return r;
 }
@@ -216,6 +234,40 @@ std::variant<std::vector<Command>, RegisterError> decodeHoldingWrite(
     set.weather.thickness_m = readFloat(kLayerFloats[1], base);
     set.weather.coverage = readFloat(kLayerFloats[2], base) / 100.0;
     commands.emplace_back(set);
+  }
+  if (w.touches(M::kFogTop, 4)) {
+    const double top = readFloat(kAtmosphereFloats[0], 0);
+    const double visibility = readFloat(kAtmosphereFloats[1], 0);
+    if (!error && visibility != 0.0 && visibility < Limits::kFogVisibility.lo)
+      error = RegisterError{kIllegalDataValue,
+                            "fog visibility (register " + std::to_string(M::kFogVisibility) +
+                                "): " + formatNumber(visibility) +
+                                " is out of range (allowed: 0 for no fog, or " +
+                                formatNumber(Limits::kFogVisibility.lo) + " to " +
+                                formatNumber(Limits::kFogVisibility.hi) + ")"};
+    if (visibility == 0.0)
+      commands.emplace_back(command::SetFog{false, {}, {}, {}});
+    else
+      commands.emplace_back(command::SetFog{true, top, visibility, {}});
+  }
+  if (w.touches(M::kSunDate, 4)) {
+    const std::uint32_t date = std::uint32_t(next[M::kSunDate]) << 16 | next[M::kSunDate + 1];
+    const double seconds = readFloat(kAtmosphereFloats[2], 0);
+    if (date != 0) {  // 0 leaves the sun where the angles put it
+      CivilTime t;
+      t.year = int(date / 10000);
+      t.month = int(date / 100 % 100);
+      t.day = int(date % 100);
+      const double s = std::floor(std::clamp(seconds, 0.0, 86399.999));
+      t.hour = int(s / 3600.0);
+      t.minute = int((s - t.hour * 3600.0) / 60.0);
+      t.second = std::clamp(seconds - t.hour * 3600.0 - t.minute * 60.0, 0.0, 59.999);
+      if (std::string e = civilTimeError(t); !error && !e.empty())
+        error = RegisterError{kIllegalDataValue,
+                              "sun date (registers " + std::to_string(M::kSunDate) + "-" +
+                                  std::to_string(M::kSunDate + 1) + ", YYYYMMDD): " + e};
+      commands.emplace_back(command::SetSun{std::nullopt, std::nullopt, t});
+    }
   }
   if (error) return *error;
   return commands;

@@ -31,7 +31,12 @@ struct ModbusMap {
   static constexpr int kLayerBase = 1;       // float32 m
   static constexpr int kLayerThickness = 3;  // float32 m
   static constexpr int kLayerCoverage = 5;   // float32 percent
-  static constexpr int kHoldingCount = kLayerStart + 3 * kLayerStride;
+  // Atmosphere after the layers: ground fog, and the sun from a date and time at [site].
+  static constexpr int kFogTop = 56;         // float32 m
+  static constexpr int kFogVisibility = 58;  // float32 m; 0: no fog
+  static constexpr int kSunDate = 60;        // uint32 YYYYMMDD, high word first; 0: by angles
+  static constexpr int kSunTime = 62;        // float32 seconds into the UTC day
+  static constexpr int kHoldingCount = 64;
 
   // Coils (read 0x01; write 0x05, 0x0F).
   static constexpr int kRenderCoil = 0;  // write 1: render the Modbus view; reads 0 when done
@@ -59,6 +64,8 @@ struct ModbusSettings {
   double sun_azimuth = 0.0, sun_elevation = 45.0;
   double time_scale = 1.0;
   std::array<WeatherLayer, ProtocolLimits::kWeatherLayers> layers;
+  double fog_top = 0.0, fog_visibility = 0.0;  // visibility 0: no fog
+  std::optional<CivilTime> sun_utc;
 };
 
 struct ModbusStatus {

@@ -101,6 +101,7 @@ void Engine::setMode(TickMode mode) {
   State& s = *state_;
   if (mode == s.mode) return;
   s.mode = mode;
+  lockstep_ = mode == TickMode::kLockstep;
   // Realtime ticks and subscription periods start from now, not from when they last ran.
   s.next_tick = Clock::now();
   for (Subscription& sub : s.subscriptions) sub.next_due = Clock::now();

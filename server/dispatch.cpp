@@ -116,8 +116,7 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
       [&](const SetTime& c) -> std::optional<Outcome> {
         if (c.time_scale) s.time_scale = *c.time_scale;
         if (c.paused) s.paused = *c.paused;
-        if (c.mode)
-          setMode(*c.mode == ClockMode::kLockstep ? TickMode::kLockstep : TickMode::kRealtime);
+        if (c.mode) setMode(*c.mode);
         if (c.advance) advance(*c.advance);
         return json{{"time", world.timeSeconds()},
                     {"time_scale", s.time_scale},
@@ -185,11 +184,15 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
         if (std::string e = parseTargetJson(c.target, config_.entity_types, target); !e.empty())
           return badField(e);
         std::string error = world.edit([&](Scene& now, WorldDynamics&) -> std::string {
+          for (Target& other : now.targets)
+            if (other.name == target.name) {
+              if (!c.replace) return "target.name: \"" + target.name + "\" is taken";
+              other = target;  // a CIGI entity the world already holds (after a restart)
+              return "";
+            }
           if (now.targets.size() >= std::size_t(ProtocolLimits::kMaxTargets))
             return "target: the world holds " + std::to_string(ProtocolLimits::kMaxTargets) +
                    " targets already";
-          for (const Target& other : now.targets)
-            if (other.name == target.name) return "target.name: \"" + target.name + "\" is taken";
           now.targets.push_back(target);
           return "";
         });

@@ -21,6 +21,7 @@ Engine::Engine(DaemonConfig config)
   state_->views = config_.views;
   state_->time_scale = config_.time_scale;
   state_->mode = config_.mode;
+  lockstep_ = config_.mode == TickMode::kLockstep;
 }
 
 Engine::~Engine() {

@@ -125,8 +125,11 @@ class Engine {
   std::atomic<int> modbus_clients{0};
   std::atomic<std::uint64_t> frames_dropped{0};
   void noteError(ErrorCode code);
+  // CIGI messages applied, refused (by reason) and packets ignored, for stats and metrics.
+  void countCigi(const std::string& what);
 
   const DaemonConfig& config() const { return config_; }
+  bool lockstep() const { return lockstep_.load(); }  // the clock's mode now (any thread)
 
  private:
   using Clock = std::chrono::steady_clock;
@@ -190,8 +193,11 @@ class Engine {
   ModbusStatus published_status_;
   nlohmann::json published_stats_;
   std::atomic<bool> trigger_pending_{false};
+  std::atomic<bool> lockstep_{false};
   std::atomic<std::uint64_t> errors_{0};
   std::atomic<int> last_error_{0};
+  mutable std::mutex cigi_mutex_;
+  std::map<std::string, std::uint64_t> cigi_counts_;
   mutable std::mutex subscribers_mutex_;
   std::map<std::int64_t, int> subscribers_;  // client: subscriptions, for subscriptionsOf
 };

@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "config/daemon_config.h"
+#include "server/cigi_server.h"
 #include "server/engine.h"
 #include "server/modbus_server.h"
 #include "server/socket_server.h"
@@ -63,10 +64,12 @@ int runServeCommand(const ServeCommandOptions& o) {
   SocketServer socket(io, engine);
   MetricsServer metrics(io, engine);
   ModbusServer modbus(engine);
+  CigiServer cigi(io, engine);
   std::string error;
   if (config.socket_enabled) error = socket.listen(config.socket);
   if (error.empty() && config.metrics_enabled) error = metrics.listen(config.metrics);
   if (error.empty() && config.modbus_enabled) error = modbus.listen(config.modbus);
+  if (error.empty() && config.cigi.enabled) error = cigi.listen(config.cigi);
   if (!error.empty()) {
     spdlog::error("{}", error);
     modbus.close();
@@ -77,9 +80,10 @@ int runServeCommand(const ServeCommandOptions& o) {
   std::thread io_thread([&io] { io.run(); });
 
   // The ready line: tests and supervisors read the ports from it.
-  std::printf(
-      "nephele ready socket=%d modbus=%d metrics=%d\n", config.socket_enabled ? socket.port() : -1,
-      config.modbus_enabled ? modbus.port() : -1, config.metrics_enabled ? metrics.port() : -1);
+  std::printf("nephele ready socket=%d modbus=%d metrics=%d cigi=%d\n",
+              config.socket_enabled ? socket.port() : -1,
+              config.modbus_enabled ? modbus.port() : -1,
+              config.metrics_enabled ? metrics.port() : -1, config.cigi.enabled ? cigi.port() : -1);
   std::fflush(stdout);
   spdlog::info("event=listening socket={}:{} modbus={}:{} metrics={}", config.socket.bind,
                socket.port(), config.modbus.bind, modbus.port(),
@@ -95,6 +99,7 @@ int runServeCommand(const ServeCommandOptions& o) {
   asio::post(io, [&] {
     socket.close();
     metrics.close();
+    cigi.close();
   });
   work.reset();
   io_thread.join();

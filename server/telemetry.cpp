@@ -55,6 +55,10 @@ void Engine::publish() {
       {"last_frame", frameStatsJson(s.renderer->lastFrameStats())},
   };
   {
+    std::lock_guard lock(cigi_mutex_);
+    stats["cigi"] = cigi_counts_;
+  }
+  {
     std::lock_guard lock(published_mutex_);
     published_stats_ = std::move(stats);
   }
@@ -79,6 +83,11 @@ void Engine::publishReadings() {
   settings.sun_elevation = world.base().sun.elevation_deg;
   settings.time_scale = s.time_scale;
   settings.layers = s.weather;
+  if (const std::optional<Fog>& fog = world.base().fog) {
+    settings.fog_top = fog->top_m;
+    settings.fog_visibility = fog->visibility_m;
+  }
+  settings.sun_utc = s.sun_utc;
   ModbusStatus status;
   status.status = s.mode == TickMode::kLockstep ? ModbusStatusCode::kLockstep
                   : s.paused                    ? ModbusStatusCode::kPaused
@@ -102,6 +111,11 @@ ModbusStatus Engine::modbusStatus() const {
   ModbusStatus status = published_status_;
   status.last_error = std::uint16_t(last_error_.load());
   return status;
+}
+
+void Engine::countCigi(const std::string& what) {
+  std::lock_guard lock(cigi_mutex_);
+  ++cigi_counts_[what];
 }
 
 json Engine::stats() const {

@@ -58,3 +58,29 @@ TEST(Frames, PixelRaysFollowSpecImagePlane) {
 
 }  // namespace
 }  // namespace nephele
+
+namespace nephele {
+namespace {
+
+// orientationOf inverts bodyToWorld, including rolled, inverted and vertical attitudes (the
+// CIGI views compose an entity's attitude with the view's offset through it).
+TEST(Frames, OrientationOfInvertsBodyToWorld) {
+  for (double h : {0.0, 37.0, 181.0, 359.0})
+    for (double p : {-89.0, -30.0, 0.0, 45.0, 89.9})
+      for (double r : {-179.0, -20.0, 0.0, 60.0, 180.0}) {
+        const glm::dmat3 m = bodyToWorld({h, p, r});
+        const glm::dmat3 back = bodyToWorld(orientationOf(m));
+        for (int c = 0; c < 3; ++c)
+          for (int k = 0; k < 3; ++k)
+            EXPECT_NEAR(back[c][k], m[c][k], 1e-9) << h << " " << p << " " << r;
+      }
+  for (double p : {-90.0, 90.0}) {  // vertical: the body axes still come back
+    const glm::dmat3 m = bodyToWorld({30.0, p, 10.0});
+    const glm::dmat3 back = bodyToWorld(orientationOf(m));
+    for (int c = 0; c < 3; ++c)
+      for (int k = 0; k < 3; ++k) EXPECT_NEAR(back[c][k], m[c][k], 1e-9) << p;
+  }
+}
+
+}  // namespace
+}  // namespace nephele

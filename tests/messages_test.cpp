@@ -63,6 +63,32 @@ TEST(Messages, ParsesEveryCommandWithItsFields) {
       std::get<command::Subscribe>(parsed(R"({"cmd":"subscribe","view":"a","rate":5})").command)
           .rate_hz,
       5.0);
+  // Issue 16: several views from one tick, a camera for one render, atmosphere, targets.
+  const auto r = std::get<command::Render>(
+      parsed(R"({"cmd":"render","views":["a","b"],"format":"raw"})").command);
+  EXPECT_EQ(r.views, (std::vector<std::string>{"a", "b"}));
+  const auto rc = std::get<command::Render>(
+      parsed(R"({"cmd":"render","view":"a","camera":{"position":[1,2,3],"vfov":30,"width":8}})")
+          .command);
+  EXPECT_EQ(*rc.camera->position, glm::dvec3(1, 2, 3));
+  EXPECT_EQ(*rc.camera->width, 8);
+  EXPECT_FALSE(rc.camera->image.has_value());
+  const auto fog = std::get<command::SetFog>(
+      parsed(R"({"cmd":"set_fog","top":200,"visibility":500,"colour":[0.5,0.5,0.6]})").command);
+  EXPECT_EQ(*fog.top, 200.0);
+  EXPECT_EQ(*fog.visibility, 500.0);
+  EXPECT_FALSE(fog.enabled.has_value());
+  const auto sun = std::get<command::SetSun>(
+      parsed(R"({"cmd":"set_sun","utc":"2026-03-20T14:00+02:00"})").command);
+  EXPECT_EQ(sun.utc->hour, 12);
+  EXPECT_EQ(
+      *std::get<command::SetTime>(parsed(R"({"cmd":"set_time","mode":"lockstep"})").command).mode,
+      TickMode::kLockstep);
+  const auto move = std::get<command::MoveTarget>(
+      parsed(R"({"cmd":"move_target","name":"t","centre":[1,2,3],"roll":5})").command);
+  EXPECT_EQ(*move.centre, glm::dvec3(1, 2, 3));
+  EXPECT_EQ(*move.roll, 5.0);
+  EXPECT_EQ(commandName(parsed(R"({"cmd":"list_targets"})").command), "list_targets");
   EXPECT_EQ(parsed(R"({"id":"abc","cmd":"hash"})").id, "abc");
   EXPECT_EQ(commandName(parsed(R"({"cmd":"stats"})").command), "stats");
 }
@@ -117,6 +143,22 @@ TEST(Messages, ErrorsNameTheFieldAndWhatIsAllowed) {
       {R"({"cmd":"snapshot","name":"a/b"})", ErrorCode::kBadField, "is not a name"},
       {R"({"cmd":"snapshot","name":".hidden"})", ErrorCode::kBadField, "not starting with"},
       {R"({"cmd":"hash","id":{"a":1}})", ErrorCode::kBadField, "id: must be"},
+      {R"({"cmd":"render"})", ErrorCode::kBadField, "one of view and views"},
+      {R"({"cmd":"render","view":"a","views":["b"]})", ErrorCode::kBadField, "one of view"},
+      {R"({"cmd":"render","views":[]})", ErrorCode::kBadField, "1 to 16"},
+      {R"({"cmd":"render","views":["a","a"]})", ErrorCode::kBadField, "repeated"},
+      {R"({"cmd":"render","views":["a","b"],"camera":{}})", ErrorCode::kBadField, "one view"},
+      {R"({"cmd":"render","view":"a","camera":{"vfov":0}})", ErrorCode::kBadField, "camera.vfov"},
+      {R"({"cmd":"render","view":"a","camera":{"speed":1}})", ErrorCode::kBadField,
+       "camera.speed: unknown field"},
+      {R"({"cmd":"set_fog","enabled":false,"top":3})", ErrorCode::kBadField, "removes the fog"},
+      {R"({"cmd":"set_fog","visibility":0.5})", ErrorCode::kBadField, "1 to 1e+07"},
+      {R"({"cmd":"set_sun","utc":"yesterday"})", ErrorCode::kBadField, "YYYY-MM-DD"},
+      {R"({"cmd":"set_sun","utc":"2026-01-01T00:00Z","elevation":3})", ErrorCode::kBadField,
+       "not both"},
+      {R"({"cmd":"set_time","mode":"fast"})", ErrorCode::kBadField, "realtime, lockstep"},
+      {R"({"cmd":"add_target"})", ErrorCode::kBadField, "[[target]]"},
+      {R"({"cmd":"move_target","name":"t","pitch":91})", ErrorCode::kBadField, "-90 to 90"},
   };
   for (const Case& c : cases) {
     const BadRequest bad = rejected(c.line);

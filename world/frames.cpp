@@ -1,5 +1,7 @@
 #include "world/frames.h"
 
+#include <algorithm>
+
 #include <cmath>
 #include <numbers>
 
@@ -29,6 +31,23 @@ glm::dmat3 rotationY(double a) {
 glm::dmat3 bodyToWorld(const Orientation& o) {
   return rotationZ(-radians(o.heading_deg)) * rotationX(radians(o.pitch_deg)) *
          rotationY(radians(o.roll_deg));
+}
+
+Orientation orientationOf(const glm::dmat3& r) {
+  // Columns: right, forward, up. forward = (sin h cos p, cos h cos p, sin p); the z parts of
+  // right and up are -sin r cos p and cos r cos p.
+  const glm::dvec3 right = r[0], forward = r[1], up = r[2];
+  Orientation o;
+  o.pitch_deg = std::asin(std::clamp(forward.z, -1.0, 1.0)) * 180.0 / std::numbers::pi;
+  if (std::hypot(forward.x, forward.y) > 1e-12) {
+    o.heading_deg = std::atan2(forward.x, forward.y) * 180.0 / std::numbers::pi;
+    o.roll_deg = std::atan2(-right.z, up.z) * 180.0 / std::numbers::pi;
+  } else {  // straight up or down: the heading is that of the body's up (or down) axis
+    const double s = forward.z > 0.0 ? -1.0 : 1.0;
+    o.heading_deg = std::atan2(s * up.x, s * up.y) * 180.0 / std::numbers::pi;
+  }
+  if (o.heading_deg < 0.0) o.heading_deg += 360.0;
+  return o;
 }
 
 ViewBasis viewBasis(const Camera& camera) {

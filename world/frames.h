@@ -13,6 +13,9 @@ struct Orientation {
 
 // R = Rz(-h) Rx(p) Ry(r): columns are the world directions of body right, forward and up.
 glm::dmat3 bodyToWorld(const Orientation& orientation);
+// The orientation whose bodyToWorld is the rotation `r` (heading in [0, 360), pitch in
+// [-90, 90], roll in (-180, 180]; at pitch +-90 the roll is folded into the heading).
+Orientation orientationOf(const glm::dmat3& r);
 
 struct Camera {
   glm::dvec3 position{0.0, 0.0, 2.0};

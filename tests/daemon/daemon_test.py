@@ -85,9 +85,9 @@ directory = "{frames or os.path.join(workdir, name + "-frames")}"
         if not line.startswith("nephele ready"):
             self.proc.wait(TIMEOUT)
             raise AssertionError("daemon did not start: " + open(self.log_path).read())
-        fields = dict(kv.split("=") for kv in line.split()[2:])
+        self.ports = {k: int(v) for k, v in (kv.split("=") for kv in line.split()[2:])}
         self.port, self.modbus_port, self.metrics_port = (
-            int(fields["socket"]), int(fields["modbus"]), int(fields["metrics"]))
+            self.ports["socket"], self.ports["modbus"], self.ports["metrics"])
 
     def stop(self, sig=signal.SIGTERM):
         if self.proc.poll() is None:
@@ -569,6 +569,171 @@ class LockstepAndSnapshotTest(DaemonTest):
         self.assertEqual(d.client().ok({"cmd": "hash"})["hash"], saved["hash"])
 
 
+class HostStateTest(DaemonTest):
+    """Issue 16, items 2 to 5: frames bound to their pose and tick, targets and atmosphere at
+    run time, the clock's mode, and snapshots that keep everything the host set."""
+
+    def test_render_of_several_views_and_a_camera_for_one_render(self):
+        d = self.daemon()
+        c = d.client()
+        c.ok({"cmd": "tick", "dt": 0.5})
+        sent = c.send({"cmd": "render", "views": ["front", "left"], "format": "raw"})
+        parts = [c.read() for _ in range(2)]
+        for i, (header, body) in enumerate(parts):
+            self.assertEqual(header["id"], sent)
+            image = header["result"]["image"]
+            self.assertEqual((image["part"], image["parts"]), (i, 2))
+            self.assertEqual(image["tick"], 1)
+            self.assertEqual(len(body), image["bytes"])
+        self.assertEqual([p[0]["result"]["image"]["view"] for p in parts], ["front", "left"])
+        self.assertEqual(parts[1][0]["result"]["image"]["camera"]["heading_deg"], -60.0)
+        # A camera for this render alone: the header carries it, the view keeps its own.
+        camera = {"position": [100, -50, 1200], "heading": 30, "pitch": 5, "roll": 2,
+                  "vfov": 40, "width": 80, "height": 40}
+        image, body = c.ok({"cmd": "render", "view": "front", "camera": camera, "format": "raw"})
+        cam = image["image"]["camera"]
+        self.assertEqual(cam["position"], [100, -50, 1200])
+        self.assertEqual((cam["heading_deg"], cam["pitch_deg"], cam["roll_deg"]), (30, 5, 2))
+        self.assertEqual((image["image"]["width"], image["image"]["height"]), (80, 40))
+        self.assertAlmostEqual(cam["focal_px"], 20 / math.tan(math.radians(20)), places=6)
+        self.assertEqual(len(body), 80 * 40 * 4)
+        self.assertEqual(c.ok({"cmd": "get_view", "view": "front"})["width"], 64)
+        for bad, field in [({"views": ["front", "front"]}, "views"),
+                           ({"views": ["front", "nope"]}, "view"),
+                           ({"views": ["front", "left"], "camera": {"vfov": 30}}, "camera"),
+                           ({"view": "front", "camera": {"format": "png"}}, "camera.format"),
+                           ({"view": "front", "camera": {"width": 5000, "height": 5000}},
+                            "width")]:
+            with self.subTest(bad=bad):
+                self.assertIn(field, c.error(dict({"cmd": "render"}, **bad))["message"])
+
+    def test_lockstep_subscription_gets_one_frame_per_tick(self):
+        d = self.daemon()
+        c = d.client()
+        sub = c.ok({"cmd": "subscribe", "view": "front", "rate": 60})["subscription"]
+        first, _ = c.read()
+        self.assertEqual((first["event"], first["image"]["tick"]), ("frame", 0))
+        for _ in range(3):
+            c.send({"cmd": "tick", "dt": 0.1})
+        ticks, replies = [], 0
+        while replies < 3:
+            header, _ = c.read()
+            if header.get("event") == "frame":
+                ticks.append(header["image"]["tick"])
+            else:
+                replies += 1
+        while len(ticks) < 3:
+            ticks.append(c.read()[0]["image"]["tick"])
+        self.assertEqual(ticks, [1, 2, 3])
+        # Nothing more arrives while no tick is made, whatever the rate: the next line after a
+        # pause is the reply to the next request.
+        time.sleep(0.6)
+        self.assertEqual(c.ok({"cmd": "hash"})["ticks"], 3)
+        c.ok({"cmd": "unsubscribe", "subscription": sub})
+
+    def test_mode_switch_and_tick_in_realtime(self):
+        d = self.daemon(mode="realtime")
+        c = d.client()
+        self.assertIn("realtime mode", c.error({"cmd": "tick", "dt": 0.1})["message"])
+        self.assertEqual(c.ok({"cmd": "set_time", "mode": "lockstep"})["mode"], "lockstep")
+        before = c.ok({"cmd": "hash"})
+        time.sleep(0.3)  # a lockstep world stands still
+        self.assertEqual(c.ok({"cmd": "hash"})["hash"], before["hash"])
+        self.assertEqual(c.ok({"cmd": "tick", "dt": 0.1})["ticks"], before["ticks"] + 1)
+        self.assertEqual(c.ok({"cmd": "stats"})["mode"], "lockstep")
+        c.ok({"cmd": "set_time", "mode": "realtime", "time_scale": 2})
+        wait_until(lambda: c.ok({"cmd": "hash"})["ticks"] > before["ticks"] + 3,
+                   "realtime ticks after the switch")
+        self.assertIn("mode", c.error({"cmd": "set_time", "mode": "fast"})["message"])
+
+    def test_targets_at_run_time(self):
+        d = self.daemon(extra='[[entity_type]]\nid = 1001\nname = "rib"\nshape = "box"\n'
+                              'size = [4, 2, 1]\ncolour = [0.9, 0.4, 0.1]\n')
+        c = d.client()
+        before = c.ok({"cmd": "hash"})["hash"]
+        added = c.ok({"cmd": "add_target", "target": {"name": "boat", "type": "rib",
+                                                       "centre": [0, 300, 2]}})
+        self.assertEqual((added["shape"], added["size"], added["object_id"]),
+                         ("box", [4, 2, 1], 1))
+        c.ok({"cmd": "add_target", "target": {"name": "buoy", "shape": "ellipsoid",
+                                               "centre": [20, 300, 1], "size": [1, 1, 1]}})
+        self.assertNotEqual(c.ok({"cmd": "hash"})["hash"], before)
+        moved = c.ok({"cmd": "move_target", "name": "boat", "centre": [5, 310, 2],
+                      "heading": 45})
+        self.assertEqual((moved["centre"], moved["heading"]), ([5, 310, 2], 45))
+        listed = c.ok({"cmd": "list_targets"})["targets"]
+        self.assertEqual([t["name"] for t in listed], ["boat", "buoy"])
+        for target, words in [({"name": "boat", "shape": "box"}, "is taken"),
+                              ({"name": "x", "type": "frigate"}, "rib"),
+                              ({"name": "x", "mesh": "/etc/passwd"}, "entity_type"),
+                              ({"name": "x", "size": [0, 1, 1]}, "size"),
+                              ({"name": "x", "shape": "cone"}, "shape"),
+                              ({"shape": "box"}, "name")]:
+            with self.subTest(target=target):
+                self.assertIn(words, c.error({"cmd": "add_target", "target": target})["message"])
+        self.assertEqual(c.error({"cmd": "move_target", "name": "nope"})["code"], "not_found")
+        c.ok({"cmd": "remove_target", "name": "buoy"})
+        self.assertEqual(len(c.ok({"cmd": "list_targets"})["targets"]), 1)
+
+    def test_fog_and_sun_from_date_and_time(self):
+        d = self.daemon(extra="[site]\nlatitude = 51.5\nlongitude = -0.1\n")
+        c = d.client()
+        before = c.ok({"cmd": "hash"})["hash"]
+        fog = c.ok({"cmd": "set_fog", "top": 150, "visibility": 800})
+        self.assertEqual((fog["enabled"], fog["top"], fog["visibility"]), (True, 150, 800))
+        self.assertNotEqual(c.ok({"cmd": "hash"})["hash"], before)
+        self.assertEqual(c.ok({"cmd": "set_fog", "enabled": False}), {"enabled": False})
+        self.assertIn("visibility", c.error({"cmd": "set_fog", "visibility": 0})["message"])
+        # Midsummer noon at London: the sun due south at 90 - 51.5 + 23.44 degrees.
+        sun = c.ok({"cmd": "set_sun", "utc": "2026-06-21T12:00:00Z"})
+        self.assertAlmostEqual(sun["elevation"], 90 - 51.5 + 23.44, delta=0.2)
+        self.assertAlmostEqual(sun["azimuth"], 180, delta=2.0)
+        night = c.ok({"cmd": "set_sun", "utc": "2026-12-21T01:00:00+01:00"})
+        self.assertLess(night["elevation"], -50)
+        for utc, words in [("2026-02-29T12:00Z", "day"), ("2026-06-21T12:00", "time zone"),
+                           ("2200-01-01T00:00Z", "year")]:
+            with self.subTest(utc=utc):
+                self.assertIn(words, c.error({"cmd": "set_sun", "utc": utc})["message"])
+        self.assertIn("not both", c.error({"cmd": "set_sun", "utc": "2026-06-21T12:00Z",
+                                           "azimuth": 3})["message"])
+
+    def test_restart_restores_everything_the_host_set(self):
+        d = self.daemon(name="s", extra='[snapshot]\npath = "{snapshot}"\ninterval = 0')
+        c = d.client()
+        c.ok({"cmd": "set_view", "view": "left", "position": [10, 20, 800], "heading": 12,
+              "vfov": 35, "width": 48, "height": 30, "format": "jpeg", "channels": ["colour"]})
+        c.ok({"cmd": "set_weather", "layer": 2, "type": 2, "base": 3000, "thickness": 400,
+              "coverage": 70})
+        c.ok({"cmd": "set_fog", "top": 90, "visibility": 1500})
+        c.ok({"cmd": "add_target", "target": {"name": "t1", "centre": [0, 200, 50]}})
+        c.ok({"cmd": "set_sun", "utc": "2026-03-20T09:30:00Z"})
+        for _ in range(3):
+            c.ok({"cmd": "tick", "dt": 0.2})
+        c.ok({"cmd": "render", "view": "front"})
+        c.ok({"cmd": "set_time", "time_scale": 3, "paused": True})
+        state = {k: c.ok({"cmd": k}) for k in ["hash", "get_view", "list_targets"]}
+        stats = c.ok({"cmd": "stats"})
+        self.assertEqual(d.stop(), 0)
+        d.start()
+        c = d.client()
+        for k in ["hash", "get_view", "list_targets"]:
+            self.assertEqual(c.ok({"cmd": k}), state[k], k)
+        after = c.ok({"cmd": "stats"})
+        for k in ["ticks", "frames", "time_scale", "paused", "mode"]:
+            self.assertEqual(after[k], stats[k], k)
+        # The weather registers (Modbus holding 32 + 8 per layer) came back with the layer.
+        from pymodbus.client import ModbusTcpClient
+        mb = ModbusTcpClient("127.0.0.1", port=d.modbus_port)
+        mb.connect()
+        try:
+            regs = mb.read_holding_registers(40, 1, slave=1).registers
+        finally:
+            mb.close()
+        self.assertEqual(regs, [2])  # altostratus, in layer 2's type register
+        with open(d.snapshot + ".daemon.json") as f:
+            self.assertEqual(json.load(f)["ticks"], 3)
+
+
 class ModbusTest(DaemonTest):
     def setUp(self):
         super().setUp()
@@ -600,6 +765,32 @@ class ModbusTest(DaemonTest):
         self.assertNotEqual(self.c.ok({"cmd": "hash"})["hash"], before)
         regs = self.mb.read_holding_registers(32, 7, slave=1).registers
         self.assertEqual(regs[0], 7)
+
+    def test_fog_and_sun_date_registers(self):
+        def unfloat(words):
+            return struct.unpack(">f", struct.pack(">HH", *words))[0]
+        before = self.c.ok({"cmd": "hash"})["hash"]
+        self.assertFalse(self.mb.write_registers(56, floats(120.0) + floats(900.0),
+                                                 slave=1).isError())
+        self.assertNotEqual(self.c.ok({"cmd": "hash"})["hash"], before)
+        date = 20260621
+        self.assertFalse(self.mb.write_registers(60, [date >> 16, date & 0xffff] +
+                                                 floats(43200.0), slave=1).isError())
+        regs = self.mb.read_holding_registers(0, 64, slave=1).registers
+        self.assertEqual((unfloat(regs[56:58]), unfloat(regs[58:60])), (120.0, 900.0))
+        self.assertEqual((regs[60] << 16 | regs[61], unfloat(regs[62:64])), (date, 43200.0))
+        # Noon at the default site (0 N, 0 E) at the June solstice: the sun stands to the
+        # north at 90 - 23.44 degrees, and the angle registers say so.
+        self.assertAlmostEqual(unfloat(regs[22:24]), 90 - 23.44, delta=0.3)
+        self.assertLess(min(unfloat(regs[20:22]), 360 - unfloat(regs[20:22])), 5)
+        # A day that does not exist is refused and changes nothing; visibility 0 removes fog.
+        bad = 20260230
+        self.assertTrue(self.mb.write_registers(60, [bad >> 16, bad & 0xffff] + floats(0.0),
+                                                slave=1).isError())
+        self.assertEqual(self.mb.read_holding_registers(60, 2, slave=1).registers,
+                         [date >> 16, date & 0xffff])
+        self.assertFalse(self.mb.write_registers(58, floats(0.0), slave=1).isError())
+        self.assertEqual(self.mb.read_holding_registers(56, 4, slave=1).registers, [0, 0, 0, 0])
 
     def test_bad_writes_get_exceptions_and_change_nothing(self):
         before = self.c.ok({"cmd": "hash"})["hash"]

@@ -1,0 +1,389 @@
+#include "protocol/cigi_session.h"
+
+#include <cmath>
+#include <numbers>
+#include <set>
+#include <sstream>
+
+#include "world/formations/cloud_field.h"
+#include "world/frames.h"
+#include "world/limits.h"
+#include "world/solar.h"
+
+namespace nephele::cigi {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+// WGS 84 (NIMA TR8350.2): semi-major axis and flattening.
+constexpr double kWgs84A = 6378137.0;
+constexpr double kWgs84F = 1.0 / 298.257223563;
+
+std::string text(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+bool finite(std::initializer_list<double> values) {
+  for (double v : values)
+    if (!std::isfinite(v)) return false;
+  return true;
+}
+
+// CIGI body axes (x forward, y right, z down) to Nephele's (x right, y forward, z up).
+glm::dvec3 fromCigiBody(double x, double y, double z) {
+  return {y, x, -z};
+}
+
+// Wind blowing from `from_deg` (clockwise from north, as CIGI gives it) at `speed`: east, north.
+glm::dvec2 windVelocity(double speed, double from_deg) {
+  return -speed * glm::dvec2(std::sin(from_deg * kDeg), std::cos(from_deg * kDeg));
+}
+
+// The weather fields Nephele draws; a packet differing only elsewhere changes nothing.
+bool sameCloudLayer(const WeatherControl& a, const WeatherControl& b) {
+  return a.enabled == b.enabled && a.cloud_type == b.cloud_type && a.base == b.base &&
+         a.thickness == b.thickness && a.coverage == b.coverage && a.wind_speed == b.wind_speed &&
+         a.wind_direction == b.wind_direction;
+}
+bool sameFog(const WeatherControl& a, const WeatherControl& b) {
+  return a.enabled == b.enabled && a.base == b.base && a.thickness == b.thickness &&
+         a.visibility == b.visibility;
+}
+
+std::string entityName(std::uint16_t id) {
+  return "cigi-" + std::to_string(id);
+}
+
+}  // namespace
+
+glm::dvec3 localPosition(double latitude_deg, double longitude_deg, double altitude_m,
+                         double origin_latitude_deg, double origin_longitude_deg) {
+  const double e2 = kWgs84F * (2.0 - kWgs84F);
+  const double s = std::sin(origin_latitude_deg * kDeg);
+  const double w = 1.0 - e2 * s * s;
+  const double prime_vertical = kWgs84A / std::sqrt(w);                 // N
+  const double meridional = kWgs84A * (1.0 - e2) / (w * std::sqrt(w));  // M
+  double dlon = longitude_deg - origin_longitude_deg;
+  dlon -= 360.0 * std::round(dlon / 360.0);  // across the antimeridian
+  return {dlon * kDeg * prime_vertical * std::cos(origin_latitude_deg * kDeg),
+          (latitude_deg - origin_latitude_deg) * kDeg * meridional, altitude_m};
+}
+
+std::optional<Session::Pose> Session::poseOf(const State& state, std::uint16_t id,
+                                             int depth) const {
+  const auto it = state.entities.find(id);
+  if (it == state.entities.end()) {
+    if (id == 0) return Pose{};  // the ownship before the host has placed it: the origin
+    return std::nullopt;
+  }
+  const EntityControl& e = it->second.packet;
+  const glm::dmat3 own = bodyToWorld({e.yaw, e.pitch, e.roll});
+  if (e.attached && e.parent_id != id && depth < 16) {
+    const std::optional<Pose> parent = poseOf(state, e.parent_id, depth + 1);
+    if (!parent) return std::nullopt;
+    return Pose{
+        parent->position + parent->attitude * fromCigiBody(e.latitude, e.longitude, e.altitude),
+        parent->attitude * own};
+  }
+  if (e.attached) return std::nullopt;  // attached to itself, or a chain deeper than 16
+  return Pose{localPosition(e.latitude, e.longitude, e.altitude, settings_.latitude_deg,
+                            settings_.longitude_deg),
+              own};
+}
+
+std::variant<Session::State, Refusal> Session::next(const Message& message,
+                                                    HostFrame& frame) const {
+  State s = state_;
+  frame.control = std::get<IgControl>(message.packets.front());
+  const IgControl& igc = frame.control;
+  if (s.last_host_frame && std::int32_t(igc.host_frame - *s.last_host_frame) <= 0)
+    return Refusal{"out_of_order", "host frame " + std::to_string(igc.host_frame) +
+                                       " does not follow " + std::to_string(*s.last_host_frame) +
+                                       " (a late or repeated datagram)"};
+  frame.dt_s = settings_.default_frame_s;
+  if (igc.timestamp_valid && s.last_timestamp)
+    frame.dt_s =
+        double(std::uint32_t(igc.timestamp - *s.last_timestamp)) / double(kTimestampTicksPerSecond);
+  frame.dt_s = std::clamp(frame.dt_s, 0.0, Limits::kMaxTick);
+  s.last_host_frame = igc.host_frame;
+  if (igc.timestamp_valid) s.last_timestamp = igc.timestamp;
+  if (igc.mode == IgMode::kStandby) {
+    if (message.packets.size() > 1)
+      frame.ignored.push_back(
+          "IG Control mode is standby/reset: the message's other packets are "
+          "not applied");
+    return s;
+  }
+  auto bad = [](std::string what) { return Refusal{"bad_value", std::move(what)}; };
+  bool views_moved = false;
+  std::set<std::uint16_t> changed_entities;
+  const auto typeName = [&](std::uint16_t type) -> const std::string* {
+    for (const auto& [id, name] : settings_.entity_types)
+      if (id == type) return &name;
+    return nullptr;
+  };
+  for (std::size_t i = 1; i < message.packets.size(); ++i) {
+    const Packet& packet = message.packets[i];
+    if (const auto* e = std::get_if<EntityControl>(&packet)) {
+      const std::string where = "Entity Control " + std::to_string(e->entity_id);
+      if (!finite({e->roll, e->pitch, e->yaw, e->latitude, e->longitude, e->altitude}))
+        return bad(where + ": a position or angle is not a finite number");
+      if (!e->attached && (std::abs(e->latitude) > 90.0 || std::abs(e->longitude) > 360.0))
+        return bad(where + ": latitude " + text(e->latitude) + ", longitude " + text(e->longitude) +
+                   " (allowed: -90 to 90, -360 to 360 degrees)");
+      if (e->entity_id == 0) {  // the ownship: it carries the views
+        s.entities[0] = {*e, false};
+        views_moved = true;
+        continue;
+      }
+      const auto known = s.entities.find(e->entity_id);
+      if (e->state != EntityState::kActive) {
+        if (known != s.entities.end()) {
+          if (known->second.target)
+            frame.commands.emplace_back(command::RemoveTarget{entityName(e->entity_id)});
+          s.entities.erase(known);
+        }
+        continue;
+      }
+      if (!typeName(e->type)) {
+        frame.ignored.push_back(where + ": entity type " + std::to_string(e->type) +
+                                " is not in the daemon config's [[entity_type]]");
+        continue;
+      }
+      if (known == s.entities.end() || !(known->second.packet == *e))
+        changed_entities.insert(e->entity_id);
+      s.entities[e->entity_id] = {*e, true};
+    } else if (const auto* v = std::get_if<ViewControl>(&packet)) {
+      if (v->view_id >= settings_.views.size()) {
+        frame.ignored.push_back("View Control: view " + std::to_string(v->view_id) +
+                                " is not one of the " + std::to_string(settings_.views.size()) +
+                                " views of [cigi] views");
+        continue;
+      }
+      if (!finite({v->x, v->y, v->z, v->roll, v->pitch, v->yaw}))
+        return bad("View Control " + std::to_string(v->view_id) + ": an offset is not finite");
+      ViewState& view = s.views[v->view_id];
+      ViewControl merged = view.control.value_or(ViewControl{});
+      float* fields[] = {&merged.x, &merged.y, &merged.z, &merged.roll, &merged.pitch, &merged.yaw};
+      const float values[] = {v->x, v->y, v->z, v->roll, v->pitch, v->yaw};
+      for (int k = 0; k < 6; ++k)
+        if (v->enables & (1 << k)) *fields[k] = values[k];
+      merged.view_id = v->view_id;
+      merged.entity_id = v->entity_id;
+      merged.enables = 0x3f;
+      view.control = merged;
+      views_moved = true;
+    } else if (const auto* d = std::get_if<ViewDefinition>(&packet)) {
+      if (d->view_id >= settings_.views.size()) {
+        frame.ignored.push_back("View Definition: view " + std::to_string(d->view_id) +
+                                " is not one of [cigi] views");
+        continue;
+      }
+      const bool asymmetric_ok = d->left < d->right && d->bottom < d->top;
+      if (!finite({d->left, d->right, d->top, d->bottom}) || !asymmetric_ok || d->left <= -89.0f ||
+          d->right >= 89.0f || d->bottom <= -89.0f || d->top >= 89.0f)
+        return bad("View Definition " + std::to_string(d->view_id) + ": left " + text(d->left) +
+                   ", right " + text(d->right) + ", bottom " + text(d->bottom) + ", top " +
+                   text(d->top) +
+                   " (allowed: left < right and bottom < top, each within -89 to 89 degrees)");
+      if (d->orthographic) frame.ignored.push_back("View Definition: orthographic projection");
+      s.views[d->view_id].definition = *d;
+      views_moved = true;
+    } else if (const auto* w = std::get_if<WeatherControl>(&packet)) {
+      const std::string where = "Weather Control layer " + std::to_string(w->layer);
+      if (w->scope != WeatherScope::kGlobal) {
+        frame.ignored.push_back(where +
+                                ": regional and entity scope (only global weather is drawn)");
+        continue;
+      }
+      if (w->layer > Layer::kCloud3) {
+        frame.ignored.push_back(where + ": precipitation and obscurants are not drawn");
+        continue;
+      }
+      const auto last = s.weather.find(w->layer);
+      const bool fog = w->layer == Layer::kGroundFog;
+      if (last != s.weather.end() &&
+          (fog ? sameFog(last->second, *w) : sameCloudLayer(last->second, *w)))
+        continue;
+      if (!finite({w->base, w->thickness, w->coverage, w->visibility, w->wind_speed,
+                   w->wind_direction}))
+        return bad(where + ": a field is not a finite number");
+      if (fog) {
+        command::SetFog c;
+        c.enabled = w->enabled;
+        if (w->enabled) {
+          const double top = double(w->base) + double(w->thickness);
+          if (!(top >= 0.0 && top <= Limits::kMaxAltitude) ||
+              !Limits::kFogVisibility.contains(w->visibility))
+            return bad(where + ": fog top (base + thickness) " + text(top) + " and visibility " +
+                       text(w->visibility) + " (allowed: top 0 to " + text(Limits::kMaxAltitude) +
+                       " m, visibility " + text(Limits::kFogVisibility.lo) + " to " +
+                       text(Limits::kFogVisibility.hi) + " m)");
+          c.top = top;
+          c.visibility = w->visibility;
+        }
+        frame.commands.emplace_back(c);
+      } else {
+        command::SetWeather c;
+        c.layer = w->layer;
+        WeatherLayer& layer = c.weather;
+        layer.type = w->enabled ? CloudType(std::min<int>(w->cloud_type, 15)) : CloudType::kNone;
+        if (w->enabled && w->cloud_type >= kCloudTypeCount)
+          return bad(where + ": cloud type " + std::to_string(w->cloud_type) +
+                     " (allowed: 0 to 10)");
+        layer.base_m = w->base;
+        layer.thickness_m = w->thickness;
+        layer.coverage = w->coverage / 100.0;
+        if (w->enabled) {
+          if (!(layer.base_m >= 0.0 && layer.base_m <= Limits::kMaxBase) ||
+              !Limits::kThickness.contains(layer.thickness_m) ||
+              !Limits::kCoveragePercent.contains(w->coverage) ||
+              !(w->wind_speed >= 0.0 && w->wind_speed <= Limits::kMaxWind))
+            return bad(where + ": base " + text(w->base) + ", thickness " + text(w->thickness) +
+                       ", coverage " + text(w->coverage) + ", wind " + text(w->wind_speed) +
+                       " (allowed: base 0 to " + text(Limits::kMaxBase) + " m, thickness " +
+                       text(Limits::kThickness.lo) + " to " + text(Limits::kThickness.hi) +
+                       " m, coverage 0 to 100 %, wind 0 to " + text(Limits::kMaxWind) + " m/s)");
+          layer.wind = windVelocity(w->wind_speed, w->wind_direction);
+          if (std::string e = weatherLayerError(layer); !e.empty()) return bad(where + ": " + e);
+        } else {
+          layer.base_m = std::clamp(layer.base_m, 0.0, Limits::kMaxBase);
+          layer.thickness_m =
+              std::clamp(layer.thickness_m, Limits::kThickness.lo, Limits::kThickness.hi);
+          layer.coverage = std::clamp(layer.coverage, 0.0, 1.0);
+        }
+        frame.commands.emplace_back(c);
+        if (w->scud) frame.ignored.push_back(where + ": scud");
+        if (w->transition_band != 0.0f) frame.ignored.push_back(where + ": transition band");
+        if (w->visibility != 0.0f) frame.ignored.push_back(where + ": visibility in the layer");
+      }
+      s.weather[w->layer] = *w;
+    } else if (const auto* a = std::get_if<AtmosphereControl>(&packet)) {
+      if (s.atmosphere && s.atmosphere->wind_speed == a->wind_speed &&
+          s.atmosphere->wind_direction == a->wind_direction)
+        continue;
+      if (!finite({a->wind_speed, a->wind_direction}) ||
+          !(a->wind_speed >= 0.0 && a->wind_speed <= Limits::kMaxWind))
+        return bad("Atmosphere Control: wind speed " + text(a->wind_speed) + " (allowed: 0 to " +
+                   text(Limits::kMaxWind) + " m/s)");
+      frame.commands.emplace_back(command::SetWind{windVelocity(a->wind_speed, a->wind_direction)});
+      if (a->visibility != 0.0f)
+        frame.ignored.push_back(
+            "Atmosphere Control: global visibility (haze is drawn only in "
+            "the ground fog, Weather Control layer 0)");
+      s.atmosphere = *a;
+    } else if (const auto* c = std::get_if<CelestialSphereControl>(&packet)) {
+      if (!c->date_valid) continue;  // the ICD: date and time not to be applied
+      if (s.celestial && s.celestial->date == c->date && s.celestial->hour == c->hour &&
+          s.celestial->minute == c->minute)
+        continue;
+      CivilTime t;
+      t.month = int(c->date / 1000000);
+      t.day = int(c->date / 10000 % 100);
+      t.year = int(c->date % 10000);
+      t.hour = c->hour;
+      t.minute = c->minute;
+      t.second = 0.0;
+      if (std::string e = civilTimeError(t); !e.empty())
+        return bad("Celestial Sphere Control: date " + std::to_string(c->date) + " (MMDDYYYY) " +
+                   std::to_string(c->hour) + ":" + std::to_string(c->minute) + ": " + e);
+      frame.commands.emplace_back(command::SetSun{std::nullopt, std::nullopt, t});
+      s.celestial = *c;
+    } else if (const auto* o = std::get_if<OtherPacket>(&packet)) {
+      frame.ignored.push_back("packet " + std::to_string(o->id) + " (not used by Nephele)");
+    }
+  }
+  // Targets after the entities they hang from: every changed entity, and every attached one
+  // (its parent may have moved).
+  for (const auto& [id, entity] : s.entities) {
+    if (!entity.target || !(changed_entities.count(id) || entity.packet.attached)) continue;
+    const std::optional<Pose> pose = poseOf(s, id);
+    if (!pose) {
+      frame.ignored.push_back("Entity Control " + std::to_string(id) +
+                              ": attached to an entity the host has not placed");
+      continue;
+    }
+    if (std::abs(pose->position.x) > Limits::kMaxCoordinate ||
+        std::abs(pose->position.y) > Limits::kMaxCoordinate ||
+        std::abs(pose->position.z) > Limits::kMaxCoordinate)
+      return bad("Entity Control " + std::to_string(id) + ": " + text(pose->position.x) + ", " +
+                 text(pose->position.y) + " m from the origin (allowed: within " +
+                 text(Limits::kMaxCoordinate) + " m)");
+    const Orientation o = orientationOf(pose->attitude);
+    const bool known = state_.entities.count(id) && state_.entities.at(id).target;
+    if (known) {
+      frame.commands.emplace_back(command::MoveTarget{entityName(id), pose->position, o.heading_deg,
+                                                      o.pitch_deg, o.roll_deg});
+    } else {
+      nlohmann::json target{{"name", entityName(id)},
+                            {"type", *typeName(entity.packet.type)},
+                            {"centre", {pose->position.x, pose->position.y, pose->position.z}},
+                            {"heading", o.heading_deg},
+                            {"pitch", o.pitch_deg},
+                            {"roll", o.roll_deg}};
+      frame.commands.emplace_back(command::AddTarget{target, true});
+    }
+  }
+  if (views_moved) {
+    for (std::uint16_t id = 0; id < settings_.views.size(); ++id) {
+      const ViewState view = s.views.count(id) ? s.views.at(id) : ViewState{};
+      const ViewControl control = view.control.value_or(ViewControl{});
+      const std::optional<Pose> carrier = poseOf(s, control.entity_id);
+      if (!carrier) {
+        frame.ignored.push_back("View Control " + std::to_string(id) + ": entity " +
+                                std::to_string(control.entity_id) + " is not placed");
+        continue;
+      }
+      command::SetView c;
+      c.view = settings_.views[id];
+      ViewPatch& p = c.patch;
+      const glm::dvec3 position =
+          carrier->position + carrier->attitude * fromCigiBody(control.x, control.y, control.z);
+      if (position.z < 0.0 || std::abs(position.x) > Limits::kMaxCoordinate ||
+          std::abs(position.y) > Limits::kMaxCoordinate || position.z > Limits::kMaxCoordinate)
+        return bad("view " + std::to_string(id) + " at " + text(position.x) + ", " +
+                   text(position.y) + ", " + text(position.z) +
+                   " m (allowed: at or above the ground, within " + text(Limits::kMaxCoordinate) +
+                   " m of the origin)");
+      p.position = position;
+      const Orientation o = orientationOf(carrier->attitude *
+                                          bodyToWorld({control.yaw, control.pitch, control.roll}));
+      p.heading = o.heading_deg;
+      p.pitch = o.pitch_deg;
+      p.roll = o.roll_deg;
+      if (view.definition) {
+        const ViewDefinition& d = *view.definition;
+        // The frustum's vertical extent gives the field of view; its horizontal extent the
+        // width at the view's configured height (square pixels).
+        const double up = std::tan(d.top * kDeg), down = std::tan(d.bottom * kDeg);
+        const double right = std::tan(d.right * kDeg), left = std::tan(d.left * kDeg);
+        const double half = 0.5 * (up - down);
+        p.vfov = 2.0 * std::atan(half) / kDeg;
+        const int height = id < settings_.view_heights.size() ? settings_.view_heights[id] : 480;
+        p.width = std::clamp(int(std::lround(height * (right - left) / (up - down))), 1,
+                             Limits::kMaxImageSide);
+        if (std::abs(up + down) > 1e-6 || std::abs(right + left) > 1e-6)
+          frame.ignored.push_back("View Definition " + std::to_string(id) +
+                                  ": an asymmetric frustum is drawn centred, with its extent");
+      }
+      frame.commands.emplace_back(std::move(c));
+    }
+  }
+  return s;
+}
+
+std::variant<HostFrame, Refusal> Session::map(const Message& message) const {
+  HostFrame frame;
+  auto result = next(message, frame);
+  if (auto* r = std::get_if<Refusal>(&result)) return *r;
+  return frame;
+}
+
+void Session::commit(const Message& message) {
+  HostFrame frame;
+  auto result = next(message, frame);
+  if (auto* s = std::get_if<State>(&result)) state_ = std::move(*s);
+}
+
+}  // namespace nephele::cigi

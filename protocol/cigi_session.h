@@ -1,0 +1,88 @@
+#pragma once
+// What a CIGI host's packets mean to Nephele (docs/CIGI.md): each host message becomes the
+// socket protocol's commands, applied as one batch, so that CIGI, the socket and Modbus
+// share every check. A session remembers what the host has set (entities, view offsets and
+// frusta, weather, sun) so that a packet repeated every frame, as hosts do, changes nothing
+// and costs nothing. No sockets.
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "protocol/cigi.h"
+#include "protocol/messages.h"
+
+namespace nephele::cigi {
+
+struct SessionSettings {
+  double latitude_deg = 0.0, longitude_deg = 0.0;         // the database origin ([site])
+  std::vector<std::string> views;                         // view id n is views[n]
+  std::vector<int> view_heights;                          // each view's configured height, pixels
+  std::vector<std::pair<int, std::string>> entity_types;  // CIGI entity type -> [[entity_type]]
+  double default_frame_s = 1.0 / 60.0;  // host frame time when the timestamps do not tell
+};
+
+// A host frame ready for the daemon.
+struct HostFrame {
+  IgControl control;
+  std::vector<Command> commands;     // in order
+  double dt_s = 0.0;                 // the host's frame time, by which a lockstep world advances
+  std::vector<std::string> ignored;  // packets or fields not supported, with why
+};
+
+// A message the session refuses as a whole (nothing of it is applied).
+struct Refusal {
+  std::string reason;  // "out_of_order", ...
+  std::string message;
+};
+
+// The geodetic position (degrees, metres) in the database's east, north, up metres: a
+// flat-earth (equirectangular) projection about the origin with the WGS 84 radii of
+// curvature there, so that altitude stays altitude (MODEL.md section 13).
+glm::dvec3 localPosition(double latitude_deg, double longitude_deg, double altitude_m,
+                         double origin_latitude_deg, double origin_longitude_deg);
+
+class Session {
+ public:
+  explicit Session(SessionSettings settings) : settings_(std::move(settings)) {}
+
+  // Turns a decoded host message into commands. The session changes only once the daemon
+  // has applied the frame (commit), so that a refused batch is sent again in full.
+  std::variant<HostFrame, Refusal> map(const Message& message) const;
+  void commit(const Message& message);
+
+  std::uint32_t lastHostFrame() const { return state_.last_host_frame.value_or(0); }
+
+ private:
+  struct Pose {
+    glm::dvec3 position{0.0};
+    glm::dmat3 attitude{1.0};  // body to world (Nephele's body axes: right, forward, up)
+  };
+  struct Entity {
+    EntityControl packet;
+    bool target = false;  // in the world as a target (not the ownship)
+  };
+  struct ViewState {
+    std::optional<ViewControl> control;
+    std::optional<ViewDefinition> definition;
+  };
+  // The state after a message, computed without changing this one.
+  struct State {
+    std::optional<std::uint32_t> last_host_frame;
+    std::optional<std::uint32_t> last_timestamp;
+    std::map<std::uint16_t, Entity> entities;
+    std::map<std::uint16_t, ViewState> views;
+    std::map<std::uint8_t, WeatherControl> weather;  // by layer, as last applied
+    std::optional<AtmosphereControl> atmosphere;
+    std::optional<CelestialSphereControl> celestial;
+  };
+  std::variant<State, Refusal> next(const Message& message, HostFrame& frame) const;
+  std::optional<Pose> poseOf(const State& state, std::uint16_t entity, int depth = 0) const;
+
+  SessionSettings settings_;
+  State state_;
+};
+
+}  // namespace nephele::cigi

@@ -1,0 +1,152 @@
+#include "server/cigi_server.h"
+
+#include <spdlog/spdlog.h>
+
+#include <memory>
+
+namespace nephele {
+
+using asio::ip::udp;
+
+namespace {
+
+constexpr std::size_t kMaxWaiting = 64;        // datagrams held while one is with the Engine
+constexpr std::uint64_t kLoggedRefusals = 20;  // then one log line in every 1000
+
+cigi::SessionSettings sessionSettings(const DaemonConfig& config) {
+  cigi::SessionSettings s;
+  s.latitude_deg = config.site.latitude_deg;
+  s.longitude_deg = config.site.longitude_deg;
+  s.views = config.cigi.views;
+  for (const std::string& name : s.views)
+    for (const ViewConfig& v : config.views)
+      if (v.name == name) s.view_heights.push_back(v.camera.height);
+  for (const EntityType& t : config.entity_types) s.entity_types.emplace_back(t.id, t.name);
+  s.default_frame_s = 1.0 / config.tick_rate_hz;
+  return s;
+}
+
+}  // namespace
+
+CigiServer::CigiServer(asio::io_context& io, Engine& engine)
+    : io_(io), engine_(engine), socket_(io), session_(sessionSettings(engine.config())) {}
+
+std::string CigiServer::listen(const CigiConfig& config) {
+  std::error_code ec;
+  const asio::ip::address address = asio::ip::make_address(config.bind, ec);
+  if (ec) return "cigi.bind: \"" + config.bind + "\" is not an IP address";
+  socket_.open(address.is_v6() ? udp::v6() : udp::v4(), ec);
+  if (!ec) socket_.bind(udp::endpoint(address, std::uint16_t(config.ig_port)), ec);
+  if (ec)
+    return "cigi: cannot listen on " + config.bind + ":" + std::to_string(config.ig_port) + ": " +
+           ec.message();
+  port_ = socket_.local_endpoint().port();
+  host_port_ = config.host_port;
+  receive();
+  return "";
+}
+
+void CigiServer::close() {
+  closed_ = true;
+  std::error_code ec;
+  socket_.close(ec);
+}
+
+void CigiServer::receive() {
+  socket_.async_receive_from(
+      asio::buffer(buffer_), sender_, [this](std::error_code ec, std::size_t n) {
+        if (closed_) return;
+        if (!ec) {
+          if (waiting_.size() >= kMaxWaiting) {
+            refuse("busy",
+                   "more than " + std::to_string(kMaxWaiting) +
+                       " messages are waiting for the world thread",
+                   sender_);
+          } else {
+            waiting_.push_back(
+                {std::vector<std::uint8_t>(buffer_.begin(), buffer_.begin() + n), sender_});
+            next();
+          }
+        }
+        receive();
+      });
+}
+
+// The one place where a datagram is refused: logged (the first few, then a sample) and
+// counted by reason in the daemon's stats and metrics.
+void CigiServer::refuse(const std::string& reason, const std::string& message,
+                        const udp::endpoint& from) {
+  engine_.countCigi("refused_" + reason);
+  if (logged_refusals_ < kLoggedRefusals || logged_refusals_ % 1000 == 0)
+    spdlog::warn("event=cigi_refused reason={} from={}:{} error=\"{}\"", reason,
+                 from.address().to_string(), from.port(), message);
+  ++logged_refusals_;
+}
+
+void CigiServer::next() {
+  if (busy_ || waiting_.empty() || closed_) return;
+  Datagram d = std::move(waiting_.front());
+  waiting_.pop_front();
+  auto decoded = cigi::decodeHostMessage(d.bytes);
+  if (auto* e = std::get_if<cigi::DecodeError>(&decoded)) {
+    refuse(std::string(cigi::faultName(e->fault)), e->message, d.from);
+    return next();
+  }
+  auto message = std::make_shared<cigi::Message>(std::move(std::get<cigi::Message>(decoded)));
+  auto mapped = session_.map(*message);
+  if (auto* r = std::get_if<cigi::Refusal>(&mapped)) {
+    refuse(r->reason, r->message, d.from);
+    return next();
+  }
+  cigi::HostFrame& frame = std::get<cigi::HostFrame>(mapped);
+  for (const std::string& what : frame.ignored) {
+    engine_.countCigi("ignored");
+    spdlog::debug("event=cigi_ignored what=\"{}\"", what);
+  }
+  // Synchronous (lockstep) mode: the world advances by the host's frame time, and the tick
+  // renders each subscribed view once.
+  if (engine_.lockstep() && frame.control.mode != cigi::IgMode::kStandby)
+    frame.commands.emplace_back(command::Tick{frame.dt_s});
+  busy_ = true;
+  const cigi::IgControl control = frame.control;
+  auto done = [this, message, control, from = d.from](std::optional<ProtocolError> error) {
+    asio::post(io_, [this, message, control, from, error] {
+      busy_ = false;
+      if (closed_) return;
+      if (error) {
+        refuse("refused_by_world", error->message, from);
+      } else {
+        session_.commit(*message);
+        engine_.countCigi("messages");
+        sendStartOfFrame(control, message->order, from);
+      }
+      next();
+    });
+  };
+  if (!engine_.submitBatch(std::move(frame.commands), false, nullptr, done)) {
+    busy_ = false;
+    refuse("busy", "the daemon's request queue is full", d.from);
+    next();
+  }
+}
+
+void CigiServer::sendStartOfFrame(const cigi::IgControl& control, cigi::ByteOrder order,
+                                  const udp::endpoint& to) {
+  cigi::StartOfFrame sof;
+  sof.database = control.database;
+  sof.mode =
+      control.mode == cigi::IgMode::kStandby ? cigi::IgMode::kStandby : cigi::IgMode::kOperate;
+  sof.ig_frame = ++ig_frame_;
+  sof.last_host_frame = control.host_frame;
+  sof.timestamp_valid = true;
+  sof.timestamp = std::uint32_t(std::chrono::duration_cast<std::chrono::microseconds>(
+                                    std::chrono::steady_clock::now() - started_)
+                                    .count() /
+                                10);
+  auto bytes = std::make_shared<std::vector<std::uint8_t>>();
+  cigi::encode(sof, order, *bytes);  // answered in the host's own byte order
+  const udp::endpoint target(to.address(), host_port_ ? std::uint16_t(host_port_) : to.port());
+  socket_.async_send_to(asio::buffer(*bytes), target, [bytes](std::error_code, std::size_t) {});
+}
+
+}  // namespace nephele

@@ -1,0 +1,56 @@
+#pragma once
+// CIGI 3.3 over UDP (docs/CIGI.md): host messages arrive on [cigi] ig_port, are decoded
+// (protocol/cigi.h), mapped to commands (protocol/cigi_session.h) and applied by the Engine
+// as one batch; Start of Frame goes back to the sender's address at [cigi] host_port.
+// Messages are handled one at a time, in arrival order; a refused one changes nothing and is
+// counted by reason in the daemon's stats.
+#include <asio.hpp>
+
+#include <array>
+#include <cstdint>
+#include <deque>
+#include <string>
+#include <vector>
+
+#include "protocol/cigi.h"
+#include "protocol/cigi_session.h"
+#include "server/engine.h"
+
+namespace nephele {
+
+class CigiServer {
+ public:
+  CigiServer(asio::io_context& io, Engine& engine);
+  std::string listen(const CigiConfig& config);
+  int port() const { return port_; }
+  void close();
+
+ private:
+  struct Datagram {
+    std::vector<std::uint8_t> bytes;
+    asio::ip::udp::endpoint from;
+  };
+  void receive();
+  void next();  // handles the oldest waiting datagram, if none is in hand
+  void refuse(const std::string& reason, const std::string& message,
+              const asio::ip::udp::endpoint& from);
+  void sendStartOfFrame(const cigi::IgControl& control, cigi::ByteOrder order,
+                        const asio::ip::udp::endpoint& to);
+
+  asio::io_context& io_;
+  Engine& engine_;
+  asio::ip::udp::socket socket_;
+  int port_ = 0;
+  int host_port_ = 0;
+  std::array<std::uint8_t, 65536> buffer_{};
+  asio::ip::udp::endpoint sender_;
+  std::deque<Datagram> waiting_;
+  bool busy_ = false;  // a message is with the Engine
+  bool closed_ = false;
+  cigi::Session session_;
+  std::uint32_t ig_frame_ = 0;
+  std::uint64_t logged_refusals_ = 0;
+  std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now();
+};
+
+}  // namespace nephele

@@ -1,0 +1,426 @@
+#!/usr/bin/python3
+"""CIGI 3.3 end to end: a host written here from the ICD's packet layouts (not from Nephele's
+codec) drives `nephele serve` over loopback UDP. Every datagram either side sends is written
+to a capture file and decoded by Wireshark's CIGI dissector (tshark), whose fields must equal
+what the host meant and what it read back.
+
+Run by ctest with NEPHELE_BINARY and NEPHELE_SOURCE_DIR set."""
+import json
+import math
+import os
+import shutil
+import socket
+import struct
+import subprocess
+import sys
+import time
+import unittest
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from daemon_test import DaemonTest, wait_until  # noqa: E402
+
+ENTITY_TYPE = 1001
+SITE = (51.5, -1.25)  # the config's [site]
+
+
+# ---- The host: packets from the CIGI 3.3 ICD's layouts ----------------------------------
+
+def ig_control(frame, timestamp=None, mode=1, bo=">", version=3, minor=3, database=0):
+    flags = mode | ((timestamp is not None) << 2) | (minor << 4)
+    return struct.pack(bo + "BBBbBBHIII4x", 1, 24, version, database, flags, 0, 0x8000, frame,
+                       timestamp or 0, 0)
+
+
+def entity_control(entity, lat, lon, alt, yaw=0.0, pitch=0.0, roll=0.0, etype=ENTITY_TYPE,
+                   state=1, attached=0, parent=0, bo=">"):
+    return struct.pack(bo + "BBHBBBBHHfffddd", 2, 48, entity, state | (attached << 2), 0, 255, 0,
+                       etype, parent, roll, pitch, yaw, lat, lon, alt)
+
+
+def view_control(view, entity, x=0.0, y=0.0, z=0.0, roll=0.0, pitch=0.0, yaw=0.0, bo=">"):
+    return struct.pack(bo + "BBHBBHffffff", 16, 32, view, 0, 0x3F, entity, x, y, z, roll, pitch,
+                       yaw)
+
+
+def view_definition(view, left, right, top, bottom, near=1.0, far=50000.0, bo=">"):
+    return struct.pack(bo + "BBHBBBBffffff", 21, 32, view, 0, 0x3F, 0, 0, near, far, left, right,
+                       top, bottom)
+
+
+def weather_control(layer, enabled, cloud_type=0, coverage=0.0, base=0.0, thickness=0.0,
+                    visibility=0.0, wind=0.0, wind_from=0.0, transition=0.0, scope=0, bo=">"):
+    return struct.pack(bo + "BBHBBBB" + "f" * 12, 12, 56, 0, layer, 50,
+                       int(enabled) | (cloud_type << 4), scope, 15.0, visibility, 0.0, coverage,
+                       base, thickness, transition, wind, 0.0, wind_from, 1013.0, 0.0)
+
+
+def atmosphere_control(visibility, wind, wind_from, bo=">"):
+    return struct.pack(bo + "BBBBffffff4x", 10, 32, 1, 50, 15.0, visibility, wind, 0.0,
+                       wind_from, 1013.0)
+
+
+def celestial_control(month, day, year, hour, minute, bo=">"):
+    return struct.pack(bo + "BBBBB3xIf", 9, 16, hour, minute, 0x1F,
+                       month * 1000000 + day * 10000 + year, 0.0)
+
+
+def decode_sof(data):
+    """Start of Frame, byte order from its magic number."""
+    bo = ">" if data[6:8] == b"\x80\x00" else "<"
+    (pid, size, version, database, status, flags, magic, ig_frame, timestamp,
+     last_host) = struct.unpack(bo + "BBBbBBHIII4x", data[:24])
+    return {"id": pid, "size": size, "version": version, "database": database,
+            "mode": flags & 3, "minor": flags >> 4, "order": bo, "ig_frame": ig_frame,
+            "timestamp": timestamp, "last_host_frame": last_host, "bytes": len(data)}
+
+
+# ---- Independent references ---------------------------------------------------------------
+
+def enu(lat, lon, alt, lat0, lon0):
+    """East, north of a point seen from the origin, through WGS 84 Earth-centred coordinates
+    (exact), and its altitude."""
+    a, f = 6378137.0, 1 / 298.257223563
+    e2 = f * (2 - f)
+
+    def ecef(la, lo, h):
+        la, lo = math.radians(la), math.radians(lo)
+        n = a / math.sqrt(1 - e2 * math.sin(la) ** 2)
+        return ((n + h) * math.cos(la) * math.cos(lo), (n + h) * math.cos(la) * math.sin(lo),
+                (n * (1 - e2) + h) * math.sin(la))
+    p, o = ecef(lat, lon, 0.0), ecef(lat0, lon0, 0.0)
+    d = [p[i] - o[i] for i in range(3)]
+    la0, lo0 = math.radians(lat0), math.radians(lon0)
+    east = -math.sin(lo0) * d[0] + math.cos(lo0) * d[1]
+    north = (-math.sin(la0) * math.cos(lo0) * d[0] - math.sin(la0) * math.sin(lo0) * d[1]
+             + math.cos(la0) * d[2])
+    return east, north, alt
+
+
+def sun_spencer(year, month, day, hour, minute, lat, lon):
+    """Sun elevation and azimuth by Spencer's (1971) Fourier series for declination and the
+    equation of time: a different method from Nephele's Meeus coordinates, good to ~0.2 deg."""
+    doy = time.strptime(f"{year}-{month}-{day}", "%Y-%m-%d").tm_yday
+    g = 2 * math.pi / 365 * (doy - 1 + (hour - 12) / 24)
+    decl = (0.006918 - 0.399912 * math.cos(g) + 0.070257 * math.sin(g)
+            - 0.006758 * math.cos(2 * g) + 0.000907 * math.sin(2 * g)
+            - 0.002697 * math.cos(3 * g) + 0.00148 * math.sin(3 * g))
+    eqtime = 229.18 * (0.000075 + 0.001868 * math.cos(g) - 0.032077 * math.sin(g)
+                       - 0.014615 * math.cos(2 * g) - 0.040849 * math.sin(2 * g))
+    ha = math.radians((hour * 60 + minute + eqtime + 4 * lon) / 4 - 180)
+    phi = math.radians(lat)
+    el = math.asin(math.sin(phi) * math.sin(decl) + math.cos(phi) * math.cos(decl) * math.cos(ha))
+    az = math.atan2(math.sin(ha), math.cos(ha) * math.sin(phi) - math.tan(decl) * math.cos(phi))
+    return math.degrees(el), (math.degrees(az) + 180) % 360
+
+
+def unfloat(words):
+    return struct.unpack(">f", struct.pack(">HH", *words))[0]
+
+
+# ---- Capture and dissection -----------------------------------------------------------------
+
+class Capture:
+    """The datagrams of a test as a pcap file (Ethernet, IPv4, UDP on 127.0.0.1)."""
+
+    def __init__(self):
+        self.records = []
+
+    def add(self, payload, src_port, dst_port):
+        udp = struct.pack(">HHHH", src_port, dst_port, 8 + len(payload), 0) + payload
+        ip = struct.pack(">BBHHHBBH4s4s", 0x45, 0, 20 + len(udp), 0, 0, 64, 17, 0,
+                         bytes([127, 0, 0, 1]), bytes([127, 0, 0, 1]))
+        self.records.append(b"\0" * 12 + b"\x08\x00" + ip + udp)
+
+    def dissect(self, path, ports, fields):
+        """tshark's values of `fields` per datagram: a list of {field: [values]}."""
+        with open(path, "wb") as f:
+            f.write(struct.pack("<IHHiIII", 0xA1B2C3D4, 2, 4, 0, 0, 65535, 1))
+            for i, frame in enumerate(self.records):
+                f.write(struct.pack("<IIII", i, 0, len(frame), len(frame)) + frame)
+        args = ["tshark", "-r", path, "-T", "json"]
+        for p in ports:
+            args += ["-d", f"udp.port=={p},cigi"]
+        for field in fields:
+            args += ["-e", field]
+        out = subprocess.run(args, capture_output=True, text=True, timeout=120)
+        assert out.returncode == 0, out.stderr
+        return [p["_source"]["layers"] for p in json.loads(out.stdout)]
+
+
+class CigiTest(DaemonTest):
+    def setUp(self):
+        super().setUp()
+        if not shutil.which("tshark"):
+            self.fail("tshark is missing: run deploy/setup.sh (Debian package tshark)")
+        self.host = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        self.host.bind(("127.0.0.1", 0))
+        self.host.settimeout(10)
+        self.host_port = self.host.getsockname()[1]
+        self.capture = Capture()
+
+    def tearDown(self):
+        self.host.close()
+        super().tearDown()
+
+    def start(self, mode="lockstep"):
+        d = self.daemon(mode=mode, extra=f'''[cigi]
+enabled = true
+ig_port = 0
+host_port = {self.host_port}
+views = ["front", "left"]
+[site]
+latitude = {SITE[0]}
+longitude = {SITE[1]}
+[[entity_type]]
+id = {ENTITY_TYPE}
+name = "rib"
+shape = "box"
+size = [4, 2, 1]
+''')
+        self.ig_port = d.ports["cigi"]
+        self.assertGreater(self.ig_port, 0)
+        return d
+
+    def send(self, *packets):
+        data = b"".join(packets)
+        self.host.sendto(data, ("127.0.0.1", self.ig_port))
+        self.capture.add(data, self.host_port, self.ig_port)
+        return data
+
+    def receive_sof(self):
+        data, _ = self.host.recvfrom(65536)
+        self.capture.add(data, self.ig_port, self.host_port)
+        return decode_sof(data)
+
+    def frame(self, *packets, frame, timestamp=None, bo=">"):
+        self.send(ig_control(frame, timestamp, bo=bo), *packets)
+        sof = self.receive_sof()
+        self.assertEqual(sof["last_host_frame"], frame)
+        return sof
+
+    def no_reply(self, seconds=0.3):
+        self.host.settimeout(seconds)
+        try:
+            with self.assertRaises(socket.timeout):
+                self.host.recvfrom(65536)
+        finally:
+            self.host.settimeout(10)
+
+    def test_a_host_drives_views_entities_clouds_fog_and_sun(self):
+        d = self.start()
+        c = d.client()
+        lat, lon = SITE[0] + 0.01, SITE[1] + 0.02  # about 1.4 km east, 1.1 km north
+        boat = (SITE[0] + 0.015, SITE[1] + 0.021, 2.0)
+        sof = self.frame(entity_control(0, lat, lon, 1200.0, yaw=30.0, pitch=-5.0),
+                         view_definition(0, -30.0, 30.0, 20.0, -20.0),
+                         view_control(1, 0, x=2.0, y=0.5, z=-1.0, yaw=-60.0),
+                         entity_control(7, *boat, yaw=90.0),
+                         weather_control(1, True, 7, coverage=40.0, base=1500.0, thickness=800.0,
+                                         wind=10.0, wind_from=270.0),
+                         weather_control(0, True, base=0.0, thickness=120.0, visibility=900.0),
+                         atmosphere_control(20000.0, 5.0, 90.0),
+                         celestial_control(6, 21, 2026, 14, 30), frame=1, timestamp=100000)
+        self.assertEqual((sof["id"], sof["size"], sof["version"], sof["minor"], sof["mode"],
+                          sof["order"], sof["ig_frame"]), (101, 24, 3, 3, 1, ">", 1))
+        front = c.ok({"cmd": "get_view", "view": "front"})
+        east, north, up = enu(lat, lon, 1200.0, *SITE)
+        self.assertAlmostEqual(front["position"][0], east, delta=1.0)
+        self.assertAlmostEqual(front["position"][1], north, delta=1.0)
+        self.assertAlmostEqual(front["position"][2], up, delta=1e-6)
+        self.assertAlmostEqual(front["heading"], 30.0, places=4)
+        self.assertAlmostEqual(front["pitch"], -5.0, places=4)
+        self.assertAlmostEqual(front["vfov"], 40.0, places=4)  # top 20, bottom -20
+        self.assertEqual(front["width"],
+                         round(48 * math.tan(math.radians(30)) / math.tan(math.radians(20))))
+        # View 1 sits 2 m ahead, 0.5 m right and 1 m up on the ownship, looking 60 deg left.
+        left = c.ok({"cmd": "get_view", "view": "left"})
+        h, p = math.radians(30.0), math.radians(-5.0)
+        fwd = (math.sin(h) * math.cos(p), math.cos(h) * math.cos(p), math.sin(p))
+        right = (math.cos(h), -math.sin(h), 0.0)
+        upv = (-math.sin(h) * math.sin(p), -math.cos(h) * math.sin(p), math.cos(p))
+        for i in range(3):
+            expected = front["position"][i] + 2.0 * fwd[i] + 0.5 * right[i] + 1.0 * upv[i]
+            self.assertAlmostEqual(left["position"][i], expected, delta=1e-3)
+        self.assertAlmostEqual(left["heading"], 330.0, delta=0.2)
+        targets = c.ok({"cmd": "list_targets"})["targets"]
+        self.assertEqual([t["name"] for t in targets], ["cigi-7"])
+        be, bn, bu = enu(*boat, *SITE)
+        self.assertAlmostEqual(targets[0]["centre"][0], be, delta=1.0)
+        self.assertAlmostEqual(targets[0]["centre"][1], bn, delta=1.0)
+        self.assertEqual((targets[0]["heading"], targets[0]["size"]), (90.0, [4, 2, 1]))
+        # The weather, fog and sun as the Modbus registers read them.
+        from pymodbus.client import ModbusTcpClient
+        mb = ModbusTcpClient("127.0.0.1", port=d.modbus_port)
+        mb.connect()
+        try:
+            regs = mb.read_holding_registers(0, 64, slave=1).registers
+        finally:
+            mb.close()
+        self.assertEqual(regs[32], 7)  # cumulus
+        self.assertEqual([unfloat(regs[33:35]), unfloat(regs[35:37]), unfloat(regs[37:39])],
+                         [1500.0, 800.0, 40.0])
+        self.assertEqual([unfloat(regs[56:58]), unfloat(regs[58:60])], [120.0, 900.0])
+        self.assertEqual(regs[60] << 16 | regs[61], 20260621)
+        el, az = sun_spencer(2026, 6, 21, 14, 30, *SITE)
+        self.assertAlmostEqual(unfloat(regs[22:24]), el, delta=0.3)
+        self.assertAlmostEqual(unfloat(regs[20:22]), az, delta=0.5)
+        # The same packets again change nothing (no regeneration of the layer), and moving
+        # the boat moves it; inactive removes it.
+        hash_before = c.ok({"cmd": "hash"})
+        self.frame(weather_control(1, True, 7, coverage=40.0, base=1500.0, thickness=800.0,
+                                   wind=10.0, wind_from=270.0), frame=2, timestamp=101667)
+        self.assertEqual(c.ok({"cmd": "list_targets"})["targets"], targets)
+        self.assertEqual(c.ok({"cmd": "hash"})["ticks"], hash_before["ticks"] + 1)
+        self.frame(entity_control(7, *boat, yaw=95.0), frame=3, timestamp=103334)
+        self.assertEqual(c.ok({"cmd": "list_targets"})["targets"][0]["heading"], 95.0)
+        self.frame(entity_control(7, *boat, state=0), frame=4, timestamp=105001)
+        self.assertEqual(c.ok({"cmd": "list_targets"})["targets"], [])
+        stats = c.ok({"cmd": "stats"})["cigi"]
+        self.assertEqual(stats["messages"], 4)
+        self.assertNotIn("refused_malformed", stats)
+        self.check_with_tshark()
+
+    def test_synchronous_mode_advances_by_the_host_frame_and_renders_once(self):
+        d = self.start()
+        c = d.client()
+        sub = c.ok({"cmd": "subscribe", "view": "front", "rate": 60, "format": "raw"})
+        first, _ = c.read()
+        self.assertEqual(first["image"]["tick"], 0)
+        t0 = c.ok({"cmd": "hash"})["time"]
+        stamps = [200000, 201667, 203334, 205001]  # 10 microsecond units: 1/60 s apart
+        for i, stamp in enumerate(stamps):
+            self.frame(entity_control(0, SITE[0], SITE[1], 800.0 + i), frame=10 + i,
+                       timestamp=stamp)
+        ticks = []
+        while len(ticks) < 4:
+            header, body = c.read()
+            self.assertEqual(header["event"], "frame")
+            ticks.append(header["image"]["tick"])
+            self.assertEqual(len(body), header["image"]["bytes"])
+        self.assertEqual(ticks, [1, 2, 3, 4])
+        state = c.ok({"cmd": "hash"})
+        # The first frame has no earlier timestamp: one tick period (1/30 s); then 1/60 s each.
+        self.assertAlmostEqual(state["time"] - t0, 1 / 30 + 3 * 0.01667, places=6)
+        self.assertEqual(header["image"]["camera"]["position"][2], 803.0)
+        c.ok({"cmd": "unsubscribe", "subscription": sub["subscription"]})
+
+    def test_little_endian_host(self):
+        d = self.start()
+        c = d.client()
+        sof = self.frame(entity_control(0, SITE[0], SITE[1], 950.0, yaw=45.0, bo="<"),
+                         weather_control(2, True, 9, coverage=60.0, base=2000.0,
+                                         thickness=300.0, bo="<"),
+                         frame=5, timestamp=1000, bo="<")
+        self.assertEqual(sof["order"], "<")  # answered in the host's byte order
+        front = c.ok({"cmd": "get_view", "view": "front"})
+        self.assertEqual((front["position"], front["heading"]), ([0, 0, 950.0], 45.0))
+        self.check_with_tshark()
+
+    def test_bad_datagrams_change_nothing_and_are_counted(self):
+        d = self.start()
+        c = d.client()
+        self.frame(entity_control(0, SITE[0], SITE[1], 500.0), frame=100, timestamp=1)
+        before = c.ok({"cmd": "hash"})
+        good = ig_control(101, 2) + entity_control(0, SITE[0], SITE[1], 999.0)
+        bad = {
+            "truncated": [good[:10], good[:40],
+                          ig_control(101, 2) + entity_control(0, 0, 0, 0)[:24] + b"\0" * 8],
+            "oversized": [good + (struct.pack(">BB", 200, 8) + b"\0" * 6) * 4200],
+            "wrong_version": [ig_control(101, 2, version=2) + good[24:]],
+            "bad_magic": [good[:6] + b"\x12\x34" + good[8:]],
+            "wrong_first_packet": [good[24:] + good[:24], b"\x65\x18" + good[2:24]],
+            "malformed": [good + b"\x02\x07" + b"\0" * 6, good + b"\x02\x00" + b"\0" * 6,
+                          good + good[:24],
+                          good[:24] + struct.pack(">BB", 2, 40) + good[26:64]],
+            "out_of_order": [ig_control(100, 2) + good[24:], ig_control(99, 2) + good[24:]],
+            "bad_value": [ig_control(101, 2) + entity_control(0, 95.0, 0, 10),
+                          ig_control(101, 2) + weather_control(1, True, 12, 50, 1000, 500),
+                          ig_control(101, 2) + celestial_control(2, 30, 2026, 12, 0),
+                          ig_control(101, 2) + entity_control(0, SITE[0], SITE[1], float("nan")),
+                          ig_control(101, 2) + view_definition(0, 30, -30, 20, -20)],
+        }
+        for reason, datagrams in bad.items():
+            for data in datagrams:
+                with self.subTest(reason=reason, size=len(data)):
+                    self.host.sendto(data, ("127.0.0.1", self.ig_port))
+                    self.no_reply()
+        after = c.ok({"cmd": "hash"})
+        self.assertEqual(after["hash"], before["hash"])
+        self.assertEqual(c.ok({"cmd": "get_view", "view": "front"})["position"][2], 500.0)
+        stats = c.ok({"cmd": "stats"})["cigi"]
+        for reason, datagrams in bad.items():
+            self.assertEqual(stats.get("refused_" + reason), len(datagrams), (reason, stats))
+        self.assertIn("event=cigi_refused reason=wrong_version", d.log_text())
+        # The daemon still answers the host, in order.
+        self.frame(entity_control(0, SITE[0], SITE[1], 999.0), frame=101, timestamp=2)
+        self.assertEqual(c.ok({"cmd": "get_view", "view": "front"})["position"][2], 999.0)
+
+    def check_with_tshark(self):
+        """Every datagram of the test, decoded by Wireshark's CIGI dissector: its fields must
+        be the ones the host wrote and read."""
+        fields = ["cigi.packet_id", "cigi.version", "cigi.byte_swap",
+                  "cigi.ig_control.frame_ctr", "cigi.ig_control.host_frame_number",
+                  "cigi.ig_control.minor_version",
+                  "cigi.entity_control.entity_id", "cigi.entity_control.entity_type",
+                  "cigi.entity_control.yaw", "cigi.entity_control.lat_xoff",
+                  "cigi.entity_control.alt_zoff", "cigi.entity_control.entity_state",
+                  "cigi.view_def.view_id", "cigi.view_def.top", "cigi.view_def.left",
+                  "cigi.view_control.view_id", "cigi.view_control.entity_id",
+                  "cigi.view_control.yaw",
+                  "cigi.weather_control.layer_id", "cigi.weather_control.cloud_type",
+                  "cigi.weather_control.coverage", "cigi.weather_control.elevation",
+                  "cigi.weather_control.thickness", "cigi.weather_control.visibility_range",
+                  "cigi.atmosphere_control.horiz_wind",
+                  "cigi.celestial_sphere_control.date", "cigi.celestial_sphere_control.hour",
+                  "cigi.sof.ig_frame_number",
+                  "cigi.sof.last_host_frame_number",
+                  "cigi.sof.minor_version", "cigi.sof.ig_mode"]
+        path = os.path.join(self.tmp.name, "cigi.pcap")
+        decoded = self.capture.dissect(path, [self.ig_port, self.host_port], fields)
+        self.assertEqual(len(decoded), len(self.capture.records))
+        for layers, frame in zip(decoded, self.capture.records):
+            payload = frame[14 + 20 + 8:]
+            with self.subTest(first_packet=payload[0]):
+                self.assertEqual(layers["cigi.version"], ["3"])
+                ids, sizes, at = [], [], 0
+                while at < len(payload):  # the packets as laid out in the bytes
+                    ids.append(str(payload[at]))
+                    at += payload[at + 1]
+                self.assertEqual(layers["cigi.packet_id"], ids)
+                bo = ">" if payload[6:8] == b"\x80\x00" else "<"
+                if payload[0] == 101:  # Start of Frame, from Nephele
+                    sof = decode_sof(payload)
+                    self.assertEqual(layers["cigi.sof.ig_frame_number"],
+                                     [str(sof["ig_frame"])])
+                    self.assertEqual(layers["cigi.sof.last_host_frame_number"],
+                                     [str(sof["last_host_frame"])])
+                    self.assertEqual(layers["cigi.sof.minor_version"], ["3"])
+                    continue
+                (frame_number,) = struct.unpack(bo + "I", payload[8:12])
+                self.assertEqual(layers["cigi.ig_control.host_frame_number"], [str(frame_number)])
+                at = 24
+                entity_ids, types, yaws, weather_layers, coverages = [], [], [], [], []
+                while at < len(payload):
+                    pid = payload[at]
+                    if pid == 2:
+                        (eid,) = struct.unpack(bo + "H", payload[at + 2:at + 4])
+                        (etype,) = struct.unpack(bo + "H", payload[at + 8:at + 10])
+                        (yaw,) = struct.unpack(bo + "f", payload[at + 20:at + 24])
+                        entity_ids.append(str(eid))
+                        types.append(str(etype))
+                        yaws.append(float(yaw))
+                    if pid == 12:
+                        weather_layers.append(str(payload[at + 4]))
+                        coverages.append(struct.unpack(bo + "f", payload[at + 20:at + 24])[0])
+                    at += payload[at + 1]
+                self.assertEqual(layers.get("cigi.entity_control.entity_id", []), entity_ids)
+                self.assertEqual(layers.get("cigi.entity_control.entity_type", []), types)
+                self.assertEqual([float(v) for v in layers.get("cigi.entity_control.yaw", [])],
+                                 yaws)
+                self.assertEqual(layers.get("cigi.weather_control.layer_id", []), weather_layers)
+                self.assertEqual([float(v) for v in
+                                  layers.get("cigi.weather_control.coverage", [])], coverages)
+
+
+if __name__ == "__main__":
+    unittest.main()
