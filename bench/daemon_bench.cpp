@@ -2,7 +2,12 @@
 //   1. request-to-last-byte latency of a 640x480 frame, raw RGBA and PNG;
 //   2. Modbus write-to-visible latency: from a holding-register write (heading) to the first
 //      subscribed frame that shows it;
-//   3. frames per second delivered to 1, 4 and 16 subscribers at the 60 Hz maximum.
+//   3. frames per second delivered to 1, 4 and 16 subscribers at the 60 Hz maximum;
+//   4. host frames in lockstep (issue 16): a CIGI host frame (IG Control and the ownship's
+//      Entity Control) to Start of Frame and to every subscribed view's frame delivered, and
+//      the same for the socket protocol's tick, with one and three 640x480 raw views; as
+//      multiples of the render time alone (the daemon's own render p50 times the views) and
+//      of the platform floor (one constant-colour pass and readback, timed here).
 // Figures only; these machines are shared and noisy.
 #include <arpa/inet.h>
 #include <fcntl.h>
@@ -16,6 +21,10 @@
 #include <unistd.h>
 
 #include <nlohmann/json.hpp>
+
+#include "protocol/cigi.h"
+#include "renderer/gl/gl_platform.h"
+#include "renderer/gl/gl_renderer.h"
 
 #include <algorithm>
 #include <atomic>
@@ -46,7 +55,7 @@ double percentile(std::vector<double> v, double p) {
 // The daemon as a child process; the ports come from its ready line.
 struct Daemon {
   pid_t pid = 0;
-  int socket_port = 0, modbus_port = 0;
+  int socket_port = 0, modbus_port = 0, metrics_port = 0, cigi_port = 0;
 
   explicit Daemon(const std::string& config) {
     int out[2];
@@ -65,8 +74,8 @@ struct Daemon {
     char c;
     while (read(out[0], &c, 1) == 1 && c != '\n') line += c;
     close(out[0]);
-    if (std::sscanf(line.c_str(), "nephele ready socket=%d modbus=%d", &socket_port,
-                    &modbus_port) != 2)
+    if (std::sscanf(line.c_str(), "nephele ready socket=%d modbus=%d metrics=%d cigi=%d",
+                    &socket_port, &modbus_port, &metrics_port, &cigi_port) != 4)
       throw std::runtime_error("the daemon did not start: " + line);
   }
   ~Daemon() {
@@ -227,6 +236,112 @@ void subscribers(const Daemon& daemon, int count, double seconds) {
       count, total / count / seconds, total / seconds);
 }
 
+// A lockstep daemon with three 640x480 raw views and CIGI answering to `host_port`.
+std::string writeLockstepConfig(const std::filesystem::path& dir, int host_port) {
+  const std::string path = (dir / "lockstep.toml").string();
+  std::ofstream out(path);
+  out << "scene = \"" << NEPHELE_SOURCE_DIR << "/config/scenes/cumulus.toml\"\n"
+      << "[world]\nmode = \"lockstep\"\ntick_rate = 60\n";
+  for (const auto& [name, heading] : {std::pair{"front", 0}, {"left", -60}, {"right", 60}})
+    out << "[[view]]\nname = \"" << name << "\"\nheading = " << heading
+        << "\nwidth = 640\nheight = 480\nformat = \"raw\"\n";
+  out << "[socket]\nport = 0\n[modbus]\nenabled = false\n"
+      << "[cigi]\nenabled = true\nig_port = 0\nhost_port = " << host_port << "\n"
+      << "[output]\ndirectory = \"" << (dir / "frames").string() << "\"\n";
+  return path;
+}
+
+double floorMs(int width, int height) {
+  std::string error;
+  auto platform = nephele::createGlPlatform(nephele::GlBackend::kAuto, error);
+  if (!platform) throw std::runtime_error("no GL for the floor: " + error);
+  nephele::GlRenderer gl(*platform);
+  std::vector<double> ms;
+  for (int i = 0; i < 9; ++i) {
+    const auto t0 = Clock::now();
+    gl.renderFloor(width, height);
+    ms.push_back(msBetween(t0, Clock::now()));
+  }
+  return percentile(ms, 0.5);
+}
+
+// Host frames over CIGI and over the socket, each followed by one frame of every view.
+void hostFrames(const std::filesystem::path& dir, int views, int repeats, double floor_ms) {
+  const int udp = socket(AF_INET, SOCK_DGRAM, 0);
+  sockaddr_in host{};
+  host.sin_family = AF_INET;
+  host.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t length = sizeof host;
+  if (bind(udp, reinterpret_cast<sockaddr*>(&host), sizeof host) ||
+      getsockname(udp, reinterpret_cast<sockaddr*>(&host), &length))
+    throw std::runtime_error("udp bind");
+  Daemon daemon(writeLockstepConfig(dir, ntohs(host.sin_port)));
+  sockaddr_in ig = host;
+  ig.sin_port = htons(std::uint16_t(daemon.cigi_port));
+  Client sub(daemon.socket_port), control(daemon.socket_port);
+  std::vector<std::uint8_t> body;
+  const char* names[] = {"front", "left", "right"};
+  for (int v = 0; v < views; ++v) {
+    sub.request({{"cmd", "subscribe"}, {"view", names[v]}, {"rate", 60}}, body);
+    sub.receive(body);  // its first frame
+  }
+  auto frames = [&] {
+    for (int got = 0; got < views;)
+      if (sub.receive(body).value("event", "") == "frame") ++got;
+  };
+  std::vector<double> to_sof, cigi_frames, to_reply, socket_frames;
+  for (int i = 0; i < repeats + 3; ++i) {
+    std::vector<std::uint8_t> message;
+    nephele::cigi::IgControl igc;
+    igc.host_frame = std::uint32_t(i + 1);
+    igc.timestamp = std::uint32_t(1667 * i);
+    igc.timestamp_valid = true;
+    nephele::cigi::EntityControl ownship;
+    ownship.altitude = 1500.0 + i;  // moves every frame
+    nephele::cigi::encode(igc, nephele::cigi::ByteOrder::kBig, message);
+    nephele::cigi::encode(ownship, nephele::cigi::ByteOrder::kBig, message);
+    const auto t0 = Clock::now();
+    sendto(udp, message.data(), message.size(), 0, reinterpret_cast<sockaddr*>(&ig), sizeof ig);
+    std::uint8_t reply[64];
+    if (recv(udp, reply, sizeof reply, 0) < 24 || reply[0] != nephele::cigi::Id::kStartOfFrame)
+      throw std::runtime_error("no Start of Frame");
+    const auto t_sof = Clock::now();
+    frames();
+    const auto t_frames = Clock::now();
+    if (i >= 3) {
+      to_sof.push_back(msBetween(t0, t_sof));
+      cigi_frames.push_back(msBetween(t0, t_frames));
+    }
+  }
+  for (int i = 0; i < repeats + 3; ++i) {
+    const auto t0 = Clock::now();
+    json r = control.request({{"cmd", "tick"}, {"dt", 1.0 / 60.0}}, body);
+    if (!r["ok"]) throw std::runtime_error(r.dump());
+    const auto t_reply = Clock::now();
+    frames();
+    if (i >= 3) {
+      to_reply.push_back(msBetween(t0, t_reply));
+      socket_frames.push_back(msBetween(t0, Clock::now()));
+    }
+  }
+  json stats = control.request({{"cmd", "stats"}}, body)["result"];
+  const double render = stats["render_ms"]["p50"].get<double>() * views;
+  close(udp);
+  std::printf(
+      "host frames, lockstep, %d view%s of 640x480 raw (%d frames each; render alone "
+      "%.1f ms = %.0f x floor %.2f ms):\n",
+      views, views > 1 ? "s" : "", repeats, render, render / floor_ms, floor_ms);
+  auto row = [&](const char* what, const std::vector<double>& ms) {
+    std::printf("  %-32s p50 %7.1f ms (%4.2f x render)  p99 %7.1f ms (%4.2f x render)\n", what,
+                percentile(ms, 0.5), percentile(ms, 0.5) / render, percentile(ms, 0.99),
+                percentile(ms, 0.99) / render);
+  };
+  row("CIGI host frame to Start of Frame", to_sof);
+  row("CIGI host frame to frames", cigi_frames);
+  row("socket tick to reply", to_reply);
+  row("socket tick to frames", socket_frames);
+}
+
 }  // namespace
 
 int main() {
@@ -243,6 +358,8 @@ int main() {
       modbusLatency(daemon, 20);
       for (int n : {1, 4, 16}) subscribers(daemon, n, 5.0);
     }
+    const double floor_ms = floorMs(640, 480);
+    for (int views : {1, 3}) hostFrames(dir, views, 40, floor_ms);
     std::filesystem::remove_all(dir);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "daemon_bench: %s\n", e.what());

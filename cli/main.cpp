@@ -28,7 +28,13 @@ int main(int argc, char** argv) {
   nephele::DatasetCommandOptions dataset;
   nephele::addDatasetCommand(app, dataset);
 
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // --help and --version exit 0; every bad flag or missing file exits with the documented
+    // status 2, not the command-line library's own codes.
+    return app.exit(e) == 0 ? 0 : 2;
+  }
   spdlog::set_level(spdlog::level::from_str(log_level));
   if (app.got_subcommand("render")) return nephele::runRenderCommand(render);
   if (app.got_subcommand("serve")) return nephele::runServeCommand(serve);

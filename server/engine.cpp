@@ -53,6 +53,13 @@ bool Engine::stop() {
   return shutdown_saved_;
 }
 
+double Engine::heartbeatAge() const {
+  const std::int64_t beat = heartbeat_ns_.load();
+  if (beat == 0) return 0.0;  // not started yet
+  return std::chrono::duration<double>(Clock::now().time_since_epoch() - Clock::duration(beat))
+      .count();
+}
+
 bool Engine::stopping() const {
   std::lock_guard lock(queue_mutex_);
   return stopping_;
@@ -154,6 +161,7 @@ void Engine::run(std::promise<std::string>& started) {
   started.set_value("");
 
   for (;;) {
+    heartbeat_ns_ = Clock::now().time_since_epoch().count();
     std::deque<Job> jobs;
     std::vector<std::int64_t> gone;
     bool stopping = false;

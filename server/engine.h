@@ -130,6 +130,10 @@ class Engine {
 
   const DaemonConfig& config() const { return config_; }
   bool lockstep() const { return lockstep_.load(); }  // the clock's mode now (any thread)
+  // Seconds since the world thread last went round its loop (any thread): the health check
+  // of /healthz and the systemd watchdog.
+  double heartbeatAge() const;
+  static constexpr double kStuckSeconds = 20.0;
 
  private:
   using Clock = std::chrono::steady_clock;
@@ -194,6 +198,7 @@ class Engine {
   nlohmann::json published_stats_;
   std::atomic<bool> trigger_pending_{false};
   std::atomic<bool> lockstep_{false};
+  std::atomic<std::int64_t> heartbeat_ns_{0};  // steady clock, at the top of each loop
   std::atomic<std::uint64_t> errors_{0};
   std::atomic<int> last_error_{0};
   mutable std::mutex cigi_mutex_;

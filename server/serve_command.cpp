@@ -3,6 +3,7 @@
 #include <signal.h>
 
 #include <spdlog/spdlog.h>
+#include <systemd/sd-daemon.h>
 
 #include <cstdio>
 #include <thread>
@@ -85,6 +86,23 @@ int runServeCommand(const ServeCommandOptions& o) {
               config.modbus_enabled ? modbus.port() : -1,
               config.metrics_enabled ? metrics.port() : -1, config.cigi.enabled ? cigi.port() : -1);
   std::fflush(stdout);
+  // systemd (Type=notify): ready now; with WatchdogSec, a beat every half period while the
+  // world thread keeps going round its loop. Without systemd these do nothing.
+  sd_notifyf(0, "READY=1\nSTATUS=serving socket %d modbus %d cigi %d",
+             config.socket_enabled ? socket.port() : -1, config.modbus_enabled ? modbus.port() : -1,
+             config.cigi.enabled ? cigi.port() : -1);
+  std::uint64_t watchdog_us = 0;
+  std::atomic<bool> stopping{false};
+  std::thread watchdog;
+  if (sd_watchdog_enabled(0, &watchdog_us) > 0)
+    watchdog = std::thread([&] {
+      const auto period = std::chrono::microseconds(watchdog_us / 2);
+      while (!stopping) {
+        if (engine.heartbeatAge() < double(watchdog_us) * 1e-6) sd_notify(0, "WATCHDOG=1");
+        std::this_thread::sleep_for(
+            std::min<std::chrono::microseconds>(period, std::chrono::milliseconds(200)));
+      }
+    });
   spdlog::info("event=listening socket={}:{} modbus={}:{} metrics={}", config.socket.bind,
                socket.port(), config.modbus.bind, modbus.port(),
                config.metrics_enabled ? std::to_string(metrics.port()) : "off");
@@ -92,6 +110,9 @@ int runServeCommand(const ServeCommandOptions& o) {
   int received = 0;
   sigwait(&signals, &received);
   spdlog::info("event=stopping signal={}", received == SIGTERM ? "SIGTERM" : "SIGINT");
+  sd_notify(0, "STOPPING=1");
+  stopping = true;
+  if (watchdog.joinable()) watchdog.join();
   modbus.close();
   // The request in hand finishes, queued ones are answered "shutting down", the snapshot is
   // saved. Then each connection writes out what it was sent (docs/RELIABILITY.md).

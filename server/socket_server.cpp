@@ -571,13 +571,22 @@ void MetricsServer::accept() {
             std::string first_line;
             std::istream in(&x->request);
             std::getline(in, first_line);
+            // GET /metrics: Prometheus text. GET /healthz: 200 while the world thread runs its
+            // loop (it wakes at least twice a second), 503 once it has been stuck for
+            // kStuckSeconds (a render or advance that long is a fault for an IG).
             const bool metrics = first_line.rfind("GET /metrics ", 0) == 0;
-            const std::string body = metrics ? engine_.prometheusText() : "not found\n";
-            x->response =
-                std::string(metrics ? "HTTP/1.1 200 OK\r\n" : "HTTP/1.1 404 Not Found\r\n") +
-                "Content-Type: text/plain; version=0.0.4\r\n"
-                "Content-Length: " +
-                std::to_string(body.size()) + "\r\nConnection: close\r\n\r\n" + body;
+            const bool health = first_line.rfind("GET /healthz ", 0) == 0;
+            const bool healthy = engine_.heartbeatAge() < Engine::kStuckSeconds;
+            const std::string body = metrics  ? engine_.prometheusText()
+                                     : health ? (healthy ? "ok\n" : "world thread stuck\n")
+                                              : "not found\n";
+            const char* status = metrics || (health && healthy) ? "HTTP/1.1 200 OK\r\n"
+                                 : health ? "HTTP/1.1 503 Service Unavailable\r\n"
+                                          : "HTTP/1.1 404 Not Found\r\n";
+            x->response = std::string(status) +
+                          "Content-Type: text/plain; version=0.0.4\r\n"
+                          "Content-Length: " +
+                          std::to_string(body.size()) + "\r\nConnection: close\r\n\r\n" + body;
             asio::async_write(x->socket, asio::buffer(x->response),
                               [x](std::error_code, std::size_t) { x->close(); });
           });

@@ -104,10 +104,16 @@ TEST_F(RenderCommandTest, BadFlagsAreRejected) {
   CommandResult run = runNephele("render " + preset + " -o " + path("out.bmp"));
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_THAT(run.output, HasSubstr("allowed: .png"));
+  // Flags the command-line library refuses, and a missing scene file, exit with the
+  // documented status 2 too (not the library's own codes).
   run = runNephele("render " + preset + " -o " + path("out.png") + " --width 0");
-  EXPECT_NE(run.exit_code, 0);
+  EXPECT_EQ(run.exit_code, 2);
   run = runNephele("render " + preset + " -o " + path("out.png") + " --gl vulkan");
-  EXPECT_NE(run.exit_code, 0);
+  EXPECT_EQ(run.exit_code, 2);
+  run = runNephele("render " + path("missing.toml") + " -o " + path("out.png"));
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_THAT(run.output, HasSubstr("missing.toml"));
+  EXPECT_EQ(runNephele("serve -c " + path("missing.toml")).exit_code, 2);
   EXPECT_THAT(run.output, HasSubstr("vulkan"));
   run = runNephele("render " + preset + " -o " + path("out.png") + " --position 1,2,-5");
   EXPECT_EQ(run.exit_code, 2);

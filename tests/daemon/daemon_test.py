@@ -697,6 +697,32 @@ class HostStateTest(DaemonTest):
         self.assertIn("not both", c.error({"cmd": "set_sun", "utc": "2026-06-21T12:00Z",
                                            "azimuth": 3})["message"])
 
+    def test_systemd_readiness_watchdog_and_health(self):
+        # Item 7: Type=notify readiness through sd_notify, watchdog beats, /healthz.
+        path = os.path.join(self.tmp.name, "notify.sock")
+        notify = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
+        notify.bind(path)
+        notify.settimeout(TIMEOUT)
+        d = self.daemon(env={"NOTIFY_SOCKET": path, "WATCHDOG_USEC": "400000"})
+        messages = []
+        while not any(m.startswith("READY=1") for m in messages):
+            messages.append(notify.recv(4096).decode())
+        self.assertIn(f"socket {d.port}", [m for m in messages if m.startswith("READY=1")][0])
+        self.assertEqual(notify.recv(4096).decode(), "WATCHDOG=1")
+        with socket.create_connection(("127.0.0.1", d.metrics_port), timeout=TIMEOUT) as h:
+            h.sendall(b"GET /healthz HTTP/1.0\r\n\r\n")
+            self.assertTrue(h.makefile("rb").readline().startswith(b"HTTP/1.1 200"))
+        self.assertEqual(d.stop(), 0)
+        rest = []
+        notify.settimeout(1)
+        try:
+            while True:
+                rest.append(notify.recv(4096).decode())
+        except socket.timeout:
+            pass
+        self.assertIn("STOPPING=1", rest)
+        notify.close()
+
     def test_restart_restores_everything_the_host_set(self):
         d = self.daemon(name="s", extra='[snapshot]\npath = "{snapshot}"\ninterval = 0')
         c = d.client()
