@@ -190,6 +190,32 @@ inline constexpr std::string_view kCommandNames =
     "change_cloud, remove_cloud, add_target, move_target, remove_target, list_targets, tick, "
     "render, subscribe, unsubscribe, snapshot, restore, stats, hash";
 
+// The clock: its numbers are the Modbus status register's (protocol/MODBUS.md).
+enum class RunState : std::uint16_t { kRunning = 1, kPaused = 2, kLockstep = 3 };
+
+// What a host reads back, on any interface (the Modbus registers, stats): the view it steers,
+// the weather and atmosphere it set, and the clock.
+struct HostReadings {
+  glm::dvec3 position{0.0};
+  double heading = 0.0, pitch = 0.0, roll = 0.0, vfov = 60.0;
+  int width = 640, height = 480;
+  glm::dvec2 wind{0.0};
+  double sun_azimuth = 0.0, sun_elevation = 45.0;
+  double time_scale = 1.0;
+  std::array<WeatherLayer, ProtocolLimits::kWeatherLayers> layers;
+  double fog_top = 0.0, fog_visibility = 0.0;  // visibility 0: no fog
+  std::optional<CivilTime> sun_utc;
+};
+
+struct HostStatus {
+  RunState status = RunState::kRunning;
+  std::uint32_t frames = 0;
+  double render_ms = 0.0;
+  std::uint64_t ticks = 0;
+  std::uint16_t last_error = 0;
+  double time_s = 0.0;
+};
+
 struct Request {
   nlohmann::json id;  // echoed in the reply: a number, a string or null
   Command command;

@@ -90,7 +90,7 @@ float getFloat(const std::uint16_t* registers) {
   return std::bit_cast<float>(std::uint32_t(registers[0]) << 16 | registers[1]);
 }
 
-HoldingRegisters encodeHolding(const ModbusSettings& s) {
+HoldingRegisters encodeHolding(const HostReadings& s) {
   HoldingRegisters r{};
   for (int i = 0; i < 3; ++i) putFloat(&r[std::size_t(M::kPositionX + 2 * i)], s.position[i]);
   putFloat(&r[M::kHeading], s.heading);
@@ -124,7 +124,7 @@ HoldingRegisters encodeHolding(const ModbusSettings& s) {
   return r;
 }
 
-InputRegisters encodeInput(const ModbusStatus& s) {
+InputRegisters encodeInput(const HostStatus& s) {
   InputRegisters r{};
   r[M::kStatus] = std::uint16_t(s.status);
   r[M::kFrames] = std::uint16_t(s.frames >> 16);
@@ -253,7 +253,7 @@ std::variant<std::vector<Command>, RegisterError> decodeHoldingWrite(
   if (w.touches(M::kSunDate, 4)) {
     const std::uint32_t date = std::uint32_t(next[M::kSunDate]) << 16 | next[M::kSunDate + 1];
     const double seconds = readFloat(kAtmosphereFloats[2], 0);
-    if (date != 0) {  // 0 leaves the sun where the angles put it
+    if (date != 0 && !error) {  // 0 leaves the sun where the angles put it; seconds checked
       CivilTime t;
       t.year = int(date / 10000);
       t.month = int(date / 100 % 100);

@@ -44,7 +44,7 @@ struct ModbusMap {
   static constexpr int kCoilCount = 2;
 
   // Input registers (read 0x04).
-  static constexpr int kStatus = 0;     // uint16, ModbusStatusCode
+  static constexpr int kStatus = 0;     // uint16, RunState
   static constexpr int kFrames = 1;     // uint32, frames rendered
   static constexpr int kRenderMs = 3;   // float32, last render's milliseconds
   static constexpr int kTicks = 5;      // uint64 in four registers, most significant first
@@ -53,35 +53,11 @@ struct ModbusMap {
   static constexpr int kInputCount = 12;
 };
 
-enum class ModbusStatusCode : std::uint16_t { kRunning = 1, kPaused = 2, kLockstep = 3 };
-
-// The values behind the holding registers.
-struct ModbusSettings {
-  glm::dvec3 position{0.0};
-  double heading = 0.0, pitch = 0.0, roll = 0.0, vfov = 60.0;
-  int width = 640, height = 480;
-  glm::dvec2 wind{0.0};
-  double sun_azimuth = 0.0, sun_elevation = 45.0;
-  double time_scale = 1.0;
-  std::array<WeatherLayer, ProtocolLimits::kWeatherLayers> layers;
-  double fog_top = 0.0, fog_visibility = 0.0;  // visibility 0: no fog
-  std::optional<CivilTime> sun_utc;
-};
-
-struct ModbusStatus {
-  ModbusStatusCode status = ModbusStatusCode::kRunning;
-  std::uint32_t frames = 0;
-  double render_ms = 0.0;
-  std::uint64_t ticks = 0;
-  std::uint16_t last_error = 0;
-  double time_s = 0.0;
-};
-
 using HoldingRegisters = std::array<std::uint16_t, ModbusMap::kHoldingCount>;
 using InputRegisters = std::array<std::uint16_t, ModbusMap::kInputCount>;
 
-HoldingRegisters encodeHolding(const ModbusSettings& settings);
-InputRegisters encodeInput(const ModbusStatus& status);
+HoldingRegisters encodeHolding(const HostReadings& settings);
+InputRegisters encodeInput(const HostStatus& status);
 
 struct RegisterError {
   int exception = kIllegalDataValue;

@@ -94,6 +94,7 @@ void Engine::renderFrame(const ViewConfig& view, const ImageRequest& image, View
   }
   s.last_render_ms = msSince(t0);
   s.render_ms.push_back(s.last_render_ms);
+  s.render_seconds.add(s.last_render_ms * 1e-3);
   if (s.render_ms.size() > kRenderHistory) s.render_ms.pop_front();
   ++s.frames;
   frame.meta = {{"view", view.name},

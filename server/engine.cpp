@@ -182,6 +182,7 @@ void Engine::run(std::promise<std::string>& started) {
     for (Job& job : jobs) {
       if (!stopping) {
         execute(job);
+        s.request_seconds.add(std::chrono::duration<double>(Clock::now() - job.queued).count());
         continue;
       }
       const ProtocolError cancelled{ErrorCode::kFailed, "the daemon is shutting down"};

@@ -22,7 +22,6 @@
 
 #include "config/daemon_config.h"
 #include "protocol/messages.h"
-#include "protocol/register_map.h"
 
 namespace nephele {
 
@@ -112,9 +111,9 @@ class Engine {
   // How many subscriptions a socket client holds (any thread).
   int subscriptionsOf(std::int64_t client) const;
 
-  // Thread-safe readings for the Modbus registers, stats and metrics.
-  ModbusSettings modbusSettings() const;
-  ModbusStatus modbusStatus() const;
+  // Thread-safe readings for the transports (Modbus registers), stats and metrics.
+  HostReadings readings() const;
+  HostStatus status() const;
   bool renderTriggerPending() const { return trigger_pending_.load(); }
   void clearRenderTrigger() { trigger_pending_ = false; }  // a withdrawn render write
   nlohmann::json stats() const;
@@ -193,8 +192,8 @@ class Engine {
   bool shutdown_saved_ = true;
 
   mutable std::mutex published_mutex_;
-  ModbusSettings published_settings_;
-  ModbusStatus published_status_;
+  HostReadings published_settings_;
+  HostStatus published_status_;
   nlohmann::json published_stats_;
   std::atomic<bool> trigger_pending_{false};
   std::atomic<bool> lockstep_{false};

@@ -105,6 +105,24 @@ inline void eraseWithDevelopment(std::vector<T>& items, std::vector<D>& developm
   development = std::move(kept_development);
 }
 
+// Latencies for Prometheus: counts per bucket of seconds (cumulative in the text format), with
+// their sum and count since the daemon started.
+struct Histogram {
+  static constexpr std::array<double, 13> kBounds{0.001, 0.0025, 0.005, 0.01, 0.025, 0.05, 0.1,
+                                                  0.25,  0.5,    1.0,   2.5,  5.0,   10.0};
+  std::array<std::uint64_t, kBounds.size() + 1> counts{};  // the last: above every bound
+  double sum = 0.0;
+  std::uint64_t count = 0;
+  void add(double seconds) {
+    std::size_t i = 0;
+    while (i < kBounds.size() && seconds > kBounds[i]) ++i;
+    ++counts[i];
+    sum += seconds;
+    ++count;
+  }
+  json toJson() const { return {{"counts", counts}, {"sum", sum}, {"count", count}}; }
+};
+
 // A visitor of one lambda per alternative.
 template <class... F>
 struct Overloaded : F... {
@@ -133,6 +151,7 @@ using engine_detail::kEncoderQueue;
 
 // One queued piece of work.
 struct Engine::Job {
+  Clock::time_point queued = Clock::now();
   enum class Kind { kRequest, kBatch } kind = Kind::kRequest;
   Request request;
   std::int64_t client = 0;
@@ -219,6 +238,8 @@ struct Engine::State {
   std::uint64_t requests = 0;
   double last_render_ms = 0.0;
   std::deque<double> render_ms;
+  engine_detail::Histogram render_seconds;   // one view's render
+  engine_detail::Histogram request_seconds;  // a request or batch, from queueing to done
   std::deque<std::pair<Clock::time_point, std::uint64_t>> tick_history;  // one per second
   std::vector<Subscription> subscriptions;
   std::int64_t next_subscription = 1;

@@ -266,7 +266,7 @@ std::vector<std::uint8_t> ModbusServer::answer(const ModbusRequest& request) {
       if (!fits(ModbusMap::kCoilCount)) return outOfMap(ModbusMap::kCoilCount, "coils");
       std::array<std::uint8_t, ModbusMap::kCoilCount> coils{};
       coils[ModbusMap::kRenderCoil] = engine_.renderTriggerPending();
-      coils[ModbusMap::kPauseCoil] = engine_.modbusStatus().status == ModbusStatusCode::kPaused;
+      coils[ModbusMap::kPauseCoil] = engine_.status().status == RunState::kPaused;
       return encodeReadBits(request, std::span(coils).subspan(std::size_t(request.address),
                                                               std::size_t(request.count)));
     }
@@ -276,19 +276,19 @@ std::vector<std::uint8_t> ModbusServer::answer(const ModbusRequest& request) {
     case ModbusFunction::kReadHoldingRegisters: {
       if (!fits(ModbusMap::kHoldingCount))
         return outOfMap(ModbusMap::kHoldingCount, "holding registers");
-      const HoldingRegisters holding = encodeHolding(engine_.modbusSettings());
+      const HoldingRegisters holding = encodeHolding(engine_.readings());
       return encodeReadRegisters(request, std::span(holding).subspan(std::size_t(request.address),
                                                                      std::size_t(request.count)));
     }
     case ModbusFunction::kReadInputRegisters: {
       if (!fits(ModbusMap::kInputCount)) return outOfMap(ModbusMap::kInputCount, "input registers");
-      const InputRegisters input = encodeInput(engine_.modbusStatus());
+      const InputRegisters input = encodeInput(engine_.status());
       return encodeReadRegisters(request, std::span(input).subspan(std::size_t(request.address),
                                                                    std::size_t(request.count)));
     }
     case ModbusFunction::kWriteSingleRegister:
     case ModbusFunction::kWriteMultipleRegisters: {
-      const HoldingRegisters current = encodeHolding(engine_.modbusSettings());
+      const HoldingRegisters current = encodeHolding(engine_.readings());
       auto decoded = decodeHoldingWrite(current, request.address, request.registers,
                                         engine_.config().modbus_view);
       if (auto* e = std::get_if<RegisterError>(&decoded))

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "protocol/modbus_frame.h"
+#include "protocol/register_map.h"
 #include "server/engine.h"
 
 namespace nephele {

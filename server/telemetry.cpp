@@ -58,6 +58,8 @@ void Engine::publish() {
     std::lock_guard lock(cigi_mutex_);
     stats["cigi"] = cigi_counts_;
   }
+  stats["histograms"] = {{"render_seconds", s.render_seconds.toJson()},
+                         {"request_seconds", s.request_seconds.toJson()}};
   {
     std::lock_guard lock(published_mutex_);
     published_stats_ = std::move(stats);
@@ -68,7 +70,7 @@ void Engine::publish() {
 void Engine::publishReadings() {
   const State& s = *state_;
   const World& world = *s.world;
-  ModbusSettings settings;
+  HostReadings settings;
   const ViewConfig& view = *s.view(config_.modbus_view);
   settings.position = view.camera.position;
   settings.heading = view.camera.orientation.heading_deg;
@@ -88,10 +90,10 @@ void Engine::publishReadings() {
     settings.fog_visibility = fog->visibility_m;
   }
   settings.sun_utc = s.sun_utc;
-  ModbusStatus status;
-  status.status = s.mode == TickMode::kLockstep ? ModbusStatusCode::kLockstep
-                  : s.paused                    ? ModbusStatusCode::kPaused
-                                                : ModbusStatusCode::kRunning;
+  HostStatus status;
+  status.status = s.mode == TickMode::kLockstep ? RunState::kLockstep
+                  : s.paused                    ? RunState::kPaused
+                                                : RunState::kRunning;
   status.frames = std::uint32_t(s.frames);
   status.render_ms = s.last_render_ms;
   status.ticks = s.ticks;
@@ -101,14 +103,14 @@ void Engine::publishReadings() {
   published_status_ = status;
 }
 
-ModbusSettings Engine::modbusSettings() const {
+HostReadings Engine::readings() const {
   std::lock_guard lock(published_mutex_);
   return published_settings_;
 }
 
-ModbusStatus Engine::modbusStatus() const {
+HostStatus Engine::status() const {
   std::lock_guard lock(published_mutex_);
-  ModbusStatus status = published_status_;
+  HostStatus status = published_status_;
   status.last_error = std::uint16_t(last_error_.load());
   return status;
 }
@@ -136,10 +138,6 @@ std::string Engine::prometheusText() const {
   metric("ticks_per_second", "gauge", "Ticks per second over the last 5 s.",
          st["ticks_per_second"].get<double>());
   metric("frames_total", "counter", "Frames rendered.", st["frames"].get<double>());
-  metric("render_ms_p50", "gauge", "Median render time (last 1024).",
-         st["render_ms"]["p50"].get<double>());
-  metric("render_ms_p99", "gauge", "99th percentile render time (last 1024).",
-         st["render_ms"]["p99"].get<double>());
   metric("socket_clients", "gauge", "Socket clients.", st["clients"]["socket"].get<double>());
   metric("modbus_clients", "gauge", "Modbus clients.", st["clients"]["modbus"].get<double>());
   metric("queue_depth", "gauge", "Requests waiting.", st["queue"]["depth"].get<double>());
@@ -147,6 +145,32 @@ std::string Engine::prometheusText() const {
   metric("frames_dropped_total", "counter", "Frames dropped for slow clients.",
          st["frames_dropped"].get<double>());
   metric("errors_total", "counter", "Error replies and failed work.", st["errors"].get<double>());
+  // Latencies as histograms, in seconds (Prometheus base units).
+  auto histogram = [&](const char* name, const char* help) {
+    const json& h = st["histograms"][name];
+    out << "# HELP nephele_" << name << ' ' << help << "\n# TYPE nephele_" << name
+        << " histogram\n";
+    std::uint64_t cumulative = 0;
+    for (std::size_t i = 0; i <= Histogram::kBounds.size(); ++i) {
+      cumulative += h["counts"][i].get<std::uint64_t>();
+      out << "nephele_" << name << "_bucket{le=\"";
+      if (i < Histogram::kBounds.size())
+        out << Histogram::kBounds[i];
+      else
+        out << "+Inf";
+      out << "\"} " << cumulative << '\n';
+    }
+    out << "nephele_" << name << "_sum " << h["sum"].get<double>() << "\nnephele_" << name
+        << "_count " << h["count"].get<std::uint64_t>() << '\n';
+  };
+  histogram("render_seconds", "Time to render one view.");
+  histogram("request_seconds",
+            "Time from a request's queueing to its reply (images: to the "
+            "render, before encoding).");
+  out << "# HELP nephele_cigi_total CIGI messages applied, refused by reason, packets ignored.\n"
+         "# TYPE nephele_cigi_total counter\n";
+  for (const auto& [what, n] : st["cigi"].items())
+    out << "nephele_cigi_total{what=\"" << what << "\"} " << n.get<std::uint64_t>() << '\n';
   return out.str();
 }
 

@@ -19,7 +19,7 @@ std::vector<std::uint16_t> floatWords(float v) {
 }
 
 HoldingRegisters sample() {
-  ModbusSettings s;
+  HostReadings s;
   s.position = {100.0, -2000.0, 1500.0};
   s.heading = 90.0;
   s.width = 640;
@@ -58,7 +58,7 @@ TEST(RegisterMap, FloatsAreHighWordFirst) {
 }
 
 TEST(RegisterMap, InputRegistersCarryWideCounters) {
-  ModbusStatus s;
+  HostStatus s;
   s.frames = 0x12345678;
   s.ticks = 0x0102030405060708ull;
   const InputRegisters r = encodeInput(s);
@@ -127,6 +127,42 @@ TEST(RegisterMap, Coils) {
   EXPECT_FALSE(pause.render);
   EXPECT_TRUE(*pause.paused);
   EXPECT_EQ(std::get<RegisterError>(decodeCoilWrite(2, on)).exception, kIllegalDataAddress);
+}
+
+}  // namespace
+}  // namespace nephele
+
+namespace nephele {
+namespace {
+
+// Issue 16: fog and the sun's date and time; a NaN time of day (found by protocol_fuzz) and a
+// day that does not exist are refused.
+TEST(RegisterMap, FogAndSunDate) {
+  std::uint16_t v[4];
+  putFloat(v, 150.0);
+  putFloat(v + 2, 800.0);
+  auto fog = decodeHoldingWrite(HoldingRegisters{}, ModbusMap::kFogTop, v, "front");
+  ASSERT_TRUE(std::holds_alternative<std::vector<Command>>(fog));
+  const auto& set = std::get<command::SetFog>(std::get<std::vector<Command>>(fog).at(0));
+  EXPECT_EQ((std::pair{*set.top, *set.visibility}), (std::pair{150.0, 800.0}));
+  const std::uint32_t date = 20260621;
+  v[0] = std::uint16_t(date >> 16), v[1] = std::uint16_t(date & 0xffff);
+  putFloat(v + 2, 3600.0 * 13 + 61.5);
+  auto sun = decodeHoldingWrite(HoldingRegisters{}, ModbusMap::kSunDate, v, "front");
+  ASSERT_TRUE(std::holds_alternative<std::vector<Command>>(sun));
+  const CivilTime t = *std::get<command::SetSun>(std::get<std::vector<Command>>(sun).at(0)).utc;
+  EXPECT_EQ((std::array{t.year, t.month, t.day, t.hour, t.minute}),
+            (std::array{2026, 6, 21, 13, 1}));
+  EXPECT_NEAR(t.second, 1.5, 1e-3);
+  putFloat(v + 2, std::nan(""));
+  EXPECT_TRUE(std::holds_alternative<RegisterError>(
+      decodeHoldingWrite(HoldingRegisters{}, ModbusMap::kSunDate, v, "front")));
+  const std::uint32_t bad = 20260230;
+  v[0] = std::uint16_t(bad >> 16), v[1] = std::uint16_t(bad & 0xffff);
+  putFloat(v + 2, 0.0);
+  const auto refused = decodeHoldingWrite(HoldingRegisters{}, ModbusMap::kSunDate, v, "front");
+  ASSERT_TRUE(std::holds_alternative<RegisterError>(refused));
+  EXPECT_NE(std::get<RegisterError>(refused).message.find("day 30"), std::string::npos);
 }
 
 }  // namespace

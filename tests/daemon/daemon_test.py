@@ -479,6 +479,7 @@ class SocketProtocolTest(DaemonTest):
 
     def test_metrics_endpoint(self):
         d = self.daemon()
+        d.client().ok({"cmd": "render", "view": "front"})
         s = socket.create_connection(("127.0.0.1", d.metrics_port), timeout=TIMEOUT)
         s.sendall(b"GET /metrics HTTP/1.1\r\nHost: x\r\n\r\n")
         text = b""
@@ -486,7 +487,13 @@ class SocketProtocolTest(DaemonTest):
             text += chunk
         self.assertIn(b"200 OK", text)
         self.assertIn(b"nephele_ticks_total", text)
-        self.assertIn(b"nephele_render_ms_p99", text)
+        # Latencies are histograms in seconds: cumulative buckets up to +Inf equal the count.
+        lines = text.decode().splitlines()
+        self.assertIn("# TYPE nephele_render_seconds histogram", lines)
+        count = [l for l in lines if l.startswith("nephele_render_seconds_count ")][0]
+        inf = [l for l in lines if l.startswith('nephele_render_seconds_bucket{le="+Inf"}')][0]
+        self.assertEqual(inf.split()[-1], count.split()[-1])
+        self.assertGreater(int(count.split()[-1]), 0)
 
 
 class LockstepAndSnapshotTest(DaemonTest):

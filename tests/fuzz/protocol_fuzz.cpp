@@ -1,11 +1,13 @@
 // libFuzzer target for the bytes the daemon takes from the network: socket-protocol request
-// lines, Modbus TCP frames and Modbus register and coil writes. Built with clang by
-// tests/CMakeLists.txt and run briefly by ctest. The first input byte picks the decoder.
+// lines, Modbus TCP frames, Modbus register and coil writes, and CIGI datagrams. Built with clang
+// by tests/CMakeLists.txt and run briefly by ctest. The first input byte picks the decoder.
 #include <cstddef>
 #include <cstdint>
 #include <string_view>
 #include <vector>
 
+#include "protocol/cigi.h"
+#include "protocol/cigi_session.h"
 #include "protocol/messages.h"
 #include "protocol/modbus_frame.h"
 #include "protocol/register_map.h"
@@ -15,6 +17,32 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (size < 1) return 0;
   const std::uint8_t selector = data[0];
   ++data, --size;
+  if (selector >= 0xF0) {
+    // A CIGI host datagram: decoded, mapped to commands by a session, and every decoded
+    // packet written again must read back the same.
+    const auto decoded = cigi::decodeHostMessage(std::span(data, size));
+    if (const auto* m = std::get_if<cigi::Message>(&decoded)) {
+      std::vector<std::uint8_t> again;
+      for (const cigi::Packet& p : m->packets) cigi::encode(p, m->order, again);
+      const auto redecoded = cigi::decodeHostMessage(again);
+      const auto* m2 = std::get_if<cigi::Message>(&redecoded);
+      if (!m2 || m2->packets.size() != m->packets.size()) __builtin_trap();
+      for (std::size_t i = 0; i < m->packets.size(); ++i) {
+        const cigi::Packet& a = m->packets[i];
+        const bool comparable = a == a;  // a NaN field compares unequal to itself
+        if (comparable && !(a == m2->packets[i])) __builtin_trap();
+      }
+      cigi::SessionSettings settings;
+      settings.views = {"front", "left"};
+      settings.view_heights = {480, 240};
+      settings.entity_types = {{1001, "rib"}};
+      cigi::Session session(settings);
+      (void)session.map(*m);
+      session.commit(*m);
+      (void)session.map(*m);
+    }
+    return 0;
+  }
   if (selector % 4 == 3) {
     // A stream of Modbus TCP frames, framed the way the server frames them.
     while (size >= ModbusFrame::kHeaderBytes) {
@@ -63,7 +91,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     std::vector<std::uint16_t> values;
     for (std::size_t i = 0; i + 1 < size && values.size() < 123; i += 2)
       values.push_back(std::uint16_t(data[i] << 8 | data[i + 1]));
-    ModbusSettings settings;
+    HostReadings settings;
     (void)decodeHoldingWrite(encodeHolding(settings), address - 64, values, "front");
   } else {
     std::vector<std::uint8_t> bits(data, data + std::min<std::size_t>(size, 1968));
