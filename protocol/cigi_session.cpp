@@ -180,13 +180,10 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
                                 " is not one of [cigi] views");
         continue;
       }
-      const bool asymmetric_ok = d->left < d->right && d->bottom < d->top;
-      if (!finite({d->left, d->right, d->top, d->bottom}) || !asymmetric_ok || d->left <= -89.0f ||
-          d->right >= 89.0f || d->bottom <= -89.0f || d->top >= 89.0f)
+      if (std::string e = frustumError({d->left, d->right, d->bottom, d->top}); !e.empty())
         return bad("View Definition " + std::to_string(d->view_id) + ": left " + text(d->left) +
                    ", right " + text(d->right) + ", bottom " + text(d->bottom) + ", top " +
-                   text(d->top) +
-                   " (allowed: left < right and bottom < top, each within -89 to 89 degrees)");
+                   text(d->top) + ": " + e.substr(9));
       if (d->orthographic) frame.ignored.push_back("View Definition: orthographic projection");
       s.views[d->view_id].definition = *d;
       views_moved = true;
@@ -352,20 +349,9 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
       p.heading = o.heading_deg;
       p.pitch = o.pitch_deg;
       p.roll = o.roll_deg;
-      if (view.definition) {
+      if (view.definition) {  // an off-axis view when the frustum is asymmetric
         const ViewDefinition& d = *view.definition;
-        // The frustum's vertical extent gives the field of view; its horizontal extent the
-        // width at the view's configured height (square pixels).
-        const double up = std::tan(d.top * kDeg), down = std::tan(d.bottom * kDeg);
-        const double right = std::tan(d.right * kDeg), left = std::tan(d.left * kDeg);
-        const double half = 0.5 * (up - down);
-        p.vfov = 2.0 * std::atan(half) / kDeg;
-        const int height = id < settings_.view_heights.size() ? settings_.view_heights[id] : 480;
-        p.width = std::clamp(int(std::lround(height * (right - left) / (up - down))), 1,
-                             Limits::kMaxImageSide);
-        if (std::abs(up + down) > 1e-6 || std::abs(right + left) > 1e-6)
-          frame.ignored.push_back("View Definition " + std::to_string(id) +
-                                  ": an asymmetric frustum is drawn centred, with its extent");
+        p.frustum = Frustum{d.left, d.right, d.bottom, d.top};
       }
       frame.commands.emplace_back(std::move(c));
     }

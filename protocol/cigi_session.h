@@ -19,7 +19,6 @@ namespace nephele::cigi {
 struct SessionSettings {
   double latitude_deg = 0.0, longitude_deg = 0.0;         // the database origin ([site])
   std::vector<std::string> views;                         // view id n is views[n]
-  std::vector<int> view_heights;                          // each view's configured height, pixels
   std::vector<std::pair<int, std::string>> entity_types;  // CIGI entity type -> [[entity_type]]
   double default_frame_s = 1.0 / 60.0;  // host frame time when the timestamps do not tell
 };

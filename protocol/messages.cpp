@@ -212,11 +212,21 @@ ViewPatch readViewPatch(FieldReader& r, bool image = true) {
   p.vfov = r.number("vfov", Limits::kMinVfov, Limits::kMaxVfov);
   if (auto w = r.integer("width", 1, Limits::kMaxImageSide)) p.width = int(*w);
   if (auto h = r.integer("height", 1, Limits::kMaxImageSide)) p.height = int(*h);
+  if (const json* f = r.object("frustum")) {
+    FieldReader fr(*f, "frustum");
+    const Range a = Limits::kFrustumAngle;
+    Frustum frustum{fr.requiredNumber("left", a.lo, a.hi), fr.requiredNumber("right", a.lo, a.hi),
+                    fr.requiredNumber("bottom", a.lo, a.hi), fr.requiredNumber("top", a.lo, a.hi)};
+    fr.finish("left, right, bottom, top");
+    if (std::string e = frustumError(frustum); !e.empty()) r.fail("frustum", e.substr(9));
+    if (p.vfov) r.fail("frustum", "give vfov (a centred view) or frustum, not both");
+    p.frustum = frustum;
+  }
   if (image) p.image = readImage(r);
   return p;
 }
 
-constexpr const char* kCameraKeys = "position, heading, pitch, roll, vfov, width, height";
+constexpr const char* kCameraKeys = "position, heading, pitch, roll, vfov, width, height, frustum";
 
 // The views of a render: "view" (one name) or "views" (an array of names).
 std::vector<std::string> readViews(FieldReader& r) {
@@ -287,7 +297,8 @@ Command readCommand(const std::string& cmd, FieldReader& r) {
   if (cmd == "set_view") {
     SetView c{r.requiredName("view"), readViewPatch(r)};
     r.finish(
-        "cmd, id, view, position, heading, pitch, roll, vfov, width, height, format, channels");
+        "cmd, id, view, position, heading, pitch, roll, vfov, width, height, frustum, format, "
+        "channels");
     return c;
   }
   if (cmd == "set_weather") {

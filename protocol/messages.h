@@ -84,6 +84,7 @@ struct ViewPatch {
   std::optional<glm::dvec3> position;
   std::optional<double> heading, pitch, roll, vfov;
   std::optional<int> width, height;
+  std::optional<Frustum> frustum;     // an off-axis view; a later vfov makes it centred again
   std::optional<ImageRequest> image;  // the view's default format and channels
 };
 

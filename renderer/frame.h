@@ -6,6 +6,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "image/image.h"
@@ -117,6 +118,20 @@ struct Frame {
       visibility[i] = 1.0f - colour.rgba[i * 4 + 3];
   }
   int height() const { return info.height; }
+  // The w x h rectangle at (x0, y0) of every plane (an off-axis view cut from a centred
+  // render); the intrinsics are the caller's to set.
+  Frame cropped(int x0, int y0, int w, int h) const {
+    Frame out;
+    out.info = info;
+    out.info.width = w;
+    out.info.height = h;
+    out.channels = channels;
+    if (!colour.rgba.empty()) out.colour = cropImage(colour, x0, y0, w, h);
+    for (const ChannelInfo& c : kChannels)
+      if (const std::vector<float>* plane = ownPlane(c.channel); plane && !plane->empty())
+        *out.ownPlane(c.channel) = cropPlane(*plane, info.width, info.height, 1, x0, y0, w, h);
+    return out;
+  }
   // The frame's own one-float-per-pixel plane of a channel; null for colour and coverage,
   // which live in `colour` (RGB and alpha).
   const std::vector<float>* ownPlane(Channel c) const {
@@ -136,6 +151,9 @@ struct Frame {
         break;
     }
     return nullptr;
+  }
+  std::vector<float>* ownPlane(Channel c) {
+    return const_cast<std::vector<float>*>(std::as_const(*this).ownPlane(c));
   }
   // The single-float plane of a channel (coverage is copied out of colour's alpha); colour,
   // three floats per pixel, has none: read `colour`.

@@ -18,9 +18,6 @@ cigi::SessionSettings sessionSettings(const DaemonConfig& config) {
   s.latitude_deg = config.site.latitude_deg;
   s.longitude_deg = config.site.longitude_deg;
   s.views = config.cigi.views;
-  for (const std::string& name : s.views)
-    for (const ViewConfig& v : config.views)
-      if (v.name == name) s.view_heights.push_back(v.camera.height);
   for (const EntityType& t : config.entity_types) s.entity_types.emplace_back(t.id, t.name);
   s.default_frame_s = 1.0 / config.tick_rate_hz;
   return s;

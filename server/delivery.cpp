@@ -79,6 +79,13 @@ void Engine::renderFrame(const ViewConfig& view, const ImageRequest& image, View
   State& s = *state_;
   Scene scene = s.world->scene();
   scene.camera = view.camera;
+  // An off-axis view is cut from a centred render of the same focal length (exact: a pinhole
+  // image moves its principal point when cropped).
+  std::optional<OffAxisView> off_axis;
+  if (view.frustum) {
+    off_axis = offAxisView(view.camera, *view.frustum);
+    scene.camera = off_axis->render;
+  }
   const auto t0 = Clock::now();
   if (image.floatPlanes()) {
     FrameRequest request;
@@ -92,22 +99,43 @@ void Engine::renderFrame(const ViewConfig& view, const ImageRequest& image, View
   } else {
     frame.srgb = s.renderer->renderSrgb8(scene, config_.scene.render);
   }
+  FrameInfo info = frameInfo(view.camera, s.world->timeSeconds(), std::uint64_t(s.ticks));
+  if (off_axis) {
+    const OffAxisView& o = *off_axis;
+    if (image.floatPlanes())
+      frame.planes = frame.planes.cropped(o.x0, o.y0, o.width, o.height);
+    else if (image.format == ImageFormat::kExr)
+      frame.linear = cropImage(frame.linear, o.x0, o.y0, o.width, o.height);
+    else
+      frame.srgb = cropImage(frame.srgb, o.x0, o.y0, o.width, o.height);
+    info.width = o.width;
+    info.height = o.height;
+    info.focal_px = o.focal_px;
+    info.cx = o.cx;
+    info.cy = o.cy;
+    if (image.floatPlanes()) frame.planes.info = info;
+  }
   s.last_render_ms = msSince(t0);
   s.render_ms.push_back(s.last_render_ms);
   s.render_seconds.add(s.last_render_ms * 1e-3);
   if (s.render_ms.size() > kRenderHistory) s.render_ms.pop_front();
   ++s.frames;
-  frame.meta = {{"view", view.name},
-                {"width", view.camera.width},
-                {"height", view.camera.height},
-                {"time", s.world->timeSeconds()},
-                {"tick", s.ticks},
-                {"frame", s.frames},
-                {"camera", cameraJson(frameInfo(view.camera, s.world->timeSeconds(),
-                                                std::uint64_t(s.ticks)))}};
+  frame.meta = {{"view", view.name},         {"width", info.width},
+                {"height", info.height},     {"time", s.world->timeSeconds()},
+                {"tick", s.ticks},           {"frame", s.frames},
+                {"camera", cameraJson(info)}};
+  if (view.frustum) frame.meta["camera"]["frustum"] = frustumJson(*view.frustum);
 }
 
-std::optional<ProtocolError> Engine::pixelLimit(const Camera& camera) const {
+std::optional<ProtocolError> Engine::pixelLimit(const ViewConfig& view) const {
+  // An off-axis view renders the centred view that holds it.
+  const Camera camera = view.frustum ? offAxisView(view.camera, *view.frustum).render : view.camera;
+  if (camera.width > Limits::kMaxImageSide || camera.height > Limits::kMaxImageSide)
+    return ProtocolError{ErrorCode::kLimit, "frustum: the view it is cut from would be " +
+                                                std::to_string(camera.width) + "x" +
+                                                std::to_string(camera.height) +
+                                                " pixels (allowed: at most " +
+                                                std::to_string(Limits::kMaxImageSide) + " a side)"};
   const std::int64_t w = camera.width, h = camera.height;
   if (w * h <= config_.max_image_pixels) return std::nullopt;
   return ProtocolError{ErrorCode::kLimit, "width x height: " + std::to_string(w) + "x" +
@@ -125,7 +153,7 @@ std::optional<Outcome> Engine::renderRequest(const command::Render& c, Job& job)
   }
   if (c.camera) {  // for this render alone: the view itself stays as it is
     applyViewPatch(views.front(), *c.camera);
-    if (auto error = pixelLimit(views.front().camera)) return *error;
+    if (auto error = pixelLimit(views.front())) return *error;
   }
   if (encoder_->depth() >= kEncoderQueue)
     return ProtocolError{ErrorCode::kBusy, "the image encoder is busy; try again"};

@@ -41,7 +41,7 @@ std::optional<ProtocolError> Engine::check(const Command& command) const {
     if (!view) return unknownView(s.views, c->view);
     ViewConfig changed = *view;
     applyViewPatch(changed, c->patch);
-    if (auto error = pixelLimit(changed.camera)) return error;
+    if (auto error = pixelLimit(changed)) return error;
   }
   if (const auto* c = std::get_if<command::Tick>(&command)) {
     if (s.mode == TickMode::kRealtime)

@@ -156,7 +156,7 @@ class Engine {
   void setMode(TickMode mode);
   std::optional<std::variant<nlohmann::json, ProtocolError>> renderRequest(const command::Render& c,
                                                                            Job& job);
-  std::optional<ProtocolError> pixelLimit(const Camera& camera) const;
+  std::optional<ProtocolError> pixelLimit(const ViewConfig& view) const;
   // Snapshots: the World's file and the daemon's state beside it (snapshots.cpp).
   nlohmann::json daemonState() const;
   std::string writeSnapshot(const std::string& path);

@@ -60,18 +60,24 @@ inline json frameStatsJson(const FrameStats& f) {
   return out;
 }
 
+inline json frustumJson(const Frustum& f) {
+  return {{"left", f.left}, {"right", f.right}, {"bottom", f.bottom}, {"top", f.top}};
+}
+
 inline json viewJson(const ViewConfig& v) {
   const Camera& c = v.camera;
-  return {{"name", v.name},
-          {"position", {c.position.x, c.position.y, c.position.z}},
-          {"heading", c.orientation.heading_deg},
-          {"pitch", c.orientation.pitch_deg},
-          {"roll", c.orientation.roll_deg},
-          {"vfov", c.vfov_deg},
-          {"width", c.width},
-          {"height", c.height},
-          {"format", imageFormatName(v.image.format)},
-          {"channels", channelNames(v.image)}};
+  json out{{"name", v.name},
+           {"position", {c.position.x, c.position.y, c.position.z}},
+           {"heading", c.orientation.heading_deg},
+           {"pitch", c.orientation.pitch_deg},
+           {"roll", c.orientation.roll_deg},
+           {"vfov", c.vfov_deg},
+           {"width", c.width},
+           {"height", c.height},
+           {"format", imageFormatName(v.image.format)},
+           {"channels", channelNames(v.image)}};
+  if (v.frustum) out["frustum"] = frustumJson(*v.frustum);
+  return out;
 }
 
 inline const char* modeName(TickMode mode) {
@@ -138,9 +144,17 @@ inline void applyViewPatch(ViewConfig& v, const ViewPatch& p) {
   if (p.heading) cam.orientation.heading_deg = *p.heading;
   if (p.pitch) cam.orientation.pitch_deg = *p.pitch;
   if (p.roll) cam.orientation.roll_deg = *p.roll;
-  if (p.vfov) cam.vfov_deg = *p.vfov;
+  if (p.vfov) {
+    cam.vfov_deg = *p.vfov;
+    v.frustum.reset();
+  }
   if (p.width) cam.width = *p.width;
   if (p.height) cam.height = *p.height;
+  if (p.frustum) v.frustum = *p.frustum;
+  if (v.frustum) {  // the vertical extent, and the width at this height with square pixels
+    cam.vfov_deg = v.frustum->top - v.frustum->bottom;
+    cam.width = offAxisView(cam, *v.frustum).width;
+  }
   if (p.image) v.image = *p.image;
 }
 

@@ -54,6 +54,7 @@ json weatherRequest(int layer, const WeatherLayer& w) {
 json viewRequest(const ViewConfig& v) {
   json r = viewJson(v);
   r.erase("name");
+  if (r.contains("frustum")) r.erase("vfov");  // the frustum gives it
   r["view"] = v.name;
   r["cmd"] = "set_view";
   return r;

@@ -84,3 +84,45 @@ TEST(Frames, OrientationOfInvertsBodyToWorld) {
 
 }  // namespace
 }  // namespace nephele
+
+namespace nephele {
+namespace {
+
+// An off-axis view cut from a centred render: the crop's edges, seen through the render
+// camera's own rays, are the frustum's sides to within half a pixel, and its principal point
+// is where the optical axis lands.
+TEST(Frames, OffAxisViewCropsToTheFrustum) {
+  const Frustum cases[] = {
+      {-30, 30, -20, 20}, {-20, 40, -10, 25}, {-45, -5, 3, 30}, {-5, 5, -80, 80}};
+  for (const Frustum& f : cases) {
+    ASSERT_EQ(frustumError(f), "");
+    Camera camera;
+    camera.height = 200;
+    camera.orientation = {30.0, 10.0, 0.0};
+    const OffAxisView v = offAxisView(camera, f);
+    ASSERT_LE(v.x0 + v.width, v.render.width);
+    ASSERT_LE(v.y0 + v.height, v.render.height);
+    EXPECT_EQ(v.height, 200);
+    const ViewBasis basis = viewBasis(v.render);
+    auto angle = [&](double x, double y, bool horizontal) {
+      const glm::dvec3 d = rayDirection(basis, v.render, x, y);
+      const double along = glm::dot(d, basis.forward);
+      return std::atan((horizontal ? glm::dot(d, basis.right) : glm::dot(d, basis.up)) / along) *
+             180.0 / M_PI;
+    };
+    const double half_pixel = std::atan(0.5 / v.focal_px) * 180.0 / M_PI * 1.01;
+    const double mid_y = v.y0 + 0.5 * v.height, mid_x = v.x0 + 0.5 * v.width;
+    EXPECT_NEAR(angle(v.x0, mid_y, true), f.left, half_pixel);
+    EXPECT_NEAR(angle(v.x0 + v.width, mid_y, true), f.right, half_pixel);
+    EXPECT_NEAR(angle(mid_x, v.y0, false), f.top, half_pixel);
+    EXPECT_NEAR(angle(mid_x, v.y0 + v.height, false), f.bottom, half_pixel);
+    // The principal point is the optical axis: zero angle both ways.
+    EXPECT_NEAR(angle(v.x0 + v.cx, v.y0 + v.cy, true), 0.0, 1e-9);
+    EXPECT_NEAR(angle(v.x0 + v.cx, v.y0 + v.cy, false), 0.0, 1e-9);
+  }
+  EXPECT_NE(frustumError({10, -10, -5, 5}), "");
+  EXPECT_NE(frustumError({-10, 10, -5, 95}), "");
+}
+
+}  // namespace
+}  // namespace nephele

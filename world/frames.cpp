@@ -1,5 +1,7 @@
 #include "world/frames.h"
 
+#include "world/limits.h"
+
 #include <algorithm>
 
 #include <cmath>
@@ -48,6 +50,42 @@ Orientation orientationOf(const glm::dmat3& r) {
   }
   if (o.heading_deg < 0.0) o.heading_deg += 360.0;
   return o;
+}
+
+std::string frustumError(const Frustum& f) {
+  const Range r = Limits::kFrustumAngle;
+  for (double a : {f.left, f.right, f.bottom, f.top})
+    if (!std::isfinite(a) || !r.contains(a))
+      return "frustum: an angle is out of range (allowed: left < right and bottom < top, each " +
+             std::to_string(int(r.lo)) + " to " + std::to_string(int(r.hi)) + " degrees)";
+  if (!(f.left < f.right && f.bottom < f.top))
+    return "frustum: left must be below right and bottom below top";
+  return "";
+}
+
+OffAxisView offAxisView(const Camera& camera, const Frustum& f) {
+  const double tl = std::tan(radians(f.left)), tr = std::tan(radians(f.right));
+  const double tb = std::tan(radians(f.bottom)), tt = std::tan(radians(f.top));
+  OffAxisView v;
+  const int height = std::max(1, camera.height);
+  v.focal_px = height / (tt - tb);
+  // The centred view reaches the farther side each way; its centre is a whole pixel corner.
+  const int half_w = int(std::ceil(v.focal_px * std::max(std::abs(tl), std::abs(tr)) - 1e-9));
+  const int half_h = int(std::ceil(v.focal_px * std::max(std::abs(tb), std::abs(tt)) - 1e-9));
+  v.render = camera;
+  v.render.width = std::max(2 * half_w, 1);
+  v.render.height = std::max(2 * half_h, 1);
+  v.render.vfov_deg = 2.0 * std::atan(half_h / v.focal_px) * 180.0 / std::numbers::pi;
+  // Each edge of the crop is the pixel edge nearest its side of the frustum (image y down);
+  // top and bottom are `height` apart exactly, as f (tan top - tan bottom) = height.
+  auto edge = [](double x, int hi) { return std::clamp(int(std::lround(x)), 0, hi); };
+  v.x0 = edge(half_w + v.focal_px * tl, v.render.width - 1);
+  v.y0 = edge(half_h - v.focal_px * tt, v.render.height - 1);
+  v.width = std::max(1, edge(half_w + v.focal_px * tr, v.render.width) - v.x0);
+  v.height = std::max(1, std::min(height, v.render.height - v.y0));
+  v.cx = half_w - v.x0;
+  v.cy = half_h - v.y0;
+  return v;
 }
 
 ViewBasis viewBasis(const Camera& camera) {

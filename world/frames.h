@@ -2,6 +2,8 @@
 // World frame, orientation and camera (MODEL.md section 1).
 #include <glm/glm.hpp>
 
+#include <string>
+
 namespace nephele {
 
 // Heading clockwise from north (+Y), pitch nose up, roll right wing down; degrees.
@@ -36,6 +38,28 @@ struct ViewBasis {
 };
 
 ViewBasis viewBasis(const Camera& camera);
+
+// An off-axis (asymmetric) view: the angles of the frustum's four sides from the view's axis,
+// degrees, left and bottom negative when they lie left of and below the axis (CIGI View
+// Definition's left, right, bottom, top).
+struct Frustum {
+  double left = -30.0, right = 30.0, bottom = -20.0, top = 20.0;
+  bool operator==(const Frustum&) const = default;
+};
+// "" when left < right, bottom < top and each is within Limits::kFrustumAngle, else why.
+std::string frustumError(const Frustum& f);
+
+// How an off-axis view of `height` pixels is drawn exactly: the centred pinhole view `render`
+// (same pose and focal length, wide enough to hold the frustum) cropped to the rectangle at
+// (x0, y0) of width x height pixels. Square pixels: the width follows from the frustum's
+// extents. The principal point (cx, cy) of the crop is exact; each edge is the asked side to
+// within half a pixel.
+struct OffAxisView {
+  Camera render;
+  int x0 = 0, y0 = 0, width = 0, height = 0;
+  double focal_px = 0.0, cx = 0.0, cy = 0.0;
+};
+OffAxisView offAxisView(const Camera& camera, const Frustum& frustum);
 
 // Straight down onto a square `span_m` metres wide centred at `xy`, from above clouds whose
 // base is `base_m` and thickness `thickness_m` (heaps reach 1.3 times it): a 4 degree view

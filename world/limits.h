@@ -35,6 +35,7 @@ struct Limits {
   // Angles in degrees, each allowed from -max to +max; sun azimuth and elevation follow
   // heading and pitch.
   static constexpr double kMaxHeading = 360.0, kMaxPitch = 90.0, kMaxRoll = 180.0;
+  static constexpr Range kFrustumAngle{-89.0, 89.0};  // an off-axis view's sides, degrees
 
   // Time, seconds of simulation time.
   static constexpr double kMaxTime = 1.0e9;     // a scene's start time

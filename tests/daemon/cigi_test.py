@@ -214,6 +214,7 @@ size = [4, 2, 1]
         sof = self.frame(entity_control(0, lat, lon, 1200.0, yaw=30.0, pitch=-5.0),
                          view_definition(0, -30.0, 30.0, 20.0, -20.0),
                          view_control(1, 0, x=2.0, y=0.5, z=-1.0, yaw=-60.0),
+                         view_definition(1, -50.0, 10.0, 15.0, -5.0),
                          entity_control(7, *boat, yaw=90.0),
                          weather_control(1, True, 7, coverage=40.0, base=1500.0, thickness=800.0,
                                          wind=10.0, wind_from=270.0),
@@ -242,6 +243,10 @@ size = [4, 2, 1]
             expected = front["position"][i] + 2.0 * fwd[i] + 0.5 * right[i] + 1.0 * upv[i]
             self.assertAlmostEqual(left["position"][i], expected, delta=1e-3)
         self.assertAlmostEqual(left["heading"], 330.0, delta=0.2)
+        # An asymmetric frustum: drawn off-axis, its sides as asked.
+        self.assertEqual(left["frustum"], {"left": -50.0, "right": 10.0, "bottom": -5.0,
+                                           "top": 15.0})
+        self.assertAlmostEqual(left["vfov"], 20.0)
         targets = c.ok({"cmd": "list_targets"})["targets"]
         self.assertEqual([t["name"] for t in targets], ["cigi-7"])
         be, bn, bu = enu(*boat, *SITE)

@@ -614,6 +614,44 @@ class HostStateTest(DaemonTest):
             with self.subTest(bad=bad):
                 self.assertIn(field, c.error(dict({"cmd": "render"}, **bad))["message"])
 
+    def test_off_axis_view_is_the_centred_view_cropped(self):
+        # An asymmetric frustum (CIGI View Definition, set_view "frustum") is drawn as the
+        # centred view of the same focal length holding it, cropped: compare with a render of
+        # that centred view, cropped here.
+        d = self.daemon()
+        c = d.client()
+        fr = {"left": -20.0, "right": 40.0, "bottom": -10.0, "top": 25.0}
+        view = c.ok({"cmd": "set_view", "view": "front", "frustum": fr, "heading": 10})
+        t = {k: math.tan(math.radians(v)) for k, v in fr.items()}
+        f = 48 / (t["top"] - t["bottom"])
+        self.assertEqual(view["frustum"], fr)
+        self.assertAlmostEqual(view["vfov"], 35.0)
+        half_w = math.ceil(f * max(abs(t["left"]), abs(t["right"])) - 1e-9)
+        half_h = math.ceil(f * max(abs(t["bottom"]), abs(t["top"])) - 1e-9)
+        x0, x1 = round(half_w + f * t["left"]), round(half_w + f * t["right"])
+        y0 = round(half_h - f * t["top"])
+        self.assertEqual((view["width"], view["height"]), (x1 - x0, 48))
+        image, body = c.ok({"cmd": "render", "view": "front", "format": "raw"})
+        cam = image["image"]["camera"]
+        self.assertAlmostEqual(cam["focal_px"], f, places=6)
+        self.assertEqual(cam["principal_point"], [half_w - x0, half_h - y0])
+        centred, full = c.ok({"cmd": "render", "view": "front", "format": "raw", "camera": {
+            "vfov": 2 * math.degrees(math.atan(half_h / f)), "width": 2 * half_w,
+            "height": 2 * half_h}})
+        self.assertEqual(c.ok({"cmd": "get_view", "view": "front"})["frustum"], fr)
+        w = x1 - x0
+        cropped = b"".join(full[((y0 + y) * 2 * half_w + x0) * 4:((y0 + y) * 2 * half_w + x1) * 4]
+                           for y in range(48))
+        self.assertEqual(len(body), w * 48 * 4)
+        self.assertEqual(body, cropped)
+        self.assertGreater(len(set(body[3::4])), 1)  # a cloud edge in view: not a blank test
+        # vfov makes the view centred again; a frustum that needs a view above the size limit
+        # is refused.
+        self.assertNotIn("frustum", c.ok({"cmd": "set_view", "view": "front", "vfov": 50}))
+        self.assertIn("frustum", c.error({"cmd": "set_view", "view": "front", "height": 4000,
+                                          "frustum": {"left": -88, "right": 1, "bottom": -1,
+                                                      "top": 1}})["message"])
+
     def test_lockstep_subscription_gets_one_frame_per_tick(self):
         d = self.daemon()
         c = d.client()

@@ -34,7 +34,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       }
       cigi::SessionSettings settings;
       settings.views = {"front", "left"};
-      settings.view_heights = {480, 240};
       settings.entity_types = {{1001, "rib"}};
       cigi::Session session(settings);
       (void)session.map(*m);
