@@ -74,7 +74,7 @@ void readDaemon(const toml::table& root, const std::string& file, DaemonConfig& 
     for (std::size_t i = 0; i + 1 < out.views.size(); ++i)
       if (out.views[i].name == view.name) v.failAt("name", "\"" + view.name + "\" names two views");
   }
-  if (out.views.empty()) out.views.push_back({"main", out.scene.scene.camera, {}});
+  if (out.views.empty()) out.views.push_back({"main", out.scene.scene.camera, {}, {}});
 
   if (auto s = t.table("socket")) {
     s->allow({"enabled", "bind", "port", "token", "max_clients", "max_subscriptions", "max_queue",

@@ -217,7 +217,7 @@ std::variant<std::vector<Command>, RegisterError> decodeHoldingWrite(
     commands.emplace_back(sun);
   }
   if (w.touches(M::kTimeScale, 2))
-    commands.emplace_back(command::SetTime{readFloat(kOtherFloats[4], 0), {}, {}});
+    commands.emplace_back(command::SetTime{readFloat(kOtherFloats[4], 0), {}, {}, {}});
 
   for (int layer = 0; layer < ProtocolLimits::kWeatherLayers; ++layer) {
     const int base = M::kLayerStart + layer * M::kLayerStride;

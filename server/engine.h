@@ -42,7 +42,7 @@ using SharedReply = std::shared_ptr<const Reply>;
 
 inline SharedReply makeReply(std::string header,
                              std::shared_ptr<const std::vector<std::uint8_t>> body = nullptr) {
-  return std::make_shared<const Reply>(Reply{std::move(header), std::move(body)});
+  return std::make_shared<const Reply>(Reply{std::move(header), std::move(body), {}});
 }
 
 // Several replies written as one, in order.

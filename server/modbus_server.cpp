@@ -302,7 +302,7 @@ std::vector<std::uint8_t> ModbusServer::answer(const ModbusRequest& request) {
         return exception(e->exception, e->message);
       const CoilWrite& write = std::get<CoilWrite>(decoded);
       std::vector<Command> commands;
-      if (write.paused) commands.push_back(command::SetTime{{}, write.paused, {}});
+      if (write.paused) commands.push_back(command::SetTime{{}, write.paused, {}, {}});
       if (commands.empty() && !write.render) return encodeWriteReply(request);
       return applied(runBatch(std::move(commands), write.render));
     }
