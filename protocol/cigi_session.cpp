@@ -366,6 +366,13 @@ std::variant<HostFrame, Refusal> Session::map(const Message& message) const {
   return frame;
 }
 
+void Session::forget() {
+  std::erase_if(state_.entities, [](const auto& entry) { return entry.second.target; });
+  state_.weather.clear();
+  state_.atmosphere.reset();
+  state_.celestial.reset();
+}
+
 void Session::commit(const Message& message) {
   HostFrame frame;
   auto result = next(message, frame);

@@ -51,6 +51,10 @@ class Session {
   // has applied the frame (commit), so that a refused batch is sent again in full.
   std::variant<HostFrame, Refusal> map(const Message& message) const;
   void commit(const Message& message);
+  // After the daemon refused a frame (a target removed over the socket, say): what the session
+  // believed applied is forgotten, so that the next packets place targets and set the weather
+  // afresh. Frame numbers, the ownship and the views stay.
+  void forget();
 
   std::uint32_t lastHostFrame() const { return state_.last_host_frame.value_or(0); }
 

@@ -112,6 +112,7 @@ void CigiServer::next() {
       if (closed_) return;
       if (error) {
         refuse("refused_by_world", error->message, from);
+        session_.forget();
       } else {
         session_.commit(*message);
         engine_.countCigi("messages");

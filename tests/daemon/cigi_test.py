@@ -278,10 +278,18 @@ size = [4, 2, 1]
         self.assertEqual(c.ok({"cmd": "hash"})["ticks"], hash_before["ticks"] + 1)
         self.frame(entity_control(7, *boat, yaw=95.0), frame=3, timestamp=103334)
         self.assertEqual(c.ok({"cmd": "list_targets"})["targets"][0]["heading"], 95.0)
-        self.frame(entity_control(7, *boat, state=0), frame=4, timestamp=105001)
+        # A target removed over the socket: the next frame that moves it is refused by the
+        # world, and the one after places it afresh.
+        c.ok({"cmd": "remove_target", "name": "cigi-7"})
+        self.send(ig_control(4, 105001), entity_control(7, *boat, yaw=100.0))
+        self.no_reply()
+        self.frame(entity_control(7, *boat, yaw=100.0), frame=5, timestamp=106668)
+        self.assertEqual(c.ok({"cmd": "list_targets"})["targets"][0]["heading"], 100.0)
+        self.frame(entity_control(7, *boat, state=0), frame=6, timestamp=108335)
         self.assertEqual(c.ok({"cmd": "list_targets"})["targets"], [])
         stats = c.ok({"cmd": "stats"})["cigi"]
-        self.assertEqual(stats["messages"], 4)
+        self.assertEqual(stats["messages"], 5)
+        self.assertEqual(stats["refused_refused_by_world"], 1)
         self.assertNotIn("refused_malformed", stats)
         self.check_with_tshark()
 
