@@ -205,6 +205,7 @@ struct HostReadings {
   double time_scale = 1.0;
   std::array<WeatherLayer, ProtocolLimits::kWeatherLayers> layers;
   double fog_top = 0.0, fog_visibility = 0.0;  // visibility 0: no fog
+  glm::dvec3 fog_colour = Fog{}.colour;        // the fog's, or what a new fog would have
   std::optional<CivilTime> sun_utc;
 };
 

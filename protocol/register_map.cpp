@@ -39,6 +39,9 @@ constexpr FloatField kAtmosphereFloats[] = {
     {M::kFogTop, "fog top", 0.0, Limits::kMaxAltitude},
     {M::kFogVisibility, "fog visibility", 0.0, Limits::kFogVisibility.hi},
     {M::kSunTime, "sun time of day", 0.0, 86399.999},
+    {M::kFogColour, "fog red", Limits::kColour.lo, Limits::kColour.hi},
+    {M::kFogColour + 2, "fog green", Limits::kColour.lo, Limits::kColour.hi},
+    {M::kFogColour + 4, "fog blue", Limits::kColour.lo, Limits::kColour.hi},
 };
 constexpr FloatField kLayerFloats[] = {
     {M::kLayerBase, "base", 0.0, Limits::kMaxBase},
@@ -114,6 +117,7 @@ HoldingRegisters encodeHolding(const HostReadings& s) {
   }
   putFloat(&r[M::kFogTop], s.fog_top);
   putFloat(&r[M::kFogVisibility], s.fog_visibility);
+  for (int i = 0; i < 3; ++i) putFloat(&r[std::size_t(M::kFogColour + 2 * i)], s.fog_colour[i]);
   if (s.sun_utc) {
     const CivilTime& t = *s.sun_utc;
     const std::uint32_t date = std::uint32_t(t.year * 10000 + t.month * 100 + t.day);
@@ -235,9 +239,11 @@ std::variant<std::vector<Command>, RegisterError> decodeHoldingWrite(
     set.weather.coverage = readFloat(kLayerFloats[2], base) / 100.0;
     commands.emplace_back(set);
   }
-  if (w.touches(M::kFogTop, 4)) {
+  if (w.touches(M::kFogTop, 4) || w.touches(M::kFogColour, 6)) {  // the fog, set whole
     const double top = readFloat(kAtmosphereFloats[0], 0);
     const double visibility = readFloat(kAtmosphereFloats[1], 0);
+    const glm::dvec3 colour(readFloat(kAtmosphereFloats[3], 0), readFloat(kAtmosphereFloats[4], 0),
+                            readFloat(kAtmosphereFloats[5], 0));
     if (!error && visibility != 0.0 && visibility < Limits::kFogVisibility.lo)
       error = RegisterError{kIllegalDataValue,
                             "fog visibility (register " + std::to_string(M::kFogVisibility) +
@@ -248,7 +254,7 @@ std::variant<std::vector<Command>, RegisterError> decodeHoldingWrite(
     if (visibility == 0.0)
       commands.emplace_back(command::SetFog{false, {}, {}, {}});
     else
-      commands.emplace_back(command::SetFog{true, top, visibility, {}});
+      commands.emplace_back(command::SetFog{true, top, visibility, colour});
   }
   if (w.touches(M::kSunDate, 4)) {
     const std::uint32_t date = std::uint32_t(next[M::kSunDate]) << 16 | next[M::kSunDate + 1];

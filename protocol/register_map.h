@@ -36,7 +36,8 @@ struct ModbusMap {
   static constexpr int kFogVisibility = 58;  // float32 m; 0: no fog
   static constexpr int kSunDate = 60;        // uint32 YYYYMMDD, high word first; 0: by angles
   static constexpr int kSunTime = 62;        // float32 seconds into the UTC day
-  static constexpr int kHoldingCount = 64;
+  static constexpr int kFogColour = 64;      // 3 x float32, linear RGB
+  static constexpr int kHoldingCount = 70;
 
   // Coils (read 0x01; write 0x05, 0x0F).
   static constexpr int kRenderCoil = 0;  // write 1: render the Modbus view; reads 0 when done

@@ -88,6 +88,7 @@ void Engine::publishReadings() {
   if (const std::optional<Fog>& fog = world.base().fog) {
     settings.fog_top = fog->top_m;
     settings.fog_visibility = fog->visibility_m;
+    settings.fog_colour = fog->colour;
   }
   settings.sun_utc = s.sun_utc;
   HostStatus status;

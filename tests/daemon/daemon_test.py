@@ -847,8 +847,18 @@ class ModbusTest(DaemonTest):
         date = 20260621
         self.assertFalse(self.mb.write_registers(60, [date >> 16, date & 0xffff] +
                                                  floats(43200.0), slave=1).isError())
-        regs = self.mb.read_holding_registers(0, 64, slave=1).registers
+        regs = self.mb.read_holding_registers(0, 70, slave=1).registers
         self.assertEqual((unfloat(regs[56:58]), unfloat(regs[58:60])), (120.0, 900.0))
+        self.assertAlmostEqual(unfloat(regs[64:66]), 0.75, places=6)  # the default fog colour
+        # The colour alone sets the fog whole: same top and visibility, new colour.
+        fog_hash = self.c.ok({"cmd": "hash"})["hash"]
+        self.assertFalse(self.mb.write_registers(64, floats(0.5) + floats(0.4) + floats(0.3),
+                                                 slave=1).isError())
+        fog = self.mb.read_holding_registers(56, 14, slave=1).registers
+        self.assertEqual([unfloat(fog[i:i + 2]) for i in (0, 2, 8, 10, 12)],
+                         [120.0, 900.0, 0.5, 0.4000000059604645, 0.30000001192092896])
+        self.assertNotEqual(self.c.ok({"cmd": "hash"})["hash"], fog_hash)
+        self.assertTrue(self.mb.write_registers(64, floats(-1.0), slave=1).isError())
         self.assertEqual((regs[60] << 16 | regs[61], unfloat(regs[62:64])), (date, 43200.0))
         # Noon at the default site (0 N, 0 E) at the June solstice: the sun stands to the
         # north at 90 - 23.44 degrees, and the angle registers say so.
