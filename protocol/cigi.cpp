@@ -192,34 +192,41 @@ void layout(C& c, CelestialSphereControl& p) {
   c.number(12, p.star_intensity);
 }
 
-// Identifier and size of each packet type Nephele reads or writes.
+// Identifier, size and name of each packet type Nephele reads or writes.
 struct Kind {
   std::uint8_t id, size;
+  const char* name;
 };
 constexpr Kind kindOf(const IgControl&) {
-  return {Id::kIgControl, Size::kIgControl};
-}
-constexpr Kind kindOf(const EntityControl&) {
-  return {Id::kEntityControl, Size::kEntityControl};
-}
-constexpr Kind kindOf(const ViewControl&) {
-  return {Id::kViewControl, Size::kViewControl};
-}
-constexpr Kind kindOf(const ViewDefinition&) {
-  return {Id::kViewDefinition, Size::kViewDefinition};
-}
-constexpr Kind kindOf(const WeatherControl&) {
-  return {Id::kWeatherControl, Size::kWeatherControl};
-}
-constexpr Kind kindOf(const AtmosphereControl&) {
-  return {Id::kAtmosphereControl, Size::kAtmosphereControl};
-}
-constexpr Kind kindOf(const CelestialSphereControl&) {
-  return {Id::kCelestialSphereControl, Size::kCelestialSphereControl};
+  return {Id::kIgControl, Size::kIgControl, "IG Control"};
 }
 constexpr Kind kindOf(const StartOfFrame&) {
-  return {Id::kStartOfFrame, Size::kStartOfFrame};
+  return {Id::kStartOfFrame, Size::kStartOfFrame, "Start of Frame"};
 }
+constexpr Kind kindOf(const EntityControl&) {
+  return {Id::kEntityControl, Size::kEntityControl, "Entity Control"};
+}
+constexpr Kind kindOf(const ViewControl&) {
+  return {Id::kViewControl, Size::kViewControl, "View Control"};
+}
+constexpr Kind kindOf(const ViewDefinition&) {
+  return {Id::kViewDefinition, Size::kViewDefinition, "View Definition"};
+}
+constexpr Kind kindOf(const WeatherControl&) {
+  return {Id::kWeatherControl, Size::kWeatherControl, "Weather Control"};
+}
+constexpr Kind kindOf(const AtmosphereControl&) {
+  return {Id::kAtmosphereControl, Size::kAtmosphereControl, "Atmosphere Control"};
+}
+constexpr Kind kindOf(const CelestialSphereControl&) {
+  return {Id::kCelestialSphereControl, Size::kCelestialSphereControl, "Celestial Sphere Control"};
+}
+
+// The packet types decoded into fields; any other is kept as an OtherPacket.
+template <class... T>
+struct PacketTypes {};
+using Decoded = PacketTypes<IgControl, StartOfFrame, EntityControl, ViewControl, ViewDefinition,
+                            WeatherControl, AtmosphereControl, CelestialSphereControl>;
 
 template <class T>
 Packet read(const std::uint8_t* p, ByteOrder order) {
@@ -234,18 +241,17 @@ std::string number(std::size_t n) {
 }
 
 // Decodes a message whose first packet must be `first` (IG Control or Start of Frame).
-std::variant<Message, DecodeError> decode(std::span<const std::uint8_t> bytes, Kind first,
-                                          const char* first_name) {
+std::variant<Message, DecodeError> decode(std::span<const std::uint8_t> bytes, Kind first) {
   if (bytes.size() > kMaxMessageBytes)
     return DecodeError{Fault::kOversized, "message of " + number(bytes.size()) +
                                               " bytes (allowed: at most " +
                                               number(kMaxMessageBytes) + ")"};
   if (bytes.size() < first.size)
     return DecodeError{Fault::kTruncated, "message of " + number(bytes.size()) +
-                                              " bytes is shorter than a " + first_name +
+                                              " bytes is shorter than a " + first.name +
                                               " packet (" + number(first.size) + " bytes)"};
   if (bytes[0] != first.id || bytes[1] != first.size)
-    return DecodeError{Fault::kWrongFirst, std::string("the first packet must be ") + first_name +
+    return DecodeError{Fault::kWrongFirst, std::string("the first packet must be ") + first.name +
                                                " (identifier " + number(first.id) + ", size " +
                                                number(first.size) + "); it has identifier " +
                                                number(bytes[0]) + " and size " + number(bytes[1])};
@@ -277,59 +283,27 @@ std::variant<Message, DecodeError> decode(std::span<const std::uint8_t> bytes, K
                                                 " runs past the end of the message (" +
                                                 number(bytes.size()) + " bytes)"};
     const std::uint8_t* p = bytes.data() + at;
-    auto fixed = [&](Kind kind, const char* name) -> std::optional<DecodeError> {
-      if (size == kind.size) return std::nullopt;
-      return DecodeError{Fault::kMalformed, std::string(name) + " at byte " + number(at) +
-                                                " has size " + number(size) +
-                                                " (allowed: " + number(kind.size) + ")"};
-    };
     std::optional<DecodeError> error;
-    switch (id) {
-      case Id::kIgControl:
-        if (!(error = fixed(kindOf(IgControl{}), "IG Control"))) {
-          if (at != 0 || first.id != Id::kIgControl)
-            return DecodeError{Fault::kMalformed,
-                               "IG Control at byte " + number(at) +
-                                   " (allowed: once, as the first packet of a host message)"};
-          message.packets.push_back(read<IgControl>(p, message.order));
-        }
-        break;
-      case Id::kStartOfFrame:
-        if (!(error = fixed(kindOf(StartOfFrame{}), "Start of Frame"))) {
-          if (at != 0 || first.id != Id::kStartOfFrame)
-            return DecodeError{Fault::kMalformed,
-                               "Start of Frame at byte " + number(at) +
-                                   " (allowed: once, as the first packet of an IG message)"};
-          message.packets.push_back(read<StartOfFrame>(p, message.order));
-        }
-        break;
-      case Id::kEntityControl:
-        if (!(error = fixed(kindOf(EntityControl{}), "Entity Control")))
-          message.packets.push_back(read<EntityControl>(p, message.order));
-        break;
-      case Id::kViewControl:
-        if (!(error = fixed(kindOf(ViewControl{}), "View Control")))
-          message.packets.push_back(read<ViewControl>(p, message.order));
-        break;
-      case Id::kViewDefinition:
-        if (!(error = fixed(kindOf(ViewDefinition{}), "View Definition")))
-          message.packets.push_back(read<ViewDefinition>(p, message.order));
-        break;
-      case Id::kWeatherControl:
-        if (!(error = fixed(kindOf(WeatherControl{}), "Weather Control")))
-          message.packets.push_back(read<WeatherControl>(p, message.order));
-        break;
-      case Id::kAtmosphereControl:
-        if (!(error = fixed(kindOf(AtmosphereControl{}), "Atmosphere Control")))
-          message.packets.push_back(read<AtmosphereControl>(p, message.order));
-        break;
-      case Id::kCelestialSphereControl:
-        if (!(error = fixed(kindOf(CelestialSphereControl{}), "Celestial Sphere Control")))
-          message.packets.push_back(read<CelestialSphereControl>(p, message.order));
-        break;
-      default:
-        message.packets.push_back(OtherPacket{id, size});
-    }
+    bool decoded = false;
+    auto readAs = [&]<class T>(T) {
+      const Kind kind = kindOf(T{});
+      if (id != kind.id) return;
+      decoded = true;
+      const bool opening = id == Id::kIgControl || id == Id::kStartOfFrame;
+      if (size != kind.size)
+        error = DecodeError{Fault::kMalformed, std::string(kind.name) + " at byte " + number(at) +
+                                                   " has size " + number(size) +
+                                                   " (allowed: " + number(kind.size) + ")"};
+      else if (opening && (at != 0 || first.id != id))
+        error = DecodeError{Fault::kMalformed, std::string(kind.name) + " at byte " + number(at) +
+                                                   " (allowed: once, as the first packet of " +
+                                                   (id == Id::kIgControl ? "a host" : "an IG") +
+                                                   " message)"};
+      else
+        message.packets.push_back(read<T>(p, message.order));
+    };
+    [&]<class... T>(PacketTypes<T...>) { (readAs(T{}), ...); }(Decoded{});
+    if (!decoded) message.packets.push_back(OtherPacket{id, size});
     if (error) return *error;
     at += size;
   }
@@ -357,11 +331,11 @@ std::string_view faultName(Fault fault) {
 }
 
 std::variant<Message, DecodeError> decodeHostMessage(std::span<const std::uint8_t> bytes) {
-  return decode(bytes, kindOf(IgControl{}), "IG Control");
+  return decode(bytes, kindOf(IgControl{}));
 }
 
 std::variant<Message, DecodeError> decodeIgMessage(std::span<const std::uint8_t> bytes) {
-  return decode(bytes, kindOf(StartOfFrame{}), "Start of Frame");
+  return decode(bytes, kindOf(StartOfFrame{}));
 }
 
 void encode(const Packet& packet, ByteOrder order, std::vector<std::uint8_t>& out) {
