@@ -23,6 +23,7 @@
 #include <nlohmann/json.hpp>
 
 #include "protocol/cigi.h"
+#include "renderer/frame_timing.h"
 #include "renderer/gl/gl_platform.h"
 #include "renderer/gl/gl_renderer.h"
 
@@ -256,13 +257,7 @@ double floorMs(int width, int height) {
   auto platform = nephele::createGlPlatform(nephele::GlBackend::kAuto, error);
   if (!platform) throw std::runtime_error("no GL for the floor: " + error);
   nephele::GlRenderer gl(*platform);
-  std::vector<double> ms;
-  for (int i = 0; i < 9; ++i) {
-    const auto t0 = Clock::now();
-    gl.renderFloor(width, height);
-    ms.push_back(msBetween(t0, Clock::now()));
-  }
-  return percentile(ms, 0.5);
+  return nephele::medianMilliseconds(9, [&] { gl.renderFloor(width, height); });
 }
 
 // Host frames over CIGI and over the socket, each followed by one frame of every view.

@@ -359,24 +359,26 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
   return s;
 }
 
-std::variant<HostFrame, Refusal> Session::map(const Message& message) const {
+std::variant<HostFrame, Refusal> Session::map(const Message& message) {
   HostFrame frame;
   auto result = next(message, frame);
+  pending_.reset();
   if (auto* r = std::get_if<Refusal>(&result)) return *r;
+  pending_ = std::move(std::get<State>(result));
   return frame;
 }
 
 void Session::forget() {
+  pending_.reset();
   std::erase_if(state_.entities, [](const auto& entry) { return entry.second.target; });
   state_.weather.clear();
   state_.atmosphere.reset();
   state_.celestial.reset();
 }
 
-void Session::commit(const Message& message) {
-  HostFrame frame;
-  auto result = next(message, frame);
-  if (auto* s = std::get_if<State>(&result)) state_ = std::move(*s);
+void Session::commit() {
+  if (pending_) state_ = std::move(*pending_);
+  pending_.reset();
 }
 
 }  // namespace nephele::cigi

@@ -47,13 +47,14 @@ class Session {
  public:
   explicit Session(SessionSettings settings) : settings_(std::move(settings)) {}
 
-  // Turns a decoded host message into commands. The session changes only once the daemon
-  // has applied the frame (commit), so that a refused batch is sent again in full.
-  std::variant<HostFrame, Refusal> map(const Message& message) const;
-  void commit(const Message& message);
+  // Turns a decoded host message into commands, and keeps the state they lead to. The session
+  // takes that state only once the daemon has applied the frame (commit), so that a refused
+  // batch is sent again in full.
+  std::variant<HostFrame, Refusal> map(const Message& message);
+  void commit();
   // After the daemon refused a frame (a target removed over the socket, say): what the session
   // believed applied is forgotten, so that the next packets place targets and set the weather
-  // afresh. Frame numbers, the ownship and the views stay.
+  // afresh. Frame numbers, the ownship and the views stay. The frame mapped last is dropped.
   void forget();
 
   std::uint32_t lastHostFrame() const { return state_.last_host_frame.value_or(0); }
@@ -86,6 +87,7 @@ class Session {
 
   SessionSettings settings_;
   State state_;
+  std::optional<State> pending_;  // after the last frame mapped, until commit
 };
 
 }  // namespace nephele::cigi

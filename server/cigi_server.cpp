@@ -89,8 +89,8 @@ void CigiServer::next() {
     refuse(std::string(cigi::faultName(e->fault)), e->message, d.from);
     return next();
   }
-  auto message = std::make_shared<cigi::Message>(std::move(std::get<cigi::Message>(decoded)));
-  auto mapped = session_.map(*message);
+  const cigi::Message& message = std::get<cigi::Message>(decoded);
+  auto mapped = session_.map(message);
   if (auto* r = std::get_if<cigi::Refusal>(&mapped)) {
     refuse(r->reason, r->message, d.from);
     return next();
@@ -106,17 +106,18 @@ void CigiServer::next() {
     frame.commands.emplace_back(command::Tick{frame.dt_s});
   busy_ = true;
   const cigi::IgControl control = frame.control;
-  auto done = [this, message, control, from = d.from](std::optional<ProtocolError> error) {
-    asio::post(io_, [this, message, control, from, error] {
+  auto done = [this, order = message.order, control,
+               from = d.from](std::optional<ProtocolError> error) {
+    asio::post(io_, [this, order, control, from, error] {
       busy_ = false;
       if (closed_) return;
       if (error) {
         refuse("refused_by_world", error->message, from);
         session_.forget();
       } else {
-        session_.commit(*message);
+        session_.commit();
         engine_.countCigi("messages");
-        sendStartOfFrame(control, message->order, from);
+        sendStartOfFrame(control, order, from);
       }
       next();
     });

@@ -1,9 +1,8 @@
 #include <spdlog/spdlog.h>
 
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
+#include "config/table_reader.h"
 #include "server/engine_state.h"
 #include "world/file_output.h"
 #include "world/limits.h"
@@ -101,10 +100,10 @@ std::string Engine::restoreSnapshot(const std::string& path) {
     std::error_code ec;
     if (std::filesystem::file_size(side, ec) > kMaxDaemonStateBytes || ec)
       return bad("larger than 4 MiB or unreadable");
-    std::ifstream in(side, std::ios::binary);
-    std::stringstream text;
-    text << in.rdbuf();
-    json j = json::parse(text.str(), nullptr, false);
+    std::string text;
+    if (std::string e = config_detail::readTextFile(side, "daemon state", text); !e.empty())
+      return e;
+    json j = json::parse(text, nullptr, false);
     if (j.is_discarded() || !j.is_object() || j.value("format", "") != "nephele-daemon-state")
       return bad("not a daemon state file");
     if (j.value("version", 0) != kDaemonStateVersion)

@@ -37,7 +37,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       settings.entity_types = {{1001, "rib"}};
       cigi::Session session(settings);
       (void)session.map(*m);
-      session.commit(*m);
+      session.commit();
       (void)session.map(*m);
     }
     return 0;
