@@ -480,11 +480,18 @@ class SocketProtocolTest(DaemonTest):
     def test_metrics_endpoint(self):
         d = self.daemon()
         d.client().ok({"cmd": "render", "view": "front"})
-        s = socket.create_connection(("127.0.0.1", d.metrics_port), timeout=TIMEOUT)
-        s.sendall(b"GET /metrics HTTP/1.1\r\nHost: x\r\n\r\n")
-        text = b""
-        while chunk := s.recv(65536):
-            text += chunk
+
+        def scrape_with_the_render():
+            s = socket.create_connection(("127.0.0.1", d.metrics_port), timeout=TIMEOUT)
+            s.sendall(b"GET /metrics HTTP/1.1\r\nHost: x\r\n\r\n")
+            text = b""
+            while chunk := s.recv(65536):
+                text += chunk
+            s.close()
+            return text if b"nephele_render_seconds_count 1" in text else None
+        # The metrics are the figures the world thread last published (once per loop, at
+        # least twice a second): wait for the render to be among them.
+        text = wait_until(scrape_with_the_render, "the render in the published metrics")
         self.assertIn(b"200 OK", text)
         self.assertIn(b"nephele_ticks_total", text)
         # Latencies are histograms in seconds: cumulative buckets up to +Inf equal the count.
