@@ -338,7 +338,8 @@ int runDatasetCommand(const DatasetCommandOptions& o) {
     spdlog::error("{}", error);
     return 1;
   }
-  if (std::string e = renderer->reserve(spec.width, spec.height, true); !e.empty()) {
+  if (std::string e = renderer->reserve(spec.width, spec.height, true, /*targets=*/true);
+      !e.empty()) {
     spdlog::error("dataset.width/height: {}", e);
     return 2;
   }

@@ -227,7 +227,9 @@ int runRenderCommand(const RenderCommandOptions& o) {
   }
   spdlog::info("renderer: {}", renderer->description());
   const Camera& camera = file.scene.camera;
-  if (std::string e = renderer->reserve(camera.width, camera.height, isFloatFormat(*format));
+  const bool targets = !file.scene.targets.empty() || request.channels.has(Channel::kDepth) ||
+                       request.channels.has(Channel::kObjectId);
+  if (std::string e = renderer->reserve(camera.width, camera.height, isFloatFormat(*format), targets);
       !e.empty()) {
     spdlog::error("--width/--height: {}", e);
     return 2;

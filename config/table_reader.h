@@ -84,7 +84,7 @@ class TableReader {
     const toml::node* node = take(key);
     if (!node) return;
     if (!node->is_boolean()) fail(*node, key, "must be true or false");
-    out = node->value<bool>().value();
+    out = node->as_boolean()->get();
   }
 
   // A string that must be one of `allowed`; returns its index.
@@ -93,7 +93,7 @@ class TableReader {
     if (!node) return current;
     if (!node->is_string())
       fail(*node, key, "must be a string (one of: " + joinKeys(allowed) + ")");
-    const std::string value = node->value<std::string>().value();
+    const std::string& value = node->as_string()->get();
     if (const int index = nameIndex(allowed, value); index >= 0) return index;
     fail(*node, key, "\"" + value + "\" is not allowed (one of: " + joinKeys(allowed) + ")");
   }
@@ -102,7 +102,7 @@ class TableReader {
     const toml::node* node = take(key);
     if (!node) return;
     if (!node->is_string()) fail(*node, key, "must be a string");
-    out = node->value<std::string>().value();
+    out = node->as_string()->get();
   }
 
   // A name, by the one name rule (world/limits.h).
@@ -110,7 +110,7 @@ class TableReader {
     const toml::node* node = take(key);
     if (!node) return;
     if (!node->is_string()) fail(*node, key, "must be a string of " + std::string(kNameRule));
-    std::string value = node->value<std::string>().value();
+    std::string value = node->as_string()->get();
     if (std::string e = nameError(value); !e.empty()) fail(*node, key, e);
     out = std::move(value);
   }
@@ -149,7 +149,7 @@ class TableReader {
     if (!array || array->size() > max_count || !array->is_homogeneous(toml::node_type::string))
       fail(*node, key, "must be an array of at most " + std::to_string(max_count) + " strings");
     out.clear();
-    for (const toml::node& v : *array) out.push_back(v.value<std::string>().value());
+    for (const toml::node& v : *array) out.push_back(v.as_string()->get());
   }
 
   // A range to draw from: a number (fixed) or [low, high], each in `range`, low <= high.
@@ -247,7 +247,12 @@ class TableReader {
 
   double toNumber(const toml::node& node, std::string_view key, double lo, double hi) const {
     if (!node.is_number()) fail(node, key, "must be a number");
-    const double v = node.value<double>().value();
+    if (const auto* integer = node.as_integer(); integer && !heldExactly(integer->get()))
+      fail(node, key,
+           std::to_string(integer->get()) + " cannot be held exactly (allowed: " +
+               formatNumber(lo) + " to " + formatNumber(hi) + ")");
+    const double v = node.is_integer() ? double(node.as_integer()->get())
+                                       : node.as_floating_point()->get();
     if (!std::isfinite(v))
       fail(node, key,
            formatNumber(v) + " is not a finite number (allowed: " + formatNumber(lo) + " to " +
@@ -261,8 +266,10 @@ class TableReader {
 
   std::int64_t toInteger(const toml::node& node, std::string_view key, std::int64_t lo,
                          std::int64_t hi) const {
-    if (!node.is_integer()) fail(node, key, "must be an integer");
-    const std::int64_t v = node.value<std::int64_t>().value();
+    if (!node.is_integer())
+      fail(node, key,
+           "must be an integer (allowed: " + std::to_string(lo) + " to " + std::to_string(hi) + ")");
+    const std::int64_t v = node.as_integer()->get();
     if (v < lo || v > hi)
       fail(node, key,
            std::to_string(v) + " is out of range (allowed: " + std::to_string(lo) + " to " +

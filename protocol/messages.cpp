@@ -38,6 +38,8 @@ class FieldReader {
     const json* v = take(key);
     if (!v) return std::nullopt;
     if (!v->is_number()) fail(key, "must be a number (allowed: " + range(lo, hi) + ")");
+    if (!heldExactly(*v))
+      fail(key, v->dump() + " cannot be held exactly (allowed: " + range(lo, hi) + ")");
     const double x = v->get<double>();
     if (!std::isfinite(x) || x < lo || x > hi)
       fail(key, formatNumber(x) + " is out of range (allowed: " + range(lo, hi) + ")");
@@ -60,7 +62,7 @@ class FieldReader {
                                     : std::int64_t(std::min<std::uint64_t>(
                                           v->get<std::uint64_t>(), std::uint64_t(INT64_MAX)));
     if (x < lo || x > hi)
-      fail(key, std::to_string(x) + " is out of range (allowed: " + std::to_string(lo) + " to " +
+      fail(key, v->dump() + " is out of range (allowed: " + std::to_string(lo) + " to " +
                     std::to_string(hi) + ")");
     return x;
   }
@@ -105,8 +107,8 @@ class FieldReader {
     glm::vec<N, double> out;
     for (int i = 0; i < N; ++i) {
       const json& e = (*v)[std::size_t(i)];
-      if (!e.is_number() || !std::isfinite(e.get<double>()) || e.get<double>() < lo ||
-          e.get<double>() > hi)
+      if (!e.is_number() || !heldExactly(e) || !std::isfinite(e.get<double>()) ||
+          e.get<double>() < lo || e.get<double>() > hi)
         fail(key, "element " + std::to_string(i) + " is not a number in " + range(lo, hi));
       out[i] = e.get<double>();
     }
@@ -141,6 +143,12 @@ class FieldReader {
   }
   std::string qualified(const std::string& key) const {
     return path_.empty() ? key : path_ + "." + key;
+  }
+  // An integer read as a number must lie within +-2^53 (world/limits.h, heldExactly).
+  static bool heldExactly(const json& v) {
+    if (v.is_number_unsigned()) return v.get<std::uint64_t>() <= std::uint64_t(kMaxExactInteger);
+    if (v.is_number_integer()) return nephele::heldExactly(v.get<std::int64_t>());
+    return true;
   }
   static std::string range(double lo, double hi) {
     return formatNumber(lo) + " to " + formatNumber(hi);

@@ -17,8 +17,8 @@ class GlBackendRenderer final : public Renderer {
     return gl_.renderFrame(scene, settings_, request);
   }
   Srgb8Image renderSrgb8(const Scene& scene) override { return gl_.renderSrgb8(scene, settings_); }
-  std::string reserve(int width, int height, bool linear) override {
-    return gl_.reserveTarget(width, height, linear);
+  std::string reserve(int width, int height, bool linear, bool targets) override {
+    return gl_.reserveTarget(width, height, linear, targets);
   }
   std::string statsLine() const override { return gl_.lastFrameStats().line(); }
   std::string description() const override {
@@ -41,7 +41,7 @@ class ReferenceBackendRenderer final : public Renderer {
   Srgb8Image renderSrgb8(const Scene& scene) override {
     return toSrgb8(renderReferenceFrame(scene, settings_, {}, progress_).colour);
   }
-  std::string reserve(int, int, bool) override { return ""; }
+  std::string reserve(int, int, bool, bool) override { return ""; }
   std::string description() const override {
     const std::string n = std::to_string(settings_.samples_per_axis);
     return "reference: " + n + "x" + n + " samples per pixel";

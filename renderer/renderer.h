@@ -29,8 +29,9 @@ class Renderer {
   virtual Frame render(const Scene& scene, const FrameRequest& request) = 0;
   // Colour only, sRGB bytes: the GL back end reads its 8-bit target directly.
   virtual Srgb8Image renderSrgb8(const Scene& scene) = 0;
-  // Empty when a width x height frame (float or 8-bit) can be drawn, else why not.
-  virtual std::string reserve(int width, int height, bool linear) = 0;
+  // Empty when a width x height frame (float or 8-bit; with targets, or depth or object ids
+  // asked, when `targets`) can be drawn, else why not. Call it before any work.
+  virtual std::string reserve(int width, int height, bool linear, bool targets) = 0;
   // What the last frame did (GL: passes, ellipsoids drawn and culled, terms); may be empty.
   virtual std::string statsLine() const { return ""; }
   // "gl: osmesa, OpenGL 4.5 ..., GL_RENDERER llvmpipe ..." or "reference: 4x4 samples ...".

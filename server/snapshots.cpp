@@ -104,11 +104,16 @@ std::string Engine::restoreSnapshot(const std::string& path) {
     if (std::string e = config_detail::readTextFile(side, "daemon state", text); !e.empty())
       return e;
     json j = json::parse(text, nullptr, false);
-    if (j.is_discarded() || !j.is_object() || j.value("format", "") != "nephele-daemon-state")
+    // json::value() throws when the key holds another type: every key is typed here first.
+    auto has = [&](const char* key, json::value_t type) {
+      return j.contains(key) && j[key].type() == type;
+    };
+    if (j.is_discarded() || !j.is_object() || !has("format", json::value_t::string) ||
+        j["format"] != "nephele-daemon-state")
       return bad("not a daemon state file");
-    if (j.value("version", 0) != kDaemonStateVersion)
-      return bad("version " + j["version"].dump() + " is not " +
-                 std::to_string(kDaemonStateVersion));
+    if (!has("version", json::value_t::number_unsigned) || j["version"] != kDaemonStateVersion)
+      return bad("version " + (j.contains("version") ? j["version"].dump() : "missing") +
+                 " is not " + std::to_string(kDaemonStateVersion));
     for (const char* key : {"ticks", "frames"})
       if (!j.contains(key) || !j[key].is_number_unsigned())
         return bad(std::string(key) + ": missing");
@@ -116,8 +121,8 @@ std::string Engine::restoreSnapshot(const std::string& path) {
         !(j["time_scale"].get<double>() >= 0.0 &&
           j["time_scale"].get<double>() <= ProtocolLimits::kMaxTimeScale))
       return bad("time_scale: missing or out of range");
-    const std::string mode = j.value("mode", "");
-    if (mode != "realtime" && mode != "lockstep") return bad("mode: not realtime or lockstep");
+    if (!has("mode", json::value_t::string) || (j["mode"] != "realtime" && j["mode"] != "lockstep"))
+      return bad("mode: not realtime or lockstep");
     if (!j.contains("paused") || !j["paused"].is_boolean()) return bad("paused: missing");
     if (j.contains("sun_utc")) {
       CivilTime t;

@@ -4,6 +4,7 @@
 // of them accepts is never refused by another (docs/ACCURACY.md lists how each edge is
 // tested).
 #include <cmath>
+#include <cstdint>
 #include <ostream>
 #include <string>
 #include <string_view>
@@ -25,6 +26,12 @@ inline bool outOfRange(std::ostream& out, const char* name, double value, Range 
       << ")";
   return true;
 }
+
+// IEEE 754 binary64 holds every integer of magnitude up to 2^53 exactly, and not every one
+// beyond. Where a reader takes a number, an integer outside +-2^53 is refused rather than
+// rounded, in every reader alike (scene files, configs, requests).
+inline constexpr std::int64_t kMaxExactInteger = std::int64_t(1) << 53;
+inline bool heldExactly(std::int64_t v) { return v >= -kMaxExactInteger && v <= kMaxExactInteger; }
 
 struct Limits {
   // Camera and image.

@@ -165,12 +165,23 @@ GlRenderer::GlRenderer(const GlPlatform& platform)
 
 GlRenderer::~GlRenderer() = default;
 
+// Reads the bound framebuffer's w x h RGBA pixels of `type` into `out`, rows bottom-up, in
+// bands of at most 256 MiB: llvmpipe's readback of 2 GiB or more in one call overflows a
+// 32-bit size and writes out of bounds (a 16384x8192 float frame, issue 26).
+void GlRenderer::readPixels(int w, int h, GLenum type, void* out) const {
+  const std::size_t row_bytes = std::size_t(w) * 4 * (type == GL_FLOAT ? sizeof(float) : 1);
+  const int band = int(std::max<std::size_t>(1, (std::size_t(256) << 20) / row_bytes));
+  gl_.PixelStorei(GL_PACK_ALIGNMENT, 4);
+  for (int y = 0; y < h; y += band)
+    gl_.ReadPixels(0, y, w, std::min(band, h - y), GL_RGBA, type,
+                   static_cast<char*>(out) + std::size_t(y) * row_bytes);
+}
+
 FloatImage GlRenderer::renderFloat(const Scene& scene, const RenderSettings& settings) {
   drawFrame(scene, settings, TargetFormat::kFloat);
   const int w = scene.camera.width, h = scene.camera.height;
   FloatImage image{w, h, std::vector<float>(std::size_t(w) * h * 4)};
-  gl_.PixelStorei(GL_PACK_ALIGNMENT, 4);
-  gl_.ReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, image.rgba.data());
+  readPixels(w, h, GL_FLOAT, image.rgba.data());
   // GL rows run bottom-up; FloatImage rows run top-down.
   const std::size_t row = std::size_t(w) * 4;
   for (int y = 0; y < h / 2; ++y)
@@ -229,8 +240,7 @@ Srgb8Image GlRenderer::renderSrgb8(const Scene& scene, const RenderSettings& set
   drawFrame(scene, settings, TargetFormat::kSrgb8);
   const int w = scene.camera.width, h = scene.camera.height;
   Srgb8Image image{w, h, /*bottom_up=*/true, std::vector<std::uint8_t>(std::size_t(w) * h * 4)};
-  gl_.PixelStorei(GL_PACK_ALIGNMENT, 4);
-  gl_.ReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, image.rgba.data());
+  readPixels(w, h, GL_UNSIGNED_BYTE, image.rgba.data());
   return image;
 }
 
@@ -262,20 +272,26 @@ void main() { o_colour = u_colour; }
   gl_.Disable(GL_BLEND);
   Srgb8Image image{width, height, /*bottom_up=*/true,
                    std::vector<std::uint8_t>(std::size_t(width) * height * 4)};
-  gl_.PixelStorei(GL_PACK_ALIGNMENT, 4);
-  gl_.ReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, image.rgba.data());
+  readPixels(width, height, GL_UNSIGNED_BYTE, image.rgba.data());
   return image;
 }
 
-std::string GlRenderer::reserveTarget(int width, int height, bool linear) {
+std::string GlRenderer::reserveTarget(int width, int height, bool linear, bool targets) {
   const TargetFormat format = linear ? TargetFormat::kFloat : TargetFormat::kSrgb8;
-  if (allocateTarget(width, height, format)) return {};
-  const double gib = double(width) * height * (linear ? 16.0 : 4.0) / double(1 << 30);
+  const bool frame = allocateTarget(width, height, format);
+  if (frame && (!targets || targets_.allocate(width, height))) return {};
+  const double mib = double(width) * height / double(1 << 20);
   std::ostringstream out;
   out.precision(3);
-  out << width << "x" << height << (linear ? " float (EXR)" : " 8-bit") << " target of " << gib
-      << " GiB: this OpenGL cannot allocate it (llvmpipe allocates up to 1 GiB per target: "
-         "16384x16384 8-bit, 8192x8192 float); use a smaller size or an 8-bit format";
+  if (frame)
+    out << width << "x" << height << " target layers (" << mib * 20.0
+        << " MiB: RGBA16F, two R32F and a 32-bit depth buffer, for the scene's targets)";
+  else
+    out << width << "x" << height << (linear ? " float (EXR)" : " 8-bit") << " target of "
+        << mib * (linear ? 16.0 : 4.0) << " MiB";
+  out << ": this OpenGL cannot allocate it (llvmpipe: at most 2 GiB per buffer, so 16384x16384 "
+         "8-bit and 16384x8192 float); use a smaller size"
+      << (linear ? " or an 8-bit format" : "");
   return out.str();
 }
 
@@ -283,14 +299,19 @@ bool GlRenderer::allocateTarget(int width, int height, TargetFormat format) {
   if (colour_buffer_ && width == target_width_ && height == target_height_ &&
       format == target_format_)
     return true;
+  target_width_ = target_height_ = 0;
+  while (gl_.GetError() != GL_NO_ERROR) {
+  }
   colour_buffer_ = createRenderbuffer(gl_);
   gl_.NamedRenderbufferStorage(colour_buffer_.get(),
                                format == TargetFormat::kFloat ? GL_RGBA32F : GL_SRGB8_ALPHA8, width,
                                height);
   gl_.NamedFramebufferRenderbuffer(framebuffer_.get(), GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER,
                                    colour_buffer_.get());
+  // An allocation that fails may leave the framebuffer complete and flag GL_OUT_OF_MEMORY.
   if (gl_.CheckNamedFramebufferStatus(framebuffer_.get(), GL_FRAMEBUFFER) !=
-      GL_FRAMEBUFFER_COMPLETE) {
+          GL_FRAMEBUFFER_COMPLETE ||
+      gl_.GetError() != GL_NO_ERROR) {
     colour_buffer_ = GlObject();
     return false;
   }

@@ -49,7 +49,9 @@ class GlRenderer {
   // Allocates the target a width x height frame needs (linear float or 8-bit sRGB) and says,
   // before any work, when this GL cannot: what a platform can allocate depends on its memory
   // limits, not only on GL_MAX_RENDERBUFFER_SIZE. Empty when the target is ready.
-  std::string reserveTarget(int width, int height, bool linear);
+  // `targets`: the frame draws targets (the scene has some, or depth or object ids are asked),
+  // which need target layers of the same size.
+  std::string reserveTarget(int width, int height, bool linear, bool targets);
 
   // Far-cloud impostors rendered since construction (each reuse saves one).
   int impostorRenders() const { return ellipsoids_.impostorRenders(); }
@@ -81,6 +83,7 @@ class GlRenderer {
                        const RenderSettings& settings);
   void prepareTarget(int width, int height, TargetFormat format);
   bool allocateTarget(int width, int height, TargetFormat format);
+  void readPixels(int width, int height, GLenum type, void* out) const;
   GLuint program(const SkyPassLayout& layout);
   CachedTexture& cachedTexture(const LayerTextureSpec& spec, const RenderSettings& settings);
   GLuint gpuTexture(CachedTexture& cached, const RenderSettings& settings);

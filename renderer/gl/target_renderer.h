@@ -22,6 +22,8 @@ class TargetRenderer {
   // After draw: the distance along each pixel's unit view ray to the nearest target (1e30 where
   // none) and 1 + that target's index (0 where none), rows bottom-up as GL stores them.
   void read(std::vector<float>* distance, std::vector<float>* id) const;
+  // Allocates the width x height targets draw() uses; false when this GL cannot.
+  bool allocate(int width, int height);
 
  private:
   void prepare(int width, int height);

@@ -1,11 +1,14 @@
 // libFuzzer target for the bytes the daemon takes from the network: socket-protocol request
-// lines, Modbus TCP frames, Modbus register and coil writes, and CIGI datagrams. Built with clang
+// lines (with the cloud and target objects of add_cloud and add_target, which the world thread
+// reads through the scene-file readers), Modbus TCP frames, Modbus register and coil writes,
+// and CIGI datagrams. Built with clang
 // by tests/CMakeLists.txt and run briefly by ctest. The first input byte picks the decoder.
 #include <cstddef>
 #include <cstdint>
 #include <string_view>
 #include <vector>
 
+#include "config/scene_file.h"
 #include "protocol/cigi.h"
 #include "protocol/cigi_session.h"
 #include "protocol/messages.h"
@@ -77,10 +80,20 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (selector % 3 == 0) {
     const auto result = parseRequest(std::string_view(reinterpret_cast<const char*>(data), size));
     // Every outcome must turn into a reply line.
-    if (const auto* bad = std::get_if<BadRequest>(&result))
+    if (const auto* bad = std::get_if<BadRequest>(&result)) {
       (void)errorReply(bad->id, bad->error);
-    else
-      (void)okReply(std::get<Request>(result).id, commandName(std::get<Request>(result).command));
+      return 0;
+    }
+    const Command& command = std::get<Request>(result).command;
+    (void)okReply(std::get<Request>(result).id, commandName(command));
+    // The objects the world thread reads later, through the scene-file readers.
+    if (const auto* c = std::get_if<command::AddCloud>(&command)) {
+      EllipsoidCloud cloud;
+      (void)parseCloudJson(c->cloud, 1, cloud);
+    } else if (const auto* t = std::get_if<command::AddTarget>(&command)) {
+      Target target;
+      (void)parseTargetJson(t->target, {}, target);
+    }
     return 0;
   }
   if (size < 2) return 0;
