@@ -14,6 +14,9 @@
 #include <cstring>
 #include <future>
 
+#include "server/log_limiter.h"
+#include "server/tcp_peer.h"
+
 namespace nephele {
 namespace {
 
@@ -33,6 +36,17 @@ bool sendAll(int fd, const std::vector<std::uint8_t>& bytes) {
 
 }  // namespace
 
+bool ModbusServer::ClientState::connectionOver() {
+  std::lock_guard lock(fd_mutex);
+  return fd < 0 || peerHasClosed(fd);
+}
+
+void ModbusServer::ClientState::closeSocket() {
+  std::lock_guard lock(fd_mutex);
+  ::close(fd);
+  fd = -1;
+}
+
 ModbusServer::ModbusServer(Engine& engine) : engine_(engine) {}
 
 ModbusServer::~ModbusServer() {
@@ -48,8 +62,11 @@ std::string ModbusServer::listen(const ListenConfig& where) {
   listen_fd_ = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
   const int yes = 1;
   setsockopt(listen_fd_, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+  // The kernel's longest backlog, as the socket listener has: a burst of connections waits
+  // there for the accept thread instead of having its SYNs dropped (a client then retries
+  // only after a second).
   if (listen_fd_ < 0 || ::bind(listen_fd_, reinterpret_cast<sockaddr*>(&address), sizeof address) ||
-      ::listen(listen_fd_, 64)) {
+      ::listen(listen_fd_, SOMAXCONN)) {
     const std::string why = std::strerror(errno);
     if (listen_fd_ >= 0) ::close(listen_fd_);
     listen_fd_ = -1;
@@ -71,24 +88,63 @@ void ModbusServer::close() {
   std::lock_guard lock(clients_mutex_);
   for (Client& c : clients_) c.thread.join();
   clients_.clear();
+  listenerLog().flushAll();
+}
+
+int ModbusServer::activeClients() const {
+  return int(std::count_if(clients_.begin(), clients_.end(),
+                           [](const Client& c) { return !c.state->end; }));
+}
+
+void ModbusServer::makeRoom() {
+  // A peer that closed its connection (dropped in the middle of a frame, say) holds a slot
+  // for nothing: its thread may not have read the end yet, or not even started.
+  for (Client& c : clients_)
+    if (!c.state->end && c.state->connectionOver()) c.state->end = "closed";
+  if (activeClients() < engine_.config().modbus_max_clients) return;
+  // The newcomer takes the place of the client idle longest, if that has been idle (between
+  // frames) for at least the request timeout.
+  const Clock::rep now = Clock::now().time_since_epoch().count();
+  ClientState* idlest = nullptr;
+  Clock::rep longest = secondsToDuration(engine_.config().modbus_timeouts.request_s).count();
+  for (Client& c : clients_) {
+    ClientState& s = *c.state;
+    if (s.end || s.mid_request) continue;
+    if (const Clock::rep idle = now - s.last_activity; idle >= longest) {
+      longest = idle;
+      idlest = &s;
+    }
+  }
+  if (idlest) idlest->end = "evicted_idle";
 }
 
 void ModbusServer::acceptLoop() {
   const DaemonConfig& config = engine_.config();
   while (!stop_) {
+    listenerLog().flush();
     pollfd p{listen_fd_, POLLIN, 0};
     if (poll(&p, 1, kPollMs) <= 0) continue;
     sockaddr_in peer{};
     socklen_t length = sizeof peer;
     const int fd = ::accept4(listen_fd_, reinterpret_cast<sockaddr*>(&peer), &length, SOCK_CLOEXEC);
-    if (fd < 0) continue;
+    if (fd < 0) {
+      // Out of file descriptors, say: the connection stays in the backlog and the listening
+      // socket readable, so accepting again at once would spin; pause as the socket server does.
+      if (errno != EINTR && errno != ECONNABORTED && errno != EAGAIN) {
+        if (listenerLog().admit("modbus_accept_failed"))
+          spdlog::warn("event=modbus_accept_failed error=\"{}\"", std::strerror(errno));
+        std::this_thread::sleep_for(std::chrono::milliseconds(kPollMs));
+      }
+      continue;
+    }
     char text[INET_ADDRSTRLEN] = {};
     inet_ntop(AF_INET, &peer.sin_addr, text, sizeof text);
     const std::string address = text;
     const auto& allow = config.modbus_allow;
     if (std::find(allow.begin(), allow.end(), "*") == allow.end() &&
         std::find(allow.begin(), allow.end(), address) == allow.end()) {
-      spdlog::warn("event=modbus_refused peer={} reason=not_allowed", address);
+      if (listenerLog().admit("modbus_refused/not_allowed"))
+        spdlog::warn("event=modbus_refused peer={} reason=not_allowed", address);
       engine_.noteError(ErrorCode::kUnauthorized);
       ::close(fd);
       continue;
@@ -99,33 +155,15 @@ void ModbusServer::acceptLoop() {
       c.thread.join();
       return true;
     });
-    auto active = [&] {
-      return std::count_if(clients_.begin(), clients_.end(),
-                           [](const Client& c) { return !c.state->evict; });
-    };
-    if (active() >= config.modbus_max_clients) {
-      // At the limit, the newcomer takes the place of the client idle longest, if that has
-      // been idle (between frames) for at least the request timeout.
-      const Clock::rep now = Clock::now().time_since_epoch().count();
-      ClientState* idlest = nullptr;
-      Clock::rep longest = secondsToDuration(config.modbus_timeouts.request_s).count();
-      for (Client& c : clients_) {
-        ClientState& s = *c.state;
-        if (s.evict || s.mid_request) continue;
-        if (const Clock::rep idle = now - s.last_activity; idle >= longest) {
-          longest = idle;
-          idlest = &s;
-        }
-      }
-      if (idlest) idlest->evict = true;
-    }
-    if (active() >= config.modbus_max_clients) {
-      spdlog::warn("event=modbus_refused peer={} reason=max_clients", address);
+    if (activeClients() >= config.modbus_max_clients) makeRoom();
+    if (activeClients() >= config.modbus_max_clients) {
+      if (listenerLog().admit("modbus_refused/max_clients"))
+        spdlog::warn("event=modbus_refused peer={} reason=max_clients", address);
       engine_.noteError(ErrorCode::kLimit);
       ::close(fd);
       continue;
     }
-    auto state = std::make_shared<ClientState>();
+    auto state = std::make_shared<ClientState>(fd);
     state->last_activity = Clock::now().time_since_epoch().count();
     const std::string peer_name = address + ":" + std::to_string(ntohs(peer.sin_port));
     clients_.push_back({std::thread([this, fd, peer_name, state] {
@@ -138,7 +176,7 @@ void ModbusServer::acceptLoop() {
 
 void ModbusServer::serveClient(int fd, const std::string& peer, ClientState& state) {
   ++engine_.modbus_clients;
-  spdlog::info("event=modbus_connected peer={}", peer);
+  if (listenerLog().admit("modbus_connected")) spdlog::info("event=modbus_connected peer={}", peer);
   const Timeouts& timeouts = engine_.config().modbus_timeouts;
   // A client that does not read its replies is dropped rather than blocking this thread.
   const auto send_timeout = secondsToDuration(timeouts.request_s);
@@ -155,8 +193,8 @@ void ModbusServer::serveClient(int fd, const std::string& peer, ClientState& sta
   Clock::time_point last_activity = Clock::now();
   const char* why = "stop";
   while (!stop_) {
-    if (state.evict) {
-      why = "evicted_idle";
+    if (const char* end = state.end) {
+      why = end;
       break;
     }
     const auto now = Clock::now();
@@ -190,7 +228,8 @@ void ModbusServer::serveClient(int fd, const std::string& peer, ClientState& sta
           std::span<const std::uint8_t, ModbusFrame::kHeaderBytes>(frame.data(), 7));
       if (auto* e = std::get_if<std::string>(&decoded)) {
         // The stream cannot be framed past this header: close rather than guess.
-        spdlog::warn("event=modbus_bad_frame peer={} error=\"{}\"", peer, *e);
+        if (listenerLog().admit("modbus_bad_frame"))
+          spdlog::warn("event=modbus_bad_frame peer={} error=\"{}\"", peer, *e);
         engine_.noteError(ErrorCode::kBadField);
         why = "bad_frame";
         break;
@@ -213,15 +252,17 @@ void ModbusServer::serveClient(int fd, const std::string& peer, ClientState& sta
       break;
     }
   }
-  ::close(fd);
+  state.closeSocket();
   --engine_.modbus_clients;
-  spdlog::info("event=modbus_closed peer={} reason={}", peer, why);
+  if (listenerLog().admit(std::string("modbus_closed/") + why))
+    spdlog::info("event=modbus_closed peer={} reason={}", peer, why);
 }
 
 std::vector<std::uint8_t> ModbusServer::refuse(const MbapHeader& header,
                                                const ModbusException& exception) {
-  spdlog::warn("event=modbus_exception function=0x{:02x} code={} message=\"{}\"",
-               exception.function, exception.code, exception.message);
+  if (listenerLog().admit("modbus_exception"))
+    spdlog::warn("event=modbus_exception function=0x{:02x} code={} message=\"{}\"",
+                 exception.function, exception.code, exception.message);
   engine_.noteError(exception.code == kServerDeviceBusy ? ErrorCode::kBusy : ErrorCode::kBadField);
   return encodeModbusException(header, exception);
 }

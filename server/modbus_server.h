@@ -2,9 +2,9 @@
 // Modbus TCP for the host simulator, register map in protocol/MODBUS.md, frames decoded by
 // protocol/modbus_frame.h. Each client has its own thread, so a slow or half-written request
 // holds up only its sender; request and idle timeouts, and room made at the client limit by
-// closing the idlest connection, keep a few clients from starving the rest
-// (docs/RELIABILITY.md). Writes are decoded and checked before anything changes; a refused
-// one changes nothing.
+// ending connections whose peer has closed them and then the idlest, keep a few clients from
+// starving the rest (docs/RELIABILITY.md). Writes are decoded and checked before anything
+// changes; a refused one changes nothing.
 #include <atomic>
 #include <chrono>
 #include <memory>
@@ -32,16 +32,32 @@ class ModbusServer {
   using Clock = std::chrono::steady_clock;
   // What the accept thread knows of a client thread.
   struct ClientState {
+    explicit ClientState(int socket) : fd(socket) {}
+    // Whether the connection is over: closed by the client thread, which is ending, or by
+    // the peer, which the client thread may not have read yet (or not even started).
+    bool connectionOver();
+    void closeSocket();  // by the client thread, when it ends
+
     std::atomic<bool> finished{false};
-    std::atomic<bool> evict{false};        // set by the accept thread to make room
+    // Set by the accept thread to make room: why the client must end (nullptr: it need not).
+    std::atomic<const char*> end{nullptr};
     std::atomic<bool> mid_request{false};  // part of a frame has arrived
     std::atomic<Clock::rep> last_activity{0};
+
+   private:
+    std::mutex fd_mutex;  // the accept thread looks at the socket while the client may close it
+    int fd;               // -1 once closed
   };
   struct Client {
     std::thread thread;
     std::shared_ptr<ClientState> state;
   };
   void acceptLoop();
+  // At the client limit: ends the clients whose connection is over (closed by the peer), then,
+  // if that freed no slot, the one idle longest (at least the request timeout). Call with
+  // clients_mutex_ held.
+  void makeRoom();
+  int activeClients() const;  // not told to end; call with clients_mutex_ held
   void serveClient(int fd, const std::string& peer, ClientState& state);
   // The reply to one decoded request (an exception or the data).
   std::vector<std::uint8_t> answer(const ModbusRequest& request);

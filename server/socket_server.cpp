@@ -8,6 +8,9 @@
 #include <optional>
 #include <utility>
 
+#include "server/log_limiter.h"
+#include "server/tcp_peer.h"
+
 namespace nephele {
 
 using asio::ip::tcp;
@@ -65,11 +68,16 @@ class Connection : public std::enable_shared_from_this<Connection> {
 
   void start() {
     ++engine_.socket_clients;
-    spdlog::info("event=client_connected id={} peer={}", id_, peer_);
+    if (listenerLog().admit("client_connected"))
+      spdlog::info("event=client_connected id={} peer={}", id_, peer_);
     resume();
   }
 
   bool closed() const { return closed_; }
+
+  // Whether the peer has closed the connection while this side still reads it: no request
+  // can come any more, and replies still owed are dropped at its end of file anyway.
+  bool closedByPeer() { return !closed_ && !finishing_ && peerHasClosed(socket_.native_handle()); }
 
   void close(const char* why) {
     if (closed_.exchange(true)) return;
@@ -79,7 +87,8 @@ class Connection : public std::enable_shared_from_this<Connection> {
     if (drain_timer_) drain_timer_->cancel();
     --engine_.socket_clients;
     engine_.clientGone(id_);
-    spdlog::info("event=client_closed id={} peer={} reason={}", id_, peer_, why);
+    if (listenerLog().admit(std::string("client_closed/") + why))
+      spdlog::info("event=client_closed id={} peer={} reason={}", id_, peer_, why);
   }
 
   // Stops reading and closes once everything queued is written, or after `limit`.
@@ -253,7 +262,8 @@ class Connection : public std::enable_shared_from_this<Connection> {
       authorised_ = hello->token && tokenMatches(*hello->token, token);
       if (!authorised_) {
         ++bad_tokens_;
-        spdlog::warn("event=bad_token id={} peer={} count={}", id_, peer_, bad_tokens_);
+        if (listenerLog().admit("bad_token"))
+          spdlog::warn("event=bad_token id={} peer={} count={}", id_, peer_, bad_tokens_);
         const bool last = bad_tokens_ >= kMaxBadTokens;
         sendError(request.id, {ErrorCode::kUnauthorized,
                                last ? "token: wrong " + std::to_string(kMaxBadTokens) +
@@ -424,7 +434,11 @@ SocketServer::SocketServer(asio::io_context& io, Engine& engine)
       accept_timer_(io),
       refusing_(std::make_shared<std::atomic<int>>(0)) {}
 
-SocketServer::~SocketServer() = default;
+// Last of the listeners to go (serve destroys them in reverse order): what the log held back
+// until now, the lines of connections drained at shutdown included, is summarised.
+SocketServer::~SocketServer() {
+  listenerLog().flushAll();
+}
 
 std::string SocketServer::listen(const ListenConfig& where) {
   if (std::string e = openAcceptor(acceptor_, where, "socket"); !e.empty()) return e;
@@ -435,6 +449,7 @@ std::string SocketServer::listen(const ListenConfig& where) {
 }
 
 void SocketServer::sweep() {
+  listenerLog().flush();
   const auto now = Clock::now();
   std::erase_if(connections_, [&](const auto& entry) {
     Connection& c = *entry.second;
@@ -454,7 +469,8 @@ void SocketServer::accept() {
       if (ec != asio::error::operation_aborted) {
         // Out of file descriptors, say: the listening socket stays readable, so accepting
         // again at once would spin; try again after a pause.
-        spdlog::warn("event=accept_failed error=\"{}\"", ec.message());
+        if (listenerLog().admit("accept_failed"))
+          spdlog::warn("event=accept_failed error=\"{}\"", ec.message());
         accept_timer_.expires_after(kAcceptRetry);
         accept_timer_.async_wait([this](std::error_code e) {
           if (!e && !closed_) accept();
@@ -468,8 +484,15 @@ void SocketServer::accept() {
     dropClosed();
     const int max_clients = engine_.config().max_clients;
     if (int(connections_.size()) >= max_clients) {
-      // At the limit, a newcomer takes the place of the connection that has had nothing to
-      // do for longest, if that has been idle for at least the request timeout: idle
+      // At the limit, connections whose peer has closed them hold their slots for nothing
+      // (their end of file may be read after this handler): they go first.
+      for (auto& [id, c] : connections_)
+        if (c->closedByPeer()) c->close("eof");
+      dropClosed();
+    }
+    if (int(connections_.size()) >= max_clients) {
+      // Still at the limit, a newcomer takes the place of the connection that has had nothing
+      // to do for longest, if that has been idle for at least the request timeout: idle
       // connections never starve a working one.
       const auto now = Clock::now();
       std::shared_ptr<Connection> idlest;
@@ -483,7 +506,8 @@ void SocketServer::accept() {
       dropClosed();
     }
     if (int(connections_.size()) >= max_clients) {
-      spdlog::warn("event=client_refused reason=max_clients");
+      if (listenerLog().admit("client_refused/max_clients"))
+        spdlog::warn("event=client_refused reason=max_clients");
       engine_.noteError(ErrorCode::kLimit);
       if (refusing_->load() < kMaxRefusing) {
         refuseOverLimit(std::move(socket), max_clients, refusing_);
@@ -542,7 +566,8 @@ void MetricsServer::accept() {
   acceptor_.async_accept([this](std::error_code ec, tcp::socket socket) {
     if (ec == asio::error::operation_aborted || closed_) return;
     if (ec) {  // as SocketServer::accept: a pause, not a spin
-      spdlog::warn("event=metrics_accept_failed error=\"{}\"", ec.message());
+      if (listenerLog().admit("metrics_accept_failed"))
+        spdlog::warn("event=metrics_accept_failed error=\"{}\"", ec.message());
       accept_timer_.expires_after(kAcceptRetry);
       accept_timer_.async_wait([this](std::error_code e) {
         if (!e && !closed_) accept();
