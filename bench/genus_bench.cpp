@@ -156,6 +156,87 @@ void printBodyFigures(GlRenderer& renderer, const SceneFile& file) {
       under_sum / std::max(top_sum, 1e-9));
 }
 
+// A cloud's own light per unit opacity at pixel p: the frame is alpha C + (1 - alpha) sky, so
+// C = (frame - (1 - alpha) sky) / alpha, as linear luminance.
+double ownLuminance(const FloatImage& frame, const FloatImage& sky, int p) {
+  const float* c = &frame.rgba[4 * std::size_t(p)];
+  const float* s = &sky.rgba[4 * std::size_t(p)];
+  const double alpha = c[3];
+  double y = 0.0;
+  const double weights[3] = {0.2126, 0.7152, 0.0722};
+  for (int k = 0; k < 3; ++k) y += weights[k] * (c[k] - (1.0 - alpha) * s[k]) / alpha;
+  return y;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+// Light figures of a heap (issue 27, MODEL.md section 14): the largest heap of the tiles near
+// the origin, alone, seen level from 8 km. (b) With the sun 90 degrees to the right at 10
+// degrees up, the median luminance of the heap's right (sunlit) half over its left half,
+// pixels of coverage > 0.5 split at the centroid's column. (c) With the sun 12 degrees above
+// the line to the heap's middle, behind it, the median light per unit opacity of its thin
+// edge (coverage 0.05 to 0.5) over its body's (coverage > 0.95): a silver lining is > 1.
+void printLightFigures(GlRenderer& renderer, const SceneFile& file) {
+  if (file.scene.fields.empty()) return;
+  const CloudField& field = file.scene.fields.front();
+  EllipsoidCloud heap;
+  double widest = 0.0;
+  for (std::int64_t i = -1; i <= 1; ++i)
+    for (std::int64_t j = -1; j <= 1; ++j)
+      for (EllipsoidCloud& c : tileClouds(field, i, j)) {
+        const BoundingBox box = boundingBox(c);
+        if (box.hi.x - box.lo.x > widest) widest = box.hi.x - box.lo.x, heap = std::move(c);
+      }
+  if (heap.ellipsoids.empty()) return;
+  const BoundingBox box = boundingBox(heap);
+  const glm::dvec3 middle = 0.5 * (box.lo + box.hi);
+  Scene scene = file.scene;
+  scene.fields.clear();
+  scene.layers.clear();
+  scene.clouds = {heap};
+  Camera& c = scene.camera;
+  c.width = 480, c.height = 360;
+  c.position = middle - glm::dvec3(0.0, 8000.0, 0.0);  // looking north at it
+  c.orientation = {0.0, 0.0, 0.0};
+  c.vfov_deg = 2.0 * glm::degrees(std::atan(0.7 * std::max(box.hi.z - box.lo.z, widest) / 8000.0));
+  Scene clear = scene;
+  clear.clouds.clear();
+
+  scene.sun.azimuth_deg = 90.0, scene.sun.elevation_deg = 10.0;  // to the right (east)
+  const FloatImage side = renderer.renderFloat(scene, file.render);
+  const FloatImage side_sky = renderer.renderFloat(Scene(clear), file.render);
+  std::vector<int> covered;
+  double centroid = 0.0;
+  for (int p = 0; p < c.width * c.height; ++p)
+    if (side.rgba[4 * std::size_t(p) + 3] > 0.5f) covered.push_back(p), centroid += p % c.width;
+  centroid /= std::max<std::size_t>(covered.size(), 1);
+  std::vector<double> lit, away;
+  for (int p : covered)
+    (p % c.width >= centroid ? lit : away).push_back(ownLuminance(side, side_sky, p));
+
+  scene.sun.azimuth_deg = 0.0;  // behind it, 12 degrees above the line to its middle
+  scene.sun.elevation_deg = 12.0;
+  clear.sun = scene.sun;
+  const FloatImage back = renderer.renderFloat(scene, file.render);
+  const FloatImage back_sky = renderer.renderFloat(clear, file.render);
+  std::vector<double> edge, body;
+  for (int p = 0; p < c.width * c.height; ++p) {
+    const float alpha = back.rgba[4 * std::size_t(p) + 3];
+    if (alpha > 0.05f && alpha < 0.5f) edge.push_back(ownLuminance(back, back_sky, p));
+    if (alpha > 0.95f) body.push_back(ownLuminance(back, back_sky, p));
+  }
+  std::printf(
+      "  light: heap of %zu ellipsoids, %.0f m wide; sun 90 deg to the side: sunlit half / "
+      "shadowed half %.2f (%zu, %zu px); sun 12 deg behind: thin edge / body per unit opacity "
+      "%.2f (%zu, %zu px)\n",
+      heap.ellipsoids.size(), widest, median(lit) / std::max(median(away), 1e-9), lit.size(),
+      away.size(), median(edge) / std::max(median(body), 1e-9), edge.size(), body.size());
+}
+
 // Fraction of the sky hemisphere seen from the ground whose coverage exceeds one half, from
 // the five upper faces of a cube map (each pixel weighted by its solid angle, proportional to
 // (1 + u^2 + v^2)^-3/2 on a face at unit distance), averaged over four places 20 km apart.
@@ -337,6 +418,7 @@ int main(int argc, char** argv) {
     }
     GlRenderer renderer(*platform);
     printBodyFigures(renderer, file);
+    printLightFigures(renderer, file);
   }
   if (names.empty() || std::find(names.begin(), names.end(), "harbour") != names.end()) {
     GlRenderer renderer(*platform);

@@ -229,7 +229,8 @@ int runRenderCommand(const RenderCommandOptions& o) {
   const Camera& camera = file.scene.camera;
   const bool targets = !file.scene.targets.empty() || request.channels.has(Channel::kDepth) ||
                        request.channels.has(Channel::kObjectId);
-  if (std::string e = renderer->reserve(camera.width, camera.height, isFloatFormat(*format), targets);
+  if (std::string e =
+          renderer->reserve(camera.width, camera.height, isFloatFormat(*format), targets);
       !e.empty()) {
     spdlog::error("--width/--height: {}", e);
     return 2;

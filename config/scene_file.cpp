@@ -302,14 +302,15 @@ void readCluster(TableReader& t, std::uint64_t seed, std::vector<Ellipsoid>& out
 void readCloud(TableReader& t, std::uint64_t seed, EllipsoidCloud& cloud,
                CloudDevelopment& develop) {
   t.allow({"name", "colour", "threshold", "limb_threshold", "transition", "ambient",
-           "texture_fraction", "specular", "shininess", "seed", "texture", "cumulus", "cluster",
-           "ellipsoid", "develop"});
+           "texture_fraction", "specular", "shininess", "light_extinction", "seed", "texture",
+           "cumulus", "cluster", "ellipsoid", "develop"});
   t.name("name", cloud.name);
   t.vector("colour", cloud.colour, Limits::kColour);
   t.number("threshold", cloud.threshold_centre, Limits::kCloudThreshold);
   t.number("limb_threshold", cloud.threshold_limb, Limits::kCloudThreshold);
   t.number("transition", cloud.transition, Limits::kTransition);
   readShading(t, cloud.shading);
+  t.number("light_extinction", cloud.light_extinction, Limits::kLightExtinction);
   cloud.texture.seed = seed;
   t.seed("seed", cloud.texture.seed);
   if (auto texture = t.table("texture")) readSolidTexture(*texture, cloud.texture);

@@ -251,8 +251,8 @@ class TableReader {
       fail(node, key,
            std::to_string(integer->get()) + " cannot be held exactly (allowed: " +
                formatNumber(lo) + " to " + formatNumber(hi) + ")");
-    const double v = node.is_integer() ? double(node.as_integer()->get())
-                                       : node.as_floating_point()->get();
+    const double v =
+        node.is_integer() ? double(node.as_integer()->get()) : node.as_floating_point()->get();
     if (!std::isfinite(v))
       fail(node, key,
            formatNumber(v) + " is not a finite number (allowed: " + formatNumber(lo) + " to " +
@@ -267,8 +267,9 @@ class TableReader {
   std::int64_t toInteger(const toml::node& node, std::string_view key, std::int64_t lo,
                          std::int64_t hi) const {
     if (!node.is_integer())
-      fail(node, key,
-           "must be an integer (allowed: " + std::to_string(lo) + " to " + std::to_string(hi) + ")");
+      fail(
+          node, key,
+          "must be an integer (allowed: " + std::to_string(lo) + " to " + std::to_string(hi) + ")");
     const std::int64_t v = node.as_integer()->get();
     if (v < lo || v > hi)
       fail(node, key,

@@ -29,20 +29,36 @@ using nlohmann::json;
 
 // The edges, as the text a client or an operator writes. The inexact ones are integers no
 // binary64 holds; a reader must refuse them wherever it reads a number.
-const std::vector<std::string> kEdges = {
-    "9007199254740993",     "-9007199254740993",     "9223372036854775807",
-    "-9223372036854775808", "9223372036854775808",   "18446744073709551616",
-    "-0",                   "-0.0",                  "5e-324",
-    "-5e-324",              "1e308",                 "-1.7976931348623157e308",
-    "1",                    "1.0",                   "0.5"};
-const std::vector<std::string> kTomlEdges = {"9007199254740993", "9223372036854775807",
-                                             "-9223372036854775808", "-0.0", "5e-324", "1e308",
-                                             "1", "1.0"};
+const std::vector<std::string> kEdges = {"9007199254740993",
+                                         "-9007199254740993",
+                                         "9223372036854775807",
+                                         "-9223372036854775808",
+                                         "9223372036854775808",
+                                         "18446744073709551616",
+                                         "-0",
+                                         "-0.0",
+                                         "5e-324",
+                                         "-5e-324",
+                                         "1e308",
+                                         "-1.7976931348623157e308",
+                                         "1",
+                                         "1.0",
+                                         "0.5"};
+const std::vector<std::string> kTomlEdges = {"9007199254740993",
+                                             "9223372036854775807",
+                                             "-9223372036854775808",
+                                             "-0.0",
+                                             "5e-324",
+                                             "1e308",
+                                             "1",
+                                             "1.0"};
 bool inexact(const std::string& edge) {
   return edge == "9007199254740993" || edge == "-9007199254740993";
 }
 // Integer fields, where every int64 may be legal.
-bool integerField(const std::string& key) { return key == "seed" || key == "subscription"; }
+bool integerField(const std::string& key) {
+  return key == "seed" || key == "subscription";
+}
 
 std::string readFile(const std::filesystem::path& path) {
   std::ifstream in(path);
@@ -121,7 +137,8 @@ std::vector<json> requests() {
       json::parse(R"({"id":1,"cmd":"subscribe","view":"front","rate":5})"),
       json::parse(R"({"id":1,"cmd":"unsubscribe","subscription":3})"),
   };
-  for (const auto& entry : std::filesystem::directory_iterator(NEPHELE_SOURCE_DIR "/config/scenes")) {
+  for (const auto& entry :
+       std::filesystem::directory_iterator(NEPHELE_SOURCE_DIR "/config/scenes")) {
     if (entry.path().extension() != ".toml") continue;
     const toml::table scene = toml::parse_file(entry.path().string());
     for (const char* kind : {"cloud", "target"}) {
@@ -146,8 +163,8 @@ std::vector<json> requests() {
 TEST(NumericEdges, EveryRequestFieldRefusesWhatItCannotHoldAndNamesTheField) {
   int tried = 0, refused = 0;
   for (const json& request : requests()) {
-    ASSERT_EQ(readRequest(request.dump()), "") << "the unaltered request must be accepted: "
-                                               << request.dump();
+    ASSERT_EQ(readRequest(request.dump()), "")
+        << "the unaltered request must be accepted: " << request.dump();
     std::vector<Leaf> leaves;
     numericLeaves(request, json::json_pointer(), "", leaves);
     for (const Leaf& leaf : leaves) {
@@ -164,7 +181,8 @@ TEST(NumericEdges, EveryRequestFieldRefusesWhatItCannotHoldAndNamesTheField) {
         }
         ++refused;
         EXPECT_NE(error.find(leaf.key), std::string::npos)
-            << "the error does not name " << leaf.key << ": " << error << "\n" << line;
+            << "the error does not name " << leaf.key << ": " << error << "\n"
+            << line;
       }
     }
   }
@@ -186,7 +204,8 @@ void tomlLeaves(const toml::node& node, const std::string& path, const std::stri
   if (node.is_number() && seen.insert(path).second)
     out.push_back({node.source().begin.line, node.source().begin.column, key});
   if (const toml::table* t = node.as_table())
-    for (auto&& [k, v] : *t) tomlLeaves(v, path + "." + std::string(k.str()), std::string(k.str()), seen, out);
+    for (auto&& [k, v] : *t)
+      tomlLeaves(v, path + "." + std::string(k.str()), std::string(k.str()), seen, out);
   if (const toml::array* a = node.as_array())
     for (const toml::node& v : *a) tomlLeaves(v, path, key, seen, out);
 }
@@ -197,15 +216,17 @@ std::string withTomlEdge(const std::string& text, const TomlLeaf& leaf, const st
   for (std::size_t line = 1; line < leaf.line; ++line) at = text.find('\n', at) + 1;
   at += leaf.column - 1;
   std::size_t end = at;
-  while (end < text.size() && std::string_view("+-0123456789.eE_xobXOBabcdefABCDEFinf").find(
-                                  text[end]) != std::string_view::npos)
+  while (end < text.size() &&
+         std::string_view("+-0123456789.eE_xobXOBabcdefABCDEFinf").find(text[end]) !=
+             std::string_view::npos)
     ++end;
   return text.substr(0, at) + edge + text.substr(end);
 }
 
 // Every numeric value of every file a reader takes, each edge in turn.
-void checkTomlFiles(const std::vector<std::filesystem::path>& files,
-                    const std::function<std::string(const std::string&, const std::string&)>& read) {
+void checkTomlFiles(
+    const std::vector<std::filesystem::path>& files,
+    const std::function<std::string(const std::string&, const std::string&)>& read) {
   int tried = 0;
   std::set<std::string> seen;
   for (const auto& path : files) {
@@ -249,11 +270,12 @@ TEST(NumericEdges, EverySceneFileKeyRefusesWhatItCannotHoldAndNamesTheKey) {
 }
 
 TEST(NumericEdges, EveryDaemonConfigKeyRefusesWhatItCannotHoldAndNamesTheKey) {
-  checkTomlFiles({NEPHELE_SOURCE_DIR "/config/daemon.toml", NEPHELE_SOURCE_DIR "/deploy/nephele.toml"},
-                 [](const std::string& text, const std::string& name) {
-                   DaemonConfig config;
-                   return parseDaemonConfig(text, name, config);
-                 });
+  checkTomlFiles(
+      {NEPHELE_SOURCE_DIR "/config/daemon.toml", NEPHELE_SOURCE_DIR "/deploy/nephele.toml"},
+      [](const std::string& text, const std::string& name) {
+        DaemonConfig config;
+        return parseDaemonConfig(text, name, config);
+      });
 }
 
 TEST(NumericEdges, EveryDatasetKeyRefusesWhatItCannotHoldAndNamesTheKey) {

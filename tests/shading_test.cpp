@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "world/formations/heap_light.h"
+
 #include <cmath>
 #include <limits>
 
@@ -65,6 +67,59 @@ TEST(GardnerIntensity, NormalTurnsTowardsViewerAndBackLitHasNoHighlight) {
   ShadingParams diffuse{0.0, 0.0, 0.0, 1.0};
   EXPECT_EQ(gardnerIntensity(diffuse, 0.5, {0, 0, -1}, l, {0, 0, 1}), 1.0);
   EXPECT_EQ(gardnerIntensity({1.0, 0.0, 0.0, 1.0}, 0.0, {0, 0, 1}, l, {0, 0, -1}), 1.0);
+}
+
+// MODEL.md section 14, against values worked by hand: a sphere of radius 100 m whose centre is
+// 300 m above another's takes away 200 m of the lower one's light straight up.
+TEST(HeapLight, TransmittanceThroughTheOtherLobes) {
+  EllipsoidCloud cloud;
+  cloud.light_extinction = 0.02;
+  Ellipsoid lower, upper, aside;
+  lower.radii = upper.radii = aside.radii = glm::dvec3(100.0);
+  lower.centre = {0.0, 0.0, 1000.0};
+  upper.centre = {0.0, 0.0, 1300.0};
+  aside.centre = {5000.0, 0.0, 1000.0};
+  cloud.ellipsoids = {lower, upper, aside};
+  const glm::dvec3 up(0.0, 0.0, 1.0);
+  const std::vector<LobeLight> lights = lobeLights(cloud, up);              // the sun overhead
+  const double through = 1.0 / (1.0 + 0.75 * (1.0 - 0.85) * 0.02 * 200.0);  // two-stream
+  EXPECT_NEAR(lights[0].sun, through, 1e-12);
+  EXPECT_NEAR(lights[0].sky, 0.5 + 0.5 * through, 1e-12);
+  for (int i : {1, 2}) {
+    EXPECT_DOUBLE_EQ(lights[i].sun, 1.0) << i;
+    EXPECT_DOUBLE_EQ(lights[i].sky, 1.0) << i;
+  }
+  // The sun from the side: nothing lies east of the lower lobe but the distant one, which a
+  // ray 5 km long at its height passes through the middle of.
+  const std::vector<LobeLight> east = lobeLights(cloud, {1.0, 0.0, 0.0});
+  EXPECT_NEAR(east[0].sun, through, 1e-12);
+  EXPECT_DOUBLE_EQ(east[1].sun, 1.0);
+  // Off: every lobe takes all the light, and the intensity is eq. 8.
+  cloud.light_extinction = 0.0;
+  for (const LobeLight& l : lobeLights(cloud, up)) EXPECT_EQ(l.sun + l.sky, 2.0);
+  const glm::dvec3 n(0.0, -1.0, 0.0), to_sun = glm::normalize(glm::dvec3(0.3, -1.0, 0.5));
+  const glm::dvec3 d(0.0, 1.0, 0.0);
+  EXPECT_DOUBLE_EQ(heapIntensity(cloud, LobeLight{0.3, 0.6}, 0.4, n, to_sun, d, 0.7),
+                   gardnerIntensity(cloud.shading, 0.4, n, to_sun, -d));
+}
+
+TEST(HeapLight, EquationWithSunSkyAndForwardScattering) {
+  EllipsoidCloud cloud;
+  cloud.light_extinction = 0.02;
+  cloud.shading = {0.3, 0.2, 0.0, 8.0};
+  const glm::dvec3 to_sun = glm::normalize(glm::dvec3(0.0, 1.0, 0.2));  // behind the surface
+  const glm::dvec3 d(0.0, 1.0, 0.0), n(0.0, -1.0, 0.0);  // looking north at a face turned south
+  const LobeLight light{0.5, 0.8};
+  // Id = 0 (the face is turned from the sun): I = (1 - a) t It + a K + S P / (4 pi) TR, with
+  // P the Cornette-Shanks phase (g = 0.85) at cos theta = d . L.
+  const double c = glm::dot(d, to_sun), g = 0.85;
+  const double phase = 1.5 * (1.0 - g * g) / (2.0 + g * g) * (1.0 + c * c) /
+                       std::pow(1.0 + g * g - 2.0 * g * c, 1.5);
+  const double expected = 0.7 * 0.2 * 0.4 + 0.3 * 0.8 + 0.5 * phase / (4.0 * M_PI) * 0.25;
+  EXPECT_NEAR(heapIntensity(cloud, light, 0.4, n, to_sun, d, 0.25), expected, 1e-12);
+  // A thin edge against the sun gives off more per unit opacity than the opaque body.
+  EXPECT_GT(heapIntensity(cloud, light, 0.4, n, to_sun, d, 0.9),
+            1.2 * heapIntensity(cloud, light, 0.4, n, to_sun, d, 0.0));
 }
 
 }  // namespace

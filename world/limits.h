@@ -31,7 +31,9 @@ inline bool outOfRange(std::ostream& out, const char* name, double value, Range 
 // beyond. Where a reader takes a number, an integer outside +-2^53 is refused rather than
 // rounded, in every reader alike (scene files, configs, requests).
 inline constexpr std::int64_t kMaxExactInteger = std::int64_t(1) << 53;
-inline bool heldExactly(std::int64_t v) { return v >= -kMaxExactInteger && v <= kMaxExactInteger; }
+inline bool heldExactly(std::int64_t v) {
+  return v >= -kMaxExactInteger && v <= kMaxExactInteger;
+}
 
 struct Limits {
   // Camera and image.
@@ -59,6 +61,7 @@ struct Limits {
   static constexpr Range kTransition{0.0, 10.0};      // D; 0 is a hard threshold
   static constexpr Range kFraction{0.0, 1.0};         // a, t, s of eq. 8; probabilities
   static constexpr Range kShininess{1.0, 1000.0};
+  static constexpr Range kLightExtinction{0.0, 1.0};  // per metre, through a heap (section 14)
   static constexpr Range kColour{0.0, 100.0};         // linear RGB; above 1 for bright HDR suns
   static constexpr Range kContrastOffset{0.0, 10.0};  // Gardner's T0
   static constexpr Range kTermRotation{0.0, 90.0};    // lattice-breaking angle, degrees

@@ -22,18 +22,23 @@ double gardnerIntensity(const ShadingParams& shading, double diffuse, double hig
          a;  // Gardner eq. 8
 }
 
-double gardnerIntensity(const ShadingParams& shading, double texture_value, glm::dvec3 normal,
-                        glm::dvec3 to_sun, glm::dvec3 to_viewer) {
+DiffuseHighlight diffuseHighlight(const ShadingParams& shading, glm::dvec3 normal,
+                                  glm::dvec3 to_sun, glm::dvec3 to_viewer) {
   glm::dvec3 n = glm::normalize(normal);
   if (glm::dot(n, to_viewer) < 0.0) n = -n;
   const double n_dot_l = glm::dot(n, to_sun);
-  const double diffuse = std::max(0.0, n_dot_l);
-  double highlight = 0.0;
+  DiffuseHighlight out{std::max(0.0, n_dot_l), 0.0};
   if (n_dot_l > 0.0 && shading.specular > 0.0) {
     const glm::dvec3 reflected = 2.0 * n_dot_l * n - to_sun;
-    highlight = std::pow(std::max(0.0, glm::dot(reflected, to_viewer)), shading.shininess);
+    out.highlight = std::pow(std::max(0.0, glm::dot(reflected, to_viewer)), shading.shininess);
   }
-  return gardnerIntensity(shading, diffuse, highlight, texture_value);
+  return out;
+}
+
+double gardnerIntensity(const ShadingParams& shading, double texture_value, glm::dvec3 normal,
+                        glm::dvec3 to_sun, glm::dvec3 to_viewer) {
+  const DiffuseHighlight d = diffuseHighlight(shading, normal, to_sun, to_viewer);
+  return gardnerIntensity(shading, d.diffuse, d.highlight, texture_value);
 }
 
 double sphereDiffuse(double cos_alpha) {

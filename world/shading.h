@@ -15,6 +15,14 @@ struct ShadingParams {
 double gardnerIntensity(const ShadingParams& shading, double diffuse, double highlight,
                         double texture_value);
 
+// Id = max(0, N.L) and Is = max(0, R.V)^e at a surface (0 where N.L <= 0 or s = 0), N turned
+// towards the viewer.
+struct DiffuseHighlight {
+  double diffuse = 0.0, highlight = 0.0;
+};
+DiffuseHighlight diffuseHighlight(const ShadingParams& shading, glm::dvec3 normal,
+                                  glm::dvec3 to_sun, glm::dvec3 to_viewer);
+
 // Gardner eq. 8 at a surface: Id and Is from the geometry. `normal` is any surface normal
 // (it is turned towards the viewer here), `to_sun` and `to_viewer` are unit vectors.
 double gardnerIntensity(const ShadingParams& shading, double texture_value, glm::dvec3 normal,

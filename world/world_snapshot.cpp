@@ -16,6 +16,7 @@
 #include <xxhash.h>
 
 #include "world/file_output.h"
+#include "world/limits.h"
 #include "world/world.h"
 
 namespace nephele {
@@ -24,7 +25,7 @@ namespace {
 static_assert(std::endian::native == std::endian::little, "snapshots assume a little-endian host");
 
 constexpr char kMagic[8] = {'N', 'E', 'P', 'H', 'S', 'N', 'A', 'P'};
-constexpr std::uint32_t kFormatVersion = 5;
+constexpr std::uint32_t kFormatVersion = 6;
 constexpr std::size_t kHeaderBytes = sizeof kMagic + 4 + 8 + 8;
 
 class Writer {
@@ -184,8 +185,10 @@ void io(A& a, Ellipsoid& e) {
 template <class A>
 void io(A& a, EllipsoidCloud& c) {
   io(a, c.name), io(a, c.colour), io(a, c.threshold_centre), io(a, c.threshold_limb);
-  io(a, c.transition), io(a, c.shading), io(a, c.texture), io(a, c.ellipsoids, 72),
-      io(a, c.drift_m);
+  io(a, c.transition), io(a, c.shading), io(a, c.light_extinction), io(a, c.texture),
+      io(a, c.ellipsoids, 72), io(a, c.drift_m);
+  if (!Limits::kLightExtinction.contains(c.light_extinction))
+    a.fail("cloud " + c.name + ": light_extinction out of range");
 }
 template <class A>
 void io(A& a, std::array<std::uint32_t, 3>& triangle) {

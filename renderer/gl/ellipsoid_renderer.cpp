@@ -9,8 +9,10 @@
 
 #include "renderer/gl/sky_shaders.h"
 #include "renderer/gl/view_uniforms.h"
+#include "world/automaton/cloud_density.h"
 #include "world/check.h"
 #include "world/formations/ellipsoid.h"
+#include "world/formations/heap_light.h"
 
 namespace nephele {
 namespace {
@@ -168,6 +170,7 @@ bool makeEllipsoidRecord(const Ellipsoid& e, const Camera& camera, EllipsoidReco
   for (int i = 0; i < 3; ++i) out.v[11 + i] = row(body[i] * e.radii[i]);
   out.v[14] = row(e.centre - camera.position);
   out.v[15] = glm::vec4(0.0f);
+  out.v[16] = glm::vec4(1.0f, 1.0f, 0.0f, 0.0f);
   centre_distance = glm::length(e.centre - camera.position);
   return true;
 }
@@ -279,6 +282,8 @@ void EllipsoidRenderer::setCloudUniforms(GLuint p, const Scene& scene, const Ell
   setUniform3(gl_, p, "u_thresholds",
               {cloud.threshold_centre, cloud.threshold_limb, cloud.transition});
   setUniform3(gl_, p, "u_to_sun", sunDirection(scene.sun));
+  const glm::vec2 forward(cloud.light_extinction > 0.0 ? 1.0f : 0.0f, float(kDiffuseAsymmetry));
+  gl_.ProgramUniform2fv(p, gl_.GetUniformLocation(p, "u_scatter"), 1, &forward.x);
   // The precision rule of MODEL.md section 2: the texture's local origin is the eye, reduced modulo
   // the period in double; shaders see camera-relative offsets only.
   const SolidTexture& texture = *cached.source;
@@ -332,11 +337,11 @@ std::string impostorKey(const Scene& scene, const EllipsoidCloud& cloud,
   key << cloud.colour.x << cloud.colour.y << cloud.colour.z << '/' << cloud.threshold_centre << '/'
       << cloud.threshold_limb << '/' << cloud.transition << '/' << cloud.shading.ambient << '/'
       << cloud.shading.texture_fraction << '/' << cloud.shading.specular << '/'
-      << cloud.shading.shininess << '/' << textureKey(cloud.texture, settings) << '/'
-      << int(settings.ellipsoid_passes) << int(settings.ellipsoid_order) << int(settings.limb)
-      << int(settings.term_filter) << '/' << scene.sun.azimuth_deg << '/' << scene.sun.elevation_deg
-      << '/' << scene.sun.colour.x << scene.sun.colour.y << scene.sun.colour.z << '/'
-      << scene.fog.has_value();
+      << cloud.shading.shininess << '/' << cloud.light_extinction << '/'
+      << textureKey(cloud.texture, settings) << '/' << int(settings.ellipsoid_passes)
+      << int(settings.ellipsoid_order) << int(settings.limb) << int(settings.term_filter) << '/'
+      << scene.sun.azimuth_deg << '/' << scene.sun.elevation_deg << '/' << scene.sun.colour.x
+      << scene.sun.colour.y << scene.sun.colour.z << '/' << scene.fog.has_value();
   if (scene.fog) key << scene.fog->top_m << '/' << scene.fog->visibility_m;
   for (const Ellipsoid& e : cloud.ellipsoids)
     key << '|' << e.radii.x << ',' << e.radii.y << ',' << e.radii.z << ',' << e.centre.x << ','
@@ -447,10 +452,13 @@ void EllipsoidRenderer::drawCloudDirect(const Scene& scene, std::size_t index,
   // Visible ellipsoids, back to front by centre distance; the nearest surface distance.
   std::vector<std::pair<double, EllipsoidRecord>> visible;
   double nearest_m = std::numeric_limits<double>::infinity();
-  for (const Ellipsoid& e : cloud.ellipsoids) {
+  const std::vector<LobeLight> lights = lobeLights(cloud, sunDirection(scene.sun));
+  for (std::size_t i = 0; i < cloud.ellipsoids.size(); ++i) {
+    const Ellipsoid& e = cloud.ellipsoids[i];
     EllipsoidRecord record;
     double distance = 0.0;
     if (!makeEllipsoidRecord(e, scene.camera, record, distance)) continue;
+    record.v[16] = glm::vec4(float(lights[i].sun), float(lights[i].sky), 0.0f, 0.0f);
     visible.push_back({distance, record});
     nearest_m = std::min(nearest_m, distance - std::max({e.radii.x, e.radii.y, e.radii.z}));
   }

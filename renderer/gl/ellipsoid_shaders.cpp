@@ -17,6 +17,7 @@ struct EllipsoidRecord {
   vec4 body[3];    // columns of R S: unit sphere to camera-relative offsets
   vec4 centre;     // centre - eye
   vec4 tile;       // atlas tile: texel origin xy, size zw
+  vec4 light;      // x sunlight, y sky light reaching it through its heap (MODEL.md section 14)
 };
 layout(std430, binding = 0) readonly buffer EllipsoidRecords { EllipsoidRecord u_e[]; };
 )";
@@ -30,6 +31,7 @@ uniform vec3 u_thresholds;    // T1, T2, D
 uniform vec3 u_to_sun;
 uniform vec3 u_tex_origin;    // texture coordinate of the eye, periods, in [0, 1)
 uniform vec3 u_inv_period;    // periods per metre
+uniform vec2 u_scatter;       // x: 1 with the heap's light (MODEL.md section 14), else 0; y: g
 
 vec3 toUnit(int i, vec3 v) {
   return vec3(dot(u_e[i].w[0].xyz, v), dot(u_e[i].w[1].xyz, v), dot(u_e[i].w[2].xyz, v));
@@ -119,9 +121,19 @@ float solidValue(vec3 p, vec3 dpdx, vec3 dpdy) {
 }
 #endif
 
-// Gardner eq. 8 times cloud and sun colour, fogged; n faces the viewer, r points at the
-// surface from the eye, `distance` in metres.
-vec3 surfaceColour(vec3 n, vec3 r, float it, float distance) {
+// L.sun P(cos theta) / (4 pi), P Cornette-Shanks (Shen eq. 11) with asymmetry g.
+float forwardScattered(float sun, float c) {
+  float g = u_scatter.y, g2 = g * g;
+  return sun * 1.5 * (1.0 - g2) / (2.0 + g2) * (1.0 + c * c) /
+         pow(max(1.0 + g2 - 2.0 * g * c, 1e-6), 1.5) / (4.0 * kPi);
+}
+
+// Gardner eq. 8 with the light reaching ellipsoid i through its heap, plus the light scattered
+// forward through the surface's translucence tr (MODEL.md section 14), times cloud and sun
+// colour, fogged; n faces the viewer, r points at the surface from the eye, `distance` in
+// metres.
+vec3 surfaceColour(int i, vec3 n, vec3 r, float it, float tr, float distance) {
+  vec2 light = u_e[i].light.xy;
   float n_dot_l = dot(n, u_to_sun);
   float diffuse = max(n_dot_l, 0.0);
   float highlight = 0.0;
@@ -131,8 +143,11 @@ vec3 surfaceColour(vec3 n, vec3 r, float it, float distance) {
     highlight = pow(max(dot(reflected, -normalize(r)), 0.0), u_shading.w);
   }
 #endif
-  return applyFog(gardnerIntensity(u_shading, diffuse, highlight, it) * u_cloud_colour,
-                  normalize(r), distance);
+  float intensity = gardnerIntensity(u_shading, light.x * diffuse, light.x * highlight, it) +
+                    u_shading.x * (light.y - 1.0);
+  vec3 d = normalize(r);
+  intensity += u_scatter.x * forwardScattered(light.x, dot(d, u_to_sun)) * tr;
+  return applyFog(intensity * u_cloud_colour, d, distance);
 }
 
 // Gardner eq. 11 given the threshold excess x = It - T1 - (T2 - T1)(1 - g): opacity 1 - TR.
@@ -150,8 +165,9 @@ vec4 ellipsoidSurface(int i, vec3 r, float s) {
   vec3 dpdy = s * (dry - r * (dot(n, dry) / n_dot_r));
   float it = solidValue(p, dpdx, dpdy);
   float excess = it - u_thresholds.x - (u_thresholds.y - u_thresholds.x) * (1.0 - limbG(i, r));
-  float alpha = opacityFromExcess(excess) * u_e[i].limb_axis.w;
-  return vec4(surfaceColour(n, r, it, s * length(r)) * alpha, alpha);
+  float opacity = opacityFromExcess(excess);
+  float alpha = opacity * u_e[i].limb_axis.w;
+  return vec4(surfaceColour(i, n, r, it, 1.0 - opacity, s * length(r)) * alpha, alpha);
 }
 
 // Whether a hit at s (units of r) shows in this pass: in front of the ground and targets,
@@ -257,7 +273,8 @@ void main() {
 #else
   vec3 n = normalize(gradientFromUnit(u_index, v_unit));
   if (dot(n, p) > 0.0) n = -n;
-  o_colour = vec4(surfaceColour(n, p, it, length(p)), 0.0);
+  float excess = it - u_thresholds.x - (u_thresholds.y - u_thresholds.x) * (1.0 - limbG(u_index, p));
+  o_colour = vec4(surfaceColour(u_index, n, p, it, 1.0 - opacityFromExcess(excess), length(p)), 0.0);
 #endif
 }
 )";

@@ -33,7 +33,7 @@ struct EllipsoidPassLayout {
 };
 
 // Per-ellipsoid record in the shader storage buffer (std430, 16 vec4).
-inline constexpr int kEllipsoidRecordVec4s = 16;
+inline constexpr int kEllipsoidRecordVec4s = 17;
 // Storage-buffer and texture binding points.
 inline constexpr int kEllipsoidBufferBinding = 0;
 inline constexpr int kBinBufferBinding = 1;

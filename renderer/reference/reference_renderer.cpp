@@ -10,6 +10,7 @@
 
 #include "world/automaton/cloud_density.h"
 #include "world/formations/ellipsoid.h"
+#include "world/formations/heap_light.h"
 #include "world/frames.h"
 #include "world/textures/layer_texture.h"
 
@@ -57,7 +58,8 @@ struct RayLabels {
 struct EllipsoidEntry {
   EllipsoidView view;
   std::size_t cloud;
-  double fade;  // in-cloud model: the surface fades as the eye nears it
+  double fade;      // in-cloud model: the surface fades as the eye nears it
+  LobeLight light;  // MODEL.md section 14
 };
 
 class ReferenceTracer {
@@ -69,11 +71,12 @@ class ReferenceTracer {
     std::vector<const SolidTexture*> solid_pointers;
     for (std::size_t c = 0; c < scene.clouds.size(); ++c) {
       solid_pointers.push_back(&solid_textures_.emplace_back(scene.clouds[c].texture));
-      for (const Ellipsoid& e : scene.clouds[c].ellipsoids) {
-        EllipsoidView view(e, scene.camera.position);
+      const std::vector<LobeLight> lights = lobeLights(scene.clouds[c], sun_);
+      for (std::size_t i = 0; i < lights.size(); ++i) {
+        EllipsoidView view(scene.clouds[c].ellipsoids[i], scene.camera.position);
         if (view.eyeInside()) continue;  // MODEL.md section 4: no surface to show
         const double fade = surfaceFade(view.eyeRadius());
-        if (fade > 0.0) ellipsoids_.push_back({view, c, fade});
+        if (fade > 0.0) ellipsoids_.push_back({view, c, fade, lights[i]});
       }
     }
     veil_ = inCloudVeil(
@@ -191,8 +194,8 @@ class ReferenceTracer {
     const double t = solid_textures_[entry.cloud].value(p - scene_.clouds[entry.cloud].drift_m);
     const double tr = ellipsoidTranslucence(t, cloud.threshold_centre, cloud.threshold_limb,
                                             entry.view.limb(direction), cloud.transition);
-    const double intensity =
-        gardnerIntensity(cloud.shading, t, entry.view.normalAt(direction, s), sun_, -direction);
+    const double intensity = heapIntensity(cloud, entry.light, t, entry.view.normalAt(direction, s),
+                                           sun_, direction, tr);
     return {s, withFog(intensity * cloud.colour * scene_.sun.colour, direction, s),
             (1.0 - tr) * entry.fade, s};
   }

@@ -13,10 +13,12 @@
 
 #include "world/counter_random.h"
 #include "world/formations/cluster.h"
+#include "world/formations/heap_light.h"
 #include "world/formations/weather.h"
 #include "world/frames.h"
 #include "world/limits.h"
 #include "world/scene.h"
+#include "world/sky.h"
 #include "world/textures/solid_texture.h"
 
 namespace nephele {
@@ -33,11 +35,13 @@ enum Draw : std::uint64_t { kCount = 1, kX, kY, kSize, kHeight, kShape, kKeep, k
 // opaque whatever the texture; T2 above one makes the limb clear; D sets how soft the edge is.
 // With these the opacity-1/2 outline seen straight down lies at rho^2 = (It - T1 - D/2) /
 // (T2 - T1) of the ellipsoid's projected radius.
+// light_extinction (MODEL.md section 14): 20 per km puts the sky light under a heap's middle at
+// about a third of the open sky's, and the sunlight behind a lobe at a half to a quarter.
 struct HeapLook {
-  double colour, ambient, texture_fraction, t1, t2, d;
+  double colour, ambient, texture_fraction, t1, t2, d, light_extinction;
 };
-constexpr HeapLook kCumulusLook{1.0, 0.38, 0.45, -0.6, 1.0, 0.3};
-constexpr HeapLook kCumulonimbusLook{0.9, 0.3, 0.4, -0.6, 1.0, 0.3};
+constexpr HeapLook kCumulusLook{1.0, 0.3, 0.2, -0.6, 1.0, 0.3, 0.02};
+constexpr HeapLook kCumulonimbusLook{0.9, 0.25, 0.2, -0.6, 1.0, 0.3, 0.02};
 
 bool isCb(const CloudField& f) {
   return f.type == CloudType::kCumulonimbus;
@@ -152,6 +156,7 @@ EllipsoidCloud heapCloud(const CloudField& f, std::string name) {
   cloud.transition = look.d;
   cloud.shading.ambient = look.ambient;
   cloud.shading.texture_fraction = look.texture_fraction;
+  cloud.light_extinction = look.light_extinction;
   // One texture for the whole field (the renderer caches textures by their parameters); it is
   // solid, so every heap shows a different part of it.
   cloud.texture.seed = hashCounters(f.seed, 0x54657874ull);
@@ -500,7 +505,31 @@ bool planeSeenBeyond(const Camera& camera, double altitude, double range) {
 // renderer need not draw the heaps once per side of it), drawn for the field's coverage in its
 // region, lit like the heaps, drifting with them, with a hole of `range` around the camera.
 // Its threshold is calibrated once per field (a few milliseconds).
-CloudLayer farDeck(const CloudField& f, double range) {
+// The far deck's look: the heap's eq. 8 with the mean light its lobes take (MODEL.md section
+// 14), lobes weighted by their horizontal cross-section, for one typical heap of the field.
+// I = (1 - a)(1 - t) S Id + (1 - a) t It + a K is eq. 8 with a' = a K / c, t' = (1 - a) t /
+// ((1 - a)((1 - t) S + t)) and the colour times c = (1 - a)((1 - t) S + t) + a K.
+void lightFarDeck(const CloudField& f, glm::dvec3 to_sun, CloudLayer& deck) {
+  EllipsoidCloud heap = heapCloud(f, "");
+  heap.ellipsoids = heapEllipsoids(f, glm::dvec3(0.0, 0.0, f.base_m), 1.0, 1.0, f.seed, true);
+  const std::vector<LobeLight> lights = lobeLights(heap, to_sun);
+  double sun = 0.0, sky = 0.0, weight = 0.0;
+  for (std::size_t i = 0; i < lights.size(); ++i) {
+    const double w = heap.ellipsoids[i].radii.x * heap.ellipsoids[i].radii.y;
+    sun += w * lights[i].sun, sky += w * lights[i].sky, weight += w;
+  }
+  if (weight <= 0.0) return;
+  sun /= weight, sky /= weight;
+  ShadingParams& s = deck.shading;
+  const double a = s.ambient, t = s.texture_fraction;
+  const double c = (1.0 - a) * ((1.0 - t) * sun + t) + a * sky;
+  if (!((1.0 - a) * ((1.0 - t) * sun + t) > 0.0)) return;
+  s.ambient = a * sky / c;
+  s.texture_fraction = (1.0 - a) * t / ((1.0 - a) * ((1.0 - t) * sun + t));
+  deck.colour *= c;
+}
+
+CloudLayer farDeck(const CloudField& f, double range, glm::dvec3 to_sun) {
   static std::mutex mutex;
   static std::map<std::string, CloudLayer> decks;
   const std::string key = fieldKey(f);
@@ -537,6 +566,7 @@ CloudLayer farDeck(const CloudField& f, double range) {
   deck.colour = glm::dvec3(look.colour);
   deck.shading.ambient = look.ambient;
   deck.shading.texture_fraction = look.texture_fraction;
+  lightFarDeck(f, to_sun, deck);
   deck.texture.drift_offset_m = f.drift_m;
   // Heaps stand in the tiles whose middle is within the range, so their density falls from
   // full to none over a tile either side of it; the deck rises over the same band.
@@ -556,7 +586,7 @@ Scene withFieldClouds(const Scene& scene, double heap_range_m) {
                       std::make_move_iterator(heaps.end()));
     const double range = heapRange(field, scene.camera, heap_range_m);
     if (field.coverage > 0.0 && planeSeenBeyond(scene.camera, field.base_m, range))
-      out.layers.push_back(farDeck(field, range));
+      out.layers.push_back(farDeck(field, range, sunDirection(scene.sun)));
   }
   out.fields.clear();
   return out;

@@ -24,6 +24,9 @@ struct EllipsoidCloud {
   double threshold_limb = 0.6;       // Gardner's T2 (Elinas' "T2" is T2 - T1)
   double transition = 0.25;          // D, >= 0
   ShadingParams shading{0.35, 0.5, 0.0, 8.0};
+  // Extinction per metre of the light passing through the cloud's ellipsoids (MODEL.md section
+  // 14): lobes shadowed by others, dark bases, a silver lining. 0 is Gardner's eq. 8 alone.
+  double light_extinction = 0.0;
   SolidTextureSpec texture;
   std::vector<Ellipsoid> ellipsoids;
   // How far the cloud has drifted since time 0. Its ellipsoid centres already include it; the
