@@ -123,6 +123,17 @@ struct CelestialSphereControl {
   bool operator==(const CelestialSphereControl&) const = default;
 };
 
+// Start of Frame's IG Status, which CIGI 3.3 leaves to the IG (docs/CIGI.md, "IG status"): what
+// became of the host frame it answers.
+struct IgStatus {
+  static constexpr std::uint8_t kApplied = 0;         // every packet applied
+  static constexpr std::uint8_t kPacketsRefused = 1;  // some packets refused, the rest applied
+  static constexpr std::uint8_t kLate = 2;            // late or repeated: nothing applied
+  static constexpr std::uint8_t kFrameJump = 3;       // a jump in numbering, awaiting the next
+  static constexpr std::uint8_t kWorldRefused = 4;    // the world refused it: nothing applied
+  static constexpr std::uint8_t kBusy = 5;  // the daemon's queue was full: nothing applied
+};
+
 struct StartOfFrame {
   std::int8_t database = 0;
   std::uint8_t ig_status = 0;

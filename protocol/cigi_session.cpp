@@ -97,10 +97,25 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
   State s = state_;
   frame.control = std::get<IgControl>(message.packets.front());
   const IgControl& igc = frame.control;
-  if (s.last_host_frame && std::int32_t(igc.host_frame - *s.last_host_frame) <= 0)
-    return Refusal{"out_of_order", "host frame " + std::to_string(igc.host_frame) +
-                                       " does not follow " + std::to_string(*s.last_host_frame) +
-                                       " (a late or repeated datagram)"};
+  if (s.last_host_frame) {
+    const std::int32_t ahead = std::int32_t(igc.host_frame - *s.last_host_frame);
+    if (ahead <= 0 || ahead > kMaxFrameJump) {
+      // Late, repeated, a restart of the host or a corrupted number: refused, until enough
+      // consecutive frames show a new run (docs/CIGI.md, "Frame numbers").
+      const bool late = ahead <= 0 && ahead > -kReorderWindow;
+      const int run = s.jumped_to && igc.host_frame == *s.jumped_to + 1 ? s.jump_run + 1 : 1;
+      if (run < (late ? kRestartRunBehind : kRestartRunElsewhere))
+        return Refusal{
+            late ? "out_of_order" : "frame_jump",
+            "host frame " + std::to_string(igc.host_frame) + " after " +
+                std::to_string(*s.last_host_frame) +
+                (late ? " (a late or repeated datagram)" : " (a restart or a corrupted number)"),
+            igc, run};
+      s.last_timestamp.reset();  // a new run of the host: its clock starts again too
+    }
+  }
+  s.jumped_to.reset();
+  s.jump_run = 0;
   frame.dt_s = settings_.default_frame_s;
   if (igc.timestamp_valid && s.last_timestamp)
     frame.dt_s =
@@ -115,7 +130,8 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
           "not applied");
     return s;
   }
-  auto bad = [](std::string what) { return Refusal{"bad_value", std::move(what)}; };
+  // A packet with a value out of range is refused alone; the frame's other packets apply.
+  auto bad = [&](std::string what) { frame.refused.push_back(std::move(what)); };
   bool views_moved = false;
   std::set<std::uint16_t> changed_entities;
   const auto typeName = [&](std::uint16_t type) -> const std::string* {
@@ -127,11 +143,15 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
     const Packet& packet = message.packets[i];
     if (const auto* e = std::get_if<EntityControl>(&packet)) {
       const std::string where = "Entity Control " + std::to_string(e->entity_id);
-      if (!finite({e->roll, e->pitch, e->yaw, e->latitude, e->longitude, e->altitude}))
-        return bad(where + ": a position or angle is not a finite number");
-      if (!e->attached && (std::abs(e->latitude) > 90.0 || std::abs(e->longitude) > 360.0))
-        return bad(where + ": latitude " + text(e->latitude) + ", longitude " + text(e->longitude) +
-                   " (allowed: -90 to 90, -360 to 360 degrees)");
+      if (!finite({e->roll, e->pitch, e->yaw, e->latitude, e->longitude, e->altitude})) {
+        bad(where + ": a position or angle is not a finite number");
+        continue;
+      }
+      if (!e->attached && (std::abs(e->latitude) > 90.0 || std::abs(e->longitude) > 360.0)) {
+        bad(where + ": latitude " + text(e->latitude) + ", longitude " + text(e->longitude) +
+            " (allowed: -90 to 90, -360 to 360 degrees)");
+        continue;
+      }
       if (e->entity_id == 0) {  // the ownship: it carries the views
         s.entities[0] = {*e, false};
         views_moved = true;
@@ -161,8 +181,10 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
                                 " views of [cigi] views");
         continue;
       }
-      if (!finite({v->x, v->y, v->z, v->roll, v->pitch, v->yaw}))
-        return bad("View Control " + std::to_string(v->view_id) + ": an offset is not finite");
+      if (!finite({v->x, v->y, v->z, v->roll, v->pitch, v->yaw})) {
+        bad("View Control " + std::to_string(v->view_id) + ": an offset is not finite");
+        continue;
+      }
       ViewState& view = s.views[v->view_id];
       ViewControl merged = view.control.value_or(ViewControl{});
       float* fields[] = {&merged.x, &merged.y, &merged.z, &merged.roll, &merged.pitch, &merged.yaw};
@@ -180,10 +202,12 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
                                 " is not one of [cigi] views");
         continue;
       }
-      if (std::string e = frustumError({d->left, d->right, d->bottom, d->top}); !e.empty())
-        return bad("View Definition " + std::to_string(d->view_id) + ": left " + text(d->left) +
-                   ", right " + text(d->right) + ", bottom " + text(d->bottom) + ", top " +
-                   text(d->top) + ": " + e.substr(9));
+      if (std::string e = frustumError({d->left, d->right, d->bottom, d->top}); !e.empty()) {
+        bad("View Definition " + std::to_string(d->view_id) + ": left " + text(d->left) +
+            ", right " + text(d->right) + ", bottom " + text(d->bottom) + ", top " + text(d->top) +
+            ": " + e.substr(9));
+        continue;
+      }
       if (d->orthographic) frame.ignored.push_back("View Definition: orthographic projection");
       s.views[d->view_id].definition = *d;
       views_moved = true;
@@ -204,19 +228,23 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
           (fog ? sameFog(last->second, *w) : sameCloudLayer(last->second, *w)))
         continue;
       if (!finite({w->base, w->thickness, w->coverage, w->visibility, w->wind_speed,
-                   w->wind_direction}))
-        return bad(where + ": a field is not a finite number");
+                   w->wind_direction})) {
+        bad(where + ": a field is not a finite number");
+        continue;
+      }
       if (fog) {
         command::SetFog c;
         c.enabled = w->enabled;
         if (w->enabled) {
           const double top = double(w->base) + double(w->thickness);
           if (!(top >= 0.0 && top <= Limits::kMaxAltitude) ||
-              !Limits::kFogVisibility.contains(w->visibility))
-            return bad(where + ": fog top (base + thickness) " + text(top) + " and visibility " +
-                       text(w->visibility) + " (allowed: top 0 to " + text(Limits::kMaxAltitude) +
-                       " m, visibility " + text(Limits::kFogVisibility.lo) + " to " +
-                       text(Limits::kFogVisibility.hi) + " m)");
+              !Limits::kFogVisibility.contains(w->visibility)) {
+            bad(where + ": fog top (base + thickness) " + text(top) + " and visibility " +
+                text(w->visibility) + " (allowed: top 0 to " + text(Limits::kMaxAltitude) +
+                " m, visibility " + text(Limits::kFogVisibility.lo) + " to " +
+                text(Limits::kFogVisibility.hi) + " m)");
+            continue;
+          }
           c.top = top;
           c.visibility = w->visibility;
         }
@@ -226,9 +254,10 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
         c.layer = w->layer;
         WeatherLayer& layer = c.weather;
         layer.type = w->enabled ? CloudType(std::min<int>(w->cloud_type, 15)) : CloudType::kNone;
-        if (w->enabled && w->cloud_type >= kCloudTypeCount)
-          return bad(where + ": cloud type " + std::to_string(w->cloud_type) +
-                     " (allowed: 0 to 10)");
+        if (w->enabled && w->cloud_type >= kCloudTypeCount) {
+          bad(where + ": cloud type " + std::to_string(w->cloud_type) + " (allowed: 0 to 10)");
+          continue;
+        }
         layer.base_m = w->base;
         layer.thickness_m = w->thickness;
         layer.coverage = w->coverage / 100.0;
@@ -236,14 +265,19 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
           if (!(layer.base_m >= 0.0 && layer.base_m <= Limits::kMaxBase) ||
               !Limits::kThickness.contains(layer.thickness_m) ||
               !Limits::kCoveragePercent.contains(w->coverage) ||
-              !(w->wind_speed >= 0.0 && w->wind_speed <= Limits::kMaxWind))
-            return bad(where + ": base " + text(w->base) + ", thickness " + text(w->thickness) +
-                       ", coverage " + text(w->coverage) + ", wind " + text(w->wind_speed) +
-                       " (allowed: base 0 to " + text(Limits::kMaxBase) + " m, thickness " +
-                       text(Limits::kThickness.lo) + " to " + text(Limits::kThickness.hi) +
-                       " m, coverage 0 to 100 %, wind 0 to " + text(Limits::kMaxWind) + " m/s)");
+              !(w->wind_speed >= 0.0 && w->wind_speed <= Limits::kMaxWind)) {
+            bad(where + ": base " + text(w->base) + ", thickness " + text(w->thickness) +
+                ", coverage " + text(w->coverage) + ", wind " + text(w->wind_speed) +
+                " (allowed: base 0 to " + text(Limits::kMaxBase) + " m, thickness " +
+                text(Limits::kThickness.lo) + " to " + text(Limits::kThickness.hi) +
+                " m, coverage 0 to 100 %, wind 0 to " + text(Limits::kMaxWind) + " m/s)");
+            continue;
+          }
           layer.wind = windVelocity(w->wind_speed, w->wind_direction);
-          if (std::string e = weatherLayerError(layer); !e.empty()) return bad(where + ": " + e);
+          if (std::string e = weatherLayerError(layer); !e.empty()) {
+            bad(where + ": " + e);
+            continue;
+          }
         } else {
           layer.base_m = std::clamp(layer.base_m, 0.0, Limits::kMaxBase);
           layer.thickness_m =
@@ -261,9 +295,11 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
           s.atmosphere->wind_direction == a->wind_direction)
         continue;
       if (!finite({a->wind_speed, a->wind_direction}) ||
-          !(a->wind_speed >= 0.0 && a->wind_speed <= Limits::kMaxWind))
-        return bad("Atmosphere Control: wind speed " + text(a->wind_speed) + " (allowed: 0 to " +
-                   text(Limits::kMaxWind) + " m/s)");
+          !(a->wind_speed >= 0.0 && a->wind_speed <= Limits::kMaxWind)) {
+        bad("Atmosphere Control: wind speed " + text(a->wind_speed) + " (allowed: 0 to " +
+            text(Limits::kMaxWind) + " m/s)");
+        continue;
+      }
       frame.commands.emplace_back(command::SetWind{windVelocity(a->wind_speed, a->wind_direction)});
       if (a->visibility != 0.0f)
         frame.ignored.push_back(
@@ -282,9 +318,11 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
       t.hour = c->hour;
       t.minute = c->minute;
       t.second = 0.0;
-      if (std::string e = civilTimeError(t); !e.empty())
-        return bad("Celestial Sphere Control: date " + std::to_string(c->date) + " (MMDDYYYY) " +
-                   std::to_string(c->hour) + ":" + std::to_string(c->minute) + ": " + e);
+      if (std::string e = civilTimeError(t); !e.empty()) {
+        bad("Celestial Sphere Control: date " + std::to_string(c->date) + " (MMDDYYYY) " +
+            std::to_string(c->hour) + ":" + std::to_string(c->minute) + ": " + e);
+        continue;
+      }
       frame.commands.emplace_back(command::SetSun{std::nullopt, std::nullopt, t});
       s.celestial = *c;
     } else if (const auto* o = std::get_if<OtherPacket>(&packet)) {
@@ -303,10 +341,12 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
     }
     if (std::abs(pose->position.x) > Limits::kMaxCoordinate ||
         std::abs(pose->position.y) > Limits::kMaxCoordinate ||
-        std::abs(pose->position.z) > Limits::kMaxCoordinate)
-      return bad("Entity Control " + std::to_string(id) + ": " + text(pose->position.x) + ", " +
-                 text(pose->position.y) + " m from the origin (allowed: within " +
-                 text(Limits::kMaxCoordinate) + " m)");
+        std::abs(pose->position.z) > Limits::kMaxCoordinate) {
+      bad("Entity Control " + std::to_string(id) + ": " + text(pose->position.x) + ", " +
+          text(pose->position.y) + " m from the origin (allowed: within " +
+          text(Limits::kMaxCoordinate) + " m)");
+      continue;
+    }
     const Orientation o = orientationOf(pose->attitude);
     const bool known = state_.entities.count(id) && state_.entities.at(id).target;
     if (known) {
@@ -338,11 +378,12 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
       const glm::dvec3 position =
           carrier->position + carrier->attitude * fromCigiBody(control.x, control.y, control.z);
       if (position.z < 0.0 || std::abs(position.x) > Limits::kMaxCoordinate ||
-          std::abs(position.y) > Limits::kMaxCoordinate || position.z > Limits::kMaxCoordinate)
-        return bad("view " + std::to_string(id) + " at " + text(position.x) + ", " +
-                   text(position.y) + ", " + text(position.z) +
-                   " m (allowed: at or above the ground, within " + text(Limits::kMaxCoordinate) +
-                   " m of the origin)");
+          std::abs(position.y) > Limits::kMaxCoordinate || position.z > Limits::kMaxCoordinate) {
+        bad("view " + std::to_string(id) + " at " + text(position.x) + ", " + text(position.y) +
+            ", " + text(position.z) + " m (allowed: at or above the ground, within " +
+            text(Limits::kMaxCoordinate) + " m of the origin)");
+        continue;
+      }
       p.position = position;
       const Orientation o = orientationOf(carrier->attitude *
                                           bodyToWorld({control.yaw, control.pitch, control.roll}));
@@ -363,7 +404,12 @@ std::variant<HostFrame, Refusal> Session::map(const Message& message) {
   HostFrame frame;
   auto result = next(message, frame);
   pending_.reset();
-  if (auto* r = std::get_if<Refusal>(&result)) return *r;
+  if (auto* r = std::get_if<Refusal>(&result)) {
+    // A jump is remembered at once, refused or not, so that the next frame can confirm it.
+    state_.jumped_to = r->control.host_frame;
+    state_.jump_run = r->run;
+    return *r;
+  }
   pending_ = std::move(std::get<State>(result));
   return frame;
 }

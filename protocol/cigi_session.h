@@ -29,13 +29,27 @@ struct HostFrame {
   std::vector<Command> commands;     // in order
   double dt_s = 0.0;                 // the host's frame time, by which a lockstep world advances
   std::vector<std::string> ignored;  // packets or fields not supported, with why
+  std::vector<std::string> refused;  // packets refused for a value out of range, with why
 };
 
-// A message the session refuses as a whole (nothing of it is applied).
+// A message the session refuses as a whole (nothing of it is applied): "out_of_order" (late or
+// repeated) or "frame_jump" (numbering that jumped, followed once the next frame confirms it).
 struct Refusal {
-  std::string reason;  // "out_of_order", ...
+  std::string reason;
   std::string message;
+  IgControl control;  // the message's IG Control, which Start of Frame answers
+  int run = 0;        // frame numbers refused: consecutive ones in a row, this one included
 };
+
+// Host frame numbering (docs/CIGI.md, "Frame numbers"), in 32-bit serial order. A frame that
+// is not 1 to kMaxFrameJump ahead of the last one applied is refused: up to kReorderWindow
+// behind it, as late or repeated; elsewhere, as a jump (a restart of the host, or a corrupted
+// number). Consecutive refused numbers (n, n + 1, ...) are a new run of the host, which is
+// followed at the kRestartRunBehind-th of them within the window (two late datagrams in a row
+// are refused) and at the kRestartRunElsewhere-th elsewhere.
+inline constexpr std::int32_t kReorderWindow = 16;
+inline constexpr std::int32_t kMaxFrameJump = 3000;
+inline constexpr int kRestartRunBehind = 3, kRestartRunElsewhere = 2;
 
 // The geodetic position (degrees, metres) in the database's east, north, up metres: a
 // flat-earth (equirectangular) projection about the origin with the WGS 84 radii of
@@ -55,6 +69,7 @@ class Session {
   // After the daemon refused a frame (a target removed over the socket, say): what the session
   // believed applied is forgotten, so that the next packets place targets and set the weather
   // afresh. Frame numbers, the ownship and the views stay. The frame mapped last is dropped.
+  // Packets refused for their values (HostFrame::refused) leave the rest of the frame applied.
   void forget();
 
   std::uint32_t lastHostFrame() const { return state_.last_host_frame.value_or(0); }
@@ -75,6 +90,8 @@ class Session {
   // The state after a message, computed without changing this one.
   struct State {
     std::optional<std::uint32_t> last_host_frame;
+    std::optional<std::uint32_t> jumped_to;  // the last frame number refused, and how many
+    int jump_run = 0;                        // consecutive numbers were refused up to it
     std::optional<std::uint32_t> last_timestamp;
     std::map<std::uint16_t, Entity> entities;
     std::map<std::uint16_t, ViewState> views;

@@ -4,14 +4,15 @@
 
 #include <memory>
 
+#include "server/log_limiter.h"
+
 namespace nephele {
 
 using asio::ip::udp;
 
 namespace {
 
-constexpr std::size_t kMaxWaiting = 64;        // datagrams held while one is with the Engine
-constexpr std::uint64_t kLoggedRefusals = 20;  // then one log line in every 1000
+constexpr std::size_t kMaxWaiting = 64;  // datagrams held while one is with the Engine
 
 cigi::SessionSettings sessionSettings(const DaemonConfig& config) {
   cigi::SessionSettings s;
@@ -69,15 +70,15 @@ void CigiServer::receive() {
       });
 }
 
-// The one place where a datagram is refused: logged (the first few, then a sample) and
-// counted by reason in the daemon's stats and metrics.
+// The one place where a datagram or a packet is refused: counted by reason in the daemon's
+// stats and metrics, and logged through the listeners' limiter (the reasons are the code's,
+// never a datagram's).
 void CigiServer::refuse(const std::string& reason, const std::string& message,
                         const udp::endpoint& from) {
   engine_.countCigi("refused_" + reason);
-  if (logged_refusals_ < kLoggedRefusals || logged_refusals_ % 1000 == 0)
+  if (listenerLog().admit("cigi_refused/" + reason))
     spdlog::warn("event=cigi_refused reason={} from={}:{} error=\"{}\"", reason,
                  from.address().to_string(), from.port(), message);
-  ++logged_refusals_;
 }
 
 void CigiServer::next() {
@@ -90,9 +91,14 @@ void CigiServer::next() {
     return next();
   }
   const cigi::Message& message = std::get<cigi::Message>(decoded);
+  // Every message with a valid IG Control is answered with a Start of Frame, whose IG status
+  // says what became of it (docs/CIGI.md): a host in synchronous mode never waits in vain.
   auto mapped = session_.map(message);
   if (auto* r = std::get_if<cigi::Refusal>(&mapped)) {
     refuse(r->reason, r->message, d.from);
+    sendStartOfFrame(
+        r->control, message.order, d.from,
+        r->reason == "frame_jump" ? cigi::IgStatus::kFrameJump : cigi::IgStatus::kLate);
     return next();
   }
   cigi::HostFrame& frame = std::get<cigi::HostFrame>(mapped);
@@ -100,24 +106,28 @@ void CigiServer::next() {
     engine_.countCigi("ignored");
     spdlog::debug("event=cigi_ignored what=\"{}\"", what);
   }
+  for (const std::string& what : frame.refused) refuse("bad_value", what, d.from);
+  const std::uint8_t status =
+      frame.refused.empty() ? cigi::IgStatus::kApplied : cigi::IgStatus::kPacketsRefused;
   // Synchronous (lockstep) mode: the world advances by the host's frame time, and the tick
   // renders each subscribed view once.
   if (engine_.lockstep() && frame.control.mode != cigi::IgMode::kStandby)
     frame.commands.emplace_back(command::Tick{frame.dt_s});
   busy_ = true;
   const cigi::IgControl control = frame.control;
-  auto done = [this, order = message.order, control,
+  auto done = [this, order = message.order, control, status,
                from = d.from](std::optional<ProtocolError> error) {
-    asio::post(io_, [this, order, control, from, error] {
+    asio::post(io_, [this, order, control, status, from, error] {
       busy_ = false;
       if (closed_) return;
       if (error) {
         refuse("refused_by_world", error->message, from);
         session_.forget();
+        sendStartOfFrame(control, order, from, cigi::IgStatus::kWorldRefused);
       } else {
         session_.commit();
         engine_.countCigi("messages");
-        sendStartOfFrame(control, order, from);
+        sendStartOfFrame(control, order, from, status);
       }
       next();
     });
@@ -125,14 +135,16 @@ void CigiServer::next() {
   if (!engine_.submitBatch(std::move(frame.commands), false, nullptr, done)) {
     busy_ = false;
     refuse("busy", "the daemon's request queue is full", d.from);
+    sendStartOfFrame(control, message.order, d.from, cigi::IgStatus::kBusy);
     next();
   }
 }
 
 void CigiServer::sendStartOfFrame(const cigi::IgControl& control, cigi::ByteOrder order,
-                                  const udp::endpoint& to) {
+                                  const udp::endpoint& to, std::uint8_t status) {
   cigi::StartOfFrame sof;
   sof.database = control.database;
+  sof.ig_status = status;
   sof.mode =
       control.mode == cigi::IgMode::kStandby ? cigi::IgMode::kStandby : cigi::IgMode::kOperate;
   sof.ig_frame = ++ig_frame_;

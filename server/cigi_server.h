@@ -34,8 +34,9 @@ class CigiServer {
   void next();  // handles the oldest waiting datagram, if none is in hand
   void refuse(const std::string& reason, const std::string& message,
               const asio::ip::udp::endpoint& from);
+  // Answers the host frame of `control`; `status` is a cigi::IgStatus code.
   void sendStartOfFrame(const cigi::IgControl& control, cigi::ByteOrder order,
-                        const asio::ip::udp::endpoint& to);
+                        const asio::ip::udp::endpoint& to, std::uint8_t status);
 
   asio::io_context& io_;
   Engine& engine_;
@@ -49,7 +50,6 @@ class CigiServer {
   bool closed_ = false;
   cigi::Session session_;
   std::uint32_t ig_frame_ = 0;
-  std::uint64_t logged_refusals_ = 0;
   std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now();
 };
 

@@ -70,7 +70,7 @@ def decode_sof(data):
     (pid, size, version, database, status, flags, magic, ig_frame, timestamp,
      last_host) = struct.unpack(bo + "BBBbBBHIII4x", data[:24])
     return {"id": pid, "size": size, "version": version, "database": database,
-            "mode": flags & 3, "minor": flags >> 4, "order": bo, "ig_frame": ig_frame,
+            "status": status, "mode": flags & 3, "minor": flags >> 4, "order": bo, "ig_frame": ig_frame,
             "timestamp": timestamp, "last_host_frame": last_host, "bytes": len(data)}
 
 
@@ -279,10 +279,10 @@ size = [4, 2, 1]
         self.frame(entity_control(7, *boat, yaw=95.0), frame=3, timestamp=103334)
         self.assertEqual(c.ok({"cmd": "list_targets"})["targets"][0]["heading"], 95.0)
         # A target removed over the socket: the next frame that moves it is refused by the
-        # world, and the one after places it afresh.
+        # world (Start of Frame says so: IG status 4), and the one after places it afresh.
         c.ok({"cmd": "remove_target", "name": "cigi-7"})
         self.send(ig_control(4, 105001), entity_control(7, *boat, yaw=100.0))
-        self.no_reply()
+        self.assertEqual(self.receive_sof()["status"], 4)
         self.frame(entity_control(7, *boat, yaw=100.0), frame=5, timestamp=106668)
         self.assertEqual(c.ok({"cmd": "list_targets"})["targets"][0]["heading"], 100.0)
         self.frame(entity_control(7, *boat, state=0), frame=6, timestamp=108335)
@@ -346,17 +346,17 @@ size = [4, 2, 1]
                           good + good[:24],
                           good[:24] + struct.pack(">BB", 2, 40) + good[26:64]],
             "out_of_order": [ig_control(100, 2) + good[24:], ig_control(99, 2) + good[24:]],
-            "bad_value": [ig_control(101, 2) + entity_control(0, 95.0, 0, 10),
-                          ig_control(101, 2) + weather_control(1, True, 12, 50, 1000, 500),
-                          ig_control(101, 2) + celestial_control(2, 30, 2026, 12, 0),
-                          ig_control(101, 2) + entity_control(0, SITE[0], SITE[1], float("nan")),
-                          ig_control(101, 2) + view_definition(0, 30, -30, 20, -20)],
         }
         for reason, datagrams in bad.items():
             for data in datagrams:
                 with self.subTest(reason=reason, size=len(data)):
                     self.host.sendto(data, ("127.0.0.1", self.ig_port))
-                    self.no_reply()
+                    if reason == "out_of_order":  # a valid IG Control: answered, IG status 2
+                        sof = self.receive_sof()
+                        self.assertEqual((sof["status"], sof["last_host_frame"]),
+                                         (2, struct.unpack(">I", data[8:12])[0]))
+                    else:
+                        self.no_reply()
         after = c.ok({"cmd": "hash"})
         self.assertEqual(after["hash"], before["hash"])
         self.assertEqual(c.ok({"cmd": "get_view", "view": "front"})["position"][2], 500.0)
@@ -367,6 +367,77 @@ size = [4, 2, 1]
         # The daemon still answers the host, in order.
         self.frame(entity_control(0, SITE[0], SITE[1], 999.0), frame=101, timestamp=2)
         self.assertEqual(c.ok({"cmd": "get_view", "view": "front"})["position"][2], 999.0)
+
+    def test_case16_a_host_that_restarts_its_frame_numbers_is_followed_within_3_frames(self):
+        """Issue 26: after a host restarted its frame numbers (the CIGI Class Library counts
+        from 0), or after one corrupted number, every later frame was refused as late."""
+        d = self.start()
+        c = d.client()
+
+        def altitude():
+            return c.ok({"cmd": "get_view", "view": "front"})["position"][2]
+
+        for n in range(30):  # the host's first run
+            self.assertEqual(self.frame(entity_control(0, SITE[0], SITE[1], 100.0 + n),
+                                        frame=n)["status"], 0)
+        # The same program started again: numbers from 0. The first frame is refused as a jump
+        # (IG status 3), the second confirms the new run and applies.
+        sof = self.frame(entity_control(0, SITE[0], SITE[1], 500.0), frame=0)
+        self.assertEqual(sof["status"], 3)
+        self.assertEqual(altitude(), 129.0)
+        for n in range(1, 10):
+            self.assertEqual(self.frame(entity_control(0, SITE[0], SITE[1], 500.0 + n),
+                                        frame=n)["status"], 0, n)
+            self.assertEqual(altitude(), 500.0 + n)
+        # A restart soon after the last one, within the reordering window: the third
+        # consecutive number applies.
+        statuses = [self.frame(entity_control(0, SITE[0], SITE[1], 700.0 + n), frame=n)["status"]
+                    for n in range(3)]
+        self.assertEqual(statuses, [2, 2, 0])
+        self.assertEqual(altitude(), 702.0)
+        # One corrupted frame number, far ahead or far behind: refused, and the host's next
+        # frames go on as before.
+        for corrupt in (0x7FFFFFF0, 0x80000000 + 5):
+            self.assertEqual(self.frame(entity_control(0, SITE[0], SITE[1], 900.0),
+                                        frame=corrupt)["status"], 3)
+        self.assertEqual(altitude(), 702.0)
+        self.assertEqual(self.frame(entity_control(0, SITE[0], SITE[1], 703.0), frame=3)["status"], 0)
+        self.assertEqual(altitude(), 703.0)
+        # Late and repeated datagrams within the window are still refused and counted.
+        self.assertEqual(self.frame(entity_control(0, SITE[0], SITE[1], 1.0), frame=3)["status"], 2)
+        self.assertEqual(self.frame(entity_control(0, SITE[0], SITE[1], 1.0), frame=1)["status"], 2)
+        self.assertEqual(self.frame(entity_control(0, SITE[0], SITE[1], 704.0), frame=4)["status"], 0)
+        self.assertEqual(altitude(), 704.0)
+        stats = c.ok({"cmd": "stats"})["cigi"]
+        self.assertEqual(stats["refused_frame_jump"], 3, stats)
+        self.assertEqual(stats["refused_out_of_order"], 4, stats)
+
+    def test_case17_a_frame_with_one_refused_packet_gets_start_of_frame_and_its_valid_packets_apply(self):
+        """Issue 26: a frame with one value out of range (coverage 150 %) got no Start of Frame
+        and its ownship move was lost; a synchronous host waits for Start of Frame."""
+        d = self.start()
+        c = d.client()
+        self.frame(entity_control(0, SITE[0], SITE[1], 500.0), frame=1, timestamp=1)
+        bad = [weather_control(1, True, 7, coverage=150.0, base=1500.0, thickness=800.0),
+               entity_control(7, 95.0, 0, 10),
+               weather_control(1, True, 12, 50, 1000, 500),
+               celestial_control(2, 30, 2026, 12, 0),
+               entity_control(7, SITE[0], SITE[1], float("nan")),
+               view_definition(0, 30, -30, 20, -20)]
+        for k, packet in enumerate(bad):
+            with self.subTest(packet=k):
+                sof = self.frame(entity_control(0, SITE[0], SITE[1], 600.0 + k), packet,
+                                 frame=2 + k, timestamp=2 + k)
+                self.assertEqual(sof["status"], 1)  # some packets refused, the rest applied
+                view = c.ok({"cmd": "get_view", "view": "front"})
+                self.assertEqual(view["position"][2], 600.0 + k)
+        self.assertEqual(c.ok({"cmd": "list_targets"})["targets"], [])
+        stats = c.ok({"cmd": "stats"})["cigi"]
+        self.assertEqual(stats["refused_bad_value"], len(bad), stats)
+        self.assertIn("event=cigi_refused reason=bad_value", d.log_text())
+        # A frame of valid packets only is answered with IG status 0.
+        self.assertEqual(self.frame(entity_control(0, SITE[0], SITE[1], 700.0), frame=20)["status"],
+                         0)
 
     def check_with_tshark(self):
         """Every datagram of the test, decoded by Wireshark's CIGI dissector: its fields must
