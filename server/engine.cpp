@@ -31,13 +31,16 @@ Engine::~Engine() {
 std::string Engine::start() {
   std::promise<std::string> started;
   std::future<std::string> result = started.get_future();
+  // The encoder exists before the world thread, which reads it (a race found by the tsan
+  // preset when it was made after).
+  encoder_ = std::make_unique<Encoder>();
   thread_ = std::thread([this, &started] { run(started); });
   std::string error = result.get();
   if (!error.empty()) {
     thread_.join();
+    encoder_.reset();
     return error;
   }
-  encoder_ = std::make_unique<Encoder>();
   return "";
 }
 
