@@ -110,7 +110,7 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
             "host frame " + std::to_string(igc.host_frame) + " after " +
                 std::to_string(*s.last_host_frame) +
                 (late ? " (a late or repeated datagram)" : " (a restart or a corrupted number)"),
-            igc, run};
+            igc, late ? IgStatus::kLate : IgStatus::kFrameJump, run};
       s.last_timestamp.reset();  // a new run of the host: its clock starts again too
     }
   }

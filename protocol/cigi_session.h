@@ -37,8 +37,9 @@ struct HostFrame {
 struct Refusal {
   std::string reason;
   std::string message;
-  IgControl control;  // the message's IG Control, which Start of Frame answers
-  int run = 0;        // frame numbers refused: consecutive ones in a row, this one included
+  IgControl control;                      // the message's IG Control, which Start of Frame answers
+  std::uint8_t status = IgStatus::kLate;  // Start of Frame's IG status for it
+  int run = 0;  // frame numbers refused: consecutive ones in a row, this one included
 };
 
 // Host frame numbering (docs/CIGI.md, "Frame numbers"), in 32-bit serial order. A frame that

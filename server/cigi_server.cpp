@@ -96,9 +96,7 @@ void CigiServer::next() {
   auto mapped = session_.map(message);
   if (auto* r = std::get_if<cigi::Refusal>(&mapped)) {
     refuse(r->reason, r->message, d.from);
-    sendStartOfFrame(
-        r->control, message.order, d.from,
-        r->reason == "frame_jump" ? cigi::IgStatus::kFrameJump : cigi::IgStatus::kLate);
+    sendStartOfFrame(r->control, message.order, d.from, r->status);
     return next();
   }
   cigi::HostFrame& frame = std::get<cigi::HostFrame>(mapped);

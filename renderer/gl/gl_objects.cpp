@@ -52,6 +52,16 @@ GlObject createRenderbuffer(const GlApi& gl) {
   return {gl, GlObject::Kind::kRenderbuffer, name};
 }
 
+void clearGlErrors(const GlApi& gl) {
+  while (gl.GetError() != GL_NO_ERROR) {
+  }
+}
+
+bool framebufferUsable(const GlApi& gl, GLuint framebuffer) {
+  return gl.CheckNamedFramebufferStatus(framebuffer, GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE &&
+         gl.GetError() == GL_NO_ERROR;
+}
+
 GlObject createVertexArray(const GlApi& gl) {
   GLuint name = 0;
   gl.CreateVertexArrays(1, &name);

@@ -55,6 +55,12 @@ GlObject createRenderbuffer(const GlApi& gl);
 GlObject createVertexArray(const GlApi& gl);
 GlObject createBuffer(const GlApi& gl);
 
+// Allocating render targets: clear GL's error flags first, then, once the storage is made and
+// attached, ask whether the framebuffer is usable: complete, and no GL error since (a failed
+// allocation may leave a framebuffer complete and flag GL_OUT_OF_MEMORY).
+void clearGlErrors(const GlApi& gl);
+bool framebufferUsable(const GlApi& gl, GLuint framebuffer);
+
 // A triangle mesh on the GPU: positions (attribute 0, vec3) and 32-bit indices.
 struct IndexedMesh {
   GlObject vertex_array, vertices, indices;

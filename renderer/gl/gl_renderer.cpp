@@ -300,18 +300,14 @@ bool GlRenderer::allocateTarget(int width, int height, TargetFormat format) {
       format == target_format_)
     return true;
   target_width_ = target_height_ = 0;
-  while (gl_.GetError() != GL_NO_ERROR) {
-  }
+  clearGlErrors(gl_);
   colour_buffer_ = createRenderbuffer(gl_);
   gl_.NamedRenderbufferStorage(colour_buffer_.get(),
                                format == TargetFormat::kFloat ? GL_RGBA32F : GL_SRGB8_ALPHA8, width,
                                height);
   gl_.NamedFramebufferRenderbuffer(framebuffer_.get(), GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER,
                                    colour_buffer_.get());
-  // An allocation that fails may leave the framebuffer complete and flag GL_OUT_OF_MEMORY.
-  if (gl_.CheckNamedFramebufferStatus(framebuffer_.get(), GL_FRAMEBUFFER) !=
-          GL_FRAMEBUFFER_COMPLETE ||
-      gl_.GetError() != GL_NO_ERROR) {
+  if (!framebufferUsable(gl_, framebuffer_.get())) {
     colour_buffer_ = GlObject();
     return false;
   }

@@ -79,8 +79,7 @@ void TargetRenderer::prepare(int width, int height) {
 bool TargetRenderer::allocate(int width, int height) {
   if (framebuffer_ && width == width_ && height == height_) return true;
   width_ = height_ = 0;
-  while (gl_.GetError() != GL_NO_ERROR) {
-  }
+  clearGlErrors(gl_);
   framebuffer_ = createFramebuffer(gl_);
   colour_ = createTexture(gl_, GL_TEXTURE_2D);
   distance_ = createTexture(gl_, GL_TEXTURE_2D);
@@ -101,9 +100,7 @@ bool TargetRenderer::allocate(int width, int height) {
   gl_.NamedFramebufferRenderbuffer(f, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_.get());
   const GLenum buffers[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
   gl_.NamedFramebufferDrawBuffers(f, 3, buffers);
-  // An allocation that fails may leave the framebuffer complete and flag GL_OUT_OF_MEMORY.
-  if (gl_.CheckNamedFramebufferStatus(f, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE ||
-      gl_.GetError() != GL_NO_ERROR) {
+  if (!framebufferUsable(gl_, f)) {
     for (GlObject* o : {&framebuffer_, &colour_, &distance_, &id_, &depth_}) *o = GlObject();
     return false;
   }
