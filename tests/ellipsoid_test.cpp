@@ -173,6 +173,63 @@ TEST(Ellipsoid, EyeBoxContainsTheSurface) {
   for (int a = 0; a < 3; ++a) EXPECT_GT(reached[a], 0.99);  // tight, not just large
 }
 
+// screenBounds against the ellipsoid's own points projected: every point in front of the eye
+// that lands on screen lies in the rectangle, and each side not at the screen's edge is
+// reached. Three cases: wholly in front, straddling the eye plane (the image runs to the top
+// of the screen only), and wholly behind (no rectangle).
+TEST(Ellipsoid, ScreenBoundsHoldTheImageTightly) {
+  struct Case {
+    Ellipsoid e;
+    glm::dvec3 eye;
+    Orientation look;
+  };
+  const std::vector<Case> cases = {
+      {tilted(), {-2500.0, -1500.0, 300.0}, {60.0, 15.0, 10.0}},
+      {{{2000.0, 1500.0, 600.0}, {0.0, 300.0, 1000.0}, {20.0, 0.0, 0.0}},
+       {0.0, 0.0, 2.0},
+       {0.0, 15.0, 0.0}},
+      {{{300.0, 300.0, 300.0}, {0.0, -5000.0, 500.0}, {}}, {0.0, 0.0, 500.0}, {0.0, 0.0, 0.0}}};
+  std::mt19937_64 rng(5);
+  for (std::size_t c = 0; c < cases.size(); ++c) {
+    const auto& [e, eye, look] = cases[c];
+    Camera camera;
+    camera.position = eye;
+    camera.orientation = look;
+    camera.width = 640;
+    camera.height = 480;
+    const ViewBasis basis = viewBasis(camera);
+    const glm::dvec4 bounds = screenBounds(e, eye, basis);
+    const glm::dmat3 body = bodyToWorld(e.orientation);
+    glm::dvec4 seen(1e9, 1e9, -1e9, -1e9);
+    for (int i = 0; i < 200000; ++i) {
+      const glm::dvec3 p = e.centre + body * (randomUnit(rng) * e.radii) - eye;
+      const double z = glm::dot(p, basis.forward);
+      if (z <= 0.0) continue;
+      const double x = glm::dot(p, basis.right) / (z * basis.tan_half_vfov * basis.aspect);
+      const double y = glm::dot(p, basis.up) / (z * basis.tan_half_vfov);
+      if (std::abs(x) > 1.0 || std::abs(y) > 1.0) continue;
+      seen = {std::min(seen.x, x), std::min(seen.y, y), std::max(seen.z, x), std::max(seen.w, y)};
+    }
+    SCOPED_TRACE("case " + std::to_string(c));
+    if (c == 1) {  // straddling: the image runs to the top of the screen, not the bottom
+      EXPECT_EQ(bounds.w, 1.0);
+      EXPECT_GT(bounds.y, -1.0);
+    }
+    if (seen.x > seen.z) {  // nothing on screen
+      EXPECT_GT(bounds.x, bounds.z);
+      continue;
+    }
+    EXPECT_LE(bounds.x, seen.x + 1e-9);
+    EXPECT_LE(bounds.y, seen.y + 1e-9);
+    EXPECT_GE(bounds.z, seen.z - 1e-9);
+    EXPECT_GE(bounds.w, seen.w - 1e-9);
+    const double tight = 0.01 * std::max(bounds.z - bounds.x, bounds.w - bounds.y);
+    for (int side = 0; side < 4; ++side) {
+      if (std::abs(bounds[side]) < 1.0) EXPECT_NEAR(bounds[side], seen[side], tight) << side;
+    }
+  }
+}
+
 TEST(Ellipsoid, InvalidParametersAreNamed) {
   Ellipsoid e = tilted();
   EXPECT_EQ(ellipsoidError(e), "");

@@ -33,24 +33,11 @@ glm::vec4 row(glm::dvec3 v, double w = 0.0) {
   return glm::vec4(glm::dvec4(v, w));
 }
 
-// Rectangle [x0, x1] x [y0, y1] in NDC covering the eye-space box's projection, widened by
-// a pixel; the whole screen when the box reaches behind the eye. False when off screen.
-bool screenRectangle(const EyeBox& box, const Camera& camera, const ViewBasis& basis,
+// The ellipsoid's screen rectangle in NDC (x0, y0, x1, y1), widened by a pixel; false when
+// off screen.
+bool screenRectangle(const Ellipsoid& e, const Camera& camera, const ViewBasis& basis,
                      glm::dvec4& rect) {
-  const glm::dvec3 lo = box.centre - box.half_extent, hi = box.centre + box.half_extent;
-  if (hi.z <= 0.0) return false;  // wholly behind the eye
-  if (lo.z <= 0.0) {
-    rect = {-1.0, -1.0, 1.0, 1.0};
-    return true;
-  }
-  const double sx = 1.0 / (basis.tan_half_vfov * basis.aspect), sy = 1.0 / basis.tan_half_vfov;
-  rect = {1e30, 1e30, -1e30, -1e30};
-  for (int corner = 0; corner < 8; ++corner) {
-    const glm::dvec3 p((corner & 1) ? hi.x : lo.x, (corner & 2) ? hi.y : lo.y,
-                       (corner & 4) ? hi.z : lo.z);
-    const double x = sx * p.x / p.z, y = sy * p.y / p.z;
-    rect = {std::min(rect.x, x), std::min(rect.y, y), std::max(rect.z, x), std::max(rect.w, y)};
-  }
+  rect = screenBounds(e, camera.position, basis);
   const double mx = 2.0 / camera.width, my = 2.0 / camera.height;
   rect = {std::max(rect.x - mx, -1.0), std::max(rect.y - my, -1.0), std::min(rect.z + mx, 1.0),
           std::min(rect.w + my, 1.0)};
@@ -144,15 +131,15 @@ int adaptiveSlices(double radius_px) {
 
 }  // namespace
 
-bool makeEllipsoidRecord(const Ellipsoid& e, const Camera& camera, EllipsoidRecord& out,
-                         double& centre_distance) {
+bool makeEllipsoidRecord(const Ellipsoid& e, const Camera& camera, bool spotlight,
+                         EllipsoidRecord& out, double& centre_distance) {
   const EllipsoidView view(e, camera.position);
   if (view.eyeInside()) return false;  // MODEL.md section 4: the in-cloud veil shows it
   const double fade = surfaceFade(view.eyeRadius());
   if (fade <= 0.0) return false;
   const ViewBasis basis = viewBasis(camera);
   glm::dvec4 rect;
-  if (!screenRectangle(eyeSpaceBox(e, camera.position, basis), camera, basis, rect)) return false;
+  if (!screenRectangle(e, camera, basis, rect)) return false;
 
   const glm::dmat3& w = view.toUnitSphere();
   for (int i = 0; i < 3; ++i) out.v[i] = row(glm::dvec3(w[0][i], w[1][i], w[2][i]));
@@ -162,21 +149,28 @@ bool makeEllipsoidRecord(const Ellipsoid& e, const Camera& camera, EllipsoidReco
   const glm::dmat3& p = view.limbForm();
   for (int i = 0; i < 3; ++i) out.v[5 + i] = row(glm::dvec3(p[0][i], p[1][i], p[2][i]));
   // Spotlight coordinates: P = L^T L from P's two non-negative eigenpairs.
-  const SymmetricEigen eigen = symmetricEigen(p);
-  for (int i = 0; i < 2; ++i)
-    out.v[8 + i] = row(std::sqrt(std::max(eigen.values[2 - i], 0.0)) * eigen.vectors[2 - i]);
+  if (spotlight) {
+    const SymmetricEigen eigen = symmetricEigen(p);
+    for (int i = 0; i < 2; ++i)
+      out.v[8 + i] = row(std::sqrt(std::max(eigen.values[2 - i], 0.0)) * eigen.vectors[2 - i]);
+  } else {
+    out.v[8] = out.v[9] = glm::vec4(0.0f);
+  }
   out.v[10] = glm::vec4(rect);
   const glm::dmat3 body = bodyToWorld(e.orientation);
   for (int i = 0; i < 3; ++i) out.v[11 + i] = row(body[i] * e.radii[i]);
   out.v[14] = row(e.centre - camera.position);
   out.v[15] = glm::vec4(0.0f);
-  out.v[16] = glm::vec4(1.0f, 1.0f, 0.0f, 0.0f);
   centre_distance = glm::length(e.centre - camera.position);
+  const double near_bound = centre_distance - std::max({e.radii.x, e.radii.y, e.radii.z});
+  out.v[16] = glm::vec4(1.0f, 1.0f, float(near_bound), 0.0f);
   return true;
 }
 
 EllipsoidRenderer::EllipsoidRenderer(const GlApi& gl)
-    : gl_(gl), vertex_array_(createVertexArray(gl)) {}
+    : gl_(gl), vertex_array_(createVertexArray(gl)) {
+  gl_.GetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &max_texels_);
+}
 
 EllipsoidRenderer::~EllipsoidRenderer() = default;
 
@@ -186,11 +180,14 @@ void EllipsoidRenderer::beginFrame(FrameStats& stats) {
   next_buffer_ = 0;
 }
 
-GLuint EllipsoidRenderer::frameBuffer(const void* data, std::size_t bytes) {
+void EllipsoidRenderer::bindFrameTexture(int unit, GLenum format, const void* data,
+                                         std::size_t bytes) {
   // A fresh buffer for every upload in a frame: llvmpipe may still be drawing from the last
   // one (it defers rasterisation), and rewriting it in place would change earlier draws.
-  if (next_buffer_ == buffer_pool_.size()) buffer_pool_.push_back(createBuffer(gl_));
-  const GLuint buffer = buffer_pool_[next_buffer_++].get();
+  if (next_buffer_ == buffer_pool_.size())
+    buffer_pool_.push_back({createBuffer(gl_), createTexture(gl_, GL_TEXTURE_BUFFER)});
+  const FrameTexture& entry = buffer_pool_[next_buffer_++];
+  const GLuint buffer = entry.buffer.get();
   if (bytes >= 16) {
     gl_.NamedBufferData(buffer, GLsizeiptr(bytes), data, GL_STREAM_DRAW);
   } else {  // never bind an empty store
@@ -198,7 +195,8 @@ GLuint EllipsoidRenderer::frameBuffer(const void* data, std::size_t bytes) {
     gl_.NamedBufferData(buffer, 16, zeros, GL_STREAM_DRAW);
     if (bytes > 0) gl_.NamedBufferSubData(buffer, 0, GLsizeiptr(bytes), data);
   }
-  return buffer;
+  gl_.TextureBuffer(entry.texture.get(), format, buffer);
+  gl_.BindTextureUnit(GLuint(unit), entry.texture.get());
 }
 
 void EllipsoidRenderer::endFrame() {
@@ -314,31 +312,32 @@ void EllipsoidRenderer::setCloudUniforms(GLuint p, const Scene& scene, const Ell
 }
 
 void EllipsoidRenderer::uploadRecords(const std::vector<EllipsoidRecord>& records) {
-  gl_.BindBufferBase(GL_SHADER_STORAGE_BUFFER, kEllipsoidBufferBinding,
-                     frameBuffer(records.data(), records.size() * sizeof(EllipsoidRecord)));
-}
-
-void EllipsoidRenderer::drawCloud(const Scene& scene, std::size_t index,
-                                  const RenderSettings& settings, const FrameTarget& target,
-                                  bool targets_drawn, const AltitudeBand& band) {
-  if (settings.impostor_tolerance_px > 0.0 &&
-      drawImpostor(scene, index, settings, target, targets_drawn, band))
-    return;
-  drawCloudDirect(scene, index, settings, target, targets_drawn, band);
+  bindFrameTexture(kRecordTextureUnit, GL_RGBA32F, records.data(),
+                   records.size() * sizeof(EllipsoidRecord));
 }
 
 namespace {
+
+// What a cloud's pass takes besides its ellipsoids and the scene: clouds with the same key
+// can share one pass.
+std::string cloudLookKey(const EllipsoidCloud& cloud, const RenderSettings& settings) {
+  std::ostringstream key;
+  key.precision(17);
+  key << cloud.colour.x << ',' << cloud.colour.y << ',' << cloud.colour.z << '/'
+      << cloud.threshold_centre << '/' << cloud.threshold_limb << '/' << cloud.transition << '/'
+      << cloud.shading.ambient << '/' << cloud.shading.texture_fraction << '/'
+      << cloud.shading.specular << '/' << cloud.shading.shininess << '/' << cloud.light_extinction
+      << '/' << cloud.drift_m.x << ',' << cloud.drift_m.y << ',' << cloud.drift_m.z << '/'
+      << textureKey(cloud.texture, settings);
+  return key.str();
+}
 
 // Everything an impostor's picture depends on besides the eye.
 std::string impostorKey(const Scene& scene, const EllipsoidCloud& cloud,
                         const RenderSettings& settings) {
   std::ostringstream key;
   key.precision(17);
-  key << cloud.colour.x << cloud.colour.y << cloud.colour.z << '/' << cloud.threshold_centre << '/'
-      << cloud.threshold_limb << '/' << cloud.transition << '/' << cloud.shading.ambient << '/'
-      << cloud.shading.texture_fraction << '/' << cloud.shading.specular << '/'
-      << cloud.shading.shininess << '/' << cloud.light_extinction << '/'
-      << textureKey(cloud.texture, settings) << '/' << int(settings.ellipsoid_passes)
+  key << cloudLookKey(cloud, settings) << '/' << int(settings.ellipsoid_passes)
       << int(settings.ellipsoid_order) << int(settings.limb) << int(settings.term_filter) << '/'
       << scene.sun.azimuth_deg << '/' << scene.sun.elevation_deg << '/' << scene.sun.colour.x
       << scene.sun.colour.y << scene.sun.colour.z << '/' << scene.fog.has_value();
@@ -351,6 +350,25 @@ std::string impostorKey(const Scene& scene, const EllipsoidCloud& cloud,
 }
 
 }  // namespace
+
+void EllipsoidRenderer::drawClouds(const Scene& scene, const std::vector<std::size_t>& indices,
+                                   const RenderSettings& settings, const FrameTarget& target,
+                                   bool targets_drawn, const AltitudeBand& band) {
+  // Batches in the order of their farthest cloud; impostors first, being far.
+  std::vector<std::pair<std::string, std::vector<std::size_t>>> batches;
+  for (std::size_t index : indices) {
+    if (settings.impostor_tolerance_px > 0.0 &&
+        drawImpostor(scene, index, settings, target, targets_drawn, band))
+      continue;
+    const std::string key = cloudLookKey(scene.clouds[index], settings);
+    auto batch = std::find_if(batches.begin(), batches.end(),
+                              [&](const auto& entry) { return entry.first == key; });
+    if (batch == batches.end()) batch = batches.insert(batches.end(), {key, {}});
+    batch->second.push_back(index);
+  }
+  for (const auto& [key, members] : batches)
+    drawDirect(scene, members, settings, target, targets_drawn, band);
+}
 
 bool EllipsoidRenderer::drawImpostor(const Scene& scene, std::size_t index,
                                      const RenderSettings& settings, const FrameTarget& target,
@@ -404,7 +422,7 @@ bool EllipsoidRenderer::drawImpostor(const Scene& scene, std::size_t index,
     gl_.BindFramebuffer(GL_FRAMEBUFFER, impostor.framebuffer.get());
     gl_.Viewport(0, 0, size, size);
     const FrameTarget impostor_target{impostor.framebuffer.get(), size, size};
-    drawCloudDirect(view, index, settings, impostor_target, false, AltitudeBand{});
+    drawDirect(view, {index}, settings, impostor_target, false, AltitudeBand{});
     gl_.BindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
     gl_.Viewport(0, 0, target.width, target.height);
     const ViewBasis basis = viewBasis(view.camera);
@@ -445,31 +463,40 @@ bool EllipsoidRenderer::drawImpostor(const Scene& scene, std::size_t index,
   return true;
 }
 
-void EllipsoidRenderer::drawCloudDirect(const Scene& scene, std::size_t index,
-                                        const RenderSettings& settings, const FrameTarget& target,
-                                        bool targets_drawn, const AltitudeBand& band) {
-  const EllipsoidCloud& cloud = scene.clouds[index];
-  // Visible ellipsoids, back to front by centre distance; the nearest surface distance.
-  std::vector<std::pair<double, EllipsoidRecord>> visible;
-  double nearest_m = std::numeric_limits<double>::infinity();
-  const std::vector<LobeLight> lights = lobeLights(cloud, sunDirection(scene.sun));
-  for (std::size_t i = 0; i < cloud.ellipsoids.size(); ++i) {
-    const Ellipsoid& e = cloud.ellipsoids[i];
+void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::size_t>& indices,
+                                   const RenderSettings& settings, const FrameTarget& target,
+                                   bool targets_drawn, const AltitudeBand& band) {
+  // The clouds look alike: the first one's texture and shading stand for all of them.
+  const EllipsoidCloud& cloud = scene.clouds[indices.front()];
+  // Visible ellipsoids with their sort keys (centre distance, nearest possible hit); the
+  // nearest surface distance.
+  struct Visible {
+    double centre_distance, near_bound;
     EllipsoidRecord record;
-    double distance = 0.0;
-    if (!makeEllipsoidRecord(e, scene.camera, record, distance)) continue;
-    record.v[16] = glm::vec4(float(lights[i].sun), float(lights[i].sky), 0.0f, 0.0f);
-    visible.push_back({distance, record});
-    nearest_m = std::min(nearest_m, distance - std::max({e.radii.x, e.radii.y, e.radii.z}));
+  };
+  std::vector<Visible> visible;
+  const bool spotlight = settings.limb == LimbEvaluation::kSpotlight;
+  double nearest_m = std::numeric_limits<double>::infinity();
+  int total = 0;
+  for (std::size_t index : indices) {
+    const EllipsoidCloud& member = scene.clouds[index];
+    total += int(member.ellipsoids.size());
+    const std::vector<LobeLight> lights = lobeLights(member, sunDirection(scene.sun));
+    for (std::size_t i = 0; i < member.ellipsoids.size(); ++i) {
+      Visible v;
+      if (!makeEllipsoidRecord(member.ellipsoids[i], scene.camera, spotlight, v.record,
+                               v.centre_distance))
+        continue;
+      v.record.v[16].x = float(lights[i].sun);
+      v.record.v[16].y = float(lights[i].sky);
+      v.near_bound = v.record.v[16].z;
+      nearest_m = std::min(nearest_m, v.near_bound);
+      visible.push_back(v);
+    }
   }
   stats_->ellipsoids_drawn += int(visible.size());
-  stats_->ellipsoids_culled += int(cloud.ellipsoids.size() - visible.size());
+  stats_->ellipsoids_culled += total - int(visible.size());
   if (visible.empty()) return;
-  std::stable_sort(visible.begin(), visible.end(),
-                   [](const auto& a, const auto& b) { return a.first > b.first; });
-  std::vector<EllipsoidRecord> records;
-  records.reserve(visible.size());
-  for (const auto& entry : visible) records.push_back(entry.second);
 
   CachedTexture& texture = cachedTexture(cloud.texture, settings);
   EllipsoidPassLayout base;
@@ -481,85 +508,125 @@ void EllipsoidRenderer::drawCloudDirect(const Scene& scene, std::size_t index,
                  : procedural               ? SolidTextureKind::kProcedural
                                             : SolidTextureKind::kBakedGardner;
   base.term_filter = settings.term_filter;
-  base.spotlight = settings.limb == LimbEvaluation::kSpotlight;
+  base.spotlight = spotlight;
   base.fog = scene.fog.has_value();
   base.specular = cloud.shading.specular > 0.0;
   base.targets = targets_drawn;
   if (base.texture != SolidTextureKind::kProcedural)
     gl_.BindTextureUnit(kVolumeTextureUnit, gpuTexture(texture));
   if (base.spotlight) gl_.BindTextureUnit(kSpotlightTextureUnit, spotlightTexture());
-
   gl_.Enable(GL_BLEND);
   gl_.BlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+
+  // The per-pixel pass orders every hit of the batch: its records and bin lists must fit in
+  // buffer textures. Otherwise, and when asked, ellipsoids are blended back to front by
+  // their centres.
+  const std::size_t max_records = std::size_t(max_texels_) / kEllipsoidRecordVec4s;
+  bool per_pixel = settings.ellipsoid_passes == EllipsoidPasses::kFused &&
+                   settings.ellipsoid_order == EllipsoidOrder::kPerPixel &&
+                   visible.size() <= max_records;
+  auto records = [&](bool front_to_back) {
+    if (front_to_back)  // nearest bound first: the per-pixel pass composites front to back
+      std::stable_sort(visible.begin(), visible.end(), [](const Visible& a, const Visible& b) {
+        return a.near_bound < b.near_bound;
+      });
+    else
+      std::stable_sort(visible.begin(), visible.end(), [](const Visible& a, const Visible& b) {
+        return a.centre_distance > b.centre_distance;
+      });
+    std::vector<EllipsoidRecord> out;
+    out.reserve(visible.size());
+    for (const Visible& v : visible) out.push_back(v.record);
+    return out;
+  };
   if (settings.ellipsoid_passes == EllipsoidPasses::kMultipass) {
-    drawTiles(scene, cloud, texture, base, settings, records, target, band);
+    std::vector<EllipsoidRecord> ordered = records(false);
+    drawTiles(scene, cloud, texture, base, settings, ordered, target, band);
     return;
   }
-  uploadRecords(records);
   gl_.BindVertexArray(vertex_array_.get());
-  // Screen bins, each listing the ellipsoids whose rectangles overlap it (not needed when
-  // the centre order is asked for).
-  const bool by_centre = settings.ellipsoid_order == EllipsoidOrder::kCentre;
-  const int bins_x = (target.width + kPerPixelBinSize - 1) / kPerPixelBinSize;
-  const int bins_y = (target.height + kPerPixelBinSize - 1) / kPerPixelBinSize;
-  std::vector<std::vector<GLint>> lists(std::size_t(bins_x) * bins_y);
-  auto pixel = [](float ndc, int size) { return (double(ndc) + 1.0) * 0.5 * size; };
-  std::size_t deepest = 0;
-  for (int i = 0; i < int(records.size()) && !by_centre; ++i) {
-    const glm::vec4 rect = records[i].v[10];
-    const int x0 = std::clamp(int(pixel(rect.x, target.width)) / kPerPixelBinSize, 0, bins_x - 1);
-    const int x1 = std::clamp(int(pixel(rect.z, target.width)) / kPerPixelBinSize, 0, bins_x - 1);
-    const int y0 = std::clamp(int(pixel(rect.y, target.height)) / kPerPixelBinSize, 0, bins_y - 1);
-    const int y1 = std::clamp(int(pixel(rect.w, target.height)) / kPerPixelBinSize, 0, bins_y - 1);
-    for (int y = y0; y <= y1; ++y)
-      for (int x = x0; x <= x1; ++x) {
-        std::vector<GLint>& list = lists[std::size_t(y) * bins_x + x];
-        list.push_back(i);
-        deepest = std::max(deepest, list.size());
-      }
-  }
-  // Where no two ellipsoids share a bin, no pixel has two hits to sort: the centre pass
-  // draws the same image, faster.
-  if (by_centre || deepest <= 1) {
+  auto drawByCentre = [&](const std::vector<EllipsoidRecord>& ordered) {
     EllipsoidPassLayout layout = base;
     layout.program = EllipsoidProgram::kFusedCentre;
     const GLuint p = program(layout);
     gl_.UseProgram(p);
     setCloudUniforms(p, scene, cloud, texture, layout.texture, band);
     gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_first"), 0);
-    gl_.DrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(records.size()));
-    ++stats_->ellipsoid_passes;
-    return;
+    for (std::size_t first = 0; first < ordered.size(); first += max_records) {
+      const std::size_t count = std::min(max_records, ordered.size() - first);
+      bindFrameTexture(kRecordTextureUnit, GL_RGBA32F, ordered.data() + first,
+                       count * sizeof(EllipsoidRecord));
+      gl_.DrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(count));
+      ++stats_->ellipsoid_passes;
+    }
+  };
+  if (!per_pixel) return drawByCentre(records(false));
+
+  const std::vector<EllipsoidRecord> ordered = records(true);
+  // Screen bins over the batch's rectangle, each listing the ellipsoids whose rectangles
+  // overlap it, in the records' order (two passes: count, then fill).
+  auto bin = [&](float ndc, int size) {
+    return std::clamp(int((double(ndc) + 1.0) * 0.5 * size) / kPerPixelBinSize, 0,
+                      (size - 1) / kPerPixelBinSize);
+  };
+  glm::ivec4 area(std::numeric_limits<int>::max(), std::numeric_limits<int>::max(), -1, -1);
+  std::vector<glm::ivec4> spans(ordered.size());
+  std::int64_t listed = 0;
+  for (std::size_t i = 0; i < ordered.size(); ++i) {
+    const glm::vec4 rect = ordered[i].v[10];
+    spans[i] = {bin(rect.x, target.width), bin(rect.y, target.height), bin(rect.z, target.width),
+                bin(rect.w, target.height)};
+    area = {std::min(area.x, spans[i].x), std::min(area.y, spans[i].y),
+            std::max(area.z, spans[i].z), std::max(area.w, spans[i].w)};
+    listed += std::int64_t(spans[i].z - spans[i].x + 1) * (spans[i].w - spans[i].y + 1);
   }
-  // Per pixel: every bin in one draw, each pixel sorting its bin's hits.
+  const int bins_x = area.z - area.x + 1, bins_y = area.w - area.y + 1;
+  if (listed > max_texels_ || std::int64_t(bins_x) * bins_y > max_texels_)
+    return drawByCentre(records(false));
+  std::vector<glm::ivec2> bins(std::size_t(bins_x) * bins_y, glm::ivec2(0));
+  auto binAt = [&](int x, int y) -> glm::ivec2& {
+    return bins[std::size_t(y - area.y) * bins_x + (x - area.x)];
+  };
+  for (const glm::ivec4& span : spans)
+    for (int y = span.y; y <= span.w; ++y)
+      for (int x = span.x; x <= span.z; ++x) ++binAt(x, y).y;
+  int deepest = 0, first = 0;
+  for (glm::ivec2& b : bins) {
+    deepest = std::max(deepest, b.y);
+    b.x = first;
+    first += b.y;
+    b.y = 0;
+  }
+  // Where no two ellipsoids share a bin, no pixel has two hits to order: the centre pass
+  // draws the same image, faster.
+  if (deepest <= 1) return drawByCentre(ordered);
+  std::vector<GLint> items(static_cast<std::size_t>(first));
+  for (std::size_t i = 0; i < spans.size(); ++i)
+    for (int y = spans[i].y; y <= spans[i].w; ++y)
+      for (int x = spans[i].x; x <= spans[i].z; ++x) {
+        glm::ivec2& b = binAt(x, y);
+        items[std::size_t(b.x + b.y++)] = GLint(i);
+      }
   EllipsoidPassLayout layout = base;
   layout.program = EllipsoidProgram::kFusedPerPixel;
   const GLuint p = program(layout);
   gl_.UseProgram(p);
   setCloudUniforms(p, scene, cloud, texture, layout.texture, band);
-  struct Bin {
-    glm::vec4 rect;
-    glm::ivec4 items;  // first, count
+  gl_.ProgramUniform2i(p, gl_.GetUniformLocation(p, "u_bin_origin"), area.x, area.y);
+  gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_bins_x"), bins_x);
+  gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_bin_size"), kPerPixelBinSize);
+  auto ndc = [](int bins, int size) {
+    return float(2.0 * std::min(bins * kPerPixelBinSize, size) / size - 1.0);
   };
-  std::vector<Bin> bins;
-  std::vector<GLint> items;
-  auto ndc = [](int p, int size) { return float(2.0 * std::min(p, size) / size - 1.0); };
-  for (int y = 0; y < bins_y; ++y)
-    for (int x = 0; x < bins_x; ++x) {
-      const std::vector<GLint>& list = lists[std::size_t(y) * bins_x + x];
-      if (list.empty()) continue;
-      const int px = x * kPerPixelBinSize, py = y * kPerPixelBinSize;
-      bins.push_back(
-          {{ndc(px, target.width), ndc(py, target.height), ndc(px + kPerPixelBinSize, target.width),
-            ndc(py + kPerPixelBinSize, target.height)},
-           {GLint(items.size()), GLint(list.size()), 0, 0}});
-      items.insert(items.end(), list.begin(), list.end());
-    }
-  gl_.BindBufferBase(GL_SHADER_STORAGE_BUFFER, kBinBufferBinding,
-                     frameBuffer(bins.data(), bins.size() * sizeof(Bin)));
-  gl_.BindBufferBase(GL_SHADER_STORAGE_BUFFER, kBinItemBufferBinding,
-                     frameBuffer(items.data(), items.size() * sizeof(GLint)));
-  gl_.DrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(bins.size()));
+  const float x0 = ndc(area.x, target.width), y0 = ndc(area.y, target.height);
+  const float x1 = ndc(area.z + 1, target.width), y1 = ndc(area.w + 1, target.height);
+  const glm::vec2 polygon[4] = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
+  gl_.ProgramUniform2fv(p, gl_.GetUniformLocation(p, "u_polygon"), 4, &polygon[0].x);
+  bindFrameTexture(kRecordTextureUnit, GL_RGBA32F, ordered.data(),
+                   ordered.size() * sizeof(EllipsoidRecord));
+  bindFrameTexture(kBinTextureUnit, GL_RG32I, bins.data(), bins.size() * sizeof(glm::ivec2));
+  bindFrameTexture(kBinItemTextureUnit, GL_R32I, items.data(), items.size() * sizeof(GLint));
+  gl_.DrawArrays(GL_TRIANGLE_FAN, 0, 4);
   ++stats_->ellipsoid_passes;
 }
 

@@ -31,9 +31,10 @@ struct EllipsoidRecord {
 
 // Everything the GPU needs for one ellipsoid seen from `camera`; false when it cannot show
 // (behind the eye, off screen, the eye inside it, or faded out by the in-cloud model).
-// `centre_distance` is the back-to-front sort key.
-bool makeEllipsoidRecord(const Ellipsoid& ellipsoid, const Camera& camera, EllipsoidRecord& out,
-                         double& centre_distance);
+// `centre_distance` is the back-to-front sort key. The spotlight rows are filled only when
+// `spotlight` asks for them.
+bool makeEllipsoidRecord(const Ellipsoid& ellipsoid, const Camera& camera, bool spotlight,
+                         EllipsoidRecord& out, double& centre_distance);
 
 class EllipsoidRenderer {
  public:
@@ -45,12 +46,16 @@ class EllipsoidRenderer {
   void beginFrame(FrameStats& stats);
   void endFrame();
 
-  // Draws cloud `index` of the scene "over" what `target` holds, blending premultiplied.
-  // `targets_drawn`: the target colour and distance textures are bound. A far cloud may be
-  // drawn from its impostor (RenderSettings::impostor_tolerance_px). Only the surfaces in
-  // `band` are drawn, so that a layer can cut through the cloud.
-  void drawCloud(const Scene& scene, std::size_t index, const RenderSettings& settings,
-                 const FrameTarget& target, bool targets_drawn, const AltitudeBand& band = {});
+  // Draws clouds `indices` of the scene (back to front by their distance) "over" what
+  // `target` holds, blending premultiplied. `targets_drawn`: the target colour and distance
+  // textures are bound. A far cloud may be drawn from its impostor
+  // (RenderSettings::impostor_tolerance_px); the others are drawn in batches of clouds that
+  // look alike (same texture, drift and shading), each batch in one pass whose pixels
+  // composite every hit of the batch in depth order. Only the surfaces in `band` are drawn,
+  // so that a layer can cut through the clouds.
+  void drawClouds(const Scene& scene, const std::vector<std::size_t>& indices,
+                  const RenderSettings& settings, const FrameTarget& target, bool targets_drawn,
+                  const AltitudeBand& band = {});
 
   // Impostors rendered so far (for measurement and tests).
   int impostorRenders() const { return impostor_renders_; }
@@ -81,8 +86,10 @@ class EllipsoidRenderer {
     bool used = false;
   };
 
-  void drawCloudDirect(const Scene& scene, std::size_t index, const RenderSettings& settings,
-                       const FrameTarget& target, bool targets_drawn, const AltitudeBand& band);
+  // Clouds `indices`, which look alike, drawn from their ellipsoids in one batch.
+  void drawDirect(const Scene& scene, const std::vector<std::size_t>& indices,
+                  const RenderSettings& settings, const FrameTarget& target, bool targets_drawn,
+                  const AltitudeBand& band);
   // False when the cloud is too near for an impostor; then the caller draws it directly.
   bool drawImpostor(const Scene& scene, std::size_t index, const RenderSettings& settings,
                     const FrameTarget& target, bool targets_drawn, const AltitudeBand& band);
@@ -94,7 +101,8 @@ class EllipsoidRenderer {
   void setCloudUniforms(GLuint program, const Scene& scene, const EllipsoidCloud& cloud,
                         const CachedTexture& texture, SolidTextureKind kind,
                         const AltitudeBand& band);
-  GLuint frameBuffer(const void* data, std::size_t bytes);
+  // Binds to `unit` a buffer texture of `format` holding `bytes` of `data`.
+  void bindFrameTexture(int unit, GLenum format, const void* data, std::size_t bytes);
   void uploadRecords(const std::vector<EllipsoidRecord>& records);
   void drawTiles(const Scene& scene, const EllipsoidCloud& cloud, CachedTexture& texture,
                  const EllipsoidPassLayout& base, const RenderSettings& settings,
@@ -108,9 +116,13 @@ class EllipsoidRenderer {
   void prepareAtlas(TileFormat format);
 
   const GlApi& gl_;
-  GlObject vertex_array_;              // empty: attribute-less draws
-  std::vector<GlObject> buffer_pool_;  // storage buffers, one per upload in a frame
+  GlObject vertex_array_;  // empty: attribute-less draws
+  struct FrameTexture {
+    GlObject buffer, texture;
+  };
+  std::vector<FrameTexture> buffer_pool_;  // buffer textures, one per upload in a frame
   std::size_t next_buffer_ = 0;
+  GLint max_texels_ = 0;  // GL_MAX_TEXTURE_BUFFER_SIZE
   GlObject spotlight_;
   GlObject atlas_;
   GlObject atlas_framebuffer_;

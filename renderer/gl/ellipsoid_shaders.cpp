@@ -6,7 +6,8 @@ namespace nephele {
 namespace {
 
 const char* kRecords = R"(
-// One ellipsoid seen from the eye, everything camera-relative (see EllipsoidRenderer).
+// One ellipsoid seen from the eye, everything camera-relative (see EllipsoidRenderer); the
+// texels of record(i, k) in this order:
 struct EllipsoidRecord {
   vec4 w[3];       // rows of W = S^-1 R^T: unit-sphere offset of a camera-relative point
   vec4 eye_unit;   // o = W (eye - centre); w: c = |o|^2 - 1 (> 0: the eye is outside)
@@ -17,9 +18,14 @@ struct EllipsoidRecord {
   vec4 body[3];    // columns of R S: unit sphere to camera-relative offsets
   vec4 centre;     // centre - eye
   vec4 tile;       // atlas tile: texel origin xy, size zw
-  vec4 light;      // x sunlight, y sky light reaching it through its heap (MODEL.md section 14)
+  vec4 light;      // x sunlight, y sky light reaching it through its heap (MODEL.md section 14);
+                   // z the nearest a hit on it can be, metres (front-to-back order)
 };
-layout(std430, binding = 0) readonly buffer EllipsoidRecords { EllipsoidRecord u_e[]; };
+// Records live in a buffer texture, kRecordTexels RGBA32F texels each: llvmpipe fetches texels
+// for eight pixels at once, where a storage buffer is read one pixel at a time.
+layout(binding = 13) uniform samplerBuffer u_records;
+const int kRecordTexels = 17;
+vec4 record(int i, int k) { return texelFetch(u_records, i * kRecordTexels + k); }
 )";
 
 const char* kCloud = R"(
@@ -34,24 +40,24 @@ uniform vec3 u_inv_period;    // periods per metre
 uniform vec2 u_scatter;       // x: 1 with the heap's light (MODEL.md section 14), else 0; y: g
 
 vec3 toUnit(int i, vec3 v) {
-  return vec3(dot(u_e[i].w[0].xyz, v), dot(u_e[i].w[1].xyz, v), dot(u_e[i].w[2].xyz, v));
+  return vec3(dot(record(i, 0).xyz, v), dot(record(i, 1).xyz, v), dot(record(i, 2).xyz, v));
 }
 // W^T u: the quadric's gradient direction at unit-sphere point u.
 vec3 gradientFromUnit(int i, vec3 u) {
-  return u.x * u_e[i].w[0].xyz + u.y * u_e[i].w[1].xyz + u.z * u_e[i].w[2].xyz;
+  return u.x * record(i, 0).xyz + u.y * record(i, 1).xyz + u.z * record(i, 2).xyz;
 }
 
 // Nearest root s of |o + s W r| = 1, in units of r; negative when the ellipsoid is missed or
 // lies behind the eye. Delta / 4 = |w|^2 - |o x w|^2 keeps far ellipsoids exact.
 float hitEllipsoid(int i, vec3 r) {
-  vec3 w = toUnit(i, r), o = u_e[i].eye_unit.xyz;
+  vec3 w = toUnit(i, r), o = record(i, 3).xyz;
   float a = dot(w, w);
   vec3 c = cross(o, w);
   float quarter_delta = a - dot(c, c);
   if (quarter_delta <= 0.0) return -1.0;
   float half_b = dot(o, w);
   float q = -(half_b + (half_b >= 0.0 ? 1.0 : -1.0) * sqrt(quarter_delta));
-  return min(q / a, u_e[i].eye_unit.w / q);
+  return min(q / a, record(i, 3).w / q);
 }
 
 #ifdef SPOTLIGHT
@@ -60,16 +66,16 @@ layout(binding = 10) uniform sampler2D u_spotlight;  // 1 - rho^2 over [-1, 1]^2
 
 // The limb function g (MODEL.md section 4) for view direction d.
 float limbG(int i, vec3 d) {
-  vec3 a = u_e[i].limb_axis.xyz;
+  vec3 a = record(i, 4).xyz;
   float along = dot(d, a);
   if (along <= 0.0) return 0.0;
   vec3 q = d / along - a;
 #ifdef SPOTLIGHT
   // Elinas: a radial texture projected from the eye along the cone's axis.
-  vec2 st = vec2(dot(u_e[i].l[0].xyz, q), dot(u_e[i].l[1].xyz, q));
+  vec2 st = vec2(dot(record(i, 8).xyz, q), dot(record(i, 9).xyz, q));
   return textureLod(u_spotlight, 0.5 + 0.5 * st, 0.0).r;
 #else
-  vec3 pq = vec3(dot(u_e[i].p[0].xyz, q), dot(u_e[i].p[1].xyz, q), dot(u_e[i].p[2].xyz, q));
+  vec3 pq = vec3(dot(record(i, 5).xyz, q), dot(record(i, 6).xyz, q), dot(record(i, 7).xyz, q));
   return clamp(1.0 - dot(q, pq), 0.0, 1.0);
 #endif
 }
@@ -133,7 +139,7 @@ float forwardScattered(float sun, float c) {
 // colour, fogged; n faces the viewer, r points at the surface from the eye, `distance` in
 // metres.
 vec3 surfaceColour(int i, vec3 n, vec3 r, float it, float tr, float distance) {
-  vec2 light = u_e[i].light.xy;
+  vec2 light = record(i, 16).xy;
   float n_dot_l = dot(n, u_to_sun);
   float diffuse = max(n_dot_l, 0.0);
   float highlight = 0.0;
@@ -156,7 +162,7 @@ float opacityFromExcess(float x) { return 1.0 - translucence(x, u_thresholds.z);
 // Premultiplied colour and opacity of ellipsoid i where the ray r meets it at s.
 vec4 ellipsoidSurface(int i, vec3 r, float s) {
   vec3 p = s * r;
-  vec3 n = normalize(gradientFromUnit(i, u_e[i].eye_unit.xyz + s * toUnit(i, r)));
+  vec3 n = normalize(gradientFromUnit(i, record(i, 3).xyz + s * toUnit(i, r)));
   if (dot(n, r) > 0.0) n = -n;  // turned towards the viewer
   // Ray differentials on the tangent plane: the hit moves by s (dr - r (n.dr) / (n.r)).
   vec3 drx = u_right * (2.0 / u_viewport.x), dry = u_up * (2.0 / u_viewport.y);
@@ -166,7 +172,7 @@ vec4 ellipsoidSurface(int i, vec3 r, float s) {
   float it = solidValue(p, dpdx, dpdy);
   float excess = it - u_thresholds.x - (u_thresholds.y - u_thresholds.x) * (1.0 - limbG(i, r));
   float opacity = opacityFromExcess(excess);
-  float alpha = opacity * u_e[i].limb_axis.w;
+  float alpha = opacity * record(i, 4).w;
   return vec4(surfaceColour(i, n, r, it, 1.0 - opacity, s * length(r)) * alpha, alpha);
 }
 
@@ -186,73 +192,74 @@ void main() {
 )";
 
 const char* kFusedPerPixel = R"(
-layout(std430, binding = 2) readonly buffer BinItems { int u_items[]; };
-flat in int v_first;  // this screen bin's ellipsoids: u_items[v_first .. v_first + v_count)
-flat in int v_count;
-const int kMaxHits = 8;
+// The batch's screen bins, kPerPixelBinSize pixels a side, from bin u_bin_origin on, u_bins_x
+// to a row: bin b lists its ellipsoids u_items[u_bins[b].x .. + u_bins[b].y) nearest first
+// by the distance no hit on them can be nearer than (the record's light.z, metres).
+layout(binding = 7) uniform isamplerBuffer u_bins;   // RG32I: first item, count
+layout(binding = 8) uniform isamplerBuffer u_items;  // R32I
+uniform ivec2 u_bin_origin;
+uniform int u_bins_x;
+uniform int u_bin_size;
 
 // Hits are ordered by (depth, ellipsoid index), so equal depths still have one order.
 bool before(float s, int i, float t, int j) { return s < t || (s == t && i < j); }
 
 // Ellipsoid i's hit on this pixel's ray where it shows, else -1.
-float shownHit(int i, vec2 ndc, vec3 r, float limit) {
-  vec4 rect = u_e[i].rect;
-  if (any(lessThan(ndc, rect.xy)) || any(greaterThan(ndc, rect.zw))) return -1.0;
+float shownHit(int i, vec3 r, float limit) {
   float s = hitEllipsoid(i, r);
   return hitShows(r, s, limit) ? s : -1.0;
 }
 
 void main() {
   vec3 r = viewRay();
-  vec2 ndc = 2.0 * gl_FragCoord.xy / u_viewport - 1.0;
-  float limit = opaqueDistance(r) / length(r);
-  // The nearest kMaxHits hits, sorted near to far; `total` counts every hit.
-  float depth[kMaxHits];
-  int index[kMaxHits];
-  int n = 0, total = 0;
-  for (int k = 0; k < v_count; ++k) {
-    int i = u_items[v_first + k];
-    float s = shownHit(i, ndc, r, limit);
-    if (s < 0.0) continue;
-    ++total;
-    if (n == kMaxHits && !before(s, i, depth[n - 1], index[n - 1])) continue;
-    int j = min(n, kMaxHits - 1);
-    n = min(n + 1, kMaxHits);
-    for (; j > 0 && before(s, i, depth[j - 1], index[j - 1]); --j) {
-      depth[j] = depth[j - 1];
-      index[j] = index[j - 1];
-    }
-    depth[j] = s;
-    index[j] = i;
-  }
-  if (n == 0) discard;
-  // "Over", accumulated front to back (the same sum), so that hits behind an opaque one are
-  // never shaded; what they could add is below 1/1024.
+  float metres_per_unit = length(r);
+  float limit = opaqueDistance(r) / metres_per_unit;
+  ivec2 bin = ivec2(gl_FragCoord.xy) / u_bin_size - u_bin_origin;
+  ivec2 list = texelFetch(u_bins, bin.y * u_bins_x + bin.x).xy;
+  // Front to back (MODEL.md section 15): the ellipsoids come nearest bound first, and a hit
+  // that no ellipsoid still to come can be in front of is final. Up to four hits wait,
+  // nearest first (depth d, ellipsoid id; empty slots at kNone). Each round tests ellipsoids
+  // until the nearest waiting hit is final (or four wait: then the nearest goes first), then
+  // composites the final hits; the walk ends once the pixel is opaque, since what lies
+  // behind would add less than 1/1024. Shading stays out of the testing loop: llvmpipe runs
+  // both sides of every branch, so a loop pays for all of its body on every turn.
+  const float kNone = 3.0e38;
   const float kOpaque = 1.0 - 1.0 / 1024.0;
+  vec4 d = vec4(kNone);
+  ivec4 id = ivec4(-1);
+  int waiting = 0, k = 0;
+  float next = kNone;  // the bound of ellipsoid k, the next to test (kNone when none is left)
   vec4 result = vec4(0.0);
-  for (int j = 0; j < n && result.a < kOpaque; ++j)
-    result += (1.0 - result.a) * ellipsoidSurface(index[j], r, depth[j]);
-  // More hits than the stack holds (rare: a deep pile of translucent lobes): peel the rest
-  // exactly, one nearest-remaining hit per round, so that every hit is composited in order.
-  float last_s = depth[n - 1];
-  int last_i = index[n - 1];
-  for (int peeled = n; peeled < total && result.a < kOpaque; ++peeled) {
-    float best_s = 1e38;
-    int best_i = -1;
-    for (int k = 0; k < v_count; ++k) {
-      int i = u_items[v_first + k];
-      float s = shownHit(i, ndc, r, limit);
-      if (s < 0.0 || !before(last_s, last_i, s, i)) continue;
-      if (best_i < 0 || before(s, i, best_s, best_i)) {
-        best_s = s;
-        best_i = i;
+  while (result.a < kOpaque) {
+    for (; k < list.y; ++k) {
+      int i = texelFetch(u_items, list.x + k).x;
+      next = record(i, 16).z / metres_per_unit;
+      if (next >= limit) {
+        k = list.y;
+        break;
       }
+      if (waiting == 4 || (waiting > 0 && d.x <= next)) break;
+      float s = shownHit(i, r, limit);
+      if (s < 0.0) continue;
+      // Insert (s, i) in order with constant indices (llvmpipe spills indexed arrays).
+      int at = int(before(d.x, id.x, s, i)) + int(before(d.y, id.y, s, i)) +
+               int(before(d.z, id.z, s, i));
+      d = vec4(at > 0 ? d.x : s, at > 1 ? d.y : (at == 1 ? s : d.x),
+               at > 2 ? d.z : (at == 2 ? s : d.y), at == 3 ? s : d.z);
+      id = ivec4(at > 0 ? id.x : i, at > 1 ? id.y : (at == 1 ? i : id.x),
+                 at > 2 ? id.z : (at == 2 ? i : id.y), at == 3 ? i : id.z);
+      ++waiting;
     }
-    if (best_i < 0) break;
-    result += (1.0 - result.a) * ellipsoidSurface(best_i, r, best_s);
-    last_s = best_s;
-    last_i = best_i;
+    if (k >= list.y) next = kNone;
+    if (waiting == 0) break;
+    do {
+      result += (1.0 - result.a) * ellipsoidSurface(id.x, r, d.x);
+      d = vec4(d.yzw, kNone);
+      id = ivec4(id.yzw, -1);
+      --waiting;
+    } while (waiting > 0 && d.x <= next && result.a < kOpaque);
   }
+  if (result.a <= 0.0) discard;
   o_colour = result;
 }
 )";
@@ -284,18 +291,18 @@ uniform int u_index;
 uniform vec2 u_atlas_size;
 layout(binding = 11) uniform sampler2D u_atlas;
 void main() {
-  vec4 rect = u_e[u_index].rect, tile = u_e[u_index].tile;
+  vec4 rect = record(u_index, 10), tile = record(u_index, 15);
   vec2 ndc = 2.0 * gl_FragCoord.xy / u_viewport - 1.0;
   vec2 uv = (ndc - rect.xy) / (rect.zw - rect.xy);
   vec2 texel = tile.xy + clamp(uv * tile.zw, vec2(0.5), tile.zw - 0.5);
   vec4 t = texture(u_atlas, texel / u_atlas_size);
   // Elinas' colour-matrix step, here in the shader: alpha = (It - T1 - (T2 - T1)(1 - g)) / D.
-  float alpha = opacityFromExcess(t.a) * u_e[u_index].limb_axis.w;
+  float alpha = opacityFromExcess(t.a) * record(u_index, 4).w;
   vec3 r = viewRay();
   float s = hitEllipsoid(u_index, r);
   // A tile texel just outside the exact silhouette (no hit) stands at the ray's closest
   // approach to the centre, so a cloud drawn in several bands draws it in exactly one.
-  if (s <= 0.0) s = max(dot(u_e[u_index].centre.xyz, r) / dot(r, r), 0.0);
+  if (s <= 0.0) s = max(dot(record(u_index, 14).xyz, r) / dot(r, r), 0.0);
   if (!hitShows(r, s, opaqueDistance(r) / length(r))) discard;
   o_colour = vec4(t.rgb * alpha, alpha);
 }
@@ -342,29 +349,9 @@ uniform int u_first;
 flat out int v_index;
 void main() {
   v_index = u_first + gl_InstanceID;
-  vec4 rect = u_e[v_index].rect;
+  vec4 rect = record(v_index, 10);
   vec2 corner = vec2(gl_VertexID & 1, gl_VertexID >> 1);  // triangle strip
   gl_Position = vec4(mix(rect.xy, rect.zw, corner), 0.0, 1.0);
-}
-)";
-      return s;
-    case EllipsoidProgram::kFusedPerPixel:
-      s += R"(
-// Screen bins (Gardner sorted per scan-line region; here per square of pixels): each lists
-// the ellipsoids whose rectangles overlap it.
-struct Bin {
-  vec4 rect;    // NDC x0, y0, x1, y1
-  ivec4 items;  // first, count
-};
-layout(std430, binding = 1) readonly buffer Bins { Bin u_bins[]; };
-flat out int v_first;
-flat out int v_count;
-void main() {
-  Bin bin = u_bins[gl_InstanceID];
-  v_first = bin.items.x;
-  v_count = bin.items.y;
-  vec2 corner = vec2(gl_VertexID & 1, gl_VertexID >> 1);  // triangle strip
-  gl_Position = vec4(mix(bin.rect.xy, bin.rect.zw, corner), 0.0, 1.0);
 }
 )";
       return s;
@@ -380,8 +367,8 @@ out vec3 v_position;
 out vec3 v_unit;
 void main() {
   v_unit = a_unit;
-  v_position = mat3(u_e[u_index].body[0].xyz, u_e[u_index].body[1].xyz,
-                    u_e[u_index].body[2].xyz) * a_unit + u_e[u_index].centre.xyz;
+  v_position = mat3(record(u_index, 11).xyz, record(u_index, 12).xyz,
+                    record(u_index, 13).xyz) * a_unit + record(u_index, 14).xyz;
   gl_Position = u_projection * vec4(v_position, 1.0);
 }
 )";

@@ -9,7 +9,7 @@ namespace nephele {
 
 enum class EllipsoidProgram {
   kFusedCentre,    // instanced screen rectangles, one per ellipsoid, back to front
-  kFusedPerPixel,  // one rectangle per cloud; each pixel sorts the cloud's hits by depth
+  kFusedPerPixel,  // one rectangle per batch; each pixel walks its bin's hits front to back
   kTileThreshold,  // Elinas pass 1: alpha = It - T1
   kTileLimb,       // Elinas pass 2: alpha -= (T2 - T1)(1 - g)
   kTileColour,     // Elinas colour pass: Gardner eq. 8, fogged
@@ -32,14 +32,14 @@ struct EllipsoidPassLayout {
   std::string key() const;
 };
 
-// Per-ellipsoid record in the shader storage buffer (std430, 16 vec4).
+// Per-ellipsoid record: RGBA32F texels of a buffer texture.
 inline constexpr int kEllipsoidRecordVec4s = 17;
-// Storage-buffer and texture binding points.
-inline constexpr int kEllipsoidBufferBinding = 0;
-inline constexpr int kBinBufferBinding = 1;
-inline constexpr int kBinItemBufferBinding = 2;
+// Texture units.
+inline constexpr int kBinTextureUnit = 7;
+inline constexpr int kBinItemTextureUnit = 8;
+inline constexpr int kRecordTextureUnit = 13;
 // Side of the square screen bins of the per-pixel pass, pixels.
-inline constexpr int kPerPixelBinSize = 16;
+inline constexpr int kPerPixelBinSize = 8;
 inline constexpr int kVolumeTextureUnit = 9;
 inline constexpr int kSpotlightTextureUnit = 10;
 inline constexpr int kAtlasTextureUnit = 11;

@@ -35,6 +35,7 @@ using GlDepthMaskProc = void(APIENTRYP)(GLboolean flag);
   X(PFNGLUSEPROGRAMPROC, UseProgram)                                     \
   X(PFNGLGETUNIFORMLOCATIONPROC, GetUniformLocation)                     \
   X(PFNGLPROGRAMUNIFORM1IPROC, ProgramUniform1i)                         \
+  X(PFNGLPROGRAMUNIFORM2IPROC, ProgramUniform2i)                         \
   X(PFNGLPROGRAMUNIFORM1FPROC, ProgramUniform1f)                         \
   X(PFNGLPROGRAMUNIFORM1FVPROC, ProgramUniform1fv)                       \
   X(PFNGLPROGRAMUNIFORM2FVPROC, ProgramUniform2fv)                       \
@@ -50,6 +51,7 @@ using GlDepthMaskProc = void(APIENTRYP)(GLboolean flag);
   X(PFNGLTEXTUREPARAMETERIPROC, TextureParameteri)                       \
   X(PFNGLGENERATETEXTUREMIPMAPPROC, GenerateTextureMipmap)               \
   X(PFNGLBINDTEXTUREUNITPROC, BindTextureUnit)                           \
+  X(PFNGLTEXTUREBUFFERPROC, TextureBuffer)                               \
   X(PFNGLCREATERENDERBUFFERSPROC, CreateRenderbuffers)                   \
   X(PFNGLDELETERENDERBUFFERSPROC, DeleteRenderbuffers)                   \
   X(PFNGLNAMEDRENDERBUFFERSTORAGEPROC, NamedRenderbufferStorage)         \

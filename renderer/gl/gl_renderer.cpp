@@ -653,12 +653,22 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
   auto next_cloud = clouds.begin();
   for (int band = top_band; band >= 0; --band) {
     if (next_cloud != clouds.end() && next_cloud->band == band) flushSky();
-    for (; next_cloud != clouds.end() && next_cloud->band == band; ++next_cloud)
-      if (next_cloud->automaton)
+    // Automata one by one; each run of ellipsoid clouds between them with one window in one
+    // call, which batches the clouds that look alike.
+    while (next_cloud != clouds.end() && next_cloud->band == band) {
+      if (next_cloud->automaton) {
         automata_.drawCloud(scene, next_cloud->index, settings, targets, next_cloud->window);
-      else
-        ellipsoids_.drawCloud(scene, next_cloud->index, settings, frame, targets,
-                              next_cloud->window);
+        ++next_cloud;
+        continue;
+      }
+      std::vector<std::size_t> run;
+      const AltitudeBand window = next_cloud->window;
+      for (; next_cloud != clouds.end() && next_cloud->band == band && !next_cloud->automaton &&
+             next_cloud->window.slabs == window.slabs;
+           ++next_cloud)
+        run.push_back(next_cloud->index);
+      ellipsoids_.drawClouds(scene, run, settings, frame, targets, window);
+    }
     // Then the layers of rank band - 1 (rank 0 is nearest the camera) on both sides.
     if (band >= 1) {
       if (std::size_t(band) <= above.size()) pending_above.push_back(above[above.size() - band]);

@@ -136,4 +136,48 @@ EyeBox eyeSpaceBox(const Ellipsoid& e, glm::dvec3 eye, const ViewBasis& basis) {
   return box;
 }
 
+namespace {
+
+// NDC interval [lo, hi] of the planes through the eye with normal n(x) = axis - x forward
+// that meet the ellipsoid: f(x) = n^T A n >= 0, A = T T^T - c c^T (the dual quadric's block,
+// T the body-to-world matrix times the radii, c the centre relative to the eye). f is
+// quadratic, a x^2 - 2 b x + k. With a < 0 the ellipsoid lies wholly on one side of the eye
+// plane, and if in front, the planes that meet it lie between the two roots; with a > 0 it
+// straddles the eye plane and they lie outside them.
+glm::dvec2 planeInterval(const glm::dmat3& t, glm::dvec3 c, glm::dvec3 axis, glm::dvec3 forward) {
+  const glm::dvec3 ta = glm::transpose(t) * axis, tf = glm::transpose(t) * forward;
+  const double ca = glm::dot(c, axis), cf = glm::dot(c, forward);
+  const double a = glm::dot(tf, tf) - cf * cf;
+  const double b = glm::dot(ta, tf) - ca * cf;
+  const double k = glm::dot(ta, ta) - ca * ca;
+  const double disc = b * b - a * k;
+  const glm::dvec2 none(1.0, -1.0), all(-1.0, 1.0);
+  if (a < 0.0 && cf < 0.0) return none;  // wholly behind the eye plane
+  if (!(disc > 0.0) || a == 0.0) return a < 0.0 ? none : all;
+  const double root = std::sqrt(disc);
+  // The roots without cancellation: q = b + sign(b) sqrt(disc), x = q / a and k / q.
+  const double q = b + std::copysign(root, b);
+  const double r1 = q / a, r2 = q != 0.0 ? k / q : -r1;
+  const double lo = std::min(r1, r2), hi = std::max(r1, r2);
+  if (a < 0.0) return {std::max(lo, -1.0), std::min(hi, 1.0)};
+  // Outside the roots: (-inf, lo] and [hi, inf), each within [-1, 1] if it reaches it.
+  glm::dvec2 span = none;
+  if (lo >= -1.0) span = {-1.0, std::min(lo, 1.0)};
+  if (hi <= 1.0) span = {span.x > span.y ? std::max(hi, -1.0) : span.x, 1.0};
+  return span;
+}
+
+}  // namespace
+
+glm::dvec4 screenBounds(const Ellipsoid& e, glm::dvec3 eye, const ViewBasis& basis) {
+  const glm::dmat3 body = bodyToWorld(e.orientation);
+  const glm::dmat3 t(body[0] * e.radii.x, body[1] * e.radii.y, body[2] * e.radii.z);
+  const glm::dvec3 c = e.centre - eye;
+  const glm::dvec2 x =
+      planeInterval(t, c, basis.right / (basis.tan_half_vfov * basis.aspect), basis.forward);
+  const glm::dvec2 y = planeInterval(t, c, basis.up / basis.tan_half_vfov, basis.forward);
+  if (x.x > x.y || y.x > y.y) return {1.0, 1.0, -1.0, -1.0};
+  return {x.x, y.x, x.y, y.y};
+}
+
 }  // namespace nephele

@@ -98,4 +98,11 @@ struct EyeBox {
 };
 EyeBox eyeSpaceBox(const Ellipsoid& ellipsoid, glm::dvec3 eye, const ViewBasis& basis);
 
+// The smallest rectangle [x0, y0, x1, y1] of normalised device coordinates (-1 to 1, x right,
+// y up) holding the ellipsoid's image, from the planes through the eye that touch it
+// (MODEL.md section 15); empty (x0 > x1) when the image misses the screen. Part of an
+// ellipsoid behind the eye plane makes the image unbounded on that side; the rectangle
+// then runs to the screen's edge there.
+glm::dvec4 screenBounds(const Ellipsoid& ellipsoid, glm::dvec3 eye, const ViewBasis& basis);
+
 }  // namespace nephele
