@@ -225,7 +225,9 @@ TEST(Ellipsoid, ScreenBoundsHoldTheImageTightly) {
     EXPECT_GE(bounds.w, seen.w - 1e-9);
     const double tight = 0.01 * std::max(bounds.z - bounds.x, bounds.w - bounds.y);
     for (int side = 0; side < 4; ++side) {
-      if (std::abs(bounds[side]) < 1.0) EXPECT_NEAR(bounds[side], seen[side], tight) << side;
+      if (std::abs(bounds[side]) < 1.0) {
+        EXPECT_NEAR(bounds[side], seen[side], tight) << side;
+      }
     }
   }
 }
