@@ -163,7 +163,7 @@ bool makeEllipsoidRecord(const Ellipsoid& e, const Camera& camera, bool spotligh
   out.v[15] = glm::vec4(0.0f);
   centre_distance = glm::length(e.centre - camera.position);
   const double near_bound = centre_distance - std::max({e.radii.x, e.radii.y, e.radii.z});
-  out.v[16] = glm::vec4(1.0f, 1.0f, float(near_bound), 0.0f);
+  out.v[16] = glm::vec4(1.0f, 1.0f, float(near_bound), 1.0f);
   return true;
 }
 
@@ -280,8 +280,9 @@ void EllipsoidRenderer::setCloudUniforms(GLuint p, const Scene& scene, const Ell
   setUniform3(gl_, p, "u_thresholds",
               {cloud.threshold_centre, cloud.threshold_limb, cloud.transition});
   setUniform3(gl_, p, "u_to_sun", sunDirection(scene.sun));
-  const glm::vec2 forward(cloud.light_extinction > 0.0 ? 1.0f : 0.0f, float(kDiffuseAsymmetry));
-  gl_.ProgramUniform2fv(p, gl_.GetUniformLocation(p, "u_scatter"), 1, &forward.x);
+  const bool heap_lit = cloud.light_extinction > 0.0;
+  setUniform3(gl_, p, "u_scatter",
+              {heap_lit ? 1.0 : 0.0, kDiffuseAsymmetry, heap_lit ? kSkinWrap : 0.0});
   // The precision rule of MODEL.md section 2: the texture's local origin is the eye, reduced modulo
   // the period in double; shaders see camera-relative offsets only.
   const SolidTexture& texture = *cached.source;
@@ -489,6 +490,7 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
         continue;
       v.record.v[16].x = float(lights[i].sun);
       v.record.v[16].y = float(lights[i].sky);
+      v.record.v[16].w = float(lights[i].sun_face);
       v.near_bound = v.record.v[16].z;
       nearest_m = std::min(nearest_m, v.near_bound);
       visible.push_back(v);

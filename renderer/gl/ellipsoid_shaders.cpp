@@ -18,8 +18,9 @@ struct EllipsoidRecord {
   vec4 body[3];    // columns of R S: unit sphere to camera-relative offsets
   vec4 centre;     // centre - eye
   vec4 tile;       // atlas tile: texel origin xy, size zw
-  vec4 light;      // x sunlight, y sky light reaching it through its heap (MODEL.md section 14);
-                   // z the nearest a hit on it can be, metres (front-to-back order)
+  vec4 light;      // x sunlight at the centre, y sky light, w sunlight at the sunward point,
+                   // reaching it through its heap (MODEL.md section 14); z the nearest a hit
+                   // on it can be, metres (front-to-back order)
 };
 // Records live in a buffer texture, kRecordTexels RGBA32F texels each: llvmpipe fetches texels
 // for eight pixels at once, where a storage buffer is read one pixel at a time.
@@ -37,7 +38,8 @@ uniform vec3 u_thresholds;    // T1, T2, D
 uniform vec3 u_to_sun;
 uniform vec3 u_tex_origin;    // texture coordinate of the eye, periods, in [0, 1)
 uniform vec3 u_inv_period;    // periods per metre
-uniform vec2 u_scatter;       // x: 1 with the heap's light (MODEL.md section 14), else 0; y: g
+uniform vec3 u_scatter;  // x: 1 with the heap's light (MODEL.md section 14), else 0; y: g;
+                         // z: the skin's wrap w (kSkinWrap) with the heap's light, else 0
 
 vec3 toUnit(int i, vec3 v) {
   return vec3(dot(record(i, 0).xyz, v), dot(record(i, 1).xyz, v), dot(record(i, 2).xyz, v));
@@ -139,9 +141,10 @@ float forwardScattered(float sun, float c) {
 // colour, fogged; n faces the viewer, r points at the surface from the eye, `distance` in
 // metres.
 vec3 surfaceColour(int i, vec3 n, vec3 r, float it, float tr, float distance) {
-  vec2 light = record(i, 16).xy;
+  vec4 light = record(i, 16);
   float n_dot_l = dot(n, u_to_sun);
-  float diffuse = max(n_dot_l, 0.0);
+  float diffuse = max((n_dot_l + u_scatter.z) / (1.0 + u_scatter.z), 0.0);
+  float sun = light.x + (light.w - light.x) * 0.5 * (1.0 + clamp(n_dot_l, -1.0, 1.0));
   float highlight = 0.0;
 #ifdef SPECULAR
   if (n_dot_l > 0.0) {
@@ -149,10 +152,10 @@ vec3 surfaceColour(int i, vec3 n, vec3 r, float it, float tr, float distance) {
     highlight = pow(max(dot(reflected, -normalize(r)), 0.0), u_shading.w);
   }
 #endif
-  float intensity = gardnerIntensity(u_shading, light.x * diffuse, light.x * highlight, it) +
+  float intensity = gardnerIntensity(u_shading, sun * diffuse, sun * highlight, it) +
                     u_shading.x * (light.y - 1.0);
   vec3 d = normalize(r);
-  intensity += u_scatter.x * forwardScattered(light.x, dot(d, u_to_sun)) * tr;
+  intensity += u_scatter.x * forwardScattered(sun, dot(d, u_to_sun)) * tr;
   return applyFog(intensity * u_cloud_colour, d, distance);
 }
 

@@ -40,8 +40,8 @@ enum Draw : std::uint64_t { kCount = 1, kX, kY, kSize, kHeight, kShape, kKeep, k
 struct HeapLook {
   double colour, ambient, texture_fraction, t1, t2, d, light_extinction;
 };
-constexpr HeapLook kCumulusLook{1.0, 0.3, 0.2, -0.6, 1.0, 0.3, 0.02};
-constexpr HeapLook kCumulonimbusLook{0.9, 0.25, 0.2, -0.6, 1.0, 0.3, 0.02};
+constexpr HeapLook kCumulusLook{1.0, 0.2, 0.3, -0.2, 1.1, 0.05, 0.02};
+constexpr HeapLook kCumulonimbusLook{0.9, 0.2, 0.3, -0.2, 1.1, 0.05, 0.02};
 
 bool isCb(const CloudField& f) {
   return f.type == CloudType::kCumulonimbus;
@@ -506,7 +506,8 @@ bool planeSeenBeyond(const Camera& camera, double altitude, double range) {
 // region, lit like the heaps, drifting with them, with a hole of `range` around the camera.
 // Its threshold is calibrated once per field (a few milliseconds).
 // The far deck's look: the heap's eq. 8 with the mean light its lobes take (MODEL.md section
-// 14), lobes weighted by their horizontal cross-section, for one typical heap of the field.
+// 14; the sunlight as lobeSunlightOverLambert), lobes weighted by their horizontal
+// cross-section, for one typical heap of the field.
 // I = (1 - a)(1 - t) S Id + (1 - a) t It + a K is eq. 8 with a' = a K / c, t' = (1 - a) t /
 // ((1 - a)((1 - t) S + t)) and the colour times c = (1 - a)((1 - t) S + t) + a K.
 void lightFarDeck(const CloudField& f, glm::dvec3 to_sun, CloudLayer& deck) {
@@ -516,7 +517,7 @@ void lightFarDeck(const CloudField& f, glm::dvec3 to_sun, CloudLayer& deck) {
   double sun = 0.0, sky = 0.0, weight = 0.0;
   for (std::size_t i = 0; i < lights.size(); ++i) {
     const double w = heap.ellipsoids[i].radii.x * heap.ellipsoids[i].radii.y;
-    sun += w * lights[i].sun, sky += w * lights[i].sky, weight += w;
+    sun += w * lobeSunlightOverLambert(lights[i]), sky += w * lights[i].sky, weight += w;
   }
   if (weight <= 0.0) return;
   sun /= weight, sky /= weight;

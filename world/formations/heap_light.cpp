@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include "world/automaton/cloud_density.h"
+#include "world/frames.h"
 
 namespace nephele {
 namespace {
@@ -21,9 +22,9 @@ double chordLength(const Ellipsoid& e, glm::dvec3 p, glm::dvec3 dir) {
   return std::max(0.0, far - std::max(near, 0.0));
 }
 
-// Optical depth from the centre of ellipsoid i along `dir` through the others.
-double depthThroughOthers(const EllipsoidCloud& cloud, std::size_t i, glm::dvec3 dir) {
-  const glm::dvec3 p = cloud.ellipsoids[i].centre;
+// Optical depth from point p of ellipsoid i along `dir` through the others.
+double depthThroughOthers(const EllipsoidCloud& cloud, std::size_t i, glm::dvec3 p,
+                          glm::dvec3 dir) {
   double length = 0.0;
   for (std::size_t j = 0; j < cloud.ellipsoids.size(); ++j) {
     if (j == i) continue;
@@ -46,12 +47,38 @@ std::vector<LobeLight> lobeLights(const EllipsoidCloud& cloud, glm::dvec3 to_sun
   for (std::size_t i = 0; i < out.size(); ++i) {
     // MODEL.md section 14: light inside a cloud is scattered on, not removed, so it falls as the
     // two-stream transmittance of the depth, not exp(-depth).
-    out[i].sun = to_sun.z > -1.0 ? diffuseTransmittance(depthThroughOthers(cloud, i, to_sun)) : 0.0;
+    const Ellipsoid& e = cloud.ellipsoids[i];
+    // The sunward point: where the normal is to_sun, centre + M L / sqrt(L.M L) with
+    // M = T T^T, T the body-to-world matrix times the radii.
+    const glm::dmat3 body = bodyToWorld(e.orientation);
+    const glm::dmat3 t(body[0] * e.radii.x, body[1] * e.radii.y, body[2] * e.radii.z);
+    const glm::dvec3 tl = glm::transpose(t) * to_sun;
+    const glm::dvec3 face = e.centre + t * tl / std::max(glm::length(tl), 1e-300);
+    auto sunlight = [&](glm::dvec3 from) {
+      return to_sun.z > -1.0 ? diffuseTransmittance(depthThroughOthers(cloud, i, from, to_sun))
+                             : 0.0;
+    };
+    out[i].sun = sunlight(e.centre);
+    out[i].sun_face = sunlight(face);
     // Half the sky light comes from the sky overhead, through the heap; half from the horizon
     // and the ground, which the heap does not hide.
-    out[i].sky = 0.5 + 0.5 * diffuseTransmittance(depthThroughOthers(cloud, i, {0.0, 0.0, 1.0}));
+    out[i].sky =
+        0.5 + 0.5 * diffuseTransmittance(depthThroughOthers(cloud, i, e.centre, {0.0, 0.0, 1.0}));
   }
   return out;
+}
+
+double surfaceSunlight(const LobeLight& light, double n_dot_l) {
+  return light.sun + (light.sun_face - light.sun) * 0.5 * (1.0 + std::clamp(n_dot_l, -1.0, 1.0));
+}
+
+double skinDiffuse(double n_dot_l) {
+  return std::max(0.0, (n_dot_l + kSkinWrap) / (1.0 + kSkinWrap));
+}
+
+double lobeSunlightOverLambert(const LobeLight& light) {
+  const double l = 1.0 + kSkinWrap, d = light.sun_face - light.sun;
+  return (light.sun + d * (1.0 - kSkinWrap) / 2.0) * l + d * l * l / 3.0;
 }
 
 double forwardScattered(double sun, double cos_theta) {
@@ -66,10 +93,14 @@ double heapIntensity(const EllipsoidCloud& cloud, const LobeLight& light, double
   if (cloud.light_extinction <= 0.0)
     return gardnerIntensity(shading, d.diffuse, d.highlight, texture_value);
   // Gardner eq. 8 with the sun's terms times L.sun and the ambient term times L.sky.
+  glm::dvec3 n = glm::normalize(normal);  // turned to the viewer, as diffuseHighlight turns it
+  if (glm::dot(n, direction) > 0.0) n = -n;
+  const double n_dot_l = glm::dot(n, to_sun);
+  const double sun = surfaceSunlight(light, n_dot_l);
   const double eq8 =
-      gardnerIntensity(shading, light.sun * d.diffuse, light.sun * d.highlight, texture_value) +
+      gardnerIntensity(shading, sun * skinDiffuse(n_dot_l), sun * d.highlight, texture_value) +
       shading.ambient * (light.sky - 1.0);
-  return eq8 + forwardScattered(light.sun, glm::dot(direction, to_sun)) * translucence;
+  return eq8 + forwardScattered(sun, glm::dot(direction, to_sun)) * translucence;
 }
 
 }  // namespace nephele
