@@ -40,8 +40,8 @@ enum Draw : std::uint64_t { kCount = 1, kX, kY, kSize, kHeight, kShape, kKeep, k
 struct HeapLook {
   double colour, ambient, texture_fraction, t1, t2, d, light_extinction;
 };
-constexpr HeapLook kCumulusLook{1.0, 0.2, 0.3, -0.2, 1.1, 0.05, 0.02};
-constexpr HeapLook kCumulonimbusLook{0.9, 0.2, 0.3, -0.2, 1.1, 0.05, 0.02};
+constexpr HeapLook kCumulusLook{1.0, 0.2, 0.3, -0.4, 1.1, 0.05, 0.02};
+constexpr HeapLook kCumulonimbusLook{0.9, 0.2, 0.3, -0.6, 1.1, 0.05, 0.02};
 
 bool isCb(const CloudField& f) {
   return f.type == CloudType::kCumulonimbus;

@@ -124,18 +124,6 @@ glm::dmat3 silhouetteConic(const EllipsoidView& view, const ViewBasis& basis) {
   return glm::transpose(b) * view.discriminantForm() * b;
 }
 
-EyeBox eyeSpaceBox(const Ellipsoid& e, glm::dvec3 eye, const ViewBasis& basis) {
-  const glm::dvec3 rel = e.centre - eye;
-  // Half-extent along unit axis n is |S R^T n| (the support function of the ellipsoid).
-  const glm::dmat3 scaled_body = glm::dmat3(e.radii.x, 0, 0, 0, e.radii.y, 0, 0, 0, e.radii.z) *
-                                 glm::transpose(bodyToWorld(e.orientation));
-  EyeBox box;
-  box.centre = {glm::dot(rel, basis.right), glm::dot(rel, basis.up), glm::dot(rel, basis.forward)};
-  box.half_extent = {glm::length(scaled_body * basis.right), glm::length(scaled_body * basis.up),
-                     glm::length(scaled_body * basis.forward)};
-  return box;
-}
-
 namespace {
 
 // NDC interval [lo, hi] of the planes through the eye with normal n(x) = axis - x forward

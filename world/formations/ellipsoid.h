@@ -1,7 +1,7 @@
 #pragma once
 // Gardner's ellipsoid primitive (MODEL.md sections 4 and 5): nine parameters, its quadric, and,
 // for one eye, the ray quadratic, the exact limb function g, the silhouette conic and the
-// eye-space bounding box. Everything is camera-relative and in double, so a cloud 100 km
+// image's screen rectangle. Everything is camera-relative and in double, so a cloud 100 km
 // from the origin is as exact as one at it.
 #include <optional>
 #include <string>
@@ -89,14 +89,6 @@ class EllipsoidView {
 // (MODEL.md section 1), the rays that touch the ellipsoid are [u v 1] C [u v 1]^T = 0 and the
 // rays that meet it have a non-negative value. C = B^T K B with B = [right up forward].
 glm::dmat3 silhouetteConic(const EllipsoidView& view, const ViewBasis& basis);
-
-// The ellipsoid's axis-aligned bounding box in the camera frame (x right, y up, z forward),
-// relative to the eye.
-struct EyeBox {
-  glm::dvec3 centre;
-  glm::dvec3 half_extent;
-};
-EyeBox eyeSpaceBox(const Ellipsoid& ellipsoid, glm::dvec3 eye, const ViewBasis& basis);
 
 // The smallest rectangle [x0, y0, x1, y1] of normalised device coordinates (-1 to 1, x right,
 // y up) holding the ellipsoid's image, from the planes through the eye that touch it
