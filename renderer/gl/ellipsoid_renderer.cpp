@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <limits>
 #include <numbers>
@@ -21,7 +22,8 @@ constexpr double kTwoPi = 2.0 * std::numbers::pi;
 constexpr int kAtlasSize = 2048;
 constexpr int kMaxTileSize = 1024;
 constexpr int kSpotlightSize = 64;
-constexpr double kTileNear = 1.0e-3;  // metres: the tile frusta's near plane
+constexpr std::int64_t kMaxListed = std::int64_t(1) << 24;  // per-pixel bin entries per batch
+constexpr double kTileNear = 1.0e-3;                        // metres: the tile frusta's near plane
 
 int nextPowerOfTwo(double x) {
   int p = 1;
@@ -583,7 +585,9 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
     listed += std::int64_t(spans[i].z - spans[i].x + 1) * (spans[i].w - spans[i].y + 1);
   }
   const int bins_x = area.z - area.x + 1, bins_y = area.w - area.y + 1;
-  if (listed > max_texels_ || std::int64_t(bins_x) * bins_y > max_texels_)
+  // Bin lists beyond kMaxListed entries (64 MiB) fall back to the centre pass as well.
+  const std::int64_t max_listed = std::min<std::int64_t>(max_texels_, kMaxListed);
+  if (listed > max_listed || std::int64_t(bins_x) * bins_y > max_listed)
     return drawByCentre(records(false));
   std::vector<glm::ivec2> bins(std::size_t(bins_x) * bins_y, glm::ivec2(0));
   auto binAt = [&](int x, int y) -> glm::ivec2& {

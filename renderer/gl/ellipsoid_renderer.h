@@ -50,9 +50,10 @@ class EllipsoidRenderer {
   // `target` holds, blending premultiplied. `targets_drawn`: the target colour and distance
   // textures are bound. A far cloud may be drawn from its impostor
   // (RenderSettings::impostor_tolerance_px); the others are drawn in batches of clouds that
-  // look alike (same texture, drift and shading), each batch in one pass whose pixels
-  // composite every hit of the batch in depth order. Only the surfaces in `band` are drawn,
-  // so that a layer can cut through the clouds.
+  // look alike (same texture, drift and shading), each batch as one (the per-pixel pass
+  // composites every hit of the batch in depth order; the centre and multipass passes blend
+  // its ellipsoids back to front). Only the surfaces in `band` are drawn, so that a layer
+  // can cut through the clouds.
   void drawClouds(const Scene& scene, const std::vector<std::size_t>& indices,
                   const RenderSettings& settings, const FrameTarget& target, bool targets_drawn,
                   const AltitudeBand& band = {});
