@@ -159,8 +159,8 @@ bool makeEllipsoidRecord(const Ellipsoid& e, const Camera& camera, bool spotligh
     out.v[8] = out.v[9] = glm::vec4(0.0f);
   }
   out.v[10] = glm::vec4(rect);
-  const glm::dmat3 body = bodyToWorld(e.orientation);
-  for (int i = 0; i < 3; ++i) out.v[11 + i] = row(body[i] * e.radii[i]);
+  const glm::dmat3 body = unitSphereToWorld(e);
+  for (int i = 0; i < 3; ++i) out.v[11 + i] = row(body[i]);
   out.v[14] = row(e.centre - camera.position);
   out.v[15] = glm::vec4(0.0f);
   centre_distance = glm::length(e.centre - camera.position);
@@ -471,10 +471,10 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
                                    bool targets_drawn, const AltitudeBand& band) {
   // The clouds look alike: the first one's texture and shading stand for all of them.
   const EllipsoidCloud& cloud = scene.clouds[indices.front()];
-  // Visible ellipsoids with their sort keys (centre distance, nearest possible hit); the
-  // nearest surface distance.
+  // Visible ellipsoids with the back-to-front key (the front-to-back key, the nearest a hit
+  // can be, is the record's light.z); the nearest surface distance.
   struct Visible {
-    double centre_distance, near_bound;
+    double centre_distance;
     EllipsoidRecord record;
   };
   std::vector<Visible> visible;
@@ -493,8 +493,7 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
       v.record.v[16].x = float(lights[i].sun);
       v.record.v[16].y = float(lights[i].sky);
       v.record.v[16].w = float(lights[i].sun_face);
-      v.near_bound = v.record.v[16].z;
-      nearest_m = std::min(nearest_m, v.near_bound);
+      nearest_m = std::min(nearest_m, double(v.record.v[16].z));
       visible.push_back(v);
     }
   }
@@ -526,13 +525,13 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   // buffer textures. Otherwise, and when asked, ellipsoids are blended back to front by
   // their centres.
   const std::size_t max_records = std::size_t(max_texels_) / kEllipsoidRecordVec4s;
-  bool per_pixel = settings.ellipsoid_passes == EllipsoidPasses::kFused &&
-                   settings.ellipsoid_order == EllipsoidOrder::kPerPixel &&
-                   visible.size() <= max_records;
+  const bool per_pixel = settings.ellipsoid_passes == EllipsoidPasses::kFused &&
+                         settings.ellipsoid_order == EllipsoidOrder::kPerPixel &&
+                         visible.size() <= max_records;
   auto records = [&](bool front_to_back) {
     if (front_to_back)  // nearest bound first: the per-pixel pass composites front to back
       std::stable_sort(visible.begin(), visible.end(), [](const Visible& a, const Visible& b) {
-        return a.near_bound < b.near_bound;
+        return a.record.v[16].z < b.record.v[16].z;
       });
     else
       std::stable_sort(visible.begin(), visible.end(), [](const Visible& a, const Visible& b) {

@@ -29,6 +29,11 @@ glm::dmat3 worldToUnitSphere(const Ellipsoid& e) {
   return inverse_scale * glm::transpose(bodyToWorld(e.orientation));
 }
 
+glm::dmat3 unitSphereToWorld(const Ellipsoid& e) {
+  const glm::dmat3 body = bodyToWorld(e.orientation);
+  return {body[0] * e.radii.x, body[1] * e.radii.y, body[2] * e.radii.z};
+}
+
 double quadricValue(const Ellipsoid& e, glm::dvec3 point) {
   const glm::dvec3 o = worldToUnitSphere(e) * (point - e.centre);
   return glm::dot(o, o) - 1.0;
@@ -158,8 +163,7 @@ glm::dvec2 planeInterval(const glm::dmat3& t, glm::dvec3 c, glm::dvec3 axis, glm
 }  // namespace
 
 glm::dvec4 screenBounds(const Ellipsoid& e, glm::dvec3 eye, const ViewBasis& basis) {
-  const glm::dmat3 body = bodyToWorld(e.orientation);
-  const glm::dmat3 t(body[0] * e.radii.x, body[1] * e.radii.y, body[2] * e.radii.z);
+  const glm::dmat3 t = unitSphereToWorld(e);
   const glm::dvec3 c = e.centre - eye;
   const glm::dvec2 x =
       planeInterval(t, c, basis.right / (basis.tan_half_vfov * basis.aspect), basis.forward);

@@ -24,6 +24,8 @@ std::string ellipsoidError(const Ellipsoid& ellipsoid);
 // Maps world offsets from the centre into the ellipsoid's unit-sphere frame: W = S^-1 R^T,
 // so the surface is |W (X - centre)| = 1.
 glm::dmat3 worldToUnitSphere(const Ellipsoid& ellipsoid);
+// Its inverse, T = R S: the unit sphere's points to world offsets from the centre.
+glm::dmat3 unitSphereToWorld(const Ellipsoid& ellipsoid);
 
 // The quadric Q(X) = (X - C)^T M (X - C) - 1 with M = W^T W (MODEL.md section 5).
 double quadricValue(const Ellipsoid& ellipsoid, glm::dvec3 point);

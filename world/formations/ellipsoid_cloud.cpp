@@ -40,9 +40,8 @@ std::pair<double, double> cloudVerticalExtent(const EllipsoidCloud& cloud) {
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (const Ellipsoid& e : cloud.ellipsoids) {
     // Vertical half-extent: |row z of R S|.
-    const glm::dmat3 body = bodyToWorld(e.orientation);
-    const double half = glm::length(
-        glm::dvec3(body[0].z * e.radii.x, body[1].z * e.radii.y, body[2].z * e.radii.z));
+    const glm::dmat3 t = unitSphereToWorld(e);
+    const double half = glm::length(glm::dvec3(t[0].z, t[1].z, t[2].z));
     lo = std::min(lo, e.centre.z - half);
     hi = std::max(hi, e.centre.z + half);
   }

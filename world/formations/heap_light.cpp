@@ -5,7 +5,6 @@
 #include <numbers>
 
 #include "world/automaton/cloud_density.h"
-#include "world/frames.h"
 
 namespace nephele {
 namespace {
@@ -50,8 +49,7 @@ std::vector<LobeLight> lobeLights(const EllipsoidCloud& cloud, glm::dvec3 to_sun
     const Ellipsoid& e = cloud.ellipsoids[i];
     // The sunward point: where the normal is to_sun, centre + M L / sqrt(L.M L) with
     // M = T T^T, T the body-to-world matrix times the radii.
-    const glm::dmat3 body = bodyToWorld(e.orientation);
-    const glm::dmat3 t(body[0] * e.radii.x, body[1] * e.radii.y, body[2] * e.radii.z);
+    const glm::dmat3 t = unitSphereToWorld(e);
     const glm::dvec3 tl = glm::transpose(t) * to_sun;
     const glm::dvec3 face = e.centre + t * tl / std::max(glm::length(tl), 1e-300);
     auto sunlight = [&](glm::dvec3 from) {
