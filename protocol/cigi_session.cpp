@@ -330,7 +330,9 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
     }
   }
   // Targets after the entities they hang from: every changed entity, and every attached one
-  // (its parent may have moved).
+  // (its parent may have moved). An entity refused here keeps what was last applied for it,
+  // so that the world and the session agree on which targets exist.
+  std::vector<std::uint16_t> refused_entities;
   for (const auto& [id, entity] : s.entities) {
     if (!entity.target || !(changed_entities.count(id) || entity.packet.attached)) continue;
     const std::optional<Pose> pose = poseOf(s, id);
@@ -345,6 +347,7 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
       bad("Entity Control " + std::to_string(id) + ": " + text(pose->position.x) + ", " +
           text(pose->position.y) + " m from the origin (allowed: within " +
           text(Limits::kMaxCoordinate) + " m)");
+      refused_entities.push_back(id);
       continue;
     }
     const Orientation o = orientationOf(pose->attitude);
@@ -361,6 +364,12 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
                             {"roll", o.roll_deg}};
       frame.commands.emplace_back(command::AddTarget{target, true});
     }
+  }
+  for (const std::uint16_t id : refused_entities) {
+    if (const auto applied = state_.entities.find(id); applied != state_.entities.end())
+      s.entities[id] = applied->second;
+    else
+      s.entities.erase(id);
   }
   if (views_moved) {
     for (std::uint16_t id = 0; id < settings_.views.size(); ++id) {

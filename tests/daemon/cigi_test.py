@@ -439,6 +439,23 @@ size = [4, 2, 1]
         self.assertEqual(self.frame(entity_control(0, SITE[0], SITE[1], 700.0), frame=20)["status"],
                          0)
 
+    def test_case17_an_entity_refused_for_its_position_is_placed_when_it_comes_back(self):
+        """An entity refused for a position beyond the world's range was kept as placed, so
+        the host's next, valid Entity Control for it became a move of a target that did not
+        exist, and the world refused that whole frame (its ownship move too)."""
+        d = self.start()
+        c = d.client()
+        self.frame(entity_control(0, SITE[0], SITE[1], 500.0), frame=1, timestamp=1)
+        sof = self.frame(entity_control(7, SITE[0], SITE[1], 2e8), frame=2, timestamp=2)
+        self.assertEqual(sof["status"], 1)
+        self.assertEqual(c.ok({"cmd": "list_targets"})["targets"], [])
+        sof = self.frame(entity_control(0, SITE[0], SITE[1], 600.0),
+                         entity_control(7, SITE[0], SITE[1], 20.0), frame=3, timestamp=3)
+        self.assertEqual(sof["status"], 0, c.ok({"cmd": "stats"})["cigi"])
+        self.assertEqual([t["name"] for t in c.ok({"cmd": "list_targets"})["targets"]],
+                         ["cigi-7"])
+        self.assertEqual(c.ok({"cmd": "get_view", "view": "front"})["position"][2], 600.0)
+
     def check_with_tshark(self):
         """Every datagram of the test, decoded by Wireshark's CIGI dissector: its fields must
         be the ones the host wrote and read."""

@@ -7,6 +7,7 @@ which has pymodbus)."""
 import json
 import math
 import os
+import re
 import signal
 import socket
 import struct
@@ -1337,19 +1338,24 @@ class AbuseTest(DaemonTest):
         the backlog; the daemon must pause between attempts (not burn a core) and serve
         newcomers once descriptors are free."""
         import resource
-        if os.environ.get("ASAN_OPTIONS"):
-            # Under the sanitizer build, UBSan reports an invalid vptr on asio's misc error
-            # category in Connection::onRead's end-of-file comparison in about one run in
-            # three of this case under load (docs/RELIABILITY.md); not understood yet, so the
-            # case runs in the release suite only.
-            self.skipTest("sanitizer build: see docs/RELIABILITY.md, case 14")
+        # Under the sanitizer build UBSan cannot check a vptr while no descriptor is free: on
+        # a miss in its type cache the runtime probes whether the vtable is readable by
+        # writing it into a pipe (compiler-rt's IsAccessibleMemoryRange), the pipe cannot be
+        # made, and a sound object is reported as having an "invalid vptr" whose "memory
+        # cannot be printed" (reproduced with a ten-line program that exhausts its
+        # descriptors and compares two std::error_code). The runtime's suppressions cannot
+        # match it (they match the dynamic type, which the failed probe leaves unknown), so
+        # this case lets UBSan go on after a report and accepts exactly that report, at the
+        # error_category calls of <system_error>; any other report fails the case.
+        ubsan = os.environ.get("UBSAN_OPTIONS")
+        env = {"UBSAN_OPTIONS": ubsan + ":halt_on_error=0"} if ubsan else None
 
         def cpu_seconds(pid):
             with open(f"/proc/{pid}/stat") as f:
                 fields = f.read().rsplit(")", 1)[1].split()
             return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
-        d = self.daemon()
+        d = self.daemon(env=env)
         first = d.client()
         first.ok({"cmd": "hello"})
         open_fds = len(os.listdir(f"/proc/{d.proc.pid}/fd"))
@@ -1376,6 +1382,12 @@ class AbuseTest(DaemonTest):
                 if time.time() > deadline:
                     raise
                 time.sleep(0.2)
+        probe_failure = re.compile(
+            r"^\S*/system_error:\d+:\d+: runtime error: member call on address (0x[0-9a-f]+) "
+            r"which does not point to an object of type 'error_category'\n\1: note: object "
+            r"has invalid vptr\n<memory cannot be printed>\n", re.M)
+        others = probe_failure.sub("", d.log_text())
+        self.assertNotIn("runtime error", others)
 
 
     def test_live_fuzz_of_every_command_leaves_the_daemon_answering(self):
