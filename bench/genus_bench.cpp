@@ -175,12 +175,12 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-// Light figures of a heap (issue 27, MODEL.md section 14): the largest heap of the tiles near
-// the origin, alone, seen level from 8 km. (b) With the sun 90 degrees to the right at 10
-// degrees up, the median luminance of the heap's right (sunlit) half over its left half,
-// pixels of coverage > 0.5 split at the centroid's column. (c) With the sun 12 degrees above
-// the line to the heap's middle, behind it, the median light per unit opacity of its thin
-// edge (coverage 0.05 to 0.5) over its body's (coverage > 0.95): a silver lining is > 1.
+// Light figures of a heap (issue 27, MODEL.md section 14): the widest tile of heaps near the
+// origin, alone, seen level from 8 km. (b) With the sun 90 degrees to the right at 10 degrees
+// up, the median luminance of the right (sunlit) half of its largest connected silhouette
+// (coverage > 0.5) over its left half, split at the silhouette's centroid column. (c) With the sun
+// 12 degrees above the line to the heap's middle, behind it, the median light per unit opacity of
+// its thin edge (coverage 0.05 to 0.5) over its body's (coverage > 0.95): a silver lining is > 1.
 void printLightFigures(GlRenderer& renderer, const SceneFile& file, const std::string& name,
                        const std::string& images) {
   if (file.scene.fields.empty()) return;
@@ -211,10 +211,13 @@ void printLightFigures(GlRenderer& renderer, const SceneFile& file, const std::s
   scene.sun.azimuth_deg = 90.0, scene.sun.elevation_deg = 10.0;  // to the right (east)
   const FloatImage side = renderer.renderFloat(scene, file.render);
   const FloatImage side_sky = renderer.renderFloat(Scene(clear), file.render);
+  // The heaps of a tile stand apart or in groups: the figure is taken on the largest
+  // connected silhouette, so that its two halves are the two sides of the same mass.
   std::vector<int> covered;
+  for (const CloudRegion& region : cloudRegions(side, kMinCloudPixels))
+    if (region.pixels.size() > covered.size()) covered = region.pixels;
   double centroid = 0.0;
-  for (int p = 0; p < c.width * c.height; ++p)
-    if (side.rgba[4 * std::size_t(p) + 3] > 0.5f) covered.push_back(p), centroid += p % c.width;
+  for (int p : covered) centroid += p % c.width;
   centroid /= std::max<std::size_t>(covered.size(), 1);
   std::vector<double> lit, away;
   for (int p : covered)
