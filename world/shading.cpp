@@ -27,7 +27,7 @@ DiffuseHighlight diffuseHighlight(const ShadingParams& shading, glm::dvec3 norma
   glm::dvec3 n = glm::normalize(normal);
   if (glm::dot(n, to_viewer) < 0.0) n = -n;
   const double n_dot_l = glm::dot(n, to_sun);
-  DiffuseHighlight out{std::max(0.0, n_dot_l), 0.0};
+  DiffuseHighlight out{std::max(0.0, n_dot_l), 0.0, n_dot_l};
   if (n_dot_l > 0.0 && shading.specular > 0.0) {
     const glm::dvec3 reflected = 2.0 * n_dot_l * n - to_sun;
     out.highlight = std::pow(std::max(0.0, glm::dot(reflected, to_viewer)), shading.shininess);

@@ -16,9 +16,9 @@ double gardnerIntensity(const ShadingParams& shading, double diffuse, double hig
                         double texture_value);
 
 // Id = max(0, N.L) and Is = max(0, R.V)^e at a surface (0 where N.L <= 0 or s = 0), N turned
-// towards the viewer.
+// towards the viewer; n_dot_l is N.L itself, negative on the side turned from the sun.
 struct DiffuseHighlight {
-  double diffuse = 0.0, highlight = 0.0;
+  double diffuse = 0.0, highlight = 0.0, n_dot_l = 0.0;
 };
 DiffuseHighlight diffuseHighlight(const ShadingParams& shading, glm::dvec3 normal,
                                   glm::dvec3 to_sun, glm::dvec3 to_viewer);

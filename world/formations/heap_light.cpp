@@ -90,13 +90,10 @@ double heapIntensity(const EllipsoidCloud& cloud, const LobeLight& light, double
   const DiffuseHighlight d = diffuseHighlight(shading, normal, to_sun, -direction);
   if (cloud.light_extinction <= 0.0)
     return gardnerIntensity(shading, d.diffuse, d.highlight, texture_value);
-  // Gardner eq. 8 with the sun's terms times L.sun and the ambient term times L.sky.
-  glm::dvec3 n = glm::normalize(normal);  // turned to the viewer, as diffuseHighlight turns it
-  if (glm::dot(n, direction) > 0.0) n = -n;
-  const double n_dot_l = glm::dot(n, to_sun);
-  const double sun = surfaceSunlight(light, n_dot_l);
+  // Gardner eq. 8 with the sun's terms times S(n) and the ambient term times L.sky.
+  const double sun = surfaceSunlight(light, d.n_dot_l);
   const double eq8 =
-      gardnerIntensity(shading, sun * skinDiffuse(n_dot_l), sun * d.highlight, texture_value) +
+      gardnerIntensity(shading, sun * skinDiffuse(d.n_dot_l), sun * d.highlight, texture_value) +
       shading.ambient * (light.sky - 1.0);
   return eq8 + forwardScattered(sun, glm::dot(direction, to_sun)) * translucence;
 }
