@@ -28,6 +28,11 @@ Knob knob(const char* name, Edit edit) {
   return k;
 }
 
+// Relative luminance of linear RGB (ITU-R BT.709 weights).
+inline double linearLuminance(double r, double g, double b) {
+  return 0.2126 * r + 0.7152 * g + 0.0722 * b;
+}
+
 // The default GL platform, or null after printing why there is none.
 inline std::unique_ptr<GlPlatform> openPlatform() {
   std::string error;

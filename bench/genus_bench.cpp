@@ -92,7 +92,7 @@ BodyFigure bodyFigure(const FloatImage& image, const std::vector<int>& region) {
     const float* c = &image.rgba[4 * std::size_t(p)];
     ++f.inner;
     f.opaque += c[3] > 0.95f;
-    f.luminance += 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+    f.luminance += bench::linearLuminance(c[0], c[1], c[2]);
   }
   f.luminance /= std::max(f.inner, 1);
   return f;
@@ -163,10 +163,8 @@ double ownLuminance(const FloatImage& frame, const FloatImage& sky, int p) {
   const float* c = &frame.rgba[4 * std::size_t(p)];
   const float* s = &sky.rgba[4 * std::size_t(p)];
   const double alpha = c[3];
-  double y = 0.0;
-  const double weights[3] = {0.2126, 0.7152, 0.0722};
-  for (int k = 0; k < 3; ++k) y += weights[k] * (c[k] - (1.0 - alpha) * s[k]) / alpha;
-  return y;
+  auto own = [&](int k) { return (c[k] - (1.0 - alpha) * s[k]) / alpha; };
+  return bench::linearLuminance(own(0), own(1), own(2));
 }
 
 double median(std::vector<double> v) {

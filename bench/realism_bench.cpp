@@ -50,7 +50,7 @@ Figures measure(GlRenderer& renderer, CloudType type, double coverage, double sp
   int covered = 0;
   for (std::size_t i = 0; i < radiance.size(); ++i) {
     const float* p = &image.rgba[4 * i];
-    radiance[i] = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+    radiance[i] = bench::linearLuminance(p[0], p[1], p[2]);
     covered += p[3] >= 0.5f;
   }
   f.fraction = double(covered) / double(radiance.size());
