@@ -248,6 +248,78 @@ void printLightFigures(GlRenderer& renderer, const SceneFile& file, const std::s
       away.size(), median(edge) / std::max(median(body), 1e-9), edge.size(), body.size());
 }
 
+// Cumulonimbus figures (issue 27 item 5d): the field's typical heap alone (with the shear the
+// world's wind gives it), seen level across the shear from 80 km, downwind to the right, with
+// the preset's sun. Coverage > 0.5 in the column through the base's middle from the lowest to
+// the highest covered row (a continuous tower has no uncovered row in it); the tower's width
+// at 0.45 of that height; the widest run of the top fifth (the anvil), its width over the
+// tower's and how far its middle lies downwind of the base.
+void printCumulonimbusFigures(GlRenderer& renderer, const SceneFile& file, const std::string& name,
+                              const std::string& images) {
+  const Scene world = World(file.scene, file.dynamics).scene();
+  if (world.fields.empty() || world.fields.front().type != CloudType::kCumulonimbus) return;
+  const CloudField& field = world.fields.front();
+  const glm::dvec3 base(0.0, 0.0, field.base_m);
+  Scene scene = file.scene;
+  scene.fields.clear();
+  scene.layers.clear();
+  scene.clouds = {typicalHeap(field, base)};
+  const double speed = glm::length(field.shear);
+  const glm::dvec2 downwind = speed > 0.0 ? field.shear / speed : glm::dvec2(1.0, 0.0);
+  // Aimed a thickness downwind of the base, so that an anvil reaching three thicknesses
+  // downwind and one upwind fits the 4:3 frame.
+  constexpr double kDistance = 120000.0;
+  const double aside = field.thickness_m;
+  Camera& c = scene.camera;
+  c.width = 480, c.height = 360;
+  c.orientation = {glm::degrees(std::atan2(-downwind.y, downwind.x)), 0.0, 0.0};  // right: downwind
+  const glm::dvec3 forward(-downwind.y, downwind.x, 0.0);
+  c.position = base + glm::dvec3(aside * downwind, 0.55 * field.thickness_m) - kDistance * forward;
+  c.vfov_deg = 2.0 * glm::degrees(std::atan(1.6 * field.thickness_m / kDistance));
+  const FloatImage image = renderer.renderFloat(scene, file.render);
+  if (!images.empty()) {
+    std::filesystem::create_directories(images);
+    if (const std::string error = writeImageFile(images + "/" + name + "_across_shear.png", image);
+        !error.empty())
+      std::fprintf(stderr, "%s\n", error.c_str());
+  }
+  const double tan_half = std::tan(glm::radians(c.vfov_deg) / 2.0);
+  const double metres_per_px = 2.0 * kDistance * tan_half / c.height;
+  const int axis = int(c.width / 2 - aside / metres_per_px);  // the base's middle
+  auto covered = [&](int x, int y) { return image.pixel(x, y)[3] > 0.5f; };
+  int top = -1, bottom = -1;
+  for (int y = 0; y < c.height; ++y)
+    if (covered(axis, y)) bottom = y, top = top < 0 ? y : top;
+  if (top < 0) return;
+  int gaps = 0;
+  for (int y = top; y <= bottom; ++y) gaps += !covered(axis, y);
+  // The covered run through column x of row y, or through its widest part when x is clear.
+  auto run = [&](int y, int x) {
+    int lo = x, hi = x;
+    while (lo > 0 && covered(lo - 1, y)) --lo;
+    while (hi + 1 < c.width && covered(hi + 1, y)) ++hi;
+    return std::pair{lo, hi};
+  };
+  const int mid_row = bottom - int(0.45 * (bottom - top));
+  const auto [tower_lo, tower_hi] = run(mid_row, axis);
+  int anvil_lo = 0, anvil_hi = -1;
+  for (int y = top; y <= top + (bottom - top) / 5; ++y)
+    for (int x = 0; x < c.width; ++x)
+      if (covered(x, y)) {
+        const auto [lo, hi] = run(y, x);
+        if (hi - lo > anvil_hi - anvil_lo) anvil_lo = lo, anvil_hi = hi;
+        x = hi;
+      }
+  const double tower = (tower_hi - tower_lo + 1) * metres_per_px;
+  const double anvil = (anvil_hi - anvil_lo + 1) * metres_per_px;
+  std::printf(
+      "  cumulonimbus alone across the shear (%.1f m/s): column through the base, %d of %d rows "
+      "uncovered; tower %.0f m wide at 0.45 of its height, anvil %.0f m wide (%.1f times), its "
+      "middle %.0f m downwind of the base\n",
+      speed, gaps, bottom - top + 1, tower, anvil, anvil / std::max(tower, 1.0),
+      (0.5 * (anvil_lo + anvil_hi) - axis) * metres_per_px);
+}
+
 // Fraction of the sky hemisphere seen from the ground whose coverage exceeds one half, from
 // the five upper faces of a cube map (each pixel weighted by its solid angle, proportional to
 // (1 + u^2 + v^2)^-3/2 on a face at unit distance), averaged over four places 20 km apart.
@@ -442,6 +514,7 @@ int main(int argc, char** argv) {
     GlRenderer renderer(*platform);
     printBodyFigures(renderer, file);
     printLightFigures(renderer, file, path.stem().string(), images);
+    printCumulonimbusFigures(renderer, file, path.stem().string(), images);
   }
   if (names.empty() || std::find(names.begin(), names.end(), "harbour") != names.end()) {
     GlRenderer renderer(*platform);

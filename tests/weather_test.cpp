@@ -14,6 +14,7 @@
 #include "image/cloud_statistics.h"
 #include "world/counter_random.h"
 #include "world/formations/cloud_field.h"
+#include "world/formations/ellipsoid.h"
 
 namespace nephele {
 namespace {
@@ -213,6 +214,61 @@ TEST(CloudField, TilesDoNotDependOnVisitingOrder) {
   for (const EllipsoidCloud& c : fieldClouds(f, far)) far_count += c.ellipsoids.size();
   EXPECT_GT(far_count, near_count / 2);
   EXPECT_LT(far_count, near_count * 2);
+}
+
+// A cumulonimbus (MODEL.md section 10) is one tower from its base to its anvil, and its anvil
+// is at least three times as wide as the tower and carried downwind by the shear; checked on
+// the ellipsoids themselves: points well inside one (|W (p - c)|^2 < 1/2) all the way up the
+// vertical through the base from the middle of its flat bottom, and the extents along the shear
+// from each ellipsoid's support |W^-T d| (which sees a mistaken heading, unlike a bounding sphere).
+TEST(CloudField, CumulonimbusIsOneTowerUnderAnAnvilCarriedDownwind) {
+  CloudField f;
+  f.name = "cb";
+  f.type = CloudType::kCumulonimbus;
+  f.base_m = 900.0;
+  f.thickness_m = 9000.0;
+  auto insideSome = [](const std::vector<Ellipsoid>& heap, glm::dvec3 p) {
+    for (const Ellipsoid& e : heap) {
+      const glm::dvec3 q = worldToUnitSphere(e) * (p - e.centre);
+      if (glm::dot(q, q) < 0.5) return true;
+    }
+    return false;
+  };
+  // Extents along unit d of the ellipsoids centred above (anvil) and below (tower) z.
+  struct Extent {
+    double lo = 1e30, hi = -1e30;
+    double width() const { return hi - lo; }
+    double middle() const { return 0.5 * (lo + hi); }
+  };
+  auto extent = [](const std::vector<Ellipsoid>& heap, glm::dvec2 d, bool above, double z) {
+    Extent x;
+    for (const Ellipsoid& e : heap) {
+      if ((e.centre.z > z) != above) continue;
+      const glm::dvec3 along(d, 0.0);
+      const double c = glm::dot(glm::dvec3(e.centre), along);
+      const double support =
+          glm::length(glm::inverse(glm::transpose(worldToUnitSphere(e))) * along);
+      x.lo = std::min(x.lo, c - support), x.hi = std::max(x.hi, c + support);
+    }
+    return x;
+  };
+  const double anvil_z = f.base_m + 0.8 * f.thickness_m, tower_z = f.base_m + 0.6 * f.thickness_m;
+  for (glm::dvec2 shear : {glm::dvec2(12.0, 0.0), glm::dvec2(0.0, -20.0), glm::dvec2(0.0)}) {
+    f.shear = shear;
+    SCOPED_TRACE(testing::Message() << "shear " << shear.x << ", " << shear.y);
+    const std::vector<Ellipsoid> heap = typicalHeap(f, {0.0, 0.0, f.base_m}).ellipsoids;
+    // From the middle of the flat base (0.05 h above the cloud base) to the anvil.
+    for (double z = f.base_m + 0.05 * f.thickness_m; z < anvil_z; z += 50.0)
+      ASSERT_TRUE(insideSome(heap, {0.0, 0.0, z})) << "gap at " << z << " m";
+    const double speed = glm::length(shear);
+    const glm::dvec2 d = speed > 0.0 ? shear / speed : glm::dvec2(1.0, 0.0);
+    const Extent anvil = extent(heap, d, true, anvil_z), tower = extent(heap, d, false, tower_z);
+    EXPECT_GE(anvil.width(), 3.0 * tower.width());
+    if (speed > 0.0)
+      EXPECT_GT(anvil.middle() - tower.middle(), 0.25 * f.thickness_m);
+    else
+      EXPECT_LT(std::abs(anvil.middle() - tower.middle()), 0.1 * f.thickness_m);
+  }
 }
 
 TEST(Weather, InvalidLayersAreRefusedWithTheAllowedRange) {

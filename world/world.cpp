@@ -187,7 +187,11 @@ Scene World::scene() const {
     cloud.transition = d.transition.at(t, cloud.transition);
   }
   if (!dynamics_.wind.empty())
-    for (CloudField& field : s.fields) field.drift_m += dynamics_.wind.at(fieldAltitude(field)) * t;
+    for (CloudField& field : s.fields) {
+      const glm::dvec2 carried = dynamics_.wind.at(fieldAltitude(field));
+      field.drift_m += carried * t;
+      field.shear = dynamics_.wind.at(field.base_m + field.thickness_m) - carried;
+    }
   if (!dynamics_.wind.empty())
     for (EllipsoidCloud& cloud : s.clouds) {
       const glm::dvec3 drift(dynamics_.wind.at(cloudAltitude(cloud)) * t, 0.0);

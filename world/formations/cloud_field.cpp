@@ -72,77 +72,160 @@ HeapScale heapScale(std::uint64_t seed, std::uint64_t k) {
 // lobe.
 constexpr double kDetailRadii = 12.0;
 
+// How heaps take the wind shear (MODEL.md section 10): they lean downwind by kLean metres per
+// metre of height, and a cumulonimbus's anvil is carried downwind, fully one-sided at
+// kFullShear and more.
+constexpr double kLean = 0.15;
+constexpr double kFullShear = 15.0;  // m/s between the heaps' top and the wind carrying them
+struct Shear {
+  glm::dvec2 direction;  // unit, downwind at the top relative to the heap
+  double amount;         // 0 (none) to 1
+};
+Shear shearOf(const CloudField& f) {
+  const double speed = glm::length(f.shear);
+  if (!(speed > 1e-3)) return {{1.0, 0.0}, 0.0};
+  return {f.shear / speed, std::min(speed / kFullShear, 1.0)};
+}
+// The heading (clockwise from north, of the body or boundary x axis) that points x along `d`.
+double headingAlong(glm::dvec2 d) {
+  return glm::degrees(std::atan2(-d.y, d.x));
+}
+
+// Far away a heap's lobes merge into one mound: an ellipsoid filling the box that holds them
+// (four fifths of its half-extents, so that it covers about what they cover).
+Ellipsoid mound(const std::vector<Ellipsoid>& lobes) {
+  glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-lo);
+  for (const Ellipsoid& e : lobes) {
+    const double reach = std::max({e.radii.x, e.radii.y});
+    lo = glm::min(lo, e.centre - glm::dvec3(reach, reach, e.radii.z));
+    hi = glm::max(hi, e.centre + glm::dvec3(reach, reach, e.radii.z));
+  }
+  Ellipsoid out;
+  out.centre = 0.5 * (lo + hi);
+  out.radii = 0.4 * (hi - lo);
+  return out;
+}
+
+// A cumulonimbus of tower radius about 0.3 r and height h on `base` (WMO International Cloud
+// Atlas, Cb incus): one continuous tower from a flat base to the tropopause, where it spreads
+// into an anvil three to four times its width, carried downwind by the shear, with an
+// overshooting dome over the updraft. The base is dark through the light model (section 14).
+std::vector<Ellipsoid> cumulonimbusEllipsoids(const CloudField& f, glm::dvec3 base, double r,
+                                              double h, double squash, std::uint64_t seed,
+                                              bool detailed) {
+  const Shear shear = shearOf(f);
+  auto u = [&](std::uint64_t a, std::uint64_t b = 0) {
+    return unitFromBits(hashCounters(seed, 0x4362ull, a, b));
+  };
+  // The updraft's axis, leaning downwind with height.
+  auto axis = [&](double z) {
+    return glm::dvec3(glm::dvec2(base) + shear.direction * (kLean * shear.amount * z), base.z + z);
+  };
+  std::vector<Ellipsoid> out;
+  Ellipsoid bottom;  // flat, its bottom on the cloud base
+  bottom.radii = {0.45 * r, 0.45 * r * squash, 0.05 * h};
+  bottom.centre = base + glm::dvec3(0.0, 0.0, bottom.radii.z);
+  bottom.orientation.heading_deg = 360.0 * u(1);
+  out.push_back(bottom);
+  // The tower: a column of lobes each 0.4 h tall, 0.15 h apart from the base up, so that no
+  // gap opens from the base to the anvil, with bulges half sunk into its faces that grow
+  // upward.
+  std::vector<Ellipsoid> tower;
+  constexpr int kLevels = 5;
+  for (int i = 0; i < kLevels; ++i) {
+    const double z = (0.2 + 0.15 * i) * h, rise = double(i) / (kLevels - 1);
+    Ellipsoid core;
+    core.radii = glm::dvec3(0.42 * r, 0.42 * r * squash, 0.2 * h) * (0.95 + 0.1 * u(2, i));
+    core.centre = axis(z);
+    core.orientation.heading_deg = 360.0 * u(3, i);
+    tower.push_back(core);
+    const double turn = 2.0 * std::numbers::pi * u(4, i);
+    for (int q = 0; q < 3; ++q) {
+      const std::uint64_t k = 8 * std::uint64_t(i) + std::uint64_t(q);
+      const double azimuth = turn + 2.0 * std::numbers::pi * (q + 0.5 * u(5, k)) / 3.0;
+      const double size = (0.22 + 0.08 * rise) * r * (0.85 + 0.3 * u(6, k));
+      Ellipsoid bulge;
+      bulge.radii = {size, size, 0.11 * h * (0.85 + 0.3 * u(7, k))};
+      bulge.centre =
+          axis(z + 0.08 * h * (2.0 * u(8, k) - 1.0)) +
+          (0.26 + 0.06 * u(9, k)) * r * glm::dvec3(std::cos(azimuth), std::sin(azimuth), 0.0);
+      bulge.orientation.heading_deg = 360.0 * u(10, k);
+      tower.push_back(bulge);
+    }
+  }
+  if (!detailed) tower = {mound(tower)};
+  out.insert(out.end(), tower.begin(), tower.end());
+  Ellipsoid dome;  // overshooting the anvil's top
+  dome.radii = {0.25 * r, 0.25 * r, 0.08 * h};
+  dome.centre = axis(0.96 * h);
+  out.push_back(dome);
+  // The anvil: a flat sheet at nine tenths of the height, longer along the shear and carried
+  // downwind, under flat lobes that make its top lumpy and thin it downwind.
+  const double along = (1.5 + 0.5 * shear.amount) * r, across = 1.2 * r;
+  const glm::dvec3 middle =
+      axis(0.88 * h) + glm::dvec3(shear.direction * (0.9 * shear.amount * r), 0.0);
+  const double heading = headingAlong(shear.direction);
+  Ellipsoid sheet;
+  sheet.radii = {along, across, 0.06 * h};
+  sheet.centre = middle;
+  sheet.orientation.heading_deg = heading;
+  out.push_back(sheet);
+  ClusterSpec cap;
+  cap.element.radii = {0.4 * r, 0.4 * r, 0.06 * h};
+  cap.centre = glm::dvec2(middle);
+  cap.boundary_radii = {along - 0.35 * r, across - 0.35 * r};
+  cap.boundary_heading_deg = heading;
+  cap.spacing = glm::dvec2(0.45 * r);  // the anvil sets the outline: kept at every distance
+  cap.altitude_m = middle.z + 0.02 * h;
+  cap.size_variation = 0.2;
+  cap.position_variation = 0.3;
+  cap.heading_variation_deg = 90.0;
+  cap.seed = hashCounters(seed, kShape, 3);
+  for (Ellipsoid e : clusterEllipsoids(cap)) {
+    // Thinner and lower towards its downwind edge.
+    const double t = glm::dot(glm::dvec2(e.centre - middle), shear.direction) / along;
+    e.radii.z *= 1.0 - 0.35 * std::max(t, 0.0) * shear.amount;
+    e.centre.z -= 0.03 * h * t * t;
+    out.push_back(e);
+  }
+  return out;
+}
+
 // The ellipsoids of one heap standing on `base` (the middle of its flat bottom).
 std::vector<Ellipsoid> heapEllipsoids(const CloudField& f, glm::dvec3 base, double size,
                                       double height, std::uint64_t seed, bool detailed) {
   const double r = heapRadius(f) * size;
   const double h = f.thickness_m * height;
+  const double squash = 0.8 + 0.2 * unitFromBits(hashCounters(seed, kShape));
+  if (isCb(f)) return cumulonimbusEllipsoids(f, base, r, h, squash, seed, detailed);
   std::vector<Ellipsoid> out;
   // The flat base: wide, a third of the height, its bottom on the cloud base.
   Ellipsoid bottom;
-  const double squash = 0.8 + 0.2 * unitFromBits(hashCounters(seed, kShape));
-  bottom.radii = {r, r * squash, (isCb(f) ? 0.12 : 0.3) * h};
+  bottom.radii = {r, r * squash, 0.3 * h};
   bottom.centre = base + glm::dvec3(0.0, 0.0, bottom.radii.z);
   bottom.orientation.heading_deg = 360.0 * unitFromBits(hashCounters(seed, kShape, 1));
-  if (!isCb(f)) out.push_back(bottom);
-  // Gardner's towers: lobes on a jittered lattice raised by a dummy dome under the middle.
+  out.push_back(bottom);
+  // Gardner's towers: lobes on a jittered lattice raised by a dummy dome under the middle,
+  // leaning downwind with the shear.
   Ellipsoid dome;
-  dome.radii = {0.45 * r, 0.45 * r, (isCb(f) ? 0.75 : 0.55) * h};
+  dome.radii = {0.45 * r, 0.45 * r, 0.55 * h};
   dome.centre = base;
   ClusterSpec lobes;
   lobes.element.radii = {0.38 * r, 0.38 * r, 0.3 * h};
-  if (isCb(f)) lobes.element.radii = {0.28 * r, 0.28 * r, 0.18 * h};
   lobes.centre = glm::dvec2(base);
   lobes.boundary_radii = glm::dvec2(0.42 * r);
   lobes.spacing = glm::dvec2(0.3 * r);
-  lobes.altitude_m = base.z + (isCb(f) ? 0.1 : 0.25) * h;
+  lobes.altitude_m = base.z + 0.25 * h;
   lobes.size_variation = 0.25;
   lobes.position_variation = 0.4;
   lobes.heading_variation_deg = 90.0;
   lobes.seed = hashCounters(seed, kShape, 2);
   std::vector<Ellipsoid> tower = clusterEllipsoids(lobes, {dome});
-  if (!detailed && !tower.empty()) {
-    // Far away the lobes merge into one mound: an ellipsoid filling the box that holds them
-    // (four fifths of its half-extents, so that it covers about what they cover).
-    glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-lo);
-    for (const Ellipsoid& e : tower) {
-      const double reach = std::max({e.radii.x, e.radii.y});
-      lo = glm::min(lo, e.centre - glm::dvec3(reach, reach, e.radii.z));
-      hi = glm::max(hi, e.centre + glm::dvec3(reach, reach, e.radii.z));
-    }
-    Ellipsoid mound;
-    mound.centre = 0.5 * (lo + hi);
-    mound.radii = 0.4 * (hi - lo);
-    tower = {mound};
-  }
+  const Shear shear = shearOf(f);
+  for (Ellipsoid& e : tower)
+    e.centre += glm::dvec3(shear.direction * (kLean * shear.amount * (e.centre.z - base.z)), 0.0);
+  if (!detailed && !tower.empty()) tower = {mound(tower)};
   out.insert(out.end(), tower.begin(), tower.end());
-  if (isCb(f)) {
-    // The anvil: a second, flat cluster over a wide plateau at nine tenths of the height, so
-    // that it spreads level and droops a little at its edge ([G]: a base and a cap).
-    Ellipsoid plateau;
-    plateau.radii = {3.0 * r, 3.0 * r, 0.88 * h};
-    plateau.centre = base;
-    ClusterSpec cap;
-    cap.element.radii = {0.5 * r, 0.5 * r, 0.07 * h};
-    cap.centre = glm::dvec2(base);
-    cap.boundary_radii = glm::dvec2(0.7 * r);
-    cap.spacing = glm::dvec2(0.35 * r);  // the anvil sets the outline: kept at every distance
-    cap.altitude_m = base.z;
-    cap.size_variation = 0.2;
-    cap.position_variation = 0.3;
-    cap.heading_variation_deg = 90.0;
-    cap.seed = hashCounters(seed, kShape, 3);
-    const std::vector<Ellipsoid> anvil = clusterEllipsoids(cap, {plateau});
-    out.insert(out.end(), anvil.begin(), anvil.end());
-    // The trunk: one tall ellipsoid from the base to the anvil, so that the tower stands
-    // unbroken behind its lobes.
-    Ellipsoid trunk;
-    trunk.radii = {0.3 * r, 0.3 * r * squash, 0.45 * h};
-    trunk.centre = base + glm::dvec3(0.0, 0.0, trunk.radii.z);
-    out.push_back(trunk);
-    bottom.radii.x *= 0.6, bottom.radii.y *= 0.6;
-    out.push_back(bottom);
-  }
   return out;
 }
 
@@ -214,7 +297,7 @@ double unitArea(CloudType type, bool side) {
       cloud.ellipsoids = heapEllipsoids(f, {0.0, 0.0, 1000.0}, scale.size, scale.height,
                                         hashCounters(77, k), true);
       // A square around the heap: across it (x) and down through it (y) or along its height.
-      const double half = 2.5 * r * scale.size, cell = 2.0 * half / kGrid;
+      const double half = (isCb(f) ? 3.6 : 2.5) * r * scale.size, cell = 2.0 * half / kGrid;
       const double height = 2.0 * f.thickness_m * scale.height, step_up = height / kGrid;
       int inside = 0;
       for (int y = 0; y < kGrid; ++y)
@@ -329,7 +412,7 @@ std::string fieldKey(const CloudField& f) {
   std::ostringstream key;
   key.precision(17);
   key << f.name << '/' << int(f.type) << '/' << f.base_m << '/' << f.thickness_m << '/'
-      << f.coverage << '/' << f.seed;
+      << f.coverage << '/' << f.seed << '/' << f.shear.x << ',' << f.shear.y;
   const Region& r = f.region;
   if (!r.everywhere())
     key << "/r" << r.centre.x << ',' << r.centre.y << ',' << r.half_size.x << ',' << r.half_size.y
@@ -431,6 +514,12 @@ std::vector<EllipsoidCloud> tileClouds(const CloudField& f, std::int64_t i, std:
   return out;
 }
 
+EllipsoidCloud typicalHeap(const CloudField& f, glm::dvec3 base) {
+  EllipsoidCloud heap = heapCloud(f, f.name + "/typical");
+  heap.ellipsoids = heapEllipsoids(f, base, 1.0, 1.0, f.seed, true);
+  return heap;
+}
+
 double heapRange(const CloudField& f, const Camera& camera, double heap_range_m) {
   if (heap_range_m > 0.0) return heap_range_m;
   // From high up the view reaches further: the range grows with the height above the heaps.
@@ -450,7 +539,7 @@ std::vector<EllipsoidCloud> fieldClouds(const CloudField& f, const Camera& camer
   const double top = f.base_m + (isCb(f) ? 1.3 : 1.2) * f.thickness_m * rise;
   // A tile is kept when its box (grown by the largest heap that can reach out of it) is not
   // wholly outside the view frustum (the renderer's test for clouds).
-  const double reach = 3.0 * heapRadius(f) * (1.0 + kSizeVariation);
+  const double reach = 3.6 * heapRadius(f) * (1.0 + kSizeVariation);
   const glm::dvec3 eye3(eye, camera.position.z);
   const std::string key = fieldKey(f);
   const auto lo = glm::floor((eye - range) / size), hi = glm::floor((eye + range) / size);
@@ -511,8 +600,7 @@ bool planeSeenBeyond(const Camera& camera, double altitude, double range) {
 // I = (1 - a)(1 - t) S Id + (1 - a) t It + a K is eq. 8 with a' = a K / c, t' = (1 - a) t /
 // ((1 - a)((1 - t) S + t)) and the colour times c = (1 - a)((1 - t) S + t) + a K.
 void lightFarDeck(const CloudField& f, glm::dvec3 to_sun, CloudLayer& deck) {
-  EllipsoidCloud heap = heapCloud(f, "");
-  heap.ellipsoids = heapEllipsoids(f, glm::dvec3(0.0, 0.0, f.base_m), 1.0, 1.0, f.seed, true);
+  const EllipsoidCloud heap = typicalHeap(f, glm::dvec3(0.0, 0.0, f.base_m));
   const std::vector<LobeLight> lights = lobeLights(heap, to_sun);
   double sun = 0.0, sky = 0.0, weight = 0.0;
   for (std::size_t i = 0; i < lights.size(); ++i) {

@@ -64,6 +64,10 @@ struct CloudField {
   // cover and height vary from cluster to cluster (MODEL.md section 11).
   Region region;
   ClusterVariation clusters;
+  // The wind at the heaps' top less the wind that carries them, east and north, m/s (set from
+  // the world's wind profile when the scene is taken): heaps lean with it and a cumulonimbus's
+  // anvil spreads along it (MODEL.md section 10).
+  glm::dvec2 shear{0.0, 0.0};
 
   // Heaps are a Boolean model (Poisson centres, random sizes): the fraction they cover is
   // 1 - exp(-density * mean footprint) for any coverage up to 1, but above this their
@@ -89,6 +93,10 @@ std::vector<EllipsoidCloud> tileClouds(const CloudField& field, std::int64_t i, 
 inline double fieldAltitude(const CloudField& field) {
   return field.base_m + 0.5 * field.thickness_m;
 }
+
+// One heap of the field, of typical size and height, standing on `base`: lit and textured as
+// the field's heaps are (the far deck takes its light from it; the look figures measure it).
+EllipsoidCloud typicalHeap(const CloudField& field, glm::dvec3 base);
 
 // How far from the camera heaps are drawn as ellipsoids: `heap_range_m` when positive, else
 // CloudField::kRangeM plus twice the camera's height above the field's base.
