@@ -173,36 +173,33 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-// Light figures of a heap (issue 27, MODEL.md section 14): the widest tile of heaps near the
-// origin, alone, seen level from 8 km. (b) With the sun 90 degrees to the right at 10 degrees
-// up, the median luminance of the right (sunlit) half of its largest connected silhouette
-// (coverage > 0.5) over its left half, split at the silhouette's centroid column. (c) With the sun
-// 12 degrees above the line to the heap's middle, behind it, the median light per unit opacity of
-// its thin edge (coverage 0.05 to 0.5) over its body's (coverage > 0.95): a silver lining is > 1.
+// Light figures of a heap (issue 27, MODEL.md section 14): the field's typical heap
+// (typicalHeap) alone, seen level from 8 km or three times its size, whichever is further. (b) With
+// the sun 90 degrees to the right at 10 degrees up, the median luminance of the right (sunlit) half
+// of its largest connected silhouette (coverage > 0.5) over its left half, split at the
+// silhouette's centroid column. (c) With the sun 12 degrees above the line to the heap's middle,
+// behind it, the median light per unit opacity of its thin edge (coverage 0.05 to 0.5) over its
+// body's (coverage > 0.95): a silver lining is > 1.
 void printLightFigures(GlRenderer& renderer, const SceneFile& file, const std::string& name,
                        const std::string& images) {
   if (file.scene.fields.empty()) return;
   const CloudField& field = file.scene.fields.front();
-  EllipsoidCloud heap;
-  double widest = 0.0;
-  for (std::int64_t i = -1; i <= 1; ++i)
-    for (std::int64_t j = -1; j <= 1; ++j)
-      for (EllipsoidCloud& c : tileClouds(field, i, j)) {
-        const BoundingBox box = boundingBox(c);
-        if (box.hi.x - box.lo.x > widest) widest = box.hi.x - box.lo.x, heap = std::move(c);
-      }
+  const EllipsoidCloud heap = typicalHeap(field, {0.0, 0.0, field.base_m});
   if (heap.ellipsoids.empty()) return;
   const BoundingBox box = boundingBox(heap);
   const glm::dvec3 middle = 0.5 * (box.lo + box.hi);
+  const double widest = box.hi.x - box.lo.x;
+  const double size = std::max(box.hi.z - box.lo.z, widest);
+  const double distance = std::max(8000.0, 3.0 * size);
   Scene scene = file.scene;
   scene.fields.clear();
   scene.layers.clear();
   scene.clouds = {heap};
   Camera& c = scene.camera;
   c.width = 480, c.height = 360;
-  c.position = middle - glm::dvec3(0.0, 8000.0, 0.0);  // looking north at it
+  c.position = middle - glm::dvec3(0.0, distance, 0.0);  // looking north at it
   c.orientation = {0.0, 0.0, 0.0};
-  c.vfov_deg = 2.0 * glm::degrees(std::atan(0.7 * std::max(box.hi.z - box.lo.z, widest) / 8000.0));
+  c.vfov_deg = 2.0 * glm::degrees(std::atan(0.7 * size / distance));
   Scene clear = scene;
   clear.clouds.clear();
 

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <sstream>
 
 #include "config/scene_file.h"
 #include "renderer/renderer.h"
@@ -31,6 +32,15 @@ std::string applyOverrides(const RenderCommandOptions& o, SceneFile& file) {
   if (o.roll) camera.orientation.roll_deg = *o.roll;
   if (o.vfov) camera.vfov_deg = *o.vfov;
   if (o.time) file.scene.time_s = *o.time;
+  if (o.sun) {
+    std::ostringstream out;
+    if (outOfRange(out, "--sun azimuth", (*o.sun)[0],
+                   {-Limits::kMaxHeading, Limits::kMaxHeading}) ||
+        outOfRange(out, "--sun elevation", (*o.sun)[1], {-Limits::kMaxPitch, Limits::kMaxPitch}))
+      return "command line: " + out.str();
+    file.scene.sun.azimuth_deg = (*o.sun)[0];
+    file.scene.sun.elevation_deg = (*o.sun)[1];
+  }
   if (o.time && !file.dynamics.automata.empty() && *o.time > Limits::kMaxAutomatonTime)
     return "command line: --time " + std::to_string(*o.time) +
            " is out of range with automaton clouds (allowed: 0 to 86400 s)";
@@ -135,6 +145,9 @@ void addRenderCommand(CLI::App& app, RenderCommandOptions& o) {
       ->check(CLI::Range(-Limits::kMaxRoll, Limits::kMaxRoll));
   cmd->add_option("--vfov", o.vfov, "Vertical field of view, degrees")
       ->check(CLI::Range(Limits::kMinVfov, Limits::kMaxVfov));
+  cmd->add_option("--sun", o.sun,
+                  "Sun azimuth (degrees clockwise from north) and elevation (degrees), AZ,EL")
+      ->delimiter(',');
   cmd->add_option("--time", o.time, "Simulation time in seconds (layers drift with it)")
       ->check(CLI::Range(0.0, Limits::kMaxTime));
   cmd->add_flag("--stats", o.stats,

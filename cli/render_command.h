@@ -1,5 +1,6 @@
 #pragma once
 // `nephele render SCENE -o OUT`: one image of a scene file.
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -23,6 +24,7 @@ struct RenderCommandOptions {
   std::optional<int> width, height;
   std::optional<std::vector<double>> position;
   std::optional<double> heading, pitch, roll, vfov, time;
+  std::optional<std::array<double, 2>> sun;  // azimuth, elevation, degrees
   std::optional<std::string> texture, term_filter, sky_passes;
   std::optional<std::string> ellipsoid_passes, ellipsoid_order, limb, tile_format;
   std::optional<int> tile_resolution, tessellation;

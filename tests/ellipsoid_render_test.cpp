@@ -110,12 +110,33 @@ TEST_F(EllipsoidRenderTest, HeapLightMatchesReference) {
     file.scene.sun.azimuth_deg = azimuth;
     const FloatImage reference = renderReference(file.scene, file.reference);
     const std::string name = "heap_light_" + std::to_string(int(azimuth));
-    // 32.8 dB measured with the sun behind (the silver lining's texture detail).
-    expectClose(renderer_->renderFloat(file.scene, file.render), reference, 32.5, 0.45, name);
+    // Against the 4x4 reference: 31.9 dB measured with the sun behind (the silver lining's
+    // texture detail, and the heap light varying across each lobe, which GL samples once per
+    // pixel; 32.8 dB when the light was constant over a lobe).
+    expectClose(renderer_->renderFloat(file.scene, file.render), reference, 31.5, 0.45, name);
+    // Point-sampled, every term, soft edges (errors scale with 1 / D): over the cloud's
+    // pixels (the horizon row, which GL antialiases analytically, is not the cloud's) the GL
+    // computes the reference's heap light (MODEL.md section 14) to 2e-3 per channel.
+    RenderSettings exact = file.render;
+    exact.texture_evaluation = TextureEvaluation::kProcedural;
+    exact.term_filter = TermFilter::kNone;
+    Scene soft = file.scene;
+    soft.clouds[0].transition = 0.3;
+    const FloatImage gl = renderer_->renderFloat(soft, exact);
+    const FloatImage point = renderReference(soft, {1, 0});
+    int cloudy = 0, large = 0;
+    for (std::size_t p = 0; p < gl.rgba.size() / 4; ++p) {
+      if (!(point.rgba[4 * p + 3] > 0.0f)) continue;
+      ++cloudy;
+      for (int c = 0; c < 3; ++c)
+        large += std::abs(gl.rgba[4 * p + c] - point.rgba[4 * p + c]) > 2e-3f;
+    }
+    EXPECT_GT(cloudy, 1000) << name;
+    EXPECT_LE(large, 12) << name << ": of " << 3 * cloudy << " channels";
     RenderSettings multipass = file.render;
     multipass.ellipsoid_passes = EllipsoidPasses::kMultipass;
-    expectClose(renderer_->renderFloat(file.scene, multipass), reference, 32.0, 0.5,
-                name + "_multipass");
+    expectClose(renderer_->renderFloat(file.scene, multipass), reference, 31.0, 0.5,
+                name + "_multipass");  // 31.6 dB measured
   }
 }
 

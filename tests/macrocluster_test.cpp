@@ -141,10 +141,10 @@ TEST_F(MacroclusterRenderTest, ClustersVaryTheirCover) {
 
 // A field seen from 10 km towards its horizon, heaps as ellipsoids to `range` and a far deck
 // beyond.
-Scene horizonScene() {
+Scene horizonScene(std::uint64_t seed = 3) {
   WeatherLayer w = typicalWeatherLayer(CloudType::kCumulus, 0.4);
   Scene scene;
-  const WeatherClouds add = weatherClouds(w, "h", 3);
+  const WeatherClouds add = weatherClouds(w, "h", seed);
   scene.layers = add.layers;
   scene.fields = add.fields;
   scene.sun.elevation_deg = 35.0;
@@ -180,17 +180,28 @@ TEST_F(MacroclusterRenderTest, FarDeckEqualsOneSampleReference) {
 
 // The switch-over: heaps out to 15 km and the deck beyond, against the one-sample reference
 // with heaps to the automatic range (58 km), band by band of 8 rows: cover within 0.1 and
-// luminance within 0.08 (measured 0.056 and 0.041 here; scale_bench's field, whose clusters
-// vary, measures 0.18 and 0.095 with the range at 5 km: the deck does not vary with them).
+// luminance within 0.08, the images averaged over four fields (seeds 3 to 6). One field's
+// 128 columns hold few heaps per band, whose placement alone moves a band's cover by up to
+// 0.1: a single field measures 0.051 to 0.114 over seeds 3 to 7. scale_bench's field, whose
+// clusters vary, measures 0.18 and 0.095 with the range at 5 km: the deck does not vary with
+// them.
 TEST_F(MacroclusterRenderTest, FarDeckSwitchOverWithinTolerance) {
-  const Scene scene = horizonScene();
   RenderSettings gl;
   gl.heap_range_m = 15000.0;
-  const FloatImage a = renderer_->renderFloat(scene, gl);
-  const FloatImage b = renderReference(scene, {1, 0, 0.0});
+  FloatImage a, b;
+  constexpr int kFields = 4;
+  for (int k = 0; k < kFields; ++k) {
+    const Scene scene = horizonScene(3 + k);
+    const FloatImage one_a = renderer_->renderFloat(scene, gl);
+    const FloatImage one_b = renderReference(scene, {1, 0, 0.0});
+    if (k == 0) a = one_a, b = one_b;
+    for (std::size_t i = 0; k > 0 && i < a.rgba.size(); ++i)
+      a.rgba[i] += one_a.rgba[i], b.rgba[i] += one_b.rgba[i];
+  }
+  for (std::size_t i = 0; i < a.rgba.size(); ++i) a.rgba[i] /= kFields, b.rgba[i] /= kFields;
   const ProfileError e = rowProfileError(a, b);
-  std::printf("far deck switch-over at 15 km: band cover %.3f, luminance %.3f\n", e.cover,
-              e.luminance);
+  std::printf("far deck switch-over at 15 km, mean of %d fields: band cover %.3f, luminance %.3f\n",
+              kFields, e.cover, e.luminance);
   EXPECT_LE(e.cover, 0.1);
   EXPECT_LE(e.luminance, 0.08);
   if (e.cover > 0.1 || e.luminance > 0.08) writeFailureImages(a, b, "far_deck_switch");

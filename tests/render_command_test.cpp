@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 namespace {
@@ -53,6 +54,24 @@ TEST_F(RenderCommandTest, RendersAPresetWithOverrides) {
   EXPECT_THAT(run.output, HasSubstr("osmesa"));
   EXPECT_THAT(run.output, HasSubstr("GL_RENDERER"));
   EXPECT_TRUE(std::filesystem::exists(path("out.png")));
+}
+
+// --sun moves the scene's sun: the same view lit from two directions differs, and the same
+// direction given twice does not.
+TEST_F(RenderCommandTest, SunFlagLightsTheSceneFromWhereItSays) {
+  const std::string preset = NEPHELE_SOURCE_DIR "/config/scenes/cumulus.toml";
+  auto render = [&](const std::string& name, const std::string& sun) {
+    const CommandResult run = runNephele("render " + preset + " -o " + path(name) +
+                                         " --width 96 --height 54 --sun " + sun);
+    EXPECT_EQ(run.exit_code, 0) << run.output;
+    std::ifstream in(path(name), std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  const std::string front = render("a.png", "0,30"), again = render("b.png", "0,30");
+  const std::string behind = render("c.png", "180,30");
+  ASSERT_FALSE(front.empty());
+  EXPECT_EQ(front, again);
+  EXPECT_NE(front, behind);
 }
 
 // The latest start time a scene may have (Limits::kMaxTime, 1e9 s) is longer than one
@@ -137,6 +156,9 @@ TEST_F(RenderCommandTest, BadFlagsAreRejected) {
   run = runNephele("render " + preset + " -o " + path("out.png") + " --tile-resolution 12");
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_THAT(run.output, HasSubstr("tile_resolution: 12 is not allowed (allowed: 0 for adaptive"));
+  run = runNephele("render " + preset + " -o " + path("out.png") + " --sun 500,10");
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_THAT(run.output, HasSubstr("--sun azimuth: 500 is out of range (allowed: -360 to 360)"));
   run = runNephele("render " + preset + " -o " + path("out.png") + " --ellipsoid-order random");
   EXPECT_NE(run.exit_code, 0);
   EXPECT_THAT(run.output, HasSubstr("random"));

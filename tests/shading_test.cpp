@@ -69,49 +69,65 @@ TEST(GardnerIntensity, NormalTurnsTowardsViewerAndBackLitHasNoHighlight) {
   EXPECT_EQ(gardnerIntensity({1.0, 0.0, 0.0, 1.0}, 0.0, {0, 0, 1}, l, {0, 0, -1}), 1.0);
 }
 
-// MODEL.md section 14, against values worked by hand: a sphere of radius 100 m whose centre is
-// 300 m above another's takes away 200 m of the lower one's light straight up.
-TEST(HeapLight, TransmittanceThroughTheOtherLobes) {
+// MODEL.md section 14, against values worked by hand. Two spheres of radius 100 m, centres
+// 100 m apart one above the other, are one heap (each centre lies within the other); their
+// envelope has the second moments of the two: centroid 1050 m, horizontal variance
+// 100^2 / 5, vertical 100^2 / 5 + 50^2, so semi-axes 100 m and sqrt(100^2 + 5 50^2) = 150 m,
+// and it is filled (two volumes of 4/3 pi 100^3 over 4/3 pi 100 100 150: more than 1, so 1).
+// A sphere 5 km away is a heap of its own, its envelope itself.
+TEST(HeapLight, EnvelopeOfEachHeapAndTheDepthThroughIt) {
   EllipsoidCloud cloud;
   cloud.light_extinction = 0.02;
   Ellipsoid lower, upper, aside;
   lower.radii = upper.radii = aside.radii = glm::dvec3(100.0);
   lower.centre = {0.0, 0.0, 1000.0};
-  upper.centre = {0.0, 0.0, 1300.0};
+  upper.centre = {0.0, 0.0, 1100.0};
   aside.centre = {5000.0, 0.0, 1000.0};
   cloud.ellipsoids = {lower, upper, aside};
-  const glm::dvec3 up(0.0, 0.0, 1.0);
-  const std::vector<LobeLight> lights = lobeLights(cloud, up);              // the sun overhead
-  const double through = 1.0 / (1.0 + 0.75 * (1.0 - 0.85) * 0.02 * 200.0);  // two-stream
-  EXPECT_NEAR(lights[0].sun, through, 1e-12);
-  EXPECT_NEAR(lights[0].sky, 0.5 + 0.5 * through, 1e-12);
-  // The lower lobe's top, 1100 m, lies 100 m below the upper's bottom: its sunward point sees
-  // the whole 200 m of the upper lobe too. A lobe between them, 1150 m to 1250 m, takes the
-  // upper's light from 1250 m at its top: the upper lobe's chord from there is 150 m.
-  EXPECT_NEAR(lights[0].sun_face, through, 1e-12);
-  Ellipsoid middle;
-  middle.radii = {50.0, 50.0, 50.0};
-  middle.centre = {0.0, 0.0, 1200.0};
-  EllipsoidCloud stacked = cloud;
-  stacked.ellipsoids.push_back(middle);
-  const std::vector<LobeLight> with_middle = lobeLights(stacked, up);
-  EXPECT_NEAR(with_middle[3].sun_face, 1.0 / (1.0 + 0.75 * 0.15 * 0.02 * 150.0), 1e-12);
-  EXPECT_NEAR(with_middle[3].sun, 1.0 / (1.0 + 0.75 * 0.15 * 0.02 * 200.0), 1e-12);
-  for (int i : {1, 2}) {
-    EXPECT_DOUBLE_EQ(lights[i].sun, 1.0) << i;
-    EXPECT_DOUBLE_EQ(lights[i].sky, 1.0) << i;
+  const std::vector<HeapEnvelope> envelopes = heapEnvelopes(cloud);
+  ASSERT_EQ(envelopes.size(), 3u);
+  for (int i : {0, 1}) {
+    EXPECT_NEAR(envelopes[i].centre.z, 1050.0, 1e-9);
+    EXPECT_NEAR(envelopes[i].radii.x, 100.0, 1e-9);
+    EXPECT_NEAR(envelopes[i].radii.z, 150.0, 1e-9);
+    EXPECT_DOUBLE_EQ(envelopes[i].extinction, 0.02);
   }
-  // The sun from the side: nothing lies east of the lower lobe but the distant one, which a
-  // ray 5 km long at its height passes through the middle of.
-  const std::vector<LobeLight> east = lobeLights(cloud, {1.0, 0.0, 0.0});
-  EXPECT_NEAR(east[0].sun, through, 1e-12);
-  EXPECT_DOUBLE_EQ(east[1].sun, 1.0);
-  // Off: every lobe takes all the light, and the intensity is eq. 8.
+  EXPECT_NEAR(envelopes[2].centre.x, 5000.0, 1e-9);
+  EXPECT_NEAR(envelopes[2].radii.y, 100.0, 1e-9);
+  EXPECT_NEAR(envelopes[2].extinction, 0.02, 1e-12);
+  auto two_stream = [](double tau) { return 1.0 / (1.0 + 0.75 * (1.0 - 0.85) * tau); };
+  const glm::dvec3 up(0.0, 0.0, 1.0), down(0.0, 0.0, -1.0), west(-1.0, 0.0, 0.0);
+  // The bottom of the heap, facing down, with the sun overhead: the whole 300 m of the
+  // envelope above it (900 m to 1200 m), counted fully since the face looks away from it.
+  const HeapLight bottom = heapLightAt(envelopes[0], {0.0, 0.0, 900.0}, down, up);
+  EXPECT_NEAR(bottom.sun, two_stream(0.02 * 300.0), 1e-12);
+  EXPECT_NEAR(bottom.sky, 0.5 + 0.5 * two_stream(0.02 * 300.0), 1e-12);
+  // The top takes all the light; a west face with the sun in the east looks through the
+  // envelope at 1000 m, where its half-width is 100 sqrt(1 - (50 / 150)^2), counted by
+  // (1 - n.L) / 2 = 1; a face turned to 60 degrees from the sun counts it by (1 - cos 60) / 2.
+  const HeapLight top = heapLightAt(envelopes[1], {0.0, 0.0, 1200.0}, up, up);
+  EXPECT_DOUBLE_EQ(top.sun, 1.0);
+  EXPECT_DOUBLE_EQ(top.sky, 1.0);
+  const double width = 2.0 * 100.0 * std::sqrt(1.0 - 1.0 / 9.0);
+  const glm::dvec3 east(1.0, 0.0, 0.0);
+  EXPECT_NEAR(heapLightAt(envelopes[0], {-100.0, 0.0, 1000.0}, west, east).sun,
+              two_stream(0.02 * width), 1e-9);
+  const glm::dvec3 half_way(0.5, 0.0, std::sqrt(0.75));
+  EXPECT_NEAR(heapLightAt(envelopes[0], {-100.0, 0.0, 1000.0}, half_way, east).sun,
+              two_stream(0.02 * width * 0.25), 1e-9);
+  // Parts named by the cloud override the grouping: three parts, three envelopes.
+  EllipsoidCloud parted = cloud;
+  parted.parts = {0, 1, 2};
+  EXPECT_NEAR(heapEnvelopes(parted)[0].radii.z, 100.0, 1e-9);
+  // Off: every point takes all the light, and the intensity is eq. 8.
   cloud.light_extinction = 0.0;
-  for (const LobeLight& l : lobeLights(cloud, up)) EXPECT_EQ(l.sun + l.sky, 2.0);
+  for (const HeapEnvelope& e : heapEnvelopes(cloud)) {
+    const HeapLight light = heapLightAt(e, e.centre, down, up);
+    EXPECT_EQ(light.sun + light.sky, 2.0);
+  }
   const glm::dvec3 n(0.0, -1.0, 0.0), to_sun = glm::normalize(glm::dvec3(0.3, -1.0, 0.5));
   const glm::dvec3 d(0.0, 1.0, 0.0);
-  EXPECT_DOUBLE_EQ(heapIntensity(cloud, LobeLight{0.3, 0.6, 0.5}, 0.4, n, to_sun, d, 0.7),
+  EXPECT_DOUBLE_EQ(heapIntensity(cloud, HeapLight{0.3, 0.6}, 0.4, n, to_sun, d, 0.7),
                    gardnerIntensity(cloud.shading, 0.4, n, to_sun, -d));
 }
 
@@ -121,25 +137,22 @@ TEST(HeapLight, EquationWithSunSkyAndForwardScattering) {
   cloud.shading = {0.3, 0.2, 0.0, 8.0};
   const glm::dvec3 to_sun = glm::normalize(glm::dvec3(0.0, 1.0, 0.2));  // behind the surface
   const glm::dvec3 d(0.0, 1.0, 0.0), n(0.0, -1.0, 0.0);  // looking north at a face turned south
-  const LobeLight light{0.5, 0.8, 0.9};  // sun at the centre, sky, sun at the sunward point
-  // The surface's sunlight runs from the centre's (n.L = -1) to the sunward point's (n.L = 1):
-  // S = 0.5 + 0.4 (1 + n.L) / 2. The skin's diffuse max(0, (n.L + w) / (1 + w)) is 0 here,
-  // so I = (1 - a) t It + a K + S P / (4 pi) TR, with P the Cornette-Shanks phase (g = 0.85)
-  // at cos theta = d . L.
-  const double n_dot_l = glm::dot(n, to_sun);
-  ASSERT_LT(n_dot_l, -kSkinWrap);
-  const double sun = 0.5 + 0.4 * 0.5 * (1.0 + n_dot_l);
+  const HeapLight light{0.5, 0.8};                       // sun and sky reaching the point
+  // The skin's diffuse max(0, (n.L + w) / (1 + w)) is 0 here, so
+  // I = (1 - a) t It + a K + S P / (4 pi) TR, with P the Cornette-Shanks phase (g = 0.85) at
+  // cos theta = d . L.
+  ASSERT_LT(glm::dot(n, to_sun), -kSkinWrap);
   const double c = glm::dot(d, to_sun), g = 0.85;
   const double phase = 1.5 * (1.0 - g * g) / (2.0 + g * g) * (1.0 + c * c) /
                        std::pow(1.0 + g * g - 2.0 * g * c, 1.5);
-  const double expected = 0.7 * 0.2 * 0.4 + 0.3 * 0.8 + sun * phase / (4.0 * M_PI) * 0.25;
+  const double expected = 0.7 * 0.2 * 0.4 + 0.3 * 0.8 + 0.5 * phase / (4.0 * M_PI) * 0.25;
   EXPECT_NEAR(heapIntensity(cloud, light, 0.4, n, to_sun, d, 0.25), expected, 1e-12);
-  // A face turned to the sun takes the sunward point's light through its skin; seen from the
-  // sun's side (cos theta = -1, no highlight with s = 0):
-  // I = (1 - a)((1 - t) S_face (1 + w) / (1 + w) + t It) + a K + S_face P(-1) / (4 pi) TR.
+  // A face turned to the sun takes it through its skin; seen from the sun's side
+  // (cos theta = -1, no highlight with s = 0):
+  // I = (1 - a)((1 - t) S (1 + w) / (1 + w) + t It) + a K + S P(-1) / (4 pi) TR.
   const double back_phase = 1.5 * (1.0 - g * g) / (2.0 + g * g) * 2.0 / std::pow(1.0 + g, 3.0);
   EXPECT_NEAR(heapIntensity(cloud, light, 0.4, to_sun, to_sun, -to_sun, 0.25),
-              0.7 * (0.8 * 0.9 + 0.2 * 0.4) + 0.3 * 0.8 + 0.9 * back_phase / (4.0 * M_PI) * 0.25,
+              0.7 * (0.8 * 0.5 + 0.2 * 0.4) + 0.3 * 0.8 + 0.5 * back_phase / (4.0 * M_PI) * 0.25,
               1e-12);
   // A thin edge against the sun gives off more per unit opacity than the opaque body.
   EXPECT_GT(heapIntensity(cloud, light, 0.4, n, to_sun, d, 0.9),

@@ -165,7 +165,9 @@ bool makeEllipsoidRecord(const Ellipsoid& e, const Camera& camera, bool spotligh
   out.v[15] = glm::vec4(0.0f);
   centre_distance = glm::length(e.centre - camera.position);
   const double near_bound = centre_distance - std::max({e.radii.x, e.radii.y, e.radii.z});
-  out.v[16] = glm::vec4(1.0f, 1.0f, float(near_bound), 1.0f);
+  out.v[16] = glm::vec4(0.0f, 0.0f, float(near_bound), 0.0f);
+  out.v[17] = glm::vec4(0.0f);  // no heap envelope: eq. 8 unchanged (MODEL.md section 14)
+  out.v[18] = glm::vec4(1.0f, 1.0f, 1.0f, 0.0f);
   return true;
 }
 
@@ -484,15 +486,15 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   for (std::size_t index : indices) {
     const EllipsoidCloud& member = scene.clouds[index];
     total += int(member.ellipsoids.size());
-    const std::vector<LobeLight> lights = lobeLights(member, sunDirection(scene.sun));
+    const std::vector<HeapEnvelope> envelopes = heapEnvelopes(member);
     for (std::size_t i = 0; i < member.ellipsoids.size(); ++i) {
       Visible v;
       if (!makeEllipsoidRecord(member.ellipsoids[i], scene.camera, spotlight, v.record,
                                v.centre_distance))
         continue;
-      v.record.v[16].x = float(lights[i].sun);
-      v.record.v[16].y = float(lights[i].sky);
-      v.record.v[16].w = float(lights[i].sun_face);
+      const HeapEnvelope& e = envelopes[i];
+      v.record.v[17] = glm::vec4(row(e.centre - scene.camera.position, e.extinction));
+      v.record.v[18] = glm::vec4(glm::dvec4(1.0 / e.radii, 0.0));
       nearest_m = std::min(nearest_m, double(v.record.v[16].z));
       visible.push_back(v);
     }

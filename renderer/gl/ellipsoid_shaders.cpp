@@ -18,14 +18,14 @@ struct EllipsoidRecord {
   vec4 body[3];    // columns of R S: unit sphere to camera-relative offsets
   vec4 centre;     // centre - eye
   vec4 tile;       // atlas tile: texel origin xy, size zw
-  vec4 light;      // x sunlight at the centre, y sky light, w sunlight at the sunward point,
-                   // reaching it through its heap (MODEL.md section 14); z the nearest a hit
-                   // on it can be, metres (front-to-back order)
+  vec4 order;      // z: the nearest a hit on it can be, metres (front-to-back order)
+  vec4 envelope;   // its heap's envelope (MODEL.md section 14): centre - eye; w extinction
+  vec4 inv_radii;  // 1 / the envelope's semi-axes
 };
 // Records live in a buffer texture, kRecordTexels RGBA32F texels each: llvmpipe fetches texels
 // for eight pixels at once, where a storage buffer is read one pixel at a time.
 layout(binding = 13) uniform samplerBuffer u_records;
-const int kRecordTexels = 17;
+const int kRecordTexels = 19;
 vec4 record(int i, int k) { return texelFetch(u_records, i * kRecordTexels + k); }
 )";
 
@@ -136,15 +136,38 @@ float forwardScattered(float sun, float c) {
          pow(max(1.0 + g2 - 2.0 * g * c, 1e-6), 1.5) / (4.0 * kPi);
 }
 
-// Gardner eq. 8 with the light reaching ellipsoid i through its heap, plus the light scattered
-// forward through the surface's translucence tr (MODEL.md section 14), times cloud and sun
-// colour, fogged; n faces the viewer, r points at the surface from the eye, `distance` in
-// metres.
-vec3 surfaceColour(int i, vec3 n, vec3 r, float it, float tr, float distance) {
-  vec4 light = record(i, 16);
+// Length of the ray p + s v (v unit, s >= 0) inside the envelope of ellipsoid i's heap, p
+// camera-relative (envelopeChord).
+float envelopeChord(int i, vec3 p, vec3 v) {
+  vec3 inv = record(i, 18).xyz;
+  vec3 o = (p - record(i, 17).xyz) * inv, w = v * inv;
+  float a = dot(w, w), half_b = dot(o, w), c = dot(o, o) - 1.0;
+  float quarter_delta = half_b * half_b - a * c;
+  if (quarter_delta <= 0.0 || a <= 0.0) return 0.0;
+  float root = sqrt(quarter_delta);
+  return max(0.0, (-half_b + root) / a - max((-half_b - root) / a, 0.0));
+}
+
+// Two-stream transmittance of optical depth tau (diffuseTransmittance), asymmetry g.
+float diffuseTransmittance(float tau) { return 1.0 / (1.0 + 0.75 * (1.0 - u_scatter.y) * tau); }
+
+// Gardner eq. 8 with the light reaching surface point p of ellipsoid i through its heap
+// (heapLightAt), plus the light scattered forward through the surface's translucence tr
+// (MODEL.md section 14), times cloud and sun colour, fogged; n faces the viewer, r points at
+// the surface from the eye, p camera-relative, `distance` in metres.
+vec3 surfaceColour(int i, vec3 n, vec3 r, vec3 p, float it, float tr, float distance) {
+  float extinction = record(i, 17).w;
+  vec2 light = vec2(1.0);  // sun, sky
+  if (extinction > 0.0) {
+    float toward_sun = 0.5 * (1.0 - clamp(dot(n, u_to_sun), -1.0, 1.0));
+    float toward_sky = 0.5 * (1.0 - clamp(n.z, -1.0, 1.0));
+    light = vec2(diffuseTransmittance(extinction * toward_sun * envelopeChord(i, p, u_to_sun)),
+                 0.5 + 0.5 * diffuseTransmittance(extinction * toward_sky *
+                                                  envelopeChord(i, p, vec3(0.0, 0.0, 1.0))));
+  }
   float n_dot_l = dot(n, u_to_sun);
   float diffuse = max((n_dot_l + u_scatter.z) / (1.0 + u_scatter.z), 0.0);
-  float sun = light.x + (light.w - light.x) * 0.5 * (1.0 + clamp(n_dot_l, -1.0, 1.0));
+  float sun = light.x;
   float highlight = 0.0;
 #ifdef SPECULAR
   if (n_dot_l > 0.0) {
@@ -176,7 +199,7 @@ vec4 ellipsoidSurface(int i, vec3 r, float s) {
   float excess = it - u_thresholds.x - (u_thresholds.y - u_thresholds.x) * (1.0 - limbG(i, r));
   float opacity = opacityFromExcess(excess);
   float alpha = opacity * record(i, 4).w;
-  return vec4(surfaceColour(i, n, r, it, 1.0 - opacity, s * length(r)) * alpha, alpha);
+  return vec4(surfaceColour(i, n, r, p, it, 1.0 - opacity, s * length(r)) * alpha, alpha);
 }
 
 // Whether a hit at s (units of r) shows in this pass: in front of the ground and targets,
@@ -284,7 +307,7 @@ void main() {
   vec3 n = normalize(gradientFromUnit(u_index, v_unit));
   if (dot(n, p) > 0.0) n = -n;
   float excess = it - u_thresholds.x - (u_thresholds.y - u_thresholds.x) * (1.0 - limbG(u_index, p));
-  o_colour = vec4(surfaceColour(u_index, n, p, it, 1.0 - opacityFromExcess(excess), length(p)), 0.0);
+  o_colour = vec4(surfaceColour(u_index, n, p, p, it, 1.0 - opacityFromExcess(excess), length(p)), 0.0);
 #endif
 }
 )";

@@ -33,7 +33,7 @@ struct EllipsoidPassLayout {
 };
 
 // Per-ellipsoid record: RGBA32F texels of a buffer texture.
-inline constexpr int kEllipsoidRecordVec4s = 17;
+inline constexpr int kEllipsoidRecordVec4s = 19;
 // Texture units.
 inline constexpr int kBinTextureUnit = 7;
 inline constexpr int kBinItemTextureUnit = 8;

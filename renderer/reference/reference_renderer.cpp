@@ -58,8 +58,8 @@ struct RayLabels {
 struct EllipsoidEntry {
   EllipsoidView view;
   std::size_t cloud;
-  double fade;      // in-cloud model: the surface fades as the eye nears it
-  LobeLight light;  // MODEL.md section 14
+  double fade;            // in-cloud model: the surface fades as the eye nears it
+  HeapEnvelope envelope;  // MODEL.md section 14
 };
 
 class ReferenceTracer {
@@ -71,12 +71,12 @@ class ReferenceTracer {
     std::vector<const SolidTexture*> solid_pointers;
     for (std::size_t c = 0; c < scene.clouds.size(); ++c) {
       solid_pointers.push_back(&solid_textures_.emplace_back(scene.clouds[c].texture));
-      const std::vector<LobeLight> lights = lobeLights(scene.clouds[c], sun_);
-      for (std::size_t i = 0; i < lights.size(); ++i) {
+      const std::vector<HeapEnvelope> envelopes = heapEnvelopes(scene.clouds[c]);
+      for (std::size_t i = 0; i < envelopes.size(); ++i) {
         EllipsoidView view(scene.clouds[c].ellipsoids[i], scene.camera.position);
         if (view.eyeInside()) continue;  // MODEL.md section 4: no surface to show
         const double fade = surfaceFade(view.eyeRadius());
-        if (fade > 0.0) ellipsoids_.push_back({view, c, fade, lights[i]});
+        if (fade > 0.0) ellipsoids_.push_back({view, c, fade, envelopes[i]});
       }
     }
     veil_ = inCloudVeil(
@@ -194,8 +194,9 @@ class ReferenceTracer {
     const double t = solid_textures_[entry.cloud].value(p - scene_.clouds[entry.cloud].drift_m);
     const double tr = ellipsoidTranslucence(t, cloud.threshold_centre, cloud.threshold_limb,
                                             entry.view.limb(direction), cloud.transition);
-    const double intensity = heapIntensity(cloud, entry.light, t, entry.view.normalAt(direction, s),
-                                           sun_, direction, tr);
+    const glm::dvec3 normal = entry.view.normalAt(direction, s);
+    const double intensity = heapIntensity(cloud, heapLightAt(entry.envelope, p, normal, sun_), t,
+                                           normal, sun_, direction, tr);
     return {s, withFog(intensity * cloud.colour * scene_.sun.colour, direction, s),
             (1.0 - tr) * entry.fade, s};
   }

@@ -112,7 +112,7 @@ Ellipsoid mound(const std::vector<Ellipsoid>& lobes) {
 // overshooting dome over the updraft. The base is dark through the light model (section 14).
 std::vector<Ellipsoid> cumulonimbusEllipsoids(const CloudField& f, glm::dvec3 base, double r,
                                               double h, double squash, std::uint64_t seed,
-                                              bool detailed) {
+                                              bool detailed, std::size_t& anvil_from) {
   const Shear shear = shearOf(f);
   auto u = [&](std::uint64_t a, std::uint64_t b = 0) {
     return unitFromBits(hashCounters(seed, 0x4362ull, a, b));
@@ -165,6 +165,7 @@ std::vector<Ellipsoid> cumulonimbusEllipsoids(const CloudField& f, glm::dvec3 ba
   const glm::dvec3 middle =
       axis(0.88 * h) + glm::dvec3(shear.direction * (0.9 * shear.amount * r), 0.0);
   const double heading = headingAlong(shear.direction);
+  anvil_from = out.size();
   Ellipsoid sheet;
   sheet.radii = {along, across, 0.06 * h};
   sheet.centre = middle;
@@ -191,13 +192,15 @@ std::vector<Ellipsoid> cumulonimbusEllipsoids(const CloudField& f, glm::dvec3 ba
   return out;
 }
 
-// The ellipsoids of one heap standing on `base` (the middle of its flat bottom).
+// The ellipsoids of one heap standing on `base` (the middle of its flat bottom); those from
+// `anvil_from` on are a cumulonimbus's anvil, lit as a heap of its own (MODEL.md section 14).
 std::vector<Ellipsoid> heapEllipsoids(const CloudField& f, glm::dvec3 base, double size,
-                                      double height, std::uint64_t seed, bool detailed) {
+                                      double height, std::uint64_t seed, bool detailed,
+                                      std::size_t& anvil_from) {
   const double r = heapRadius(f) * size;
   const double h = f.thickness_m * height;
   const double squash = 0.8 + 0.2 * unitFromBits(hashCounters(seed, kShape));
-  if (isCb(f)) return cumulonimbusEllipsoids(f, base, r, h, squash, seed, detailed);
+  if (isCb(f)) return cumulonimbusEllipsoids(f, base, r, h, squash, seed, detailed, anvil_from);
   std::vector<Ellipsoid> out;
   // The flat base: wide, a third of the height, its bottom on the cloud base.
   Ellipsoid bottom;
@@ -209,7 +212,7 @@ std::vector<Ellipsoid> heapEllipsoids(const CloudField& f, glm::dvec3 base, doub
   // leaning downwind with the shear.
   Ellipsoid dome;
   dome.radii = {0.45 * r, 0.45 * r, 0.55 * h};
-  dome.centre = base;
+  dome.centre = glm::dvec3(glm::dvec2(base), 0.0);  // terrainHeight counts from z = 0
   ClusterSpec lobes;
   lobes.element.radii = {0.38 * r, 0.38 * r, 0.3 * h};
   lobes.centre = glm::dvec2(base);
@@ -226,7 +229,18 @@ std::vector<Ellipsoid> heapEllipsoids(const CloudField& f, glm::dvec3 base, doub
     e.centre += glm::dvec3(shear.direction * (kLean * shear.amount * (e.centre.z - base.z)), 0.0);
   if (!detailed && !tower.empty()) tower = {mound(tower)};
   out.insert(out.end(), tower.begin(), tower.end());
+  anvil_from = out.size();
   return out;
+}
+
+// Appends one heap to `cloud`, its ellipsoids and their parts (EllipsoidCloud::parts): the heap
+// one part, a cumulonimbus's anvil another.
+void addHeap(EllipsoidCloud& cloud, std::vector<Ellipsoid> heap, std::size_t anvil_from) {
+  const std::uint32_t part = cloud.parts.empty() ? 0 : cloud.parts.back() + 1;
+  for (std::size_t i = 0; i < heap.size(); ++i) {
+    cloud.parts.push_back(i < anvil_from ? part : part + 1);
+    cloud.ellipsoids.push_back(heap[i]);
+  }
 }
 
 EllipsoidCloud heapCloud(const CloudField& f, std::string name) {
@@ -294,8 +308,9 @@ double unitArea(CloudType type, bool side) {
       // Sizes and heights drawn as the tiles draw them (makeTile).
       const HeapScale scale = heapScale(77, std::uint64_t(k));
       EllipsoidCloud cloud = heapCloud(f, "");
+      std::size_t anvil_from = 0;
       cloud.ellipsoids = heapEllipsoids(f, {0.0, 0.0, 1000.0}, scale.size, scale.height,
-                                        hashCounters(77, k), true);
+                                        hashCounters(77, k), true, anvil_from);
       // A square around the heap: across it (x) and down through it (y) or along its height.
       const double half = (isCb(f) ? 3.6 : 2.5) * r * scale.size, cell = 2.0 * half / kGrid;
       const double height = 2.0 * f.thickness_m * scale.height, step_up = height / kGrid;
@@ -441,11 +456,12 @@ EllipsoidCloud makeTile(const CloudField& f, std::int64_t i, std::int64_t j, boo
       continue;
     HeapScale scale = heapScale(tile_seed, std::uint64_t(k));
     scale.height *= clusterFactor(f.clusters, f.seed, kRise, glm::dvec2(base));
-    const std::vector<Ellipsoid> heap =
+    std::size_t anvil_from = 0;
+    std::vector<Ellipsoid> heap =
         heapEllipsoids(f, base, scale.size, scale.height,
-                       hashCounters(tile_seed, kShape, std::uint64_t(k)), detailed);
+                       hashCounters(tile_seed, kShape, std::uint64_t(k)), detailed, anvil_from);
     if (cloud.ellipsoids.size() + heap.size() > std::size_t(Limits::kMaxEllipsoidsPerCloud)) break;
-    cloud.ellipsoids.insert(cloud.ellipsoids.end(), heap.begin(), heap.end());
+    addHeap(cloud, std::move(heap), anvil_from);
   }
   return cloud;
 }
@@ -516,7 +532,8 @@ std::vector<EllipsoidCloud> tileClouds(const CloudField& f, std::int64_t i, std:
 
 EllipsoidCloud typicalHeap(const CloudField& f, glm::dvec3 base) {
   EllipsoidCloud heap = heapCloud(f, f.name + "/typical");
-  heap.ellipsoids = heapEllipsoids(f, base, 1.0, 1.0, f.seed, true);
+  std::size_t anvil_from = 0;
+  addHeap(heap, heapEllipsoids(f, base, 1.0, 1.0, f.seed, true, anvil_from), anvil_from);
   return heap;
 }
 
@@ -595,20 +612,13 @@ bool planeSeenBeyond(const Camera& camera, double altitude, double range) {
 // region, lit like the heaps, drifting with them, with a hole of `range` around the camera.
 // Its threshold is calibrated once per field (a few milliseconds).
 // The far deck's look: the heap's eq. 8 with the mean light its lobes take (MODEL.md section
-// 14; the sunlight as lobeSunlightOverLambert), lobes weighted by their horizontal
-// cross-section, for one typical heap of the field.
+// 14, meanHeapLight: the sunlight as a multiple of the Lambertian mean), lobes weighted by
+// their horizontal cross-section, for one typical heap of the field.
 // I = (1 - a)(1 - t) S Id + (1 - a) t It + a K is eq. 8 with a' = a K / c, t' = (1 - a) t /
 // ((1 - a)((1 - t) S + t)) and the colour times c = (1 - a)((1 - t) S + t) + a K.
 void lightFarDeck(const CloudField& f, glm::dvec3 to_sun, CloudLayer& deck) {
-  const EllipsoidCloud heap = typicalHeap(f, glm::dvec3(0.0, 0.0, f.base_m));
-  const std::vector<LobeLight> lights = lobeLights(heap, to_sun);
-  double sun = 0.0, sky = 0.0, weight = 0.0;
-  for (std::size_t i = 0; i < lights.size(); ++i) {
-    const double w = heap.ellipsoids[i].radii.x * heap.ellipsoids[i].radii.y;
-    sun += w * lobeSunlightOverLambert(lights[i]), sky += w * lights[i].sky, weight += w;
-  }
-  if (weight <= 0.0) return;
-  sun /= weight, sky /= weight;
+  const MeanHeapLight mean = meanHeapLight(typicalHeap(f, glm::dvec3(0.0, 0.0, f.base_m)), to_sun);
+  const double sun = mean.sun_over_lambert, sky = mean.sky;
   ShadingParams& s = deck.shading;
   const double a = s.ambient, t = s.texture_fraction;
   const double c = (1.0 - a) * ((1.0 - t) * sun + t) + a * sky;

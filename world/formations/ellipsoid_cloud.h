@@ -29,6 +29,10 @@ struct EllipsoidCloud {
   double light_extinction = 0.0;
   SolidTextureSpec texture;
   std::vector<Ellipsoid> ellipsoids;
+  // The separately lit parts its ellipsoids fall into (MODEL.md section 14): ellipsoid i is in
+  // part parts[i]. Empty (a scene file's clouds) groups them by overlap instead. Generated
+  // heaps set it, one part per heap and one per cumulonimbus anvil; it is not saved.
+  std::vector<std::uint32_t> parts;
   // How far the cloud has drifted since time 0. Its ellipsoid centres already include it; the
   // texture is looked up at (X - drift) so that it moves with the cloud.
   glm::dvec3 drift_m{0.0};

@@ -2,100 +2,174 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
+#include <numeric>
+
+#include <glm/gtc/matrix_access.hpp>
 
 #include "world/automaton/cloud_density.h"
 
 namespace nephele {
 namespace {
 
-// Length of the ray p + s dir (dir unit, s >= 0) inside the ellipsoid `e`, metres.
-double chordLength(const Ellipsoid& e, glm::dvec3 p, glm::dvec3 dir) {
-  const glm::dmat3 w = worldToUnitSphere(e);
-  const glm::dvec3 o = w * (p - e.centre), d = w * dir;
+// Two ellipsoids belong to one heap when the centre of either lies within this multiple of
+// the other (MODEL.md section 14).
+constexpr double kJoin = 1.25;
+
+// The root of i's group, halving the path on the way.
+std::size_t groupOf(std::vector<std::size_t>& parent, std::size_t i) {
+  while (parent[i] != i) i = parent[i] = parent[parent[i]];
+  return i;
+}
+
+}  // namespace
+
+std::vector<HeapEnvelope> heapEnvelopes(const EllipsoidCloud& cloud) {
+  const std::vector<Ellipsoid>& lobes = cloud.ellipsoids;
+  const std::size_t n = lobes.size();
+  std::vector<HeapEnvelope> out(n);
+  if (!(cloud.light_extinction > 0.0) || n == 0) return out;
+  // Heaps: groups of ellipsoids joined by overlapping bounding spheres, found by a sweep along
+  // x over the spheres' extents.
+  std::vector<double> reach(n);
+  for (std::size_t i = 0; i < n; ++i)
+    reach[i] = std::max({lobes[i].radii.x, lobes[i].radii.y, lobes[i].radii.z});
+  std::vector<std::size_t> order(n), parent(n);
+  std::iota(order.begin(), order.end(), 0);
+  std::iota(parent.begin(), parent.end(), 0);
+  if (cloud.parts.size() == n) {
+    // The parts the cloud names: each part's first ellipsoid stands for it.
+    std::vector<std::size_t> first(n, n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t part = std::min<std::size_t>(cloud.parts[i], n - 1);
+      if (first[part] == n) first[part] = i;
+      parent[i] = first[part];
+    }
+    order.clear();
+  }
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return lobes[a].centre.x - reach[a] < lobes[b].centre.x - reach[b];
+  });
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const std::size_t a = order[k];
+    for (std::size_t m = k + 1; m < order.size(); ++m) {
+      const std::size_t b = order[m];
+      if (lobes[b].centre.x - reach[b] > lobes[a].centre.x + reach[a]) break;
+      const double together = reach[a] + reach[b];
+      const glm::dvec3 between = lobes[a].centre - lobes[b].centre;
+      if (glm::dot(between, between) >= together * together) continue;
+      // Joined when either centre lies within kJoin times the other ellipsoid: lobes that sit
+      // on one another, not a flat sheet that merely reaches a lobe's edge.
+      const glm::dvec3 in_b = worldToUnitSphere(lobes[b]) * between;
+      const glm::dvec3 in_a = worldToUnitSphere(lobes[a]) * between;
+      if (glm::dot(in_b, in_b) < kJoin * kJoin || glm::dot(in_a, in_a) < kJoin * kJoin)
+        parent[groupOf(parent, a)] = groupOf(parent, b);
+    }
+  }
+  // Each group's volume, centroid and second moments along the axes (a solid ellipsoid of
+  // volume V with T = body-to-world times radii has moments V T T^T / 5 about its centre).
+  struct Group {
+    double volume = 0.0;
+    glm::dvec3 first{0.0}, second{0.0};  // sums of V c and V (diag(T T^T) / 5 + c^2)
+  };
+  std::vector<Group> groups(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const glm::dmat3 t = unitSphereToWorld(lobes[i]);
+    const glm::dvec3 spread(glm::dot(glm::row(t, 0), glm::row(t, 0)),
+                            glm::dot(glm::row(t, 1), glm::row(t, 1)),
+                            glm::dot(glm::row(t, 2), glm::row(t, 2)));
+    const double v = 4.0 / 3.0 * std::numbers::pi * std::abs(glm::determinant(t));
+    const glm::dvec3 c = lobes[i].centre;
+    Group& g = groups[groupOf(parent, i)];
+    g.volume += v;
+    g.first += v * c;
+    g.second += v * (spread / 5.0 + c * c);
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    const Group& g = groups[groupOf(parent, i)];
+    HeapEnvelope& e = out[i];
+    if (!(g.volume > 0.0)) continue;
+    // The axis-aligned ellipsoid of the same second moments: semi-axes sqrt(5 variance).
+    e.centre = g.first / g.volume;
+    const glm::dvec3 variance = glm::max(g.second / g.volume - e.centre * e.centre, 0.0);
+    e.radii = glm::max(glm::sqrt(5.0 * variance), glm::dvec3(1e-3));
+    const double volume = 4.0 / 3.0 * std::numbers::pi * e.radii.x * e.radii.y * e.radii.z;
+    e.extinction = cloud.light_extinction * std::min(g.volume / volume, 1.0);
+  }
+  return out;
+}
+
+double envelopeChord(const HeapEnvelope& envelope, glm::dvec3 p, glm::dvec3 dir) {
+  const glm::dvec3 o = (p - envelope.centre) / envelope.radii, d = dir / envelope.radii;
   const double a = glm::dot(d, d), half_b = glm::dot(o, d), c = glm::dot(o, o) - 1.0;
   const double quarter_delta = half_b * half_b - a * c;
-  if (quarter_delta <= 0.0 || a <= 0.0) return 0.0;
+  if (!(quarter_delta > 0.0) || !(a > 0.0)) return 0.0;
   const double root = std::sqrt(quarter_delta);
   const double near = (-half_b - root) / a, far = (-half_b + root) / a;
   return std::max(0.0, far - std::max(near, 0.0));
 }
 
-// Optical depth from point p of ellipsoid i along `dir` through the others.
-double depthThroughOthers(const EllipsoidCloud& cloud, std::size_t i, glm::dvec3 p,
-                          glm::dvec3 dir) {
-  double length = 0.0;
-  for (std::size_t j = 0; j < cloud.ellipsoids.size(); ++j) {
-    if (j == i) continue;
-    const Ellipsoid& e = cloud.ellipsoids[j];
-    // A ball of the longest semi-axis first: most ellipsoids are far off the ray.
-    const double reach = std::max({e.radii.x, e.radii.y, e.radii.z});
-    const glm::dvec3 to = e.centre - p;
-    const double along = glm::dot(to, dir);
-    if (along < -reach || glm::dot(to, to) - along * along > reach * reach) continue;
-    length += chordLength(e, p, dir);
-  }
-  return cloud.light_extinction * length;
-}
-
-}  // namespace
-
-std::vector<LobeLight> lobeLights(const EllipsoidCloud& cloud, glm::dvec3 to_sun) {
-  std::vector<LobeLight> out(cloud.ellipsoids.size());
-  if (cloud.light_extinction <= 0.0) return out;
-  for (std::size_t i = 0; i < out.size(); ++i) {
-    // MODEL.md section 14: light inside a cloud is scattered on, not removed, so it falls as the
-    // two-stream transmittance of the depth, not exp(-depth).
-    const Ellipsoid& e = cloud.ellipsoids[i];
-    // The sunward point: where the normal is to_sun, centre + M L / sqrt(L.M L) with
-    // M = T T^T, T the body-to-world matrix times the radii.
-    const glm::dmat3 t = unitSphereToWorld(e);
-    const glm::dvec3 tl = glm::transpose(t) * to_sun;
-    const glm::dvec3 face = e.centre + t * tl / std::max(glm::length(tl), 1e-300);
-    auto sunlight = [&](glm::dvec3 from) {
-      return to_sun.z > -1.0 ? diffuseTransmittance(depthThroughOthers(cloud, i, from, to_sun))
-                             : 0.0;
-    };
-    out[i].sun = sunlight(e.centre);
-    out[i].sun_face = sunlight(face);
-    // Half the sky light comes from the sky overhead, through the heap; half from the horizon
-    // and the ground, which the heap does not hide.
-    out[i].sky =
-        0.5 + 0.5 * diffuseTransmittance(depthThroughOthers(cloud, i, e.centre, {0.0, 0.0, 1.0}));
-  }
-  return out;
-}
-
-double surfaceSunlight(const LobeLight& light, double n_dot_l) {
-  return light.sun + (light.sun_face - light.sun) * 0.5 * (1.0 + std::clamp(n_dot_l, -1.0, 1.0));
+HeapLight heapLightAt(const HeapEnvelope& envelope, glm::dvec3 p, glm::dvec3 normal,
+                      glm::dvec3 to_sun) {
+  if (!(envelope.extinction > 0.0)) return {};
+  // MODEL.md section 14: light inside a cloud is scattered on, not removed, so it falls as the
+  // two-stream transmittance of the depth, not exp(-depth). A face turned towards the light
+  // looks out of the heap, not through it: the depth counts by (1 - n.v) / 2.
+  const double k = envelope.extinction;
+  auto depth = [&](glm::dvec3 v) {
+    return k * envelopeChord(envelope, p, v) * 0.5 *
+           (1.0 - std::clamp(glm::dot(normal, v), -1.0, 1.0));
+  };
+  return {diffuseTransmittance(depth(to_sun)),
+          0.5 + 0.5 * diffuseTransmittance(depth({0.0, 0.0, 1.0}))};
 }
 
 double skinDiffuse(double n_dot_l) {
   return std::max(0.0, (n_dot_l + kSkinWrap) / (1.0 + kSkinWrap));
 }
 
-double lobeSunlightOverLambert(const LobeLight& light) {
-  const double l = 1.0 + kSkinWrap, d = light.sun_face - light.sun;
-  return (light.sun + d * (1.0 - kSkinWrap) / 2.0) * l + d * l * l / 3.0;
+MeanHeapLight meanHeapLight(const EllipsoidCloud& cloud, glm::dvec3 to_sun) {
+  if (!(cloud.light_extinction > 0.0) || cloud.ellipsoids.empty()) return {};
+  const std::vector<HeapEnvelope> envelopes = heapEnvelopes(cloud);
+  constexpr int kNormals = 64;
+  const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
+  double sun = 0.0, sky = 0.0, weight = 0.0;
+  for (std::size_t i = 0; i < cloud.ellipsoids.size(); ++i) {
+    const Ellipsoid& e = cloud.ellipsoids[i];
+    const glm::dmat3 t = unitSphereToWorld(e), m = t * glm::transpose(t);
+    const double w = e.radii.x * e.radii.y;
+    for (int k = 0; k < kNormals; ++k) {
+      // Normals evenly over the sphere (a Fibonacci lattice); the surface point whose normal
+      // is n is centre + M n / sqrt(n . M n).
+      const double z = 1.0 - (2.0 * k + 1.0) / kNormals, ring = std::sqrt(1.0 - z * z);
+      const glm::dvec3 n(ring * std::cos(golden * k), ring * std::sin(golden * k), z);
+      const glm::dvec3 p = e.centre + m * n / std::sqrt(glm::dot(n, m * n));
+      const HeapLight light = heapLightAt(envelopes[i], p, n, to_sun);
+      sun += w * light.sun * skinDiffuse(glm::dot(n, to_sun));
+      sky += w * light.sky;
+    }
+    weight += w * kNormals;
+  }
+  return {sun / weight / 0.25, sky / weight};
 }
 
 double forwardScattered(double sun, double cos_theta) {
   return sun * cornetteShanksPhase(cos_theta, kDiffuseAsymmetry) / (4.0 * std::numbers::pi);
 }
 
-double heapIntensity(const EllipsoidCloud& cloud, const LobeLight& light, double texture_value,
+double heapIntensity(const EllipsoidCloud& cloud, const HeapLight& light, double texture_value,
                      glm::dvec3 normal, glm::dvec3 to_sun, glm::dvec3 direction,
                      double translucence) {
   const ShadingParams& shading = cloud.shading;
   const DiffuseHighlight d = diffuseHighlight(shading, normal, to_sun, -direction);
-  if (cloud.light_extinction <= 0.0)
+  if (!(cloud.light_extinction > 0.0))
     return gardnerIntensity(shading, d.diffuse, d.highlight, texture_value);
-  // Gardner eq. 8 with the sun's terms times S(n) and the ambient term times L.sky.
-  const double sun = surfaceSunlight(light, d.n_dot_l);
-  const double eq8 =
-      gardnerIntensity(shading, sun * skinDiffuse(d.n_dot_l), sun * d.highlight, texture_value) +
-      shading.ambient * (light.sky - 1.0);
-  return eq8 + forwardScattered(sun, glm::dot(direction, to_sun)) * translucence;
+  // Gardner eq. 8 with the sun's terms times S and the ambient term times K.
+  const double eq8 = gardnerIntensity(shading, light.sun * skinDiffuse(d.n_dot_l),
+                                      light.sun * d.highlight, texture_value) +
+                     shading.ambient * (light.sky - 1.0);
+  return eq8 + forwardScattered(light.sun, glm::dot(direction, to_sun)) * translucence;
 }
 
 }  // namespace nephele

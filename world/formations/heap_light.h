@@ -1,9 +1,9 @@
 #pragma once
-// Light through a heap (MODEL.md section 14): how much sunlight and sky light reaches each
-// ellipsoid of a cloud through the cloud's other ellipsoids, computed once per cloud and sun
-// direction (per-particle attenuation in the manner of Harris and Lastra 2001, applied to
-// Gardner's ellipsoids), and the forward-scattered light a thin edge gives off with the sun
-// behind it (the silver lining).
+// Light through a heap (MODEL.md section 14): how much sunlight and sky light reaches a point
+// on a lobe through the heap it belongs to, the heap taken as its envelope (an ellipsoid
+// holding its lobes, filled with their mean extinction), evaluated per surface point so that
+// the light runs on smoothly from lobe to lobe and the heap has one terminator; and the
+// forward-scattered light a thin edge gives off with the sun behind it (the silver lining).
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -12,35 +12,50 @@
 
 namespace nephele {
 
-// The share of the sun's light and of the sky's light that reaches one ellipsoid: the sun's
-// at its centre and at its most sunward point, the sky's at its centre.
-struct LobeLight {
-  double sun = 1.0;
-  double sky = 1.0;
-  double sun_face = 1.0;
+// The heap a lobe belongs to, as it is lit: an axis-aligned ellipsoid and the extinction per
+// metre inside it. extinction 0 leaves Gardner's eq. 8 unchanged.
+struct HeapEnvelope {
+  glm::dvec3 centre{0.0};
+  glm::dvec3 radii{1.0};
+  double extinction = 0.0;
 };
 
-// For each ellipsoid of `cloud`: the two-stream transmittance (diffuseTransmittance) of the
-// optical depth through the cloud's other ellipsoids, at the cloud's light_extinction, from
-// its centre towards the sun (`to_sun`, unit) and straight up, and from the point of its
-// surface whose normal is to_sun towards the sun. All 1 when light_extinction is 0.
-std::vector<LobeLight> lobeLights(const EllipsoidCloud& cloud, glm::dvec3 to_sun);
+// One envelope per ellipsoid of `cloud`. The cloud's ellipsoids fall into heaps: its parts
+// when it names them (EllipsoidCloud::parts), else groups joined pairwise where the centre of
+// either ellipsoid lies within 1.25 times the other (lobes that sit on one another); a heap's
+// envelope is the axis-aligned ellipsoid with the second moments of its ellipsoids taken as
+// solids (semi-axes sqrt(5 variance) about their centroid, which is an ellipsoid itself when
+// alone and axis-aligned), and its extinction the cloud's light_extinction times the share
+// of the envelope its ellipsoids fill (the sum of their volumes over the envelope's, at most
+// 1). All extinctions are 0 when the
+// cloud's light_extinction is 0.
+std::vector<HeapEnvelope> heapEnvelopes(const EllipsoidCloud& cloud);
 
-// The sunlight at a surface point of a lobe with unit normal n: from the centre's share where
-// n turns from the sun to the sunward point's where it faces it,
-//   S(n) = S_centre + (S_face - S_centre) (1 + n.L) / 2.
-double surfaceSunlight(const LobeLight& light, double n_dot_l);
+// Length of the ray p + s dir (dir unit, s >= 0) inside the envelope, metres.
+double envelopeChord(const HeapEnvelope& envelope, glm::dvec3 p, glm::dvec3 dir);
 
-// Gardner eq. 8 with the heap's light (MODEL.md section 14): the diffuse and highlight terms
-// take the sunlight reaching the surface (surfaceSunlight; the diffuse term through the skin,
-// skinDiffuse), the
-// ambient term the sky light, and light scattered forward through the surface's translucent
-// part is added,
-//   I = (1 - a){(1 - t)[(1 - s) S Id' + s S Is] + t It} + a L.sky + S P(cos theta) / (4 pi) TR,
+// The share of the sun's and of the sky's light reaching point p, of outward unit normal n,
+// through its heap: the two-stream transmittance (diffuseTransmittance) of the optical depth
+// towards the sun (`to_sun`, unit), and half the sky's from overhead through the heap, half
+// from the horizon and the ground, which it does not hide: sky = 1/2 + 1/2 T(depth straight
+// up). The depth towards v is the envelope's extinction times its chord from p along v,
+// times (1 - n.v) / 2: a face turned towards the light looks out of the heap, not through it.
+struct HeapLight {
+  double sun = 1.0;
+  double sky = 1.0;
+};
+HeapLight heapLightAt(const HeapEnvelope& envelope, glm::dvec3 p, glm::dvec3 normal,
+                      glm::dvec3 to_sun);
+
+// Gardner eq. 8 with the heap's light at the surface point (MODEL.md section 14): the diffuse
+// and highlight terms take the sunlight reaching it (the diffuse term through the skin,
+// skinDiffuse), the ambient term the sky light, and light scattered forward through the
+// surface's translucent part is added,
+//   I = (1 - a){(1 - t)[(1 - s) S Id' + s S Is] + t It} + a K + S P(cos theta) / (4 pi) TR,
 // P the Cornette-Shanks phase function with the droplets' asymmetry, cos theta = d . to_sun
 // for the view direction d, TR the surface's translucence (Gardner eq. 11). With the cloud's
 // light_extinction 0 it is eq. 8 unchanged.
-double heapIntensity(const EllipsoidCloud& cloud, const LobeLight& light, double texture_value,
+double heapIntensity(const EllipsoidCloud& cloud, const HeapLight& light, double texture_value,
                      glm::dvec3 normal, glm::dvec3 to_sun, glm::dvec3 direction,
                      double translucence);
 
@@ -51,12 +66,15 @@ double heapIntensity(const EllipsoidCloud& cloud, const LobeLight& light, double
 inline constexpr double kSkinWrap = 0.6;
 double skinDiffuse(double n_dot_l);
 
-// A lobe's sunlit diffuse term over its whole surface, S(n) skinDiffuse(n.L) averaged over
-// normals spread evenly over the sphere (n.L uniform on [-1, 1]), as a multiple of the
-// Lambertian mean max(0, n.L), 1/4: with L = 1 + w and D = S_face - S_centre,
-//   [S_centre + D (1 - w) / 2] L + D L^2 / 3.
-// What a surface standing for many lobes (the far deck) multiplies its own diffuse term by.
-double lobeSunlightOverLambert(const LobeLight& light);
+// The light a surface standing for many heaps (the far deck) takes: over the surfaces of the
+// cloud's ellipsoids, each weighted by its horizontal cross-section, the mean of S skinDiffuse
+// as a multiple of the Lambertian mean max(0, n.L) (1/4), and the mean of K; each ellipsoid's
+// surface sampled at 64 normals spread evenly over the sphere.
+struct MeanHeapLight {
+  double sun_over_lambert = 1.0;
+  double sky = 1.0;
+};
+MeanHeapLight meanHeapLight(const EllipsoidCloud& cloud, glm::dvec3 to_sun);
 
 // L.sun P(cos theta) / (4 pi): the forward-scattered term alone.
 double forwardScattered(double sun, double cos_theta);
