@@ -1,0 +1,44 @@
+#!/bin/sh
+# Renders the picture board of docs/BOARD.md into docs/board/: the convective genera, the
+# cloudscape and the presets built from ellipsoids or automata, each from three places, with
+# the sun in front of the camera (its azimuth the camera's heading) and behind it (opposite),
+# 25 degrees up. 320x180 PNG, about 3 MB in all.
+#
+#   docs/board/make_board.sh [path/to/nephele]     (default build/nephele)
+set -eu
+nephele=${1:-build/nephele}
+here=$(cd "$(dirname "$0")" && pwd)
+scenes="$here/../../config/scenes"
+
+# shot PRESET VIEW HEADING [camera flags...]: the view twice, sun in front and sun behind.
+shot() {
+  preset=$1 view=$2 heading=$3
+  shift 3
+  for sun in front behind; do
+    if [ "$sun" = front ]; then azimuth=$heading; else azimuth=$(( (heading + 180) % 360 )); fi
+    "$nephele" render "$scenes/$preset.toml" -o "$here/${preset}_${view}_sun_$sun.png" \
+      --width 320 --height 180 --heading "$heading" --sun "$azimuth,25" "$@" >/dev/null 2>&1 ||
+      { echo "failed: $preset $view, sun $sun" >&2; exit 1; }
+    echo "  $preset $view, sun $sun"
+  done
+}
+
+# Weather presets: from the ground; from just under the heaps' base, level, with a 30 degree
+# lens (heaps 10 km off stand a tenth of the view high); from 1.5 km above their top.
+shot genus_cumulus ground 40 --position 0,0,2 --pitch 15 --vfov 60
+shot genus_cumulus side 40 --position 0,0,1000 --pitch 2 --vfov 30
+shot genus_cumulus above 40 --position 0,0,4200 --pitch -20 --vfov 60
+shot genus_cumulonimbus ground 40 --position 0,0,2 --pitch 15 --vfov 60
+shot genus_cumulonimbus side 40 --position 0,-10000,700 --pitch 12 --vfov 60
+shot genus_cumulonimbus above 40 --position 0,0,12900 --pitch -20 --vfov 60
+shot cloudscape ground 200 --position 0,0,2 --pitch 12 --vfov 60
+shot cloudscape side 200 --position 0,0,900 --pitch 2 --vfov 30
+shot cloudscape above 200 --position 0,0,4300 --pitch -20 --vfov 60
+# Scene presets: their own view, and from 3 km above it looking down at 30 degrees.
+shot cumulus own 0 --position 0,-4500,300 --pitch 10 --vfov 40
+shot cumulus above 0 --position 0,-6000,4500 --pitch -30 --vfov 40
+shot cumulus_target own 0 --position -250,-3200,1080 --pitch -1.2 --vfov 4
+shot gardner_cluster own 0 --position 0,-7000,600 --pitch 10 --vfov 50
+shot gardner_cluster above 0 --position 0,-9000,5000 --pitch -30 --vfov 50
+shot harbour own 0 --position 0,-3000,150 --pitch 8 --vfov 55
+shot harbour above 0 --position 0,-3500,2500 --pitch -30 --vfov 55
