@@ -15,6 +15,7 @@
 #include "world/counter_random.h"
 #include "world/formations/cloud_field.h"
 #include "world/formations/ellipsoid.h"
+#include "world/formations/genus.h"
 
 namespace nephele {
 namespace {
@@ -269,6 +270,26 @@ TEST(CloudField, CumulonimbusIsOneTowerUnderAnAnvilCarriedDownwind) {
     else
       EXPECT_LT(std::abs(anvil.middle() - tower.middle()), 0.1 * f.thickness_m);
   }
+}
+
+// The genus table (world/formations/genus.h) is what every reader sees: each genus's name
+// reads back as the genus, its typical layer is a valid layer, and it draws heaps exactly when
+// the table says so (the convective genera), planes otherwise.
+TEST(Weather, EveryGenusOfTheTableReadsBackAndDrawsAsItsRowSays) {
+  for (CloudType type : kGenera) {
+    const std::string_view name = cloudTypeName(type);
+    SCOPED_TRACE(std::string(name));
+    EXPECT_EQ(genus(type).name, name);
+    ASSERT_TRUE(cloudTypeFromName(name).has_value());
+    EXPECT_EQ(*cloudTypeFromName(name), type);
+    const WeatherLayer layer = typicalWeatherLayer(type, 0.4);
+    EXPECT_EQ(weatherLayerError(layer), "");
+    const WeatherClouds drawn = weatherClouds(layer, "w", 5);
+    EXPECT_EQ(!drawn.fields.empty(), genus(type).heaps);
+    EXPECT_EQ(drawn.layers.empty(), genus(type).heaps);  // 0.4 is below the heaps' own cover
+  }
+  EXPECT_EQ(cloudTypeName(CloudType(kCloudTypeCount)), "unknown");
+  EXPECT_FALSE(cloudTypeFromName("cumulus humilis").has_value());
 }
 
 TEST(Weather, InvalidLayersAreRefusedWithTheAllowedRange) {

@@ -13,6 +13,7 @@
 
 #include "world/counter_random.h"
 #include "world/formations/cluster.h"
+#include "world/formations/genus.h"
 #include "world/formations/heap_light.h"
 #include "world/formations/weather.h"
 #include "world/frames.h"
@@ -24,36 +25,20 @@
 namespace nephele {
 namespace {
 
-constexpr std::array<std::string_view, kCloudTypeCount> kNames{
-    "none",         "altocumulus", "altostratus",  "cirrocumulus",  "cirrostratus", "cirrus",
-    "cumulonimbus", "cumulus",     "nimbostratus", "stratocumulus", "stratus"};
-
 // Purposes of the counter-based draws (hashCounters' third key).
 enum Draw : std::uint64_t { kCount = 1, kX, kY, kSize, kHeight, kShape, kKeep, kCover, kRise };
-
-// A heap's look (Gardner eq. 8 and 11). T1 well below zero makes the middle of every ellipsoid
-// opaque whatever the texture; T2 above one makes the limb clear; D sets how soft the edge is.
-// With these the opacity-1/2 outline seen straight down lies at rho^2 = (It - T1 - D/2) /
-// (T2 - T1) of the ellipsoid's projected radius.
-// light_extinction (MODEL.md section 14): 20 per km puts the sky light under a heap's middle at
-// about a third of the open sky's, and the sunlight behind a lobe at a half to a quarter.
-struct HeapLook {
-  double colour, ambient, texture_fraction, t1, t2, d, light_extinction;
-};
-constexpr HeapLook kCumulusLook{1.0, 0.2, 0.3, -0.4, 1.1, 0.05, 0.02};
-constexpr HeapLook kCumulonimbusLook{0.9, 0.2, 0.3, -0.6, 1.1, 0.05, 0.02};
 
 bool isCb(const CloudField& f) {
   return f.type == CloudType::kCumulonimbus;
 }
 const HeapLook& lookOf(const CloudField& f) {
-  return isCb(f) ? kCumulonimbusLook : kCumulusLook;
+  return genus(f.type).heap_look;
 }
 
-// Typical horizontal radius of a heap's base ellipsoid, metres: heaps are about as wide as
-// they are tall (cumulus) or, for a cumulonimbus, its anvil spreads to twice its height.
+// Typical horizontal radius of a heap's base, metres (the genus table's radius per metre of
+// thickness).
 double heapRadius(const CloudField& f) {
-  return (isCb(f) ? 1.0 : 0.9) * f.thickness_m;
+  return lookOf(f).radius * f.thickness_m;
 }
 constexpr double kSizeVariation = 0.3;  // radius times 1 + v (2u - 1)
 
@@ -475,12 +460,12 @@ TileCache& tileCache() {
 
 std::string_view cloudTypeName(CloudType type) {
   const int i = int(type);
-  return i >= 0 && i < kCloudTypeCount ? kNames[std::size_t(i)] : "unknown";
+  return i >= 0 && i < kCloudTypeCount ? genus(type).name : "unknown";
 }
 
 std::optional<CloudType> cloudTypeFromName(std::string_view name) {
   for (int i = 0; i < kCloudTypeCount; ++i)
-    if (kNames[std::size_t(i)] == name) return CloudType(i);
+    if (genus(CloudType(i)).name == name) return CloudType(i);
   return std::nullopt;
 }
 
@@ -504,8 +489,7 @@ std::string weatherLayerError(const WeatherLayer& w) {
   if (std::string error = clusterVariationError(w.clusters); !error.empty()) return error;
   if (w.region.transition_m > 0.0 && w.region.side == 0)
     return "transition: applies to one side of a front only (front left or right)";
-  const bool heaps = w.type == CloudType::kCumulus || w.type == CloudType::kCumulonimbus;
-  if ((w.clusters.spacing_m > 0.0 || w.clusters.amount > 0.0) && !heaps)
+  if ((w.clusters.spacing_m > 0.0 || w.clusters.amount > 0.0) && !genus(w.type).heaps)
     return "variation: applies to heaps only (type cumulus or cumulonimbus), not " +
            std::string(cloudTypeName(w.type));
   if (w.clusters.amount > 0.0 && !(w.clusters.spacing_m > 0.0))

@@ -5,46 +5,17 @@
 #include <cmath>
 
 #include "world/counter_random.h"
+#include "world/formations/genus.h"
 #include "world/textures/layer_texture.h"
 
 namespace nephele {
 namespace {
 
-// How a genus is drawn (MODEL.md section 10): Gardner sky-plane texture (base frequencies in
-// radians per metre, term count, contrast offset T0, lattice-breaking rotation), its
-// transition D and shading, how many planes stand through the layer's thickness, and whether
-// the genus is convective (a field of heaps, this plane only as the deck under them). A veil
-// stays translucent at full cover (opacity just above 1/2 where it is thinnest) where a deck
-// turns opaque.
-struct GenusLook {
-  double fx1, fy1;
-  int terms;
-  double t0, rotation_deg, transition, grey, ambient, texture_fraction;
-  int planes;
-  bool heaps;
-  bool veil = false;
-};
-
-// Every genus's texture breaks Gardner's lattice by rotation (GenusLook) and by scale, each
+// Every genus's texture breaks Gardner's lattice by rotation (PlaneLook) and by scale, each
 // component spread over half an octave either side of its term's frequency: the highest
 // secondary autocorrelation peak of the drawn coverage stays near 0.2 (cirrus 0.25) for any
 // seed, where rotation alone left 0.3 to 0.4 (docs/ACCURACY.md, "Knobs of the model").
 constexpr double kJitterOctaves = 0.5;
-
-// Indexed by CloudType.
-constexpr std::array<GenusLook, kCloudTypeCount> kLooks{{
-    {0, 0, 1, 0, 0, 0, 0, 0, 0, 0, false},                             // none
-    {3.0e-3, 3.0e-3, 6, 0.5, 90.0, 0.12, 0.95, 0.55, 0.50, 1, false},  // altocumulus: cells
-    {1.2e-3, 1.2e-3, 5, 2.0, 90.0, 0.50, 0.72, 0.70, 0.35, 2, false},  // altostratus: sheet
-    {8.0e-3, 6.5e-3, 6, 0.5, 90.0, 0.15, 1.00, 0.70, 0.50, 1, false},  // cirrocumulus: ripples
-    {1.0e-3, 1.0e-3, 4, 2.0, 90.0, 3.00, 1.00, 0.80, 0.30, 1, false, true},  // cirrostratus
-    {1.0e-3, 0.35e-3, 5, 0.2, 30.0, 0.50, 1.00, 0.75, 0.60, 1, false},       // cirrus: streaks
-    {1.0e-3, 1.0e-3, 4, 2.0, 90.0, 0.80, 0.42, 0.80, 0.30, 1, true},         // cumulonimbus: deck
-    {2.0e-3, 1.6e-3, 6, 0.6, 90.0, 0.12, 0.82, 0.55, 0.55, 1, true},         // cumulus: Sc deck
-    {1.0e-3, 1.0e-3, 4, 2.0, 90.0, 0.80, 0.42, 0.80, 0.30, 3, false},        // nimbostratus: deck
-    {2.0e-3, 1.6e-3, 6, 0.6, 90.0, 0.12, 0.82, 0.55, 0.55, 1, false},        // stratocumulus: lumps
-    {1.5e-3, 1.5e-3, 4, 2.5, 90.0, 0.60, 0.66, 0.75, 0.30, 2, false},        // stratus: grey sheet
-}};
 
 // Texture values at seeded points spread over 24 x 24 texture periods (the texture has no
 // period once rotated), sorted.
@@ -89,7 +60,7 @@ double thresholdFromSamples(const std::vector<double>& values, double transition
 }
 
 // The planes of a stratiform layer, or the deck under heaps, covering `coverage`.
-std::vector<CloudLayer> planes(const WeatherLayer& w, const GenusLook& look, double coverage,
+std::vector<CloudLayer> planes(const WeatherLayer& w, const PlaneLook& look, double coverage,
                                const std::string& prefix, std::uint64_t seed) {
   CloudLayer layer;
   layer.colour = glm::dvec3(look.grey);
@@ -135,9 +106,10 @@ WeatherClouds weatherClouds(const WeatherLayer& w, const std::string& prefix, st
   WeatherClouds out;
   if (w.type == CloudType::kNone || !(w.coverage > 0.0) || !weatherLayerError(w).empty())
     return out;
-  const GenusLook& look = kLooks[std::size_t(w.type)];
+  const Genus& g = genus(w.type);
+  const PlaneLook& look = g.planes;
   const double coverage = std::min(w.coverage, 1.0);
-  if (!look.heaps) {
+  if (!g.heaps) {
     out.layers = planes(w, look, coverage, prefix, seed);
     return out;
   }
@@ -165,23 +137,8 @@ std::uint64_t weatherSeed(std::uint64_t scene_seed, int layer) {
 }
 
 WeatherLayer typicalWeatherLayer(CloudType type, double coverage) {
-  switch (type) {
-    case CloudType::kCirrus:
-    case CloudType::kCirrocumulus:
-    case CloudType::kCirrostratus:
-      return {type, 8000.0, 600.0, coverage, {}, {}, {}};
-    case CloudType::kAltocumulus:
-    case CloudType::kAltostratus:
-      return {type, 4000.0, 700.0, coverage, {}, {}, {}};
-    case CloudType::kNimbostratus:
-      return {type, 900.0, 2500.0, coverage, {}, {}, {}};
-    case CloudType::kCumulonimbus:
-      return {type, 900.0, 9000.0, coverage, {}, {}, {}};
-    case CloudType::kCumulus:
-      return {type, 1200.0, 1200.0, coverage, {}, {}, {}};
-    default:  // stratocumulus, stratus
-      return {type, 700.0, 500.0, coverage, {}, {}, {}};
-  }
+  const Genus& g = genus(type);
+  return {type, g.typical_base_m, g.typical_thickness_m, coverage, {}, {}, {}};
 }
 
 double thresholdForCoverage(const LayerTextureSpec& spec, double transition, int planes,

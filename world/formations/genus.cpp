@@ -1,0 +1,96 @@
+#include "world/formations/genus.h"
+
+#include <array>
+
+namespace nephele {
+namespace {
+
+// Heaps: 20 per km of light extinction puts the sky light under a heap's middle at about a
+// third of the open sky's (MODEL.md section 14). A cumulonimbus's T1 is lower, so that its
+// tower reads as one mass; its radius is its tower's spread (its anvil reaches three times it).
+constexpr HeapLook kNoHeaps{1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0};
+constexpr HeapLook kCumulusHeaps{1.0, 0.2, 0.3, -0.4, 1.1, 0.05, 0.02, 0.9};
+constexpr HeapLook kCumulonimbusHeaps{0.9, 0.2, 0.3, -0.6, 1.1, 0.05, 0.02, 1.0};
+
+// Indexed by CloudType. Typical layers: the atlas's altitude bands for mid-latitudes.
+constexpr std::array<Genus, kCloudTypeCount> kGenera{{
+    {"none", 700.0, 500.0, {0, 0, 1, 0, 0, 0, 0, 0, 0, 0, false}, false, kNoHeaps},
+    // cells
+    {"altocumulus",
+     4000.0,
+     700.0,
+     {3.0e-3, 3.0e-3, 6, 0.5, 90.0, 0.12, 0.95, 0.55, 0.50, 1, false},
+     false,
+     kNoHeaps},
+    // a sheet
+    {"altostratus",
+     4000.0,
+     700.0,
+     {1.2e-3, 1.2e-3, 5, 2.0, 90.0, 0.50, 0.72, 0.70, 0.35, 2, false},
+     false,
+     kNoHeaps},
+    // ripples
+    {"cirrocumulus",
+     8000.0,
+     600.0,
+     {8.0e-3, 6.5e-3, 6, 0.5, 90.0, 0.15, 1.00, 0.70, 0.50, 1, false},
+     false,
+     kNoHeaps},
+    // a veil
+    {"cirrostratus",
+     8000.0,
+     600.0,
+     {1.0e-3, 1.0e-3, 4, 2.0, 90.0, 3.00, 1.00, 0.80, 0.30, 1, true},
+     false,
+     kNoHeaps},
+    // streaks
+    {"cirrus",
+     8000.0,
+     600.0,
+     {1.0e-3, 0.35e-3, 5, 0.2, 30.0, 0.50, 1.00, 0.75, 0.60, 1, false},
+     false,
+     kNoHeaps},
+    // towers over a dark deck
+    {"cumulonimbus",
+     900.0,
+     9000.0,
+     {1.0e-3, 1.0e-3, 4, 2.0, 90.0, 0.80, 0.42, 0.80, 0.30, 1, false},
+     true,
+     kCumulonimbusHeaps},
+    // heaps over a stratocumulus deck
+    {"cumulus",
+     1200.0,
+     1200.0,
+     {2.0e-3, 1.6e-3, 6, 0.6, 90.0, 0.12, 0.82, 0.55, 0.55, 1, false},
+     true,
+     kCumulusHeaps},
+    // a dark deck three planes deep
+    {"nimbostratus",
+     900.0,
+     2500.0,
+     {1.0e-3, 1.0e-3, 4, 2.0, 90.0, 0.80, 0.42, 0.80, 0.30, 3, false},
+     false,
+     kNoHeaps},
+    // lumps
+    {"stratocumulus",
+     700.0,
+     500.0,
+     {2.0e-3, 1.6e-3, 6, 0.6, 90.0, 0.12, 0.82, 0.55, 0.55, 1, false},
+     false,
+     kNoHeaps},
+    // a grey sheet
+    {"stratus",
+     700.0,
+     500.0,
+     {1.5e-3, 1.5e-3, 4, 2.5, 90.0, 0.60, 0.66, 0.75, 0.30, 2, false},
+     false,
+     kNoHeaps},
+}};
+
+}  // namespace
+
+const Genus& genus(CloudType type) {
+  return kGenera[std::size_t(type)];
+}
+
+}  // namespace nephele
