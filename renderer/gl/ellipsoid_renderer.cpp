@@ -474,7 +474,7 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   // The clouds look alike: the first one's texture and shading stand for all of them.
   const EllipsoidCloud& cloud = scene.clouds[indices.front()];
   // Visible ellipsoids with the back-to-front key (the front-to-back key, the nearest a hit
-  // can be, is the record's light.z); the nearest surface distance.
+  // can be, is the record's order.z); the nearest surface distance.
   struct Visible {
     double centre_distance;
     EllipsoidRecord record;

@@ -220,7 +220,7 @@ void main() {
 const char* kFusedPerPixel = R"(
 // The batch's screen bins, kPerPixelBinSize pixels a side, from bin u_bin_origin on, u_bins_x
 // to a row: bin b lists its ellipsoids u_items[u_bins[b].x .. + u_bins[b].y) nearest first
-// by the distance no hit on them can be nearer than (the record's light.z, metres).
+// by the distance no hit on them can be nearer than (the record's order.z, metres).
 layout(binding = 7) uniform isamplerBuffer u_bins;   // RG32I: first item, count
 layout(binding = 8) uniform isamplerBuffer u_items;  // R32I
 uniform ivec2 u_bin_origin;

@@ -57,9 +57,9 @@ HeapScale heapScale(std::uint64_t seed, std::uint64_t k) {
 // lobe.
 constexpr double kDetailRadii = 12.0;
 
-// How heaps take the wind shear (MODEL.md section 10): they lean downwind by kLean metres per
-// metre of height, and a cumulonimbus's anvil is carried downwind, fully one-sided at
-// kFullShear and more.
+// How heaps take the wind shear (MODEL.md section 10): they lean downwind by kLean times the
+// shear's share metres per metre of height, and a cumulonimbus's anvil is carried downwind;
+// the share is |shear| / kFullShear, at most 1.
 constexpr double kLean = 0.15;
 constexpr double kFullShear = 15.0;  // m/s between the heaps' top and the wind carrying them
 struct Shear {
@@ -91,10 +91,11 @@ Ellipsoid mound(const std::vector<Ellipsoid>& lobes) {
   return out;
 }
 
-// A cumulonimbus of tower radius about 0.3 r and height h on `base` (WMO International Cloud
+// A cumulonimbus of tower radius about half r and height h on `base` (WMO International Cloud
 // Atlas, Cb incus): one continuous tower from a flat base to the tropopause, where it spreads
-// into an anvil three to four times its width, carried downwind by the shear, with an
-// overshooting dome over the updraft. The base is dark through the light model (section 14).
+// into an anvil several times its width, carried downwind by the shear, with an overshooting
+// dome over the updraft (MODEL.md section 10). The base is dark through the light model
+// (section 14).
 std::vector<Ellipsoid> cumulonimbusEllipsoids(const CloudField& f, glm::dvec3 base, double r,
                                               double h, double squash, std::uint64_t seed,
                                               bool detailed, std::size_t& anvil_from) {

@@ -30,11 +30,14 @@ std::vector<HeapEnvelope> heapEnvelopes(const EllipsoidCloud& cloud) {
   const std::size_t n = lobes.size();
   std::vector<HeapEnvelope> out(n);
   if (!(cloud.light_extinction > 0.0) || n == 0) return out;
-  // Heaps: groups of ellipsoids joined by overlapping bounding spheres, found by a sweep along
-  // x over the spheres' extents.
+  // Heaps: the parts the cloud names, or else groups joined pairwise, the candidate pairs
+  // found by a sweep along x over the ellipsoids' bounding spheres.
   std::vector<double> reach(n);
-  for (std::size_t i = 0; i < n; ++i)
+  std::vector<glm::dmat3> to_unit(n);
+  for (std::size_t i = 0; i < n; ++i) {
     reach[i] = std::max({lobes[i].radii.x, lobes[i].radii.y, lobes[i].radii.z});
+    to_unit[i] = worldToUnitSphere(lobes[i]);
+  }
   std::vector<std::size_t> order(n), parent(n);
   std::iota(order.begin(), order.end(), 0);
   std::iota(parent.begin(), parent.end(), 0);
@@ -60,9 +63,8 @@ std::vector<HeapEnvelope> heapEnvelopes(const EllipsoidCloud& cloud) {
       const glm::dvec3 between = lobes[a].centre - lobes[b].centre;
       if (glm::dot(between, between) >= together * together) continue;
       // Joined when either centre lies within kJoin times the other ellipsoid: lobes that sit
-      // on one another, not a flat sheet that merely reaches a lobe's edge.
-      const glm::dvec3 in_b = worldToUnitSphere(lobes[b]) * between;
-      const glm::dvec3 in_a = worldToUnitSphere(lobes[a]) * between;
+      // on or in one another, not ones that merely touch.
+      const glm::dvec3 in_b = to_unit[b] * between, in_a = to_unit[a] * between;
       if (glm::dot(in_b, in_b) < kJoin * kJoin || glm::dot(in_a, in_a) < kJoin * kJoin)
         parent[groupOf(parent, a)] = groupOf(parent, b);
     }
