@@ -109,19 +109,19 @@ std::vector<Ellipsoid> cumulonimbusEllipsoids(const CloudField& f, glm::dvec3 ba
   };
   std::vector<Ellipsoid> out;
   Ellipsoid bottom;  // flat, its bottom on the cloud base
-  bottom.radii = {0.45 * r, 0.45 * r * squash, 0.05 * h};
+  bottom.radii = {0.45 * r, 0.45 * r * squash, 0.08 * h};
   bottom.centre = base + glm::dvec3(0.0, 0.0, bottom.radii.z);
   bottom.orientation.heading_deg = 360.0 * u(1);
   out.push_back(bottom);
-  // The tower: a column of lobes each 0.4 h tall, 0.15 h apart from the base up, so that no
-  // gap opens from the base to the anvil, with bulges half sunk into its faces that grow
-  // upward.
+  // The tower: a column of lobes each about 0.5 h tall, 0.13 h apart from the base up, so
+  // that no gap opens from the base to the anvil and no seam shows between them, with bulges
+  // half sunk into its faces that grow upward.
   std::vector<Ellipsoid> tower;
   constexpr int kLevels = 5;
   for (int i = 0; i < kLevels; ++i) {
-    const double z = (0.2 + 0.15 * i) * h, rise = double(i) / (kLevels - 1);
+    const double z = (0.26 + 0.13 * i) * h, rise = double(i) / (kLevels - 1);
     Ellipsoid core;
-    core.radii = glm::dvec3(0.42 * r, 0.42 * r * squash, 0.2 * h) * (0.95 + 0.1 * u(2, i));
+    core.radii = glm::dvec3(0.42 * r, 0.42 * r * squash, 0.26 * h) * (0.95 + 0.1 * u(2, i));
     core.centre = axis(z);
     core.orientation.heading_deg = 360.0 * u(3, i);
     tower.push_back(core);
@@ -131,7 +131,7 @@ std::vector<Ellipsoid> cumulonimbusEllipsoids(const CloudField& f, glm::dvec3 ba
       const double azimuth = turn + 2.0 * std::numbers::pi * (q + 0.5 * u(5, k)) / 3.0;
       const double size = (0.22 + 0.08 * rise) * r * (0.85 + 0.3 * u(6, k));
       Ellipsoid bulge;
-      bulge.radii = {size, size, 0.11 * h * (0.85 + 0.3 * u(7, k))};
+      bulge.radii = {size, size, 0.15 * h * (0.85 + 0.3 * u(7, k))};
       bulge.centre =
           axis(z + 0.08 * h * (2.0 * u(8, k) - 1.0)) +
           (0.26 + 0.06 * u(9, k)) * r * glm::dvec3(std::cos(azimuth), std::sin(azimuth), 0.0);
