@@ -206,8 +206,8 @@ void printLightFigures(GlRenderer& renderer, const SceneFile& file, const std::s
   scene.sun.azimuth_deg = 90.0, scene.sun.elevation_deg = 10.0;  // to the right (east)
   const FloatImage side = renderer.renderFloat(scene, file.render);
   const FloatImage side_sky = renderer.renderFloat(Scene(clear), file.render);
-  // The heaps of a tile stand apart or in groups: the figure is taken on the largest
-  // connected silhouette, so that its two halves are the two sides of the same mass.
+  // The figure is taken on the largest connected silhouette, so that a stray fragment of the
+  // heap's edge does not move the split between its two sides.
   std::vector<int> covered;
   for (const CloudRegion& region : cloudRegions(side, kMinCloudPixels))
     if (region.pixels.size() > covered.size()) covered = region.pixels;
@@ -246,7 +246,7 @@ void printLightFigures(GlRenderer& renderer, const SceneFile& file, const std::s
 }
 
 // Cumulonimbus figures (issue 27 item 5d): the field's typical heap alone (with the shear the
-// world's wind gives it), seen level across the shear from 80 km, downwind to the right, with
+// world's wind gives it), seen level across the shear from 120 km, downwind to the right, with
 // the preset's sun. Coverage > 0.5 in the column through the base's middle from the lowest to
 // the highest covered row (a continuous tower has no uncovered row in it); the tower's width
 // at 0.45 of that height; the widest run of the top fifth (the anvil), its width over the

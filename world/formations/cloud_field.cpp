@@ -71,6 +71,10 @@ Shear shearOf(const CloudField& f) {
   if (!(speed > 1e-3)) return {{1.0, 0.0}, 0.0};
   return {f.shear / speed, std::min(speed / kFullShear, 1.0)};
 }
+// How far downwind the shear moves a heap's part `height` metres above its base.
+glm::dvec3 leanAt(const Shear& shear, double height) {
+  return glm::dvec3(shear.direction * (kLean * shear.amount * height), 0.0);
+}
 // The heading (clockwise from north, of the body or boundary x axis) that points x along `d`.
 double headingAlong(glm::dvec2 d) {
   return glm::degrees(std::atan2(-d.y, d.x));
@@ -104,9 +108,7 @@ std::vector<Ellipsoid> cumulonimbusEllipsoids(const CloudField& f, glm::dvec3 ba
     return unitFromBits(hashCounters(seed, 0x4362ull, a, b));
   };
   // The updraft's axis, leaning downwind with height.
-  auto axis = [&](double z) {
-    return glm::dvec3(glm::dvec2(base) + shear.direction * (kLean * shear.amount * z), base.z + z);
-  };
+  auto axis = [&](double z) { return base + glm::dvec3(0.0, 0.0, z) + leanAt(shear, z); };
   std::vector<Ellipsoid> out;
   Ellipsoid bottom;  // flat, its bottom on the cloud base
   bottom.radii = {0.45 * r, 0.45 * r * squash, 0.08 * h};
@@ -211,8 +213,7 @@ std::vector<Ellipsoid> heapEllipsoids(const CloudField& f, glm::dvec3 base, doub
   lobes.seed = hashCounters(seed, kShape, 2);
   std::vector<Ellipsoid> tower = clusterEllipsoids(lobes, {dome});
   const Shear shear = shearOf(f);
-  for (Ellipsoid& e : tower)
-    e.centre += glm::dvec3(shear.direction * (kLean * shear.amount * (e.centre.z - base.z)), 0.0);
+  for (Ellipsoid& e : tower) e.centre += leanAt(shear, e.centre.z - base.z);
   if (!detailed && !tower.empty()) tower = {mound(tower)};
   out.insert(out.end(), tower.begin(), tower.end());
   anvil_from = out.size();

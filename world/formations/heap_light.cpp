@@ -38,8 +38,7 @@ std::vector<HeapEnvelope> heapEnvelopes(const EllipsoidCloud& cloud) {
     reach[i] = std::max({lobes[i].radii.x, lobes[i].radii.y, lobes[i].radii.z});
     to_unit[i] = worldToUnitSphere(lobes[i]);
   }
-  std::vector<std::size_t> order(n), parent(n);
-  std::iota(order.begin(), order.end(), 0);
+  std::vector<std::size_t> parent(n), order;
   std::iota(parent.begin(), parent.end(), 0);
   if (cloud.parts.size() == n) {
     // The parts the cloud names: each part's first ellipsoid stands for it.
@@ -49,7 +48,9 @@ std::vector<HeapEnvelope> heapEnvelopes(const EllipsoidCloud& cloud) {
       if (first[part] == n) first[part] = i;
       parent[i] = first[part];
     }
-    order.clear();
+  } else {
+    order.resize(n);
+    std::iota(order.begin(), order.end(), 0);
   }
   std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
     return lobes[a].centre.x - reach[a] < lobes[b].centre.x - reach[b];
