@@ -7,7 +7,9 @@
 //      Entity Control) to Start of Frame and to every subscribed view's frame delivered, and
 //      the same for the socket protocol's tick, with one and three 640x480 raw views; as
 //      multiples of the render time alone (the daemon's own render p50 times the views) and
-//      of the platform floor (one constant-colour pass and readback, timed here).
+//      of the platform floor (one constant-colour pass and readback, timed here);
+//   5. the same host frames with a cumulus sky (genus_cumulus.toml) against a clear sky, as
+//      multiples of the clear sky's (issue 27).
 // Figures only; these machines are shared and noisy.
 #include <arpa/inet.h>
 #include <fcntl.h>
@@ -237,11 +239,12 @@ void subscribers(const Daemon& daemon, int count, double seconds) {
       count, total / count / seconds, total / seconds);
 }
 
-// A lockstep daemon with three 640x480 raw views and CIGI answering to `host_port`.
-std::string writeLockstepConfig(const std::filesystem::path& dir, int host_port) {
+// A lockstep daemon on `scene` with three 640x480 raw views and CIGI answering to `host_port`.
+std::string writeLockstepConfig(const std::filesystem::path& dir, int host_port,
+                                const std::string& scene) {
   const std::string path = (dir / "lockstep.toml").string();
   std::ofstream out(path);
-  out << "scene = \"" << NEPHELE_SOURCE_DIR << "/config/scenes/cumulus.toml\"\n"
+  out << "scene = \"" << scene << "\"\n"
       << "[world]\nmode = \"lockstep\"\ntick_rate = 60\n";
   for (const auto& [name, heading] : {std::pair{"front", 0}, {"left", -60}, {"right", 60}})
     out << "[[view]]\nname = \"" << name << "\"\nheading = " << heading
@@ -260,8 +263,14 @@ double floorMs(int width, int height) {
   return nephele::medianMilliseconds(9, [&] { gl.renderFloor(width, height); });
 }
 
-// Host frames over CIGI and over the socket, each followed by one frame of every view.
-void hostFrames(const std::filesystem::path& dir, int views, int repeats, double floor_ms) {
+struct HostFrameFigures {
+  double render = 0.0, to_sof = 0.0, cigi_frames = 0.0, to_reply = 0.0, socket_frames = 0.0;
+};
+
+// Host frames over CIGI and over the socket, each followed by one frame of every view, on
+// `scene` (what it is called in the heading); the medians.
+HostFrameFigures hostFrames(const std::filesystem::path& dir, int views, int repeats,
+                            double floor_ms, const std::string& scene, const char* what) {
   const int udp = socket(AF_INET, SOCK_DGRAM, 0);
   sockaddr_in host{};
   host.sin_family = AF_INET;
@@ -270,7 +279,7 @@ void hostFrames(const std::filesystem::path& dir, int views, int repeats, double
   if (bind(udp, reinterpret_cast<sockaddr*>(&host), sizeof host) ||
       getsockname(udp, reinterpret_cast<sockaddr*>(&host), &length))
     throw std::runtime_error("udp bind");
-  Daemon daemon(writeLockstepConfig(dir, ntohs(host.sin_port)));
+  Daemon daemon(writeLockstepConfig(dir, ntohs(host.sin_port), scene));
   sockaddr_in ig = host;
   ig.sin_port = htons(std::uint16_t(daemon.cigi_port));
   Client sub(daemon.socket_port), control(daemon.socket_port);
@@ -323,9 +332,9 @@ void hostFrames(const std::filesystem::path& dir, int views, int repeats, double
   const double render = stats["render_ms"]["p50"].get<double>() * views;
   close(udp);
   std::printf(
-      "host frames, lockstep, %d view%s of 640x480 raw (%d frames each; render alone "
+      "host frames, lockstep, %s, %d view%s of 640x480 raw (%d frames each; render alone "
       "%.1f ms = %.0f x floor %.2f ms):\n",
-      views, views > 1 ? "s" : "", repeats, render, render / floor_ms, floor_ms);
+      what, views, views > 1 ? "s" : "", repeats, render, render / floor_ms, floor_ms);
   auto row = [&](const char* what, const std::vector<double>& ms) {
     std::printf("  %-32s p50 %7.1f ms (%4.2f x render)  p99 %7.1f ms (%4.2f x render)\n", what,
                 percentile(ms, 0.5), percentile(ms, 0.5) / render, percentile(ms, 0.99),
@@ -335,6 +344,28 @@ void hostFrames(const std::filesystem::path& dir, int views, int repeats, double
   row("CIGI host frame to frames", cigi_frames);
   row("socket tick to reply", to_reply);
   row("socket tick to frames", socket_frames);
+  return {render, percentile(to_sof, 0.5), percentile(cigi_frames, 0.5), percentile(to_reply, 0.5),
+          percentile(socket_frames, 0.5)};
+}
+
+// A cumulus sky (genus_cumulus.toml: the weather mapping's field at 35 %) against the same
+// daemon with no cloud, one view each, as multiples of the clear sky's figures (issue 27).
+void cumulusSky(const std::filesystem::path& dir, int repeats, double floor_ms) {
+  const std::string clear_scene = (dir / "clear.toml").string();
+  std::ofstream(clear_scene) << "# no cloud: the clear sky the cumulus sky is measured against\n";
+  const HostFrameFigures clear = hostFrames(dir, 1, repeats, floor_ms, clear_scene, "clear sky");
+  const HostFrameFigures cumulus =
+      hostFrames(dir, 1, repeats, floor_ms, NEPHELE_SOURCE_DIR "/config/scenes/genus_cumulus.toml",
+                 "cumulus sky 35 %");
+  std::printf("cumulus sky over the clear sky, medians (x clear):\n");
+  auto row = [](const char* what, double a, double b) {
+    std::printf("  %-32s %7.1f ms over %6.1f ms = %5.1f x clear\n", what, a, b, a / b);
+  };
+  row("render alone", cumulus.render, clear.render);
+  row("CIGI host frame to Start of Frame", cumulus.to_sof, clear.to_sof);
+  row("CIGI host frame to frames", cumulus.cigi_frames, clear.cigi_frames);
+  row("socket tick to reply", cumulus.to_reply, clear.to_reply);
+  row("socket tick to frames", cumulus.socket_frames, clear.socket_frames);
 }
 
 }  // namespace
@@ -354,7 +385,10 @@ int main() {
       for (int n : {1, 4, 16}) subscribers(daemon, n, 5.0);
     }
     const double floor_ms = floorMs(640, 480);
-    for (int views : {1, 3}) hostFrames(dir, views, 40, floor_ms);
+    for (int views : {1, 3})
+      hostFrames(dir, views, 40, floor_ms, NEPHELE_SOURCE_DIR "/config/scenes/cumulus.toml",
+                 "the 27-lobe cumulus");
+    cumulusSky(dir, 40, floor_ms);
     std::filesystem::remove_all(dir);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "daemon_bench: %s\n", e.what());

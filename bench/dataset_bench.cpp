@@ -51,7 +51,7 @@ int main(int argc, char** argv) {
     }
     const double floor_ms = medianMilliseconds(7, [&] { gl.renderFloor(spec.width, spec.height); });
     RenderSettings settings;
-    settings.heap_range_m = spec.heap_range_m;
+    settings.heaps = spec.heaps;
     const FrameRequest request{{Channel::kColour, Channel::kObjectId, Channel::kVisibility}};
     gl.renderFrame(drawSample(spec, 0).scene, settings, request);  // warm-up: shaders, tables
     double draw = 0, heaps = 0, render = 0, label = 0, srgb = 0, png = 0, mask = 0;
@@ -62,7 +62,7 @@ int main(int argc, char** argv) {
       draw += msSince(t);
       t = Clock::now();
       // The heaps around the camera, which the render builds first (tiles of ellipsoids).
-      const Scene with_heaps = withFieldClouds(sample.scene, spec.heap_range_m);
+      const Scene with_heaps = withFieldClouds(sample.scene, spec.heaps);
       heaps += msSince(t);
       t = Clock::now();
       const Frame frame = gl.renderFrame(with_heaps, settings, request);
@@ -115,7 +115,7 @@ int main(int argc, char** argv) {
   std::vector<std::vector<float>> exact;
   for (int divisor : {1, 2, 4, 8}) {
     RenderSettings settings;
-    settings.heap_range_m = spec.heap_range_m;
+    settings.heaps = spec.heaps;
     settings.channel_divisor = divisor;
     double ms = 0.0, flipped = 0.0, relative = 0.0;
     const int n = std::min(samples, 4);

@@ -91,7 +91,7 @@ int main(int argc, char** argv) {
   camera.orientation = {90.0, -8.0, 0.0};  // east, a little down
   camera.vfov_deg = 60.0;
   RenderSettings settings;
-  settings.heap_range_m = heap_range;
+  settings.heaps.range_m = heap_range;
 
   auto place = [&](double t) {
     Scene s = scene;

@@ -59,7 +59,7 @@ void horizon(GlPlatform& platform, const std::vector<std::string>& sizes, int re
   GlRenderer renderer(platform);
   for (double km : ranges_km) {
     RenderSettings settings;
-    settings.heap_range_m = km * 1000.0;
+    settings.heaps.range_m = km * 1000.0;
     scene.camera = small;
     const FloatImage image = renderer.renderFloat(scene, settings);
     const ImageError error = compareImages(image, reference);

@@ -137,7 +137,12 @@ std::vector<Setting> settingsFor(const SceneFile& file) {
   // heaps out to the automatic range.
   if (!file.scene.fields.empty())
     for (double m : {5000.0, 15000.0})
-      add("heap_range", withKnob(m), [m](RenderSettings& s) { s.heap_range_m = m; });
+      add("heap_range", withKnob(m), [m](RenderSettings& s) { s.heaps.range_m = m; });
+  // Every lobe of heaps whose radius spans this many pixels, their outlines below (0: every
+  // lobe, as the reference draws them; 10000: outlines alone).
+  if (!file.scene.fields.empty())
+    for (double px : {0.0, 16.0, 64.0, 10000.0})
+      add("heap_detail", withKnob(px), [px](RenderSettings& s) { s.heaps.detail_px = px; });
   if (!file.dynamics.automata.empty()) {
     for (double step : {0.5, 2.0, 4.0})
       add("volume_step", withKnob(step), [step](RenderSettings& s) { s.volume_step = step; });
@@ -166,6 +171,14 @@ std::vector<Setting> settingsFor(const SceneFile& file) {
     model("rotation", "15", 15.0, -1.0);
     for (double octaves : {0.0, 1.0}) model("jitter", withKnob(octaves), -1.0, octaves);
   }
+  // Distance haze (MODEL.md section 5) on scenes of heaps, where it shows: another model, whose
+  // time is the haze's cost and whose error is the renderer's against the hazy reference.
+  if (!file.scene.fields.empty() && !file.scene.haze)
+    out.push_back({"haze", "40000", [](RenderSettings&) {},
+                   [](SceneFile& f) {
+                     f.scene.haze = Haze{40000.0, 1200.0};
+                   },
+                   true});
   return out;
 }
 
@@ -208,6 +221,7 @@ constexpr SceneEntry kScenes[] = {
     {"inside", "inside_cloud", "a camera inside the edge of a cloud lobe"},
     {"altocumulus", "genus_altocumulus", "altocumulus from the weather mapping, from the ground"},
     {"cumulus_field", "genus_cumulus", "a cumulus field from the weather mapping, from the ground"},
+    {"cumulus_above", "genus_cumulus", "the same field from 1.5 km above its tops, 15 deg down"},
 };
 
 // "cirrus, stratus, ...": the names --scenes allows.
@@ -223,6 +237,11 @@ std::string loadScenes(std::vector<BenchScene>& out) {
     const std::string path = NEPHELE_SOURCE_DIR "/config/scenes/" + std::string(e.preset) + ".toml";
     if (std::string error = loadSceneFile(path, file); !error.empty()) return error;
     if (std::string(e.name) == "field_500") file = cumulusField(file);
+    if (std::string(e.name) == "cumulus_above") {
+      const CloudField& field = file.scene.fields.at(0);
+      file.scene.camera.position.z = field.base_m + 1.2 * field.thickness_m + 1500.0;
+      file.scene.camera.orientation.pitch_deg = -15.0;
+    }
     out.push_back({e.name, e.what, file});
   }
   return {};
@@ -516,8 +535,13 @@ int runBenchCommand(const BenchCommandOptions& o) {
     result.name = bench_scene.name;
     result.what = bench_scene.what;
 
+    // The scene's own reference settings at the sweep's supersampling, with every lobe of
+    // every heap in range, so that the heaps' level of detail is measured, not shared.
+    ReferenceSettings reference_settings = bench_scene.file.reference;
+    reference_settings.samples_per_axis = samples;
+    reference_settings.heaps.detail_px = 0.0;
     const auto ref_start = Clock::now();
-    const FloatImage reference = renderReference(scene, {samples, 0}, [&](double fraction) {
+    const FloatImage reference = renderReference(scene, reference_settings, [&](double fraction) {
       if (tty) std::fprintf(stderr, "\r%s: reference %3.0f %%", tag.c_str(), 100.0 * fraction);
     });
     result.reference_s = secondsSince(ref_start);
@@ -543,7 +567,7 @@ int runBenchCommand(const BenchCommandOptions& o) {
       if (setting.changes_model) {
         if (tty)
           std::fprintf(stderr, "\r%s: reference for %s", tag.c_str(), setting.name().c_str());
-        point.error = compareImages(image, renderReference(edited[k], {samples, 0}));
+        point.error = compareImages(image, renderReference(edited[k], reference_settings));
       } else {
         point.error = compareImages(image, reference);
       }

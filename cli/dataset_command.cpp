@@ -330,7 +330,7 @@ int runDatasetCommand(const DatasetCommandOptions& o) {
   options.kind = o.renderer == "reference" ? RendererKind::kReference : RendererKind::kGl;
   options.gl_backend = backendFromName(o.gl_backend);
   options.render.channel_divisor = o.channel_divisor;
-  options.render.heap_range_m = options.reference.heap_range_m = spec.heap_range_m;
+  options.render.heaps = options.reference.heaps = spec.heaps;
   options.reference.label_divisor = o.channel_divisor;
   std::string error;
   const std::unique_ptr<Renderer> renderer = createRenderer(options, error);

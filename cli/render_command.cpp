@@ -65,7 +65,9 @@ std::string applyOverrides(const RenderCommandOptions& o, SceneFile& file) {
   if (o.tessellation) r.tessellation = *o.tessellation;
   if (o.impostor_tolerance) r.impostor_tolerance_px = *o.impostor_tolerance;
   if (o.volume_step) r.volume_step = *o.volume_step;
-  if (o.heap_range) r.heap_range_m = file.reference.heap_range_m = *o.heap_range;
+  if (o.heap_range) r.heaps.range_m = *o.heap_range;
+  if (o.heap_detail) r.heaps.detail_px = *o.heap_detail;
+  file.reference.heaps = r.heaps;  // both renderers draw the same heaps
   if (o.samples) file.reference.samples_per_axis = *o.samples;
   std::string error = validateCamera(camera);
   if (error.empty()) error = validateRenderSettings(r);
@@ -179,6 +181,9 @@ void addRenderCommand(CLI::App& app, RenderCommandOptions& o) {
   cmd->add_option("--heap-range", o.heap_range,
                   "Cloud fields: heaps as ellipsoids to this distance (m), a far deck beyond; "
                   "0 is 40 km plus twice the height");
+  cmd->add_option("--heap-detail", o.heap_detail,
+                  "Cloud fields: every lobe of heaps whose radius spans this many pixels, their "
+                  "outline below (0..10000; default 32; 0 every lobe)");
   cmd->add_option("--volume-step", o.volume_step,
                   "Automaton clouds: view march step in lattice spacings (0.25..8)");
   cmd->add_option("--samples", o.samples, "Reference supersampling per pixel axis")
@@ -255,10 +260,10 @@ int runRenderCommand(const RenderCommandOptions& o) {
   for (const EllipsoidCloud& cloud : scene.clouds) ellipsoids += cloud.ellipsoids.size();
   spdlog::info(
       "scene {} at t = {} s: {}x{}, {} layer(s), {} cloud(s) of {} ellipsoid(s), {} automaton "
-      "cloud(s), {} target(s){}",
+      "cloud(s), {} target(s){}{}",
       o.scene_path, scene.time_s, scene.camera.width, scene.camera.height, scene.layers.size(),
       scene.clouds.size(), ellipsoids, scene.automata.size(), scene.targets.size(),
-      scene.fog ? ", fog" : "");
+      scene.fog ? ", fog" : "", scene.haze ? ", haze" : "");
   renderer->setProgress([&](double done) {
     const double seconds = millisecondsSince(start) / 1000.0;
     if (seconds >= 2.0)  // only long renders need a progress line

@@ -30,6 +30,7 @@ struct RenderCommandOptions {
   std::optional<int> tile_resolution, tessellation;
   std::optional<double> impostor_tolerance;
   std::optional<double> heap_range;
+  std::optional<double> heap_detail;
   std::optional<double> volume_step;
   std::optional<int> samples;
   bool stats = false;

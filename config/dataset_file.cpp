@@ -24,7 +24,7 @@ std::vector<std::string> cloudTypeNames() {
 
 void readDataset(TableReader& t, DatasetSpec& spec) {
   t.allow({"seed", "samples", "width", "height", "band", "masks", "depth", "coverage",
-           "occluded_fraction", "heap_range"});
+           "occluded_fraction", "heap_range", "heap_detail"});
   t.seed("seed", spec.seed);
   t.integer("samples", spec.samples, 1, Limits::kMaxSamples);
   t.integer("width", spec.width, 1, Limits::kMaxImageSide);
@@ -34,7 +34,8 @@ void readDataset(TableReader& t, DatasetSpec& spec) {
   t.boolean("depth", spec.write_depth);
   t.boolean("coverage", spec.write_coverage);
   t.number("occluded_fraction", spec.occluded_fraction, Limits::kFraction);
-  t.number("heap_range", spec.heap_range_m, Limits::kHeapRange);
+  t.number("heap_range", spec.heaps.range_m, Limits::kHeapRange);
+  t.number("heap_detail", spec.heaps.detail_px, Limits::kHeapDetail);
   t.finish();
 }
 

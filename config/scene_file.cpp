@@ -72,6 +72,13 @@ void readSky(TableReader& t, Sky& sky) {
   t.finish();
 }
 
+void readHaze(TableReader& t, Haze& haze) {
+  t.allow({"visibility", "scale_height"});
+  t.number("visibility", haze.visibility_m, Limits::kHazeVisibility);
+  t.number("scale_height", haze.scale_height_m, Limits::kHazeScaleHeight);
+  t.finish();
+}
+
 void readFog(TableReader& t, Fog& fog) {
   t.allow({"top", "visibility", "colour"});
   t.number("top", fog.top_m, 0.0, Limits::kMaxAltitude);
@@ -83,7 +90,7 @@ void readFog(TableReader& t, Fog& fog) {
 void readRender(TableReader& t, SceneFile& out) {
   t.allow({"texture", "term_filter", "sky_passes", "bake_texels_per_cycle", "reference_samples",
            "ellipsoid_passes", "ellipsoid_order", "limb", "tile_resolution", "tile_format",
-           "tessellation", "impostor_tolerance", "volume_step", "heap_range"});
+           "tessellation", "impostor_tolerance", "volume_step", "heap_range", "heap_detail"});
   out.render.texture_evaluation = TextureEvaluation(
       t.choice("texture", kTextureEvaluationNames, int(out.render.texture_evaluation)));
   out.render.term_filter =
@@ -105,8 +112,9 @@ void readRender(TableReader& t, SceneFile& out) {
     t.failAt(error.substr(0, error.find(':')), error.substr(error.find(':') + 2));
   t.number("impostor_tolerance", r.impostor_tolerance_px, 0.0, 100.0);
   t.number("volume_step", r.volume_step, 0.25, 8.0);
-  t.number("heap_range", r.heap_range_m, Limits::kHeapRange);
-  out.reference.heap_range_m = r.heap_range_m;  // both renderers draw the same heaps
+  t.number("heap_range", r.heaps.range_m, Limits::kHeapRange);
+  t.number("heap_detail", r.heaps.detail_px, Limits::kHeapDetail);
+  out.reference.heaps = r.heaps;  // both renderers draw the same heaps
   t.finish();
 }
 
@@ -469,8 +477,8 @@ WeatherLayer readWeather(TableReader& t, bool macro = false) {
 
 void readScene(const toml::table& root, const std::string& file, SceneFile& out) {
   TableReader t(root, "", file);
-  t.allow({"seed", "time", "image", "camera", "sun", "sky", "fog", "render", "wind", "layer",
-           "cloud", "automaton", "target", "weather", "macrocluster"});
+  t.allow({"seed", "time", "image", "camera", "sun", "sky", "fog", "haze", "render", "wind",
+           "layer", "cloud", "automaton", "target", "weather", "macrocluster"});
   Scene& scene = out.scene;
   t.seed("seed", scene.seed);
   t.number("time", scene.time_s, 0.0, Limits::kMaxTime);
@@ -479,6 +487,7 @@ void readScene(const toml::table& root, const std::string& file, SceneFile& out)
   if (auto sun = t.table("sun")) readSun(*sun, scene.sun);
   if (auto sky = t.table("sky")) readSky(*sky, scene.sky);
   if (auto fog = t.table("fog")) readFog(*fog, scene.fog.emplace());
+  if (auto haze = t.table("haze")) readHaze(*haze, scene.haze.emplace());
   if (auto render = t.table("render")) readRender(*render, out);
   WorldDynamics& dynamics = out.dynamics;
   std::vector<TableReader> wind = t.tables("wind");
@@ -685,8 +694,11 @@ std::string validateRenderSettings(const RenderSettings& r) {
   if (!(r.impostor_tolerance_px >= 0.0 && r.impostor_tolerance_px <= 100.0))
     return "impostor_tolerance: " + formatNumber(r.impostor_tolerance_px) +
            " is out of range (allowed: 0 to 100 pixels)";
-  if (std::ostringstream out; outOfRange(out, "heap_range", r.heap_range_m, Limits::kHeapRange))
+  if (std::ostringstream out; outOfRange(out, "heap_range", r.heaps.range_m, Limits::kHeapRange))
     return out.str() + " metres; 0 is 40 km plus twice the height";
+  if (std::ostringstream out;
+      outOfRange(out, "heap_detail", r.heaps.detail_px, Limits::kHeapDetail))
+    return out.str() + " pixels of a heap's radius; 0 draws every lobe";
   if (!(r.volume_step >= 0.25 && r.volume_step <= 8.0))
     return "volume_step: " + formatNumber(r.volume_step) +
            " is out of range (allowed: 0.25 to 8 lattice spacings)";

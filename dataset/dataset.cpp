@@ -167,7 +167,7 @@ SampleScene drawSample(const DatasetSpec& spec, int index) {
       const bool cloudy = !scene.layers.empty() || !scene.fields.empty();
       auto transmittanceTo = [&](glm::dvec3 d, double distance) {
         if (!cloudy) return 1.0;
-        if (!probe) probe.emplace(scene, spec.heap_range_m);
+        if (!probe) probe.emplace(scene, spec.heaps);
         return probe->transmittance(d, distance);
       };
       for (int attempt = 0; attempt < kPlacementAttempts && !met; ++attempt) {

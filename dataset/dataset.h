@@ -50,9 +50,8 @@ struct DatasetSpec {
   bool write_masks = true;
   bool write_depth = false;     // depth, cloud depth and object id as an EXR
   bool write_coverage = false;  // coverage and visibility as an EXR
-  // Heaps drawn as ellipsoids out to this distance and as a far deck beyond (MODEL.md section
-  // 11, RenderSettings::heap_range_m); 0 is automatic (40 km plus twice the height).
-  double heap_range_m = 0.0;
+  // How heaps are drawn by distance (RenderSettings::heaps: `heap_range`, `heap_detail`).
+  HeapDrawing heaps;
 
   // Sky: each sample has `layers` weather layers, each of a genus drawn from `genera`.
   std::vector<CloudType> genera{CloudType::kCumulus};

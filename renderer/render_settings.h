@@ -1,6 +1,7 @@
 #pragma once
 // Speed-for-accuracy knobs of the GL renderer; each is measured against the CPU reference by
 // bench/render_bench.
+#include "world/formations/cloud_field.h"
 #include "world/textures/gardner_texture.h"
 
 namespace nephele {
@@ -58,10 +59,10 @@ struct RenderSettings {
   // Far clouds drawn from an impostor rendered once and reused while the view of the cloud
   // changes by less than impostor_tolerance_px pixels; 0 turns impostors off.
   double impostor_tolerance_px = 0.0;
-  // Heaps of cloud fields are drawn as ellipsoids out to this horizontal distance, metres, and
-  // as a far deck beyond it (MODEL.md section 11); 0: 40 km plus twice the camera's height
-  // above the field.
-  double heap_range_m = 0.0;
+  // Heaps of cloud fields (world/formations/cloud_field.h): the range drawn as ellipsoids
+  // (`heap_range`, a far deck beyond) and the projected radius, in pixels, from which every
+  // lobe of a heap is drawn (`heap_detail`).
+  HeapDrawing heaps{};
 
   // Automaton clouds: the view march's step in lattice spacings (the lattice holds
   // samples_per_cell samples per cell edge). Larger steps are faster and blur thin edges.
@@ -75,10 +76,10 @@ struct RenderSettings {
 
 // The CPU reference (MODEL.md section 7).
 struct ReferenceSettings {
-  int samples_per_axis = 4;   // supersampling grid per pixel
-  int threads = 0;            // 0: one per hardware thread
-  double heap_range_m = 0.0;  // as RenderSettings::heap_range_m
-  int label_divisor = 1;      // depth, cloud depth, object id: one centre ray per N x N block
+  int samples_per_axis = 4;  // supersampling grid per pixel
+  int threads = 0;           // 0: one per hardware thread
+  HeapDrawing heaps{};       // as RenderSettings::heaps
+  int label_divisor = 1;     // depth, cloud depth, object id: one centre ray per N x N block
 };
 
 }  // namespace nephele

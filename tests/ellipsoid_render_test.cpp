@@ -350,6 +350,13 @@ TEST_F(EllipsoidRenderTest, ExtremeCasesStayFinite) {
       [](Scene&) {});  // edge-on flat disc just beside the eye
   add(cloudScene({{{500.0, 500.0, 500.0}, {0.0, 1.0e6, 1000.0}, {}}}, lookingNorth({0, 0, 1000})),
       [](Scene&) {});  // 1000 km away, at the horizon
+  add(cloudScene({{{500.0, 500.0, 500.0}, {0.0, 1.0e6, 1000.0}, {}}}, lookingNorth({0, 0, 1000})),
+      [](Scene& s) {
+        s.haze = Haze{10.0, 10.0};
+      });  // and behind the densest legal haze
+  add(cloudScene({lobe}, lookingNorth({0.0, -2000.0, 1200.0})), [](Scene& s) {
+    s.haze = Haze{1.0e7, 1.0e5};
+  });  // the thinnest
   add(cloudScene({lobe}, lookingNorth({0.0, -2000.0, 1200.0})), [](Scene& s) {
     s.clouds[0].transition = 10.0;
     s.clouds[0].threshold_limb = -2.0;

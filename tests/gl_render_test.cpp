@@ -70,6 +70,17 @@ TEST_F(GlRenderTest, PointSampledEqualsOneSampleReference) {
   SceneFile fog = preset("ground_fog");
   fog.scene.camera.orientation.pitch_deg = -50.0;  // the ground through the fog
   expectPointSampledEqual(*renderer_, fog.scene, "point_fog_down");
+  // Haze (MODEL.md section 5) on a layer above, on the ground below from 3 km, and mixed with
+  // the fog.
+  SceneFile hazy = preset("stratus");
+  hazy.scene.haze = Haze{8000.0, 1500.0};
+  hazy.scene.camera.orientation.pitch_deg = 50.0;
+  expectPointSampledEqual(*renderer_, hazy.scene, "point_haze_up");
+  hazy.scene.camera.position.z = 3000.0;
+  hazy.scene.camera.orientation.pitch_deg = -50.0;
+  expectPointSampledEqual(*renderer_, hazy.scene, "point_haze_down");
+  fog.scene.haze = Haze{5000.0, 800.0};
+  expectPointSampledEqual(*renderer_, fog.scene, "point_fog_haze_down");
 }
 
 // Largest channel difference 2e-3 in linear RGB (float against double).

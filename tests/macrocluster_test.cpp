@@ -164,9 +164,9 @@ TEST_F(MacroclusterRenderTest, FarDeckEqualsOneSampleReference) {
   RenderSettings gl;
   gl.texture_evaluation = TextureEvaluation::kProcedural;
   gl.term_filter = TermFilter::kNone;
-  gl.heap_range_m = 2000.0;
+  gl.heaps.range_m = 2000.0;
   ReferenceSettings reference{1, 0, 2000.0};
-  const Scene drawn = withFieldClouds(scene, gl.heap_range_m);
+  const Scene drawn = withFieldClouds(scene, gl.heaps);
   ASSERT_EQ(drawn.layers.size(), 1u);  // the far deck
   EXPECT_GT(drawn.layers[0].far.side_ratio, 0.0);
   const FloatImage a = renderer_->renderFloat(scene, gl);
@@ -184,16 +184,20 @@ TEST_F(MacroclusterRenderTest, FarDeckEqualsOneSampleReference) {
 // 128 columns hold few heaps per band, whose placement alone moves a band's cover by up to
 // 0.1: a single field measures 0.051 to 0.114 over seeds 3 to 7. scale_bench's field, whose
 // clusters vary, measures 0.18 and 0.095 with the range at 5 km: the deck does not vary with
-// them.
+// them. Both draw the heaps' lobes to the angular size the default draws them at 640x480
+// (heap_detail 32 px there, 6.4 px at 128x96), against which the deck was calibrated (with
+// every lobe of every heap in both: cover 0.132, luminance 0.085; with 32 px at 128x96: 0.109,
+// 0.067).
 TEST_F(MacroclusterRenderTest, FarDeckSwitchOverWithinTolerance) {
   RenderSettings gl;
-  gl.heap_range_m = 15000.0;
+  gl.heaps.range_m = 15000.0;
+  gl.heaps.detail_px = 6.4;
   FloatImage a, b;
   constexpr int kFields = 4;
   for (int k = 0; k < kFields; ++k) {
     const Scene scene = horizonScene(3 + k);
     const FloatImage one_a = renderer_->renderFloat(scene, gl);
-    const FloatImage one_b = renderReference(scene, {1, 0, 0.0});
+    const FloatImage one_b = renderReference(scene, {1, 0, {0.0, gl.heaps.detail_px}});
     if (k == 0) a = one_a, b = one_b;
     for (std::size_t i = 0; k > 0 && i < a.rgba.size(); ++i)
       a.rgba[i] += one_a.rgba[i], b.rgba[i] += one_b.rgba[i];

@@ -58,11 +58,16 @@ colour = [1, 0.5, 0.25]
 [fog]
 top = 50
 visibility = 800
+[haze]
+visibility = 25000
+scale_height = 900
 [render]
 texture = "procedural"
 term_filter = "cut"
 sky_passes = "multipass"
 bake_texels_per_cycle = 8
+heap_range = 9000
+heap_detail = 12
 reference_samples = 3
 [[layer]]
 altitude = 900
@@ -93,6 +98,12 @@ roughness = 0.5
   EXPECT_EQ(f.scene.sun.colour, glm::dvec3(1, 0.5, 0.25));
   ASSERT_TRUE(f.scene.fog);
   EXPECT_EQ(f.scene.fog->visibility_m, 800);
+  ASSERT_TRUE(f.scene.haze);
+  EXPECT_EQ(f.scene.haze->visibility_m, 25000);
+  EXPECT_EQ(f.scene.haze->scale_height_m, 900);
+  EXPECT_EQ(f.render.heaps.range_m, 9000);
+  EXPECT_EQ(f.render.heaps.detail_px, 12);
+  EXPECT_EQ(f.reference.heaps.detail_px, 12);  // both renderers draw the same heaps
   EXPECT_EQ(f.render.texture_evaluation, TextureEvaluation::kProcedural);
   EXPECT_EQ(f.render.term_filter, TermFilter::kCut);
   EXPECT_EQ(f.render.sky_passes, SkyPasses::kMultipass);
@@ -309,6 +320,11 @@ TEST(SceneFile, BadTargetsAndKnobsAreRejected) {
   EXPECT_THAT(parseError("[render]\ntessellation = 2\n"), HasSubstr("allowed: 0 for adaptive"));
   EXPECT_THAT(parseError("[render]\nellipsoid_order = \"random\"\n"),
               HasSubstr("(one of: centre, per-pixel)"));
+  EXPECT_THAT(parseError("[render]\nheap_detail = -1\n"),
+              HasSubstr("render.heap_detail: -1 is out of range (allowed: 0 to 10000)"));
+  EXPECT_THAT(parseError("[haze]\nvisibility = 5\n"),
+              HasSubstr("haze.visibility: 5 is out of range (allowed: 10 to 1e+07)"));
+  EXPECT_THAT(parseError("[haze]\ncolour = [1, 1, 1]\n"), HasSubstr("colour"));
 }
 
 TEST(SceneFile, MeshTargetsLoadRelativeToTheScene) {

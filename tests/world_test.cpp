@@ -181,7 +181,9 @@ TEST(World, WithoutAutomatonCloudsNoAutomatonWorkIsDone) {
 }
 
 TEST(World, SnapshotRestoresBitExactlyAndContinuesIdentically) {
-  World original = makeWorld();
+  auto [scene, dynamics] = smallWorld();
+  scene.haze = Haze{25000.0, 900.0};
+  World original(scene, dynamics, 1);
   ASSERT_EQ(original.advance(12.3), "");
   const std::filesystem::path path =
       std::filesystem::temp_directory_path() / "nephele_world_test.snapshot";
@@ -191,6 +193,8 @@ TEST(World, SnapshotRestoresBitExactlyAndContinuesIdentically) {
   ASSERT_EQ(restored.restoreSnapshot(path.string()), "");
   EXPECT_EQ(restored.hash(), original.hash());
   EXPECT_EQ(restored.timeNs(), original.timeNs());
+  ASSERT_TRUE(restored.base().haze);
+  EXPECT_EQ(restored.base().haze->scale_height_m, 900.0);
   EXPECT_EQ(restored.scene().automata[0].to->lattice.sunlight,
             original.scene().automata[0].to->lattice.sunlight);
   ASSERT_EQ(original.advance(20.0), "");

@@ -83,6 +83,7 @@ struct Limits {
   static constexpr Range kRegionBand{0.0, 1.0e7};      // edge and front transition widths
   static constexpr Range kClusterVariation{0.0, 1.0};  // per-cluster spread of cover, height
   static constexpr Range kHeapRange{0.0, 1.0e6};       // heaps as ellipsoids this far; 0 automatic
+  static constexpr Range kHeapDetail{0.0, 1.0e4};      // every lobe of heaps this many pixels wide
 
   // Datasets (dataset/dataset.h).
   static constexpr int kMaxSamples = 100000000;
@@ -126,6 +127,10 @@ struct Limits {
   static constexpr int kMinSolarYear = 1901, kMaxSolarYear = 2099;
   // Ground fog (McReynolds and Blythe): top and meteorological visibility, metres.
   static constexpr Range kFogVisibility{1.0, 1.0e7};
+  // Distance haze (MODEL.md section 5): visibility at Z = 0 and the extinction's scale height,
+  // metres.
+  static constexpr Range kHazeVisibility{10.0, 1.0e7};
+  static constexpr Range kHazeScaleHeight{10.0, 1.0e5};
 
   // A scene file, daemon config or mesh read whole.
   static constexpr unsigned long long kMaxTextFileBytes = 64ull << 20;

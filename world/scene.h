@@ -60,6 +60,7 @@ struct Scene {
   Sun sun;
   Sky sky;
   std::optional<Fog> fog;
+  std::optional<Haze> haze;
   std::vector<CloudLayer> layers;
   std::vector<EllipsoidCloud> clouds;
   // Fields of heaps that exist everywhere; a render sees the heaps around its camera
@@ -70,9 +71,14 @@ struct Scene {
   std::vector<AutomatonCloudView> automata;
 };
 
-// `scene` with its fields' heaps within heapRange(heap_range_m) of its camera added to its
+// Whether anything lies in the air between the eye and a surface (fog, haze).
+inline bool sceneHasAir(const Scene& scene) {
+  return scene.fog || scene.haze;
+}
+
+// `scene` with its fields' heaps within heapRange(drawing.range_m) of its camera added to its
 // clouds, and, where the view reaches beyond that, a far deck standing for the rest
 // (MODEL.md sections 10 and 11); what every renderer draws.
-Scene withFieldClouds(const Scene& scene, double heap_range_m = 0.0);
+Scene withFieldClouds(const Scene& scene, const HeapDrawing& drawing = {});
 
 }  // namespace nephele

@@ -19,8 +19,12 @@ glm::dvec3 sunDirection(const Sun& sun) {
   return {std::sin(az) * std::cos(el), std::cos(az) * std::cos(el), std::sin(el)};
 }
 
+double extinctionForVisibility(double visibility_m) {
+  return -std::log(0.02) / visibility_m;
+}
+
 double fogExtinction(const Fog& fog) {
-  return -std::log(0.02) / fog.visibility_m;
+  return extinctionForVisibility(fog.visibility_m);
 }
 
 double fogPathLength(const Fog& fog, glm::dvec3 origin, glm::dvec3 direction, double distance) {
@@ -36,6 +40,42 @@ double fogPathLength(const Fog& fog, glm::dvec3 origin, glm::dvec3 direction, do
   }
   if (!(leave > enter)) return 0.0;
   return leave == kInf ? kInf : leave - enter;
+}
+
+double hazeOpticalDepth(const Haze& haze, glm::dvec3 origin, glm::dvec3 direction,
+                        double distance) {
+  // A flat Earth sees an endless level path; 1e9 m keeps tau finite, and the horizon seen from
+  // sea level the haze's colour (tau > 390 there for every legal visibility).
+  const double s = std::min(distance, 1.0e9);
+  if (!(s > 0.0)) return 0.0;
+  const double h = haze.scale_height_m, sigma0 = extinctionForVisibility(haze.visibility_m);
+  // tau = sigma0 integral_0^s exp(-(z0 + u dz) / H) du = sigma0 H (e^-a - e^-(a + x)) / dz with
+  // a = z0 / H and x = s dz / H; near x = 0, where the difference cancels, the series
+  // sigma0 s e^-a (1 - x/2 + x^2/6). The end height is held above -50 H: only a ray past the
+  // ground goes lower, and its tau is then e^50 times any real one.
+  const double a = origin.z / h, x = s * direction.z / h;
+  if (std::abs(x) < 1e-2) return sigma0 * s * std::exp(-a) * (1.0 - x / 2.0 + x * x / 6.0);
+  return sigma0 * h / direction.z * (std::exp(-a) - std::exp(-std::max(a + x, -50.0)));
+}
+
+glm::dvec3 throughAir(glm::dvec3 colour, const std::optional<Fog>& fog,
+                      const std::optional<Haze>& haze, glm::dvec3 horizon, glm::dvec3 origin,
+                      glm::dvec3 direction, double distance) {
+  // Each depth is capped where its transmittance is already 0 in double, so the weights of the
+  // two colours stay finite.
+  constexpr double kOpaque = 1.0e3;
+  const double tau_fog =
+      fog ? std::min(fogExtinction(*fog) * fogPathLength(*fog, origin, direction, distance),
+                     kOpaque)
+          : 0.0;
+  const double tau_haze =
+      haze ? std::min(hazeOpticalDepth(*haze, origin, direction, distance), kOpaque) : 0.0;
+  const double tau = tau_fog + tau_haze;
+  if (!(tau > 0.0)) return colour;
+  const glm::dvec3 air =
+      (tau_fog * (fog ? fog->colour : glm::dvec3(0.0)) + tau_haze * horizon) / tau;
+  const double t = std::exp(-tau);
+  return t * colour + (1.0 - t) * air;
 }
 
 }  // namespace nephele

@@ -1,6 +1,8 @@
 #pragma once
-// Sky background, ground, sun (MODEL.md sections 1 and 5) and ground fog.
+// Sky background, ground, sun (MODEL.md sections 1 and 5), ground fog and distance haze.
 #include <glm/glm.hpp>
+
+#include <optional>
 
 namespace nephele {
 
@@ -31,10 +33,31 @@ struct Fog {
   glm::dvec3 colour{0.75, 0.77, 0.80};
 };
 
+// Koschmieder: the extinction per metre that leaves 2 % contrast after `visibility_m`.
+double extinctionForVisibility(double visibility_m);
 double fogExtinction(const Fog& fog);  // per metre
 
 // Length inside the fog slab of the ray origin + s * direction for 0 <= s <= distance
 // (distance may be +infinity). `direction` must be normalised.
 double fogPathLength(const Fog& fog, glm::dvec3 origin, glm::dvec3 direction, double distance);
+
+// Distance haze (MODEL.md section 5): aerosol whose extinction falls with height as
+// exp(-Z / scale_height), sigma0 = -ln(0.02) / visibility at Z = 0, seen in the sky's horizon
+// colour. Unlit, like the fog.
+struct Haze {
+  double visibility_m = 40000.0;
+  double scale_height_m = 1200.0;
+};
+
+// The haze's optical depth along origin + s * direction for 0 <= s <= distance (distance may
+// be +infinity; `direction` must be normalised). Finite or +infinity, never NaN.
+double hazeOpticalDepth(const Haze& haze, glm::dvec3 origin, glm::dvec3 direction, double distance);
+
+// `colour` seen at `distance` along the unit `direction` from `origin` through the fog and the
+// haze of a scene (either may be absent): the two mixed in proportion to their optical depths,
+// T = exp(-(tau_fog + tau_haze)), colour T + (1 - T) (tau_fog fog + tau_haze horizon) / tau.
+glm::dvec3 throughAir(glm::dvec3 colour, const std::optional<Fog>& fog,
+                      const std::optional<Haze>& haze, glm::dvec3 horizon, glm::dvec3 origin,
+                      glm::dvec3 direction, double distance);
 
 }  // namespace nephele

@@ -25,7 +25,7 @@ namespace {
 static_assert(std::endian::native == std::endian::little, "snapshots assume a little-endian host");
 
 constexpr char kMagic[8] = {'N', 'E', 'P', 'H', 'S', 'N', 'A', 'P'};
-constexpr std::uint32_t kFormatVersion = 6;
+constexpr std::uint32_t kFormatVersion = 7;
 constexpr std::size_t kHeaderBytes = sizeof kMagic + 4 + 8 + 8;
 
 class Writer {
@@ -139,6 +139,17 @@ void io(A& a, std::optional<Fog>& fog) {
   io(a, fog->top_m), io(a, fog->visibility_m), io(a, fog->colour);
 }
 template <class A>
+void io(A& a, std::optional<Haze>& haze) {
+  bool present = haze.has_value();
+  io(a, present);
+  if (!present) return haze.reset();
+  if (!haze) haze.emplace();
+  io(a, haze->visibility_m), io(a, haze->scale_height_m);
+  if (!Limits::kHazeVisibility.contains(haze->visibility_m) ||
+      !Limits::kHazeScaleHeight.contains(haze->scale_height_m))
+    a.fail("haze out of range");
+}
+template <class A>
 void io(A& a, ShadingParams& s) {
   io(a, s.ambient), io(a, s.texture_fraction), io(a, s.specular), io(a, s.shininess);
 }
@@ -223,7 +234,7 @@ void io(A& a, CloudField& f) {
 }
 template <class A>
 void io(A& a, Scene& s) {
-  io(a, s.seed), io(a, s.camera), io(a, s.sun), io(a, s.sky), io(a, s.fog);
+  io(a, s.seed), io(a, s.camera), io(a, s.sun), io(a, s.sky), io(a, s.fog), io(a, s.haze);
   io(a, s.layers, 64), io(a, s.clouds, 64), io(a, s.targets, 64), io(a, s.fields, 64);
 }
 template <class A>

@@ -80,7 +80,7 @@ void main() {
   float alpha = 1.0 - transmittance;
   if (alpha <= 0.0) discard;
   // Fog as for a surface at the entry point, on the straight colour.
-  o_colour = vec4(alpha * applyFog(radiance / alpha, d, enter), alpha);
+  o_colour = vec4(alpha * applyAir(radiance / alpha, d, enter), alpha);
 }
 )";
 
@@ -123,9 +123,9 @@ void AutomatonRenderer::endFrame() {
   std::erase_if(volumes_, [](const auto& entry) { return !entry.second.used; });
 }
 
-GLuint AutomatonRenderer::program(bool fog, bool targets, PhaseFunction phase) {
+GLuint AutomatonRenderer::program(bool air, bool targets, PhaseFunction phase) {
   std::string defines;
-  if (fog) defines += "#define FOG\n";
+  if (air) defines += "#define AIR\n";
   if (targets) defines += "#define TARGETS\n";
   if (phase == PhaseFunction::kCornetteShanks) defines += "#define CORNETTE_SHANKS\n";
   auto found = programs_.find(defines);
@@ -196,9 +196,9 @@ void AutomatonRenderer::drawCloud(const Scene& scene, std::size_t index,
   const std::vector<glm::vec2> polygon = screenRectangle(scene.camera, box_lo, box_hi);
   if (polygon.empty()) return;
   const Volume& v = volume(scene, index);
-  const GLuint p = program(scene.fog.has_value(), targets_drawn, cloud.phase);
+  const GLuint p = program(sceneHasAir(scene), targets_drawn, cloud.phase);
   gl_.UseProgram(p);
-  setViewUniforms(gl_, p, scene.camera, scene.fog, band);
+  setViewUniforms(gl_, p, scene.camera, scene, band);
   const glm::dvec3 eye = scene.camera.position;
   const DensityLattice& lattice = cloud.from->lattice;
   setUniform3(gl_, p, "u_box_min", box_lo - eye);

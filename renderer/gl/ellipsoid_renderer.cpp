@@ -276,7 +276,7 @@ const IndexedMesh& EllipsoidRenderer::sphereMesh(int slices) {
 void EllipsoidRenderer::setCloudUniforms(GLuint p, const Scene& scene, const EllipsoidCloud& cloud,
                                          const CachedTexture& cached, SolidTextureKind kind,
                                          const AltitudeBand& band) {
-  setViewUniforms(gl_, p, scene.camera, scene.fog, band);
+  setViewUniforms(gl_, p, scene.camera, scene, band);
   setUniform3(gl_, p, "u_cloud_colour", cloud.colour * scene.sun.colour);
   const ShadingParams& sh = cloud.shading;
   const glm::vec4 shading(sh.ambient, sh.texture_fraction, sh.specular, sh.shininess);
@@ -346,7 +346,13 @@ std::string impostorKey(const Scene& scene, const EllipsoidCloud& cloud,
       << int(settings.ellipsoid_order) << int(settings.limb) << int(settings.term_filter) << '/'
       << scene.sun.azimuth_deg << '/' << scene.sun.elevation_deg << '/' << scene.sun.colour.x
       << scene.sun.colour.y << scene.sun.colour.z << '/' << scene.fog.has_value();
-  if (scene.fog) key << scene.fog->top_m << '/' << scene.fog->visibility_m;
+  if (scene.fog)
+    key << scene.fog->top_m << '/' << scene.fog->visibility_m << '/' << scene.fog->colour.x << ','
+        << scene.fog->colour.y << ',' << scene.fog->colour.z;
+  key << '/' << scene.haze.has_value();
+  if (scene.haze)
+    key << scene.haze->visibility_m << '/' << scene.haze->scale_height_m << '/'
+        << scene.sky.horizon.x << ',' << scene.sky.horizon.y << ',' << scene.sky.horizon.z;
   for (const Ellipsoid& e : cloud.ellipsoids)
     key << '|' << e.radii.x << ',' << e.radii.y << ',' << e.radii.z << ',' << e.centre.x << ','
         << e.centre.y << ',' << e.centre.z << ',' << e.orientation.heading_deg << ','
@@ -447,7 +453,7 @@ bool EllipsoidRenderer::drawImpostor(const Scene& scene, std::size_t index,
   layout.targets = targets_drawn;
   const GLuint p = program(layout);
   gl_.UseProgram(p);
-  setViewUniforms(gl_, p, camera, scene.fog, band);
+  setViewUniforms(gl_, p, camera, scene, band);
   const ViewBasis basis = viewBasis(camera);
   setUniform3(gl_, p, "u_clip_x", basis.right / (basis.tan_half_vfov * basis.aspect));
   setUniform3(gl_, p, "u_clip_y", basis.up / basis.tan_half_vfov);
@@ -514,7 +520,7 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
                                             : SolidTextureKind::kBakedGardner;
   base.term_filter = settings.term_filter;
   base.spotlight = spotlight;
-  base.fog = scene.fog.has_value();
+  base.air = sceneHasAir(scene);
   base.specular = cloud.shading.specular > 0.0;
   base.targets = targets_drawn;
   if (base.texture != SolidTextureKind::kProcedural)

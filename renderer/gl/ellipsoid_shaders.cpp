@@ -179,7 +179,7 @@ vec3 surfaceColour(int i, vec3 n, vec3 r, vec3 p, float it, float tr, float dist
                     u_shading.x * (light.y - 1.0);
   vec3 d = normalize(r);
   intensity += u_scatter.x * forwardScattered(sun, dot(d, u_to_sun)) * tr;
-  return applyFog(intensity * u_cloud_colour, d, distance);
+  return applyAir(intensity * u_cloud_colour, d, distance);
 }
 
 // Gardner eq. 11 given the threshold excess x = It - T1 - (T2 - T1)(1 - g): opacity 1 - TR.
@@ -359,7 +359,7 @@ std::string EllipsoidPassLayout::key() const {
   k += char('0' + int(texture));
   k += char('0' + int(term_filter));
   k += spotlight ? 'l' : '-';
-  k += fog ? 'f' : '-';
+  k += air ? 'f' : '-';
   k += specular ? 's' : '-';
   k += targets ? 't' : '-';
   return k;
@@ -421,7 +421,7 @@ void main() {
 
 std::string ellipsoidFragmentSource(const EllipsoidPassLayout& layout) {
   std::string s = "#version 450 core\n";
-  if (layout.fog) s += "#define FOG\n";
+  if (layout.air) s += "#define AIR\n";
   if (layout.specular) s += "#define SPECULAR\n";
   if (layout.targets) s += "#define TARGETS\n";
   if (layout.spotlight) s += "#define SPOTLIGHT\n";

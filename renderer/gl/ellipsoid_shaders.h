@@ -25,7 +25,7 @@ struct EllipsoidPassLayout {
   SolidTextureKind texture = SolidTextureKind::kBakedGardner;
   TermFilter term_filter = TermFilter::kFade;
   bool spotlight = false;  // g from the projected radial texture instead of the exact form
-  bool fog = false;
+  bool air = false;
   bool specular = false;
   bool targets = false;
 

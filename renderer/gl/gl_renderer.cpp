@@ -223,7 +223,7 @@ Frame GlRenderer::renderFrame(const Scene& scene, const RenderSettings& settings
   if (asked.has(Channel::kCloudDepth) || asked.has(Channel::kLwir)) {
     ReferenceSettings trace;
     trace.samples_per_axis = 1;
-    trace.heap_range_m = settings.heap_range_m;
+    trace.heaps = settings.heaps;
     trace.label_divisor = settings.channel_divisor;
     FrameRequest traced = request;
     traced.channels = {};
@@ -455,7 +455,7 @@ void GlRenderer::drawSkyPass(const Scene& scene, const RenderSettings& settings,
   const Camera& camera = scene.camera;
   const ViewBasis basis = viewBasis(camera);
   auto uniform3 = [&](const char* name, glm::dvec3 v) { setUniform3(gl_, p, name, v); };
-  setViewUniforms(gl_, p, camera, scene.fog);
+  setViewUniforms(gl_, p, camera, scene);
   if (layout.background) {
     uniform3("u_zenith", scene.sky.zenith);
     uniform3("u_horizon", scene.sky.horizon);
@@ -480,7 +480,7 @@ void GlRenderer::drawSkyGroup(const Scene& scene, const RenderSettings& settings
                               const std::vector<LayerSlot>& below, bool background, bool targets) {
   const Camera& camera = scene.camera;
   SkyPassLayout base;
-  base.fog = scene.fog.has_value();
+  base.air = sceneHasAir(scene);
   base.term_filter = settings.term_filter;
   base.targets = targets;
   for (const CloudLayer& layer : scene.layers) {
@@ -545,7 +545,7 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
                            TargetFormat format) {
   // Fields of heaps become the clouds around this camera (MODEL.md section 10).
   if (!scene.fields.empty())
-    return drawFrame(withFieldClouds(scene, settings.heap_range_m), settings, format);
+    return drawFrame(withFieldClouds(scene, settings.heaps), settings, format);
   const Camera& camera = scene.camera;
   prepareTarget(camera.width, camera.height, format);
   stats_ = {};

@@ -5,8 +5,9 @@
 namespace nephele {
 namespace {
 
-// View (camera-relative: the shader knows only the camera's altitude), output, fog. Fog is
-// unlit and applied to each surface by its camera distance, which is exact under "over".
+// View (camera-relative: the shader knows only the camera's altitude), output, the air (fog and
+// haze). The air is unlit and applied to each surface by its camera distance, which is exact
+// under "over".
 const char* kCommon = R"(
 uniform vec3 u_right;    // image-plane basis, scaled by tan(vfov/2) * aspect
 uniform vec3 u_up;       // scaled by tan(vfov/2)
@@ -21,10 +22,15 @@ vec3 viewRay() {
   return u_right * ndc.x + u_up * ndc.y + u_forward;
 }
 
-#ifdef FOG
+#ifdef AIR
+// The air between the eye and a surface (MODEL.md section 5): ground fog and distance haze;
+// an absent one has zero extinction. world/sky.cpp's throughAir is the reference's twin.
 uniform float u_fog_top;
 uniform float u_fog_sigma;
 uniform vec3 u_fog_colour;
+uniform float u_haze_sigma;   // at Z = 0, per metre
+uniform float u_haze_height;  // scale height, metres
+uniform vec3 u_haze_colour;   // the sky's horizon
 
 // Length inside the slab 0 <= z <= top of the unit ray from the camera, up to `distance`.
 float fogPathLength(vec3 d, float distance) {
@@ -39,11 +45,32 @@ float fogPathLength(vec3 d, float distance) {
   return max(leave - enter, 0.0);
 }
 
-vec3 applyFog(vec3 colour, vec3 d, float distance) {
-  return mix(u_fog_colour, colour, exp(-u_fog_sigma * fogPathLength(d, distance)));
+// The haze's optical depth along the unit ray up to `distance`: sigma0 H (e^-a - e^-(a+x)) / dz,
+// a = z0 / H, x = s dz / H, or its series near x = 0 (hazeOpticalDepth).
+float hazeDepth(vec3 d, float distance) {
+  float s = min(distance, 1e9), h = u_haze_height;
+  float a = u_camera_z / h, x = s * d.z / h;
+  if (abs(x) < 1e-2) return u_haze_sigma * s * exp(-a) * (1.0 - x / 2.0 + x * x / 6.0);
+  return u_haze_sigma * h / d.z * (exp(-a) - exp(-max(a + x, -50.0)));
+}
+
+vec3 applyAir(vec3 colour, vec3 d, float distance) {
+  float tau_fog = min(u_fog_sigma * fogPathLength(d, distance), 1e3);
+  float tau_haze = min(hazeDepth(d, distance), 1e3);
+  float tau = tau_fog + tau_haze;
+  if (!(tau > 0.0)) return colour;
+  vec3 air = (tau_fog * u_fog_colour + tau_haze * u_haze_colour) / tau;
+  return mix(air, colour, exp(-tau));
+}
+
+// The air at the end of an endless path through it (the ground at the horizon): each medium
+// present at its cap, as applyAir weighs them there.
+vec3 airAtHorizon() {
+  float f = u_fog_sigma > 0.0 ? 1.0 : 0.0, h = u_haze_sigma > 0.0 ? 1.0 : 0.0;
+  return (f * u_fog_colour + h * u_haze_colour) / max(f + h, 1.0);
 }
 #else
-vec3 applyFog(vec3 colour, vec3 d, float distance) { return colour; }
+vec3 applyAir(vec3 colour, vec3 d, float distance) { return colour; }
 #endif
 
 #ifdef TARGETS
@@ -115,11 +142,11 @@ vec3 background(vec3 r) {
   // straight edge and its box-filtered coverage is exact.
   float ground = clamp(0.5 - r.z / u_horizon_slope, 0.0, 1.0);
   vec3 sky = u_horizon + (u_zenith - u_horizon) * sqrt(max(d.z, 0.0));  // MODEL.md section 5
-#ifdef FOG
-  // Each part carries its own fog. The ground seen at the horizon lies behind an infinite
-  // stretch of fog (the fog touches the ground), so there it is the fog colour.
-  vec3 fogged_ground = d.z < 0.0 ? applyFog(u_ground, d, u_camera_z / -d.z) : u_fog_colour;
-  return mix(applyFog(sky, d, kFar), fogged_ground, ground);
+#ifdef AIR
+  // Each part carries its own air. The ground seen at the horizon lies behind an endless
+  // stretch of air (fog and haze touch the ground), so there it is the air's colour.
+  vec3 aired_ground = d.z < 0.0 ? applyAir(u_ground, d, u_camera_z / -d.z) : airAtHorizon();
+  return mix(applyAir(sky, d, kFar), aired_ground, ground);
 #else
   return mix(sky, u_ground, ground);
 #endif
@@ -298,8 +325,8 @@ void composite(int i, vec3 r, LayerHit hit, float it, inout vec3 colour,
   if (u_far[i].y > 0.0) diffuse = sphereDiffuse(dot(u_to_sun, -normalize(r)));
 #endif
   vec3 surface = gardnerIntensity(u_shading[i], diffuse, highlight, it) * u_colour[i];
-#ifdef FOG
-  surface = applyFog(surface, normalize(r), hit.distance);
+#ifdef AIR
+  surface = applyAir(surface, normalize(r), hit.distance);
 #endif
   colour += transmittance * (1.0 - tr) * surface;
   transmittance *= tr;
@@ -336,7 +363,7 @@ std::string SkyPassLayout::key() const {
   for (LayerKind kind : below) k += char('a' + int(kind));
   k += '/';
   k += char('0' + int(term_filter));
-  k += fog ? 'f' : '-';
+  k += air ? 'f' : '-';
   k += specular ? 's' : '-';
   k += targets ? 't' : '-';
   k += regions ? 'r' : '-';
@@ -356,7 +383,7 @@ void main() { gl_Position = vec4(u_polygon[gl_VertexID], 0.0, 1.0); }
 
 std::string skyFragmentSource(const SkyPassLayout& layout) {
   std::string s = "#version 450 core\n";
-  if (layout.fog) s += "#define FOG\n";
+  if (layout.air) s += "#define AIR\n";
   if (layout.background) s += "#define BACKGROUND\n";
   if (layout.specular) s += "#define SPECULAR\n";
   if (layout.targets) s += "#define TARGETS\n";

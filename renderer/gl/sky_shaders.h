@@ -22,7 +22,7 @@ struct SkyPassLayout {
   std::vector<LayerKind> above;
   std::vector<LayerKind> below;
   TermFilter term_filter = TermFilter::kFade;
-  bool fog = false;
+  bool air = false;
   bool specular = false;
   bool targets = false;  // opaque targets were drawn first (their colour and distance)
   bool regions = false;  // some layer lies in a bounded region (region.h)

@@ -51,7 +51,7 @@ void main() {
   if (dot(n, v_position) > 0.0) n = -n;
   vec3 colour = u_albedo * (kAmbient + (1.0 - kAmbient) * max(dot(n, u_to_sun), 0.0));
   float distance = length(v_position);
-  o_colour = vec4(applyFog(colour, v_position / distance, distance), 1.0);
+  o_colour = vec4(applyAir(colour, v_position / distance, distance), 1.0);
   o_distance = distance;
   o_id = u_id;
 }
@@ -66,7 +66,7 @@ GLuint TargetRenderer::program() {
   if (program_) return program_.get();
   std::string error;
   program_ = createProgram(
-      gl_, kVertex, "#version 450 core\n#define FOG\n" + viewShaderSource() + kFragment, error);
+      gl_, kVertex, "#version 450 core\n#define AIR\n" + viewShaderSource() + kFragment, error);
   NEPHELE_CHECK(program_, "target program: " << error);
   return program_.get();
 }
@@ -151,7 +151,7 @@ bool TargetRenderer::draw(const Scene& scene) {
 
   const GLuint p = program();
   gl_.UseProgram(p);
-  setViewUniforms(gl_, p, camera, scene.fog);
+  setViewUniforms(gl_, p, camera, scene);
   const ViewBasis basis = viewBasis(camera);
   setUniform3(gl_, p, "u_clip_x", basis.right / (basis.tan_half_vfov * basis.aspect));
   setUniform3(gl_, p, "u_clip_y", basis.up / basis.tan_half_vfov);

@@ -7,7 +7,7 @@ void setUniform3(const GlApi& gl, GLuint program, const char* name, glm::dvec3 v
   gl.ProgramUniform3fv(program, gl.GetUniformLocation(program, name), 1, &f.x);
 }
 
-void setViewUniforms(const GlApi& gl, GLuint p, const Camera& camera, const std::optional<Fog>& fog,
+void setViewUniforms(const GlApi& gl, GLuint p, const Camera& camera, const Scene& scene,
                      const AltitudeBand& band) {
   gl.ProgramUniform4fv(p, gl.GetUniformLocation(p, "u_band"), 1, &band.slabs.x);
   const ViewBasis basis = viewBasis(camera);
@@ -17,11 +17,19 @@ void setViewUniforms(const GlApi& gl, GLuint p, const Camera& camera, const std:
   const glm::vec2 viewport(camera.width, camera.height);
   gl.ProgramUniform2fv(p, gl.GetUniformLocation(p, "u_viewport"), 1, &viewport.x);
   gl.ProgramUniform1f(p, gl.GetUniformLocation(p, "u_camera_z"), float(camera.position.z));
-  if (fog) {
-    gl.ProgramUniform1f(p, gl.GetUniformLocation(p, "u_fog_top"), float(fog->top_m));
-    gl.ProgramUniform1f(p, gl.GetUniformLocation(p, "u_fog_sigma"), float(fogExtinction(*fog)));
-    setUniform3(gl, p, "u_fog_colour", fog->colour);
-  }
+  // An absent medium has zero extinction (the shaders take the air only when the scene has
+  // some: sceneHasAir).
+  const std::optional<Fog>& fog = scene.fog;
+  gl.ProgramUniform1f(p, gl.GetUniformLocation(p, "u_fog_top"), fog ? float(fog->top_m) : 0.0f);
+  gl.ProgramUniform1f(p, gl.GetUniformLocation(p, "u_fog_sigma"),
+                      fog ? float(fogExtinction(*fog)) : 0.0f);
+  setUniform3(gl, p, "u_fog_colour", fog ? fog->colour : Fog{}.colour);
+  const std::optional<Haze>& haze = scene.haze;
+  gl.ProgramUniform1f(p, gl.GetUniformLocation(p, "u_haze_sigma"),
+                      haze ? float(extinctionForVisibility(haze->visibility_m)) : 0.0f);
+  gl.ProgramUniform1f(p, gl.GetUniformLocation(p, "u_haze_height"),
+                      haze ? float(haze->scale_height_m) : 1.0f);
+  setUniform3(gl, p, "u_haze_colour", scene.sky.horizon);
 }
 
 }  // namespace nephele

@@ -4,7 +4,7 @@
 
 #include "renderer/gl/gl_api.h"
 #include "world/frames.h"
-#include "world/sky.h"
+#include "world/scene.h"
 
 namespace nephele {
 
@@ -15,8 +15,9 @@ struct AltitudeBand {
   glm::vec4 slabs{-1e38f, 1e38f, 0.0f, 0.0f};
 };
 
-void setViewUniforms(const GlApi& gl, GLuint program, const Camera& camera,
-                     const std::optional<Fog>& fog, const AltitudeBand& band = {});
+// The view from `camera` and the air (fog, haze) of `scene`.
+void setViewUniforms(const GlApi& gl, GLuint program, const Camera& camera, const Scene& scene,
+                     const AltitudeBand& band = {});
 
 // Sets a vec3 uniform from doubles.
 void setUniform3(const GlApi& gl, GLuint program, const char* name, glm::dvec3 value);

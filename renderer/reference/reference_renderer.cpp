@@ -36,7 +36,7 @@ std::pair<double, double> boxSpan(glm::dvec3 lo, glm::dvec3 hi, glm::dvec3 origi
   return {enter, leave};
 }
 
-// One translucent surface on a ray, already shaded and fogged.
+// One translucent surface on a ray, already shaded and seen through the air.
 struct Surface {
   double distance;
   glm::dvec3 colour;
@@ -102,7 +102,7 @@ class ReferenceTracer {
       object_id = int(t) + 1;
       colour = targetRadiance(target, hit->normal, sun_, -direction, scene_.sun);
     }
-    colour = withFog(colour, direction, nearest_opaque);
+    colour = withAir(colour, direction, nearest_opaque);
 
     surfaces.clear();
     for (std::size_t i = 0; i < scene_.layers.size(); ++i) {
@@ -185,7 +185,7 @@ class ReferenceTracer {
         layer.far.side_ratio > 0.0
             ? gardnerIntensity(layer.shading, sphereDiffuse(glm::dot(sun_, -direction)), 0.0, t)
             : gardnerIntensity(layer.shading, t, {0.0, 0.0, 1.0}, sun_, -direction);
-    return {s, withFog(intensity * layer.colour * scene_.sun.colour, direction, s), 1.0 - tr, s};
+    return {s, withAir(intensity * layer.colour * scene_.sun.colour, direction, s), 1.0 - tr, s};
   }
 
   Surface ellipsoidSurface(const EllipsoidEntry& entry, glm::dvec3 direction, double s) const {
@@ -197,7 +197,7 @@ class ReferenceTracer {
     const glm::dvec3 normal = entry.view.normalAt(direction, s);
     const double intensity = heapIntensity(cloud, heapLightAt(entry.envelope, p, normal, sun_), t,
                                            normal, sun_, direction, tr);
-    return {s, withFog(intensity * cloud.colour * scene_.sun.colour, direction, s),
+    return {s, withAir(intensity * cloud.colour * scene_.sun.colour, direction, s),
             (1.0 - tr) * entry.fade, s};
   }
 
@@ -252,7 +252,7 @@ class ReferenceTracer {
         half = s;
         break;
       }
-    return Surface{enter, withFog(radiance / alpha, direction, enter), alpha, half};
+    return Surface{enter, withAir(radiance / alpha, direction, enter), alpha, half};
   }
 
   // Optical depth from p out of the cloud's box along the unit direction `towards`.
@@ -271,11 +271,9 @@ class ReferenceTracer {
     return tau;
   }
 
-  glm::dvec3 withFog(glm::dvec3 colour, glm::dvec3 direction, double distance) const {
-    if (!scene_.fog) return colour;
-    const double length = fogPathLength(*scene_.fog, scene_.camera.position, direction, distance);
-    const double transmittance = std::exp(-fogExtinction(*scene_.fog) * length);
-    return transmittance * colour + (1.0 - transmittance) * scene_.fog->colour;
+  glm::dvec3 withAir(glm::dvec3 colour, glm::dvec3 direction, double distance) const {
+    return throughAir(colour, scene_.fog, scene_.haze, scene_.sky.horizon, scene_.camera.position,
+                      direction, distance);
   }
 
   const Scene& scene_;
@@ -305,8 +303,7 @@ Frame renderReferenceFrame(const Scene& scene, const ReferenceSettings& settings
   if (asked.has(Channel::kObjectId)) frame.object_id.resize(pixels);
   if (infrared) frame.lwir.resize(pixels);
 
-  const Scene with_fields =
-      scene.fields.empty() ? Scene{} : withFieldClouds(scene, settings.heap_range_m);
+  const Scene with_fields = scene.fields.empty() ? Scene{} : withFieldClouds(scene, settings.heaps);
   const ReferenceTracer tracer(scene.fields.empty() ? scene : with_fields);
   const ViewBasis basis = viewBasis(camera);
   const int n = std::max(1, settings.samples_per_axis);
@@ -370,9 +367,9 @@ struct CloudProbe::State {
   State(Scene s) : scene(std::move(s)), tracer(scene) {}
 };
 
-CloudProbe::CloudProbe(const Scene& scene, double heap_range_m)
-    : state_(std::make_unique<State>(scene.fields.empty() ? scene
-                                                          : withFieldClouds(scene, heap_range_m))) {
+CloudProbe::CloudProbe(const Scene& scene, const HeapDrawing& heaps)
+    : state_(
+          std::make_unique<State>(scene.fields.empty() ? scene : withFieldClouds(scene, heaps))) {
   state_->scene.targets.clear();
 }
 CloudProbe::~CloudProbe() = default;

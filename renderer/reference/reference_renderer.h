@@ -29,7 +29,7 @@ Frame renderReferenceFrame(const Scene& scene, const ReferenceSettings& settings
 // scene's clouds (and its fields' heaps) are prepared once; its targets are ignored.
 class CloudProbe {
  public:
-  explicit CloudProbe(const Scene& scene, double heap_range_m = 0.0);
+  explicit CloudProbe(const Scene& scene, const HeapDrawing& heaps = {});
   ~CloudProbe();
   double transmittance(glm::dvec3 direction, double distance) const;
 

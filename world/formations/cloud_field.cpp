@@ -52,11 +52,6 @@ HeapScale heapScale(std::uint64_t seed, std::uint64_t k) {
   return {1.0 + kSizeVariation * (2.0 * u(kSize) - 1.0), 0.8 + 0.4 * u(kHeight)};
 }
 
-// Beyond this many heap radii from the eye a heap keeps only the ellipsoids that set its
-// outline (its base, one mound standing for its lobes, a cumulonimbus's anvil); nearer, every
-// lobe.
-constexpr double kDetailRadii = 12.0;
-
 // How heaps take the wind shear (MODEL.md section 10): they lean downwind by kLean times the
 // shear's share metres per metre of height, and a cumulonimbus's anvil is carried downwind;
 // the share is |shear| / kFullShear, at most 1.
@@ -523,21 +518,23 @@ EllipsoidCloud typicalHeap(const CloudField& f, glm::dvec3 base) {
   return heap;
 }
 
-double heapRange(const CloudField& f, const Camera& camera, double heap_range_m) {
-  if (heap_range_m > 0.0) return heap_range_m;
+double heapRange(const CloudField& f, const Camera& camera, double range_m) {
+  if (range_m > 0.0) return range_m;
   // From high up the view reaches further: the range grows with the height above the heaps.
   return CloudField::kRangeM + 2.0 * std::abs(camera.position.z - f.base_m);
 }
 
 std::vector<EllipsoidCloud> fieldClouds(const CloudField& f, const Camera& camera,
-                                        double heap_range_m) {
+                                        const HeapDrawing& drawing) {
   std::vector<EllipsoidCloud> out;
   if (!(peakCoverage(f) > 0.0)) return out;
   const double size = fieldTileSize(f);
   // The eye in the field's own frame (the field has drifted by drift_m).
   const glm::dvec2 eye = glm::dvec2(camera.position) - f.drift_m;
-  const double range = heapRange(f, camera, heap_range_m);
+  const double range = heapRange(f, camera, drawing.range_m);
   const ViewBasis basis = viewBasis(camera);
+  // Pixels per metre at unit distance: a heap of radius r at distance d spans r focal / d.
+  const double focal_px = 0.5 * camera.height / basis.tan_half_vfov;
   const double rise = f.clusters.none() ? 1.0 : 1.0 + f.clusters.amount;
   const double top = f.base_m + (isCb(f) ? 1.3 : 1.2) * f.thickness_m * rise;
   // A tile is kept when its box (grown by the largest heap that can reach out of it) is not
@@ -550,17 +547,18 @@ std::vector<EllipsoidCloud> fieldClouds(const CloudField& f, const Camera& camer
     for (double ix = lo.x; ix <= hi.x; ++ix) {
       const glm::dvec2 min_xy = glm::dvec2(ix, jy) * size - reach;
       const glm::dvec2 max_xy = glm::dvec2(ix + 1.0, jy + 1.0) * size + reach;
-      const glm::dvec2 nearest = glm::clamp(eye, min_xy, max_xy);
-      const double distance = glm::length(nearest - eye);
       if (glm::length(glm::dvec2(ix + 0.5, jy + 0.5) * size - eye) > range) continue;
       // Tiles where the region leaves no cover are never built.
       if (regionExcludesDisc(f.region, glm::dvec2(ix + 0.5, jy + 0.5) * size,
                              std::sqrt(0.5) * size))
         continue;
-      if (!boxMayBeInView(basis, eye3, glm::dvec3(min_xy, f.base_m), glm::dvec3(max_xy, top)))
-        continue;
+      const glm::dvec3 box_min(min_xy, f.base_m), box_max(max_xy, top);
+      if (!boxMayBeInView(basis, eye3, box_min, box_max)) continue;
       const std::int64_t i = std::int64_t(ix), j = std::int64_t(jy);
-      const bool detailed = distance < kDetailRadii * heapRadius(f);
+      // The nearest point of the tile's box stands for its heaps, so a tile is detailed when its
+      // nearest heap would be.
+      const double distance = glm::length(glm::clamp(eye3, box_min, box_max) - eye3);
+      const bool detailed = heapRadius(f) * focal_px >= drawing.detail_px * distance;
       const auto tile =
           tileCache().get({key, i, j, detailed}, [&] { return makeTile(f, i, j, detailed); });
       if (tile->ellipsoids.empty()) continue;
@@ -663,13 +661,13 @@ CloudLayer farDeck(const CloudField& f, double range, glm::dvec3 to_sun) {
 
 }  // namespace
 
-Scene withFieldClouds(const Scene& scene, double heap_range_m) {
+Scene withFieldClouds(const Scene& scene, const HeapDrawing& drawing) {
   Scene out = scene;
   for (const CloudField& field : scene.fields) {
-    std::vector<EllipsoidCloud> heaps = fieldClouds(field, scene.camera, heap_range_m);
+    std::vector<EllipsoidCloud> heaps = fieldClouds(field, scene.camera, drawing);
     out.clouds.insert(out.clouds.end(), std::make_move_iterator(heaps.begin()),
                       std::make_move_iterator(heaps.end()));
-    const double range = heapRange(field, scene.camera, heap_range_m);
+    const double range = heapRange(field, scene.camera, drawing.range_m);
     if (field.coverage > 0.0 && planeSeenBeyond(scene.camera, field.base_m, range))
       out.layers.push_back(farDeck(field, range, sunDirection(scene.sun)));
   }

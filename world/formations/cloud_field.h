@@ -98,13 +98,23 @@ inline double fieldAltitude(const CloudField& field) {
 // the field's heaps are (the far deck takes its light from it; the look figures measure it).
 EllipsoidCloud typicalHeap(const CloudField& field, glm::dvec3 base);
 
-// How far from the camera heaps are drawn as ellipsoids: `heap_range_m` when positive, else
-// CloudField::kRangeM plus twice the camera's height above the field's base.
-double heapRange(const CloudField& field, const Camera& camera, double heap_range_m = 0.0);
+// How a render draws a field's heaps, by their distance from the eye (two knobs of the
+// error/time sweep, docs/ACCURACY.md): as ellipsoids out to `range_m` and as a far deck beyond
+// (MODEL.md section 11; 0: CloudField::kRangeM plus twice the camera's height above the field's
+// base); every lobe of a heap whose radius spans at least `detail_px` pixels of the view, and
+// below that only the ellipsoids that set its outline (its base, one mound for its lobes, a
+// cumulonimbus's anvil); 0 draws every lobe at any distance.
+struct HeapDrawing {
+  double range_m = 0.0;
+  double detail_px = 32.0;
+};
+
+// The range of heaps drawn as ellipsoids: `range_m` when positive, else the automatic one.
+double heapRange(const CloudField& field, const Camera& camera, double range_m = 0.0);
 
 // The heaps of every tile within heapRange of the camera whose bounds meet its view, drifted
 // into place.
 std::vector<EllipsoidCloud> fieldClouds(const CloudField& field, const Camera& camera,
-                                        double heap_range_m = 0.0);
+                                        const HeapDrawing& drawing = {});
 
 }  // namespace nephele
