@@ -111,6 +111,7 @@ void printBodyFigures(GlRenderer& renderer, const SceneFile& file) {
   for (std::int64_t i = -1; i <= 1; ++i)
     for (std::int64_t j = -1; j <= 1; ++j) {
       Scene scene = file.scene;
+      scene.haze.reset();  // the figures are of the clouds' own light, not of the air
       scene.fields.clear();
       scene.layers.clear();
       scene.clouds = tileClouds(field, i, j);
@@ -179,7 +180,9 @@ double median(std::vector<double> v) {
 // of its largest connected silhouette (coverage > 0.5) over its left half, split at the
 // silhouette's centroid column. (c) With the sun 12 degrees above the line to the heap's middle,
 // behind it, the median light per unit opacity of its thin edge (coverage 0.05 to 0.5) over its
-// body's (coverage > 0.95): a silver lining is > 1.
+// body's (coverage > 0.95): a silver lining is > 1. (a) On the side-lit view's silhouette, its
+// outline's dimension and the fraction of it within a pixel of its moment ellipse
+// (outlineFigures, image/cloud_statistics.h).
 void printLightFigures(GlRenderer& renderer, const SceneFile& file, const std::string& name,
                        const std::string& images) {
   if (file.scene.fields.empty()) return;
@@ -192,6 +195,7 @@ void printLightFigures(GlRenderer& renderer, const SceneFile& file, const std::s
   const double size = std::max(box.hi.z - box.lo.z, widest);
   const double distance = std::max(8000.0, 3.0 * size);
   Scene scene = file.scene;
+  scene.haze.reset();  // the figures are of the clouds' own light, not of the air
   scene.fields.clear();
   scene.layers.clear();
   scene.clouds = {heap};
@@ -237,6 +241,11 @@ void printLightFigures(GlRenderer& renderer, const SceneFile& file, const std::s
     if (alpha > 0.05f && alpha < 0.5f) edge.push_back(ownLuminance(back, back_sky, p));
     if (alpha > 0.95f) body.push_back(ownLuminance(back, back_sky, p));
   }
+  const OutlineFigures outline = outlineFigures(covered, c.width, c.height);
+  std::printf(
+      "  outline: heap seen level from %.1f km, %zu px: dimension %.3f (ellipse 1.0, cumulus "
+      "1.3 to 1.4), %.2f of the outline within a pixel of its moment ellipse\n",
+      distance / 1000.0, covered.size(), outline.dimension, outline.near_ellipse);
   std::printf(
       "  light: heap of %zu ellipsoids, %.0f m wide; sun 90 deg to the side: sunlit half / "
       "shadowed half %.2f (%zu, %zu px); sun 12 deg behind: thin edge / body per unit opacity "

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <map>
 #include <numbers>
 #include <utility>
@@ -165,6 +166,72 @@ Fitted transectSpectrumSlope(const std::vector<double>& field, int w, double lon
   }
   const LineFit fit = fitLine(log_k, log_power);
   return {fit.slope, fit.points};
+}
+
+OutlineFigures outlineFigures(const std::vector<int>& pixels, int width, int height) {
+  OutlineFigures out;
+  if (pixels.empty() || width <= 0 || height <= 0) return out;
+  std::vector<std::uint8_t> in(std::size_t(width) * height, 0);
+  for (int p : pixels) in[std::size_t(p)] = 1;
+  // Perimeter of the silhouette coarse-grained into s x s blocks, in pixel lengths.
+  auto perimeter = [&](int s) {
+    const int bw = (width + s - 1) / s, bh = (height + s - 1) / s;
+    std::vector<std::uint8_t> block(std::size_t(bw) * bh, 0);
+    for (int by = 0; by < bh; ++by)
+      for (int bx = 0; bx < bw; ++bx) {
+        int count = 0;
+        for (int y = by * s; y < std::min(by * s + s, height); ++y)
+          for (int x = bx * s; x < std::min(bx * s + s, width); ++x)
+            count += in[std::size_t(y) * width + x];
+        block[std::size_t(by) * bw + bx] = 2 * count >= s * s;
+      }
+    auto at = [&](int x, int y) {
+      return x >= 0 && y >= 0 && x < bw && y < bh && block[std::size_t(y) * bw + x];
+    };
+    long edges = 0;
+    for (int y = 0; y < bh; ++y)
+      for (int x = 0; x < bw; ++x)
+        if (at(x, y)) edges += !at(x - 1, y) + !at(x + 1, y) + !at(x, y - 1) + !at(x, y + 1);
+    return double(edges) * s;
+  };
+  std::vector<double> log_s, log_p;
+  for (int s : {1, 2, 4, 8})
+    if (const double p = perimeter(s); p > 0.0) {
+      log_s.push_back(std::log(double(s)));
+      log_p.push_back(std::log(p));
+    }
+  if (log_s.size() >= 2) out.dimension = 1.0 - fitLine(log_s, log_p).slope;
+  // The ellipse of the same second moments: a filled ellipse of semi-axes a, b has covariance
+  // eigenvalues a^2 / 4 and b^2 / 4, so its boundary is d^T C^-1 d = 4.
+  double mx = 0.0, my = 0.0;
+  for (int p : pixels) mx += p % width + 0.5, my += p / width + 0.5;
+  mx /= double(pixels.size()), my /= double(pixels.size());
+  double cxx = 0.0, cxy = 0.0, cyy = 0.0;
+  for (int p : pixels) {
+    const double dx = p % width + 0.5 - mx, dy = p / width + 0.5 - my;
+    cxx += dx * dx, cxy += dx * dy, cyy += dy * dy;
+  }
+  const double n = double(pixels.size());
+  cxx = cxx / n + 1.0 / 12.0, cxy /= n, cyy = cyy / n + 1.0 / 12.0;  // + a pixel's own spread
+  const double det = cxx * cyy - cxy * cxy;
+  if (!(det > 0.0)) return out;
+  int outline = 0, near = 0;
+  for (int p : pixels) {
+    const int x = p % width, y = p / width;
+    auto inside = [&](int u, int v) {
+      return u >= 0 && v >= 0 && u < width && v < height && in[std::size_t(v) * width + u];
+    };
+    if (inside(x - 1, y) && inside(x + 1, y) && inside(x, y - 1) && inside(x, y + 1)) continue;
+    ++outline;
+    const double dx = x + 0.5 - mx, dy = y + 0.5 - my;
+    const double q = std::sqrt((cyy * dx * dx - 2.0 * cxy * dx * dy + cxx * dy * dy) / det) / 2.0;
+    const double r = std::hypot(dx, dy);
+    // The boundary lies at r / q along this ray; the pixel's centre is half a pixel inside an
+    // outline that follows the ellipse exactly.
+    if (q > 0.0 && std::abs(r - r / q) <= 1.0) ++near;
+  }
+  out.near_ellipse = outline > 0 ? double(near) / outline : 0.0;
+  return out;
 }
 
 }  // namespace nephele

@@ -42,6 +42,20 @@ struct Fitted {
 // edges, which makes D = 1 for squares and biases it upwards for clouds a few pixels across.
 Fitted perimeterAreaDimension(const std::vector<CloudRegion>& clouds, int min_pixels);
 
+// The outline of one silhouette (issue 27 item 5a), given as its pixels in a w x h image:
+// - dimension: the outline's divider dimension, D = 1 - d log P / d log s, where P(s) is the
+//   perimeter (pixel edges times s) of the silhouette coarse-grained into s x s blocks (a block
+//   is in it when at least half its pixels are), for s = 1, 2, 4, 8: a smooth outline keeps its
+//   perimeter at every scale (D = 1 for an ellipse), a fractal one loses the detail each coarser
+//   scale cannot hold (D = 1.26 for Koch's curve; cumulus outlines about 1.3 to 1.4).
+// - near_ellipse: the fraction of its outline pixels (those with a 4-neighbour outside it)
+//   within one pixel of the ellipse of the same second moments, measured along the ray from the
+//   ellipse's centre: 1 for an ellipse, low for an outline of turrets and notches.
+struct OutlineFigures {
+  double dimension = 0.0, near_ellipse = 0.0;
+};
+OutlineFigures outlineFigures(const std::vector<int>& pixels, int width, int height);
+
 // Exponent a of the cloud size distribution n(A) ~ A^-a (clouds per unit of area), fitted on
 // logarithmic bins of area (four per decade) from `min_pixels` up, bins with clouds only.
 Fitted sizeDistributionExponent(const std::vector<CloudRegion>& clouds, int min_pixels);

@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <random>
 
@@ -83,6 +85,73 @@ TEST(CloudStatistics, SizeDistributionExponent) {
   const Fitted a = sizeDistributionExponent(clouds, 16);
   EXPECT_GE(a.points, 10);
   EXPECT_NEAR(a.value, 2.0, 0.15);
+}
+
+// Pixels of the polygon (even-odd rule) rasterised at pixel centres on a w x h grid.
+std::vector<int> fillPolygon(const std::vector<std::pair<double, double>>& poly, int w, int h) {
+  std::vector<int> pixels;
+  for (int y = 0; y < h; ++y) {
+    const double yc = y + 0.5;
+    std::vector<double> xs;
+    for (std::size_t i = 0; i < poly.size(); ++i) {
+      const auto [x0, y0] = poly[i];
+      const auto [x1, y1] = poly[(i + 1) % poly.size()];
+      if ((y0 <= yc) != (y1 <= yc)) xs.push_back(x0 + (yc - y0) / (y1 - y0) * (x1 - x0));
+    }
+    std::sort(xs.begin(), xs.end());
+    for (std::size_t k = 0; k + 1 < xs.size(); k += 2)
+      for (int x = std::max(0, int(std::ceil(xs[k] - 0.5))); x < w && x + 0.5 < xs[k + 1]; ++x)
+        pixels.push_back(y * w + x);
+  }
+  return pixels;
+}
+
+// A smooth outline: an ellipse keeps its perimeter at every scale (D = 1) and nearly all of its
+// outline pixels lie within a pixel of its moment ellipse.
+TEST(CloudStatistics, AnEllipseOutlineIsSmoothAndOnItsEllipse) {
+  std::vector<std::pair<double, double>> ellipse;
+  for (int i = 0; i < 720; ++i) {
+    const double t = 2.0 * std::numbers::pi * i / 720.0, c = std::cos(0.5), s = std::sin(0.5);
+    const double x = 170.0 * std::cos(t), y = 90.0 * std::sin(t);
+    ellipse.push_back({256.0 + c * x - s * y, 256.0 + s * x + c * y});
+  }
+  const OutlineFigures f = outlineFigures(fillPolygon(ellipse, 512, 512), 512, 512);
+  std::printf("ellipse: D %.3f, near its ellipse %.3f\n", f.dimension, f.near_ellipse);
+  EXPECT_NEAR(f.dimension, 1.0, 0.03);
+  EXPECT_GT(f.near_ellipse, 0.9);  // 0.94: staircase corners lie up to 1.2 px out
+}
+
+// Koch's snowflake (five levels, its smallest segment 1.3 pixels) has dimension
+// log 4 / log 3 = 1.26 (measured 1.31: the coarsest scales see the first levels only) and an
+// outline mostly off its moment ellipse.
+TEST(CloudStatistics, KochsSnowflakeOutlineIsFractal) {
+  std::vector<std::pair<double, double>> poly;
+  for (int i = 0; i < 3; ++i) {
+    const double t = std::numbers::pi / 2.0 - 2.0 * std::numbers::pi * i / 3.0;
+    poly.push_back({256.0 + 180.0 * std::cos(t), 256.0 + 180.0 * std::sin(t)});
+  }
+  for (int level = 0; level < 5; ++level) {
+    std::vector<std::pair<double, double>> next;
+    for (std::size_t i = 0; i < poly.size(); ++i) {
+      const auto [x0, y0] = poly[i];
+      const auto [x1, y1] = poly[(i + 1) % poly.size()];
+      const double dx = (x1 - x0) / 3.0, dy = (y1 - y0) / 3.0;
+      const double c = 0.5, s = std::sqrt(3.0) / 2.0;  // the bump outwards (clockwise order)
+      next.push_back({x0, y0});
+      next.push_back({x0 + dx, y0 + dy});
+      next.push_back({x0 + dx + c * dx - s * dy, y0 + dy + s * dx + c * dy});
+      next.push_back({x0 + 2.0 * dx, y0 + 2.0 * dy});
+    }
+    poly = next;
+  }
+  const std::vector<int> pixels = fillPolygon(poly, 512, 512);
+  // The snowflake's area is 8/5 of its first triangle's.
+  const double triangle = 3.0 * std::sqrt(3.0) / 4.0 * 180.0 * 180.0;
+  ASSERT_NEAR(double(pixels.size()), 1.6 * triangle, 0.03 * triangle);
+  const OutlineFigures f = outlineFigures(pixels, 512, 512);
+  std::printf("Koch: D %.3f, near its ellipse %.3f\n", f.dimension, f.near_ellipse);
+  EXPECT_NEAR(f.dimension, std::log(4.0) / std::log(3.0), 0.08);
+  EXPECT_LT(f.near_ellipse, 0.5);
 }
 
 }  // namespace

@@ -201,14 +201,19 @@ std::vector<Ellipsoid> heapEllipsoids(const CloudField& f, glm::dvec3 base, doub
   lobes.centre = glm::dvec2(base);
   lobes.boundary_radii = glm::dvec2(0.42 * r);
   lobes.spacing = glm::dvec2(0.3 * r);
-  lobes.altitude_m = base.z + 0.25 * h;
+  lobes.altitude_m = base.z + 0.18 * h;
   lobes.size_variation = 0.25;
   lobes.position_variation = 0.4;
   lobes.heading_variation_deg = 90.0;
   lobes.seed = hashCounters(seed, kShape, 2);
   std::vector<Ellipsoid> tower = clusterEllipsoids(lobes, {dome});
   const Shear shear = shearOf(f);
-  for (Ellipsoid& e : tower) e.centre += leanAt(shear, e.centre.z - base.z);
+  for (Ellipsoid& e : tower) {
+    // Nothing hangs below the condensation level: a lobe the dome does not raise rests on the
+    // flat base.
+    e.centre.z = std::max(e.centre.z, base.z + e.radii.z);
+    e.centre += leanAt(shear, e.centre.z - base.z);
+  }
   if (!detailed && !tower.empty()) tower = {mound(tower)};
   out.insert(out.end(), tower.begin(), tower.end());
   anvil_from = out.size();
