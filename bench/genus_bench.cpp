@@ -12,7 +12,9 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -399,6 +401,17 @@ void printAutomatonFigures(GlRenderer& renderer) {
       clouds, under_sum / clouds, top_sum / clouds, under_sum / std::max(top_sum, 1e-9));
 }
 
+// The process's resident and peak resident memory, MiB (Linux /proc/self/status).
+std::pair<double, double> residentMiB() {
+  std::ifstream status("/proc/self/status");
+  double rss = 0.0, peak = 0.0;
+  for (std::string line; std::getline(status, line);) {
+    if (line.rfind("VmRSS:", 0) == 0) rss = std::stod(line.substr(6)) / 1024.0;
+    if (line.rfind("VmHWM:", 0) == 0) peak = std::stod(line.substr(6)) / 1024.0;
+  }
+  return {rss, peak};
+}
+
 std::size_t ellipsoidCount(const Scene& scene) {
   std::size_t n = 0;
   for (const EllipsoidCloud& c : withFieldClouds(scene).clouds) n += c.ellipsoids.size();
@@ -516,6 +529,11 @@ int main(int argc, char** argv) {
             ellipsoidCount(scene));
         std::fflush(stdout);
       }
+      const auto [rss, peak] = residentMiB();
+      std::printf(
+          "  memory after %s at %s: resident %.0f MiB, peak %.0f MiB (the process, GL "
+          "included)\n",
+          path.stem().c_str(), size.c_str(), rss, peak);
     }
     GlRenderer renderer(*platform);
     printBodyFigures(renderer, file);
