@@ -143,6 +143,18 @@ std::optional<ProtocolError> Engine::pixelLimit(const ViewConfig& view) const {
                                               std::to_string(config_.max_image_pixels) + " pixels"};
 }
 
+std::optional<ProtocolError> Engine::platformLimit(const ViewConfig& view,
+                                                   const ImageRequest& image) const {
+  const State& s = *state_;
+  const Camera camera = view.frustum ? offAxisView(view.camera, *view.frustum).render : view.camera;
+  const bool linear = image.format == ImageFormat::kExr || image.floatPlanes();
+  // Target layers when the world has targets, or the channels may ask for depth or ids.
+  const bool targets = !s.world->base().targets.empty() || image.floatPlanes();
+  const std::string error = s.renderer->reserveTarget(camera.width, camera.height, linear, targets);
+  if (error.empty()) return std::nullopt;
+  return ProtocolError{ErrorCode::kLimit, "view " + view.name + ": " + error};
+}
+
 std::optional<Outcome> Engine::renderRequest(const command::Render& c, Job& job) {
   State& s = *state_;
   std::vector<ViewConfig> views;
@@ -157,6 +169,8 @@ std::optional<Outcome> Engine::renderRequest(const command::Render& c, Job& job)
   }
   if (encoder_->depth() >= kEncoderQueue)
     return ProtocolError{ErrorCode::kBusy, "the image encoder is busy; try again"};
+  for (const ViewConfig& v : views)
+    if (auto error = platformLimit(v, c.image.value_or(v.image))) return *error;
   // Every view is rendered before anything else runs on this thread: one tick, one world.
   struct Part {
     std::shared_ptr<ViewFrame> frame;
@@ -234,6 +248,11 @@ void Engine::deliverFrames(Delivery which, const std::string& view_name) {
       std::shared_ptr<ViewFrame> planes;  // ground-truth channels: rendered for this group
       std::shared_ptr<ViewFrame>& frame = image.floatPlanes() ? planes : frames[linear ? 1 : 0];
       if (!frame) {
+        if (auto error = platformLimit(*view, image)) {
+          spdlog::error("event=frame_skipped view={} error=\"{}\"", view->name, error->message);
+          frames_dropped += members.size();
+          continue;
+        }
         frame = std::make_shared<ViewFrame>();
         renderFrame(*view, image, *frame);
       }
@@ -267,6 +286,10 @@ void Engine::renderTrigger() {
   auto frame = std::make_shared<ViewFrame>();
   ImageRequest image;
   image.format = config_.output_format;
+  if (auto error = platformLimit(view, image)) {
+    spdlog::error("event=render_trigger_failed view={} error=\"{}\"", view.name, error->message);
+    return;
+  }
   renderFrame(view, image, *frame);
   const std::string extension = config_.output_format == ImageFormat::kPng    ? ".png"
                                 : config_.output_format == ImageFormat::kJpeg ? ".jpg"

@@ -42,6 +42,7 @@ std::optional<ProtocolError> Engine::check(const Command& command) const {
     ViewConfig changed = *view;
     applyViewPatch(changed, c->patch);
     if (auto error = pixelLimit(changed)) return error;
+    if (auto error = platformLimit(changed, changed.image)) return error;
   }
   if (const auto* c = std::get_if<command::Tick>(&command)) {
     if (s.mode == TickMode::kRealtime)
@@ -248,6 +249,7 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
                                "subscribe: the daemon serves " +
                                    std::to_string(config_.max_subscriptions) +
                                    " subscriptions already (the configured limit)"};
+        if (auto error = platformLimit(*v, c.image.value_or(v->image))) return *error;
         Subscription sub;
         sub.id = s.next_subscription++;
         sub.client = job.client;

@@ -157,6 +157,10 @@ class Engine {
   std::optional<std::variant<nlohmann::json, ProtocolError>> renderRequest(const command::Render& c,
                                                                            Job& job);
   std::optional<ProtocolError> pixelLimit(const ViewConfig& view) const;
+  // Whether this GL can allocate the target `view` needs for `image` (a size within the
+  // configured pixel limit may still be more than the platform holds); asked before any work.
+  std::optional<ProtocolError> platformLimit(const ViewConfig& view,
+                                             const ImageRequest& image) const;
   // Snapshots: the World's file and the daemon's state beside it (snapshots.cpp).
   nlohmann::json daemonState() const;
   std::string writeSnapshot(const std::string& path);

@@ -332,6 +332,28 @@ class SocketProtocolTest(DaemonTest):
         view = c.ok({"cmd": "get_view", "view": "front"})
         self.assertEqual((view["vfov"], view["width"]), (40.0, 64))
 
+    def test_views_the_platform_cannot_hold_are_refused_before_any_work(self):
+        # Within the configured 256 MiP, and as 8-bit within what llvmpipe holds, but as float
+        # (EXR) more than its 2 GiB per buffer: refused with `limit` at render and subscribe
+        # (it killed the daemon before), and the daemon keeps serving. set_view asks for the
+        # view's own format (raw here) and accepts it.
+        d = self.daemon(socket_keys="max_image_pixels = 256")
+        c = d.client()
+        before = c.ok({"cmd": "hash"})
+        c.ok({"cmd": "set_view", "view": "front", "width": 11585, "height": 11585})
+        for request in [{"cmd": "render", "view": "front", "format": "exr"},
+                        {"cmd": "subscribe", "view": "front", "format": "exr", "rate": 1}]:
+            with self.subTest(request=request):
+                error = c.error(request)
+                self.assertEqual(error["code"], "limit")
+                self.assertIn("cannot allocate", error["message"])
+        c.ok({"cmd": "set_view", "view": "front", "width": 64, "height": 48})
+        header, image = c.request({"cmd": "render", "view": "front", "format": "raw"})
+        self.assertTrue(header["ok"])
+        self.assertEqual(len(image), 64 * 48 * 4)
+        self.assertEqual(c.ok({"cmd": "hash"})["hash"], before["hash"])
+        self.assertIsNone(d.proc.poll())
+
     def test_weather_clouds_tick_and_hash(self):
         d = self.daemon()
         c = d.client()
