@@ -79,7 +79,7 @@ void main() {
   }
   float alpha = 1.0 - transmittance;
   if (alpha <= 0.0) discard;
-  // Fog as for a surface at the entry point, on the straight colour.
+  // The air (fog, haze) as for a surface at the entry point, on the straight colour.
   o_colour = vec4(alpha * applyAir(radiance / alpha, d, enter), alpha);
 }
 )";
