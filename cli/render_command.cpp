@@ -245,8 +245,7 @@ int runRenderCommand(const RenderCommandOptions& o) {
   }
   spdlog::info("renderer: {}", renderer->description());
   const Camera& camera = file.scene.camera;
-  const bool targets = !file.scene.targets.empty() || request.channels.has(Channel::kDepth) ||
-                       request.channels.has(Channel::kObjectId);
+  const bool targets = needsTargetLayers(!file.scene.targets.empty(), request.channels);
   if (std::string e =
           renderer->reserve(camera.width, camera.height, isFloatFormat(*format), targets);
       !e.empty()) {

@@ -72,6 +72,12 @@ class ChannelSet {
   unsigned bits_ = 0;
 };
 
+// Whether a frame needs the GL renderer's target layers besides its colour target (what
+// Renderer::reserve is asked for): the scene has targets, or depth or object ids are asked.
+inline bool needsTargetLayers(bool scene_has_targets, const ChannelSet& channels) {
+  return scene_has_targets || channels.has(Channel::kDepth) || channels.has(Channel::kObjectId);
+}
+
 // Where a frame was seen from: the pose, the pinhole intrinsics and the clock.
 struct FrameInfo {
   glm::dvec3 position{0.0};

@@ -127,9 +127,17 @@ void Engine::renderFrame(const ViewConfig& view, const ImageRequest& image, View
   if (view.frustum) frame.meta["camera"]["frustum"] = frustumJson(*view.frustum);
 }
 
+namespace {
+
+// The camera a view is rendered with: an off-axis view renders the centred view that holds it.
+Camera renderedCamera(const ViewConfig& view) {
+  return view.frustum ? offAxisView(view.camera, *view.frustum).render : view.camera;
+}
+
+}  // namespace
+
 std::optional<ProtocolError> Engine::pixelLimit(const ViewConfig& view) const {
-  // An off-axis view renders the centred view that holds it.
-  const Camera camera = view.frustum ? offAxisView(view.camera, *view.frustum).render : view.camera;
+  const Camera camera = renderedCamera(view);
   if (camera.width > Limits::kMaxImageSide || camera.height > Limits::kMaxImageSide)
     return ProtocolError{ErrorCode::kLimit, "frustum: the view it is cut from would be " +
                                                 std::to_string(camera.width) + "x" +
@@ -146,10 +154,9 @@ std::optional<ProtocolError> Engine::pixelLimit(const ViewConfig& view) const {
 std::optional<ProtocolError> Engine::platformLimit(const ViewConfig& view,
                                                    const ImageRequest& image) const {
   const State& s = *state_;
-  const Camera camera = view.frustum ? offAxisView(view.camera, *view.frustum).render : view.camera;
+  const Camera camera = renderedCamera(view);
   const bool linear = image.format == ImageFormat::kExr || image.floatPlanes();
-  // Target layers when the world has targets, or the channels may ask for depth or ids.
-  const bool targets = !s.world->base().targets.empty() || image.floatPlanes();
+  const bool targets = needsTargetLayers(!s.world->base().targets.empty(), image.planes);
   const std::string error = s.renderer->reserveTarget(camera.width, camera.height, linear, targets);
   if (error.empty()) return std::nullopt;
   return ProtocolError{ErrorCode::kLimit, "view " + view.name + ": " + error};
