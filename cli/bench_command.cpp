@@ -137,15 +137,15 @@ std::vector<Setting> settingsFor(const SceneFile& file) {
           [px](RenderSettings& s) { s.impostor_tolerance_px = px; });
   }
   // Heaps beyond the range drawn as a far deck (MODEL.md section 11), against the reference's
-  // heaps out to the automatic range.
-  if (!file.scene.fields.empty())
+  // heaps out to the automatic range; and every lobe of heaps whose radius spans `heap_detail`
+  // pixels, their outlines below (0: every lobe, as the reference draws them; 10000: outlines
+  // alone).
+  if (!file.scene.fields.empty()) {
     for (double m : {5000.0, 15000.0})
       add("heap_range", withKnob(m), [m](RenderSettings& s) { s.heaps.range_m = m; });
-  // Every lobe of heaps whose radius spans this many pixels, their outlines below (0: every
-  // lobe, as the reference draws them; 10000: outlines alone).
-  if (!file.scene.fields.empty())
     for (double px : {0.0, 16.0, 64.0, 10000.0})
       add("heap_detail", withKnob(px), [px](RenderSettings& s) { s.heaps.detail_px = px; });
+  }
   if (!file.dynamics.automata.empty()) {
     for (double step : {0.5, 2.0, 4.0})
       add("volume_step", withKnob(step), [step](RenderSettings& s) { s.volume_step = step; });

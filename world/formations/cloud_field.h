@@ -98,8 +98,8 @@ inline double fieldAltitude(const CloudField& field) {
 // the field's heaps are (the far deck takes its light from it; the look figures measure it).
 EllipsoidCloud typicalHeap(const CloudField& field, glm::dvec3 base);
 
-// How a render draws a field's heaps, by their distance from the eye (two knobs of the
-// error/time sweep, docs/ACCURACY.md): as ellipsoids out to `range_m` and as a far deck beyond
+// How a render draws a field's heaps, by their distance and their size in the view (two knobs of
+// the error/time sweep, docs/ACCURACY.md): as ellipsoids out to `range_m` and as a far deck beyond
 // (MODEL.md section 11; 0: CloudField::kRangeM plus twice the camera's height above the field's
 // base); every lobe of a heap whose radius spans at least `detail_px` pixels of the view, and
 // below that only the ellipsoids that set its outline (its base, one mound for its lobes, a
