@@ -151,6 +151,19 @@ TEST_F(WeatherRenderTest, EveryGenusDrawsTheCoverageAsked) {
   }
 }
 
+// The species change a heap's shape (genus.h, Species): the cover drawn still follows the
+// asked where their rows measured it and between them.
+TEST_F(WeatherRenderTest, EverySpeciesDrawsTheCoverageAsked) {
+  for (double thickness : {500.0, 2200.0, 4000.0})
+    for (double c : {0.3, 0.5}) {
+      WeatherLayer w = typicalWeatherLayer(CloudType::kCumulus, c);
+      w.thickness_m = thickness;
+      const double drawn = drawnFraction(w, 11);
+      std::printf("cumulus %5.0f m thick at %.1f: drawn %.3f\n", thickness, c, drawn);
+      EXPECT_NEAR(drawn, c, 0.05) << thickness << " m thick";
+    }
+}
+
 TEST_F(WeatherRenderTest, NoGenusRepeatsAtHalfCover) {
   for (CloudType type : kGenera) {
     const WeatherLayer w = typicalWeatherLayer(type, 0.5);
@@ -270,6 +283,42 @@ TEST(CloudField, CumulonimbusIsOneTowerUnderAnAnvilCarriedDownwind) {
     else
       EXPECT_LT(std::abs(anvil.middle() - tower.middle()), 0.1 * f.thickness_m);
   }
+}
+
+// Species (genus.h): a layer's heaps are of the species its thickness names, and a heap's width
+// over its height, measured on its ellipsoids (extents from each one's support |W^-T d|), is
+// its row's within a third at the row's thickness and falls as the layer thickens: humilis
+// wider than tall, congestus taller than wide.
+TEST(CloudField, HeapsTakeTheShapeOfTheirSpecies) {
+  auto widthOverHeight = [](const CloudField& f) {
+    double width = 0.0, top = 0.0;
+    for (const Ellipsoid& e : typicalHeap(f, {0.0, 0.0, f.base_m}).ellipsoids) {
+      const glm::dmat3 inverse = glm::inverse(glm::transpose(worldToUnitSphere(e)));
+      width = std::max(width, std::abs(e.centre.x) + glm::length(inverse * glm::dvec3(1, 0, 0)));
+      top = std::max(top, e.centre.z + glm::length(inverse * glm::dvec3(0, 0, 1)));
+    }
+    return 2.0 * width / (top - f.base_m);
+  };
+  CloudField f;
+  f.base_m = 1200.0;
+  double previous = 1e9;
+  for (const Species& row : genus(CloudType::kCumulus).species) {
+    SCOPED_TRACE(std::string(row.name));
+    f.thickness_m = row.thickness_m;
+    EXPECT_EQ(heapSpecies(f), row.name);
+    const double ratio = widthOverHeight(f);
+    std::printf("%-10s %5.0f m: width over height %.2f (row %.2f)\n", std::string(row.name).c_str(),
+                row.thickness_m, ratio, row.width_over_height);
+    EXPECT_NEAR(ratio, row.width_over_height, row.width_over_height / 3.0);
+    EXPECT_LT(ratio, previous);
+    previous = ratio;
+  }
+  f.thickness_m = 400.0;
+  EXPECT_EQ(heapSpecies(f), "humilis");
+  EXPECT_GT(widthOverHeight(f), 1.5);
+  f.thickness_m = 6000.0;
+  EXPECT_EQ(heapSpecies(f), "congestus");
+  EXPECT_LT(widthOverHeight(f), 1.0);
 }
 
 // The genus table (world/formations/genus.h) is what every reader sees: each genus's name

@@ -8,6 +8,7 @@
 #include <map>
 #include <mutex>
 #include <numbers>
+#include <span>
 #include <sstream>
 #include <tuple>
 
@@ -35,10 +36,25 @@ const HeapLook& lookOf(const CloudField& f) {
   return genus(f.type).heap_look;
 }
 
-// Typical horizontal radius of a heap's base, metres (the genus table's radius per metre of
-// thickness).
+// A heap's width over its height for the field's thickness: its genus's species rows
+// interpolated in log thickness (genus.h, Species).
+double widthOverHeight(const CloudField& f) {
+  const std::span<const Species> rows = genus(f.type).species;
+  if (rows.empty()) return 1.8;  // fields are only made of genera with species
+  const double t = f.thickness_m;
+  if (!(t > rows.front().thickness_m)) return rows.front().width_over_height;
+  for (std::size_t i = 1; i < rows.size(); ++i)
+    if (t <= rows[i].thickness_m) {
+      const Species &a = rows[i - 1], &b = rows[i];
+      const double s = std::log(t / a.thickness_m) / std::log(b.thickness_m / a.thickness_m);
+      return a.width_over_height * std::pow(b.width_over_height / a.width_over_height, s);
+    }
+  return rows.back().width_over_height;
+}
+
+// Typical horizontal radius of a heap's base, metres.
 double heapRadius(const CloudField& f) {
-  return lookOf(f).radius * f.thickness_m;
+  return 0.5 * widthOverHeight(f) * f.thickness_m;
 }
 constexpr double kSizeVariation = 0.3;  // radius times 1 + v (2u - 1)
 
@@ -185,34 +201,45 @@ std::vector<Ellipsoid> heapEllipsoids(const CloudField& f, glm::dvec3 base, doub
   const double squash = 0.8 + 0.2 * unitFromBits(hashCounters(seed, kShape));
   if (isCb(f)) return cumulonimbusEllipsoids(f, base, r, h, squash, seed, detailed, anvil_from);
   std::vector<Ellipsoid> out;
-  // The flat base: wide, a third of the height, its bottom on the cloud base.
+  // A heap taller than about its width (congestus) is a tower of tiers, each a mound as a
+  // mediocris heap is, narrowing upwards (MODEL.md section 10).
+  const int tiers = std::clamp(int(std::lround(h / (1.1 * r))), 1, 4);
+  const double tier_h = h / tiers;
+  // The flat base: wide, a third of the (lowest tier's) height, its bottom on the cloud base.
+  // It sets the footprint whether the lobes or their mound are drawn (a narrower base under a
+  // tower lets the far mound cover less than the lobes: 0.22 drawn for 0.3 asked).
   Ellipsoid bottom;
-  bottom.radii = {r, r * squash, 0.3 * h};
+  bottom.radii = {r, r * squash, 0.3 * tier_h};
   bottom.centre = base + glm::dvec3(0.0, 0.0, bottom.radii.z);
   bottom.orientation.heading_deg = 360.0 * unitFromBits(hashCounters(seed, kShape, 1));
   out.push_back(bottom);
-  // Gardner's towers: lobes on a jittered lattice raised by a dummy dome under the middle,
-  // leaning downwind with the shear.
-  Ellipsoid dome;
-  dome.radii = {0.45 * r, 0.45 * r, 0.55 * h};
-  dome.centre = glm::dvec3(glm::dvec2(base), 0.0);  // terrainHeight counts from z = 0
-  ClusterSpec lobes;
-  lobes.element.radii = {0.38 * r, 0.38 * r, 0.3 * h};
-  lobes.centre = glm::dvec2(base);
-  lobes.boundary_radii = glm::dvec2(0.42 * r);
-  lobes.spacing = glm::dvec2(0.3 * r);
-  lobes.altitude_m = base.z + 0.18 * h;
-  lobes.size_variation = 0.25;
-  lobes.position_variation = 0.4;
-  lobes.heading_variation_deg = 90.0;
-  lobes.seed = hashCounters(seed, kShape, 2);
-  std::vector<Ellipsoid> tower = clusterEllipsoids(lobes, {dome});
+  // Gardner's towers: per tier, lobes on a jittered lattice raised by a dummy dome under the
+  // middle, leaning downwind with the shear.
   const Shear shear = shearOf(f);
-  for (Ellipsoid& e : tower) {
-    // Nothing hangs below the condensation level: a lobe the dome does not raise rests on the
-    // flat base.
-    e.centre.z = std::max(e.centre.z, base.z + e.radii.z);
-    e.centre += leanAt(shear, e.centre.z - base.z);
+  std::vector<Ellipsoid> tower;
+  for (int k = 0; k < tiers; ++k) {
+    const double floor = base.z + k * tier_h;
+    const double w = r * (tiers > 1 ? 1.0 - 0.25 * k / (tiers - 1) : 1.0);
+    Ellipsoid dome;
+    dome.radii = {0.45 * w, 0.45 * w, 0.55 * tier_h};
+    dome.centre = glm::dvec3(glm::dvec2(base), 0.0);  // terrainHeight counts from z = 0
+    ClusterSpec lobes;
+    lobes.element.radii = {0.38 * w, 0.38 * w, 0.3 * tier_h};
+    lobes.centre = glm::dvec2(base);
+    lobes.boundary_radii = glm::dvec2(0.42 * w);
+    lobes.spacing = glm::dvec2(0.3 * w);
+    lobes.altitude_m = floor + 0.18 * tier_h;
+    lobes.size_variation = 0.25;
+    lobes.position_variation = 0.4;
+    lobes.heading_variation_deg = 90.0;
+    lobes.seed = k == 0 ? hashCounters(seed, kShape, 2) : hashCounters(seed, kShape, 2 + k);
+    for (Ellipsoid e : clusterEllipsoids(lobes, {dome})) {
+      // Nothing hangs below the condensation level or its tier: a lobe the dome does not
+      // raise rests on the flat base or the tier under it.
+      e.centre.z = std::max(e.centre.z, floor + e.radii.z);
+      e.centre += leanAt(shear, e.centre.z - base.z);
+      tower.push_back(e);
+    }
   }
   if (!detailed && !tower.empty()) tower = {mound(tower)};
   out.insert(out.end(), tower.begin(), tower.end());
@@ -280,13 +307,14 @@ double orthographicOpacity(const EllipsoidCloud& cloud, const SolidTexture& text
 
 // Mean area seen straight down (`side` false) or from the side, horizontally, (`side` true)
 // with opacity >= 1/2 of one heap, in units of heapRadius^2, measured on 16 heaps whose sizes
-// and heights are drawn as the tiles draw theirs (the shape is scale-free but for the texture,
-// which scales with the field). Computed once per type and view.
-double unitArea(CloudType type, bool side) {
-  auto measure = [side](CloudType t) {
+// and heights are drawn as the tiles draw theirs. A heap's shape scales with its radius (the
+// texture with it) but for its width over height, so the area is measured once per species
+// row, at its thickness, on first use, and interpolated between rows in log thickness.
+double unitArea(const CloudField& field, bool side) {
+  auto measure = [side](CloudType t, double thickness) {
     CloudField f;
     f.type = t;
-    f.thickness_m = t == CloudType::kCumulonimbus ? 9000.0 : 1500.0;
+    f.thickness_m = thickness;
     const double r = heapRadius(f);
     const SolidTexture texture(heapCloud(f, "").texture);
     constexpr int kHeaps = 16, kGrid = 48;
@@ -316,25 +344,26 @@ double unitArea(CloudType type, bool side) {
     }
     return area / kHeaps;
   };
-  // Each measured on first use only: a sky of cumulus never pays for the cumulonimbus, and a
+  // Each row measured on first use only: a sky of cumulus never pays for the cumulonimbus, a
   // view that shows no far deck never measures a side.
-  if (type == CloudType::kCumulonimbus) {
-    if (side) {
-      static const double cumulonimbus_side = measure(CloudType::kCumulonimbus);
-      return cumulonimbus_side;
+  static std::mutex mutex;
+  static std::map<std::tuple<CloudType, std::size_t, bool>, double> measured;
+  const std::span<const Species> rows = genus(field.type).species;
+  auto row = [&](std::size_t i) {
+    std::lock_guard lock(mutex);
+    auto [it, added] = measured.try_emplace({field.type, i, side}, 0.0);
+    if (added) it->second = measure(field.type, rows[i].thickness_m);
+    return it->second;
+  };
+  const double t = field.thickness_m;
+  if (rows.size() < 2 || !(t > rows.front().thickness_m)) return row(0);
+  for (std::size_t i = 1; i < rows.size(); ++i)
+    if (t <= rows[i].thickness_m) {
+      const double s = std::log(t / rows[i - 1].thickness_m) /
+                       std::log(rows[i].thickness_m / rows[i - 1].thickness_m);
+      return (1.0 - s) * row(i - 1) + s * row(i);
     }
-    static const double cumulonimbus = measure(CloudType::kCumulonimbus);
-    return cumulonimbus;
-  }
-  if (side) {
-    static const double cumulus_side = measure(CloudType::kCumulus);
-    return cumulus_side;
-  }
-  static const double cumulus = measure(CloudType::kCumulus);
-  return cumulus;
-}
-double unitFootprint(CloudType type) {
-  return unitArea(type, false);
+  return row(rows.size() - 1);
 }
 
 // The most any point asks for.
@@ -346,7 +375,7 @@ double peakCoverage(const CloudField& f) {
 // Heaps per square metre giving cover c (Boolean model: 1 - exp(-density * mean footprint)).
 double heapDensity(const CloudField& f, double c) {
   const double r = heapRadius(f);
-  const double mean_area = unitFootprint(f.type) * r * r;
+  const double mean_area = unitArea(f, false) * r * r;
   return -std::log1p(-c) / mean_area;
 }
 
@@ -516,6 +545,16 @@ std::vector<EllipsoidCloud> tileClouds(const CloudField& f, std::int64_t i, std:
   return out;
 }
 
+std::string_view heapSpecies(const CloudField& f) {
+  const std::span<const Species> rows = genus(f.type).species;
+  std::string_view nearest = "";
+  double best = std::numeric_limits<double>::infinity();
+  for (const Species& s : rows)
+    if (const double d = std::abs(std::log(f.thickness_m / s.thickness_m)); d < best)
+      best = d, nearest = s.name;
+  return nearest;
+}
+
 EllipsoidCloud typicalHeap(const CloudField& f, glm::dvec3 base) {
   EllipsoidCloud heap = heapCloud(f, f.name + "/typical");
   std::size_t anvil_from = 0;
@@ -541,7 +580,7 @@ std::vector<EllipsoidCloud> fieldClouds(const CloudField& f, const Camera& camer
   // Pixels per metre at unit distance: a heap of radius r at distance d spans r focal / d.
   const double focal_px = 0.5 * camera.height / basis.tan_half_vfov;
   const double rise = f.clusters.none() ? 1.0 : 1.0 + f.clusters.amount;
-  const double top = f.base_m + (isCb(f) ? 1.3 : 1.2) * f.thickness_m * rise;
+  const double top = f.base_m + 1.3 * f.thickness_m * rise;
   // A tile is kept when its box (grown by the largest heap that can reach out of it) is not
   // wholly outside the view frustum (the renderer's test for clouds).
   const double reach = 3.6 * heapRadius(f) * (1.0 + kSizeVariation);
@@ -643,7 +682,7 @@ CloudLayer farDeck(const CloudField& f, double range, glm::dvec3 to_sun) {
       // Its cover rises towards the horizon as the heaps' sides fill the gaps: the ratio of a
       // heap's side silhouette to its footprint, both measured (unitArea).
       deck.far.coverage = w.coverage;
-      deck.far.side_ratio = unitArea(f.type, true) / unitArea(f.type, false);
+      deck.far.side_ratio = unitArea(f, true) / unitArea(f, false);
       calibrateFarCover(deck.texture, deck.transition, deck.far);
       deck.threshold = deck.far.threshold[0];  // unused while far.side_ratio > 0
       it = decks.emplace(key, deck).first;

@@ -89,6 +89,10 @@ double fieldTileSize(const CloudField& field);
 // function of (field, i, j). Names are `<field name>/<i>,<j>/<k>`.
 std::vector<EllipsoidCloud> tileClouds(const CloudField& field, std::int64_t i, std::int64_t j);
 
+// The species the field's heaps are of (genus.h, Species): the row of its genus nearest its
+// thickness in log thickness, e.g. "humilis", "mediocris" or "congestus" for cumulus.
+std::string_view heapSpecies(const CloudField& field);
+
 // The altitude whose wind carries the field: the middle of its heaps.
 inline double fieldAltitude(const CloudField& field) {
   return field.base_m + 0.5 * field.thickness_m;

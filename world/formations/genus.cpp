@@ -7,84 +7,105 @@ namespace {
 
 // Heaps: 20 per km of light extinction puts the sky light under a heap's middle at about a
 // third of the open sky's (MODEL.md section 14). A cumulonimbus's T1 is lower, so that its
-// tower reads as one mass; its radius is its tower's spread (its anvil reaches three times it).
-constexpr HeapLook kNoHeaps{1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0};
-constexpr HeapLook kCumulusHeaps{1.0, 0.2, 0.3, -0.4, 1.1, 0.05, 0.02, 0.9};
-constexpr HeapLook kCumulonimbusHeaps{0.9, 0.2, 0.3, -0.6, 1.1, 0.05, 0.02, 1.0};
+// tower reads as one mass.
+constexpr HeapLook kNoHeaps{1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0};
+constexpr HeapLook kCumulusHeaps{1.0, 0.2, 0.3, -0.4, 1.1, 0.05, 0.02};
+constexpr HeapLook kCumulonimbusHeaps{0.9, 0.2, 0.3, -0.6, 1.1, 0.05, 0.02};
+
+// Species (the atlas): humilis, of slight vertical extent and flattened, three times as wide as
+// tall in a layer 500 m thick; mediocris, of moderate extent, 1.8 times as wide at 1,200 m (a
+// heap 2.2 km across); congestus, markedly vertical, taller than wide (width 0.6 of the height)
+// at 4,000 m, a tower of stacked mounds (MODEL.md section 10). Between the rows a heap's width
+// grows as about the 0.4th power of the thickness up to mediocris and barely (0.09th) beyond,
+// so a developing layer grows its heaps upward. A cumulonimbus's width is twice the thickness:
+// its tower spans about 0.9 of it and its anvil three times the tower.
+constexpr Species kCumulusSpecies[] = {
+    {"humilis", 500.0, 3.0}, {"mediocris", 1200.0, 1.8}, {"congestus", 4000.0, 0.6}};
+constexpr Species kCumulonimbusSpecies[] = {{"capillatus incus", 9000.0, 2.0}};
 
 // Indexed by CloudType. Typical layers: the atlas's altitude bands for mid-latitudes.
 constexpr std::array<Genus, kCloudTypeCount> kGenera{{
-    {"none", 700.0, 500.0, {0, 0, 1, 0, 0, 0, 0, 0, 0, 0, false}, false, kNoHeaps},
+    {"none", 700.0, 500.0, {0, 0, 1, 0, 0, 0, 0, 0, 0, 0, false}, false, kNoHeaps, {}},
     // cells
     {"altocumulus",
      4000.0,
      700.0,
      {3.0e-3, 3.0e-3, 6, 0.5, 90.0, 0.12, 0.95, 0.55, 0.50, 1, false},
      false,
-     kNoHeaps},
+     kNoHeaps,
+     {}},
     // a sheet
     {"altostratus",
      4000.0,
      700.0,
      {1.2e-3, 1.2e-3, 5, 2.0, 90.0, 0.50, 0.72, 0.70, 0.35, 2, false},
      false,
-     kNoHeaps},
+     kNoHeaps,
+     {}},
     // ripples
     {"cirrocumulus",
      8000.0,
      600.0,
      {8.0e-3, 6.5e-3, 6, 0.5, 90.0, 0.15, 1.00, 0.70, 0.50, 1, false},
      false,
-     kNoHeaps},
+     kNoHeaps,
+     {}},
     // a veil
     {"cirrostratus",
      8000.0,
      600.0,
      {1.0e-3, 1.0e-3, 4, 2.0, 90.0, 3.00, 1.00, 0.80, 0.30, 1, true},
      false,
-     kNoHeaps},
+     kNoHeaps,
+     {}},
     // streaks
     {"cirrus",
      8000.0,
      600.0,
      {1.0e-3, 0.35e-3, 5, 0.2, 30.0, 0.50, 1.00, 0.75, 0.60, 1, false},
      false,
-     kNoHeaps},
+     kNoHeaps,
+     {}},
     // towers over a dark deck
     {"cumulonimbus",
      900.0,
      9000.0,
      {1.0e-3, 1.0e-3, 4, 2.0, 90.0, 0.80, 0.42, 0.80, 0.30, 1, false},
      true,
-     kCumulonimbusHeaps},
+     kCumulonimbusHeaps,
+     kCumulonimbusSpecies},
     // heaps over a stratocumulus deck
     {"cumulus",
      1200.0,
      1200.0,
      {2.0e-3, 1.6e-3, 6, 0.6, 90.0, 0.12, 0.82, 0.55, 0.55, 1, false},
      true,
-     kCumulusHeaps},
+     kCumulusHeaps,
+     kCumulusSpecies},
     // a dark deck three planes deep
     {"nimbostratus",
      900.0,
      2500.0,
      {1.0e-3, 1.0e-3, 4, 2.0, 90.0, 0.80, 0.42, 0.80, 0.30, 3, false},
      false,
-     kNoHeaps},
+     kNoHeaps,
+     {}},
     // lumps
     {"stratocumulus",
      700.0,
      500.0,
      {2.0e-3, 1.6e-3, 6, 0.6, 90.0, 0.12, 0.82, 0.55, 0.55, 1, false},
      false,
-     kNoHeaps},
+     kNoHeaps,
+     {}},
     // a grey sheet
     {"stratus",
      700.0,
      500.0,
      {1.5e-3, 1.5e-3, 4, 2.5, 90.0, 0.60, 0.66, 0.75, 0.30, 2, false},
      false,
-     kNoHeaps},
+     kNoHeaps,
+     {}},
 }};
 
 }  // namespace

@@ -5,7 +5,9 @@
 // theirs (the planes are then the deck under the heaps). Weather layers (weather.cpp), the heap
 // fields (cloud_field.cpp) and every reader of a genus name (scene files, set_weather, Modbus,
 // CIGI through cloudTypeName / cloudTypeFromName) read it. Adding a genus adds a row here, an
-// enumerator to CloudType (CIGI's numbering) and its cases to the tests.
+// enumerator to CloudType (CIGI's numbering) and its cases to the tests; adding a species of a
+// convective genus adds a row to its species list and its case to the tests.
+#include <span>
 #include <string_view>
 
 #include "world/formations/cloud_field.h"
@@ -28,17 +30,28 @@ struct PlaneLook {
 // Heaps (sections 10 and 14): colour; ambient and texture fractions of eq. 8; T1, T2 and D of
 // eq. 11 (T1 well below zero makes the middle of every ellipsoid opaque whatever the texture,
 // T2 above one the limb clear, D how soft the edge is); the light's extinction through a heap
-// per metre; a heap's horizontal radius per metre of the layer's thickness.
+// per metre.
 struct HeapLook {
-  double colour, ambient, texture_fraction, t1, t2, d, light_extinction, radius;
+  double colour, ambient, texture_fraction, t1, t2, d, light_extinction;
+};
+
+// A species of heap (WMO International Cloud Atlas): the layer thickness it stands for and the
+// width of its heaps (twice their base radius) over their height there. A field's heaps take
+// the width ratio interpolated between its genus's species in log thickness (power laws between
+// the rows, constant beyond the ends), so they change shape smoothly as a layer develops; the
+// field's species is the row nearest in log thickness (heapSpecies, cloud_field.h).
+struct Species {
+  std::string_view name;
+  double thickness_m, width_over_height;
 };
 
 struct Genus {
   std::string_view name;
   double typical_base_m, typical_thickness_m;  // typicalWeatherLayer
   PlaneLook planes;
-  bool heaps;  // a field of heaps (heap_look) over a deck of `planes`
+  bool heaps;  // a field of heaps (heap_look, species) over a deck of `planes`
   HeapLook heap_look;
+  std::span<const Species> species;  // thinnest first; empty without heaps
 };
 
 // The row of `type` (CloudType::kNone has a row too, drawing nothing); `type` must be one of
