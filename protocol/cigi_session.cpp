@@ -5,6 +5,7 @@
 #include <set>
 #include <sstream>
 
+#include "protocol/cloud_codes.h"
 #include "world/formations/cloud_field.h"
 #include "world/frames.h"
 #include "world/limits.h"
@@ -253,11 +254,13 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
         command::SetWeather c;
         c.layer = w->layer;
         WeatherLayer& layer = c.weather;
-        layer.type = w->enabled ? CloudType(std::min<int>(w->cloud_type, 15)) : CloudType::kNone;
-        if (w->enabled && w->cloud_type >= kCloudTypeCount) {
-          bad(where + ": cloud type " + std::to_string(w->cloud_type) + " (allowed: 0 to 10)");
+        const std::optional<CloudType> type = cloudTypeFromCode(w->cloud_type);
+        if (w->enabled && !type) {
+          bad(where + ": cloud type " + std::to_string(w->cloud_type) +
+              " (allowed: " + cloudTypeCodesAllowed() + ")");
           continue;
         }
+        layer.type = w->enabled ? *type : CloudType::kNone;
         layer.base_m = w->base;
         layer.thickness_m = w->thickness;
         layer.coverage = w->coverage / 100.0;

@@ -6,6 +6,7 @@
 
 #include <set>
 
+#include "protocol/cloud_codes.h"
 #include "world/limits.h"
 
 namespace nephele {
@@ -261,7 +262,7 @@ std::vector<std::string> readViews(FieldReader& r) {
 
 WeatherLayer readWeather(FieldReader& r) {
   WeatherLayer w;
-  if (auto t = r.integer("type", 0, kCloudTypeCount - 1)) w.type = CloudType(*t);
+  if (auto t = r.integer("type", 0, kCloudTypeCodes - 1)) w.type = *cloudTypeFromCode(int(*t));
   w.base_m = r.number("base", 0.0, Limits::kMaxBase).value_or(w.base_m);
   w.thickness_m = r.number("thickness", Limits::kThickness).value_or(w.thickness_m);
   w.coverage = r.number("coverage", Limits::kCoveragePercent).value_or(w.coverage * 100.0) / 100.0;

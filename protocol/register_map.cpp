@@ -5,6 +5,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "protocol/cloud_codes.h"
 #include "world/limits.h"
 
 namespace nephele {
@@ -110,7 +111,7 @@ HoldingRegisters encodeHolding(const HostReadings& s) {
   for (int layer = 0; layer < ProtocolLimits::kWeatherLayers; ++layer) {
     std::uint16_t* b = &r[std::size_t(M::kLayerStart + layer * M::kLayerStride)];
     const WeatherLayer& w = s.layers[std::size_t(layer)];
-    b[M::kLayerType] = std::uint16_t(w.type);
+    b[M::kLayerType] = std::uint16_t(cloudTypeCode(w.type));
     putFloat(b + M::kLayerBase, w.base_m);
     putFloat(b + M::kLayerThickness, w.thickness_m);
     putFloat(b + M::kLayerCoverage, w.coverage * 100.0);
@@ -228,12 +229,14 @@ std::variant<std::vector<Command>, RegisterError> decodeHoldingWrite(
     if (!w.touches(base, M::kLayerStride)) continue;
     command::SetWeather set{layer + 1, {}};
     const std::uint16_t type = next[std::size_t(base + M::kLayerType)];
-    if (!error && type >= kCloudTypeCount)
+    const std::optional<CloudType> genus = cloudTypeFromCode(type);
+    if (!error && !genus)
       error = RegisterError{kIllegalDataValue,
                             "layer " + std::to_string(layer + 1) + " cloud type (register " +
                                 std::to_string(base) + "): " + std::to_string(type) +
-                                " is out of range (allowed: 0 to 10, CIGI cloud types)"};
-    set.weather.type = CloudType(type);
+                                " is out of range (allowed: " + cloudTypeCodesAllowed() +
+                                ", CIGI cloud types)"};
+    set.weather.type = genus.value_or(CloudType::kNone);
     set.weather.base_m = readFloat(kLayerFloats[0], base);
     set.weather.thickness_m = readFloat(kLayerFloats[1], base);
     set.weather.coverage = readFloat(kLayerFloats[2], base) / 100.0;

@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "config/table_reader.h"
+#include "protocol/cloud_codes.h"
 #include "server/engine_state.h"
 #include "world/file_output.h"
 #include "world/limits.h"
@@ -27,9 +28,9 @@ std::string daemonStatePath(const std::string& snapshot) {
 
 // A set_weather request that sets `w` again.
 json weatherRequest(int layer, const WeatherLayer& w) {
-  json r{{"cmd", "set_weather"},       {"layer", layer},
-         {"type", int(w.type)},        {"base", w.base_m},
-         {"thickness", w.thickness_m}, {"coverage", 100.0 * w.coverage}};
+  json r{{"cmd", "set_weather"},          {"layer", layer},
+         {"type", cloudTypeCode(w.type)}, {"base", w.base_m},
+         {"thickness", w.thickness_m},    {"coverage", 100.0 * w.coverage}};
   if (w.wind) r["wind"] = {w.wind->x, w.wind->y};
   const Region& g = w.region;
   if (std::isfinite(g.half_size.x) && std::isfinite(g.half_size.y)) {

@@ -3,6 +3,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "protocol/cloud_codes.h"
+
 namespace nephele {
 namespace {
 
@@ -91,6 +93,31 @@ TEST(Messages, ParsesEveryCommandWithItsFields) {
   EXPECT_EQ(commandName(parsed(R"({"cmd":"list_targets"})").command), "list_targets");
   EXPECT_EQ(parsed(R"({"id":"abc","cmd":"hash"})").id, "abc");
   EXPECT_EQ(commandName(parsed(R"({"cmd":"stats"})").command), "stats");
+}
+
+// The host codes of the genera (protocol/cloud_codes.h) are CIGI 3.3's Weather Control cloud
+// types, written out here from the ICD; every genus of the world's table has one, and the
+// socket protocol's set_weather reads them.
+TEST(CloudCodes, AreCigisAndEveryGenusHasOne) {
+  const char* icd[] = {"none",         "altocumulus",   "altostratus",  "cirrocumulus",
+                       "cirrostratus", "cirrus",        "cumulonimbus", "cumulus",
+                       "nimbostratus", "stratocumulus", "stratus"};
+  ASSERT_EQ(std::size(icd), std::size_t(kCloudTypeCodes));
+  for (int code = 0; code < kCloudTypeCodes; ++code) {
+    const std::optional<CloudType> type = cloudTypeFromCode(code);
+    ASSERT_TRUE(type.has_value()) << code;
+    EXPECT_EQ(cloudTypeName(*type), icd[code]);
+    EXPECT_EQ(cloudTypeCode(*type), code);
+    const Request r =
+        parsed(R"({"cmd":"set_weather","layer":1,"type":)" + std::to_string(code) + "}");
+    EXPECT_EQ(std::get<command::SetWeather>(r.command).weather.type, *type);
+  }
+  for (int i = 0; i < kCloudTypeCount; ++i)
+    EXPECT_EQ(cloudTypeFromCode(cloudTypeCode(CloudType(i))), CloudType(i)) << i;
+  EXPECT_FALSE(cloudTypeFromCode(-1).has_value());
+  EXPECT_FALSE(cloudTypeFromCode(kCloudTypeCodes).has_value());
+  EXPECT_THAT(rejected(R"({"cmd":"set_weather","layer":1,"type":11})").error.message,
+              HasSubstr("type"));
 }
 
 TEST(Messages, DefaultChannelsFollowTheFormat) {

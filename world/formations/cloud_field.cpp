@@ -506,7 +506,8 @@ std::string weatherLayerError(const WeatherLayer& w) {
     return outOfRange(out, name, value, range);
   };
   if (int(w.type) < 0 || int(w.type) >= kCloudTypeCount) {
-    out << "type: " << int(w.type) << " is not a CIGI cloud type (allowed: 0 none, 1 to 10)";
+    out << "type: " << int(w.type) << " is not a genus (allowed: 0 none, 1 to "
+        << kCloudTypeCount - 1 << ", the genus table's rows)";
     return out.str();
   }
   if (outside("base", w.base_m, {0.0, Limits::kMaxBase}) ||

@@ -18,19 +18,21 @@
 
 namespace nephele {
 
-// The cloud-type enumeration of CIGI Weather Control packets, in its numbering.
+// The genera, in the order of their table (genus.cpp), "none" first. The numbers hosts send
+// for them are the protocols' (protocol/cloud_codes.h); snapshots store this order, so a new
+// genus goes at the end.
 enum class CloudType : int {
-  kNone = 0,
-  kAltocumulus = 1,
-  kAltostratus = 2,
-  kCirrocumulus = 3,
-  kCirrostratus = 4,
-  kCirrus = 5,
-  kCumulonimbus = 6,
-  kCumulus = 7,
-  kNimbostratus = 8,
-  kStratocumulus = 9,
-  kStratus = 10,
+  kNone,
+  kAltocumulus,
+  kAltostratus,
+  kCirrocumulus,
+  kCirrostratus,
+  kCirrus,
+  kCumulonimbus,
+  kCumulus,
+  kNimbostratus,
+  kStratocumulus,
+  kStratus,
 };
 inline constexpr int kCloudTypeCount = 11;
 std::string_view cloudTypeName(CloudType type);

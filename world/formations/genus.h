@@ -5,8 +5,9 @@
 // theirs (the planes are then the deck under the heaps). Weather layers (weather.cpp), the heap
 // fields (cloud_field.cpp) and every reader of a genus name (scene files, set_weather, Modbus,
 // CIGI through cloudTypeName / cloudTypeFromName) read it. Adding a genus adds a row here, an
-// enumerator to CloudType (CIGI's numbering) and its cases to the tests; adding a species of a
-// convective genus adds a row to its species list and its case to the tests.
+// enumerator to CloudType, its host code if the protocols number it (protocol/cloud_codes.cpp)
+// and its cases to the tests; adding a species of a convective genus adds a row to its species
+// list and its case to the tests.
 #include <span>
 #include <string_view>
 
