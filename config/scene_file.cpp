@@ -37,7 +37,6 @@ void config_detail::readCameraKeys(TableReader& t, Camera& camera) {
 
 namespace {
 
-using config_detail::formatNumber;
 using config_detail::joinKeys;
 using config_detail::SceneError;
 using config_detail::TableReader;

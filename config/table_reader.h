@@ -38,12 +38,6 @@ struct SceneError {
   std::string message;
 };
 
-inline std::string formatNumber(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
 inline std::string joinKeys(const std::vector<std::string>& keys) {
   std::string out;
   for (const auto& k : keys) out += (out.empty() ? "" : ", ") + k;

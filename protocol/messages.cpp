@@ -19,12 +19,6 @@ struct FieldError {
   std::string message;
 };
 
-std::string formatNumber(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
 // Reads one JSON object; every key must be read, and finish() names what is left over.
 class FieldReader {
  public:

@@ -50,12 +50,6 @@ constexpr FloatField kLayerFloats[] = {
     {M::kLayerCoverage, "coverage", Limits::kCoveragePercent.lo, Limits::kCoveragePercent.hi},
 };
 
-std::string formatNumber(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
 // Every float32 field's first register, for the half-a-float check.
 std::vector<int> floatAddresses() {
   std::vector<int> out;

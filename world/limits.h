@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <ostream>
+#include <sstream>
 #include <string>
 #include <string_view>
 
@@ -17,6 +18,13 @@ struct Range {
   double hi;
   constexpr bool contains(double x) const { return x >= lo && x <= hi; }
 };
+
+// A number as every error message shows it (the stream's default: 6 significant digits).
+inline std::string formatNumber(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
 
 // Writes "name: value is out of range (allowed: lo to hi)" to `out` and returns true when
 // `value` is not finite or outside `range`; the one wording of a range error in world/.

@@ -72,7 +72,12 @@ std::string parseUtc(std::string_view text, CivilTime& out) {
                   digits(text, p, 2, t.month) && expect(text, p, '-') &&
                   digits(text, p, 2, t.day) && expect(text, p, 'T') && digits(text, p, 2, t.hour) &&
                   expect(text, p, ':') && digits(text, p, 2, t.minute);
-  if (!ok) return "\"" + std::string(text.substr(0, 40)) + "\" is not a date and time" + form;
+  if (!ok) {
+    // Appended in steps: GCC 12 warns falsely (-Wrestrict) on "\"" + std::string(...).
+    std::string message(1, '"');
+    message.append(text.substr(0, 40)).append("\" is not a date and time").append(form);
+    return message;
+  }
   if (p < text.size() && text[p] == ':') {
     ++p;
     int whole = 0;

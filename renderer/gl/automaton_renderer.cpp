@@ -11,7 +11,7 @@
 namespace nephele {
 namespace {
 
-constexpr int kVolumeTextureUnit = 13;
+constexpr int kLatticeTextureUnit = 13;
 constexpr int kSkyTextureUnit = 8;
 constexpr int kMaxMarchSteps = 2048;
 
@@ -216,7 +216,7 @@ void AutomatonRenderer::drawCloud(const Scene& scene, std::size_t index,
   set("u_extinction", kCloudExtinctionPerMetre);
   set("u_ambient", cloud.ambient);
   set("u_phase_g", cloud.phase_g);
-  gl_.BindTextureUnit(kVolumeTextureUnit, v.texture.get());
+  gl_.BindTextureUnit(kLatticeTextureUnit, v.texture.get());
   gl_.BindTextureUnit(kSkyTextureUnit, v.sky.get());
   gl_.ProgramUniform2fv(p, gl_.GetUniformLocation(p, "u_polygon"), GLsizei(polygon.size()),
                         &polygon[0].x);

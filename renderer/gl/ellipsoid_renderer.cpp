@@ -18,7 +18,6 @@
 namespace nephele {
 namespace {
 
-constexpr double kTwoPi = 2.0 * std::numbers::pi;
 constexpr int kAtlasSize = 2048;
 constexpr int kMaxTileSize = 1024;
 constexpr int kSpotlightSize = 64;

@@ -18,8 +18,6 @@
 namespace nephele {
 namespace {
 
-constexpr double kTwoPi = 2.0 * std::numbers::pi;
-
 // The part of the screen square [-1, 1]^2 where a * x + b * y + c >= 0, as a convex polygon
 // (Sutherland-Hodgman against one line). Empty when nothing is left.
 std::vector<glm::vec2> clipScreenToHalfPlane(double a, double b, double c) {

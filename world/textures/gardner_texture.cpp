@@ -8,7 +8,6 @@
 
 namespace nephele {
 namespace {
-constexpr double kPi = std::numbers::pi;
 constexpr double kAmplitudeRatio = 0.707;  // C(i+1) = 0.707 C(i)
 
 double textureFromSums(double sx, double sy, double k) {
@@ -35,9 +34,10 @@ GardnerTexture::GardnerTexture(const GardnerTextureParams& params) : params_(par
     c *= kAmplitudeRatio;
     for (int k = 0; k < GardnerTextureParams::kComponents; ++k) {
       if (params_.seeded_phases && (k == 0 || !periodic())) {
-        phx_[i][k] = 2.0 * kPi * unitFromBits(hashCounters(params_.seed, 0x47617264ull, i, 2 * k));
-        phy_[i][k] =
-            2.0 * kPi * unitFromBits(hashCounters(params_.seed, 0x47617264ull, i, 2 * k + 1));
+        phx_[i][k] = 2.0 * std::numbers::pi *
+                     unitFromBits(hashCounters(params_.seed, 0x47617264ull, i, 2 * k));
+        phy_[i][k] = 2.0 * std::numbers::pi *
+                     unitFromBits(hashCounters(params_.seed, 0x47617264ull, i, 2 * k + 1));
       }
       ax_[i][k] = ay_[i][k] = {1.0, 0.0};
     }
@@ -45,7 +45,7 @@ GardnerTexture::GardnerTexture(const GardnerTextureParams& params) : params_(par
       // Each component of SX and of SY turns by its own angle r (2u - 1), r = rotation_deg,
       // and scales by its own factor 2^(j (2v - 1)), j = jitter_octaves: the axis vector
       // carries both, so that every evaluator (here and the GL sky shader) applies them alike.
-      const double r = params_.rotation_deg * kPi / 180.0;
+      const double r = params_.rotation_deg * std::numbers::pi / 180.0;
       const double j = params_.jitter_octaves;
       auto axis = [&](std::uint64_t which) {
         const double u = unitFromBits(hashCounters(params_.seed, 0x526f7461ull, i, which));
@@ -64,7 +64,7 @@ GardnerTexture::GardnerTexture(const GardnerTextureParams& params) : params_(par
 }
 
 glm::dvec2 GardnerTexture::period() const {
-  return {4.0 * kPi / params_.fx1, 4.0 * kPi / params_.fy1};
+  return {4.0 * std::numbers::pi / params_.fx1, 4.0 * std::numbers::pi / params_.fy1};
 }
 
 double GardnerTexture::planar(glm::dvec2 p, double term_count) const {
@@ -78,10 +78,10 @@ double GardnerTexture::solid(glm::dvec3 p, double term_count) const {
 void GardnerTexture::addTerm(int i, glm::dvec3 p, bool solid, double& sx, double& sy) const {
   // Planar phases, plus the Z term for solid textures (MODEL.md section 2).
   if (solid || periodic()) {
-    double px = 0.5 * kPi * std::sin(0.5 * fy_[i] * p.y);
-    double py = 0.5 * kPi * std::sin(0.5 * fx_[i] * p.x);
+    double px = 0.5 * std::numbers::pi * std::sin(0.5 * fy_[i] * p.y);
+    double py = 0.5 * std::numbers::pi * std::sin(0.5 * fx_[i] * p.x);
     if (solid) {
-      const double pz = kPi * std::sin(0.5 * fx_[i] * p.z);
+      const double pz = std::numbers::pi * std::sin(0.5 * fx_[i] * p.z);
       px += pz;
       py += pz;
     }
@@ -95,8 +95,10 @@ void GardnerTexture::addTerm(int i, glm::dvec3 p, bool solid, double& sx, double
     const double x1 = a.x * p.x + a.y * p.y, y1 = a.x * p.y - a.y * p.x;
     const double x2 = b.x * p.x + b.y * p.y, y2 = b.x * p.y - b.y * p.x;
     const double c = componentAmplitude(i);
-    sx += c * std::sin(fx_[i] * x1 + 0.5 * kPi * std::sin(0.5 * fy_[i] * y1) + phx_[i][k]);
-    sy += c * std::sin(fy_[i] * y2 + 0.5 * kPi * std::sin(0.5 * fx_[i] * x2) + phy_[i][k]);
+    sx += c *
+          std::sin(fx_[i] * x1 + 0.5 * std::numbers::pi * std::sin(0.5 * fy_[i] * y1) + phx_[i][k]);
+    sy += c *
+          std::sin(fy_[i] * y2 + 0.5 * std::numbers::pi * std::sin(0.5 * fx_[i] * x2) + phy_[i][k]);
   }
 }
 

@@ -2,6 +2,7 @@
 // Gardner's sum-of-sines texture (MODEL.md section 2), evaluated in double.
 #include <cmath>
 #include <cstdint>
+#include <numbers>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -99,5 +100,7 @@ class GardnerTexture {
 
 // Wraps x into [0, period).
 double wrapPeriodic(double x, double period);
+// The period of the texture's sines in their phase, which wrapPeriodic reduces phases by.
+inline constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
 }  // namespace nephele

@@ -9,7 +9,6 @@
 
 namespace nephele {
 namespace {
-constexpr double kPi = std::numbers::pi;
 
 // Unit gradient for a lattice point: uniform on the sphere from two counter-based draws.
 glm::dvec3 latticeGradient(std::uint64_t seed, int octave, int x, int y, int z) {
@@ -17,7 +16,7 @@ glm::dvec3 latticeGradient(std::uint64_t seed, int octave, int x, int y, int z) 
   const double u = unitFromBits(hashCounters(seed, 0x50336430ull + octave, cell, std::uint32_t(z)));
   const double v = unitFromBits(hashCounters(seed, 0x50336431ull + octave, cell, std::uint32_t(z)));
   const double cos_theta = 2.0 * u - 1.0, sin_theta = std::sqrt(1.0 - cos_theta * cos_theta);
-  const double phi = 2.0 * kPi * v;
+  const double phi = 2.0 * std::numbers::pi * v;
   return {sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta};
 }
 }  // namespace
@@ -60,10 +59,12 @@ VolumeTable bakeGardnerSolid(const GardnerTexture& texture, int size, int terms)
       sin_ay[i * n + t] = std::sin(ay), cos_ay[i * n + t] = std::cos(ay);
     }
     for (std::size_t z = 0; z < n; ++z) {
-      const double pz = kPi * std::sin(0.5 * fx * coordinate(z, 2));
+      const double pz = std::numbers::pi * std::sin(0.5 * fx * coordinate(z, 2));
       for (std::size_t t = 0; t < n; ++t) {
-        const double bx = 0.5 * kPi * std::sin(0.5 * fy * coordinate(t, 1)) + pz;  // PX at (y, z)
-        const double by = 0.5 * kPi * std::sin(0.5 * fx * coordinate(t, 0)) + pz;  // PY at (x, z)
+        const double bx =
+            0.5 * std::numbers::pi * std::sin(0.5 * fy * coordinate(t, 1)) + pz;  // PX at (y, z)
+        const double by =
+            0.5 * std::numbers::pi * std::sin(0.5 * fx * coordinate(t, 0)) + pz;  // PY at (x, z)
         const std::size_t j = (i * n + z) * n + t;
         sin_bx[j] = std::sin(bx), cos_bx[j] = std::cos(bx);
         sin_by[j] = std::sin(by), cos_by[j] = std::cos(by);

@@ -8,7 +8,6 @@
 
 namespace nephele {
 namespace {
-constexpr double kPi = std::numbers::pi;
 
 // Signed uniform in [-1, 1) keyed by seed, position and purpose.
 double signedRandom(std::uint64_t seed, int x, int y, std::uint64_t purpose) {
@@ -83,7 +82,7 @@ TextureTable perlinNoise(int size, int cells, int octaves, double persistence, s
   for (int octave = 0; octave < octaves; ++octave, amplitude *= persistence) {
     const int lattice = cells << octave;
     auto gradient = [&](int gx, int gy) {
-      const double angle = 2.0 * kPi *
+      const double angle = 2.0 * std::numbers::pi *
                            unitFromBits(hashCounters(seed, 0x5065726cull + octave,
                                                      std::uint32_t(wrapIndex(gx, lattice)),
                                                      std::uint32_t(wrapIndex(gy, lattice))));
@@ -126,8 +125,10 @@ GardnerTruncations bakeGardner(const GardnerTexture& texture, int size, int term
       const double x = (t + 0.5) / size * period.x, y = (t + 0.5) / size * period.y;
       const double ax = texture.frequencyX(i) * x + texture.phaseX(i);
       const double ay = texture.frequencyY(i) * y + texture.phaseY(i);
-      const double py = 0.5 * kPi * std::sin(0.5 * texture.frequencyX(i) * x);  // PY(i) at X
-      const double px = 0.5 * kPi * std::sin(0.5 * texture.frequencyY(i) * y);  // PX(i) at Y
+      const double py =
+          0.5 * std::numbers::pi * std::sin(0.5 * texture.frequencyX(i) * x);  // PY(i) at X
+      const double px =
+          0.5 * std::numbers::pi * std::sin(0.5 * texture.frequencyY(i) * y);  // PX(i) at Y
       const std::size_t j = std::size_t(i) * size + t;
       sin_ax[j] = std::sin(ax), cos_ax[j] = std::cos(ax);
       sin_ay[j] = std::sin(ay), cos_ay[j] = std::cos(ay);
