@@ -210,6 +210,7 @@ std::optional<Outcome> Engine::renderRequest(const command::Render& c, Job& job)
     }
     reply(chainReplies(std::move(replies)));
   };
+  publish();  // before the reply can go: a client's next stats is answered from it
   if (all_raw)
     send();  // nothing to encode: packing is a copy
   else

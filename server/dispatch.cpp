@@ -74,11 +74,7 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
 
       [&](const Hello& c) -> std::optional<Outcome> {
         (void)c;  // the token is checked by the transport
-        json views = json::array();
-        for (const ViewConfig& v : s.views) views.push_back(v.name);
-        return json{{"server", "nephele"},          {"version", NEPHELE_VERSION},
-                    {"protocol", kProtocolVersion}, {"views", views},
-                    {"mode", modeName(s.mode)},     {"tick_rate", config_.tick_rate_hz}};
+        return helloJson();
       },
       [&](const GetView& c) -> std::optional<Outcome> {
         if (c.view.empty()) {
@@ -303,8 +299,7 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
       },
       [&](const Stats&) -> std::optional<Outcome> {
         publish();
-        std::lock_guard lock(published_mutex_);
-        return published_stats_;
+        return stats();
       },
       [&](const Hash&) -> std::optional<Outcome> {
         return json{{"hash", hexHash(world.hash())},

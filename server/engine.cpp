@@ -184,6 +184,9 @@ void Engine::run(std::promise<std::string>& started) {
     }
     for (Job& job : jobs) {
       if (!stopping) {
+        setInHand(job.kind == Job::Kind::kBatch ? "modbus write"
+                                                : std::string(commandName(job.request.command)),
+                  job.client);
         execute(job);
         s.request_seconds.add(std::chrono::duration<double>(Clock::now() - job.queued).count());
         continue;
@@ -192,11 +195,15 @@ void Engine::run(std::promise<std::string>& started) {
       if (job.reply) job.reply(makeReply(errorReply(job.request.id, cancelled)));
       if (job.done) job.done(cancelled);
     }
+    setInHand("", 0);
     if (stopping) break;
+    setInHand("ticks", 0);
     realtimeTicks();
     // Realtime: subscriptions at their rate. Lockstep: a new subscription's first frame (the
     // ticks themselves deliver in advance()).
+    setInHand("frames", 0);
     deliverFrames(s.mode == TickMode::kRealtime ? Delivery::kDue : Delivery::kEveryTick, "");
+    setInHand("", 0);
     if (config_.snapshot_interval_s > 0.0 && !config_.snapshot_path.empty() &&
         Clock::now() >= s.next_snapshot) {
       saveSnapshot(config_.snapshot_path, "periodic");
@@ -296,7 +303,9 @@ void Engine::execute(Job& job) {
   else
     outcome = apply(job.request.command, job);
   if (!outcome) return;  // the encoder replies
-  publishReadings();     // so that a register read right after the reply sees the change
+  // So that a register read, or a stats or hello answered at once (answerAtOnce), right after
+  // the reply sees the change.
+  publish();
   if (const auto* error = std::get_if<ProtocolError>(&*outcome)) {
     noteError(error->code);
     job.reply(makeReply(errorReply(job.request.id, *error)));

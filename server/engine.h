@@ -118,6 +118,12 @@ class Engine {
   void clearRenderTrigger() { trigger_pending_ = false; }  // a withdrawn render write
   nlohmann::json stats() const;
   std::string prometheusText() const;
+  // The control plane: `hello` and `stats` answered on the caller's thread from what the world
+  // thread published after its last request and what it has in hand now, so that they are
+  // answered while the world thread renders (PROTOCOL.md, "Control plane"); nullopt for every
+  // other command. A transport asks only for a client with nothing in flight, so that each
+  // client still sees its replies in request order and the effects of its earlier requests.
+  std::optional<nlohmann::json> answerAtOnce(const Command& command);
 
   // Counters kept by the transports.
   std::atomic<int> socket_clients{0};
@@ -180,8 +186,11 @@ class Engine {
   bool saveSnapshot(const std::string& path, const char* why);
   void countSubscriptions();  // refreshes subscribers_ from the world thread's list
   Clock::time_point nextWake() const;
-  void publish();          // refreshes stats and the Modbus readings
-  void publishReadings();  // the Modbus readings alone (cheap: after every request)
+  void publish();                    // refreshes stats and the Modbus readings
+  void publishReadings();            // the Modbus readings and hello (cheap: after every request)
+  nlohmann::json helloJson() const;  // the hello reply (world thread)
+  // What the world thread has in hand, for stats (world thread; empty `what` when idle).
+  void setInHand(std::string what, std::int64_t client);
 
   DaemonConfig config_;
   std::unique_ptr<State> state_;
@@ -199,10 +208,17 @@ class Engine {
   HostReadings published_settings_;
   HostStatus published_status_;
   nlohmann::json published_stats_;
+  nlohmann::json published_hello_;
+  struct InHand {
+    std::string what;  // a command's name, "modbus write", "frames" or "ticks"; empty when idle
+    std::int64_t client = 0;
+    Clock::time_point since;
+  } in_hand_;
   std::atomic<bool> trigger_pending_{false};
   std::atomic<bool> lockstep_{false};
   std::atomic<std::int64_t> heartbeat_ns_{0};  // steady clock, at the top of each loop
   std::atomic<std::uint64_t> errors_{0};
+  std::atomic<std::uint64_t> answered_at_once_{0};  // requests the control plane answered
   std::atomic<int> last_error_{0};
   mutable std::mutex cigi_mutex_;
   std::map<std::string, std::uint64_t> cigi_counts_;

@@ -280,6 +280,13 @@ class Connection : public std::enable_shared_from_this<Connection> {
       return;
     }
     const nlohmann::json id = request.id;
+    // The control plane: with nothing of this client's in flight, hello and stats are answered
+    // here, from what the world thread has published, even while it renders.
+    if (in_flight_ == 0)
+      if (std::optional<nlohmann::json> answer = engine_.answerAtOnce(request.command)) {
+        send(makeReply(okReply(id, *answer)));
+        return;
+      }
     std::weak_ptr<Connection> weak = weak_from_this();
     asio::io_context& io = static_cast<asio::io_context&>(socket_.get_executor().context());
     auto reply = [weak, &io, id](SharedReply r) {

@@ -99,9 +99,42 @@ void Engine::publishReadings() {
   status.render_ms = s.last_render_ms;
   status.ticks = s.ticks;
   status.time_s = world.timeSeconds();
+  json hello = helloJson();
   std::lock_guard lock(published_mutex_);
   published_settings_ = settings;
   published_status_ = status;
+  published_hello_ = std::move(hello);
+}
+
+json Engine::helloJson() const {
+  const State& s = *state_;
+  json views = json::array();
+  for (const ViewConfig& v : s.views) views.push_back(v.name);
+  return json{{"server", "nephele"},          {"version", NEPHELE_VERSION},
+              {"protocol", kProtocolVersion}, {"views", views},
+              {"mode", modeName(s.mode)},     {"tick_rate", config_.tick_rate_hz}};
+}
+
+void Engine::setInHand(std::string what, std::int64_t client) {
+  std::lock_guard lock(published_mutex_);
+  in_hand_ = {std::move(what), client, Clock::now()};
+}
+
+std::optional<json> Engine::answerAtOnce(const Command& command) {
+  if (std::holds_alternative<command::Stats>(command)) {
+    ++answered_at_once_;  // counted among the requests, as the world thread counts its own
+    json out = stats();
+    if (!out.is_null()) return out;
+    --answered_at_once_;
+  }
+  if (std::holds_alternative<command::Hello>(command)) {
+    std::lock_guard lock(published_mutex_);
+    if (!published_hello_.is_null()) {
+      ++answered_at_once_;
+      return published_hello_;
+    }
+  }
+  return std::nullopt;
 }
 
 HostReadings Engine::readings() const {
@@ -122,8 +155,43 @@ void Engine::countCigi(const std::string& what) {
 }
 
 json Engine::stats() const {
-  std::lock_guard lock(published_mutex_);
-  return published_stats_;
+  // What other threads count is read now, not as of the world thread's last request (each
+  // lock alone, none held while another is taken).
+  std::size_t depth = 0;
+  {
+    std::lock_guard lock(queue_mutex_);
+    depth = queue_.size();
+  }
+  json cigi;
+  {
+    std::lock_guard lock(cigi_mutex_);
+    cigi = cigi_counts_;
+  }
+  const std::size_t encoding = encoder_ ? encoder_->depth() : 0;
+  json out;
+  InHand in_hand;
+  {
+    std::lock_guard lock(published_mutex_);
+    out = published_stats_;
+    in_hand = in_hand_;
+  }
+  if (out.is_null()) return out;
+  out["requests"] = out["requests"].get<std::uint64_t>() + answered_at_once_.load();
+  out["errors"] = errors_.load();
+  out["frames_dropped"] = frames_dropped.load();
+  out["clients"] = {{"socket", socket_clients.load()}, {"modbus", modbus_clients.load()}};
+  out["queue"]["depth"] = depth;
+  out["queue"]["encoder"] = encoding;
+  out["cigi"] = std::move(cigi);
+  if (in_hand.what.empty()) {
+    out["in_hand"] = nullptr;
+  } else {
+    out["in_hand"] = {
+        {"what", in_hand.what},
+        {"client", in_hand.client},
+        {"seconds", std::chrono::duration<double>(Clock::now() - in_hand.since).count()}};
+  }
+  return out;
 }
 
 std::string Engine::prometheusText() const {

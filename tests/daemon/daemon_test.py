@@ -354,6 +354,40 @@ class SocketProtocolTest(DaemonTest):
         self.assertEqual(c.ok({"cmd": "hash"})["hash"], before["hash"])
         self.assertIsNone(d.proc.poll())
 
+    def test_hello_and_stats_are_answered_while_the_world_renders(self):
+        # Issue 31: hello and stats come from what the world thread published, not from the
+        # world thread, so a long render (16 clouds of 4,096 ellipsoids in front of the camera,
+        # seconds even at 64x48) does not hold them; stats says what the world has in hand.
+        d = self.daemon()
+        c = d.client()
+        for i in range(16):
+            c.ok({"cmd": "add_cloud", "cloud": {"name": f"big{i}", "cumulus": {
+                "base": [0, 0, 1000], "width": 3000, "count": 4096}}})
+        other = d.client()
+        self.assertIsNone(other.ok({"cmd": "stats"})["in_hand"])
+        render = c.send({"cmd": "render", "view": "front"})
+        wait_until(lambda: (other.ok({"cmd": "stats"})["in_hand"] or {}).get("what") == "render",
+                   "the render in hand")
+        started = time.monotonic()
+        hello = other.ok({"cmd": "hello"})
+        waited = time.monotonic() - started
+        self.assertEqual(hello["views"], ["front", "left"])
+        in_hand = other.ok({"cmd": "stats"})["in_hand"]
+        self.assertEqual(in_hand["what"], "render", "the render ended before hello came back")
+        self.assertGreaterEqual(in_hand["seconds"], 0.0)
+        self.assertLess(waited, 1.0)
+        frames = other.ok({"cmd": "stats"})["frames"]
+        header, body = c.read()
+        self.assertEqual(header["id"], render)
+        self.assertTrue(header["ok"], header)
+        # Published before the reply went: the client's next stats sees its render.
+        self.assertEqual(c.ok({"cmd": "stats"})["frames"], frames + 1)
+        for view in ("left", "front"):  # encoded on the encoder thread, and raw
+            c.ok({"cmd": "set_view", "view": "front", "width": 32, "height": 24})
+            c.request({"cmd": "render", "view": view})
+            self.assertEqual(c.ok({"cmd": "stats"})["frames"], frames + 2, view)
+            frames += 1
+
     def test_weather_clouds_tick_and_hash(self):
         d = self.daemon()
         c = d.client()
