@@ -364,7 +364,7 @@ class SocketProtocolTest(DaemonTest):
             c.ok({"cmd": "add_cloud", "cloud": {"name": f"big{i}", "cumulus": {
                 "base": [0, 0, 1000], "width": 3000, "count": 4096}}})
         other = d.client()
-        self.assertIsNone(other.ok({"cmd": "stats"})["in_hand"])
+        wait_until(lambda: other.ok({"cmd": "stats"})["in_hand"] is None, "the world idle")
         render = c.send({"cmd": "render", "view": "front"})
         wait_until(lambda: (other.ok({"cmd": "stats"})["in_hand"] or {}).get("what") == "render",
                    "the render in hand")
