@@ -28,6 +28,9 @@ shot() {
 shot genus_cumulus ground 40 --position 0,0,2 --pitch 15 --vfov 60
 shot genus_cumulus side 40 --position 0,0,1000 --pitch 2 --vfov 30
 shot genus_cumulus above 40 --position 0,0,4200 --pitch -20 --vfov 60
+# The species of cumulus (a thinner and a thicker layer than genus_cumulus), from the side.
+shot cumulus_humilis side 40 --position 0,0,1800 --pitch -3 --vfov 30
+shot cumulus_congestus side 40 --position 0,0,1000 --pitch 8 --vfov 30
 shot genus_cumulonimbus ground 40 --position 0,0,2 --pitch 15 --vfov 60
 shot genus_cumulonimbus side 40 --position 0,-10000,700 --pitch 12 --vfov 60
 shot genus_cumulonimbus above 40 --position 0,0,12900 --pitch -20 --vfov 60
