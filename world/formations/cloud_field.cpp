@@ -36,20 +36,31 @@ const HeapLook& lookOf(const CloudField& f) {
   return genus(f.type).heap_look;
 }
 
-// A heap's width over its height for the field's thickness: its genus's species rows
-// interpolated in log thickness (genus.h, Species).
+// Where the field's thickness falls among its genus's species rows (genus.h, Species): between
+// rows lo and hi = lo + 1, s of the way in log thickness; at an end, lo = hi and s = 0.
+struct SpeciesSpan {
+  std::size_t lo, hi;
+  double s;
+};
+SpeciesSpan speciesSpan(const CloudField& f) {
+  const std::span<const Species> rows = genus(f.type).species;
+  const double t = f.thickness_m;
+  if (rows.empty() || !(t > rows.front().thickness_m)) return {0, 0, 0.0};
+  for (std::size_t i = 1; i < rows.size(); ++i)
+    if (t <= rows[i].thickness_m)
+      return {i - 1, i,
+              std::log(t / rows[i - 1].thickness_m) /
+                  std::log(rows[i].thickness_m / rows[i - 1].thickness_m)};
+  return {rows.size() - 1, rows.size() - 1, 0.0};
+}
+
+// A heap's width over its height for the field's thickness: a power law between the rows.
 double widthOverHeight(const CloudField& f) {
   const std::span<const Species> rows = genus(f.type).species;
   if (rows.empty()) return 1.8;  // fields are only made of genera with species
-  const double t = f.thickness_m;
-  if (!(t > rows.front().thickness_m)) return rows.front().width_over_height;
-  for (std::size_t i = 1; i < rows.size(); ++i)
-    if (t <= rows[i].thickness_m) {
-      const Species &a = rows[i - 1], &b = rows[i];
-      const double s = std::log(t / a.thickness_m) / std::log(b.thickness_m / a.thickness_m);
-      return a.width_over_height * std::pow(b.width_over_height / a.width_over_height, s);
-    }
-  return rows.back().width_over_height;
+  const SpeciesSpan at = speciesSpan(f);
+  const double a = rows[at.lo].width_over_height, b = rows[at.hi].width_over_height;
+  return a * std::pow(b / a, at.s);
 }
 
 // Typical horizontal radius of a heap's base, metres.
@@ -232,7 +243,7 @@ std::vector<Ellipsoid> heapEllipsoids(const CloudField& f, glm::dvec3 base, doub
     lobes.size_variation = 0.25;
     lobes.position_variation = 0.4;
     lobes.heading_variation_deg = 90.0;
-    lobes.seed = k == 0 ? hashCounters(seed, kShape, 2) : hashCounters(seed, kShape, 2 + k);
+    lobes.seed = hashCounters(seed, kShape, 2 + std::uint64_t(k));
     for (Ellipsoid e : clusterEllipsoids(lobes, {dome})) {
       // Nothing hangs below the condensation level or its tier: a lobe the dome does not
       // raise rests on the flat base or the tier under it.
@@ -355,15 +366,8 @@ double unitArea(const CloudField& field, bool side) {
     if (added) it->second = measure(field.type, rows[i].thickness_m);
     return it->second;
   };
-  const double t = field.thickness_m;
-  if (rows.size() < 2 || !(t > rows.front().thickness_m)) return row(0);
-  for (std::size_t i = 1; i < rows.size(); ++i)
-    if (t <= rows[i].thickness_m) {
-      const double s = std::log(t / rows[i - 1].thickness_m) /
-                       std::log(rows[i].thickness_m / rows[i - 1].thickness_m);
-      return (1.0 - s) * row(i - 1) + s * row(i);
-    }
-  return row(rows.size() - 1);
+  const SpeciesSpan at = speciesSpan(field);
+  return at.lo == at.hi ? row(at.lo) : (1.0 - at.s) * row(at.lo) + at.s * row(at.hi);
 }
 
 // The most any point asks for.
