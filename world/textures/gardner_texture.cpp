@@ -34,10 +34,8 @@ GardnerTexture::GardnerTexture(const GardnerTextureParams& params) : params_(par
     c *= kAmplitudeRatio;
     for (int k = 0; k < GardnerTextureParams::kComponents; ++k) {
       if (params_.seeded_phases && (k == 0 || !periodic())) {
-        phx_[i][k] = 2.0 * std::numbers::pi *
-                     unitFromBits(hashCounters(params_.seed, 0x47617264ull, i, 2 * k));
-        phy_[i][k] = 2.0 * std::numbers::pi *
-                     unitFromBits(hashCounters(params_.seed, 0x47617264ull, i, 2 * k + 1));
+        phx_[i][k] = kTwoPi * unitFromBits(hashCounters(params_.seed, 0x47617264ull, i, 2 * k));
+        phy_[i][k] = kTwoPi * unitFromBits(hashCounters(params_.seed, 0x47617264ull, i, 2 * k + 1));
       }
       ax_[i][k] = ay_[i][k] = {1.0, 0.0};
     }
