@@ -20,11 +20,6 @@ void Engine::publish() {
     const double seconds = std::chrono::duration<double>(now - t0).count();
     if (seconds > 0.0) ticks_per_second = double(s.ticks - n0) / seconds;
   }
-  std::size_t depth = 0;
-  {
-    std::lock_guard lock(queue_mutex_);
-    depth = queue_.size();
-  }
   const std::vector<double> history(s.render_ms.begin(), s.render_ms.end());
   const World& world = *s.world;
   json stats = {
@@ -40,24 +35,15 @@ void Engine::publish() {
         {"p50", percentile(history, 0.5)},
         {"p99", percentile(history, 0.99)},
         {"samples", history.size()}}},
-      {"clients", {{"socket", socket_clients.load()}, {"modbus", modbus_clients.load()}}},
-      {"queue",
-       {{"depth", depth},
-        {"limit", config_.max_queue},
-        {"encoder", encoder_ ? encoder_->depth() : 0},
-        {"encoder_limit", kEncoderQueue}}},
+      // The counters other threads keep (clients, queue and encoder depth, frames dropped,
+      // errors, CIGI) are added by stats() when it is read.
+      {"queue", {{"limit", config_.max_queue}, {"encoder_limit", kEncoderQueue}}},
       {"subscriptions", s.subscriptions.size()},
-      {"frames_dropped", frames_dropped.load()},
       {"requests", s.requests},
-      {"errors", errors_.load()},
       {"automaton_steps", world.automatonStepsRun()},
       {"relights", world.relightsRun()},
       {"last_frame", frameStatsJson(s.renderer->lastFrameStats())},
   };
-  {
-    std::lock_guard lock(cigi_mutex_);
-    stats["cigi"] = cigi_counts_;
-  }
   stats["histograms"] = {{"render_seconds", s.render_seconds.toJson()},
                          {"request_seconds", s.request_seconds.toJson()}};
   {
@@ -155,8 +141,8 @@ void Engine::countCigi(const std::string& what) {
 }
 
 json Engine::stats() const {
-  // What other threads count is read now, not as of the world thread's last request (each
-  // lock alone, none held while another is taken).
+  // The world thread's figures as of its last request (publish), with what other threads
+  // count read now (each lock alone, none held while another is taken).
   std::size_t depth = 0;
   {
     std::lock_guard lock(queue_mutex_);
