@@ -52,7 +52,7 @@ bool Engine::stop() {
   }
   queue_cv_.notify_all();
   if (thread_.joinable()) thread_.join();
-  encoder_.reset();  // sends what it holds, then stops
+  if (encoder_) encoder_->finish();  // sends what it holds, then stops; kept for stats()
   return shutdown_saved_;
 }
 

@@ -193,18 +193,21 @@ struct Engine::Subscription {
 class Engine::Encoder {
  public:
   Encoder() : thread_([this] { run(); }) {}
-  ~Encoder() {
+  ~Encoder() { finish(); }
+  // Sends what it holds, then stops its thread; posts after this are refused. The Encoder
+  // itself stays, so a stats request on the socket thread may still ask its depth.
+  void finish() {
     {
       std::lock_guard lock(mutex_);
       stop_ = true;
     }
     cv_.notify_all();
-    thread_.join();
+    if (thread_.joinable()) thread_.join();
   }
   bool post(std::function<void()> job) {
     {
       std::lock_guard lock(mutex_);
-      if (jobs_.size() >= kEncoderQueue) return false;
+      if (stop_ || jobs_.size() >= kEncoderQueue) return false;
       jobs_.push_back(std::move(job));
     }
     cv_.notify_one();
