@@ -282,7 +282,9 @@ EllipsoidCloud heapCloud(const CloudField& f, std::string name) {
   // One texture for the whole field (the renderer caches textures by their parameters); it is
   // solid, so every heap shows a different part of it.
   cloud.texture.seed = hashCounters(f.seed, 0x54657874ull);
-  cloud.texture.gardner.fx1 = cloud.texture.gardner.fy1 = 6.0 / heapRadius(f);
+  cloud.texture.gardner.fx1 = cloud.texture.gardner.fy1 = look.texture_cycles / heapRadius(f);
+  cloud.texture.gardner.t0 = look.texture_offset;
+  cloud.texture.gardner.terms = look.texture_terms;
   return cloud;
 }
 

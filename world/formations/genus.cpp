@@ -6,11 +6,16 @@ namespace nephele {
 namespace {
 
 // Heaps: 20 per km of light extinction puts the sky light under a heap's middle at about a
-// third of the open sky's (MODEL.md section 14). A cumulonimbus's T1 is lower, so that its
-// tower reads as one mass.
-constexpr HeapLook kNoHeaps{1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0};
-constexpr HeapLook kCumulusHeaps{1.0, 0.2, 0.3, -0.4, 1.1, 0.05, 0.02};
-constexpr HeapLook kCumulonimbusHeaps{0.9, 0.2, 0.3, -0.6, 1.1, 0.05, 0.02};
+// third of the open sky's (MODEL.md section 14). T0 = 1 keeps the texture's product positive
+// nearly everywhere, so with T2 - T1 = 0.8 its variation moves a lobe's edge over the outer
+// half of its radius: the outline is ragged down to the finest term the pixel shows (outline
+// dimension 1.10 with Gardner's T0 = 0, T1 = -0.4, T2 = 1.1, where the product is zero on
+// three quarters of the lobe and the edge a smooth arc; 1.26 with these; docs/ACCURACY.md).
+// A cumulonimbus's T1 is lower, so that its tower reads as one mass, and its texture finer
+// for its size, its lobes being a smaller part of its width.
+constexpr HeapLook kNoHeaps{1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 6.0, 5};
+constexpr HeapLook kCumulusHeaps{1.0, 0.2, 0.3, -0.4, 0.4, 0.08, 0.02, 1.0, 12.0, 6};
+constexpr HeapLook kCumulonimbusHeaps{0.9, 0.2, 0.3, -0.3, 0.6, 0.12, 0.02, 1.0, 24.0, 7};
 
 // Species (the atlas): humilis, of slight vertical extent and flattened, three times as wide as
 // tall in a layer 500 m thick; mediocris, of moderate extent, 1.8 times as wide at 1,200 m (a

@@ -29,11 +29,15 @@ struct PlaneLook {
 };
 
 // Heaps (sections 10 and 14): colour; ambient and texture fractions of eq. 8; T1, T2 and D of
-// eq. 11 (T1 well below zero makes the middle of every ellipsoid opaque whatever the texture,
-// T2 above one the limb clear, D how soft the edge is); the light's extinction through a heap
-// per metre.
+// eq. 11 (T1 below zero makes the middle of every ellipsoid opaque whatever the texture, T2 how
+// far in towards the limb the texture decides the edge, D how soft the edge is); the light's
+// extinction through a heap per metre; the solid texture's offset T0, its base frequency in
+// radians per metre times the heap's base radius, and its terms (section 2): the texture, not
+// the ellipsoids, carries the heap's ragged outline and cauliflower detail ([G]).
 struct HeapLook {
   double colour, ambient, texture_fraction, t1, t2, d, light_extinction;
+  double texture_offset, texture_cycles;
+  int texture_terms;
 };
 
 // A species of heap (WMO International Cloud Atlas): the layer thickness it stands for and the
