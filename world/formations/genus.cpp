@@ -7,12 +7,13 @@ namespace {
 
 // Heaps: 20 per km of light extinction puts the sky light under a heap's middle at about a
 // third of the open sky's (MODEL.md section 14). T0 = 1 keeps the texture's product positive
-// nearly everywhere, so with T2 - T1 = 0.8 its variation moves a lobe's edge over the outer
-// half of its radius: the outline is ragged down to the finest term the pixel shows (outline
-// dimension 1.10 with Gardner's T0 = 0, T1 = -0.4, T2 = 1.1, where the product is zero on
-// three quarters of the lobe and the edge a smooth arc; 1.26 with these; docs/ACCURACY.md).
-// A cumulonimbus's T1 is lower, so that its tower reads as one mass, and its texture finer
-// for its size, its lobes being a smaller part of its width.
+// nearly everywhere, so with T2 - T1 = 0.8 its variation moves a lobe's edge across the outer
+// part of its radius: the outline is ragged down to the finest term the pixel shows (outline
+// dimension 1.10 with T0 = 0, T1 = -0.4, T2 = 1.1, where the product is zero on three quarters
+// of a lobe and the edge is a smooth arc; 1.15 with these). A wider band (T1 = -0.2, T2 = 0.6)
+// is rougher still (1.26) but its heaps, far away with their fine terms faded, draw less cover
+// than the far deck beyond them (docs/ACCURACY.md). The texture is finer for a cumulonimbus's
+// size, its lobes being a smaller part of its width.
 constexpr HeapLook kNoHeaps{1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 6.0, 5};
 constexpr HeapLook kCumulusHeaps{1.0, 0.2, 0.3, -0.4, 0.4, 0.08, 0.02, 1.0, 12.0, 6};
 constexpr HeapLook kCumulonimbusHeaps{0.9, 0.2, 0.3, -0.3, 0.6, 0.12, 0.02, 1.0, 24.0, 7};
