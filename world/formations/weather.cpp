@@ -17,25 +17,56 @@ namespace {
 // seed, where rotation alone left 0.3 to 0.4 (docs/ACCURACY.md, "Knobs of the model").
 constexpr double kJitterOctaves = 0.5;
 
-// Texture values at seeded points spread over 24 x 24 texture periods (the texture has no
-// period once rotated), sorted.
-std::vector<double> sortedSamples(const LayerTextureSpec& spec) {
-  constexpr int kSamples = 16384;
+// Seeded points spread over 24 x 24 texture periods (the texture has no period once rotated).
+constexpr int kSamples = 16384;
+glm::dvec2 samplePoint(int k, glm::dvec2 period) {
   constexpr double kSpan = 24.0;  // periods
+  return kSpan * period *
+         glm::dvec2(unitFromBits(hashCounters(0x436f76ull, std::uint64_t(k), 0)),
+                    unitFromBits(hashCounters(0x436f76ull, std::uint64_t(k), 1)));
+}
+
+// Texture values at the sample points, sorted.
+std::vector<double> sortedSamples(const LayerTextureSpec& spec) {
   LayerTextureSpec still = spec;
   still.drift_velocity = still.drift_offset_m = glm::dvec2(0.0);
   const LayerTexture texture(still);
-  const glm::dvec2 span = kSpan * texture.period();
   std::vector<double> values;
   values.reserve(kSamples);
-  for (int k = 0; k < kSamples; ++k) {
-    const glm::dvec2 u(unitFromBits(hashCounters(0x436f76ull, std::uint64_t(k), 0)),
-                       unitFromBits(hashCounters(0x436f76ull, std::uint64_t(k), 1)));
-    values.push_back(texture.value(u * span, 0.0));
-  }
+  for (int k = 0; k < kSamples; ++k)
+    values.push_back(texture.value(samplePoint(k, texture.period()), 0.0));
   std::sort(values.begin(), values.end());
   return values;
 }
+
+// Gardner's two sums at the sample points, without T0. T0 only offsets both sums and sets
+// k = 1 / (A + T0)^2 (A the sum of the amplitudes, MODEL.md section 2), so the sorted values
+// for any T0 follow from one evaluation of the sines: planes() raises T0 step by step.
+class GardnerSamples {
+ public:
+  explicit GardnerSamples(const GardnerTextureParams& params) {
+    GardnerTextureParams zero = params;
+    zero.t0 = 0.0;
+    const GardnerTexture texture(zero);
+    amplitude_sum_ = 1.0 / std::sqrt(texture.normalisation());
+    sums_.reserve(kSamples);
+    for (int k = 0; k < kSamples; ++k)
+      sums_.push_back(texture.planarSums(samplePoint(k, texture.period())));
+  }
+  std::vector<double> sorted(double t0) const {
+    const double k = 1.0 / ((amplitude_sum_ + t0) * (amplitude_sum_ + t0));
+    std::vector<double> values;
+    values.reserve(sums_.size());
+    for (const glm::dvec2& s : sums_)
+      values.push_back(k * std::max(s.x + t0, 0.0) * std::max(s.y + t0, 0.0));
+    std::sort(values.begin(), values.end());
+    return values;
+  }
+
+ private:
+  std::vector<glm::dvec2> sums_;
+  double amplitude_sum_ = 1.0;
+};
 
 double positiveFraction(const std::vector<double>& sorted) {
   const auto zeros = std::upper_bound(sorted.begin(), sorted.end(), 0.0) - sorted.begin();
@@ -80,10 +111,11 @@ std::vector<CloudLayer> planes(const WeatherLayer& w, const PlaneLook& look, dou
   // coverages between the positive fraction and 1; raise T0 (less contrast) until the asked
   // coverage is below the positive fraction.
   constexpr double kMaxT0 = 8.0;
-  std::vector<double> samples = sortedSamples(t);
+  const GardnerSamples sums(t.gardner);
+  std::vector<double> samples = sums.sorted(t.gardner.t0);
   while (coverage < 1.0 && t.gardner.t0 < kMaxT0 && positiveFraction(samples) < coverage + 0.02) {
     t.gardner.t0 += 0.25;
-    samples = sortedSamples(t);
+    samples = sums.sorted(t.gardner.t0);
   }
   const int count = look.planes;
   layer.threshold = thresholdFromSamples(samples, layer.transition, count, coverage, look.veil);

@@ -69,6 +69,12 @@ double GardnerTexture::planar(glm::dvec2 p, double term_count) const {
   return evaluate({p.x, p.y, 0.0}, /*solid=*/false, term_count);
 }
 
+glm::dvec2 GardnerTexture::planarSums(glm::dvec2 p) const {
+  double sx = params_.t0, sy = params_.t0;
+  for (int i = 0; i < params_.terms; ++i) addTerm(i, {p.x, p.y, 0.0}, false, sx, sy);
+  return {sx, sy};
+}
+
 double GardnerTexture::solid(glm::dvec3 p, double term_count) const {
   return evaluate(p, /*solid=*/true, term_count);
 }

@@ -76,6 +76,8 @@ class GardnerTexture {
   // fractional count blends the truncations floor(count) and floor(count) + 1.
   double planar(glm::dvec2 p, double term_count) const;
   double planar(glm::dvec2 p) const { return planar(p, terms()); }
+  // SX and SY at a planar point with every term, T0 included: T = k max(SX, 0) max(SY, 0).
+  glm::dvec2 planarSums(glm::dvec2 p) const;
   // T with solid phases (ellipsoids).
   double solid(glm::dvec3 p, double term_count) const;
 
