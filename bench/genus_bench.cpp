@@ -412,10 +412,9 @@ std::pair<double, double> residentMiB() {
   return {rss, peak};
 }
 
-std::size_t ellipsoidCount(const Scene& scene) {
-  std::size_t n = 0;
-  for (const EllipsoidCloud& c : withFieldClouds(scene).clouds) n += c.ellipsoids.size();
-  return n;
+// The ellipsoids a view of `scene` draws: its clouds' and its fields' heaps around the camera.
+std::size_t drawnEllipsoids(const Scene& scene) {
+  return ellipsoidCount(withFieldClouds(scene));
 }
 
 }  // namespace
@@ -526,7 +525,7 @@ int main(int argc, char** argv) {
             "%-22s %-7s %-10s %8.2f %8.2f %9.2f %7.1f %7.1f %10.2f %7.1f %10.2f %7.1f %10zu\n",
             path.stem().c_str(), view.name, size.c_str(), floor, clear_ms, still, still / floor,
             still / clear_ms, flying, flying / clear_ms, slowest, slowest / clear_ms,
-            ellipsoidCount(scene));
+            drawnEllipsoids(scene));
         std::fflush(stdout);
       }
       const auto [rss, peak] = residentMiB();

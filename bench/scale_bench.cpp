@@ -130,8 +130,7 @@ int main(int argc, char** argv) {
       cloud.ellipsoids = cumulusEllipsoids(25, base, 0.6 * spacing_m, std::uint64_t(j * 7919 + i));
       world.clouds.push_back(std::move(cloud));
     }
-  std::size_t total = 0;
-  for (const EllipsoidCloud& c : world.clouds) total += c.ellipsoids.size();
+  const std::size_t total = ellipsoidCount(world);
   const double world_mib = bench::residentMiB() - before_mib;
   std::printf("world: %zu clouds, %zu ellipsoids over %.0f km x %.0f km; %.1f MiB resident\n",
               world.clouds.size(), total, side_km, side_km, world_mib);

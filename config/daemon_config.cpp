@@ -1,5 +1,8 @@
 #include "config/daemon_config.h"
 
+#include <unistd.h>
+
+#include <algorithm>
 #include <filesystem>
 
 #include "config/table_reader.h"
@@ -57,14 +60,19 @@ void readDaemon(const toml::table& root, const std::string& file, DaemonConfig& 
     t.failAt("scene", error);
 
   if (auto w = t.table("world")) {
-    w->allow({"mode", "tick_rate", "time_scale", "threads"});
+    w->allow({"mode", "tick_rate", "time_scale", "threads", "max_ellipsoids"});
     out.mode = TickMode(w->choice("mode", {"realtime", "lockstep"}, int(out.mode)));
     w->number("tick_rate", out.tick_rate_hz, DaemonLimits::kMinTickRate,
               DaemonLimits::kMaxTickRate);
     w->number("time_scale", out.time_scale, 0.0, ProtocolLimits::kMaxTimeScale);
     w->integer("threads", out.world_threads, 1, 64);
+    w->integer("max_ellipsoids", out.max_ellipsoids, 1, Limits::kMaxWorldEllipsoids);
     w->finish();
   }
+  if (const std::size_t n = ellipsoidCount(out.scene.scene); n > std::size_t(out.max_ellipsoids))
+    t.failAt("scene", "its clouds hold " + std::to_string(n) + " ellipsoids, more than the " +
+                          "world's budget of " + std::to_string(out.max_ellipsoids) +
+                          " ([world] max_ellipsoids)");
   std::vector<TableReader> views = t.tables("view");
   if (views.size() > std::size_t(DaemonLimits::kMaxViews))
     t.failAt("view", "more than " + std::to_string(DaemonLimits::kMaxViews) + " views");
@@ -191,6 +199,13 @@ std::string parseDaemonConfig(std::string_view text, const std::string& source_n
   }
   out = std::move(parsed);
   return "";
+}
+
+int defaultMaxEllipsoids() {
+  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+  const double bytes = pages > 0 && page > 0 ? double(pages) * double(page) : 4.0 * (1 << 30);
+  return int(std::clamp(0.25 * bytes / Limits::kBytesPerEllipsoid, 65536.0,
+                        double(Limits::kMaxWorldEllipsoids)));
 }
 
 std::string loadDaemonConfig(const std::string& path, DaemonConfig& out) {

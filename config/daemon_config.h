@@ -49,6 +49,10 @@ struct Site {
   double longitude_deg = 0.0;
 };
 
+// A quarter of the machine's physical memory in ellipsoids of Limits::kBytesPerEllipsoid,
+// within [2^16, Limits::kMaxWorldEllipsoids].
+int defaultMaxEllipsoids();
+
 struct DaemonConfig {
   std::string config_path;
   std::string scene_path;  // relative paths are relative to the config file
@@ -58,6 +62,9 @@ struct DaemonConfig {
   double tick_rate_hz = 30.0;
   double time_scale = 1.0;
   int world_threads = 1;
+  // The world budget: ellipsoids its clouds may hold (the scene's, add_cloud's, a restored
+  // snapshot's); the default is what a quarter of this machine's memory holds.
+  int max_ellipsoids = defaultMaxEllipsoids();
   std::vector<ViewConfig> views;  // at least one
 
   bool socket_enabled = true;

@@ -135,9 +135,21 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
             !e.empty())
           return badField(e);
         std::size_t ellipsoids = cloud.ellipsoids.size();
+        // The world budget (docs/RELIABILITY.md): refused with `limit`, nothing added.
+        if (world.base().clouds.size() >= kMaxClouds)
+          return ProtocolError{ErrorCode::kLimit, "cloud: the world holds " +
+                                                      std::to_string(kMaxClouds) +
+                                                      " clouds already (the most it may)"};
+        if (const std::size_t held = ellipsoidCount(world.base());
+            held + ellipsoids > std::size_t(config_.max_ellipsoids))
+          return ProtocolError{ErrorCode::kLimit,
+                               "cloud: its " + std::to_string(ellipsoids) +
+                                   " ellipsoids would make the world's " + std::to_string(held) +
+                                   " more than its budget of " +
+                                   std::to_string(config_.max_ellipsoids) +
+                                   " ([world] max_ellipsoids in the daemon config; about " +
+                                   std::to_string(Limits::kBytesPerEllipsoid) + " bytes each)"};
         std::string error = world.edit([&](Scene& now, WorldDynamics& d) -> std::string {
-          if (now.clouds.size() >= kMaxClouds)
-            return "cloud: the world holds " + std::to_string(kMaxClouds) + " clouds already";
           for (const EllipsoidCloud& other : now.clouds)
             if (other.name == cloud.name) return "cloud.name: \"" + cloud.name + "\" is taken";
           now.clouds.push_back(cloud);
@@ -290,7 +302,8 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
         if (!std::filesystem::exists(path))
           return ProtocolError{ErrorCode::kNotFound, "name: no snapshot \"" + c.name + "\""};
         if (std::string e = restoreSnapshot(path); !e.empty())
-          return ProtocolError{ErrorCode::kFailed, e};
+          return ProtocolError{
+              e.starts_with(World::kOverBudget) ? ErrorCode::kLimit : ErrorCode::kFailed, e};
         return json{{"name", c.name},
                     {"time", world.timeSeconds()},
                     {"hash", hexHash(world.hash())},

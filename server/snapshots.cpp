@@ -144,7 +144,9 @@ std::string Engine::restoreSnapshot(const std::string& path) {
     }
     state = std::move(j);
   }
-  if (std::string e = s.world->restoreSnapshot(path); !e.empty()) return e;
+  if (std::string e = s.world->restoreSnapshot(path, std::size_t(config_.max_ellipsoids));
+      !e.empty())
+    return e;
   if (!state) return "";  // a snapshot from before daemon state was saved: the world alone
   s.ticks = (*state)["ticks"].get<std::uint64_t>();
   s.frames = (*state)["frames"].get<std::uint64_t>();

@@ -23,6 +23,8 @@ TEST(DaemonConfig, DefaultsAndTheExample) {
   EXPECT_EQ(c.socket_timeouts.request_s, 10.0);
   EXPECT_EQ(c.socket_timeouts.idle_s, 300.0);
   EXPECT_EQ(c.modbus_timeouts.request_s, 2.0);
+  EXPECT_EQ(c.max_ellipsoids, defaultMaxEllipsoids());
+  EXPECT_GE(c.max_ellipsoids, 65536);
 
   DaemonConfig example;
   ASSERT_EQ(loadDaemonConfig(std::string(NEPHELE_SOURCE_DIR) + "/deploy/nephele.toml", example),
@@ -65,6 +67,11 @@ TEST(DaemonConfig, ErrorsNameTheKey) {
       {kScene + "[modbus]\nidle_timeout = -1\n", "modbus.idle_timeout"},
       {kScene + "[[view]]\nname = \"front view\"\n", "is not a name"},
       {"scene = \"/tmp\"\n", "not a regular file"},
+      {kScene + "[world]\nmax_ellipsoids = 0\n", "world.max_ellipsoids"},
+      // The world budget holds for the scene too: cumulus.toml's heap has 27 lobes.
+      {"scene = \"" + std::string(NEPHELE_SOURCE_DIR) +
+           "/config/scenes/cumulus.toml\"\n[world]\nmax_ellipsoids = 26\n",
+       "more than the world's budget of 26 ([world] max_ellipsoids)"},
   };
   for (const Case& c : cases) {
     DaemonConfig out;

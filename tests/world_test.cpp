@@ -230,6 +230,24 @@ TEST(World, CorruptOrTruncatedSnapshotsAreRefusedAndLeaveTheWorldAsItWas) {
   EXPECT_EQ(target.hash(), source.hash());
 }
 
+// Issue 31, item 2: a snapshot whose clouds hold more ellipsoids than the world budget is
+// refused (a daemon restarted with a lower `[world] max_ellipsoids`), the world unchanged.
+TEST(World, SnapshotsBeyondTheWorldBudgetAreRefused) {
+  World source = makeWorld();
+  const std::size_t held = ellipsoidCount(source.base());
+  ASSERT_GE(held, 1u);
+  const std::vector<std::uint8_t> bytes = source.snapshot();
+  World target = makeWorld();
+  ASSERT_EQ(target.advance(1.0), "");
+  const std::uint64_t before = target.hash();
+  const std::string error = target.restore(bytes, held - 1);
+  EXPECT_TRUE(error.starts_with(World::kOverBudget)) << error;
+  EXPECT_NE(error.find(std::to_string(held) + " ellipsoids"), std::string::npos) << error;
+  EXPECT_EQ(target.hash(), before);
+  ASSERT_EQ(target.restore(bytes, held), "");
+  EXPECT_EQ(target.hash(), source.hash());
+}
+
 // Issue 12, case 1: restoring from a directory, a FIFO (no writer), a 1 GiB sparse file or a
 // file longer than its header says is refused at once with a message, reads at most the
 // header, and leaves the world as it was.

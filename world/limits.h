@@ -78,6 +78,12 @@ struct Limits {
   // Ellipsoids and targets, metres: zero, negative and NaN are rejected.
   static constexpr double kMinRadius = 1.0e-3, kMaxRadius = 1.0e5;
   static constexpr int kMaxEllipsoidsPerCloud = 4096;
+  // Ellipsoids one world may hold (the daemon's `[world] max_ellipsoids`, whose default
+  // follows the machine's memory: defaultMaxEllipsoids). Held and rendered, an ellipsoid
+  // costs the daemon about 1.1 KB (issue 31: 1,638,400 of them took it from 1,020 to
+  // 2,748 MiB, 1,106 bytes each).
+  static constexpr int kMaxWorldEllipsoids = 4096 * kMaxEllipsoidsPerCloud;
+  static constexpr int kBytesPerEllipsoid = 1106;
 
   // Wind, drift and weather.
   static constexpr double kMaxWind = 200.0;   // m/s, the speed of a wind sample

@@ -71,6 +71,13 @@ struct Scene {
   std::vector<AutomatonCloudView> automata;
 };
 
+// Ellipsoids the scene's clouds hold (its fields' heaps are made per view and not counted).
+inline std::size_t ellipsoidCount(const Scene& scene) {
+  std::size_t n = 0;
+  for (const EllipsoidCloud& cloud : scene.clouds) n += cloud.ellipsoids.size();
+  return n;
+}
+
 // Whether anything lies in the air between the eye and a surface (fog, haze).
 inline bool sceneHasAir(const Scene& scene) {
   return scene.fog || scene.haze;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "world/automaton/automaton_cloud.h"
+#include "world/limits.h"
 #include "world/scene.h"
 #include "world/schedule.h"
 
@@ -86,10 +87,16 @@ class World {
   // A hash of the whole state (XXH3 of the snapshot): equal worlds give equal hashes.
   std::uint64_t hash() const;
   // Snapshots restore bit-exactly. Errors name what is wrong; on error the world is unchanged.
+  // A snapshot whose clouds hold more than `max_ellipsoids` is refused (a daemon's world
+  // budget, which may be lower than the one the snapshot was written under), with an error
+  // that begins with kOverBudget.
+  static constexpr std::string_view kOverBudget = "snapshot: over the world's budget: ";
   std::vector<std::uint8_t> snapshot() const;
-  std::string restore(std::span<const std::uint8_t> bytes);
+  std::string restore(std::span<const std::uint8_t> bytes,
+                      std::size_t max_ellipsoids = Limits::kMaxWorldEllipsoids);
   std::string saveSnapshot(const std::string& path) const;
-  std::string restoreSnapshot(const std::string& path);
+  std::string restoreSnapshot(const std::string& path,
+                              std::size_t max_ellipsoids = Limits::kMaxWorldEllipsoids);
 
  private:
   World(const Scene& scene, const WorldDynamics& dynamics, int threads, bool warm_up);

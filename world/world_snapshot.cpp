@@ -325,7 +325,7 @@ std::uint64_t World::hash() const {
   return payloadHash(std::span(bytes).subspan(kHeaderBytes));
 }
 
-std::string World::restore(std::span<const std::uint8_t> bytes) {
+std::string World::restore(std::span<const std::uint8_t> bytes, std::size_t max_ellipsoids) {
   if (bytes.size() < kHeaderBytes || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
     return "snapshot: not a Nephele snapshot (bad magic or shorter than its header)";
   std::uint32_t version = 0;
@@ -348,6 +348,10 @@ std::string World::restore(std::span<const std::uint8_t> bytes) {
   std::int64_t time_ns = 0;
   io(r, scene), io(r, dynamics), io(r, time_ns);
   if (!r.ok()) return "snapshot: " + r.error();
+  if (const std::size_t n = ellipsoidCount(scene); n > max_ellipsoids)
+    return std::string(kOverBudget) + "its clouds hold " + std::to_string(n) +
+           " ellipsoids, more than the " + std::to_string(max_ellipsoids) +
+           " this world may hold ([world] max_ellipsoids)";
   if (std::string e = worldDynamicsError(scene, dynamics); !e.empty()) return "snapshot: " + e;
   for (const EllipsoidCloud& cloud : scene.clouds)
     for (const Ellipsoid& e : cloud.ellipsoids)
@@ -379,7 +383,7 @@ std::string World::saveSnapshot(const std::string& path) const {
   return writeFileAtomically(path, snapshot(), "snapshot");
 }
 
-std::string World::restoreSnapshot(const std::string& path) {
+std::string World::restoreSnapshot(const std::string& path, std::size_t max_ellipsoids) {
   // Opened without blocking (a FIFO would wait for a writer forever) and checked to be a
   // regular file (a directory, device or FIFO is refused), then read only as far as its
   // header promises: a large file of anything else costs one header read.
@@ -414,7 +418,7 @@ std::string World::restoreSnapshot(const std::string& path) {
   bytes.resize(kHeaderBytes + length);
   if (!readFully(bytes.data() + kHeaderBytes, length))
     return "snapshot: cannot read " + path + ": " + std::strerror(errno);
-  return restore(bytes);
+  return restore(bytes, max_ellipsoids);
 }
 
 }  // namespace nephele

@@ -39,9 +39,10 @@ class Daemon:
     """A `nephele serve` process with its own config in a temporary directory."""
 
     def __init__(self, workdir, mode="lockstep", extra="", view_size=(64, 48), name="d",
-                 socket_keys="", modbus_keys="", scene=SCENE, frames=None, env=None):
+                 socket_keys="", modbus_keys="", scene=SCENE, frames=None, env=None,
+                 world_keys=""):
         """`extra` is appended to the config ({snapshot} becomes this daemon's snapshot
-        path); `socket_keys` and `modbus_keys` go into those tables."""
+        path); `world_keys`, `socket_keys` and `modbus_keys` go into those tables."""
         self.workdir = workdir
         self.env = dict(os.environ, **(env or {}))
         self.config = os.path.join(workdir, name + ".toml")
@@ -52,6 +53,7 @@ class Daemon:
 [world]
 mode = "{mode}"
 tick_rate = 30
+{world_keys}
 [[view]]
 name = "front"
 width = {view_size[0]}
@@ -582,6 +584,27 @@ class LockstepAndSnapshotTest(DaemonTest):
                          cb.ok({"cmd": "render", "view": "front"})[1])
         cb.ok({"cmd": "tick", "dt": 0.1})
         self.assertNotEqual(ca.ok({"cmd": "hash"})["hash"], cb.ok({"cmd": "hash"})["hash"])
+
+    def test_the_world_budget_refuses_what_would_exceed_it(self):
+        # Issue 31, item 2: add_cloud past [world] max_ellipsoids is refused with `limit`,
+        # naming the budget and the setting, and nothing changes; below it clouds are added.
+        d = self.daemon(name="w", world_keys="max_ellipsoids = 5000")
+        c = d.client()
+        added = c.ok({"cmd": "add_cloud", "cloud": {"name": "a", "cumulus": {
+            "base": [0, 0, 1000], "width": 3000, "count": 4096}}})
+        self.assertEqual(added["ellipsoids"], 4096)  # with the scene's 27: 4,123 held
+        before = c.ok({"cmd": "hash"})["hash"]
+        error = c.error({"cmd": "add_cloud", "cloud": {"name": "b", "cumulus": {
+            "base": [0, 0, 1000], "count": 1000}}})
+        self.assertEqual(error["code"], "limit", error)
+        self.assertIn("max_ellipsoids", error["message"])
+        self.assertIn("4123", error["message"])
+        self.assertIn("5000", error["message"])
+        self.assertEqual(c.ok({"cmd": "hash"})["hash"], before)
+        c.ok({"cmd": "add_cloud", "cloud": {"name": "b", "cumulus": {
+            "base": [0, 0, 1000], "count": 877}}})  # exactly the budget
+        self.assertEqual(c.error({"cmd": "add_cloud", "cloud": {"name": "c", "cumulus": {
+            "base": [0, 0, 1000], "count": 1}}})["code"], "limit")
 
     def test_sigterm_saves_and_restart_restores(self):
         d = self.daemon(name="r", extra='[snapshot]\npath = "{snapshot}"\ninterval = 0')
