@@ -99,6 +99,8 @@ void Engine::renderFrame(const ViewConfig& view, const ImageRequest& image, View
   } else {
     frame.srgb = s.renderer->renderSrgb8(scene, config_.scene.render);
   }
+  // Stopping: the frame is incomplete and nothing is sent or counted (docs/RELIABILITY.md).
+  if (s.renderer->lastFrameCancelled()) throw RenderCancelled{};
   FrameInfo info = frameInfo(view.camera, s.world->timeSeconds(), std::uint64_t(s.ticks));
   if (off_axis) {
     const OffAxisView& o = *off_axis;

@@ -50,6 +50,7 @@ bool Engine::stop() {
     if (stopping_ && !thread_.joinable()) return shutdown_saved_;
     stopping_ = true;
   }
+  cancel_renders_ = true;
   queue_cv_.notify_all();
   if (thread_.joinable()) thread_.join();
   if (encoder_) encoder_->finish();  // sends what it holds, then stops; kept for stats()
@@ -133,6 +134,7 @@ std::string Engine::openWorld() {
   s.platform = createGlPlatform(GlBackend::kAuto, error);
   if (!s.platform) return "no OpenGL context: " + error;
   s.renderer = std::make_unique<GlRenderer>(*s.platform);
+  s.renderer->setCancel(&cancel_renders_);
   s.world =
       std::make_unique<World>(config_.scene.scene, config_.scene.dynamics, config_.world_threads);
   if (std::string e = s.world->advanceInPieces(config_.scene.scene.time_s); !e.empty())
@@ -187,9 +189,13 @@ void Engine::run(std::promise<std::string>& started) {
         setInHand(job.kind == Job::Kind::kBatch ? "modbus write"
                                                 : std::string(commandName(job.request.command)),
                   job.client);
-        execute(job);
-        s.request_seconds.add(std::chrono::duration<double>(Clock::now() - job.queued).count());
-        continue;
+        try {
+          execute(job);
+          s.request_seconds.add(std::chrono::duration<double>(Clock::now() - job.queued).count());
+          continue;
+        } catch (const RenderCancelled&) {
+          stopping = true;  // stop() cancelled its render: answered as the queued ones
+        }
       }
       const ProtocolError cancelled{ErrorCode::kFailed, "the daemon is shutting down"};
       if (job.reply) job.reply(makeReply(errorReply(job.request.id, cancelled)));
@@ -197,12 +203,17 @@ void Engine::run(std::promise<std::string>& started) {
     }
     setInHand("", 0);
     if (stopping) break;
-    setInHand("ticks", 0);
-    realtimeTicks();
-    // Realtime: subscriptions at their rate. Lockstep: a new subscription's first frame (the
-    // ticks themselves deliver in advance()).
-    setInHand("frames", 0);
-    deliverFrames(s.mode == TickMode::kRealtime ? Delivery::kDue : Delivery::kEveryTick, "");
+    try {
+      setInHand("ticks", 0);
+      realtimeTicks();
+      // Realtime: subscriptions at their rate. Lockstep: a new subscription's first frame
+      // (the ticks themselves deliver in advance()).
+      setInHand("frames", 0);
+      deliverFrames(s.mode == TickMode::kRealtime ? Delivery::kDue : Delivery::kEveryTick, "");
+    } catch (const RenderCancelled&) {
+      setInHand("", 0);
+      break;  // stopping: the frames in hand are not sent
+    }
     setInHand("", 0);
     if (config_.snapshot_interval_s > 0.0 && !config_.snapshot_path.empty() &&
         Clock::now() >= s.next_snapshot) {

@@ -215,6 +215,8 @@ class Engine {
     Clock::time_point since;
   } in_hand_;
   std::atomic<bool> trigger_pending_{false};
+  // Raised by stop(): the render in hand ends at its next batch boundary (RenderCancelled).
+  std::atomic<bool> cancel_renders_{false};
   std::atomic<bool> lockstep_{false};
   std::atomic<std::int64_t> heartbeat_ns_{0};  // steady clock, at the top of each loop
   std::atomic<std::uint64_t> errors_{0};

@@ -190,6 +190,10 @@ struct Engine::Subscription {
 };
 
 // A thread that encodes images off the world thread, from a bounded queue.
+// Thrown by Engine::renderFrame when the daemon's stop cancelled the render in hand; the run
+// loop answers the request "shutting down".
+struct RenderCancelled {};
+
 class Engine::Encoder {
  public:
   Encoder() : thread_([this] { run(); }) {}

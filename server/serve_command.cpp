@@ -114,8 +114,9 @@ int runServeCommand(const ServeCommandOptions& o) {
   stopping = true;
   if (watchdog.joinable()) watchdog.join();
   modbus.close();
-  // The request in hand finishes, queued ones are answered "shutting down", the snapshot is
-  // saved. Then each connection writes out what it was sent (docs/RELIABILITY.md).
+  // A render in hand is cancelled at its next batch boundary, other requests in hand finish,
+  // queued ones are answered "shutting down", the snapshot is saved. Then each connection
+  // writes out what it was sent (docs/RELIABILITY.md).
   const bool saved = engine.stop();
   asio::post(io, [&] {
     socket.close();

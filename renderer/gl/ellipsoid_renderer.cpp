@@ -179,6 +179,7 @@ EllipsoidRenderer::~EllipsoidRenderer() = default;
 
 void EllipsoidRenderer::beginFrame(FrameStats& stats) {
   stats_ = &stats;
+  cancelled_ = false;
   for (auto& [key, cached] : textures_) cached.used = false;
   next_buffer_ = 0;
 }
@@ -376,8 +377,10 @@ void EllipsoidRenderer::drawClouds(const Scene& scene, const std::vector<std::si
     if (batch == batches.end()) batch = batches.insert(batches.end(), {key, {}});
     batch->second.push_back(index);
   }
-  for (const auto& [key, members] : batches)
+  for (const auto& [key, members] : batches) {
+    if (stopNow()) return;
     drawDirect(scene, members, settings, target, targets_drawn, band);
+  }
 }
 
 bool EllipsoidRenderer::drawImpostor(const Scene& scene, std::size_t index,
@@ -488,11 +491,13 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   const bool spotlight = settings.limb == LimbEvaluation::kSpotlight;
   double nearest_m = std::numeric_limits<double>::infinity();
   int total = 0;
+  std::size_t seen = 0;
   for (std::size_t index : indices) {
     const EllipsoidCloud& member = scene.clouds[index];
     total += int(member.ellipsoids.size());
     const std::vector<HeapEnvelope> envelopes = heapEnvelopes(member);
     for (std::size_t i = 0; i < member.ellipsoids.size(); ++i) {
+      if (++seen % kCancelRecords == 0 && stopNow()) return;
       Visible v;
       if (!makeEllipsoidRecord(member.ellipsoids[i], scene.camera, spotlight, v.record,
                                v.centre_distance))
@@ -562,8 +567,16 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
     gl_.UseProgram(p);
     setCloudUniforms(p, scene, cloud, texture, layout.texture, band);
     gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_first"), 0);
-    for (std::size_t first = 0; first < ordered.size(); first += max_records) {
-      const std::size_t count = std::min(max_records, ordered.size() - first);
+    // Instances blend in order, so drawing them in groups changes nothing but where a
+    // cancellation can land.
+    const bool cancellable = cancel_ && ordered.size() > kCancelInstances;
+    const std::size_t group = cancellable ? std::min(max_records, kCancelInstances) : max_records;
+    for (std::size_t first = 0; first < ordered.size(); first += group) {
+      if (cancellable && first > 0) {
+        gl_.Finish();
+        if (stopNow()) return;
+      }
+      const std::size_t count = std::min(group, ordered.size() - first);
       bindFrameTexture(kRecordTextureUnit, GL_RGBA32F, ordered.data() + first,
                        count * sizeof(EllipsoidRecord));
       gl_.DrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(count));
@@ -630,16 +643,60 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   auto ndc = [](int bins, int size) {
     return float(2.0 * std::min(bins * kPerPixelBinSize, size) / size - 1.0);
   };
-  const float x0 = ndc(area.x, target.width), y0 = ndc(area.y, target.height);
-  const float x1 = ndc(area.z + 1, target.width), y1 = ndc(area.w + 1, target.height);
-  const glm::vec2 polygon[4] = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
-  gl_.ProgramUniform2fv(p, gl_.GetUniformLocation(p, "u_polygon"), 4, &polygon[0].x);
   bindFrameTexture(kRecordTextureUnit, GL_RGBA32F, ordered.data(),
                    ordered.size() * sizeof(EllipsoidRecord));
   bindFrameTexture(kBinTextureUnit, GL_RG32I, bins.data(), bins.size() * sizeof(glm::ivec2));
   bindFrameTexture(kBinItemTextureUnit, GL_R32I, items.data(), items.size() * sizeof(GLint));
-  gl_.DrawArrays(GL_TRIANGLE_FAN, 0, 4);
+  const GLint polygon_at = gl_.GetUniformLocation(p, "u_polygon");
+  // Draws bins [bx0, bx1] x [by0, by1] (absolute bin indices): each pixel composites every
+  // hit of its bin, so disjoint rectangles give the image one quad gives.
+  auto drawRect = [&](int bx0, int by0, int bx1, int by1) {
+    const float x0 = ndc(bx0, target.width), y0 = ndc(by0, target.height);
+    const float x1 = ndc(bx1 + 1, target.width), y1 = ndc(by1 + 1, target.height);
+    const glm::vec2 polygon[4] = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
+    gl_.ProgramUniform2fv(p, polygon_at, 4, &polygon[0].x);
+    gl_.DrawArrays(GL_TRIANGLE_FAN, 0, 4);
+  };
   ++stats_->ellipsoid_passes;
+  constexpr std::int64_t kBinPixels = std::int64_t(kPerPixelBinSize) * kPerPixelBinSize;
+  if (!cancel_ || listed * kBinPixels <= kCancelWork)
+    return drawRect(area.x, area.y, area.z, area.w);
+  // Heavy: bands of whole bin rows of about kCancelWork hit tests (a row heavier than that
+  // alone in runs of its bins), each finished before the flag is read.
+  auto finished = [&] {
+    gl_.Finish();
+    return stopNow();
+  };
+  int band_from = area.y;
+  std::int64_t band_work = 0;
+  for (int y = area.y; y <= area.w; ++y) {
+    std::int64_t row_work = 0;
+    for (int x = area.x; x <= area.z; ++x) row_work += binAt(x, y).y * kBinPixels;
+    if (band_work > 0 && band_work + row_work > kCancelWork) {
+      drawRect(area.x, band_from, area.z, y - 1);
+      if (finished()) return;
+      band_from = y, band_work = 0;
+    }
+    if (row_work <= kCancelWork) {
+      band_work += row_work;
+      continue;
+    }
+    int run_from = area.x;
+    std::int64_t run_work = 0;
+    for (int x = area.x; x <= area.z; ++x) {
+      const std::int64_t work = binAt(x, y).y * kBinPixels;
+      if (run_work > 0 && run_work + work > kCancelWork) {
+        drawRect(run_from, y, x - 1, y);
+        if (finished()) return;
+        run_from = x, run_work = 0;
+      }
+      run_work += work;
+    }
+    drawRect(run_from, y, area.z, y);
+    if (finished()) return;
+    band_from = y + 1;
+  }
+  if (band_from <= area.w) drawRect(area.x, band_from, area.z, area.w);
 }
 
 void EllipsoidRenderer::prepareAtlas(TileFormat format) {

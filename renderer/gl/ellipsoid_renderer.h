@@ -1,6 +1,7 @@
 #pragma once
 // Ellipsoid clouds on the GL: visible ellipsoids culled and ordered on the CPU in double,
 // then drawn either fused (exact per-fragment hits) or with Elinas and Stuerzlinger's tiles.
+#include <atomic>
 #include <map>
 #include <memory>
 #include <string>
@@ -61,10 +62,27 @@ class EllipsoidRenderer {
   // Impostors rendered so far (for measurement and tests).
   int impostorRenders() const { return impostor_renders_; }
 
+  // A flag another thread may raise to cancel the frame being drawn (a daemon stopping,
+  // docs/RELIABILITY.md). It is read between batches, every kCancelRecords ellipsoids while
+  // records are made, and, in a heavy batch, after each part of it drawn to completion
+  // (glFinish): the per-pixel pass in bands of about kCancelWork hit tests, the centre pass
+  // in groups of kCancelInstances. Light batches draw as without it. Once raised the rest of
+  // the frame's ellipsoids are skipped and cancelled() says so until the next beginFrame.
+  void setCancel(const std::atomic<bool>* flag) { cancel_ = flag; }
+  bool cancelled() const { return cancelled_; }
+
   // The in-cloud veil over the whole frame, if the eye is in or near any ellipsoid.
   void drawVeil(const Scene& scene, const RenderSettings& settings);
 
  private:
+  static constexpr std::size_t kCancelRecords = 65536;
+  static constexpr std::int64_t kCancelWork = std::int64_t(1) << 25;
+  static constexpr std::size_t kCancelInstances = 16384;
+  bool stopNow() {
+    if (!cancelled_ && cancel_ && cancel_->load(std::memory_order_relaxed)) cancelled_ = true;
+    return cancelled_;
+  }
+
   struct CachedTexture {
     std::unique_ptr<SolidTexture> source;
     GlObject texture;
@@ -133,6 +151,8 @@ class EllipsoidRenderer {
   std::map<int, IndexedMesh> meshes_;
   std::map<std::size_t, Impostor> impostors_;  // by cloud index
   int impostor_renders_ = 0;
+  const std::atomic<bool>* cancel_ = nullptr;
+  bool cancelled_ = false;
   FrameStats* stats_ = nullptr;  // the current frame's, borrowed from the GlRenderer
 };
 
