@@ -146,6 +146,11 @@ std::vector<Setting> settingsFor(const SceneFile& file) {
     for (double px : {0.0, 16.0, 64.0, 10000.0})
       add("heap_detail", withKnob(px), [px](RenderSettings& s) { s.heaps.detail_px = px; });
   }
+  // The frame's work budget (issue 31): the presets hold a few thousand ellipsoids in view, so
+  // budgets below that show what thinning costs (the default, 65,536, changes none of them).
+  if (!file.scene.clouds.empty() || !file.scene.fields.empty())
+    for (double n : {1024.0, 4096.0})
+      add("ellipsoid_budget", withKnob(n), [n](RenderSettings& s) { s.ellipsoid_budget = n; });
   if (!file.dynamics.automata.empty()) {
     for (double step : {0.5, 2.0, 4.0})
       add("volume_step", withKnob(step), [step](RenderSettings& s) { s.volume_step = step; });

@@ -67,6 +67,7 @@ std::string applyOverrides(const RenderCommandOptions& o, SceneFile& file) {
   if (o.volume_step) r.volume_step = *o.volume_step;
   if (o.heap_range) r.heaps.range_m = *o.heap_range;
   if (o.heap_detail) r.heaps.detail_px = *o.heap_detail;
+  if (o.ellipsoid_budget) r.ellipsoid_budget = *o.ellipsoid_budget;
   file.reference.heaps = r.heaps;  // both renderers draw the same heaps
   if (o.samples) file.reference.samples_per_axis = *o.samples;
   std::string error = validateCamera(camera);
@@ -184,6 +185,9 @@ void addRenderCommand(CLI::App& app, RenderCommandOptions& o) {
   cmd->add_option("--heap-detail", o.heap_detail,
                   "Cloud fields: every lobe of heaps whose radius spans this many pixels, their "
                   "outline below (0..10000; default 32; 0 every lobe)");
+  cmd->add_option("--ellipsoid-budget", o.ellipsoid_budget,
+                  "Ellipsoids a frame draws before it draws the clouds of smallest projected "
+                  "size as one mound each (0..16777216; default 65536; 0 every ellipsoid)");
   cmd->add_option("--volume-step", o.volume_step,
                   "Automaton clouds: view march step in lattice spacings (0.25..8)");
   cmd->add_option("--samples", o.samples, "Reference supersampling per pixel axis")

@@ -89,7 +89,8 @@ void readFog(TableReader& t, Fog& fog) {
 void readRender(TableReader& t, SceneFile& out) {
   t.allow({"texture", "term_filter", "sky_passes", "bake_texels_per_cycle", "reference_samples",
            "ellipsoid_passes", "ellipsoid_order", "limb", "tile_resolution", "tile_format",
-           "tessellation", "impostor_tolerance", "volume_step", "heap_range", "heap_detail"});
+           "tessellation", "impostor_tolerance", "volume_step", "heap_range", "heap_detail",
+           "ellipsoid_budget"});
   out.render.texture_evaluation = TextureEvaluation(
       t.choice("texture", kTextureEvaluationNames, int(out.render.texture_evaluation)));
   out.render.term_filter =
@@ -113,6 +114,7 @@ void readRender(TableReader& t, SceneFile& out) {
   t.number("volume_step", r.volume_step, 0.25, 8.0);
   t.number("heap_range", r.heaps.range_m, Limits::kHeapRange);
   t.number("heap_detail", r.heaps.detail_px, Limits::kHeapDetail);
+  t.number("ellipsoid_budget", r.ellipsoid_budget, Limits::kEllipsoidBudget);
   out.reference.heaps = r.heaps;  // both renderers draw the same heaps
   t.finish();
 }
@@ -698,6 +700,9 @@ std::string validateRenderSettings(const RenderSettings& r) {
   if (std::ostringstream out;
       outOfRange(out, "heap_detail", r.heaps.detail_px, Limits::kHeapDetail))
     return out.str() + " pixels of a heap's radius; 0 draws every lobe";
+  if (std::ostringstream out;
+      outOfRange(out, "ellipsoid_budget", r.ellipsoid_budget, Limits::kEllipsoidBudget))
+    return out.str() + " ellipsoids; 0 draws every one";
   if (!(r.volume_step >= 0.25 && r.volume_step <= 8.0))
     return "volume_step: " + formatNumber(r.volume_step) +
            " is out of range (allowed: 0.25 to 8 lattice spacings)";

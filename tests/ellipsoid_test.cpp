@@ -9,6 +9,7 @@
 
 #include "world/formations/ellipsoid.h"
 #include "world/formations/ellipsoid_cloud.h"
+#include "world/scene.h"
 #include "world/target.h"
 #include "world/textures/solid_texture.h"
 
@@ -36,6 +37,37 @@ Quadratic rayQuadratic(const Ellipsoid& e, glm::dvec3 eye, glm::dvec3 d) {
 glm::dvec3 randomUnit(std::mt19937_64& rng) {
   std::normal_distribution<double> n;
   return glm::normalize(glm::dvec3(n(rng), n(rng), n(rng)));
+}
+
+// Issue 31, item 1: a frame's work budget keeps the `budget` ellipsoids of largest projected
+// size (near and large before far and small, none behind the camera), whatever order the
+// clouds come in, and changes nothing within it.
+TEST(EllipsoidBudget, KeepsTheLargestInViewAndIsDeterministic) {
+  Scene scene;
+  scene.camera.position = {0.0, 0.0, 0.0};  // heading 0: looking north (+Y)
+  auto cloud = [](const char* name, double y, double radius, int n) {
+    EllipsoidCloud c;
+    c.name = name;
+    c.texture.seed = c.texture.gardner.seed = 7;
+    for (int i = 0; i < n; ++i) c.ellipsoids.push_back({glm::dvec3(radius), {10.0 * i, y, 0.0}});
+    return c;
+  };
+  scene.clouds = {cloud("far", 10000.0, 50.0, 6), cloud("near", 1000.0, 50.0, 4),
+                  cloud("behind", -1000.0, 500.0, 5)};
+  const Scene kept = withinEllipsoidBudget(scene, 7.0);
+  EXPECT_EQ(ellipsoidCount(kept), 7u);
+  ASSERT_EQ(kept.clouds.size(), 2u);  // the cloud behind the camera is gone
+  EXPECT_EQ(kept.clouds[0].name, "far");
+  EXPECT_EQ(kept.clouds[0].ellipsoids.size(), 3u);  // its first three: ties by lobe order
+  EXPECT_EQ(kept.clouds[0].texture.seed, 0u);       // thinned: the shared texture
+  EXPECT_EQ(kept.clouds[1].name, "near");
+  EXPECT_EQ(kept.clouds[1].ellipsoids.size(), 4u);  // every near lobe
+  EXPECT_EQ(kept.clouds[1].texture.seed, 7u);
+  EXPECT_EQ(ellipsoidCount(withinEllipsoidBudget(scene, 7.0)), ellipsoidCount(kept));
+  EXPECT_EQ(withinEllipsoidBudget(scene, 7.0).clouds[0].ellipsoids[2].centre,
+            kept.clouds[0].ellipsoids[2].centre);
+  EXPECT_EQ(ellipsoidCount(withinEllipsoidBudget(scene, 15.0)), 15u);  // within: unchanged
+  EXPECT_EQ(ellipsoidCount(withinEllipsoidBudget(scene, 0.0)), 15u);   // 0: no budget
 }
 
 TEST(Ellipsoid, SymmetricEigenReconstructs) {

@@ -88,4 +88,11 @@ inline bool sceneHasAir(const Scene& scene) {
 // (MODEL.md sections 10 and 11); what every renderer draws.
 Scene withFieldClouds(const Scene& scene, const HeapDrawing& drawing = {});
 
+// A frame's work budget (issue 31): when the clouds of `scene` hold more than `budget`
+// ellipsoids, only the `budget` of largest projected size (largest radius over distance along
+// the view; ties by cloud and lobe order; behind the camera, none) are kept, and the clouds
+// thinned share one texture seed. Counted in ellipsoids, not time, so equal frames stay
+// equal. 0: no budget.
+Scene withinEllipsoidBudget(const Scene& scene, double budget);
+
 }  // namespace nephele

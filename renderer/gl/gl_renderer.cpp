@@ -544,6 +544,16 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
   // Fields of heaps become the clouds around this camera (MODEL.md section 10).
   if (!scene.fields.empty())
     return drawFrame(withFieldClouds(scene, settings.heaps), settings, format);
+  // The work budget, counted in ellipsoids (issue 31, item 1).
+  if (settings.ellipsoid_budget > 0.0 &&
+      ellipsoidCount(scene) > std::size_t(settings.ellipsoid_budget)) {
+    const Scene within = withinEllipsoidBudget(scene, settings.ellipsoid_budget);
+    if (ellipsoidCount(within) < ellipsoidCount(scene)) {
+      RenderSettings rest = settings;
+      rest.ellipsoid_budget = 0.0;
+      return drawFrame(within, rest, format);
+    }
+  }
   const Camera& camera = scene.camera;
   prepareTarget(camera.width, camera.height, format);
   stats_ = {};

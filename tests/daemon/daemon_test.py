@@ -611,7 +611,12 @@ class LockstepAndSnapshotTest(DaemonTest):
         # of the camera: 26 s at 64x48 when the issue was filed) cancels it at its next band or
         # batch: its client is answered "shutting down", the snapshot is saved, and the daemon
         # exits 0 within 5 s.
-        d = self.daemon(name="t", extra='[snapshot]\npath = "{snapshot}"\ninterval = 0')
+        # The work budget would bound this render (ellipsoid_budget): the scene turns it off.
+        scene = os.path.join(self.tmp.name, "unbudgeted.toml")
+        with open(SCENE) as f, open(scene, "w") as out:
+            out.write(f.read() + "\n[render]\nellipsoid_budget = 0\n")
+        d = self.daemon(name="t", extra='[snapshot]\npath = "{snapshot}"\ninterval = 0',
+                        scene=scene)
         c = d.client()
         for i in range(25):
             c.ok({"cmd": "add_cloud", "cloud": {"name": f"big{i}", "cumulus": {

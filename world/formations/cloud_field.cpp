@@ -712,6 +712,60 @@ CloudLayer farDeck(const CloudField& f, double range, glm::dvec3 to_sun) {
 
 }  // namespace
 
+Scene withinEllipsoidBudget(const Scene& scene, double budget) {
+  const std::size_t total = ellipsoidCount(scene);
+  if (!(budget > 0.0) || double(total) <= budget) return scene;
+  // Every ellipsoid's projected size: its largest radius over its distance along the view
+  // (behind the camera: none); the `budget` largest are kept, ties by cloud and lobe order.
+  const ViewBasis basis = viewBasis(scene.camera);
+  struct Size {
+    double size;
+    std::uint32_t cloud, lobe;
+  };
+  std::vector<Size> sizes;
+  sizes.reserve(total);
+  for (std::size_t c = 0; c < scene.clouds.size(); ++c) {
+    const std::vector<Ellipsoid>& lobes = scene.clouds[c].ellipsoids;
+    for (std::size_t i = 0; i < lobes.size(); ++i) {
+      const double reach = std::max({lobes[i].radii.x, lobes[i].radii.y, lobes[i].radii.z});
+      const double ahead = glm::dot(lobes[i].centre - scene.camera.position, basis.forward);
+      sizes.push_back({ahead < -reach ? 0.0 : reach / std::max(ahead, reach), std::uint32_t(c),
+                       std::uint32_t(i)});
+    }
+  }
+  const auto larger = [](const Size& a, const Size& b) {
+    if (a.size != b.size) return a.size > b.size;
+    return a.cloud != b.cloud ? a.cloud < b.cloud : a.lobe < b.lobe;
+  };
+  const std::size_t keep = std::size_t(budget);
+  std::nth_element(sizes.begin(), sizes.begin() + std::ptrdiff_t(keep), sizes.end(), larger);
+  std::vector<std::vector<char>> kept(scene.clouds.size());
+  for (std::size_t c = 0; c < scene.clouds.size(); ++c)
+    kept[c].assign(scene.clouds[c].ellipsoids.size(), 0);
+  for (std::size_t k = 0; k < keep; ++k) kept[sizes[k].cloud][sizes[k].lobe] = 1;
+  Scene out = scene;
+  out.clouds.clear();
+  for (std::size_t c = 0; c < scene.clouds.size(); ++c) {
+    const EllipsoidCloud& from = scene.clouds[c];
+    EllipsoidCloud cloud = from;
+    cloud.ellipsoids.clear();
+    cloud.parts.clear();
+    for (std::size_t i = 0; i < from.ellipsoids.size(); ++i) {
+      if (!kept[c][i]) continue;
+      cloud.ellipsoids.push_back(from.ellipsoids[i]);
+      if (!from.parts.empty()) cloud.parts.push_back(from.parts[i]);
+    }
+    if (cloud.ellipsoids.empty()) continue;
+    // Thinned clouds share one texture seed: clouds that differ only in it then share one
+    // baked texture and one batch (a hundred clouds of their own seeds baked a hundred 128^3
+    // tables, most of a heavy frame's time).
+    if (cloud.ellipsoids.size() < from.ellipsoids.size())
+      cloud.texture.seed = cloud.texture.gardner.seed = 0;
+    out.clouds.push_back(std::move(cloud));
+  }
+  return out;
+}
+
 Scene withFieldClouds(const Scene& scene, const HeapDrawing& drawing) {
   Scene out = scene;
   for (const CloudField& field : scene.fields) {
