@@ -744,25 +744,24 @@ Scene withinEllipsoidBudget(const Scene& scene, double budget) {
     kept[c].assign(scene.clouds[c].ellipsoids.size(), 0);
   for (std::size_t k = 0; k < keep; ++k) kept[sizes[k].cloud][sizes[k].lobe] = 1;
   Scene out = scene;
-  out.clouds.clear();
-  for (std::size_t c = 0; c < scene.clouds.size(); ++c) {
-    const EllipsoidCloud& from = scene.clouds[c];
-    EllipsoidCloud cloud = from;
-    cloud.ellipsoids.clear();
-    cloud.parts.clear();
-    for (std::size_t i = 0; i < from.ellipsoids.size(); ++i) {
+  for (std::size_t c = 0; c < out.clouds.size(); ++c) {
+    EllipsoidCloud& cloud = out.clouds[c];
+    const std::size_t before = cloud.ellipsoids.size();
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < before; ++i) {
       if (!kept[c][i]) continue;
-      cloud.ellipsoids.push_back(from.ellipsoids[i]);
-      if (!from.parts.empty()) cloud.parts.push_back(from.parts[i]);
+      cloud.ellipsoids[n] = cloud.ellipsoids[i];
+      if (!cloud.parts.empty()) cloud.parts[n] = cloud.parts[i];
+      ++n;
     }
-    if (cloud.ellipsoids.empty()) continue;
+    cloud.ellipsoids.resize(n);
+    if (!cloud.parts.empty()) cloud.parts.resize(n);
     // Thinned clouds share one texture seed: clouds that differ only in it then share one
     // baked texture and one batch (a hundred clouds of their own seeds baked a hundred 128^3
     // tables, most of a heavy frame's time).
-    if (cloud.ellipsoids.size() < from.ellipsoids.size())
-      cloud.texture.seed = cloud.texture.gardner.seed = 0;
-    out.clouds.push_back(std::move(cloud));
+    if (n < before) cloud.texture.seed = cloud.texture.gardner.seed = 0;
   }
+  std::erase_if(out.clouds, [](const EllipsoidCloud& c) { return c.ellipsoids.empty(); });
   return out;
 }
 
