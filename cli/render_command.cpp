@@ -186,8 +186,8 @@ void addRenderCommand(CLI::App& app, RenderCommandOptions& o) {
                   "Cloud fields: every lobe of heaps whose radius spans this many pixels, their "
                   "outline below (0..10000; default 32; 0 every lobe)");
   cmd->add_option("--ellipsoid-budget", o.ellipsoid_budget,
-                  "Ellipsoids a frame draws before it draws the clouds of smallest projected "
-                  "size as one mound each (0..16777216; default 65536; 0 every ellipsoid)");
+                  "Ellipsoids a frame draws at most, those of largest projected size "
+                  "(0..16777216; default 65536; 0 every ellipsoid)");
   cmd->add_option("--volume-step", o.volume_step,
                   "Automaton clouds: view march step in lattice spacings (0.25..8)");
   cmd->add_option("--samples", o.samples, "Reference supersampling per pixel axis")

@@ -63,9 +63,9 @@ struct RenderSettings {
   // (`heap_range`, a far deck beyond) and the projected radius, in pixels, from which every
   // lobe of a heap is drawn (`heap_detail`).
   HeapDrawing heaps{};
-  // The frame's work budget (`ellipsoid_budget`): past this many ellipsoids in view, the
-  // clouds of smallest projected size are drawn as one mound each until the rest fit
-  // (withinEllipsoidBudget, cloud_field.h); 0 draws every ellipsoid. The reference has none.
+  // The frame's work budget (`ellipsoid_budget`): past this many ellipsoids, only this many of
+  // largest projected size are drawn (withinEllipsoidBudget, world/scene.h); 0 draws every
+  // ellipsoid. The reference has none.
   double ellipsoid_budget = 65536.0;
 
   // Automaton clouds: the view march's step in lattice spacings (the lattice holds

@@ -189,11 +189,11 @@ struct Engine::Subscription {
   std::shared_ptr<std::atomic<bool>> gone;  // set when the sink reports its client gone
 };
 
-// A thread that encodes images off the world thread, from a bounded queue.
 // Thrown by Engine::renderFrame when the daemon's stop cancelled the render in hand; the run
 // loop answers the request "shutting down".
 struct RenderCancelled {};
 
+// A thread that encodes images off the world thread, from a bounded queue.
 class Engine::Encoder {
  public:
   Encoder() : thread_([this] { run(); }) {}

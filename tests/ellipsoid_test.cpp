@@ -49,7 +49,12 @@ TEST(EllipsoidBudget, KeepsTheLargestInViewAndIsDeterministic) {
     EllipsoidCloud c;
     c.name = name;
     c.texture.seed = c.texture.gardner.seed = 7;
-    for (int i = 0; i < n; ++i) c.ellipsoids.push_back({glm::dvec3(radius), {10.0 * i, y, 0.0}});
+    for (int i = 0; i < n; ++i) {
+      Ellipsoid e;
+      e.radii = glm::dvec3(radius);
+      e.centre = {10.0 * i, y, 0.0};
+      c.ellipsoids.push_back(e);
+    }
     return c;
   };
   scene.clouds = {cloud("far", 10000.0, 50.0, 6), cloud("near", 1000.0, 50.0, 4),

@@ -97,11 +97,10 @@ struct Limits {
   static constexpr Range kRegionBand{0.0, 1.0e7};      // edge and front transition widths
   static constexpr Range kClusterVariation{0.0, 1.0};  // per-cluster spread of cover, height
   static constexpr Range kHeapRange{0.0, 1.0e6};       // heaps as ellipsoids this far; 0 automatic
-  static constexpr Range kHeapDetail{0.0, 1.0e4};
-  // Ellipsoids a GL frame draws before it merges clouds into mounds (`ellipsoid_budget`, 0:
-  // no budget), at most what a world may hold.
-  static constexpr Range kEllipsoidBudget{
-      0.0, double(4096 * 4096)};  // every lobe of heaps this many pixels wide
+  static constexpr Range kHeapDetail{0.0, 1.0e4};      // every lobe of heaps this many pixels wide
+  // Ellipsoids a GL frame draws, those of largest projected size (`ellipsoid_budget`; 0: no
+  // budget), at most what a world may hold.
+  static constexpr Range kEllipsoidBudget{0.0, double(kMaxWorldEllipsoids)};
 
   // Datasets (dataset/dataset.h).
   static constexpr int kMaxSamples = 100000000;

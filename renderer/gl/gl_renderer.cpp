@@ -546,13 +546,10 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
     return drawFrame(withFieldClouds(scene, settings.heaps), settings, format);
   // The work budget, counted in ellipsoids (issue 31, item 1).
   if (settings.ellipsoid_budget > 0.0 &&
-      ellipsoidCount(scene) > std::size_t(settings.ellipsoid_budget)) {
-    const Scene within = withinEllipsoidBudget(scene, settings.ellipsoid_budget);
-    if (ellipsoidCount(within) < ellipsoidCount(scene)) {
-      RenderSettings rest = settings;
-      rest.ellipsoid_budget = 0.0;
-      return drawFrame(within, rest, format);
-    }
+      double(ellipsoidCount(scene)) > settings.ellipsoid_budget) {
+    RenderSettings rest = settings;  // the thinned scene is within it
+    rest.ellipsoid_budget = 0.0;
+    return drawFrame(withinEllipsoidBudget(scene, settings.ellipsoid_budget), rest, format);
   }
   const Camera& camera = scene.camera;
   prepareTarget(camera.width, camera.height, format);

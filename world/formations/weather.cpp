@@ -39,33 +39,32 @@ std::vector<double> sortedSamples(const LayerTextureSpec& spec) {
   return values;
 }
 
-// Gardner's two sums at the sample points, without T0. T0 only offsets both sums and sets
-// k = 1 / (A + T0)^2 (A the sum of the amplitudes, MODEL.md section 2), so the sorted values
-// for any T0 follow from one evaluation of the sines: planes() raises T0 step by step.
+// Gardner's two sums at the sample points, without T0. T0 only offsets both sums and sets k
+// (MODEL.md section 2), so the sorted values for any T0 follow from one evaluation of the
+// sines: planes() raises T0 step by step.
 class GardnerSamples {
  public:
-  explicit GardnerSamples(const GardnerTextureParams& params) {
-    GardnerTextureParams zero = params;
-    zero.t0 = 0.0;
-    const GardnerTexture texture(zero);
-    amplitude_sum_ = 1.0 / std::sqrt(texture.normalisation());
+  explicit GardnerSamples(const GardnerTextureParams& params) : params_(params) {
+    params_.t0 = 0.0;
+    const GardnerTexture texture(params_);
     sums_.reserve(kSamples);
     for (int k = 0; k < kSamples; ++k)
       sums_.push_back(texture.planarSums(samplePoint(k, texture.period())));
   }
   std::vector<double> sorted(double t0) const {
-    const double k = 1.0 / ((amplitude_sum_ + t0) * (amplitude_sum_ + t0));
+    GardnerTextureParams p = params_;
+    p.t0 = t0;
+    const double k = GardnerTexture(p).normalisation();
     std::vector<double> values;
     values.reserve(sums_.size());
-    for (const glm::dvec2& s : sums_)
-      values.push_back(k * std::max(s.x + t0, 0.0) * std::max(s.y + t0, 0.0));
+    for (const glm::dvec2& s : sums_) values.push_back(textureFromSums(s.x + t0, s.y + t0, k));
     std::sort(values.begin(), values.end());
     return values;
   }
 
  private:
+  GardnerTextureParams params_;  // with T0 = 0
   std::vector<glm::dvec2> sums_;
-  double amplitude_sum_ = 1.0;
 };
 
 double positiveFraction(const std::vector<double>& sorted) {

@@ -10,9 +10,6 @@ namespace nephele {
 namespace {
 constexpr double kAmplitudeRatio = 0.707;  // C(i+1) = 0.707 C(i)
 
-double textureFromSums(double sx, double sy, double k) {
-  return k * std::max(sx, 0.0) * std::max(sy, 0.0);
-}
 }  // namespace
 
 double wrapPeriodic(double x, double period) {

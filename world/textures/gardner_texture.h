@@ -1,5 +1,6 @@
 #pragma once
 // Gardner's sum-of-sines texture (MODEL.md section 2), evaluated in double.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <numbers>
@@ -39,6 +40,11 @@ enum class TermFilter {
   kCut,   // drop a term as soon as it exceeds half the sampling frequency
   kNone,  // keep every term (aliases; for measurement)
 };
+
+// Gardner's T from the two sums and k (MODEL.md section 2): k max(SX, 0) max(SY, 0).
+inline double textureFromSums(double sx, double sy, double k) {
+  return k * std::max(sx, 0.0) * std::max(sy, 0.0);
+}
 
 class GardnerTexture {
  public:
