@@ -3,6 +3,7 @@
 // states its tolerance and why.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "tests/gl_test_fixture.h"
@@ -402,6 +403,46 @@ TEST_F(EllipsoidRenderTest, CloseUpsKeepTheirTexture) {
   far_baked.texture_evaluation = TextureEvaluation::kBaked;
   expectClose(renderer_->renderFloat(far.scene, far.render),
               renderer_->renderFloat(far.scene, far_baked), 90.0, 1e-6, "far_auto_is_baked");
+}
+
+// Auto chooses per screen bin of the per-pixel pass (MODEL.md section 2): in one cloud, a
+// lobe 200 m from the eye, whose table would be magnified, is drawn as the sines draw it, and
+// two overlapping lobes 8 km away (their bins clear of the near lobe's) as the table draws
+// them. At 160x120 and 60 degrees a texel of this table (49 m) spans 4 pixels at 1.3 km.
+TEST_F(EllipsoidRenderTest, AutoTakesTheSinesOnlyWhereTheTableWouldBeMagnified) {
+  const Scene scene = cloudScene({{{60.0, 60.0, 60.0}, {-150.0, 200.0, 1000.0}, {}},
+                                  {{2500.0, 2500.0, 1200.0}, {3000.0, 8000.0, 1000.0}, {}},
+                                  {{1500.0, 1500.0, 900.0}, {3800.0, 7000.0, 1500.0}, {}}},
+                                 lookingNorth({0.0, 0.0, 1000.0}));
+  RenderSettings automatic, baked, procedural;
+  baked.texture_evaluation = TextureEvaluation::kBaked;
+  procedural.texture_evaluation = TextureEvaluation::kProcedural;
+  const FloatImage a = renderer_->renderFloat(scene, automatic);
+  const FloatImage b = renderer_->renderFloat(scene, baked);
+  const FloatImage p = renderer_->renderFloat(scene, procedural);
+  // Largest channel difference over columns [x0, x1), and the pixels covered there.
+  auto largest = [&](const FloatImage& u, const FloatImage& v, int x0, int x1) {
+    float most = 0.0f;
+    for (int y = 0; y < u.height; ++y)
+      for (int x = x0; x < x1; ++x)
+        for (int c = 0; c < 4; ++c)
+          most = std::max(most, std::abs(u.pixel(x, y)[c] - v.pixel(x, y)[c]));
+    return most;
+  };
+  auto covered = [&](int x0, int x1) {
+    int n = 0;
+    for (int y = 0; y < a.height; ++y)
+      for (int x = x0; x < x1; ++x) n += a.pixel(x, y)[3] > 0.5f;
+    return n;
+  };
+  const int half = a.width / 2;
+  ASSERT_GT(covered(0, half), 1000);       // the near lobe, on the left
+  ASSERT_GT(covered(half, a.width), 300);  // the far one, on the right
+  // Near: the table would blur the lobe, and auto draws the sines.
+  EXPECT_GT(largest(b, p, 0, half), 0.02f);
+  EXPECT_LE(largest(a, p, 0, half), 1e-6f);
+  // Far: auto draws the table.
+  EXPECT_LE(largest(a, b, half, a.width), 1e-6f);
 }
 
 // The three ellipsoid pass structures, for the defect tests below.

@@ -107,19 +107,36 @@ void uploadVolume(const GlApi& gl, GLuint texture, const VolumeTable& table) {
   gl.TextureParameteri(texture, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
 }
 
-// TextureEvaluation::kAuto: a baked texel may cover at most this many pixels where the cloud
-// is nearest; closer, bilinear magnification blurs the texture (a cumulus filling a 4 degree
-// view loses 28 dB) and the sines are evaluated per fragment instead. Measured by
+// TextureEvaluation::kAuto: a baked texel may cover at most this many pixels; nearer,
+// trilinear magnification blurs the texture (a cumulus filling a 4 degree view loses 28 dB)
+// and the sines are evaluated per fragment instead. Measured by
 // `nephele bench` (docs/ACCURACY.md).
-constexpr double kMaxBakedTexelPixels = 2.0;
+constexpr double kMaxBakedTexelPixels = 4.0;
 
-bool bakedTextureMagnified(const SolidTexture& texture, double nearest_m, const Camera& camera) {
+// Where kAuto evaluates the sines: a pixel whose footprint is smaller than
+// the baked table's texel over kMaxBakedTexelPixels. The footprint of the pixel at normalised
+// device coordinates (x, y) on a surface at distance d (the shader's ray differentials) is at
+// least d a / |r|^2, a = 2 tan(vfov/2) / height the pixel's angle on the axis and |r|^2 =
+// 1 + (x tan(hfov/2))^2 + (y tan(vfov/2))^2. So a pixel can need the sines only where the
+// nearest surface is within sinesWithin() times its |r|^2.
+double sinesWithin(const SolidTexture& texture, const Camera& camera) {
   const glm::dvec3 period = texture.period();
   const double texel_m =
       std::min({period.x, period.y, period.z}) / bakedSolidSize(*texture.gardner());
-  const double pixel_m = std::max(nearest_m, 0.0) * 2.0 *
-                         std::tan(glm::radians(camera.vfov_deg) / 2.0) / camera.height;
-  return texel_m > kMaxBakedTexelPixels * pixel_m;
+  const double pixel_angle = 2.0 * std::tan(glm::radians(camera.vfov_deg) / 2.0) / camera.height;
+  return 1.001 * texel_m / (kMaxBakedTexelPixels * pixel_angle);  // 0.1 % for rounding
+}
+
+// The largest |r|^2 over pixels [x0, x1) x [y0, y1) of the view.
+double largestRaySquared(const Camera& camera, int x0, int y0, int x1, int y1) {
+  const double tan_v = std::tan(glm::radians(camera.vfov_deg) / 2.0);
+  const double tan_h = tan_v * camera.width / camera.height;
+  auto farthest = [](int from, int to, int size) {
+    return std::max(std::abs(2.0 * from / size - 1.0), std::abs(2.0 * to / size - 1.0));
+  };
+  const double x = farthest(x0, x1, camera.width) * tan_h;
+  const double y = farthest(y0, y1, camera.height) * tan_v;
+  return 1.0 + x * x + y * y;
 }
 
 // Slices for a silhouette within half a pixel of the true one: a polygon of n sides around
@@ -515,19 +532,25 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
 
   CachedTexture& texture = cachedTexture(cloud.texture, settings);
   EllipsoidPassLayout base;
-  const bool procedural =
-      settings.texture_evaluation == TextureEvaluation::kProcedural ||
-      (settings.texture_evaluation == TextureEvaluation::kAuto && texture.source->gardner() &&
-       bakedTextureMagnified(*texture.source, nearest_m, scene.camera));
-  base.texture = !texture.source->gardner() ? SolidTextureKind::kTable
-                 : procedural               ? SolidTextureKind::kProcedural
-                                            : SolidTextureKind::kBakedGardner;
+  // kAuto: the baked table, unless some ellipsoid is so near that a pixel could see it
+  // magnified; then the sines, except in the per-pixel pass's bins where no pixel can (below).
+  const TextureEvaluation evaluation = settings.texture_evaluation;
+  const Camera& camera = scene.camera;
+  const bool gardner = texture.source->gardner() != nullptr;
+  const double sines_within = gardner ? sinesWithin(*texture.source, camera) : 0.0;
+  const bool auto_near =
+      gardner && evaluation == TextureEvaluation::kAuto &&
+      nearest_m < sines_within * largestRaySquared(camera, 0, 0, camera.width, camera.height);
+  base.texture = !gardner ? SolidTextureKind::kTable
+                 : evaluation == TextureEvaluation::kProcedural || auto_near
+                     ? SolidTextureKind::kProcedural
+                     : SolidTextureKind::kBakedGardner;
   base.term_filter = settings.term_filter;
   base.spotlight = spotlight;
   base.air = sceneHasAir(scene);
   base.specular = cloud.shading.specular > 0.0;
   base.targets = targets_drawn;
-  if (base.texture != SolidTextureKind::kProcedural)
+  if (base.texture != SolidTextureKind::kProcedural || auto_near)
     gl_.BindTextureUnit(kVolumeTextureUnit, gpuTexture(texture));
   if (base.spotlight) gl_.BindTextureUnit(kSpotlightTextureUnit, spotlightTexture());
   gl_.Enable(GL_BLEND);
@@ -608,15 +631,16 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   const std::int64_t max_listed = std::min<std::int64_t>(max_texels_, kMaxListed);
   if (listed > max_listed || std::int64_t(bins_x) * bins_y > max_listed)
     return drawByCentre(records(false));
-  std::vector<glm::ivec2> bins(std::size_t(bins_x) * bins_y, glm::ivec2(0));
-  auto binAt = [&](int x, int y) -> glm::ivec2& {
+  // A bin is first item, count, and whether a pixel in it may need the sines (auto_near).
+  std::vector<glm::ivec4> bins(std::size_t(bins_x) * bins_y, glm::ivec4(0));
+  auto binAt = [&](int x, int y) -> glm::ivec4& {
     return bins[std::size_t(y - area.y) * bins_x + (x - area.x)];
   };
   for (const glm::ivec4& span : spans)
     for (int y = span.y; y <= span.w; ++y)
       for (int x = span.x; x <= span.z; ++x) ++binAt(x, y).y;
   int deepest = 0, first = 0;
-  for (glm::ivec2& b : bins) {
+  for (glm::ivec4& b : bins) {
     deepest = std::max(deepest, b.y);
     b.x = first;
     first += b.y;
@@ -629,33 +653,70 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   for (std::size_t i = 0; i < spans.size(); ++i)
     for (int y = spans[i].y; y <= spans[i].w; ++y)
       for (int x = spans[i].x; x <= spans[i].z; ++x) {
-        glm::ivec2& b = binAt(x, y);
+        glm::ivec4& b = binAt(x, y);
         items[std::size_t(b.x + b.y++)] = GLint(i);
       }
-  EllipsoidPassLayout layout = base;
-  layout.program = EllipsoidProgram::kFusedPerPixel;
-  const GLuint p = program(layout);
-  gl_.UseProgram(p);
-  setCloudUniforms(p, scene, cloud, texture, layout.texture, band);
-  gl_.ProgramUniform2i(p, gl_.GetUniformLocation(p, "u_bin_origin"), area.x, area.y);
-  gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_bins_x"), bins_x);
-  gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_bin_size"), kPerPixelBinSize);
+  // A bin is near when a pixel in it could see the baked table magnified: its first
+  // ellipsoid (the list is nearest first) is within sinesWithin() times the bin's largest
+  // |r|^2.
+  bool any_near = false, any_far = false;
+  if (auto_near)
+    for (int y = area.y; y <= area.w; ++y)
+      for (int x = area.x; x <= area.z; ++x) {
+        glm::ivec4& b = binAt(x, y);
+        const int s = kPerPixelBinSize;
+        const double within =
+            sines_within * largestRaySquared(camera, x * s, y * s, (x + 1) * s, (y + 1) * s);
+        b.z = b.y > 0 && double(ordered[std::size_t(items[std::size_t(b.x)])].v[16].z) < within;
+      }
+  for (const glm::ivec4& b : bins) (b.z ? any_near : any_far) = true;
+  // With auto_near, the bins where no pixel is near enough to see the baked table magnified
+  // are drawn by the baked program, the others by the procedural one: the sines cost only
+  // where they show. (A per-pixel choice in one program would pay for both everywhere:
+  // llvmpipe runs both sides of a branch, and a loop at least once, for every pixel group.)
+  struct BinProgram {
+    GLuint program;
+    GLint polygon_at;
+  };
+  std::vector<BinProgram> bin_programs;
+  auto addProgram = [&](SolidTextureKind kind, int bin_kind) {
+    EllipsoidPassLayout layout = base;
+    layout.program = EllipsoidProgram::kFusedPerPixel;
+    layout.texture = kind;
+    const GLuint p = program(layout);
+    setCloudUniforms(p, scene, cloud, texture, layout.texture, band);
+    gl_.ProgramUniform2i(p, gl_.GetUniformLocation(p, "u_bin_origin"), area.x, area.y);
+    gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_bins_x"), bins_x);
+    gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_bin_size"), kPerPixelBinSize);
+    gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_bin_kind"), bin_kind);
+    bin_programs.push_back({p, gl_.GetUniformLocation(p, "u_polygon")});
+  };
+  if (!auto_near || !any_far) {
+    addProgram(base.texture, -1);
+  } else if (!any_near) {
+    addProgram(SolidTextureKind::kBakedGardner, -1);
+  } else {
+    addProgram(SolidTextureKind::kBakedGardner, 0);
+    addProgram(SolidTextureKind::kProcedural, 1);
+  }
   auto ndc = [](int bins, int size) {
     return float(2.0 * std::min(bins * kPerPixelBinSize, size) / size - 1.0);
   };
   bindFrameTexture(kRecordTextureUnit, GL_RGBA32F, ordered.data(),
                    ordered.size() * sizeof(EllipsoidRecord));
-  bindFrameTexture(kBinTextureUnit, GL_RG32I, bins.data(), bins.size() * sizeof(glm::ivec2));
+  bindFrameTexture(kBinTextureUnit, GL_RGBA32I, bins.data(), bins.size() * sizeof(glm::ivec4));
   bindFrameTexture(kBinItemTextureUnit, GL_R32I, items.data(), items.size() * sizeof(GLint));
-  const GLint polygon_at = gl_.GetUniformLocation(p, "u_polygon");
   // Draws bins [bx0, bx1] x [by0, by1] (absolute bin indices): each pixel composites every
   // hit of its bin, so disjoint rectangles give the image one quad gives.
   auto drawRect = [&](int bx0, int by0, int bx1, int by1) {
     const float x0 = ndc(bx0, target.width), y0 = ndc(by0, target.height);
     const float x1 = ndc(bx1 + 1, target.width), y1 = ndc(by1 + 1, target.height);
     const glm::vec2 polygon[4] = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
-    gl_.ProgramUniform2fv(p, polygon_at, 4, &polygon[0].x);
-    gl_.DrawArrays(GL_TRIANGLE_FAN, 0, 4);
+    for (const BinProgram& bp : bin_programs) {
+      gl_.UseProgram(bp.program);
+      gl_.ProgramUniform2fv(bp.program, bp.polygon_at, 4, &polygon[0].x);
+      gl_.DrawArrays(GL_TRIANGLE_FAN, 0, 4);
+    }
   };
   ++stats_->ellipsoid_passes;
   constexpr std::int64_t kBinPixels = std::int64_t(kPerPixelBinSize) * kPerPixelBinSize;
@@ -857,14 +918,17 @@ void EllipsoidRenderer::renderAtlasBatch(const Scene& scene, const EllipsoidClou
   }
 }
 
-void EllipsoidRenderer::drawVeil(const Scene& scene, const RenderSettings& settings) {
-  if (scene.clouds.empty()) return;
-  const Veil veil = inCloudVeil(
+Veil EllipsoidRenderer::veil(const Scene& scene, const RenderSettings& settings) {
+  if (scene.clouds.empty()) return {};
+  return inCloudVeil(
       scene.clouds,
       [&](std::size_t c) -> const SolidTexture& {
         return *cachedTexture(scene.clouds[c].texture, settings).source;
       },
       scene.camera.position, scene.sun);
+}
+
+void EllipsoidRenderer::drawVeil(const Veil& veil) {
   if (veil.opacity <= 0.0) return;
   EllipsoidPassLayout layout;
   layout.program = EllipsoidProgram::kVeil;

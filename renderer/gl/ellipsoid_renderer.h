@@ -71,8 +71,10 @@ class EllipsoidRenderer {
   void setCancel(const std::atomic<bool>* flag) { cancel_ = flag; }
   bool cancelled() const { return cancelled_; }
 
-  // The in-cloud veil over the whole frame, if the eye is in or near any ellipsoid.
-  void drawVeil(const Scene& scene, const RenderSettings& settings);
+  // The in-cloud veil at the eye (MODEL.md section 4), and the pass that draws it over the
+  // whole frame (none when its opacity is 0).
+  Veil veil(const Scene& scene, const RenderSettings& settings);
+  void drawVeil(const Veil& veil);
 
  private:
   static constexpr std::size_t kCancelRecords = 65536;

@@ -1,5 +1,7 @@
 #include "renderer/gl/ellipsoid_shaders.h"
 
+#include <cstdio>
+
 #include "renderer/gl/sky_shaders.h"
 
 namespace nephele {
@@ -221,11 +223,12 @@ const char* kFusedPerPixel = R"(
 // The batch's screen bins, kPerPixelBinSize pixels a side, from bin u_bin_origin on, u_bins_x
 // to a row: bin b lists its ellipsoids u_items[u_bins[b].x .. + u_bins[b].y) nearest first
 // by the distance no hit on them can be nearer than (the record's order.z, metres).
-layout(binding = 7) uniform isamplerBuffer u_bins;   // RG32I: first item, count
+layout(binding = 7) uniform isamplerBuffer u_bins;   // RGBA32I: first item, count, near, 0
 layout(binding = 8) uniform isamplerBuffer u_items;  // R32I
 uniform ivec2 u_bin_origin;
 uniform int u_bins_x;
 uniform int u_bin_size;
+uniform int u_bin_kind;  // -1: every bin; else only the bins whose near flag equals it
 
 // Hits are ordered by (depth, ellipsoid index), so equal depths still have one order.
 bool before(float s, int i, float t, int j) { return s < t || (s == t && i < j); }
@@ -241,7 +244,8 @@ void main() {
   float metres_per_unit = length(r);
   float limit = opaqueDistance(r) / metres_per_unit;
   ivec2 bin = ivec2(gl_FragCoord.xy) / u_bin_size - u_bin_origin;
-  ivec2 list = texelFetch(u_bins, bin.y * u_bins_x + bin.x).xy;
+  ivec4 list = texelFetch(u_bins, bin.y * u_bins_x + bin.x);
+  if (u_bin_kind >= 0 && list.z != u_bin_kind) discard;  // the other program's bin
   // Front to back (MODEL.md section 15): the ellipsoids come nearest bound first, and a hit
   // that no ellipsoid still to come can be in front of is final. Up to four hits wait,
   // nearest first (depth d, ellipsoid id; empty slots at kNone). Each round tests ellipsoids
@@ -250,7 +254,7 @@ void main() {
   // behind would add less than 1/1024. Shading stays out of the testing loop: llvmpipe runs
   // both sides of every branch, so a loop pays for all of its body on every turn.
   const float kNone = 3.0e38;
-  const float kOpaque = 1.0 - 1.0 / 1024.0;
+  const float kOpaque = OPAQUE_COVERAGE;
   vec4 d = vec4(kNone);
   ivec4 id = ivec4(-1);
   int waiting = 0, k = 0;
@@ -421,6 +425,9 @@ void main() {
 
 std::string ellipsoidFragmentSource(const EllipsoidPassLayout& layout) {
   std::string s = "#version 450 core\n";
+  char opaque[64];
+  std::snprintf(opaque, sizeof opaque, "#define OPAQUE_COVERAGE %.10f\n", kOpaqueCoverage);
+  s += opaque;
   if (layout.air) s += "#define AIR\n";
   if (layout.specular) s += "#define SPECULAR\n";
   if (layout.targets) s += "#define TARGETS\n";

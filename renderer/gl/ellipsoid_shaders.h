@@ -32,6 +32,10 @@ struct EllipsoidPassLayout {
   std::string key() const;
 };
 
+// Coverage past which a pixel counts as opaque: the per-pixel pass stops compositing, and a
+// veil this thick hides the frame behind it (what lies behind adds under 1/1024).
+inline constexpr double kOpaqueCoverage = 1.0 - 1.0 / 1024.0;
+
 // Per-ellipsoid record: RGBA32F texels of a buffer texture.
 inline constexpr int kEllipsoidRecordVec4s = 19;
 // Texture units.

@@ -567,6 +567,21 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
   for (auto& [key, cached] : textures_) cached.used = false;
   ellipsoids_.beginFrame(stats_);
   automata_.beginFrame(stats_);
+  auto finish = [&](const Veil& veil) {
+    ellipsoids_.drawVeil(veil);
+    gl_.Disable(GL_BLEND);
+    ellipsoids_.endFrame();
+    automata_.endFrame();
+    std::erase_if(textures_, [](const auto& entry) { return !entry.second.used; });
+  };
+  // The eye deep in a cloud: its veil hides what lies behind to within the per-pixel pass's
+  // opacity cut, so no sky or cloud pass is drawn under it (MODEL.md section 4).
+  const Veil veil = ellipsoids_.veil(scene, settings);
+  if (veil.opacity >= kOpaqueCoverage) {
+    const GLfloat nothing[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+    gl_.ClearNamedFramebufferfv(framebuffer_.get(), GL_COLOR, 0, nothing);
+    return finish(veil);
+  }
 
   // A ray meets only the layers on one side of the camera: above it from the highest down,
   // below it from the lowest up. Those orders are back to front.
@@ -681,11 +696,7 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
     }
   }
   flushSky();
-  ellipsoids_.drawVeil(scene, settings);
-  gl_.Disable(GL_BLEND);
-  ellipsoids_.endFrame();
-  automata_.endFrame();
-  std::erase_if(textures_, [](const auto& entry) { return !entry.second.used; });
+  finish(veil);
 }
 
 }  // namespace nephele
