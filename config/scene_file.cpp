@@ -127,17 +127,19 @@ void readGardnerParams(TableReader& t, GardnerTextureParams& g, double min_frequ
   t.number("fy1", g.fy1, min_frequency, 10.0);
   t.number("t0", g.t0, Limits::kContrastOffset);
   t.boolean("phases", g.seeded_phases);
+  t.number("amplitude_ratio", g.amplitude_ratio, Limits::kAmplitudeRatio);
 }
 
 void readTexture(TableReader& t, LayerTextureSpec& texture) {
-  t.allow({"source", "terms", "fx1", "fy1", "t0", "phases", "rotation", "jitter", "tile_size",
-           "size_log2", "roughness", "cells", "octaves", "persistence"});
+  t.allow({"source", "terms", "fx1", "fy1", "t0", "phases", "amplitude_ratio", "rotation", "jitter",
+           "tile_size", "size_log2", "roughness", "cells", "octaves", "persistence"});
   texture.source = TextureSource(
       t.choice("source", {"gardner", "perlin", "diamond-square"}, int(texture.source)));
   const std::string source(textureSourceName(texture.source));
   const bool gardner = texture.source == TextureSource::kGardner;
   const bool perlin = texture.source == TextureSource::kPerlin;
-  for (const char* key : {"terms", "fx1", "fy1", "t0", "phases", "rotation", "jitter"})
+  for (const char* key :
+       {"terms", "fx1", "fy1", "t0", "phases", "amplitude_ratio", "rotation", "jitter"})
     if (!gardner) t.forbid(key, "applies to source \"gardner\" only, not \"" + source + "\"");
   for (const char* key : {"tile_size", "size_log2"})
     if (gardner) t.forbid(key, "applies to sources \"perlin\" and \"diamond-square\" only");
@@ -226,12 +228,12 @@ void readLayer(TableReader& t, CloudLayer& layer, LayerDevelopment& develop) {
 }
 
 void readSolidTexture(TableReader& t, SolidTextureSpec& texture) {
-  t.allow({"source", "terms", "fx1", "fy1", "t0", "phases", "period", "size_log2", "cells",
-           "octaves", "persistence"});
+  t.allow({"source", "terms", "fx1", "fy1", "t0", "phases", "amplitude_ratio", "period",
+           "size_log2", "cells", "octaves", "persistence"});
   texture.source =
       SolidTextureSource(t.choice("source", {"gardner", "perlin"}, int(texture.source)));
   const bool gardner = texture.source == SolidTextureSource::kGardner;
-  for (const char* key : {"terms", "fx1", "fy1", "t0", "phases", "rotation"})
+  for (const char* key : {"terms", "fx1", "fy1", "t0", "phases", "amplitude_ratio", "rotation"})
     if (!gardner) t.forbid(key, "applies to source \"gardner\" only, not \"perlin\"");
   for (const char* key : {"period", "size_log2", "cells", "octaves", "persistence"})
     if (gardner) t.forbid(key, "applies to source \"perlin\" only, not \"gardner\"");

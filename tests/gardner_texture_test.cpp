@@ -143,6 +143,29 @@ TEST(GardnerTexture, FrequencyAndAmplitudeRelations) {
   EXPECT_DOUBLE_EQ(g.normalisation(), 1.0 / ((sum + 0.4) * (sum + 0.4)));
 }
 
+// A genus's amplitude ratio replaces Gardner's 0.707 (MODEL.md section 2): C(i) = r^(i-1),
+// and k still keeps T within [0, 1], reaching 1 where every sine is at its crest.
+TEST(GardnerTexture, AmplitudeRatioSetsTheSpectrumAndKKeepsTWithinRange) {
+  for (double r : {0.35, 0.86}) {
+    GardnerTextureParams p = params(6, 0.5);
+    p.amplitude_ratio = r;
+    const GardnerTexture g(p);
+    double sum = 0.0;
+    for (int i = 0; i < 6; ++i) {
+      EXPECT_DOUBLE_EQ(g.amplitude(i), std::pow(r, i));
+      sum += g.amplitude(i);
+    }
+    EXPECT_DOUBLE_EQ(g.normalisation(), 1.0 / ((sum + 0.5) * (sum + 0.5)));
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> coordinate(-5e4, 5e4);
+    for (int i = 0; i < 2000; ++i) {
+      const double t = g.planar({coordinate(rng), coordinate(rng)}, g.terms());
+      ASSERT_GE(t, 0.0);
+      ASSERT_LE(t, 1.0);
+    }
+  }
+}
+
 TEST(GardnerTexture, MatchesSpecFormulaWithPhaseShifts) {
   const GardnerTexture g(params(6, 0.3));
   std::mt19937_64 rng(2);

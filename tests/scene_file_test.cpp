@@ -148,6 +148,9 @@ TEST(SceneFile, OutOfRangeNamesTheAllowedRange) {
   EXPECT_THAT(parseError("[[layer]]\n[layer.texture]\nterms = 9\n"), HasSubstr("allowed: 1 to 8"));
   EXPECT_THAT(parseError("[[layer]]\n[layer.texture]\njitter = 1.5\n"),
               HasSubstr("layer[0].texture.jitter: 1.5 is out of range (allowed: 0 to 1)"));
+  EXPECT_THAT(
+      parseError("[[layer]]\n[layer.texture]\namplitude_ratio = 1.2\n"),
+      HasSubstr("layer[0].texture.amplitude_ratio: 1.2 is out of range (allowed: 0.3 to 1)"));
   EXPECT_THAT(parseError("[[layer]]\n[layer.texture]\nsource = \"perlin\"\njitter = 0.5\n"),
               HasSubstr("applies to source \"gardner\" only"));
   EXPECT_THAT(parseError("[camera]\nposition = [0, 0, -1]\n"), HasSubstr("below the ground"));

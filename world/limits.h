@@ -74,6 +74,7 @@ struct Limits {
   static constexpr Range kContrastOffset{0.0, 10.0};  // Gardner's T0
   static constexpr Range kTermRotation{0.0, 90.0};    // lattice-breaking angle, degrees
   static constexpr Range kTermJitter{0.0, 1.0};       // lattice-breaking scale spread, octaves
+  static constexpr Range kAmplitudeRatio{0.3, 1.0};   // Gardner C(i+1) / C(i)
 
   // Ellipsoids and targets, metres: zero, negative and NaN are rejected.
   static constexpr double kMinRadius = 1.0e-3, kMaxRadius = 1.0e5;

@@ -25,7 +25,7 @@ namespace {
 static_assert(std::endian::native == std::endian::little, "snapshots assume a little-endian host");
 
 constexpr char kMagic[8] = {'N', 'E', 'P', 'H', 'S', 'N', 'A', 'P'};
-constexpr std::uint32_t kFormatVersion = 7;
+constexpr std::uint32_t kFormatVersion = 8;
 constexpr std::size_t kHeaderBytes = sizeof kMagic + 4 + 8 + 8;
 
 class Writer {
@@ -156,9 +156,11 @@ void io(A& a, ShadingParams& s) {
 template <class A>
 void io(A& a, GardnerTextureParams& g) {
   io(a, g.terms), io(a, g.fx1), io(a, g.fy1), io(a, g.t0), io(a, g.seeded_phases), io(a, g.seed);
-  io(a, g.rotation_deg), io(a, g.jitter_octaves);
+  io(a, g.rotation_deg), io(a, g.jitter_octaves), io(a, g.amplitude_ratio);
   if (g.terms < 1 || g.terms > GardnerTextureParams::kMaxTerms)
     a.fail("texture terms out of range");
+  if (!Limits::kAmplitudeRatio.contains(g.amplitude_ratio))
+    a.fail("texture amplitude ratio out of range");
 }
 template <class A>
 void io(A& a, LayerTextureSpec& t) {

@@ -71,7 +71,7 @@ std::string textureKey(const SolidTextureSpec& spec, const RenderSettings& setti
   key << int(spec.source) << '/' << spec.seed << '/';
   if (spec.source == SolidTextureSource::kGardner)
     key << g.terms << '/' << g.fx1 << '/' << g.fy1 << '/' << g.t0 << '/' << g.seeded_phases << '/'
-        << g.rotation_deg << '/' << int(settings.texture_evaluation);
+        << g.rotation_deg << '/' << g.amplitude_ratio << '/' << int(settings.texture_evaluation);
   else
     key << spec.perlin_period_m << '/' << spec.perlin_size_log2 << '/' << spec.perlin_cells << '/'
         << spec.perlin_octaves << '/' << spec.perlin_persistence;

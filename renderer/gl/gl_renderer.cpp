@@ -55,7 +55,8 @@ std::string textureKey(const LayerTextureSpec& spec, const RenderSettings& setti
   if (spec.source == TextureSource::kGardner) {
     const GardnerTextureParams& g = spec.gardner;
     key << g.terms << '/' << g.fx1 << '/' << g.fy1 << '/' << g.t0 << '/' << g.seeded_phases << '/'
-        << g.rotation_deg << '/' << g.jitter_octaves << '/' << settings.bake_texels_per_cycle;
+        << g.rotation_deg << '/' << g.jitter_octaves << '/' << g.amplitude_ratio << '/'
+        << settings.bake_texels_per_cycle;
   } else {
     const NoiseTableParams& t = spec.table;
     key << t.tile_size_m.x << '/' << t.tile_size_m.y << '/' << t.size_log2 << '/' << t.roughness

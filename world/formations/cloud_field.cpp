@@ -686,6 +686,10 @@ CloudLayer farDeck(const CloudField& f, double range, glm::dvec3 to_sun) {
       // Gardner's periodic lattice, which the renderer bakes: a far deck is seen at a grazing
       // angle, where its period foreshortens below the heaps' own spacing.
       deck.texture.gardner.rotation_deg = deck.texture.gardner.jitter_octaves = 0.0;
+      // It stands for distant heaps, not for the stratocumulus genus whose texture it
+      // borrows: Gardner's amplitude ratio, with which its cover was matched to the heaps'
+      // (docs/ACCURACY.md, "Scale"), whatever ratio that genus takes for its own spectrum.
+      deck.texture.gardner.amplitude_ratio = GardnerTextureParams{}.amplitude_ratio;
       // Its cover rises towards the horizon as the heaps' sides fill the gaps: the ratio of a
       // heap's side silhouette to its footprint, both measured (unitArea).
       deck.far.coverage = w.coverage;

@@ -29,14 +29,19 @@ constexpr Species kCumulusSpecies[] = {
     {"humilis", 500.0, 3.0}, {"mediocris", 1200.0, 1.8}, {"congestus", 4000.0, 0.6}};
 constexpr Species kCumulonimbusSpecies[] = {{"capillatus incus", 9000.0, 2.0}};
 
+// Sky planes' amplitude ratios (MODEL.md section 2, "amplitude ratio"): chosen with
+// realism_bench so that the drawn field's transect spectrum comes within -5/3 +- 0.3
+// (docs/ACCURACY.md, "Realism"): higher than Gardner's 0.707 for the smooth veil and dark deck
+// (cirrostratus, nimbostratus), lower for the cellular stratocumulus and altocumulus (the
+// altocumulus with a softer transition); the rest keep 0.707.
 // Indexed by CloudType. Typical layers: the atlas's altitude bands for mid-latitudes.
 constexpr std::array<Genus, kCloudTypeCount> kGenera{{
-    {"none", 700.0, 500.0, {0, 0, 1, 0, 0, 0, 0, 0, 0, 0, false}, false, kNoHeaps, {}},
+    {"none", 700.0, 500.0, {0, 0, 1, 0.707, 0, 0, 0, 0, 0, 0, 0, false}, false, kNoHeaps, {}},
     // cells
     {"altocumulus",
      4000.0,
      700.0,
-     {3.0e-3, 3.0e-3, 6, 0.5, 90.0, 0.12, 0.95, 0.55, 0.50, 1, false},
+     {3.0e-3, 3.0e-3, 6, 0.35, 0.5, 90.0, 0.20, 0.95, 0.55, 0.50, 1, false},
      false,
      kNoHeaps,
      {}},
@@ -44,7 +49,7 @@ constexpr std::array<Genus, kCloudTypeCount> kGenera{{
     {"altostratus",
      4000.0,
      700.0,
-     {1.2e-3, 1.2e-3, 5, 2.0, 90.0, 0.50, 0.72, 0.70, 0.35, 2, false},
+     {1.2e-3, 1.2e-3, 5, 0.707, 2.0, 90.0, 0.50, 0.72, 0.70, 0.35, 2, false},
      false,
      kNoHeaps,
      {}},
@@ -52,7 +57,7 @@ constexpr std::array<Genus, kCloudTypeCount> kGenera{{
     {"cirrocumulus",
      8000.0,
      600.0,
-     {8.0e-3, 6.5e-3, 6, 0.5, 90.0, 0.15, 1.00, 0.70, 0.50, 1, false},
+     {8.0e-3, 6.5e-3, 6, 0.707, 0.5, 90.0, 0.15, 1.00, 0.70, 0.50, 1, false},
      false,
      kNoHeaps,
      {}},
@@ -60,7 +65,7 @@ constexpr std::array<Genus, kCloudTypeCount> kGenera{{
     {"cirrostratus",
      8000.0,
      600.0,
-     {1.0e-3, 1.0e-3, 4, 2.0, 90.0, 3.00, 1.00, 0.80, 0.30, 1, true},
+     {1.0e-3, 1.0e-3, 4, 0.84, 2.0, 90.0, 3.00, 1.00, 0.80, 0.30, 1, true},
      false,
      kNoHeaps,
      {}},
@@ -68,7 +73,7 @@ constexpr std::array<Genus, kCloudTypeCount> kGenera{{
     {"cirrus",
      8000.0,
      600.0,
-     {1.0e-3, 0.35e-3, 5, 0.2, 30.0, 0.50, 1.00, 0.75, 0.60, 1, false},
+     {1.0e-3, 0.35e-3, 5, 0.707, 0.2, 30.0, 0.50, 1.00, 0.75, 0.60, 1, false},
      false,
      kNoHeaps,
      {}},
@@ -76,7 +81,7 @@ constexpr std::array<Genus, kCloudTypeCount> kGenera{{
     {"cumulonimbus",
      900.0,
      9000.0,
-     {1.0e-3, 1.0e-3, 4, 2.0, 90.0, 0.80, 0.42, 0.80, 0.30, 1, false},
+     {1.0e-3, 1.0e-3, 4, 0.707, 2.0, 90.0, 0.80, 0.42, 0.80, 0.30, 1, false},
      true,
      kCumulonimbusHeaps,
      kCumulonimbusSpecies},
@@ -84,7 +89,7 @@ constexpr std::array<Genus, kCloudTypeCount> kGenera{{
     {"cumulus",
      1200.0,
      1200.0,
-     {2.0e-3, 1.6e-3, 6, 0.6, 90.0, 0.12, 0.82, 0.55, 0.55, 1, false},
+     {2.0e-3, 1.6e-3, 6, 0.707, 0.6, 90.0, 0.12, 0.82, 0.55, 0.55, 1, false},
      true,
      kCumulusHeaps,
      kCumulusSpecies},
@@ -92,7 +97,7 @@ constexpr std::array<Genus, kCloudTypeCount> kGenera{{
     {"nimbostratus",
      900.0,
      2500.0,
-     {1.0e-3, 1.0e-3, 4, 2.0, 90.0, 0.80, 0.42, 0.80, 0.30, 3, false},
+     {1.0e-3, 1.0e-3, 4, 0.86, 2.0, 90.0, 0.80, 0.42, 0.80, 0.30, 3, false},
      false,
      kNoHeaps,
      {}},
@@ -100,7 +105,7 @@ constexpr std::array<Genus, kCloudTypeCount> kGenera{{
     {"stratocumulus",
      700.0,
      500.0,
-     {2.0e-3, 1.6e-3, 6, 0.6, 90.0, 0.12, 0.82, 0.55, 0.55, 1, false},
+     {2.0e-3, 1.6e-3, 6, 0.55, 0.6, 90.0, 0.12, 0.82, 0.55, 0.55, 1, false},
      false,
      kNoHeaps,
      {}},
@@ -108,7 +113,7 @@ constexpr std::array<Genus, kCloudTypeCount> kGenera{{
     {"stratus",
      700.0,
      500.0,
-     {1.5e-3, 1.5e-3, 4, 2.5, 90.0, 0.60, 0.66, 0.75, 0.30, 2, false},
+     {1.5e-3, 1.5e-3, 4, 0.707, 2.5, 90.0, 0.60, 0.66, 0.75, 0.30, 2, false},
      false,
      kNoHeaps,
      {}},

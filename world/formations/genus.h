@@ -16,14 +16,14 @@
 namespace nephele {
 
 // Sky planes (section 10): Gardner texture base frequencies (radians per metre), term count,
-// contrast offset T0, lattice-breaking rotation; the transition D, grey level, ambient and
-// texture fractions of eq. 8; how many planes stand through the layer's thickness; a veil
-// stays translucent at full cover (opacity just above 1/2 where it is thinnest) where a deck
-// turns opaque.
+// the amplitude ratio between successive terms (section 2), contrast offset T0, lattice-breaking
+// rotation; the transition D, grey level, ambient and texture fractions of eq. 8; how many planes
+// stand through the layer's thickness; a veil stays translucent at full cover (opacity just above
+// 1/2 where it is thinnest) where a deck turns opaque.
 struct PlaneLook {
   double fx1, fy1;
   int terms;
-  double t0, rotation_deg, transition, grey, ambient, texture_fraction;
+  double amplitude_ratio, t0, rotation_deg, transition, grey, ambient, texture_fraction;
   int planes;
   bool veil;
 };

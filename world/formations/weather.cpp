@@ -102,6 +102,7 @@ std::vector<CloudLayer> planes(const WeatherLayer& w, const PlaneLook& look, dou
   t.gardner.fx1 = look.fx1;
   t.gardner.fy1 = look.fy1;
   t.gardner.terms = look.terms;
+  t.gardner.amplitude_ratio = look.amplitude_ratio;
   t.gardner.t0 = look.t0;
   t.gardner.rotation_deg = look.rotation_deg;
   t.gardner.jitter_octaves = kJitterOctaves;

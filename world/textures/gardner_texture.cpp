@@ -7,11 +7,6 @@
 #include "world/counter_random.h"
 
 namespace nephele {
-namespace {
-constexpr double kAmplitudeRatio = 0.707;  // C(i+1) = 0.707 C(i)
-
-}  // namespace
-
 double wrapPeriodic(double x, double period) {
   double r = std::fmod(x, period);
   if (r < 0.0) r += period;
@@ -28,7 +23,7 @@ GardnerTexture::GardnerTexture(const GardnerTextureParams& params) : params_(par
     // n components of C / sqrt n keep the term's power; their sum can reach sqrt n C, which
     // k allows for so that T stays within [0, 1].
     amplitude_sum += c * std::sqrt(double(components(i)));
-    c *= kAmplitudeRatio;
+    c *= params_.amplitude_ratio;
     for (int k = 0; k < GardnerTextureParams::kComponents; ++k) {
       if (params_.seeded_phases && (k == 0 || !periodic())) {
         phx_[i][k] = kTwoPi * unitFromBits(hashCounters(params_.seed, 0x47617264ull, i, 2 * k));

@@ -32,6 +32,10 @@ struct GardnerTextureParams {
   // a direction). Solid textures ignore both.
   double rotation_deg = 0.0;
   double jitter_octaves = 0.0;
+  // C(i+1) / C(i), the amplitude ratio between successive terms: Gardner's 0.707 halves the
+  // power per octave; the genus table sets its own for the spectrum of real clouds (MODEL.md
+  // section 2).
+  double amplitude_ratio = 0.707;
 };
 
 // How terms above the local sampling frequency are removed (MODEL.md section 2).
