@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "tests/gl_test_fixture.h"
+#include "world/formations/weather.h"
 #include "world/world.h"
 
 namespace nephele {
@@ -90,6 +91,26 @@ TEST_F(FrameStatsTest, NoTermAboveTheSamplingFrequency) {
   EXPECT_EQ(bare.layer_terms_total, 0);
   EXPECT_EQ(bare.passes(), bare.sky_passes);
   EXPECT_LE(bare.sky_passes, 2);  // one per side of the horizon
+}
+
+// A full deck hides the layers beyond it exactly, and they are left out: an altostratus over
+// a full stratus, seen from under the stratus, costs the stratus's terms alone and draws the
+// stratus's image to the bit; seen from between them, both are drawn.
+TEST_F(FrameStatsTest, AFullDeckLeavesOutTheLayersBeyondIt) {
+  Scene deck;
+  deck.camera.width = 64, deck.camera.height = 48;
+  deck.camera.orientation.pitch_deg = 30.0;
+  WeatherLayer stratus = typicalWeatherLayer(CloudType::kStratus, 1.0);
+  deck.layers = weatherClouds(stratus, "low", 3).layers;
+  ASSERT_FALSE(deck.layers.empty());
+  Scene both = deck;
+  WeatherLayer altostratus = typicalWeatherLayer(CloudType::kAltostratus, 0.5);
+  for (const CloudLayer& l : weatherClouds(altostratus, "high", 4).layers) both.layers.push_back(l);
+  const FrameStats alone = statsOf(deck), under = statsOf(both);
+  EXPECT_EQ(under.layer_terms_total, alone.layer_terms_total);
+  EXPECT_EQ(renderer_->renderSrgb8(both, {}).rgba, renderer_->renderSrgb8(deck, {}).rgba);
+  both.camera.position.z = 0.5 * (stratus.base_m + stratus.thickness_m + altostratus.base_m);
+  EXPECT_GT(statsOf(both).layer_terms_total, alone.layer_terms_total);
 }
 
 }  // namespace

@@ -598,10 +598,6 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
                                ? LayerKind::kProceduralGardner
                                : LayerKind::kBakedGardner;
     (layer.altitude_m > z ? above : below).push_back({&layer, &texture, kind});
-    if (const GardnerTexture* g = texture.source->gardner()) {
-      stats_.layer_terms += layerTermsAtMost(layer, *texture.source, camera, settings.term_filter);
-      stats_.layer_terms_total += g->terms();
-    }
   }
   std::sort(above.begin(), above.end(), [](const LayerSlot& a, const LayerSlot& b) {
     return a.layer->altitude_m > b.layer->altitude_m;
@@ -609,6 +605,28 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
   std::sort(below.begin(), below.end(), [](const LayerSlot& a, const LayerSlot& b) {
     return a.layer->altitude_m < b.layer->altitude_m;
   });
+  // A layer that no texture value leaves translucent (T >= 0 and T1 + D <= 0 in eq. 9, with
+  // no region or far cover to thin it: a full deck) hides every layer beyond it on its side
+  // of the camera, exactly. Those are left out of the passes: the sky shader's own skip
+  // behind an opaque surface saves nothing on llvmpipe, which runs both sides of a branch.
+  auto opaqueEverywhere = [](const LayerSlot& slot) {
+    const CloudLayer& l = *slot.layer;
+    const double edge = l.transition > 0.0 ? l.threshold + l.transition : l.threshold + 1e-300;
+    return !layerHasRegion(l) && edge <= 0.0;
+  };
+  for (std::vector<LayerSlot>* side : {&above, &below})  // each is nearest last
+    for (std::size_t k = side->size(); k-- > 1;)
+      if (opaqueEverywhere((*side)[k])) {
+        side->erase(side->begin(), side->begin() + std::ptrdiff_t(k));
+        break;
+      }
+  for (const std::vector<LayerSlot>* side : {&above, &below})
+    for (const LayerSlot& slot : *side)
+      if (const GardnerTexture* g = slot.texture->source->gardner()) {
+        stats_.layer_terms +=
+            layerTermsAtMost(*slot.layer, *slot.texture->source, camera, settings.term_filter);
+        stats_.layer_terms_total += g->terms();
+      }
 
   // Interleave clouds with the layers (docs/MODEL.md, "Compositing order"). On each side of
   // the camera, band b holds what lies beyond the b nearest layers of that side and before
