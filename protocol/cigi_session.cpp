@@ -8,6 +8,7 @@
 #include "protocol/cloud_codes.h"
 #include "world/formations/cloud_field.h"
 #include "world/frames.h"
+#include "world/geodesy.h"
 #include "world/limits.h"
 #include "world/solar.h"
 
@@ -15,9 +16,6 @@ namespace nephele::cigi {
 namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
-// WGS 84 (NIMA TR8350.2): semi-major axis and flattening.
-constexpr double kWgs84A = 6378137.0;
-constexpr double kWgs84F = 1.0 / 298.257223563;
 
 std::string text(double v) {
   std::ostringstream s;
@@ -52,6 +50,22 @@ bool sameFog(const WeatherControl& a, const WeatherControl& b) {
          a.visibility == b.visibility;
 }
 
+// The UTC moment of a Celestial Sphere Control (date MMDDYYYY, hour, minute).
+CivilTime civilTimeOf(const CelestialSphereControl& c) {
+  CivilTime t;
+  t.month = int(c.date / 1000000);
+  t.day = int(c.date / 10000 % 100);
+  t.year = int(c.date % 10000);
+  t.hour = c.hour;
+  t.minute = c.minute;
+  t.second = 0.0;
+  return t;
+}
+
+// The sun is placed again for the ownship once it has moved this far in latitude or
+// longitude: the sun's direction then moves by about as much, 0.05 degree (5 km).
+constexpr double kSunPlaceStepDeg = 0.05;
+
 std::string entityName(std::uint16_t id) {
   return "cigi-" + std::to_string(id);
 }
@@ -60,15 +74,8 @@ std::string entityName(std::uint16_t id) {
 
 glm::dvec3 localPosition(double latitude_deg, double longitude_deg, double altitude_m,
                          double origin_latitude_deg, double origin_longitude_deg) {
-  const double e2 = kWgs84F * (2.0 - kWgs84F);
-  const double s = std::sin(origin_latitude_deg * kDeg);
-  const double w = 1.0 - e2 * s * s;
-  const double prime_vertical = kWgs84A / std::sqrt(w);                 // N
-  const double meridional = kWgs84A * (1.0 - e2) / (w * std::sqrt(w));  // M
-  double dlon = longitude_deg - origin_longitude_deg;
-  dlon -= 360.0 * std::round(dlon / 360.0);  // across the antimeridian
-  return {dlon * kDeg * prime_vertical * std::cos(origin_latitude_deg * kDeg),
-          (latitude_deg - origin_latitude_deg) * kDeg * meridional, altitude_m};
+  return LocalFrame(origin_latitude_deg, origin_longitude_deg)
+      .toLocal({latitude_deg, longitude_deg, altitude_m});
 }
 
 std::optional<Session::Pose> Session::poseOf(const State& state, std::uint16_t id,
@@ -314,22 +321,32 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
       if (s.celestial && s.celestial->date == c->date && s.celestial->hour == c->hour &&
           s.celestial->minute == c->minute)
         continue;
-      CivilTime t;
-      t.month = int(c->date / 1000000);
-      t.day = int(c->date / 10000 % 100);
-      t.year = int(c->date % 10000);
-      t.hour = c->hour;
-      t.minute = c->minute;
-      t.second = 0.0;
-      if (std::string e = civilTimeError(t); !e.empty()) {
+      if (std::string e = civilTimeError(civilTimeOf(*c)); !e.empty()) {
         bad("Celestial Sphere Control: date " + std::to_string(c->date) + " (MMDDYYYY) " +
             std::to_string(c->hour) + ":" + std::to_string(c->minute) + ": " + e);
         continue;
       }
-      frame.commands.emplace_back(command::SetSun{std::nullopt, std::nullopt, t});
       s.celestial = *c;
+      s.sun_place.reset();  // placed below, for the ownship
     } else if (const auto* o = std::get_if<OtherPacket>(&packet)) {
       frame.ignored.push_back("packet " + std::to_string(o->id) + " (not used by Nephele)");
+    }
+  }
+  // The sun of the host's date where the ownship is (MODEL.md section 13), not at the site: a
+  // long flight sees it move.
+  if (s.celestial) {
+    glm::dvec2 place(settings_.latitude_deg, settings_.longitude_deg);
+    if (const auto own = s.entities.find(0);
+        own != s.entities.end() && !own->second.packet.attached)
+      place = {
+          own->second.packet.latitude,
+          own->second.packet.longitude - 360.0 * std::round(own->second.packet.longitude / 360.0)};
+    const bool moved = !s.sun_place || std::abs(place.x - s.sun_place->x) > kSunPlaceStepDeg ||
+                       std::abs(std::remainder(place.y - s.sun_place->y, 360.0)) > kSunPlaceStepDeg;
+    if (moved) {
+      frame.commands.emplace_back(
+          command::SetSun{std::nullopt, std::nullopt, civilTimeOf(*s.celestial), place});
+      s.sun_place = place;
     }
   }
   // Targets after the entities they hang from: every changed entity, and every attached one
@@ -432,6 +449,7 @@ void Session::forget() {
   state_.weather.clear();
   state_.atmosphere.reset();
   state_.celestial.reset();
+  state_.sun_place.reset();
 }
 
 void Session::commit() {

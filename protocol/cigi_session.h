@@ -52,9 +52,9 @@ inline constexpr std::int32_t kReorderWindow = 16;
 inline constexpr std::int32_t kMaxFrameJump = 3000;
 inline constexpr int kRestartRunBehind = 3, kRestartRunElsewhere = 2;
 
-// The geodetic position (degrees, metres) in the database's east, north, up metres: a
-// flat-earth (equirectangular) projection about the origin with the WGS 84 radii of
-// curvature there, so that altitude stays altitude (MODEL.md section 13).
+// The geodetic position (degrees, metres) in the database's east, north, up metres: the east
+// and north of its foot on the WGS 84 ellipsoid in the origin's east-north-up frame, and its
+// altitude as up (LocalFrame, MODEL.md section 13).
 glm::dvec3 localPosition(double latitude_deg, double longitude_deg, double altitude_m,
                          double origin_latitude_deg, double origin_longitude_deg);
 
@@ -99,6 +99,7 @@ class Session {
     std::map<std::uint8_t, WeatherControl> weather;  // by layer, as last applied
     std::optional<AtmosphereControl> atmosphere;
     std::optional<CelestialSphereControl> celestial;
+    std::optional<glm::dvec2> sun_place;  // latitude, longitude the sun was last placed for
   };
   std::variant<State, Refusal> next(const Message& message, HostFrame& frame) const;
   std::optional<Pose> poseOf(const State& state, std::uint16_t entity, int depth = 0) const;

@@ -329,7 +329,8 @@ Command readCommand(const std::string& cmd, FieldReader& r) {
   }
   if (cmd == "set_sun") {
     SetSun c{r.number("azimuth", -Limits::kMaxHeading, Limits::kMaxHeading),
-             r.number("elevation", -Limits::kMaxPitch, Limits::kMaxPitch), std::nullopt};
+             r.number("elevation", -Limits::kMaxPitch, Limits::kMaxPitch), std::nullopt,
+             std::nullopt};
     if (auto utc = r.string("utc", 64)) {
       if (c.azimuth || c.elevation)
         r.fail("utc", "give the sun by azimuth and elevation, or by utc, not both");

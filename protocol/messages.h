@@ -111,6 +111,9 @@ struct SetWind {
 struct SetSun {
   std::optional<double> azimuth, elevation;
   std::optional<CivilTime> utc;
+  // Where on the Earth the date's sun is placed, latitude and longitude in degrees (a CIGI
+  // ownship's); the config's [site] when unset.
+  std::optional<glm::dvec2> place;
 };
 // Ground fog (McReynolds and Blythe): unset fields keep their value; `enabled` false removes it.
 struct SetFog {

@@ -269,7 +269,7 @@ std::variant<std::vector<Command>, RegisterError> decodeHoldingWrite(
         error = RegisterError{kIllegalDataValue,
                               "sun date (registers " + std::to_string(M::kSunDate) + "-" +
                                   std::to_string(M::kSunDate + 1) + ", YYYYMMDD): " + e};
-      commands.emplace_back(command::SetSun{std::nullopt, std::nullopt, t});
+      commands.emplace_back(command::SetSun{std::nullopt, std::nullopt, t, std::nullopt});
     }
   }
   if (error) return *error;

@@ -59,8 +59,9 @@ Outcome Engine::setSun(const command::SetSun& c) {
   State& s = *state_;
   Sun sun = s.world->base().sun;
   if (c.utc) {
-    const SolarPosition p =
-        solarPosition(*c.utc, config_.site.latitude_deg, config_.site.longitude_deg);
+    const glm::dvec2 place =
+        c.place.value_or(glm::dvec2(config_.site.latitude_deg, config_.site.longitude_deg));
+    const SolarPosition p = solarPosition(*c.utc, place.x, place.y);
     sun.azimuth_deg = p.azimuth_deg;
     sun.elevation_deg = p.elevation_deg;
     s.sun_utc = c.utc;

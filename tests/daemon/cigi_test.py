@@ -293,6 +293,48 @@ size = [4, 2, 1]
         self.assertNotIn("refused_malformed", stats)
         self.check_with_tshark()
 
+    def test_the_sun_and_the_database_follow_the_ownship_across_the_earth(self):
+        """Issue 29, item 1: the sun of the host's date is placed where the ownship is, not at
+        [site], and positions 10, 100 and 1,000 km out agree with the Earth-centred
+        computation above to a millimetre (the flat-earth projection was 1 km off at 100 km)."""
+        d = self.start()
+        c = d.client()
+        from pymodbus.client import ModbusTcpClient
+
+        def sun():
+            mb = ModbusTcpClient("127.0.0.1", port=d.modbus_port)
+            mb.connect()
+            try:
+                regs = mb.read_holding_registers(0, 64, slave=1).registers
+            finally:
+                mb.close()
+            return unfloat(regs[22:24]), unfloat(regs[20:22])  # elevation, azimuth
+
+        frame = 1
+        for lat, lon in [(45.0, 0.0), (45.0, 10.0), (38.0, 10.0)]:
+            self.frame(entity_control(0, lat, lon, 3000.0), celestial_control(6, 21, 2026, 12, 0),
+                       frame=frame)
+            frame += 1
+            el, az = sun()
+            want_el, want_az = sun_spencer(2026, 6, 21, 12, 0, lat, lon)
+            self.assertAlmostEqual(el, want_el, delta=0.3, msg=f"{lat}, {lon}")
+            self.assertAlmostEqual(az, want_az, delta=0.5, msg=f"{lat}, {lon}")
+        # The issue's case: 45 N 0 E at noon UT on 21 June, 680 km from [site].
+        self.frame(entity_control(0, 45.0, 0.0, 3000.0), frame=frame)
+        frame += 1
+        el, az = sun()
+        self.assertAlmostEqual(el, 68.4, delta=0.3)
+        self.assertAlmostEqual(az, 179.0, delta=1.0)
+        for km in (10.0, 100.0, 1000.0):
+            lat, lon = SITE[0] + 0.6 * km / 111.2, SITE[1] + 0.8 * km / 69.2
+            self.frame(entity_control(0, lat, lon, 2500.0), frame=frame)
+            frame += 1
+            front = c.ok({"cmd": "get_view", "view": "front"})
+            east, north, up = enu(lat, lon, 2500.0, *SITE)
+            self.assertAlmostEqual(front["position"][0], east, delta=1e-3, msg=f"{km} km")
+            self.assertAlmostEqual(front["position"][1], north, delta=1e-3, msg=f"{km} km")
+            self.assertEqual(front["position"][2], up)
+
     def test_synchronous_mode_advances_by_the_host_frame_and_renders_once(self):
         d = self.start()
         c = d.client()
