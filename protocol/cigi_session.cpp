@@ -301,21 +301,37 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
       }
       s.weather[w->layer] = *w;
     } else if (const auto* a = std::get_if<AtmosphereControl>(&packet)) {
-      if (s.atmosphere && s.atmosphere->wind_speed == a->wind_speed &&
-          s.atmosphere->wind_direction == a->wind_direction)
-        continue;
-      if (!finite({a->wind_speed, a->wind_direction}) ||
-          !(a->wind_speed >= 0.0 && a->wind_speed <= Limits::kMaxWind)) {
-        bad("Atmosphere Control: wind speed " + text(a->wind_speed) + " (allowed: 0 to " +
-            text(Limits::kMaxWind) + " m/s)");
-        continue;
+      // The wind and the global visibility apply on their own: a bad one is refused alone,
+      // and what was applied is what the next packet is compared with.
+      AtmosphereControl applied = s.atmosphere.value_or(AtmosphereControl{});
+      if (!s.atmosphere || applied.wind_speed != a->wind_speed ||
+          applied.wind_direction != a->wind_direction) {
+        if (!finite({a->wind_speed, a->wind_direction}) ||
+            !(a->wind_speed >= 0.0 && a->wind_speed <= Limits::kMaxWind)) {
+          bad("Atmosphere Control: wind speed " + text(a->wind_speed) + " (allowed: 0 to " +
+              text(Limits::kMaxWind) + " m/s)");
+        } else {
+          frame.commands.emplace_back(
+              command::SetWind{windVelocity(a->wind_speed, a->wind_direction)});
+          applied.wind_speed = a->wind_speed;
+          applied.wind_direction = a->wind_direction;
+        }
       }
-      frame.commands.emplace_back(command::SetWind{windVelocity(a->wind_speed, a->wind_direction)});
-      if (a->visibility != 0.0f)
-        frame.ignored.push_back(
-            "Atmosphere Control: global visibility (haze is drawn only in "
-            "the ground fog, Weather Control layer 0)");
-      s.atmosphere = *a;
+      // Global visibility is the distance haze over everything (MODEL.md section 5), with the
+      // haze's default scale height; 0 is no haze.
+      if (!s.atmosphere || applied.visibility != a->visibility) {
+        const double v = a->visibility;
+        if (!finite({v}) || (v != 0.0 && !Limits::kHazeVisibility.contains(v))) {
+          bad("Atmosphere Control: visibility " + text(v) + " (allowed: 0 for none, or " +
+              text(Limits::kHazeVisibility.lo) + " to " + text(Limits::kHazeVisibility.hi) +
+              " m)");
+        } else {
+          frame.commands.emplace_back(v == 0.0 ? command::SetHaze{false, {}, {}}
+                                               : command::SetHaze{true, v, {}});
+          applied.visibility = a->visibility;
+        }
+      }
+      s.atmosphere = applied;
     } else if (const auto* c = std::get_if<CelestialSphereControl>(&packet)) {
       if (!c->date_valid) continue;  // the ICD: date and time not to be applied
       if (s.celestial && s.celestial->date == c->date && s.celestial->hour == c->hour &&

@@ -350,6 +350,14 @@ Command readCommand(const std::string& cmd, FieldReader& r) {
     r.finish("cmd, id, enabled, top, visibility, colour");
     return c;
   }
+  if (cmd == "set_haze") {
+    SetHaze c{r.boolean("enabled"), r.number("visibility", Limits::kHazeVisibility),
+              r.number("scale_height", Limits::kHazeScaleHeight)};
+    if (c.enabled == false && (c.visibility || c.scale_height))
+      r.fail("enabled", "false removes the haze; give no visibility or scale_height with it");
+    r.finish("cmd, id, enabled, visibility, scale_height");
+    return c;
+  }
   if (cmd == "set_time") {
     SetTime c{r.number("time_scale", 0.0, ProtocolLimits::kMaxTimeScale), r.boolean("paused"),
               r.number("advance", 0.0, Limits::kMaxAdvance), std::nullopt};
@@ -525,7 +533,8 @@ std::string_view imageFormatName(ImageFormat format) {
 std::string_view commandName(const Command& command) {
   static constexpr std::string_view kNames[] = {
       "hello",       "get_view",      "set_view",     "set_weather",  "set_wind",     "set_sun",
-      "set_fog",     "set_time",      "add_cloud",    "change_cloud", "remove_cloud", "add_target",
+      "set_fog",     "set_haze",      "set_time",     "add_cloud",    "change_cloud", "remove_cloud",
+      "add_target",
       "move_target", "remove_target", "list_targets", "tick",         "render",       "subscribe",
       "unsubscribe", "snapshot",      "restore",      "stats",        "hash"};
   static_assert(std::size(kNames) == std::variant_size_v<Command>);

@@ -116,6 +116,12 @@ struct SetSun {
   std::optional<glm::dvec2> place;
 };
 // Ground fog (McReynolds and Blythe): unset fields keep their value; `enabled` false removes it.
+// Distance haze over everything (MODEL.md section 5): unset fields keep their value; `enabled`
+// false removes it.
+struct SetHaze {
+  std::optional<bool> enabled;
+  std::optional<double> visibility, scale_height;
+};
 struct SetFog {
   std::optional<bool> enabled;
   std::optional<double> top, visibility;
@@ -183,14 +189,16 @@ struct Hash {};
 
 using Command =
     std::variant<command::Hello, command::GetView, command::SetView, command::SetWeather,
-                 command::SetWind, command::SetSun, command::SetFog, command::SetTime,
+                 command::SetWind, command::SetSun, command::SetFog, command::SetHaze,
+                 command::SetTime,
                  command::AddCloud, command::ChangeCloud, command::RemoveCloud, command::AddTarget,
                  command::MoveTarget, command::RemoveTarget, command::ListTargets, command::Tick,
                  command::Render, command::Subscribe, command::Unsubscribe, command::Snapshot,
                  command::Restore, command::Stats, command::Hash>;
 std::string_view commandName(const Command& command);
 inline constexpr std::string_view kCommandNames =
-    "hello, get_view, set_view, set_weather, set_wind, set_sun, set_fog, set_time, add_cloud, "
+    "hello, get_view, set_view, set_weather, set_wind, set_sun, set_fog, set_haze, set_time, "
+    "add_cloud, "
     "change_cloud, remove_cloud, add_target, move_target, remove_target, list_targets, tick, "
     "render, subscribe, unsubscribe, snapshot, restore, stats, hash";
 

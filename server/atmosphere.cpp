@@ -98,6 +98,27 @@ Outcome Engine::setFog(const command::SetFog& c) {
               {"colour", {fog->colour.x, fog->colour.y, fog->colour.z}}};
 }
 
+Outcome Engine::setHaze(const command::SetHaze& c) {
+  State& s = *state_;
+  std::optional<Haze> haze = s.world->base().haze;
+  if (c.enabled == false) {
+    haze.reset();
+  } else {
+    if (!haze) haze.emplace();
+    if (c.visibility) haze->visibility_m = *c.visibility;
+    if (c.scale_height) haze->scale_height_m = *c.scale_height;
+  }
+  std::string error = s.world->edit([&](Scene& now, WorldDynamics&) {
+    now.haze = haze;
+    return std::string();
+  });
+  if (!error.empty()) return ProtocolError{ErrorCode::kFailed, error};
+  if (!haze) return json{{"enabled", false}};
+  return json{{"enabled", true},
+              {"visibility", haze->visibility_m},
+              {"scale_height", haze->scale_height_m}};
+}
+
 void Engine::setMode(TickMode mode) {
   State& s = *state_;
   if (mode == s.mode) return;

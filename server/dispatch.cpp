@@ -110,6 +110,7 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
       },
       [&](const SetSun& c) -> std::optional<Outcome> { return setSun(c); },
       [&](const SetFog& c) -> std::optional<Outcome> { return setFog(c); },
+      [&](const SetHaze& c) -> std::optional<Outcome> { return setHaze(c); },
       [&](const SetTime& c) -> std::optional<Outcome> {
         if (c.time_scale) s.time_scale = *c.time_scale;
         if (c.paused) s.paused = *c.paused;

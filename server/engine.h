@@ -159,6 +159,7 @@ class Engine {
   std::optional<ProtocolError> setWeather(int layer, const WeatherLayer& weather);
   std::variant<nlohmann::json, ProtocolError> setSun(const command::SetSun& c);
   std::variant<nlohmann::json, ProtocolError> setFog(const command::SetFog& c);
+  std::variant<nlohmann::json, ProtocolError> setHaze(const command::SetHaze& c);
   void setMode(TickMode mode);
   std::optional<std::variant<nlohmann::json, ProtocolError>> renderRequest(const command::Render& c,
                                                                            Job& job);

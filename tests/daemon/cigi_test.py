@@ -269,6 +269,10 @@ size = [4, 2, 1]
         el, az = sun_spencer(2026, 6, 21, 14, 30, *SITE)
         self.assertAlmostEqual(unfloat(regs[22:24]), el, delta=0.3)
         self.assertAlmostEqual(unfloat(regs[20:22]), az, delta=0.5)
+        # Atmosphere Control's global visibility is the distance haze (set_haze with no field
+        # reads it back unchanged).
+        self.assertEqual(c.ok({"cmd": "set_haze"}),
+                         {"enabled": True, "visibility": 20000.0, "scale_height": 1200.0})
         # The same packets again change nothing (no regeneration of the layer), and moving
         # the boat moves it; inactive removes it.
         hash_before = c.ok({"cmd": "hash"})

@@ -854,6 +854,17 @@ class HostStateTest(DaemonTest):
         self.assertNotEqual(c.ok({"cmd": "hash"})["hash"], before)
         self.assertEqual(c.ok({"cmd": "set_fog", "enabled": False}), {"enabled": False})
         self.assertIn("visibility", c.error({"cmd": "set_fog", "visibility": 0})["message"])
+        # Distance haze: set, kept where unset, removed; bad values change nothing.
+        with_haze = c.ok({"cmd": "set_haze", "visibility": 25000})
+        self.assertEqual(with_haze, {"enabled": True, "visibility": 25000, "scale_height": 1200})
+        self.assertEqual(c.ok({"cmd": "set_haze", "scale_height": 800})["visibility"], 25000)
+        hazy = c.ok({"cmd": "hash"})["hash"]
+        self.assertIn("10 to 1e+07", c.error({"cmd": "set_haze", "visibility": 5})["message"])
+        self.assertIn("removes the haze",
+                      c.error({"cmd": "set_haze", "enabled": False, "visibility": 900})["message"])
+        self.assertEqual(c.ok({"cmd": "hash"})["hash"], hazy)
+        self.assertEqual(c.ok({"cmd": "set_haze", "enabled": False}), {"enabled": False})
+        self.assertNotEqual(c.ok({"cmd": "hash"})["hash"], hazy)
         # Midsummer noon at London: the sun due south at 90 - 51.5 + 23.44 degrees.
         sun = c.ok({"cmd": "set_sun", "utc": "2026-06-21T12:00:00Z"})
         self.assertAlmostEqual(sun["elevation"], 90 - 51.5 + 23.44, delta=0.2)
