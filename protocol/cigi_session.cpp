@@ -323,8 +323,7 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
         const double v = a->visibility;
         if (!finite({v}) || (v != 0.0 && !Limits::kHazeVisibility.contains(v))) {
           bad("Atmosphere Control: visibility " + text(v) + " (allowed: 0 for none, or " +
-              text(Limits::kHazeVisibility.lo) + " to " + text(Limits::kHazeVisibility.hi) +
-              " m)");
+              text(Limits::kHazeVisibility.lo) + " to " + text(Limits::kHazeVisibility.hi) + " m)");
         } else {
           frame.commands.emplace_back(v == 0.0 ? command::SetHaze{false, {}, {}}
                                                : command::SetHaze{true, v, {}});

@@ -532,11 +532,10 @@ std::string_view imageFormatName(ImageFormat format) {
 
 std::string_view commandName(const Command& command) {
   static constexpr std::string_view kNames[] = {
-      "hello",       "get_view",      "set_view",     "set_weather",  "set_wind",     "set_sun",
-      "set_fog",     "set_haze",      "set_time",     "add_cloud",    "change_cloud", "remove_cloud",
-      "add_target",
-      "move_target", "remove_target", "list_targets", "tick",         "render",       "subscribe",
-      "unsubscribe", "snapshot",      "restore",      "stats",        "hash"};
+      "hello",      "get_view",    "set_view",      "set_weather",  "set_wind",     "set_sun",
+      "set_fog",    "set_haze",    "set_time",      "add_cloud",    "change_cloud", "remove_cloud",
+      "add_target", "move_target", "remove_target", "list_targets", "tick",         "render",
+      "subscribe",  "unsubscribe", "snapshot",      "restore",      "stats",        "hash"};
   static_assert(std::size(kNames) == std::variant_size_v<Command>);
   return kNames[command.index()];
 }

@@ -187,20 +187,17 @@ struct Stats {};
 struct Hash {};
 }  // namespace command
 
-using Command =
-    std::variant<command::Hello, command::GetView, command::SetView, command::SetWeather,
-                 command::SetWind, command::SetSun, command::SetFog, command::SetHaze,
-                 command::SetTime,
-                 command::AddCloud, command::ChangeCloud, command::RemoveCloud, command::AddTarget,
-                 command::MoveTarget, command::RemoveTarget, command::ListTargets, command::Tick,
-                 command::Render, command::Subscribe, command::Unsubscribe, command::Snapshot,
-                 command::Restore, command::Stats, command::Hash>;
+using Command = std::variant<
+    command::Hello, command::GetView, command::SetView, command::SetWeather, command::SetWind,
+    command::SetSun, command::SetFog, command::SetHaze, command::SetTime, command::AddCloud,
+    command::ChangeCloud, command::RemoveCloud, command::AddTarget, command::MoveTarget,
+    command::RemoveTarget, command::ListTargets, command::Tick, command::Render, command::Subscribe,
+    command::Unsubscribe, command::Snapshot, command::Restore, command::Stats, command::Hash>;
 std::string_view commandName(const Command& command);
 inline constexpr std::string_view kCommandNames =
     "hello, get_view, set_view, set_weather, set_wind, set_sun, set_fog, set_haze, set_time, "
-    "add_cloud, "
-    "change_cloud, remove_cloud, add_target, move_target, remove_target, list_targets, tick, "
-    "render, subscribe, unsubscribe, snapshot, restore, stats, hash";
+    "add_cloud, change_cloud, remove_cloud, add_target, move_target, remove_target, "
+    "list_targets, tick, render, subscribe, unsubscribe, snapshot, restore, stats, hash";
 
 // The clock: its numbers are the Modbus status register's (protocol/MODBUS.md).
 enum class RunState : std::uint16_t { kRunning = 1, kPaused = 2, kLockstep = 3 };
@@ -215,8 +212,10 @@ struct HostReadings {
   double sun_azimuth = 0.0, sun_elevation = 45.0;
   double time_scale = 1.0;
   std::array<WeatherLayer, ProtocolLimits::kWeatherLayers> layers;
-  double fog_top = 0.0, fog_visibility = 0.0;  // visibility 0: no fog
-  glm::dvec3 fog_colour = Fog{}.colour;        // the fog's, or what a new fog would have
+  double haze_visibility = 0.0;                      // 0: no haze
+  double haze_scale_height = Haze{}.scale_height_m;  // the haze's, or a new haze's
+  double fog_top = 0.0, fog_visibility = 0.0;        // visibility 0: no fog
+  glm::dvec3 fog_colour = Fog{}.colour;              // the fog's, or what a new fog would have
   std::optional<CivilTime> sun_utc;
 };
 

@@ -35,6 +35,9 @@ constexpr FloatField kOtherFloats[] = {
     {M::kSunAzimuth, "sun azimuth", -Limits::kMaxHeading, Limits::kMaxHeading},
     {M::kSunElevation, "sun elevation", -Limits::kMaxPitch, Limits::kMaxPitch},
     {M::kTimeScale, "time scale", 0.0, ProtocolLimits::kMaxTimeScale},
+    {M::kHazeVisibility, "haze visibility", 0.0, Limits::kHazeVisibility.hi},
+    {M::kHazeScaleHeight, "haze scale height", Limits::kHazeScaleHeight.lo,
+     Limits::kHazeScaleHeight.hi},
 };
 constexpr FloatField kAtmosphereFloats[] = {
     {M::kFogTop, "fog top", 0.0, Limits::kMaxAltitude},
@@ -64,7 +67,7 @@ std::vector<int> floatAddresses() {
 }
 
 bool isReserved(int address) {
-  if (address > M::kTimeScale + 1 && address < M::kLayerStart) return true;
+  if (address > M::kHazeScaleHeight + 1 && address < M::kLayerStart) return true;
   return address >= M::kLayerStart && address < M::kFogTop &&
          (address - M::kLayerStart) % M::kLayerStride == 7;
 }
@@ -102,6 +105,8 @@ HoldingRegisters encodeHolding(const HostReadings& s) {
   putFloat(&r[M::kSunAzimuth], s.sun_azimuth);
   putFloat(&r[M::kSunElevation], s.sun_elevation);
   putFloat(&r[M::kTimeScale], s.time_scale);
+  putFloat(&r[M::kHazeVisibility], s.haze_visibility);
+  putFloat(&r[M::kHazeScaleHeight], s.haze_scale_height);
   for (int layer = 0; layer < ProtocolLimits::kWeatherLayers; ++layer) {
     std::uint16_t* b = &r[std::size_t(M::kLayerStart + layer * M::kLayerStride)];
     const WeatherLayer& w = s.layers[std::size_t(layer)];
@@ -252,6 +257,21 @@ std::variant<std::vector<Command>, RegisterError> decodeHoldingWrite(
       commands.emplace_back(command::SetFog{false, {}, {}, {}});
     else
       commands.emplace_back(command::SetFog{true, top, visibility, colour});
+  }
+  if (w.touches(M::kHazeVisibility, 4)) {  // the haze, set whole
+    const double visibility = readFloat(kOtherFloats[5], 0);
+    const double scale_height = readFloat(kOtherFloats[6], 0);
+    if (!error && visibility != 0.0 && visibility < Limits::kHazeVisibility.lo)
+      error = RegisterError{kIllegalDataValue,
+                            "haze visibility (register " + std::to_string(M::kHazeVisibility) +
+                                "): " + formatNumber(visibility) +
+                                " is out of range (allowed: 0 for no haze, or " +
+                                formatNumber(Limits::kHazeVisibility.lo) + " to " +
+                                formatNumber(Limits::kHazeVisibility.hi) + ")"};
+    if (visibility == 0.0)
+      commands.emplace_back(command::SetHaze{false, {}, {}});
+    else
+      commands.emplace_back(command::SetHaze{true, visibility, scale_height});
   }
   if (w.touches(M::kSunDate, 4)) {
     const std::uint32_t date = std::uint32_t(next[M::kSunDate]) << 16 | next[M::kSunDate + 1];

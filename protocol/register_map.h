@@ -25,6 +25,8 @@ struct ModbusMap {
   static constexpr int kWindEast = 16, kWindNorth = 18;                   // float32 m/s
   static constexpr int kSunAzimuth = 20, kSunElevation = 22;              // float32 degrees
   static constexpr int kTimeScale = 24;                                   // float32
+  static constexpr int kHazeVisibility = 26;                              // float32 m; 0: no haze
+  static constexpr int kHazeScaleHeight = 28;                             // float32 m
   // Weather layers 1..3 at kLayerStart + (layer - 1) * kLayerStride.
   static constexpr int kLayerStart = 32, kLayerStride = 8;
   static constexpr int kLayerType = 0;       // uint16, CIGI cloud type 0..10

@@ -76,6 +76,10 @@ void Engine::publishReadings() {
     settings.fog_visibility = fog->visibility_m;
     settings.fog_colour = fog->colour;
   }
+  if (const std::optional<Haze>& haze = world.base().haze) {
+    settings.haze_visibility = haze->visibility_m;
+    settings.haze_scale_height = haze->scale_height_m;
+  }
   settings.sun_utc = s.sun_utc;
   HostStatus status;
   status.status = s.mode == TickMode::kLockstep ? RunState::kLockstep

@@ -135,6 +135,35 @@ TEST(RegisterMap, Coils) {
 namespace nephele {
 namespace {
 
+// Issue 29: the distance haze, set whole from registers 26-29; 0 removes it, a visibility
+// under 10 m and a scale height out of range are refused with the register and the range.
+TEST(RegisterMap, Haze) {
+  std::uint16_t v[4];
+  putFloat(v, 25000.0);
+  putFloat(v + 2, 900.0);
+  auto haze = decodeHoldingWrite(HoldingRegisters{}, ModbusMap::kHazeVisibility, v, "front");
+  ASSERT_TRUE(std::holds_alternative<std::vector<Command>>(haze));
+  const auto& set = std::get<command::SetHaze>(std::get<std::vector<Command>>(haze).at(0));
+  EXPECT_EQ((std::tuple{*set.enabled, *set.visibility, *set.scale_height}),
+            (std::tuple{true, 25000.0, 900.0}));
+  putFloat(v, 0.0);
+  auto none = decodeHoldingWrite(HoldingRegisters{}, ModbusMap::kHazeVisibility, v, "front");
+  ASSERT_TRUE(std::holds_alternative<std::vector<Command>>(none));
+  EXPECT_EQ(std::get<command::SetHaze>(std::get<std::vector<Command>>(none).at(0)).enabled, false);
+  putFloat(v, 5.0);
+  const auto low = decodeHoldingWrite(HoldingRegisters{}, ModbusMap::kHazeVisibility, v, "front");
+  ASSERT_TRUE(std::holds_alternative<RegisterError>(low));
+  EXPECT_NE(std::get<RegisterError>(low).message.find("register 26"), std::string::npos);
+  putFloat(v, 25000.0);
+  putFloat(v + 2, 5.0);
+  const auto flat = decodeHoldingWrite(HoldingRegisters{}, ModbusMap::kHazeVisibility, v, "front");
+  ASSERT_TRUE(std::holds_alternative<RegisterError>(flat));
+  EXPECT_NE(std::get<RegisterError>(flat).message.find("haze scale height"), std::string::npos);
+  // Registers 30-31 stay reserved.
+  EXPECT_TRUE(std::holds_alternative<RegisterError>(
+      decodeHoldingWrite(HoldingRegisters{}, 30, v, "front")));
+}
+
 // Issue 16: fog and the sun's date and time; a NaN time of day (found by protocol_fuzz) and a
 // day that does not exist are refused.
 TEST(RegisterMap, FogAndSunDate) {

@@ -1008,6 +1008,15 @@ class ModbusTest(DaemonTest):
                          [date >> 16, date & 0xffff])
         self.assertFalse(self.mb.write_registers(58, floats(0.0), slave=1).isError())
         self.assertEqual(self.mb.read_holding_registers(56, 4, slave=1).registers, [0, 0, 0, 0])
+        # The haze (registers 26-29), set whole and read back over the socket and Modbus.
+        self.assertFalse(self.mb.write_registers(26, floats(25000.0) + floats(900.0),
+                                                 slave=1).isError())
+        self.assertEqual(self.c.ok({"cmd": "set_haze"}),
+                         {"enabled": True, "visibility": 25000.0, "scale_height": 900.0})
+        self.assertEqual(self.mb.read_holding_registers(26, 4, slave=1).registers,
+                         floats(25000.0) + floats(900.0))
+        self.assertFalse(self.mb.write_registers(26, floats(0.0), slave=1).isError())
+        self.assertEqual(self.mb.read_holding_registers(26, 2, slave=1).registers, [0, 0])
 
     def test_bad_writes_get_exceptions_and_change_nothing(self):
         before = self.c.ok({"cmd": "hash"})["hash"]
@@ -1020,7 +1029,8 @@ class ModbusTest(DaemonTest):
             (32, [11], 3),                     # cloud type 11
             (7, [0x4200], 2),                  # half of the heading float: ILLEGAL_DATA_ADDRESS
             (6, [0x4200, 0, 0x4200], 2),       # a float and a half
-            (26, [1], 2),                      # reserved register
+            (30, [1], 2),                      # reserved register
+            (26, floats(5.0), 3),              # haze visibility under 10 m
             (200, [1], 2),                     # outside the map
             (0, floats(1.0) + floats(2.0) + floats(-5.0), 3),  # below the ground
         ]
