@@ -66,6 +66,18 @@ std::vector<int> floatAddresses() {
   return out;
 }
 
+// A visibility register where 0 removes the medium (fog, haze): none, or the error for a value
+// between 0 and the range (readFloat has checked the rest).
+std::optional<RegisterError> zeroOrWithin(const char* medium, int address, double visibility,
+                                          Range range) {
+  if (visibility == 0.0 || visibility >= range.lo) return std::nullopt;
+  return RegisterError{kIllegalDataValue,
+                       std::string(medium) + " visibility (register " + std::to_string(address) +
+                           "): " + formatNumber(visibility) +
+                           " is out of range (allowed: 0 for no " + medium + ", or " +
+                           formatNumber(range.lo) + " to " + formatNumber(range.hi) + ")"};
+}
+
 bool isReserved(int address) {
   if (address > M::kHazeScaleHeight + 1 && address < M::kLayerStart) return true;
   return address >= M::kLayerStart && address < M::kFogTop &&
@@ -246,13 +258,7 @@ std::variant<std::vector<Command>, RegisterError> decodeHoldingWrite(
     const double visibility = readFloat(kAtmosphereFloats[1], 0);
     const glm::dvec3 colour(readFloat(kAtmosphereFloats[3], 0), readFloat(kAtmosphereFloats[4], 0),
                             readFloat(kAtmosphereFloats[5], 0));
-    if (!error && visibility != 0.0 && visibility < Limits::kFogVisibility.lo)
-      error = RegisterError{kIllegalDataValue,
-                            "fog visibility (register " + std::to_string(M::kFogVisibility) +
-                                "): " + formatNumber(visibility) +
-                                " is out of range (allowed: 0 for no fog, or " +
-                                formatNumber(Limits::kFogVisibility.lo) + " to " +
-                                formatNumber(Limits::kFogVisibility.hi) + ")"};
+    if (!error) error = zeroOrWithin("fog", M::kFogVisibility, visibility, Limits::kFogVisibility);
     if (visibility == 0.0)
       commands.emplace_back(command::SetFog{false, {}, {}, {}});
     else
@@ -261,13 +267,8 @@ std::variant<std::vector<Command>, RegisterError> decodeHoldingWrite(
   if (w.touches(M::kHazeVisibility, 4)) {  // the haze, set whole
     const double visibility = readFloat(kOtherFloats[5], 0);
     const double scale_height = readFloat(kOtherFloats[6], 0);
-    if (!error && visibility != 0.0 && visibility < Limits::kHazeVisibility.lo)
-      error = RegisterError{kIllegalDataValue,
-                            "haze visibility (register " + std::to_string(M::kHazeVisibility) +
-                                "): " + formatNumber(visibility) +
-                                " is out of range (allowed: 0 for no haze, or " +
-                                formatNumber(Limits::kHazeVisibility.lo) + " to " +
-                                formatNumber(Limits::kHazeVisibility.hi) + ")"};
+    if (!error)
+      error = zeroOrWithin("haze", M::kHazeVisibility, visibility, Limits::kHazeVisibility);
     if (visibility == 0.0)
       commands.emplace_back(command::SetHaze{false, {}, {}});
     else

@@ -117,6 +117,17 @@ def unfloat(words):
     return struct.unpack(">f", struct.pack(">HH", *words))[0]
 
 
+def holding_registers(daemon):
+    """The daemon's first 64 Modbus holding registers, read by a fresh client."""
+    from pymodbus.client import ModbusTcpClient
+    mb = ModbusTcpClient("127.0.0.1", port=daemon.modbus_port)
+    mb.connect()
+    try:
+        return mb.read_holding_registers(0, 64, slave=1).registers
+    finally:
+        mb.close()
+
+
 # ---- Capture and dissection -----------------------------------------------------------------
 
 class Capture:
@@ -254,13 +265,7 @@ size = [4, 2, 1]
         self.assertAlmostEqual(targets[0]["centre"][1], bn, delta=1.0)
         self.assertEqual((targets[0]["heading"], targets[0]["size"]), (90.0, [4, 2, 1]))
         # The weather, fog and sun as the Modbus registers read them.
-        from pymodbus.client import ModbusTcpClient
-        mb = ModbusTcpClient("127.0.0.1", port=d.modbus_port)
-        mb.connect()
-        try:
-            regs = mb.read_holding_registers(0, 64, slave=1).registers
-        finally:
-            mb.close()
+        regs = holding_registers(d)
         self.assertEqual(regs[32], 7)  # cumulus
         self.assertEqual([unfloat(regs[33:35]), unfloat(regs[35:37]), unfloat(regs[37:39])],
                          [1500.0, 800.0, 40.0])
@@ -303,15 +308,9 @@ size = [4, 2, 1]
         computation above to a millimetre (the flat-earth projection was 1 km off at 100 km)."""
         d = self.start()
         c = d.client()
-        from pymodbus.client import ModbusTcpClient
 
         def sun():
-            mb = ModbusTcpClient("127.0.0.1", port=d.modbus_port)
-            mb.connect()
-            try:
-                regs = mb.read_holding_registers(0, 64, slave=1).registers
-            finally:
-                mb.close()
+            regs = holding_registers(d)
             return unfloat(regs[22:24]), unfloat(regs[20:22])  # elevation, azimuth
 
         frame = 1
