@@ -134,7 +134,10 @@ std::string Engine::openWorld() {
   s.platform = createGlPlatform(GlBackend::kAuto, error);
   if (!s.platform) return "no OpenGL context: " + error;
   s.renderer = std::make_unique<GlRenderer>(*s.platform);
-  s.renderer->setCancel(&cancel_renders_);
+  // A long render beats the heart at each point where it can be cancelled, so /healthz and the
+  // systemd watchdog tell a render that makes progress from a stuck world thread.
+  s.renderer->setCancel(&cancel_renders_,
+                        [this] { heartbeat_ns_ = Clock::now().time_since_epoch().count(); });
   s.world =
       std::make_unique<World>(config_.scene.scene, config_.scene.dynamics, config_.world_threads);
   if (std::string e = s.world->advanceInPieces(config_.scene.scene.time_s); !e.empty())

@@ -173,6 +173,7 @@ json Engine::stats() const {
   out["queue"]["depth"] = depth;
   out["queue"]["encoder"] = encoding;
   out["cigi"] = std::move(cigi);
+  out["heartbeat_age"] = heartbeatAge();
   if (in_hand.what.empty()) {
     out["in_hand"] = nullptr;
   } else {
@@ -204,6 +205,9 @@ std::string Engine::prometheusText() const {
   metric("frames_dropped_total", "counter", "Frames dropped for slow clients.",
          st["frames_dropped"].get<double>());
   metric("errors_total", "counter", "Error replies and failed work.", st["errors"].get<double>());
+  metric("world_heartbeat_age_seconds", "gauge",
+         "Since the world thread last ran its loop or made progress in a render.",
+         st["heartbeat_age"].get<double>());
   // Latencies as histograms, in seconds (Prometheus base units).
   auto histogram = [&](const char* name, const char* help) {
     const json& h = st["histograms"][name];

@@ -2,6 +2,7 @@
 // Ellipsoid clouds on the GL: visible ellipsoids culled and ordered on the CPU in double,
 // then drawn either fused (exact per-fragment hits) or with Elinas and Stuerzlinger's tiles.
 #include <atomic>
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -68,7 +69,12 @@ class EllipsoidRenderer {
   // (glFinish): the per-pixel pass in bands of about kCancelWork hit tests, the centre pass
   // in groups of kCancelInstances. Light batches draw as without it. Once raised the rest of
   // the frame's ellipsoids are skipped and cancelled() says so until the next beginFrame.
-  void setCancel(const std::atomic<bool>* flag) { cancel_ = flag; }
+  // `alive`, if given, is called at each of those points: the frame is making progress (a
+  // daemon's watchdog heartbeat).
+  void setCancel(const std::atomic<bool>* flag, std::function<void()> alive = {}) {
+    cancel_ = flag;
+    alive_ = std::move(alive);
+  }
   bool cancelled() const { return cancelled_; }
 
   // The in-cloud veil at the eye (MODEL.md section 4), and the pass that draws it over the
@@ -81,6 +87,7 @@ class EllipsoidRenderer {
   static constexpr std::int64_t kCancelWork = std::int64_t(1) << 25;
   static constexpr std::size_t kCancelInstances = 16384;
   bool stopNow() {
+    if (alive_) alive_();
     if (!cancelled_ && cancel_ && cancel_->load(std::memory_order_relaxed)) cancelled_ = true;
     return cancelled_;
   }
@@ -154,6 +161,7 @@ class EllipsoidRenderer {
   std::map<std::size_t, Impostor> impostors_;  // by cloud index
   int impostor_renders_ = 0;
   const std::atomic<bool>* cancel_ = nullptr;
+  std::function<void()> alive_;
   bool cancelled_ = false;
   FrameStats* stats_ = nullptr;  // the current frame's, borrowed from the GlRenderer
 };

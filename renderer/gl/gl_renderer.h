@@ -56,8 +56,11 @@ class GlRenderer {
   // Far-cloud impostors rendered since construction (each reuse saves one).
   int impostorRenders() const { return ellipsoids_.impostorRenders(); }
   // A flag another thread may raise to cancel the frame being rendered; a cancelled frame's
-  // image is incomplete and lastFrameCancelled() says so (EllipsoidRenderer::setCancel).
-  void setCancel(const std::atomic<bool>* flag) { ellipsoids_.setCancel(flag); }
+  // image is incomplete and lastFrameCancelled() says so; `alive` is called wherever the flag
+  // is read (EllipsoidRenderer::setCancel).
+  void setCancel(const std::atomic<bool>* flag, std::function<void()> alive = {}) {
+    ellipsoids_.setCancel(flag, std::move(alive));
+  }
   bool lastFrameCancelled() const { return ellipsoids_.cancelled(); }
   // Automaton volume uploads since construction (one per keyframe change of a cloud).
   int volumeUploads() const { return automata_.uploads(); }
