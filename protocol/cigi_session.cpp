@@ -8,7 +8,6 @@
 #include "protocol/cloud_codes.h"
 #include "world/formations/cloud_field.h"
 #include "world/frames.h"
-#include "world/geodesy.h"
 #include "world/limits.h"
 #include "world/solar.h"
 
@@ -72,12 +71,6 @@ std::string entityName(std::uint16_t id) {
 
 }  // namespace
 
-glm::dvec3 localPosition(double latitude_deg, double longitude_deg, double altitude_m,
-                         double origin_latitude_deg, double origin_longitude_deg) {
-  return LocalFrame(origin_latitude_deg, origin_longitude_deg)
-      .toLocal({latitude_deg, longitude_deg, altitude_m});
-}
-
 std::optional<Session::Pose> Session::poseOf(const State& state, std::uint16_t id,
                                              int depth) const {
   const auto it = state.entities.find(id);
@@ -95,9 +88,7 @@ std::optional<Session::Pose> Session::poseOf(const State& state, std::uint16_t i
         parent->attitude * own};
   }
   if (e.attached) return std::nullopt;  // attached to itself, or a chain deeper than 16
-  return Pose{localPosition(e.latitude, e.longitude, e.altitude, settings_.latitude_deg,
-                            settings_.longitude_deg),
-              own};
+  return Pose{database_.toLocal({e.latitude, e.longitude, e.altitude}), own};
 }
 
 std::variant<Session::State, Refusal> Session::next(const Message& message,
@@ -353,9 +344,7 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
     glm::dvec2 place(settings_.latitude_deg, settings_.longitude_deg);
     if (const auto own = s.entities.find(0);
         own != s.entities.end() && !own->second.packet.attached)
-      place = {
-          own->second.packet.latitude,
-          own->second.packet.longitude - 360.0 * std::round(own->second.packet.longitude / 360.0)};
+      place = {own->second.packet.latitude, std::remainder(own->second.packet.longitude, 360.0)};
     const bool moved = !s.sun_place || std::abs(place.x - s.sun_place->x) > kSunPlaceStepDeg ||
                        std::abs(std::remainder(place.y - s.sun_place->y, 360.0)) > kSunPlaceStepDeg;
     if (moved) {

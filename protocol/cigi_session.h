@@ -13,6 +13,7 @@
 
 #include "protocol/cigi.h"
 #include "protocol/messages.h"
+#include "world/geodesy.h"
 
 namespace nephele::cigi {
 
@@ -52,15 +53,11 @@ inline constexpr std::int32_t kReorderWindow = 16;
 inline constexpr std::int32_t kMaxFrameJump = 3000;
 inline constexpr int kRestartRunBehind = 3, kRestartRunElsewhere = 2;
 
-// The geodetic position (degrees, metres) in the database's east, north, up metres: the east
-// and north of its foot on the WGS 84 ellipsoid in the origin's east-north-up frame, and its
-// altitude as up (LocalFrame, MODEL.md section 13).
-glm::dvec3 localPosition(double latitude_deg, double longitude_deg, double altitude_m,
-                         double origin_latitude_deg, double origin_longitude_deg);
-
 class Session {
  public:
-  explicit Session(SessionSettings settings) : settings_(std::move(settings)) {}
+  explicit Session(SessionSettings settings)
+      : settings_(std::move(settings)),
+        database_(settings_.latitude_deg, settings_.longitude_deg) {}
 
   // Turns a decoded host message into commands, and keeps the state they lead to. The session
   // takes that state only once the daemon has applied the frame (commit), so that a refused
@@ -105,6 +102,9 @@ class Session {
   std::optional<Pose> poseOf(const State& state, std::uint16_t entity, int depth = 0) const;
 
   SessionSettings settings_;
+  // Geodetic positions to the database's east, north, up metres about [site] (MODEL.md
+  // section 13).
+  LocalFrame database_;
   State state_;
   std::optional<State> pending_;  // after the last frame mapped, until commit
 };

@@ -136,8 +136,7 @@ std::string Engine::openWorld() {
   s.renderer = std::make_unique<GlRenderer>(*s.platform);
   // A long render beats the heart at each point where it can be cancelled, so /healthz and the
   // systemd watchdog tell a render that makes progress from a stuck world thread.
-  s.renderer->setCancel(&cancel_renders_,
-                        [this] { heartbeat_ns_ = Clock::now().time_since_epoch().count(); });
+  s.renderer->setCancel(&cancel_renders_, [this] { beatHeart(); });
   s.world =
       std::make_unique<World>(config_.scene.scene, config_.scene.dynamics, config_.world_threads);
   if (std::string e = s.world->advanceInPieces(config_.scene.scene.time_s); !e.empty())
@@ -169,7 +168,7 @@ void Engine::run(std::promise<std::string>& started) {
   started.set_value("");
 
   for (;;) {
-    heartbeat_ns_ = Clock::now().time_since_epoch().count();
+    beatHeart();
     std::deque<Job> jobs;
     std::vector<std::int64_t> gone;
     bool stopping = false;

@@ -219,7 +219,9 @@ class Engine {
   // Raised by stop(): the render in hand ends at its next batch boundary (RenderCancelled).
   std::atomic<bool> cancel_renders_{false};
   std::atomic<bool> lockstep_{false};
-  std::atomic<std::int64_t> heartbeat_ns_{0};  // steady clock, at the top of each loop
+  // Steady clock, at the top of each loop and wherever a render could be cancelled.
+  void beatHeart() { heartbeat_ns_ = Clock::now().time_since_epoch().count(); }
+  std::atomic<std::int64_t> heartbeat_ns_{0};
   std::atomic<std::uint64_t> errors_{0};
   std::atomic<std::uint64_t> answered_at_once_{0};  // requests the control plane answered
   std::atomic<int> last_error_{0};

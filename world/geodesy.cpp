@@ -1,6 +1,5 @@
 #include "world/geodesy.h"
 
-#include <algorithm>
 #include <cmath>
 #include <numbers>
 

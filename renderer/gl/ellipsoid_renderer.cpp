@@ -668,8 +668,8 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
         const double within =
             sines_within * largestRaySquared(camera, x * s, y * s, (x + 1) * s, (y + 1) * s);
         b.z = b.y > 0 && double(ordered[std::size_t(items[std::size_t(b.x)])].v[16].z) < within;
+        (b.z ? any_near : any_far) = true;
       }
-  for (const glm::ivec4& b : bins) (b.z ? any_near : any_far) = true;
   // With auto_near, the bins where no pixel is near enough to see the baked table magnified
   // are drawn by the baked program, the others by the procedural one: the sines cost only
   // where they show. (A per-pixel choice in one program would pay for both everywhere:

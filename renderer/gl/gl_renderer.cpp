@@ -12,6 +12,7 @@
 #include "renderer/gl/view_uniforms.h"
 #include "renderer/reference/reference_renderer.h"
 #include "world/check.h"
+#include "world/shading.h"
 #include "world/textures/layer_texture.h"
 #include "world/textures/texture_table.h"
 
@@ -605,14 +606,14 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
   std::sort(below.begin(), below.end(), [](const LayerSlot& a, const LayerSlot& b) {
     return a.layer->altitude_m < b.layer->altitude_m;
   });
-  // A layer that no texture value leaves translucent (T >= 0 and T1 + D <= 0 in eq. 9, with
-  // no region or far cover to thin it: a full deck) hides every layer beyond it on its side
-  // of the camera, exactly. Those are left out of the passes: the sky shader's own skip
-  // behind an opaque surface saves nothing on llvmpipe, which runs both sides of a branch.
+  // A layer that no texture value leaves translucent (opaque at T = 0, the least T, since
+  // eq. 9's translucence falls as T rises; no region or far cover to thin it: a full deck)
+  // hides every layer beyond it on its side of the camera, exactly. Those are left out of the
+  // passes: the sky shader's own skip behind an opaque surface saves nothing on llvmpipe,
+  // which runs both sides of a branch.
   auto opaqueEverywhere = [](const LayerSlot& slot) {
     const CloudLayer& l = *slot.layer;
-    const double edge = l.transition > 0.0 ? l.threshold + l.transition : l.threshold + 1e-300;
-    return !layerHasRegion(l) && edge <= 0.0;
+    return !layerHasRegion(l) && skyPlaneTranslucence(0.0, l.threshold, l.transition) == 0.0;
   };
   for (std::vector<LayerSlot>* side : {&above, &below})  // each is nearest last
     for (std::size_t k = side->size(); k-- > 1;)
