@@ -8,7 +8,10 @@
 //      the same for the socket protocol's tick, with one and three 640x480 raw views; as
 //      multiples of the render time alone (the daemon's own render p50 times the views) and
 //      of the platform floor (one constant-colour pass and readback, timed here);
-//   5. the same host frames with a cumulus sky (genus_cumulus.toml) against a clear sky, as
+//   5. host frames in asynchronous (realtime) mode, where Start of Frame comes at the IG's own
+//      rate: from a host frame to the first Start of Frame reporting it and to frames showing it;
+//   6. the same lockstep host frames with a cumulus sky (genus_cumulus.toml) against a clear sky,
+//   as
 //      multiples of the clear sky's (issue 27).
 // Figures only; these machines are shared and noisy.
 #include <arpa/inet.h>
@@ -239,13 +242,14 @@ void subscribers(const Daemon& daemon, int count, double seconds) {
       count, total / count / seconds, total / seconds);
 }
 
-// A lockstep daemon on `scene` with three 640x480 raw views and CIGI answering to `host_port`.
-std::string writeLockstepConfig(const std::filesystem::path& dir, int host_port,
-                                const std::string& scene) {
-  const std::string path = (dir / "lockstep.toml").string();
+// A daemon (`mode` lockstep or realtime) on `scene` with three 640x480 raw views and CIGI
+// answering to `host_port`.
+std::string writeHostConfig(const std::filesystem::path& dir, int host_port,
+                            const std::string& scene, const char* mode = "lockstep") {
+  const std::string path = (dir / "host.toml").string();
   std::ofstream out(path);
   out << "scene = \"" << scene << "\"\n"
-      << "[world]\nmode = \"lockstep\"\ntick_rate = 60\n";
+      << "[world]\nmode = \"" << mode << "\"\ntick_rate = 60\n";
   for (const auto& [name, heading] : {std::pair{"front", 0}, {"left", -60}, {"right", 60}})
     out << "[[view]]\nname = \"" << name << "\"\nheading = " << heading
         << "\nwidth = 640\nheight = 480\nformat = \"raw\"\n";
@@ -269,17 +273,38 @@ struct HostFrameFigures {
 
 // Host frames over CIGI and over the socket, each followed by one frame of every view, on
 // `scene` (what it is called in the heading); the medians.
-HostFrameFigures hostFrames(const std::filesystem::path& dir, int views, int repeats,
-                            double floor_ms, const std::string& scene, const char* what) {
+// A CIGI host's UDP socket on the loopback; its address in `host`.
+int hostSocket(sockaddr_in& host) {
   const int udp = socket(AF_INET, SOCK_DGRAM, 0);
-  sockaddr_in host{};
+  host = {};
   host.sin_family = AF_INET;
   host.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
   socklen_t length = sizeof host;
   if (bind(udp, reinterpret_cast<sockaddr*>(&host), sizeof host) ||
       getsockname(udp, reinterpret_cast<sockaddr*>(&host), &length))
     throw std::runtime_error("udp bind");
-  Daemon daemon(writeLockstepConfig(dir, ntohs(host.sin_port), scene));
+  return udp;
+}
+
+// Host frame `n`: IG Control and the ownship at 1500 + n m.
+std::vector<std::uint8_t> hostFrame(int n) {
+  std::vector<std::uint8_t> message;
+  nephele::cigi::IgControl igc;
+  igc.host_frame = std::uint32_t(n);
+  igc.timestamp = std::uint32_t(1667 * n);
+  igc.timestamp_valid = true;
+  nephele::cigi::EntityControl ownship;
+  ownship.altitude = 1500.0 + n;  // moves every frame
+  nephele::cigi::encode(igc, nephele::cigi::ByteOrder::kBig, message);
+  nephele::cigi::encode(ownship, nephele::cigi::ByteOrder::kBig, message);
+  return message;
+}
+
+HostFrameFigures hostFrames(const std::filesystem::path& dir, int views, int repeats,
+                            double floor_ms, const std::string& scene, const char* what) {
+  sockaddr_in host;
+  const int udp = hostSocket(host);
+  Daemon daemon(writeHostConfig(dir, ntohs(host.sin_port), scene));
   sockaddr_in ig = host;
   ig.sin_port = htons(std::uint16_t(daemon.cigi_port));
   Client sub(daemon.socket_port), control(daemon.socket_port);
@@ -295,15 +320,7 @@ HostFrameFigures hostFrames(const std::filesystem::path& dir, int views, int rep
   };
   std::vector<double> to_sof, cigi_frames, to_reply, socket_frames;
   for (int i = 0; i < repeats + 3; ++i) {
-    std::vector<std::uint8_t> message;
-    nephele::cigi::IgControl igc;
-    igc.host_frame = std::uint32_t(i + 1);
-    igc.timestamp = std::uint32_t(1667 * i);
-    igc.timestamp_valid = true;
-    nephele::cigi::EntityControl ownship;
-    ownship.altitude = 1500.0 + i;  // moves every frame
-    nephele::cigi::encode(igc, nephele::cigi::ByteOrder::kBig, message);
-    nephele::cigi::encode(ownship, nephele::cigi::ByteOrder::kBig, message);
+    const std::vector<std::uint8_t> message = hostFrame(i + 1);
     const auto t0 = Clock::now();
     sendto(udp, message.data(), message.size(), 0, reinterpret_cast<sockaddr*>(&ig), sizeof ig);
     std::uint8_t reply[64];
@@ -348,6 +365,66 @@ HostFrameFigures hostFrames(const std::filesystem::path& dir, int views, int rep
           percentile(socket_frames, 0.5)};
 }
 
+// Host frames in asynchronous (realtime) mode, the IG ticking at 60 Hz and each view subscribed
+// at 60 Hz: from a host frame to the first Start of Frame that reports it handled, and to a
+// frame of every view that shows it (its camera at the frame's altitude); and the rate at which
+// Start of Frame comes.
+void asynchronousHostFrames(const std::filesystem::path& dir, int views, int repeats,
+                            double floor_ms, const std::string& scene, const char* what) {
+  sockaddr_in host;
+  const int udp = hostSocket(host);
+  Daemon daemon(writeHostConfig(dir, ntohs(host.sin_port), scene, "realtime"));
+  sockaddr_in ig = host;
+  ig.sin_port = htons(std::uint16_t(daemon.cigi_port));
+  Client sub(daemon.socket_port), control(daemon.socket_port);
+  std::vector<std::uint8_t> body;
+  const char* names[] = {"front", "left", "right"};
+  for (int v = 0; v < views; ++v)
+    sub.request({{"cmd", "subscribe"}, {"view", names[v]}, {"rate", 60}}, body);
+  std::vector<double> to_sof, to_frames;
+  int sofs = 0;
+  const auto start = Clock::now();
+  for (int n = 1; n <= repeats + 3; ++n) {
+    const std::vector<std::uint8_t> message = hostFrame(n);
+    const auto t0 = Clock::now();
+    sendto(udp, message.data(), message.size(), 0, reinterpret_cast<sockaddr*>(&ig), sizeof ig);
+    for (;;) {
+      std::uint8_t reply[64];
+      if (recv(udp, reply, sizeof reply, 0) < 24 || reply[0] != nephele::cigi::Id::kStartOfFrame)
+        throw std::runtime_error("no Start of Frame");
+      ++sofs;
+      std::uint32_t last_host;  // big-endian, as the host sent
+      std::memcpy(&last_host, reply + 16, 4);
+      if (ntohl(last_host) == std::uint32_t(n)) break;
+    }
+    const auto t_sof = Clock::now();
+    for (int got = 0; got < views;) {
+      const json event = sub.receive(body);
+      if (event.value("event", "") == "frame" &&
+          event["image"]["camera"]["position"][2].get<double>() == 1500.0 + n)
+        ++got;
+    }
+    if (n > 3) {
+      to_sof.push_back(msBetween(t0, t_sof));
+      to_frames.push_back(msBetween(t0, Clock::now()));
+    }
+  }
+  const double seconds = msBetween(start, Clock::now()) / 1000.0;
+  json stats = control.request({{"cmd", "stats"}}, body)["result"];
+  const double render = stats["render_ms"]["p50"].get<double>() * views;
+  close(udp);
+  std::printf(
+      "host frames, asynchronous (realtime, 60 Hz), %s, %d view%s of 640x480 raw (%d frames "
+      "each; render alone %.1f ms = %.0f x floor %.2f ms; Start of Frame at %.1f Hz):\n",
+      what, views, views > 1 ? "s" : "", repeats, render, render / floor_ms, floor_ms,
+      sofs / seconds);
+  for (const auto& [row, ms] : {std::pair{"CIGI host frame to Start of Frame", &to_sof},
+                                {"CIGI host frame to frames", &to_frames}})
+    std::printf("  %-32s p50 %7.1f ms (%4.2f x render)  p99 %7.1f ms (%4.2f x render)\n", row,
+                percentile(*ms, 0.5), percentile(*ms, 0.5) / render, percentile(*ms, 0.99),
+                percentile(*ms, 0.99) / render);
+}
+
 // A cumulus sky (genus_cumulus.toml: the weather mapping's field at 35 %) against the same
 // daemon with no cloud, one view each, as multiples of the clear sky's figures (issue 27).
 void cumulusSky(const std::filesystem::path& dir, int repeats, double floor_ms) {
@@ -388,6 +465,10 @@ int main() {
     for (int views : {1, 3})
       hostFrames(dir, views, 40, floor_ms, NEPHELE_SOURCE_DIR "/config/scenes/cumulus.toml",
                  "the 27-lobe cumulus");
+    for (int views : {1, 3})
+      asynchronousHostFrames(dir, views, 40, floor_ms,
+                             NEPHELE_SOURCE_DIR "/config/scenes/cumulus.toml",
+                             "the 27-lobe cumulus");
     cumulusSky(dir, 40, floor_ms);
     std::filesystem::remove_all(dir);
   } catch (const std::exception& e) {

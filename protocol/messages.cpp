@@ -285,183 +285,225 @@ WeatherLayer readWeather(FieldReader& r) {
   return w;
 }
 
+using namespace command;
+
+Hello readHello(FieldReader& r) {
+  Hello c{r.string("token", 256)};
+  r.finish("cmd, id, token");
+  return c;
+}
+
+GetView readGetView(FieldReader& r) {
+  GetView c{r.name("view").value_or("")};
+  r.finish("cmd, id, view");
+  return c;
+}
+
+SetView readSetView(FieldReader& r) {
+  SetView c{r.requiredName("view"), readViewPatch(r)};
+  r.finish(
+      "cmd, id, view, position, heading, pitch, roll, vfov, width, height, frustum, format, "
+      "channels");
+  return c;
+}
+
+SetWeather readSetWeather(FieldReader& r) {
+  SetWeather c;
+  if (!r.has("layer")) r.fail("layer", "is missing (allowed: 1 to 3, the CIGI cloud layers)");
+  c.layer = int(*r.integer("layer", 1, ProtocolLimits::kWeatherLayers));
+  if (!r.has("type"))
+    r.fail("type",
+           "is missing (allowed: 0 to 10, CIGI cloud types: 0 none, 1 altocumulus, 2 "
+           "altostratus, 3 cirrocumulus, 4 cirrostratus, 5 cirrus, 6 cumulonimbus, 7 "
+           "cumulus, 8 nimbostratus, 9 stratocumulus, 10 stratus)");
+  c.weather = readWeather(r);
+  r.finish(
+      "cmd, id, layer, type, base, thickness, coverage, wind, centre, size, heading, edge, "
+      "front, transition, spacing, variation");
+  return c;
+}
+
+SetWind readSetWind(FieldReader& r) {
+  if (!r.has("velocity")) r.fail("velocity", "is missing ([east, north] m/s)");
+  SetWind c{*r.vector<2>("velocity", -Limits::kMaxWind, Limits::kMaxWind)};
+  if (glm::length(c.velocity) > Limits::kMaxWind)
+    r.fail("velocity", "speed is above " + formatNumber(Limits::kMaxWind) + " m/s");
+  r.finish("cmd, id, velocity");
+  return c;
+}
+
+SetSun readSetSun(FieldReader& r) {
+  SetSun c{r.number("azimuth", -Limits::kMaxHeading, Limits::kMaxHeading),
+           r.number("elevation", -Limits::kMaxPitch, Limits::kMaxPitch), std::nullopt,
+           std::nullopt};
+  if (auto utc = r.string("utc", 64)) {
+    if (c.azimuth || c.elevation)
+      r.fail("utc", "give the sun by azimuth and elevation, or by utc, not both");
+    CivilTime t;
+    if (std::string e = parseUtc(*utc, t); !e.empty()) r.fail("utc", e);
+    c.utc = t;
+  }
+  r.finish("cmd, id, azimuth, elevation, utc");
+  return c;
+}
+
+SetFog readSetFog(FieldReader& r) {
+  SetFog c{r.boolean("enabled"), r.number("top", 0.0, Limits::kMaxAltitude),
+           r.number("visibility", Limits::kFogVisibility),
+           r.vector<3>("colour", Limits::kColour.lo, Limits::kColour.hi)};
+  if (c.enabled == false && (c.top || c.visibility || c.colour))
+    r.fail("enabled", "false removes the fog; give no top, visibility or colour with it");
+  r.finish("cmd, id, enabled, top, visibility, colour");
+  return c;
+}
+
+SetHaze readSetHaze(FieldReader& r) {
+  SetHaze c{r.boolean("enabled"), r.number("visibility", Limits::kHazeVisibility),
+            r.number("scale_height", Limits::kHazeScaleHeight)};
+  if (c.enabled == false && (c.visibility || c.scale_height))
+    r.fail("enabled", "false removes the haze; give no visibility or scale_height with it");
+  r.finish("cmd, id, enabled, visibility, scale_height");
+  return c;
+}
+
+SetTime readSetTime(FieldReader& r) {
+  SetTime c{r.number("time_scale", 0.0, ProtocolLimits::kMaxTimeScale), r.boolean("paused"),
+            r.number("advance", 0.0, Limits::kMaxAdvance), std::nullopt};
+  if (auto mode = r.string("mode", 16)) {
+    if (*mode != "realtime" && *mode != "lockstep")
+      r.fail("mode", "\"" + *mode + "\" is not allowed (allowed: realtime, lockstep)");
+    c.mode = *mode == "realtime" ? TickMode::kRealtime : TickMode::kLockstep;
+  }
+  r.finish("cmd, id, time_scale, paused, advance, mode");
+  return c;
+}
+
+AddCloud readAddCloud(FieldReader& r) {
+  const json* cloud = r.object("cloud");
+  if (!cloud) r.fail("cloud", "is missing (an object with the keys of a scene file's [[cloud]])");
+  AddCloud c{*cloud};
+  r.finish("cmd, id, cloud");
+  return c;
+}
+
+ChangeCloud readChangeCloud(FieldReader& r) {
+  ChangeCloud c;
+  c.name = r.requiredName("name");
+  c.move = r.vector<3>("move", -Limits::kMaxCoordinate, Limits::kMaxCoordinate);
+  c.threshold = r.number("threshold", Limits::kCloudThreshold);
+  c.limb_threshold = r.number("limb_threshold", Limits::kCloudThreshold);
+  c.transition = r.number("transition", Limits::kTransition);
+  c.colour = r.vector<3>("colour", Limits::kColour.lo, Limits::kColour.hi);
+  r.finish("cmd, id, name, move, threshold, limb_threshold, transition, colour");
+  return c;
+}
+
+RemoveCloud readRemoveCloud(FieldReader& r) {
+  RemoveCloud c{r.requiredName("name")};
+  r.finish("cmd, id, name");
+  return c;
+}
+
+AddTarget readAddTarget(FieldReader& r) {
+  const json* target = r.object("target");
+  if (!target)
+    r.fail("target",
+           "is missing (an object with the keys of a scene file's [[target]], or a type "
+           "named in the daemon config's [[entity_type]])");
+  AddTarget c{*target, false};
+  r.finish("cmd, id, target");
+  return c;
+}
+
+MoveTarget readMoveTarget(FieldReader& r) {
+  MoveTarget c;
+  c.name = r.requiredName("name");
+  c.centre = r.vector<3>("centre", -Limits::kMaxCoordinate, Limits::kMaxCoordinate);
+  c.heading = r.number("heading", -Limits::kMaxHeading, Limits::kMaxHeading);
+  c.pitch = r.number("pitch", -Limits::kMaxPitch, Limits::kMaxPitch);
+  c.roll = r.number("roll", -Limits::kMaxRoll, Limits::kMaxRoll);
+  r.finish("cmd, id, name, centre, heading, pitch, roll");
+  return c;
+}
+
+RemoveTarget readRemoveTarget(FieldReader& r) {
+  RemoveTarget c{r.requiredName("name")};
+  r.finish("cmd, id, name");
+  return c;
+}
+
+ListTargets readListTargets(FieldReader& r) {
+  r.finish("cmd, id");
+  return ListTargets{};
+}
+
+Tick readTick(FieldReader& r) {
+  Tick c{r.requiredNumber("dt", 0.0, Limits::kMaxTick)};
+  r.finish("cmd, id, dt");
+  return c;
+}
+
+Render readRender(FieldReader& r) {
+  Render c{readViews(r), std::nullopt, readImage(r)};
+  if (const json* camera = r.object("camera")) {
+    if (c.views.size() != 1) r.fail("camera", "applies to a render of one view");
+    FieldReader cr(*camera, "camera");
+    c.camera = readViewPatch(cr, false);
+    cr.finish(kCameraKeys);
+  }
+  r.finish("cmd, id, view, views, camera, format, channels");
+  return c;
+}
+
+Subscribe readSubscribe(FieldReader& r) {
+  Subscribe c;
+  c.view = r.requiredName("view");
+  c.rate_hz = r.number("rate", 0.01, ProtocolLimits::kMaxSubscriptionHz).value_or(c.rate_hz);
+  c.image = readImage(r);
+  r.finish("cmd, id, view, rate, format, channels");
+  return c;
+}
+
+Unsubscribe readUnsubscribe(FieldReader& r) {
+  if (!r.has("subscription")) r.fail("subscription", "is missing");
+  Unsubscribe c{*r.integer("subscription", 1, INT64_MAX)};
+  r.finish("cmd, id, subscription");
+  return c;
+}
+
+Snapshot readSnapshot(FieldReader& r) {
+  Snapshot c{r.requiredName("name")};
+  r.finish("cmd, id, name");
+  return c;
+}
+
+Restore readRestore(FieldReader& r) {
+  Restore c{r.requiredName("name")};
+  r.finish("cmd, id, name");
+  return c;
+}
+
+Stats readStats(FieldReader& r) {
+  r.finish("cmd, id");
+  return {};
+}
+
+Hash readHash(FieldReader& r) {
+  r.finish("cmd, id");
+  return {};
+}
+
+// The readers by name, from the one list (protocol/commands.inc).
 Command readCommand(const std::string& cmd, FieldReader& r) {
-  using namespace command;
-  if (cmd == "hello") {
-    Hello c{r.string("token", 256)};
-    r.finish("cmd, id, token");
-    return c;
-  }
-  if (cmd == "get_view") {
-    GetView c{r.name("view").value_or("")};
-    r.finish("cmd, id, view");
-    return c;
-  }
-  if (cmd == "set_view") {
-    SetView c{r.requiredName("view"), readViewPatch(r)};
-    r.finish(
-        "cmd, id, view, position, heading, pitch, roll, vfov, width, height, frustum, format, "
-        "channels");
-    return c;
-  }
-  if (cmd == "set_weather") {
-    SetWeather c;
-    if (!r.has("layer")) r.fail("layer", "is missing (allowed: 1 to 3, the CIGI cloud layers)");
-    c.layer = int(*r.integer("layer", 1, ProtocolLimits::kWeatherLayers));
-    if (!r.has("type"))
-      r.fail("type",
-             "is missing (allowed: 0 to 10, CIGI cloud types: 0 none, 1 altocumulus, 2 "
-             "altostratus, 3 cirrocumulus, 4 cirrostratus, 5 cirrus, 6 cumulonimbus, 7 "
-             "cumulus, 8 nimbostratus, 9 stratocumulus, 10 stratus)");
-    c.weather = readWeather(r);
-    r.finish(
-        "cmd, id, layer, type, base, thickness, coverage, wind, centre, size, heading, edge, "
-        "front, transition, spacing, variation");
-    return c;
-  }
-  if (cmd == "set_wind") {
-    if (!r.has("velocity")) r.fail("velocity", "is missing ([east, north] m/s)");
-    SetWind c{*r.vector<2>("velocity", -Limits::kMaxWind, Limits::kMaxWind)};
-    if (glm::length(c.velocity) > Limits::kMaxWind)
-      r.fail("velocity", "speed is above " + formatNumber(Limits::kMaxWind) + " m/s");
-    r.finish("cmd, id, velocity");
-    return c;
-  }
-  if (cmd == "set_sun") {
-    SetSun c{r.number("azimuth", -Limits::kMaxHeading, Limits::kMaxHeading),
-             r.number("elevation", -Limits::kMaxPitch, Limits::kMaxPitch), std::nullopt,
-             std::nullopt};
-    if (auto utc = r.string("utc", 64)) {
-      if (c.azimuth || c.elevation)
-        r.fail("utc", "give the sun by azimuth and elevation, or by utc, not both");
-      CivilTime t;
-      if (std::string e = parseUtc(*utc, t); !e.empty()) r.fail("utc", e);
-      c.utc = t;
-    }
-    r.finish("cmd, id, azimuth, elevation, utc");
-    return c;
-  }
-  if (cmd == "set_fog") {
-    SetFog c{r.boolean("enabled"), r.number("top", 0.0, Limits::kMaxAltitude),
-             r.number("visibility", Limits::kFogVisibility),
-             r.vector<3>("colour", Limits::kColour.lo, Limits::kColour.hi)};
-    if (c.enabled == false && (c.top || c.visibility || c.colour))
-      r.fail("enabled", "false removes the fog; give no top, visibility or colour with it");
-    r.finish("cmd, id, enabled, top, visibility, colour");
-    return c;
-  }
-  if (cmd == "set_haze") {
-    SetHaze c{r.boolean("enabled"), r.number("visibility", Limits::kHazeVisibility),
-              r.number("scale_height", Limits::kHazeScaleHeight)};
-    if (c.enabled == false && (c.visibility || c.scale_height))
-      r.fail("enabled", "false removes the haze; give no visibility or scale_height with it");
-    r.finish("cmd, id, enabled, visibility, scale_height");
-    return c;
-  }
-  if (cmd == "set_time") {
-    SetTime c{r.number("time_scale", 0.0, ProtocolLimits::kMaxTimeScale), r.boolean("paused"),
-              r.number("advance", 0.0, Limits::kMaxAdvance), std::nullopt};
-    if (auto mode = r.string("mode", 16)) {
-      if (*mode != "realtime" && *mode != "lockstep")
-        r.fail("mode", "\"" + *mode + "\" is not allowed (allowed: realtime, lockstep)");
-      c.mode = *mode == "realtime" ? TickMode::kRealtime : TickMode::kLockstep;
-    }
-    r.finish("cmd, id, time_scale, paused, advance, mode");
-    return c;
-  }
-  if (cmd == "add_cloud") {
-    const json* cloud = r.object("cloud");
-    if (!cloud) r.fail("cloud", "is missing (an object with the keys of a scene file's [[cloud]])");
-    AddCloud c{*cloud};
-    r.finish("cmd, id, cloud");
-    return c;
-  }
-  if (cmd == "change_cloud") {
-    ChangeCloud c;
-    c.name = r.requiredName("name");
-    c.move = r.vector<3>("move", -Limits::kMaxCoordinate, Limits::kMaxCoordinate);
-    c.threshold = r.number("threshold", Limits::kCloudThreshold);
-    c.limb_threshold = r.number("limb_threshold", Limits::kCloudThreshold);
-    c.transition = r.number("transition", Limits::kTransition);
-    c.colour = r.vector<3>("colour", Limits::kColour.lo, Limits::kColour.hi);
-    r.finish("cmd, id, name, move, threshold, limb_threshold, transition, colour");
-    return c;
-  }
-  if (cmd == "remove_cloud") {
-    RemoveCloud c{r.requiredName("name")};
-    r.finish("cmd, id, name");
-    return c;
-  }
-  if (cmd == "add_target") {
-    const json* target = r.object("target");
-    if (!target)
-      r.fail("target",
-             "is missing (an object with the keys of a scene file's [[target]], or a type "
-             "named in the daemon config's [[entity_type]])");
-    AddTarget c{*target, false};
-    r.finish("cmd, id, target");
-    return c;
-  }
-  if (cmd == "move_target") {
-    MoveTarget c;
-    c.name = r.requiredName("name");
-    c.centre = r.vector<3>("centre", -Limits::kMaxCoordinate, Limits::kMaxCoordinate);
-    c.heading = r.number("heading", -Limits::kMaxHeading, Limits::kMaxHeading);
-    c.pitch = r.number("pitch", -Limits::kMaxPitch, Limits::kMaxPitch);
-    c.roll = r.number("roll", -Limits::kMaxRoll, Limits::kMaxRoll);
-    r.finish("cmd, id, name, centre, heading, pitch, roll");
-    return c;
-  }
-  if (cmd == "remove_target") {
-    RemoveTarget c{r.requiredName("name")};
-    r.finish("cmd, id, name");
-    return c;
-  }
-  if (cmd == "list_targets") {
-    r.finish("cmd, id");
-    return ListTargets{};
-  }
-  if (cmd == "tick") {
-    Tick c{r.requiredNumber("dt", 0.0, Limits::kMaxTick)};
-    r.finish("cmd, id, dt");
-    return c;
-  }
-  if (cmd == "render") {
-    Render c{readViews(r), std::nullopt, readImage(r)};
-    if (const json* camera = r.object("camera")) {
-      if (c.views.size() != 1) r.fail("camera", "applies to a render of one view");
-      FieldReader cr(*camera, "camera");
-      c.camera = readViewPatch(cr, false);
-      cr.finish(kCameraKeys);
-    }
-    r.finish("cmd, id, view, views, camera, format, channels");
-    return c;
-  }
-  if (cmd == "subscribe") {
-    Subscribe c;
-    c.view = r.requiredName("view");
-    c.rate_hz = r.number("rate", 0.01, ProtocolLimits::kMaxSubscriptionHz).value_or(c.rate_hz);
-    c.image = readImage(r);
-    r.finish("cmd, id, view, rate, format, channels");
-    return c;
-  }
-  if (cmd == "unsubscribe") {
-    if (!r.has("subscription")) r.fail("subscription", "is missing");
-    Unsubscribe c{*r.integer("subscription", 1, INT64_MAX)};
-    r.finish("cmd, id, subscription");
-    return c;
-  }
-  if (cmd == "snapshot" || cmd == "restore") {
-    const std::string name = r.requiredName("name");
-    r.finish("cmd, id, name");
-    if (cmd == "snapshot") return Snapshot{name};
-    return Restore{name};
-  }
-  if (cmd == "stats" || cmd == "hash") {
-    r.finish("cmd, id");
-    if (cmd == "stats") return Stats{};
-    return Hash{};
-  }
+  using Reader = Command (*)(FieldReader&);
+  static const std::pair<std::string_view, Reader> kReaders[] = {
+#define NEPHELE_COMMAND(name, Type) \
+  {#name, [](FieldReader& r) -> Command { return read##Type(r); }},
+#include "protocol/commands.inc"
+#undef NEPHELE_COMMAND
+  };
+  for (const auto& [name, read] : kReaders)
+    if (name == cmd) return read(r);
   throw FieldError{ErrorCode::kUnknownCommand, "cmd: \"" + cmd + "\" is not a command (allowed: " +
                                                    std::string(kCommandNames) + ")"};
 }
@@ -532,11 +574,10 @@ std::string_view imageFormatName(ImageFormat format) {
 
 std::string_view commandName(const Command& command) {
   static constexpr std::string_view kNames[] = {
-      "hello",      "get_view",    "set_view",      "set_weather",  "set_wind",     "set_sun",
-      "set_fog",    "set_haze",    "set_time",      "add_cloud",    "change_cloud", "remove_cloud",
-      "add_target", "move_target", "remove_target", "list_targets", "tick",         "render",
-      "subscribe",  "unsubscribe", "snapshot",      "restore",      "stats",        "hash"};
-  static_assert(std::size(kNames) == std::variant_size_v<Command>);
+#define NEPHELE_COMMAND(name, Type) #name,
+#include "protocol/commands.inc"
+#undef NEPHELE_COMMAND
+  };
   return kNames[command.index()];
 }
 

@@ -187,17 +187,28 @@ struct Stats {};
 struct Hash {};
 }  // namespace command
 
-using Command = std::variant<
-    command::Hello, command::GetView, command::SetView, command::SetWeather, command::SetWind,
-    command::SetSun, command::SetFog, command::SetHaze, command::SetTime, command::AddCloud,
-    command::ChangeCloud, command::RemoveCloud, command::AddTarget, command::MoveTarget,
-    command::RemoveTarget, command::ListTargets, command::Tick, command::Render, command::Subscribe,
-    command::Unsubscribe, command::Snapshot, command::Restore, command::Stats, command::Hash>;
+// The Command variant and the names, from the one list (protocol/commands.inc).
+namespace detail {
+template <typename Ignored, typename... Commands>
+struct CommandVariant {
+  using type = std::variant<Commands...>;
+};
+}  // namespace detail
+#define NEPHELE_COMMAND(name, Type) , command::Type
+using Command = detail::CommandVariant<void
+#include "protocol/commands.inc"
+                                       >::type;
+#undef NEPHELE_COMMAND
 std::string_view commandName(const Command& command);
-inline constexpr std::string_view kCommandNames =
-    "hello, get_view, set_view, set_weather, set_wind, set_sun, set_fog, set_haze, set_time, "
-    "add_cloud, change_cloud, remove_cloud, add_target, move_target, remove_target, "
-    "list_targets, tick, render, subscribe, unsubscribe, snapshot, restore, stats, hash";
+// "hello, get_view, ...": every name, for messages that list what is allowed.
+inline constexpr std::string_view kCommandNames = [] {
+  constexpr std::string_view all =
+#define NEPHELE_COMMAND(name, Type) #name ", "
+#include "protocol/commands.inc"
+#undef NEPHELE_COMMAND
+      "";
+  return all.substr(0, all.size() - 2);
+}();
 
 // The clock: its numbers are the Modbus status register's (protocol/MODBUS.md).
 enum class RunState : std::uint16_t { kRunning = 1, kPaused = 2, kLockstep = 3 };

@@ -40,12 +40,14 @@ std::string CigiServer::listen(const CigiConfig& config) {
            ec.message();
   port_ = socket_.local_endpoint().port();
   host_port_ = config.host_port;
+  engine_.onFrameStart([this] { asio::post(io_, [this] { igFrame(); }); });
   receive();
   return "";
 }
 
 void CigiServer::close() {
   closed_ = true;
+  engine_.onFrameStart({});
   std::error_code ec;
   socket_.close(ec);
 }
@@ -93,10 +95,11 @@ void CigiServer::next() {
   const cigi::Message& message = std::get<cigi::Message>(decoded);
   // Every message with a valid IG Control is answered with a Start of Frame, whose IG status
   // says what became of it (docs/CIGI.md): a host in synchronous mode never waits in vain.
+  // In asynchronous mode the answer is the next IG frame's Start of Frame (answer()).
   auto mapped = session_.map(message);
   if (auto* r = std::get_if<cigi::Refusal>(&mapped)) {
     refuse(r->reason, r->message, d.from);
-    sendStartOfFrame(r->control, message.order, d.from, r->status);
+    answer(r->control, message.order, d.from, r->status);
     return next();
   }
   cigi::HostFrame& frame = std::get<cigi::HostFrame>(mapped);
@@ -121,11 +124,11 @@ void CigiServer::next() {
       if (error) {
         refuse("refused_by_world", error->message, from);
         session_.forget();
-        sendStartOfFrame(control, order, from, cigi::IgStatus::kWorldRefused);
+        answer(control, order, from, cigi::IgStatus::kWorldRefused);
       } else {
         session_.commit();
         engine_.countCigi("messages");
-        sendStartOfFrame(control, order, from, status);
+        answer(control, order, from, status);
       }
       next();
     });
@@ -133,9 +136,23 @@ void CigiServer::next() {
   if (!engine_.submitBatch(std::move(frame.commands), false, nullptr, done)) {
     busy_ = false;
     refuse("busy", "the daemon's request queue is full", d.from);
-    sendStartOfFrame(control, message.order, d.from, cigi::IgStatus::kBusy);
+    answer(control, message.order, d.from, cigi::IgStatus::kBusy);
     next();
   }
+}
+
+void CigiServer::answer(const cigi::IgControl& control, cigi::ByteOrder order,
+                        const udp::endpoint& from, std::uint8_t status) {
+  if (engine_.lockstep()) return sendStartOfFrame(control, order, from, status);
+  last_handled_ = Handled{control, order, from, status};
+}
+
+// Asynchronous mode: the IG announces each of its frames at its own rate (the world's tick
+// rate), to the host that last sent a frame, reporting the last host frame it handled.
+void CigiServer::igFrame() {
+  if (closed_ || !last_handled_ || engine_.lockstep()) return;
+  sendStartOfFrame(last_handled_->control, last_handled_->order, last_handled_->from,
+                   last_handled_->status);
 }
 
 void CigiServer::sendStartOfFrame(const cigi::IgControl& control, cigi::ByteOrder order,

@@ -235,7 +235,7 @@ void Engine::run(std::promise<std::string>& started) {
 Engine::Clock::time_point Engine::nextWake() const {
   const State& s = *state_;
   Clock::time_point wake = Clock::now() + std::chrono::milliseconds(500);
-  if (s.mode == TickMode::kRealtime && !s.paused) wake = std::min(wake, s.next_tick);
+  if (s.mode == TickMode::kRealtime) wake = std::min(wake, s.next_tick);
   if (s.mode == TickMode::kRealtime)
     for (const Subscription& sub : s.subscriptions) wake = std::min(wake, sub.next_due);
   return wake;
@@ -263,9 +263,14 @@ void Engine::advance(double dt_s) {
   if (s.mode == TickMode::kLockstep) deliverFrames(Delivery::kEveryTick, "");
 }
 
+void Engine::onFrameStart(std::function<void()> started) {
+  std::lock_guard lock(frame_listener_mutex_);
+  frame_listener_ = std::move(started);
+}
+
 void Engine::realtimeTicks() {
   State& s = *state_;
-  if (s.mode != TickMode::kRealtime || s.paused) return;
+  if (s.mode != TickMode::kRealtime) return;
   const auto now = Clock::now();
   if (now < s.next_tick) return;
   const auto period = secondsToDuration(1.0 / config_.tick_rate_hz);
@@ -276,6 +281,12 @@ void Engine::realtimeTicks() {
     s.next_tick = now;
   }
   s.next_tick += period * due;
+  {
+    std::lock_guard lock(frame_listener_mutex_);
+    if (frame_listener_) frame_listener_();
+  }
+  // Paused, the frames go on (a host in asynchronous mode still hears them) but hold time.
+  if (s.paused) return;
   double dt = due * s.time_scale / config_.tick_rate_hz;
   if (checkAdvance(dt)) dt = 0.0;  // too much automaton work for one go: hold time
   for (int i = 0; i < due; ++i) ++s.ticks;

@@ -135,6 +135,10 @@ class Engine {
 
   const DaemonConfig& config() const { return config_; }
   bool lockstep() const { return lockstep_.load(); }  // the clock's mode now (any thread)
+  // Realtime mode: `started` is called on the world thread at the start of each of its frames
+  // (each round of due ticks, at the tick rate, paused or not), before the frame's work: the
+  // CIGI listener's asynchronous Start of Frame (docs/CIGI.md). One listener; any thread.
+  void onFrameStart(std::function<void()> started);
   // Seconds since the world thread last went round its loop (any thread): the health check
   // of /healthz and the systemd watchdog.
   double heartbeatAge() const;
@@ -219,6 +223,8 @@ class Engine {
   // Raised by stop(): the render in hand ends at its next batch boundary (RenderCancelled).
   std::atomic<bool> cancel_renders_{false};
   std::atomic<bool> lockstep_{false};
+  std::mutex frame_listener_mutex_;
+  std::function<void()> frame_listener_;
   // Steady clock, at the top of each loop and wherever a render could be cancelled.
   void beatHeart() { heartbeat_ns_ = Clock::now().time_since_epoch().count(); }
   std::atomic<std::int64_t> heartbeat_ns_{0};

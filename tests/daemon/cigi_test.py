@@ -362,6 +362,61 @@ size = [4, 2, 1]
         self.assertEqual(header["image"]["camera"]["position"][2], 803.0)
         c.ok({"cmd": "unsubscribe", "subscription": sub["subscription"]})
 
+    def test_asynchronous_mode_announces_each_ig_frame_at_its_own_rate(self):
+        """Issue 29, item 3: in asynchronous (realtime) mode the IG sends Start of Frame at the
+        start of each of its own frames, at its rate (tick_rate 30), whatever the host sends;
+        each reports the last host frame handled and what became of it."""
+        d = self.start(mode="realtime")
+        c = d.client()
+        self.no_reply(0.3)  # no host has spoken: there is no one to announce to
+        sofs = []
+
+        def drain():
+            self.host.setblocking(False)
+            try:
+                while True:
+                    data, _ = self.host.recvfrom(65536)
+                    sofs.append((time.monotonic(), decode_sof(data)))
+            except BlockingIOError:
+                pass
+            finally:
+                self.host.setblocking(True)
+                self.host.settimeout(10)
+
+        # A host sending at 200 Hz for a second: the IG still announces about 30 frames a
+        # second, not one per host frame.
+        started = time.monotonic()
+        for n in range(1, 201):
+            self.send(ig_control(n), entity_control(0, SITE[0], SITE[1], 500.0 + n))
+            time.sleep(0.005)
+            drain()
+        while time.monotonic() < started + 1.5:
+            time.sleep(0.02)
+            drain()
+        span = sofs[-1][0] - sofs[0][0]
+        rate = (len(sofs) - 1) / span
+        self.assertGreater(rate, 15, sofs[:5])
+        self.assertLess(rate, 45, sofs[:5])
+        numbers = [sof["ig_frame"] for _, sof in sofs]
+        self.assertEqual(numbers, list(range(numbers[0], numbers[0] + len(numbers))))
+        last = sofs[-1][1]
+        self.assertEqual(last["last_host_frame"], 200)
+        self.assertEqual(last["status"], 0)
+        self.assertEqual(c.ok({"cmd": "get_view", "view": "front"})["position"][2], 700.0)
+        # A host frame with a refused packet: the following frames say so, and name it.
+        self.send(ig_control(201), entity_control(0, SITE[0], SITE[1], 900.0),
+                  weather_control(1, True, 7, coverage=150.0, base=1500.0, thickness=800.0))
+        wait_until(lambda: drain() or (sofs[-1][1]["last_host_frame"] == 201),
+                   "a Start of Frame for host frame 201")
+        self.assertEqual(sofs[-1][1]["status"], 1)
+        self.assertEqual(c.ok({"cmd": "get_view", "view": "front"})["position"][2], 900.0)
+        # Paused, the world holds its time, but its frames go on.
+        c.ok({"cmd": "set_time", "paused": True})
+        count = len(sofs)
+        time.sleep(0.5)
+        drain()
+        self.assertGreater(len(sofs) - count, 5)
+
     def test_little_endian_host(self):
         d = self.start()
         c = d.client()
