@@ -151,6 +151,11 @@ std::vector<Setting> settingsFor(const SceneFile& file) {
   if (!file.scene.clouds.empty() || !file.scene.fields.empty())
     for (double n : {1024.0, 4096.0})
       add("ellipsoid_budget", withKnob(n), [n](RenderSettings& s) { s.ellipsoid_budget = n; });
+  // Its footprint part: the presets' views cover up to 132 views (the default, 256, changes
+  // none of them), so 16 and 64 show what thinning by footprint costs.
+  if (!file.scene.clouds.empty() || !file.scene.fields.empty())
+    for (double v : {16.0, 64.0})
+      add("ellipsoid_overdraw", withKnob(v), [v](RenderSettings& s) { s.ellipsoid_overdraw = v; });
   if (!file.dynamics.automata.empty()) {
     for (double step : {0.5, 2.0, 4.0})
       add("volume_step", withKnob(step), [step](RenderSettings& s) { s.volume_step = step; });

@@ -32,6 +32,7 @@ struct RenderCommandOptions {
   std::optional<double> heap_range;
   std::optional<double> heap_detail;
   std::optional<double> ellipsoid_budget;
+  std::optional<double> ellipsoid_overdraw;
   std::optional<double> volume_step;
   std::optional<int> samples;
   bool stats = false;

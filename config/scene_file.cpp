@@ -90,7 +90,7 @@ void readRender(TableReader& t, SceneFile& out) {
   t.allow({"texture", "term_filter", "sky_passes", "bake_texels_per_cycle", "reference_samples",
            "ellipsoid_passes", "ellipsoid_order", "limb", "tile_resolution", "tile_format",
            "tessellation", "impostor_tolerance", "volume_step", "heap_range", "heap_detail",
-           "ellipsoid_budget"});
+           "ellipsoid_budget", "ellipsoid_overdraw"});
   out.render.texture_evaluation = TextureEvaluation(
       t.choice("texture", kTextureEvaluationNames, int(out.render.texture_evaluation)));
   out.render.term_filter =
@@ -115,6 +115,7 @@ void readRender(TableReader& t, SceneFile& out) {
   t.number("heap_range", r.heaps.range_m, Limits::kHeapRange);
   t.number("heap_detail", r.heaps.detail_px, Limits::kHeapDetail);
   t.number("ellipsoid_budget", r.ellipsoid_budget, Limits::kEllipsoidBudget);
+  t.number("ellipsoid_overdraw", r.ellipsoid_overdraw, Limits::kEllipsoidOverdraw);
   out.reference.heaps = r.heaps;  // both renderers draw the same heaps
   t.finish();
 }
@@ -705,6 +706,9 @@ std::string validateRenderSettings(const RenderSettings& r) {
   if (std::ostringstream out;
       outOfRange(out, "ellipsoid_budget", r.ellipsoid_budget, Limits::kEllipsoidBudget))
     return out.str() + " ellipsoids; 0 draws every one";
+  if (std::ostringstream out;
+      outOfRange(out, "ellipsoid_overdraw", r.ellipsoid_overdraw, Limits::kEllipsoidOverdraw))
+    return out.str() + " views of footprint; 0 is no bound";
   if (!(r.volume_step >= 0.25 && r.volume_step <= 8.0))
     return "volume_step: " + formatNumber(r.volume_step) +
            " is out of range (allowed: 0.25 to 8 lattice spacings)";

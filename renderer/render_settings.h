@@ -63,10 +63,11 @@ struct RenderSettings {
   // (`heap_range`, a far deck beyond) and the projected radius, in pixels, from which every
   // lobe of a heap is drawn (`heap_detail`).
   HeapDrawing heaps{};
-  // The frame's work budget (`ellipsoid_budget`): past this many ellipsoids, only this many of
-  // largest projected size are drawn (withinEllipsoidBudget, world/scene.h); 0 draws every
-  // ellipsoid. The reference has none.
+  // The frame's work budget (withinEllipsoidBudget, world/scene.h; the reference has none): the
+  // ellipsoids of largest projected size are drawn while they number at most `ellipsoid_budget`
+  // and their footprints cover at most `ellipsoid_overdraw` views; 0 turns either off.
   double ellipsoid_budget = 65536.0;
+  double ellipsoid_overdraw = 256.0;
 
   // Automaton clouds: the view march's step in lattice spacings (the lattice holds
   // samples_per_cell samples per cell edge). Larger steps are faster and blur thin edges.

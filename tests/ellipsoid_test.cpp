@@ -59,7 +59,7 @@ TEST(EllipsoidBudget, KeepsTheLargestInViewAndIsDeterministic) {
   };
   scene.clouds = {cloud("far", 10000.0, 50.0, 6), cloud("near", 1000.0, 50.0, 4),
                   cloud("behind", -1000.0, 500.0, 5)};
-  const Scene kept = withinEllipsoidBudget(scene, 7.0);
+  const Scene kept = *withinEllipsoidBudget(scene, 7.0);
   EXPECT_EQ(ellipsoidCount(kept), 7u);
   ASSERT_EQ(kept.clouds.size(), 2u);  // the cloud behind the camera is gone
   EXPECT_EQ(kept.clouds[0].name, "far");
@@ -68,11 +68,50 @@ TEST(EllipsoidBudget, KeepsTheLargestInViewAndIsDeterministic) {
   EXPECT_EQ(kept.clouds[1].name, "near");
   EXPECT_EQ(kept.clouds[1].ellipsoids.size(), 4u);  // every near lobe
   EXPECT_EQ(kept.clouds[1].texture.seed, 7u);
-  EXPECT_EQ(ellipsoidCount(withinEllipsoidBudget(scene, 7.0)), ellipsoidCount(kept));
-  EXPECT_EQ(withinEllipsoidBudget(scene, 7.0).clouds[0].ellipsoids[2].centre,
+  EXPECT_EQ(ellipsoidCount(*withinEllipsoidBudget(scene, 7.0)), ellipsoidCount(kept));
+  EXPECT_EQ(withinEllipsoidBudget(scene, 7.0)->clouds[0].ellipsoids[2].centre,
             kept.clouds[0].ellipsoids[2].centre);
-  EXPECT_EQ(ellipsoidCount(withinEllipsoidBudget(scene, 15.0)), 15u);  // within: unchanged
-  EXPECT_EQ(ellipsoidCount(withinEllipsoidBudget(scene, 0.0)), 15u);   // 0: no budget
+  EXPECT_FALSE(withinEllipsoidBudget(scene, 15.0));  // within: unchanged
+  EXPECT_FALSE(withinEllipsoidBudget(scene, 0.0));   // 0: no budget
+}
+
+// A footprint is the projected bounding square of the largest radius, clipped to the view,
+// in views: restated here for a 90 degree square view, where a sphere of radius r at distance
+// a ahead spans tan = r / sqrt(a^2 - r^2) either side of its centre's image.
+TEST(EllipsoidBudget, FootprintIsTheClippedBoundingSquareInViews) {
+  Camera camera;
+  camera.position = {0.0, 0.0, 0.0};  // heading 0: looking north (+Y)
+  camera.vfov_deg = 90.0;
+  camera.width = camera.height = 100;
+  const ViewBasis basis = viewBasis(camera);
+  auto sphere = [](glm::dvec3 centre, double r) {
+    Ellipsoid e;
+    e.centre = centre;
+    e.radii = {r, 0.5 * r, 0.25 * r};  // the largest radius counts
+    return e;
+  };
+  // Centred: half side 3/4 of the view's half side, so (3/4)^2 of the view.
+  EXPECT_NEAR(ellipsoidFootprint(sphere({0.0, 5.0, 0.0}, 3.0), camera, basis), 0.5625, 1e-12);
+  // Its centre on the right edge: half of that square is inside.
+  EXPECT_NEAR(ellipsoidFootprint(sphere({5.0, 5.0, 0.0}, 3.0), camera, basis), 0.28125, 1e-12);
+  EXPECT_EQ(ellipsoidFootprint(sphere({0.0, 2.0, 0.0}, 3.0), camera, basis), 1.0);   // at the eye
+  EXPECT_EQ(ellipsoidFootprint(sphere({0.0, -9.0, 0.0}, 3.0), camera, basis), 0.0);  // behind
+  EXPECT_EQ(ellipsoidFootprint(sphere({50.0, 5.0, 0.0}, 3.0), camera, basis), 0.0);  // beside
+
+  // The overdraw budget takes the largest first while their footprints fit: ten such lobes of
+  // 0.5625 views each, the nearest slightly larger, within 2 views keep the three nearest.
+  Scene scene;
+  scene.camera = camera;
+  EllipsoidCloud cloud;
+  for (int i = 0; i < 10; ++i) cloud.ellipsoids.push_back(sphere({0.0, 5.0 + 1e-3 * i, 0.0}, 3.0));
+  scene.clouds = {cloud};
+  const std::optional<Scene> kept = withinEllipsoidBudget(scene, 0.0, 2.0);
+  ASSERT_TRUE(kept);
+  ASSERT_EQ(ellipsoidCount(*kept), 3u);
+  for (int i = 0; i < 3; ++i)
+    EXPECT_EQ(kept->clouds[0].ellipsoids[i].centre, cloud.ellipsoids[i].centre);
+  EXPECT_FALSE(withinEllipsoidBudget(scene, 0.0, 6.0));                    // 5.6 views: within
+  EXPECT_EQ(ellipsoidCount(*withinEllipsoidBudget(scene, 0.0, 0.1)), 1u);  // the largest always
 }
 
 TEST(Ellipsoid, SymmetricEigenReconstructs) {

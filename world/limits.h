@@ -102,6 +102,9 @@ struct Limits {
   // Ellipsoids a GL frame draws, those of largest projected size (`ellipsoid_budget`; 0: no
   // budget), at most what a world may hold.
   static constexpr Range kEllipsoidBudget{0.0, double(kMaxWorldEllipsoids)};
+  // Views that the footprints of the ellipsoids a frame draws may cover (`ellipsoid_overdraw`;
+  // 0: no bound).
+  static constexpr Range kEllipsoidOverdraw{0.0, 65536.0};
 
   // Datasets (dataset/dataset.h).
   static constexpr int kMaxSamples = 100000000;

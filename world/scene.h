@@ -88,11 +88,19 @@ inline bool sceneHasAir(const Scene& scene) {
 // (MODEL.md sections 10 and 11); what every renderer draws.
 Scene withFieldClouds(const Scene& scene, const HeapDrawing& drawing = {});
 
-// A frame's work budget (issue 31): when the clouds of `scene` hold more than `budget`
-// ellipsoids, only the `budget` of largest projected size (largest radius over distance along
-// the view; ties by cloud and lobe order; behind the camera, none) are kept, and the clouds
-// thinned share one texture seed. Counted in ellipsoids, not time, so equal frames stay
-// equal. 0: no budget.
-Scene withinEllipsoidBudget(const Scene& scene, double budget);
+// A frame's work budget (issue 31; MODEL.md section 15), in two parts, both counted in
+// geometry, never in time, so that equal frames stay equal (0 turns a part off):
+// - `budget`: at most this many ellipsoids;
+// - `overdraw`: their footprints (each one's projected bounding square, clipped to the view;
+//   the whole view for one that reaches the eye) cover at most this many views, the cost of the
+//   per-pixel pass, which tests every ellipsoid listed over a pixel.
+// Ellipsoids are taken in order of projected size (largest radius over distance along the
+// view; ties by cloud and lobe order; behind the camera, none) while both hold, the rest
+// dropped, and the clouds thinned share one texture seed. Nothing when the scene is within both.
+std::optional<Scene> withinEllipsoidBudget(const Scene& scene, double budget,
+                                           double overdraw = 0.0);
+// The footprint of `e` in views of `camera` (the projected bounding square of its largest
+// radius, clipped to the view; 1 when it reaches the eye's plane; 0 behind or outside).
+double ellipsoidFootprint(const Ellipsoid& e, const Camera& camera, const ViewBasis& basis);
 
 }  // namespace nephele

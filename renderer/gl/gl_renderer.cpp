@@ -546,12 +546,12 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
   // Fields of heaps become the clouds around this camera (MODEL.md section 10).
   if (!scene.fields.empty())
     return drawFrame(withFieldClouds(scene, settings.heaps), settings, format);
-  // The work budget, counted in ellipsoids (issue 31, item 1).
-  if (settings.ellipsoid_budget > 0.0 &&
-      double(ellipsoidCount(scene)) > settings.ellipsoid_budget) {
+  // The work budget, counted in ellipsoids and in views of their footprints (issue 31).
+  if (auto within =
+          withinEllipsoidBudget(scene, settings.ellipsoid_budget, settings.ellipsoid_overdraw)) {
     RenderSettings rest = settings;  // the thinned scene is within it
-    rest.ellipsoid_budget = 0.0;
-    return drawFrame(withinEllipsoidBudget(scene, settings.ellipsoid_budget), rest, format);
+    rest.ellipsoid_budget = rest.ellipsoid_overdraw = 0.0;
+    return drawFrame(*within, rest, format);
   }
   const Camera& camera = scene.camera;
   prepareTarget(camera.width, camera.height, format);

@@ -716,33 +716,64 @@ CloudLayer farDeck(const CloudField& f, double range, glm::dvec3 to_sun) {
 
 }  // namespace
 
-Scene withinEllipsoidBudget(const Scene& scene, double budget) {
+double ellipsoidFootprint(const Ellipsoid& e, const Camera& camera, const ViewBasis& basis) {
+  const double reach = std::max({e.radii.x, e.radii.y, e.radii.z});
+  const glm::dvec3 to = e.centre - camera.position;
+  const double ahead = glm::dot(to, basis.forward);
+  if (ahead < -reach) return 0.0;
+  if (ahead <= reach) return 1.0;  // its bounding sphere reaches the eye's plane
+  // The sphere's outline on the image plane at unit distance: centre (x, y), angular radius
+  // tan = reach / sqrt(ahead^2 - reach^2); the view spans [-w, w] x [-h, h] there.
+  const double h = basis.tan_half_vfov, w = h * basis.aspect;
+  const double x = glm::dot(to, basis.right) / ahead, y = glm::dot(to, basis.up) / ahead;
+  const double r = reach / std::sqrt(ahead * ahead - reach * reach);
+  const double across = std::max(0.0, std::min(x + r, w) - std::max(x - r, -w));
+  const double down = std::max(0.0, std::min(y + r, h) - std::max(y - r, -h));
+  return across * down / (4.0 * w * h);
+}
+
+std::optional<Scene> withinEllipsoidBudget(const Scene& scene, double budget, double overdraw) {
   const std::size_t total = ellipsoidCount(scene);
-  if (!(budget > 0.0) || double(total) <= budget) return scene;
-  // Every ellipsoid's projected size: its largest radius over its distance along the view
-  // (behind the camera: none); the `budget` largest are kept, ties by cloud and lobe order.
+  const bool counted = budget > 0.0 && double(total) > budget;
+  if (!counted && !(overdraw > 0.0)) return std::nullopt;
+  // Every ellipsoid's projected size (its largest radius over its distance along the view;
+  // behind the camera, none) and footprint.
   const ViewBasis basis = viewBasis(scene.camera);
   struct Size {
-    double size;
+    double size, footprint;
     std::uint32_t cloud, lobe;
   };
   std::vector<Size> sizes;
   sizes.reserve(total);
+  double footprint = 0.0;
   for (std::size_t c = 0; c < scene.clouds.size(); ++c) {
     const std::vector<Ellipsoid>& lobes = scene.clouds[c].ellipsoids;
     for (std::size_t i = 0; i < lobes.size(); ++i) {
       const double reach = std::max({lobes[i].radii.x, lobes[i].radii.y, lobes[i].radii.z});
       const double ahead = glm::dot(lobes[i].centre - scene.camera.position, basis.forward);
-      sizes.push_back({ahead < -reach ? 0.0 : reach / std::max(ahead, reach), std::uint32_t(c),
+      const double f = ellipsoidFootprint(lobes[i], scene.camera, basis);
+      footprint += f;
+      sizes.push_back({ahead < -reach ? 0.0 : reach / std::max(ahead, reach), f, std::uint32_t(c),
                        std::uint32_t(i)});
     }
   }
+  const bool covered = overdraw > 0.0 && footprint > overdraw;
+  if (!counted && !covered) return std::nullopt;
   const auto larger = [](const Size& a, const Size& b) {
     if (a.size != b.size) return a.size > b.size;
     return a.cloud != b.cloud ? a.cloud < b.cloud : a.lobe < b.lobe;
   };
-  const std::size_t keep = std::size_t(budget);
-  std::nth_element(sizes.begin(), sizes.begin() + std::ptrdiff_t(keep), sizes.end(), larger);
+  std::size_t keep = counted ? std::size_t(budget) : total;
+  if (keep < total)
+    std::nth_element(sizes.begin(), sizes.begin() + std::ptrdiff_t(keep), sizes.end(), larger);
+  if (covered) {  // the largest first while their footprints fit (the largest always)
+    std::sort(sizes.begin(), sizes.begin() + std::ptrdiff_t(keep), larger);
+    double sum = 0.0;
+    std::size_t fit = 0;
+    while (fit < keep && (fit == 0 || sum + sizes[fit].footprint <= overdraw))
+      sum += sizes[fit++].footprint;
+    keep = fit;
+  }
   std::vector<std::vector<char>> kept(scene.clouds.size());
   for (std::size_t c = 0; c < scene.clouds.size(); ++c)
     kept[c].assign(scene.clouds[c].ellipsoids.size(), 0);
