@@ -254,7 +254,10 @@ std::string writeHostConfig(const std::filesystem::path& dir, int host_port,
     out << "[[view]]\nname = \"" << name << "\"\nheading = " << heading
         << "\nwidth = 640\nheight = 480\nformat = \"raw\"\n";
   out << "[socket]\nport = 0\n[modbus]\nenabled = false\n"
-      << "[cigi]\nenabled = true\nig_port = 0\nhost_port = " << host_port << "\n"
+      << "[cigi]\nenabled = true\nig_port = 0\nhost_port = " << host_port
+      << "\n"
+      // The database origin at 0 N 0 E, by which the host frames place the ownship (hostFrame).
+      << "[site]\nlatitude = 0\nlongitude = 0\n"
       << "[output]\ndirectory = \"" << (dir / "frames").string() << "\"\n";
   return path;
 }
@@ -286,7 +289,8 @@ int hostSocket(sockaddr_in& host) {
   return udp;
 }
 
-// Host frame `n`: IG Control and the ownship at 1500 + n m.
+// Host frame `n`: IG Control and the ownship 4.5 km south of the database origin (0 N 0 E) at
+// 300 + n m, where the views look north at the scenes' clouds (cumulus.toml's camera).
 std::vector<std::uint8_t> hostFrame(int n) {
   std::vector<std::uint8_t> message;
   nephele::cigi::IgControl igc;
@@ -294,7 +298,8 @@ std::vector<std::uint8_t> hostFrame(int n) {
   igc.timestamp = std::uint32_t(1667 * n);
   igc.timestamp_valid = true;
   nephele::cigi::EntityControl ownship;
-  ownship.altitude = 1500.0 + n;  // moves every frame
+  ownship.latitude = -4500.0 / 111320.0;
+  ownship.altitude = 300.0 + n;  // moves every frame
   nephele::cigi::encode(igc, nephele::cigi::ByteOrder::kBig, message);
   nephele::cigi::encode(ownship, nephele::cigi::ByteOrder::kBig, message);
   return message;
@@ -401,7 +406,7 @@ void asynchronousHostFrames(const std::filesystem::path& dir, int views, int rep
     for (int got = 0; got < views;) {
       const json event = sub.receive(body);
       if (event.value("event", "") == "frame" &&
-          event["image"]["camera"]["position"][2].get<double>() == 1500.0 + n)
+          event["image"]["camera"]["position"][2].get<double>() == 300.0 + n)
         ++got;
     }
     if (n > 3) {
