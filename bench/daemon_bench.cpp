@@ -256,7 +256,7 @@ std::string writeHostConfig(const std::filesystem::path& dir, int host_port,
   out << "[socket]\nport = 0\n[modbus]\nenabled = false\n"
       << "[cigi]\nenabled = true\nig_port = 0\nhost_port = " << host_port
       << "\n"
-      // The database origin at 0 N 0 E, by which the host frames place the ownship (hostFrame).
+      // The database origin (the default) stated: the host frames place the ownship by it.
       << "[site]\nlatitude = 0\nlongitude = 0\n"
       << "[output]\ndirectory = \"" << (dir / "frames").string() << "\"\n";
   return path;
