@@ -235,9 +235,10 @@ void Engine::run(std::promise<std::string>& started) {
 Engine::Clock::time_point Engine::nextWake() const {
   const State& s = *state_;
   Clock::time_point wake = Clock::now() + std::chrono::milliseconds(500);
-  if (s.mode == TickMode::kRealtime) wake = std::min(wake, s.next_tick);
-  if (s.mode == TickMode::kRealtime)
+  if (s.mode == TickMode::kRealtime) {
+    wake = std::min(wake, s.next_tick);  // the IG's frames go on while paused
     for (const Subscription& sub : s.subscriptions) wake = std::min(wake, sub.next_due);
+  }
   return wake;
 }
 

@@ -611,10 +611,11 @@ class LockstepAndSnapshotTest(DaemonTest):
         # of the camera; 25 took 26 s at 64x48 when the issue was filed) cancels it at its next
         # band or batch: its client is answered "shutting down", the snapshot is saved, and the
         # daemon exits 0 within 5 s.
-        # The work budget would bound this render (ellipsoid_budget): the scene turns it off.
+        # The work budget would bound this render (ellipsoid_budget, ellipsoid_overdraw): the
+        # scene turns it off.
         scene = os.path.join(self.tmp.name, "unbudgeted.toml")
         with open(SCENE) as f, open(scene, "w") as out:
-            out.write(f.read() + "\n[render]\nellipsoid_budget = 0\n")
+            out.write(f.read() + "\n[render]\nellipsoid_budget = 0\nellipsoid_overdraw = 0\n")
         d = self.daemon(name="t", extra='[snapshot]\npath = "{snapshot}"\ninterval = 0',
                         scene=scene)
         c = d.client()
