@@ -168,6 +168,23 @@ void layout(C& c, WeatherControl& p) {
 }
 
 template <class C>
+void layout(C& c, EnvironmentalRegionControl& p) {
+  c.number(2, p.region_id);
+  c.bits(4, 0, 2, p.state);
+  c.bits(4, 2, 1, p.merge_weather);
+  c.bits(4, 3, 1, p.merge_aerosol);
+  c.bits(4, 4, 1, p.merge_maritime);
+  c.bits(4, 5, 1, p.merge_terrestrial);
+  c.number(8, p.latitude);
+  c.number(16, p.longitude);
+  c.number(24, p.size_x);
+  c.number(28, p.size_y);
+  c.number(32, p.corner_radius);
+  c.number(36, p.rotation);
+  c.number(40, p.transition_perimeter);
+}
+
+template <class C>
 void layout(C& c, AtmosphereControl& p) {
   c.bits(2, 0, 1, p.model_enabled);
   c.number(3, p.humidity);
@@ -215,6 +232,10 @@ constexpr Kind kindOf(const ViewDefinition&) {
 constexpr Kind kindOf(const WeatherControl&) {
   return {Id::kWeatherControl, Size::kWeatherControl, "Weather Control"};
 }
+constexpr Kind kindOf(const EnvironmentalRegionControl&) {
+  return {Id::kEnvironmentalRegionControl, Size::kEnvironmentalRegionControl,
+          "Environmental Region Control"};
+}
 constexpr Kind kindOf(const AtmosphereControl&) {
   return {Id::kAtmosphereControl, Size::kAtmosphereControl, "Atmosphere Control"};
 }
@@ -225,8 +246,9 @@ constexpr Kind kindOf(const CelestialSphereControl&) {
 // The packet types decoded into fields; any other is kept as an OtherPacket.
 template <class... T>
 struct PacketTypes {};
-using Decoded = PacketTypes<IgControl, StartOfFrame, EntityControl, ViewControl, ViewDefinition,
-                            WeatherControl, AtmosphereControl, CelestialSphereControl>;
+using Decoded =
+    PacketTypes<IgControl, StartOfFrame, EntityControl, ViewControl, ViewDefinition, WeatherControl,
+                EnvironmentalRegionControl, AtmosphereControl, CelestialSphereControl>;
 
 template <class T>
 Packet read(const std::uint8_t* p, ByteOrder order) {

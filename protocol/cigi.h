@@ -22,18 +22,21 @@ inline constexpr std::size_t kPacketAlign = 8;  // every CIGI 3 packet size is a
 // Packet identifiers and sizes in bytes.
 struct Id {
   static constexpr std::uint8_t kIgControl = 1, kEntityControl = 2, kCelestialSphereControl = 9,
-                                kAtmosphereControl = 10, kWeatherControl = 12, kViewControl = 16,
-                                kViewDefinition = 21, kStartOfFrame = 101;
+                                kAtmosphereControl = 10, kEnvironmentalRegionControl = 11,
+                                kWeatherControl = 12, kViewControl = 16, kViewDefinition = 21,
+                                kStartOfFrame = 101;
 };
 struct Size {
   static constexpr std::uint8_t kIgControl = 24, kEntityControl = 48, kCelestialSphereControl = 16,
-                                kAtmosphereControl = 32, kWeatherControl = 56, kViewControl = 32,
-                                kViewDefinition = 32, kStartOfFrame = 24;
+                                kAtmosphereControl = 32, kEnvironmentalRegionControl = 48,
+                                kWeatherControl = 56, kViewControl = 32, kViewDefinition = 32,
+                                kStartOfFrame = 24;
 };
 
 enum class IgMode : std::uint8_t { kStandby = 0, kOperate = 1, kDebug = 2 };
 enum class EntityState : std::uint8_t { kInactive = 0, kActive = 1, kDestroyed = 2 };
 enum class WeatherScope : std::uint8_t { kGlobal = 0, kRegional = 1, kEntity = 2 };
+enum class RegionState : std::uint8_t { kInactive = 0, kActive = 1, kDestroyed = 2 };
 // Weather Control layer identifiers.
 struct Layer {
   static constexpr std::uint8_t kGroundFog = 0, kCloud1 = 1, kCloud3 = 3, kRain = 4, kSnow = 5,
@@ -90,6 +93,19 @@ struct ViewDefinition {
   float near_m = 0, far_m = 0;
   float left = 0, right = 0, top = 0, bottom = 0;  // degrees from the view's axis
   bool operator==(const ViewDefinition&) const = default;
+};
+
+// A rectangle on the Earth that regional weather applies to: its centre, its extents along its
+// own X axis (turned `rotation` degrees clockwise from true north) and Y axis, and the band
+// outside it over which its weather blends into the global weather.
+struct EnvironmentalRegionControl {
+  std::uint16_t region_id = 0;
+  RegionState state = RegionState::kInactive;
+  bool merge_weather = false, merge_aerosol = false, merge_maritime = false,
+       merge_terrestrial = false;
+  double latitude = 0, longitude = 0;
+  float size_x = 0, size_y = 0, corner_radius = 0, rotation = 0, transition_perimeter = 0;
+  bool operator==(const EnvironmentalRegionControl&) const = default;
 };
 
 struct WeatherControl {
@@ -155,7 +171,8 @@ struct OtherPacket {
 };
 
 using Packet = std::variant<IgControl, EntityControl, ViewControl, ViewDefinition, WeatherControl,
-                            AtmosphereControl, CelestialSphereControl, StartOfFrame, OtherPacket>;
+                            EnvironmentalRegionControl, AtmosphereControl, CelestialSphereControl,
+                            StartOfFrame, OtherPacket>;
 
 enum class ByteOrder { kBig, kLittle };
 

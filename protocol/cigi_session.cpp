@@ -49,6 +49,72 @@ bool sameFog(const WeatherControl& a, const WeatherControl& b) {
          a.visibility == b.visibility;
 }
 
+// A Weather Control cloud layer (1 to 3) as the layer it draws, or what is wrong with it
+// (everywhere: the caller sets a regional layer's region).
+std::variant<WeatherLayer, std::string> cloudLayerOf(const WeatherControl& w) {
+  WeatherLayer layer;
+  const std::optional<CloudType> type = cloudTypeFromCode(w.cloud_type);
+  if (w.enabled && !type)
+    return "cloud type " + std::to_string(w.cloud_type) + " (allowed: " + cloudTypeCodesAllowed() +
+           ")";
+  layer.type = w.enabled ? *type : CloudType::kNone;
+  layer.base_m = w.base;
+  layer.thickness_m = w.thickness;
+  layer.coverage = w.coverage / 100.0;
+  if (!w.enabled) {  // removes the layer: its other fields need not be in range
+    layer.base_m = std::clamp(layer.base_m, 0.0, Limits::kMaxBase);
+    layer.thickness_m = std::clamp(layer.thickness_m, Limits::kThickness.lo, Limits::kThickness.hi);
+    layer.coverage = std::clamp(layer.coverage, 0.0, 1.0);
+    return layer;
+  }
+  if (!(layer.base_m >= 0.0 && layer.base_m <= Limits::kMaxBase) ||
+      !Limits::kThickness.contains(layer.thickness_m) ||
+      !Limits::kCoveragePercent.contains(w.coverage) ||
+      !(w.wind_speed >= 0.0 && w.wind_speed <= Limits::kMaxWind))
+    return "base " + text(w.base) + ", thickness " + text(w.thickness) + ", coverage " +
+           text(w.coverage) + ", wind " + text(w.wind_speed) + " (allowed: base 0 to " +
+           text(Limits::kMaxBase) + " m, thickness " + text(Limits::kThickness.lo) + " to " +
+           text(Limits::kThickness.hi) + " m, coverage 0 to 100 %, wind 0 to " +
+           text(Limits::kMaxWind) + " m/s)";
+  layer.wind = windVelocity(w.wind_speed, w.wind_direction);
+  if (std::string e = weatherLayerError(layer); !e.empty()) return e;
+  return layer;
+}
+
+// An active Environmental Region as the region of a weather layer (world/formations/region.h):
+// its X axis (along `rotation`, clockwise from north) is the region's y axis, and CIGI's
+// transition perimeter, outside the rectangle, becomes the band the cover fades over, so the
+// rectangle grows by it on every side and the region's weather is whole inside it.
+Region regionOf(const EnvironmentalRegionControl& e, const LocalFrame& database) {
+  Region r;
+  const glm::dvec3 centre = database.toLocal({e.latitude, e.longitude, 0.0});
+  r.centre = {centre.x, centre.y};
+  const double band = e.transition_perimeter;
+  r.half_size = 0.5 * glm::dvec2(e.size_y, e.size_x) + band;
+  r.heading_deg = e.rotation;
+  r.edge_m = band;
+  return r;
+}
+
+// What is wrong with an Environmental Region Control making its region active, or empty.
+std::string regionControlError(const EnvironmentalRegionControl& e) {
+  if (!finite({e.latitude, e.longitude, e.size_x, e.size_y, e.rotation, e.transition_perimeter,
+               e.corner_radius}))
+    return "a field is not a finite number";
+  const Range size = Limits::kRegionSize, band = Limits::kRegionBand;
+  if (std::abs(e.latitude) > 90.0 || std::abs(e.longitude) > 180.0 || !size.contains(e.size_x) ||
+      !size.contains(e.size_y) || !band.contains(e.transition_perimeter) ||
+      std::abs(e.rotation) > Limits::kMaxHeading)
+    return "latitude " + text(e.latitude) + ", longitude " + text(e.longitude) + ", size " +
+           text(e.size_x) + " x " + text(e.size_y) + ", rotation " + text(e.rotation) +
+           ", transition perimeter " + text(e.transition_perimeter) +
+           " (allowed: latitude -90 to 90, longitude -180 to 180, sizes " + text(size.lo) + " to " +
+           text(size.hi) + " m, rotation -" + text(Limits::kMaxHeading) + " to " +
+           text(Limits::kMaxHeading) + " degrees, transition perimeter " + text(band.lo) + " to " +
+           text(band.hi) + " m)";
+  return "";
+}
+
 // The UTC moment of a Celestial Sphere Control (date MMDDYYYY, hour, minute).
 CivilTime civilTimeOf(const CelestialSphereControl& c) {
   CivilTime t;
@@ -211,21 +277,32 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
       s.views[d->view_id].definition = *d;
       views_moved = true;
     } else if (const auto* w = std::get_if<WeatherControl>(&packet)) {
-      const std::string where = "Weather Control layer " + std::to_string(w->layer);
-      if (w->scope != WeatherScope::kGlobal) {
-        frame.ignored.push_back(where +
-                                ": regional and entity scope (only global weather is drawn)");
+      const bool regional = w->scope == WeatherScope::kRegional;
+      const std::string where =
+          "Weather Control layer " + std::to_string(w->layer) +
+          (regional ? " of region " + std::to_string(w->entity_region_id) : std::string());
+      if (w->scope == WeatherScope::kEntity) {
+        frame.ignored.push_back(where + ": entity scope (global and regional weather are drawn)");
         continue;
       }
       if (w->layer > Layer::kCloud3) {
         frame.ignored.push_back(where + ": precipitation and obscurants are not drawn");
         continue;
       }
-      const auto last = s.weather.find(w->layer);
       const bool fog = w->layer == Layer::kGroundFog;
-      if (last != s.weather.end() &&
-          (fog ? sameFog(last->second, *w) : sameCloudLayer(last->second, *w)))
+      if (fog && regional) {
+        frame.ignored.push_back(where + ": ground fog is global only");
         continue;
+      }
+      const RegionalKey key{w->entity_region_id, w->layer};
+      const WeatherControl* last = nullptr;
+      if (regional) {
+        if (auto found = s.regional_weather.find(key); found != s.regional_weather.end())
+          last = &found->second;
+      } else if (auto found = s.weather.find(w->layer); found != s.weather.end()) {
+        last = &found->second;
+      }
+      if (last && (fog ? sameFog(*last, *w) : sameCloudLayer(*last, *w))) continue;
       if (!finite({w->base, w->thickness, w->coverage, w->visibility, w->wind_speed,
                    w->wind_direction})) {
         bad(where + ": a field is not a finite number");
@@ -248,49 +325,74 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
           c.visibility = w->visibility;
         }
         frame.commands.emplace_back(c);
-      } else {
-        command::SetWeather c;
-        c.layer = w->layer;
-        WeatherLayer& layer = c.weather;
-        const std::optional<CloudType> type = cloudTypeFromCode(w->cloud_type);
-        if (w->enabled && !type) {
-          bad(where + ": cloud type " + std::to_string(w->cloud_type) +
-              " (allowed: " + cloudTypeCodesAllowed() + ")");
+        s.weather[w->layer] = *w;
+        continue;
+      }
+      auto layer = cloudLayerOf(*w);
+      if (const auto* e = std::get_if<std::string>(&layer)) {
+        bad(where + ": " + *e);
+        continue;
+      }
+      if (w->scud) frame.ignored.push_back(where + ": scud");
+      if (w->transition_band != 0.0f) frame.ignored.push_back(where + ": transition band");
+      if (w->visibility != 0.0f) frame.ignored.push_back(where + ": visibility in the layer");
+      if (!regional) {
+        frame.commands.emplace_back(
+            command::SetWeather{w->layer, std::get<WeatherLayer>(layer), std::nullopt});
+        s.weather[w->layer] = *w;
+        continue;
+      }
+      // A region's layer is drawn while its region is active (Environmental Region Control),
+      // and kept until then.
+      s.regional_weather[key] = *w;
+      const auto region = s.regions.find(w->entity_region_id);
+      if (region == s.regions.end()) {
+        frame.ignored.push_back(where + ": no Environmental Region Control has made region " +
+                                std::to_string(w->entity_region_id) +
+                                " active yet (drawn once one does)");
+        continue;
+      }
+      WeatherLayer& drawn = std::get<WeatherLayer>(layer);
+      drawn.region = regionOf(region->second, database_);
+      frame.commands.emplace_back(command::SetWeather{w->layer, drawn, w->entity_region_id});
+    } else if (const auto* e = std::get_if<EnvironmentalRegionControl>(&packet)) {
+      const std::uint16_t id = e->region_id;
+      const std::string where = "Environmental Region Control " + std::to_string(id);
+      const auto last = s.regions.find(id);
+      const bool active = e->state == RegionState::kActive;
+      if (active && last != s.regions.end() && last->second == *e) continue;
+      if (!active && last == s.regions.end() && e->state != RegionState::kDestroyed) continue;
+      if (active) {
+        std::string error = regionControlError(*e);
+        if (error.empty()) error = regionError(regionOf(*e, database_));
+        if (!error.empty()) {
+          bad(where + ": " + error);
           continue;
         }
-        layer.type = w->enabled ? *type : CloudType::kNone;
-        layer.base_m = w->base;
-        layer.thickness_m = w->thickness;
-        layer.coverage = w->coverage / 100.0;
-        if (w->enabled) {
-          if (!(layer.base_m >= 0.0 && layer.base_m <= Limits::kMaxBase) ||
-              !Limits::kThickness.contains(layer.thickness_m) ||
-              !Limits::kCoveragePercent.contains(w->coverage) ||
-              !(w->wind_speed >= 0.0 && w->wind_speed <= Limits::kMaxWind)) {
-            bad(where + ": base " + text(w->base) + ", thickness " + text(w->thickness) +
-                ", coverage " + text(w->coverage) + ", wind " + text(w->wind_speed) +
-                " (allowed: base 0 to " + text(Limits::kMaxBase) + " m, thickness " +
-                text(Limits::kThickness.lo) + " to " + text(Limits::kThickness.hi) +
-                " m, coverage 0 to 100 %, wind 0 to " + text(Limits::kMaxWind) + " m/s)");
-            continue;
-          }
-          layer.wind = windVelocity(w->wind_speed, w->wind_direction);
-          if (std::string e = weatherLayerError(layer); !e.empty()) {
-            bad(where + ": " + e);
-            continue;
-          }
-        } else {
-          layer.base_m = std::clamp(layer.base_m, 0.0, Limits::kMaxBase);
-          layer.thickness_m =
-              std::clamp(layer.thickness_m, Limits::kThickness.lo, Limits::kThickness.hi);
-          layer.coverage = std::clamp(layer.coverage, 0.0, 1.0);
+        if (e->corner_radius != 0.0f)
+          frame.ignored.push_back(where + ": corner radius (the corners are drawn square)");
+        if (e->merge_weather)
+          frame.ignored.push_back(where +
+                                  ": merging (the region's layers are drawn over the "
+                                  "global ones, not blended with them)");
+        s.regions[id] = *e;
+      } else {
+        s.regions.erase(id);
+      }
+      // Its layers follow it: drawn in its new place, or removed (inactive, destroyed).
+      for (auto it = s.regional_weather.begin(); it != s.regional_weather.end();) {
+        if (it->first.region != id) {
+          ++it;
+          continue;
+        }
+        command::SetWeather c{it->first.layer, {}, id};
+        if (active) {
+          c.weather = std::get<WeatherLayer>(cloudLayerOf(it->second));  // checked when stored
+          c.weather.region = regionOf(*e, database_);
         }
         frame.commands.emplace_back(c);
-        if (w->scud) frame.ignored.push_back(where + ": scud");
-        if (w->transition_band != 0.0f) frame.ignored.push_back(where + ": transition band");
-        if (w->visibility != 0.0f) frame.ignored.push_back(where + ": visibility in the layer");
+        it = e->state == RegionState::kDestroyed ? s.regional_weather.erase(it) : std::next(it);
       }
-      s.weather[w->layer] = *w;
     } else if (const auto* a = std::get_if<AtmosphereControl>(&packet)) {
       // The wind and the global visibility apply on their own: a bad one is refused alone,
       // and what was applied is what the next packet is compared with.

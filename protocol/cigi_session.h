@@ -81,6 +81,11 @@ class Session {
     EntityControl packet;
     bool target = false;  // in the world as a target (not the ownship)
   };
+  struct RegionalKey {
+    std::uint16_t region = 0;
+    std::uint8_t layer = 0;
+    auto operator<=>(const RegionalKey&) const = default;
+  };
   struct ViewState {
     std::optional<ViewControl> control;
     std::optional<ViewDefinition> definition;
@@ -93,7 +98,11 @@ class Session {
     std::optional<std::uint32_t> last_timestamp;
     std::map<std::uint16_t, Entity> entities;
     std::map<std::uint16_t, ViewState> views;
-    std::map<std::uint8_t, WeatherControl> weather;  // by layer, as last applied
+    std::map<std::uint8_t, WeatherControl> weather;  // global, by layer, as last applied
+    // Regional weather (Weather Control of regional scope), by region and layer, as last
+    // accepted, and the active regions it is drawn in (Environmental Region Control).
+    std::map<RegionalKey, WeatherControl> regional_weather;
+    std::map<std::uint16_t, EnvironmentalRegionControl> regions;
     std::optional<AtmosphereControl> atmosphere;
     std::optional<CelestialSphereControl> celestial;
     std::optional<glm::dvec2> sun_place;  // latitude, longitude the sun was last placed for

@@ -102,6 +102,9 @@ struct SetView {
 struct SetWeather {
   int layer = 1;  // 1 to kWeatherLayers
   WeatherLayer weather;
+  // A CIGI Environmental Region's layer (0 to 65535), drawn beside the global layer of the
+  // same number; unset: the global layer. Set by the CIGI session, not read from the socket.
+  std::optional<int> region;
 };
 struct SetWind {
   glm::dvec2 velocity{0.0};  // east, north m/s, at every altitude

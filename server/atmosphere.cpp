@@ -1,6 +1,7 @@
 #include <spdlog/spdlog.h>
 
 #include "server/engine_state.h"
+#include "world/counter_random.h"
 #include "world/formations/weather.h"
 
 // Weather and atmosphere at run time: weather layers onto formations (MODEL.md section 10),
@@ -23,13 +24,17 @@ void setWindSample(WindProfile& profile, double altitude, glm::dvec2 velocity) {
 
 }  // namespace
 
-std::optional<ProtocolError> Engine::setWeather(int layer, const WeatherLayer& weather) {
+std::optional<ProtocolError> Engine::setWeather(int layer, const WeatherLayer& weather,
+                                                std::optional<int> region) {
   State& s = *state_;
   // The daemon's own names hold a '/', which no user name may (world/limits.h): set_weather
-  // replaces exactly what it made before.
-  const std::string prefix = "weather/" + std::to_string(layer);
-  const WeatherClouds add =
-      weatherClouds(weather, prefix, weatherSeed(config_.scene.scene.seed, layer));
+  // replaces exactly what it made before. A region's layers are its own, and seeded apart.
+  const std::string prefix =
+      (region ? "weather/region" + std::to_string(*region) + "/" : std::string("weather/")) +
+      std::to_string(layer);
+  std::uint64_t seed = weatherSeed(config_.scene.scene.seed, layer);
+  if (region) seed = hashCounters(seed, 0x526567696f6eull, std::uint64_t(*region));
+  const WeatherClouds add = weatherClouds(weather, prefix, seed);
   std::string error = s.world->edit([&](Scene& now, WorldDynamics& d) -> std::string {
     auto made = [&](const std::string& name) {
       return name == prefix || name.rfind(prefix + "/", 0) == 0;
@@ -46,12 +51,12 @@ std::optional<ProtocolError> Engine::setWeather(int layer, const WeatherLayer& w
     return "";
   });
   if (!error.empty()) return ProtocolError{ErrorCode::kFailed, error};
-  s.weather[std::size_t(layer - 1)] = weather;
+  if (!region) s.weather[std::size_t(layer - 1)] = weather;  // what a host reads back
   spdlog::info(
-      "event=weather layer={} type={} base={} thickness={} coverage={:.2f} planes={} "
+      "event=weather layer={} region={} type={} base={} thickness={} coverage={:.2f} planes={} "
       "fields={}",
-      layer, cloudTypeName(weather.type), weather.base_m, weather.thickness_m, weather.coverage,
-      add.layers.size(), add.fields.size());
+      layer, region ? std::to_string(*region) : "global", cloudTypeName(weather.type),
+      weather.base_m, weather.thickness_m, weather.coverage, add.layers.size(), add.fields.size());
   return std::nullopt;
 }
 

@@ -93,12 +93,14 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
         return viewJson(*v);
       },
       [&](const SetWeather& c) -> std::optional<Outcome> {
-        if (auto error = setWeather(c.layer, c.weather)) return *error;
-        return json{{"layer", c.layer},
-                    {"type", cloudTypeName(c.weather.type)},
-                    {"layers", world.base().layers.size()},
-                    {"clouds", world.base().clouds.size()},
-                    {"fields", world.base().fields.size()}};
+        if (auto error = setWeather(c.layer, c.weather, c.region)) return *error;
+        json reply{{"layer", c.layer},
+                   {"type", cloudTypeName(c.weather.type)},
+                   {"layers", world.base().layers.size()},
+                   {"clouds", world.base().clouds.size()},
+                   {"fields", world.base().fields.size()}};
+        if (c.region) reply["region"] = *c.region;
+        return reply;
       },
       [&](const SetWind& c) -> std::optional<Outcome> {
         std::string error = world.edit([&](Scene&, WorldDynamics& d) {

@@ -160,7 +160,9 @@ class Engine {
   std::optional<std::variant<nlohmann::json, ProtocolError>> apply(const Command& command,
                                                                    Job& job);
   std::optional<ProtocolError> check(const Command& command) const;
-  std::optional<ProtocolError> setWeather(int layer, const WeatherLayer& weather);
+  // A weather layer, global or of a CIGI region (command::SetWeather::region).
+  std::optional<ProtocolError> setWeather(int layer, const WeatherLayer& weather,
+                                          std::optional<int> region = std::nullopt);
   std::variant<nlohmann::json, ProtocolError> setSun(const command::SetSun& c);
   std::variant<nlohmann::json, ProtocolError> setFog(const command::SetFog& c);
   std::variant<nlohmann::json, ProtocolError> setHaze(const command::SetHaze& c);

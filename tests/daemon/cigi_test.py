@@ -48,10 +48,18 @@ def view_definition(view, left, right, top, bottom, near=1.0, far=50000.0, bo=">
 
 
 def weather_control(layer, enabled, cloud_type=0, coverage=0.0, base=0.0, thickness=0.0,
-                    visibility=0.0, wind=0.0, wind_from=0.0, transition=0.0, scope=0, bo=">"):
-    return struct.pack(bo + "BBHBBBB" + "f" * 12, 12, 56, 0, layer, 50,
+                    visibility=0.0, wind=0.0, wind_from=0.0, transition=0.0, scope=0, region=0,
+                    bo=">"):
+    return struct.pack(bo + "BBHBBBB" + "f" * 12, 12, 56, region, layer, 50,
                        int(enabled) | (cloud_type << 4), scope, 15.0, visibility, 0.0, coverage,
                        base, thickness, transition, wind, 0.0, wind_from, 1013.0, 0.0)
+
+
+def region_control(region, state, lat, lon, size_x, size_y, rotation=0.0, perimeter=0.0,
+                   corner=0.0, merge=False, bo=">"):
+    """Environmental Region Control (11): state 0 inactive, 1 active, 2 destroyed."""
+    return struct.pack(bo + "BBHB3xddfffff4x", 11, 48, region, state | (int(merge) << 2), lat, lon,
+                       size_x, size_y, corner, rotation, perimeter)
 
 
 def atmosphere_control(visibility, wind, wind_from, bo=">"):
@@ -417,6 +425,61 @@ size = [4, 2, 1]
         drain()
         self.assertGreater(len(sofs) - count, 5)
 
+    def test_regional_weather_is_drawn_in_its_region(self):
+        """Issue 29, item 2: Weather Control of regional scope is drawn inside the rectangle
+        an Environmental Region Control makes active (rotation, transition perimeter), kept
+        while the region is inactive, moved with it and removed when it is destroyed."""
+        d = self.start()
+        c = d.client()
+        lat0, lon0 = SITE[0] + 0.05, SITE[1]  # the region's centre, about 5.6 km north
+        north = enu(lat0, lon0, 0.0, *SITE)[1]
+
+        def covered(east, y):
+            """Mean coverage seen straight down from 6 km over (east, y)."""
+            c.ok({"cmd": "set_view", "view": "front", "position": [east, y, 6000.0],
+                  "pitch": -90.0, "vfov": 30.0})
+            _, raw = c.ok({"cmd": "render", "view": "front", "format": "raw",
+                           "channels": ["coverage"]})
+            return sum(raw) / (255.0 * len(raw))
+
+        overcast = weather_control(1, True, 10, coverage=100.0, base=1000.0, thickness=300.0,
+                                   scope=1, region=9)
+        # Regional weather for a region no packet has made active is kept, not drawn.
+        self.frame(overcast, frame=1)
+        self.assertEqual(covered(0.0, north), 0.0)
+        self.assertEqual(c.ok({"cmd": "stats"})["cigi"]["ignored"], 1)
+        # Region 9: 10 km along its X axis (turned 90 degrees: east) by 4 km, 1 km perimeter.
+        self.frame(region_control(9, 1, lat0, lon0, 10000.0, 4000.0, rotation=90.0,
+                                  perimeter=1000.0), frame=2)
+        self.assertGreater(covered(0.0, north), 0.99)   # its centre
+        self.assertGreater(covered(3000.0, north), 0.99)  # 3 km east: within its 5 km half length
+        self.assertEqual(covered(0.0, north + 4500.0), 0.0)  # 4.5 km north: beyond 2 + 1 km
+        self.assertEqual(covered(0.0, -30000.0), 0.0)  # no global layer
+        # The same packets again change nothing; moving the region moves its weather.
+        ticks = c.ok({"cmd": "hash"})["ticks"]
+        self.frame(region_control(9, 1, lat0, lon0, 10000.0, 4000.0, rotation=90.0,
+                                  perimeter=1000.0), frame=3)
+        self.frame(region_control(9, 1, lat0 + 0.1, lon0, 10000.0, 4000.0, rotation=90.0,
+                                  perimeter=1000.0), frame=4)
+        self.assertEqual(covered(0.0, north), 0.0)
+        self.assertGreater(covered(0.0, enu(lat0 + 0.1, lon0, 0.0, *SITE)[1]), 0.99)
+        self.assertEqual(c.ok({"cmd": "hash"})["ticks"], ticks + 2)
+        # Inactive: not drawn, but kept; active again: drawn again; destroyed: gone for good.
+        self.frame(region_control(9, 0, lat0, lon0, 10000.0, 4000.0), frame=5)
+        self.assertEqual(covered(0.0, north), 0.0)
+        self.frame(region_control(9, 1, lat0, lon0, 10000.0, 4000.0, rotation=90.0,
+                                  perimeter=1000.0), frame=6)
+        self.assertGreater(covered(0.0, north), 0.99)
+        self.frame(region_control(9, 2, lat0, lon0, 10000.0, 4000.0), frame=7)
+        self.assertEqual(covered(0.0, north), 0.0)
+        self.frame(region_control(9, 1, lat0, lon0, 10000.0, 4000.0), frame=8)
+        self.assertEqual(covered(0.0, north), 0.0)
+        # A region out of range is refused alone; entity scope is still ignored.
+        sof = self.frame(region_control(3, 1, 95.0, lon0, 1000.0, 1000.0), frame=9)
+        self.assertEqual(sof["status"], 1)
+        self.assertIn("latitude 95", d.log_text())
+        self.check_with_tshark()
+
     def test_little_endian_host(self):
         d = self.start()
         c = d.client()
@@ -572,6 +635,10 @@ size = [4, 2, 1]
                   "cigi.weather_control.coverage", "cigi.weather_control.elevation",
                   "cigi.weather_control.thickness", "cigi.weather_control.visibility_range",
                   "cigi.atmosphere_control.horiz_wind",
+                  "cigi.env_region_control.region_id",
+                  "cigi.env_region_control.lat",
+                  "cigi.env_region_control.size_x",
+                  "cigi.env_region_control.rotation",
                   "cigi.celestial_sphere_control.date", "cigi.celestial_sphere_control.hour",
                   "cigi.sof.ig_frame_number",
                   "cigi.sof.last_host_frame_number",
@@ -601,6 +668,7 @@ size = [4, 2, 1]
                 self.assertEqual(layers["cigi.ig_control.host_frame_number"], [str(frame_number)])
                 at = 24
                 entity_ids, types, yaws, weather_layers, coverages = [], [], [], [], []
+                regions = []  # Environmental Region Control: id, latitude, size X, rotation
                 while at < len(payload):
                     pid = payload[at]
                     if pid == 2:
@@ -610,6 +678,11 @@ size = [4, 2, 1]
                         entity_ids.append(str(eid))
                         types.append(str(etype))
                         yaws.append(float(yaw))
+                    if pid == 11:
+                        (rid,) = struct.unpack(bo + "H", payload[at + 2:at + 4])
+                        (rlat,) = struct.unpack(bo + "d", payload[at + 8:at + 16])
+                        size_x, _, _, rotation = struct.unpack(bo + "4f", payload[at + 24:at + 40])
+                        regions.append((rid, rlat, size_x, rotation))
                     if pid == 12:
                         weather_layers.append(str(payload[at + 4]))
                         coverages.append(struct.unpack(bo + "f", payload[at + 20:at + 24])[0])
@@ -621,6 +694,11 @@ size = [4, 2, 1]
                 self.assertEqual(layers.get("cigi.weather_control.layer_id", []), weather_layers)
                 self.assertEqual([float(v) for v in
                                   layers.get("cigi.weather_control.coverage", [])], coverages)
+                names = ["region_id", "lat", "size_x", "rotation"]
+                dissected = [[float(v) for v in
+                              layers.get("cigi.env_region_control." + n, [])]
+                             for n in names]
+                self.assertEqual(list(zip(*dissected)), [tuple(map(float, r)) for r in regions])
 
 
 if __name__ == "__main__":
