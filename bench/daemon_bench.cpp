@@ -10,9 +10,11 @@
 //      of the platform floor (one constant-colour pass and readback, timed here);
 //   5. host frames in asynchronous (realtime) mode, where Start of Frame comes at the IG's own
 //      rate: from a host frame to the first Start of Frame reporting it and to frames showing it;
-//   6. the same lockstep host frames with a cumulus sky (genus_cumulus.toml) against a clear sky,
-//   as
-//      multiples of the clear sky's (issue 27).
+//   6. the same lockstep host frames with a cumulus sky (genus_cumulus.toml) against a clear
+//      sky, as multiples of the clear sky's (issue 27);
+//   7. with --heavy, alone: worlds grown by legal requests to the world budget (issue 31):
+//      render times at 64x48 and 640x480 as multiples of the clear frame, memory, `hello`
+//      waits during the renders, and SIGTERM during the largest.
 // Figures only; these machines are shared and noisy.
 #include <arpa/inet.h>
 #include <fcntl.h>
@@ -85,6 +87,7 @@ struct Daemon {
       throw std::runtime_error("the daemon did not start: " + line);
   }
   ~Daemon() {
+    if (pid == 0) return;
     kill(pid, SIGTERM);
     waitpid(pid, nullptr, 0);
   }
@@ -450,14 +453,109 @@ void cumulusSky(const std::filesystem::path& dir, int repeats, double floor_ms) 
   row("socket tick to frames", cumulus.socket_frames, clear.socket_frames);
 }
 
+// Issue 31, item 5: a lockstep daemon on cumulus.toml whose world grows by legal add_cloud
+// requests (cumulus clouds of 4,096 ellipsoids stacked 4.5 km in front of the camera) up to
+// the world budget set here; at each size a render at 64x48 and at 640x480 (as multiples of
+// the same view with no cloud), the longest `hello` wait of a second client during them, the
+// daemon's resident memory, and at the end the SIGTERM-to-exit time during a 640x480 render.
+void heavyWorlds(const std::filesystem::path& dir) {
+  constexpr long kWorldBudget = 2097152;  // [world] max_ellipsoids here
+  const std::string config = (dir / "heavy.toml").string();
+  std::ofstream(config) << "scene = \"" << NEPHELE_SOURCE_DIR
+                        << "/config/scenes/cumulus.toml\"\n[world]\nmode = \"lockstep\"\n"
+                        << "max_ellipsoids = " << kWorldBudget << "\n"
+                        << "[[view]]\nname = \"front\"\nwidth = 64\nheight = 48\n"
+                        << "[socket]\nport = 0\n[modbus]\nenabled = false\n"
+                        << "[output]\ndirectory = \"" << (dir / "frames").string() << "\"\n";
+  Daemon daemon(config);
+  Client c(daemon.socket_port), other(daemon.socket_port);
+  std::vector<std::uint8_t> body;
+  auto rssMiB = [&] {
+    std::ifstream status("/proc/" + std::to_string(daemon.pid) + "/status");
+    for (std::string line; std::getline(status, line);)
+      if (line.rfind("VmRSS:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;
+    return 0.0;
+  };
+  auto renderRequest = [](int width, int height) {
+    return json{{"cmd", "render"},
+                {"view", "front"},
+                {"format", "raw"},
+                {"camera", {{"width", width}, {"height", height}}}};
+  };
+  // A render's time, and the longest hello another client waited for meanwhile.
+  auto timedRender = [&](int width, int height) {
+    std::atomic<bool> done{false};
+    double longest_hello = 0.0;
+    std::thread asker([&] {
+      std::vector<std::uint8_t> b;
+      while (!done) {
+        const auto t0 = Clock::now();
+        other.request({{"cmd", "hello"}}, b);
+        longest_hello = std::max(longest_hello, msBetween(t0, Clock::now()));
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      }
+    });
+    const auto t0 = Clock::now();
+    const json reply = c.request(renderRequest(width, height), body);
+    const double ms = msBetween(t0, Clock::now());
+    done = true;
+    asker.join();
+    if (!reply["ok"]) throw std::runtime_error(reply.dump());
+    return std::pair{ms, longest_hello};
+  };
+  c.request({{"cmd", "remove_cloud"}, {"name", "cumulus"}}, body);
+  timedRender(640, 480);  // warm: programs compiled
+  const double clear_small = timedRender(64, 48).first, clear_large = timedRender(640, 480).first;
+  std::printf(
+      "heavy worlds (issue 31): cumulus clouds of 4,096 ellipsoids stacked in front of the "
+      "camera, world budget %ld; clear frame %.1f ms at 64x48, %.1f ms at 640x480\n",
+      kWorldBudget, clear_small, clear_large);
+  std::printf("  %10s %9s %22s %22s %14s\n", "ellipsoids", "RSS MiB", "64x48 ms (x clear)",
+              "640x480 ms (x clear)", "hello max ms");
+  long ellipsoids = 0;
+  int clouds = 0;
+  for (long target : {8192L, 102400L, 1048576L, kWorldBudget}) {
+    while (ellipsoids + 4096 <= target) {
+      const json r =
+          c.request({{"cmd", "add_cloud"},
+                     {"cloud",
+                      {{"name", "heavy" + std::to_string(clouds++)},
+                       {"cumulus", {{"base", {0, 0, 1000}}, {"width", 3000}, {"count", 4096}}}}}},
+                    body);
+      if (!r["ok"]) throw std::runtime_error(r.dump());
+      ellipsoids += 4096;
+    }
+    const auto [small, hello_small] = timedRender(64, 48);
+    const auto [large, hello_large] = timedRender(640, 480);
+    std::printf("  %10ld %9.0f %12.0f (%6.0f x) %12.0f (%6.0f x) %14.1f\n", ellipsoids, rssMiB(),
+                small, small / clear_small, large, large / clear_large,
+                std::max(hello_small, hello_large));
+  }
+  c.send(renderRequest(640, 480));
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  const auto t0 = Clock::now();
+  kill(daemon.pid, SIGTERM);
+  int status = 0;
+  waitpid(daemon.pid, &status, 0);
+  std::printf("  SIGTERM 0.3 s into a 640x480 render of %ld ellipsoids: exit %d after %.2f s\n",
+              ellipsoids, WIFEXITED(status) ? WEXITSTATUS(status) : -1,
+              msBetween(t0, Clock::now()) / 1000.0);
+  daemon.pid = 0;  // already reaped
+}
+
 }  // namespace
 
-int main() {
+int main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   try {
     const auto dir =
         std::filesystem::temp_directory_path() / ("nephele-bench-" + std::to_string(getpid()));
     std::filesystem::create_directories(dir);
+    if (argc > 1 && std::string(argv[1]) == "--heavy") {  // section 7 alone
+      heavyWorlds(dir);
+      std::filesystem::remove_all(dir);
+      return 0;
+    }
     {
       Daemon daemon(writeConfig(dir));
       Client client(daemon.socket_port);
