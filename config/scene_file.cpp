@@ -431,6 +431,16 @@ void readTarget(TableReader& t, const std::string& scene_path, Target& target,
 
 namespace {
 
+// The rules between a weather layer's keys are the world's, shared with set_weather; the
+// error points at the key it names.
+void checkWeather(TableReader& t, const WeatherLayer& w) {
+  if (std::string e = weatherLayerError(w); !e.empty()) {
+    const std::string key = e.substr(0, e.find(':'));
+    if (t.has(key) && e.size() > key.size() + 2) t.failAt(key, e.substr(key.size() + 2));
+    t.failHere(e);
+  }
+}
+
 // The keys a [[macrocluster]] adds to a weather layer (MODEL.md section 11): the region it
 // fills, its cluster grid and variation, and a front's side.
 void readMacrocluster(TableReader& t, WeatherLayer& w) {
@@ -449,13 +459,7 @@ void readMacrocluster(TableReader& t, WeatherLayer& w) {
   t.number("transition", r.transition_m, Limits::kRegionBand);
   t.number("spacing", w.clusters.spacing_m, Limits::kClusterSpacing);
   t.number("variation", w.clusters.amount, Limits::kClusterVariation);
-  // The rules between keys are the world's, shared with set_weather; the error points at the
-  // key it names.
-  if (std::string e = weatherLayerError(w); !e.empty()) {
-    const std::string key = e.substr(0, e.find(':'));
-    if (t.has(key) && e.size() > key.size() + 2) t.failAt(key, e.substr(key.size() + 2));
-    t.failHere(e);
-  }
+  checkWeather(t, w);
 }
 
 // A [[weather]] layer as a host sends it (MODEL.md section 10): the same mapping as set_weather.
@@ -464,7 +468,8 @@ WeatherLayer readWeather(TableReader& t, bool macro = false) {
   t.allow(macro ? std::vector<std::string>{"type", "base", "thickness", "coverage", "seed",
                                            "centre", "size", "heading", "edge", "front",
                                            "transition", "spacing", "variation"}
-                : std::vector<std::string>{"type", "base", "thickness", "coverage"});
+                : std::vector<std::string>{"type", "base", "thickness", "coverage", "visibility",
+                                           "transition_band"});
   std::vector<std::string> names;
   for (int i = 0; i < kCloudTypeCount; ++i) names.emplace_back(cloudTypeName(CloudType(i)));
   WeatherLayer w;
@@ -474,6 +479,11 @@ WeatherLayer readWeather(TableReader& t, bool macro = false) {
   double percent = 100.0 * w.coverage;
   t.number("coverage", percent, Limits::kCoveragePercent);
   w.coverage = percent / 100.0;
+  if (!macro) {  // inside the layer (MODEL.md section 5); 0 takes the genus's visibility
+    t.number("visibility", w.visibility_m, 0.0, Limits::kLayerVisibility.hi);
+    t.number("transition_band", w.transition_band_m, Limits::kTransitionBand);
+    checkWeather(t, w);
+  }
   if (macro) readMacrocluster(t, w);
   t.finish();
   return w;

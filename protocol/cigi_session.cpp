@@ -42,7 +42,8 @@ glm::dvec2 windVelocity(double speed, double from_deg) {
 bool sameCloudLayer(const WeatherControl& a, const WeatherControl& b) {
   return a.enabled == b.enabled && a.cloud_type == b.cloud_type && a.base == b.base &&
          a.thickness == b.thickness && a.coverage == b.coverage && a.wind_speed == b.wind_speed &&
-         a.wind_direction == b.wind_direction;
+         a.wind_direction == b.wind_direction && a.visibility == b.visibility &&
+         a.transition_band == b.transition_band;
 }
 bool sameFog(const WeatherControl& a, const WeatherControl& b) {
   return a.enabled == b.enabled && a.base == b.base && a.thickness == b.thickness &&
@@ -77,6 +78,9 @@ std::variant<WeatherLayer, std::string> cloudLayerOf(const WeatherControl& w) {
            text(Limits::kThickness.hi) + " m, coverage 0 to 100 %, wind 0 to " +
            text(Limits::kMaxWind) + " m/s)";
   layer.wind = windVelocity(w.wind_speed, w.wind_direction);
+  // Inside the layer (MODEL.md section 5): its visibility (0, the genus's) and transition band.
+  layer.visibility_m = w.visibility;
+  layer.transition_band_m = w.transition_band;
   if (std::string e = weatherLayerError(layer); !e.empty()) return e;
   return layer;
 }
@@ -334,8 +338,6 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
         continue;
       }
       if (w->scud) frame.ignored.push_back(where + ": scud");
-      if (w->transition_band != 0.0f) frame.ignored.push_back(where + ": transition band");
-      if (w->visibility != 0.0f) frame.ignored.push_back(where + ": visibility in the layer");
       if (!regional) {
         frame.commands.emplace_back(
             command::SetWeather{w->layer, std::get<WeatherLayer>(layer), std::nullopt});

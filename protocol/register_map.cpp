@@ -238,7 +238,7 @@ std::variant<std::vector<Command>, RegisterError> decodeHoldingWrite(
   for (int layer = 0; layer < ProtocolLimits::kWeatherLayers; ++layer) {
     const int base = M::kLayerStart + layer * M::kLayerStride;
     if (!w.touches(base, M::kLayerStride)) continue;
-    command::SetWeather set{layer + 1, {}};
+    command::SetWeather set{layer + 1, {}, std::nullopt};
     const std::uint16_t type = next[std::size_t(base + M::kLayerType)];
     const std::optional<CloudType> genus = cloudTypeFromCode(type);
     if (!error && !genus)

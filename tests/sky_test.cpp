@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -71,6 +72,39 @@ double hazeDepthBySimpson(const Haze& haze, glm::dvec3 o, glm::dvec3 d, double s
   return sum * h / 3.0;
 }
 
+// The in-layer veil's slab (MODEL.md section 5): density 1 from bottom to top, falling
+// linearly to 0 over the band either side. Its path integral, restated here as a midpoint sum
+// of the density along the ray, for rays from inside, in the bands and outside, up, down,
+// slanted, level and grazing.
+TEST(Fog, BandedSlabPathMatchesTheIntegralAlongTheRay) {
+  Fog veil;
+  veil.bottom_m = 600.0;
+  veil.top_m = 1100.0;
+  veil.band_m = 150.0;
+  auto density = [&](double z) {
+    if (z >= veil.bottom_m && z <= veil.top_m) return 1.0;
+    const double out = z < veil.bottom_m ? veil.bottom_m - z : z - veil.top_m;
+    return std::max(0.0, 1.0 - out / veil.band_m);
+  };
+  for (double z : {300.0, 500.0, 600.0, 850.0, 1150.0, 1400.0})
+    for (double dz : {-1.0, -0.3, -0.01, 0.0, 1e-5, 0.02, 0.5, 1.0})
+      for (double distance : {10.0, 700.0, 5000.0}) {
+        const glm::dvec3 d = glm::normalize(glm::dvec3(1.0, 0.2, dz));
+        constexpr int kSteps = 200000;
+        double sum = 0.0;
+        for (int i = 0; i < kSteps; ++i)
+          sum += density(z + (i + 0.5) / kSteps * distance * d.z) * distance / kSteps;
+        EXPECT_NEAR(fogPathLength(veil, {0.0, 0.0, z}, d, distance), sum, 1e-3 * (1.0 + sum))
+            << "z " << z << " dz " << dz << " distance " << distance;
+      }
+  // Without end: the whole column over |dz| looking out of it; endless on a level ray inside.
+  const double column = veil.top_m - veil.bottom_m + veil.band_m;
+  EXPECT_NEAR(fogPathLength(veil, {0, 0, 100}, {0, 0, 1}, kInf), column, 1e-9);
+  EXPECT_NEAR(fogPathLength(veil, {0, 0, 2000}, {0, 0, -1}, kInf), column, 1e-9);
+  EXPECT_EQ(fogPathLength(veil, {0, 0, 1200}, {1, 0, 0}, kInf), kInf);  // in the band
+  EXPECT_EQ(fogPathLength(veil, {0, 0, 1300}, {1, 0, 0}, kInf), 0.0);   // beyond it
+}
+
 TEST(Haze, DepthMatchesTheIntegralAlongTheRay) {
   const Haze haze{30000.0, 1200.0};
   struct Path {
@@ -110,14 +144,15 @@ TEST(Haze, ThroughAirStaysFiniteAtTheExtremes) {
           const double tau = hazeOpticalDepth(haze, {0, 0, z}, d, distance);
           ASSERT_TRUE(tau >= 0.0) << z << " " << dz << " " << distance;
           for (const auto& f : {fog, no_fog}) {
-            const glm::dvec3 c = throughAir(colour, f, haze, horizon, {0, 0, z}, d, distance);
+            const glm::dvec3 c = throughAir(colour, f, f, haze, horizon, {0, 0, z}, d, distance);
             for (int i = 0; i < 3; ++i)
               ASSERT_TRUE(c[i] >= 0.1 - 1e-12 && c[i] <= 0.9 + 1e-12)
                   << z << " " << dz << " " << distance << " " << c[i];
           }
         }
   // A level path at sea level without end is the horizon colour.
-  const glm::dvec3 end = throughAir(colour, no_fog, Haze{}, horizon, {0, 0, 0}, {1, 0, 0}, kInf);
+  const glm::dvec3 end =
+      throughAir(colour, no_fog, no_fog, Haze{}, horizon, {0, 0, 0}, {1, 0, 0}, kInf);
   EXPECT_NEAR(glm::length(end - horizon), 0.0, 1e-12);
 }
 

@@ -132,6 +132,58 @@ class WeatherRenderTest : public GlRenderTest {
   }
 };
 
+// The in-layer veil (MODEL.md section 5): from inside a stratiform layer, and from its
+// transition band, GL and the reference agree; the veil follows the layer's visibility (a
+// thinner one shows more of the planes, so the image varies more), vanishes beyond the band
+// and in a broken layer's gap.
+TEST_F(WeatherRenderTest, InsideALayerTheVeilFollowsItsVisibility) {
+  WeatherLayer w{CloudType::kStratus, 600.0, 500.0, 1.0, {}, {}, {}};
+  w.transition_band_m = 200.0;
+  Scene scene = weatherScene(w, 5);
+  scene.camera.width = 160;
+  scene.camera.height = 120;
+  scene.camera.orientation.pitch_deg = 10.0;
+  auto at = [&](double z, double visibility) {
+    w.visibility_m = visibility;
+    Scene s = weatherScene(w, 5);
+    s.camera = scene.camera;
+    s.camera.position = {0.0, 0.0, z};
+    return s;
+  };
+  auto spread = [](const FloatImage& image) {  // of the green channel, top row to bottom
+    double lo = 1e9, hi = -1e9;
+    for (std::size_t i = 1; i < image.rgba.size(); i += 4)
+      lo = std::min(lo, double(image.rgba[i])), hi = std::max(hi, double(image.rgba[i]));
+    return hi - lo;
+  };
+  for (double z : {850.0, 1200.0})  // inside; in the band above the top
+    for (double v : {0.0, 2000.0}) {
+      const Scene s = at(z, v);
+      ASSERT_TRUE(inLayerVeil(s)) << z;
+      expectClose(renderer_->renderFloat(s, {}), renderReference(s, {1, 0}), 40.0, 0.02,
+                  "in_layer_veil_" + std::to_string(int(z)) + "_" + std::to_string(int(v)));
+    }
+  // The genus's 130 m hides the planes; 2 km shows them.
+  EXPECT_LT(spread(renderer_->renderFloat(at(850.0, 0.0), {})), 0.01);
+  EXPECT_GT(spread(renderer_->renderFloat(at(850.0, 2000.0), {})), 0.03);
+  EXPECT_FALSE(inLayerVeil(at(1350.0, 0.0)));  // beyond the band: the layer's planes alone
+  EXPECT_FALSE(inLayerVeil(at(300.0, 0.0)));
+  // A broken layer: the veil is as dense as the plane's cover over the eye, the genus's 120 m
+  // under its cells and thinner in its gaps (opacity 0.38 there at 40 % cover).
+  WeatherLayer broken{CloudType::kStratocumulus, 600.0, 500.0, 0.4, {}, {}, {}};
+  Scene s = weatherScene(broken, 5);
+  double thickest = 1e9, thinnest = 0.0;
+  for (int i = 0; i < 64; ++i) {
+    s.camera.position = {250.0 * i, 0.0, 800.0};
+    const std::optional<Fog> veil = inLayerVeil(s);
+    ASSERT_TRUE(veil);
+    thickest = std::min(thickest, veil->visibility_m);
+    thinnest = std::max(thinnest, veil->visibility_m);
+  }
+  EXPECT_NEAR(thickest, genus(CloudType::kStratocumulus).planes.in_layer_visibility_m, 1e-9);
+  EXPECT_GT(thinnest, 2.0 * thickest);
+}
+
 TEST_F(WeatherRenderTest, EveryGenusDrawsTheCoverageAsked) {
   std::printf("%-14s", "drawn");
   for (double c : {0.1, 0.3, 0.5, 0.7, 0.9, 1.0}) std::printf(" %6.1f", c);

@@ -91,6 +91,10 @@ struct Limits {
   static constexpr double kMaxDrift = 300.0;  // m/s, a layer's own drift per axis
   static constexpr double kMaxBase = 20000.0;
   static constexpr Range kThickness{1.0, 15000.0};
+  // Inside a stratiform weather layer: its visibility (0 takes the genus's) and the band
+  // beyond its base and top over which it thins (MODEL.md section 5).
+  static constexpr Range kLayerVisibility{1.0, 1.0e7};
+  static constexpr Range kTransitionBand{0.0, 1.0e4};
   static constexpr Range kCoveragePercent{0.0, 100.0};
 
   // Macroclusters and fronts (world/formations/region.h), metres.

@@ -33,6 +33,12 @@ struct CloudLayer {
   // of the camera, where the heaps themselves are drawn, and fades in over the next band.
   double hole_radius_m = 0.0, hole_band_m = 0.0;
   FarCover far;  // a far deck's cover against view elevation (region.h)
+  // The base plane of a stratiform weather layer carries its slab (MODEL.md section 5): up to
+  // top_m, thinning over band_m beyond it, visibility_m inside; none while visibility_m is 0.
+  struct InLayer {
+    double top_m = 0.0, band_m = 0.0, visibility_m = 0.0;
+    bool operator==(const InLayer&) const = default;
+  } in_layer;
 };
 
 // The layer's weight at world point `xy` at time t seen from `eye` (MODEL.md section 11): its
@@ -78,9 +84,17 @@ inline std::size_t ellipsoidCount(const Scene& scene) {
   return n;
 }
 
-// Whether anything lies in the air between the eye and a surface (fog, haze).
+// The medium of the stratiform layer the camera is in, or within the transition band of
+// (MODEL.md section 5, "the in-layer veil"): the layer's slab at its in-layer visibility
+// divided by the cover of its base plane above or below the eye (clear in a gap), in the
+// colour the layer's texture and sun give it there; none elsewhere.
+std::optional<Fog> inLayerVeil(const Scene& scene);
+// Whether the camera is in a layer's slab or band (where inLayerVeil may give a veil).
+bool eyeInLayer(const Scene& scene);
+
+// Whether anything lies in the air between the eye and a surface (fog, haze, a layer's veil).
 inline bool sceneHasAir(const Scene& scene) {
-  return scene.fog || scene.haze;
+  return scene.fog || scene.haze || eyeInLayer(scene);
 }
 
 // `scene` with its fields' heaps within heapRange(drawing.range_m) of its camera added to its

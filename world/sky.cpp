@@ -27,19 +27,42 @@ double fogExtinction(const Fog& fog) {
   return extinctionForVisibility(fog.visibility_m);
 }
 
+namespace {
+
+// The fog's density at height z: 1 in [bottom, top], linear to 0 over the band either side.
+double fogDensity(const Fog& fog, double z) {
+  if (z >= fog.bottom_m && z <= fog.top_m) return 1.0;
+  const double out = z < fog.bottom_m ? fog.bottom_m - z : z - fog.top_m;
+  return fog.band_m > 0.0 ? std::max(0.0, 1.0 - out / fog.band_m) : 0.0;
+}
+
+// Its integral from below the slab to height z (+-infinity allowed).
+double fogColumn(const Fog& fog, double z) {
+  const double b = fog.band_m, low = fog.bottom_m - b, thick = fog.top_m - fog.bottom_m;
+  if (!(z > low)) return 0.0;
+  if (z <= fog.bottom_m) return (z - low) * (z - low) / (2.0 * b);
+  if (z <= fog.top_m) return 0.5 * b + (z - fog.bottom_m);
+  if (z <= fog.top_m + b) {
+    const double u = z - fog.top_m;
+    return 0.5 * b + thick + u - u * u / (2.0 * b);
+  }
+  return b + thick;
+}
+
+}  // namespace
+
 double fogPathLength(const Fog& fog, glm::dvec3 origin, glm::dvec3 direction, double distance) {
   constexpr double kInf = std::numeric_limits<double>::infinity();
-  double enter = 0.0, leave = distance;
-  if (direction.z == 0.0) {
-    if (origin.z < 0.0 || origin.z > fog.top_m) return 0.0;
-  } else {
-    double s0 = (0.0 - origin.z) / direction.z, s1 = (fog.top_m - origin.z) / direction.z;
-    if (s0 > s1) std::swap(s0, s1);
-    enter = std::max(enter, s0);
-    leave = std::min(leave, s1);
+  if (!(distance > 0.0)) return 0.0;
+  // Level, or so nearly that the column's difference would lose its digits: the density at
+  // the middle of the path times its length.
+  const double rise = distance * direction.z;
+  if (direction.z == 0.0 || (std::isfinite(rise) && std::abs(rise) < 1e-3)) {
+    const double rho = fogDensity(fog, direction.z == 0.0 ? origin.z : origin.z + 0.5 * rise);
+    return rho > 0.0 ? (distance == kInf ? kInf : rho * distance) : 0.0;
   }
-  if (!(leave > enter)) return 0.0;
-  return leave == kInf ? kInf : leave - enter;
+  const double end = std::isfinite(rise) ? origin.z + rise : (rise > 0.0 ? kInf : -kInf);
+  return std::abs(fogColumn(fog, end) - fogColumn(fog, origin.z)) / std::abs(direction.z);
 }
 
 double hazeOpticalDepth(const Haze& haze, glm::dvec3 origin, glm::dvec3 direction,
@@ -59,21 +82,24 @@ double hazeOpticalDepth(const Haze& haze, glm::dvec3 origin, glm::dvec3 directio
 }
 
 glm::dvec3 throughAir(glm::dvec3 colour, const std::optional<Fog>& fog,
-                      const std::optional<Haze>& haze, glm::dvec3 horizon, glm::dvec3 origin,
-                      glm::dvec3 direction, double distance) {
+                      const std::optional<Fog>& veil, const std::optional<Haze>& haze,
+                      glm::dvec3 horizon, glm::dvec3 origin, glm::dvec3 direction,
+                      double distance) {
   // Each depth is capped where its transmittance is already 0 in double, so the weights of the
-  // two colours stay finite.
+  // colours stay finite.
   constexpr double kOpaque = 1.0e3;
-  const double tau_fog =
-      fog ? std::min(fogExtinction(*fog) * fogPathLength(*fog, origin, direction, distance),
-                     kOpaque)
-          : 0.0;
+  auto depth = [&](const std::optional<Fog>& f) {
+    return f ? std::min(fogExtinction(*f) * fogPathLength(*f, origin, direction, distance), kOpaque)
+             : 0.0;
+  };
+  const double tau_fog = depth(fog), tau_veil = depth(veil);
   const double tau_haze =
       haze ? std::min(hazeOpticalDepth(*haze, origin, direction, distance), kOpaque) : 0.0;
-  const double tau = tau_fog + tau_haze;
+  const double tau = tau_fog + tau_veil + tau_haze;
   if (!(tau > 0.0)) return colour;
-  const glm::dvec3 air =
-      (tau_fog * (fog ? fog->colour : glm::dvec3(0.0)) + tau_haze * horizon) / tau;
+  const glm::dvec3 air = (tau_fog * (fog ? fog->colour : glm::dvec3(0.0)) +
+                          tau_veil * (veil ? veil->colour : glm::dvec3(0.0)) + tau_haze * horizon) /
+                         tau;
   const double t = std::exp(-tau);
   return t * colour + (1.0 - t) * air;
 }

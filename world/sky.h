@@ -24,21 +24,26 @@ struct Sun {
 
 glm::dvec3 sunDirection(const Sun& sun);  // unit vector towards the sun
 
-// Homogeneous fog filling the slab 0 <= Z <= top (McReynolds and Blythe's ground fog).
-// Extinction follows the meteorological visibility: 2 % contrast left after `visibility_m`,
-// sigma = -ln(0.02) / visibility. Fog is unlit: it adds its own colour.
+// A medium filling the slab bottom <= Z <= top (McReynolds and Blythe's ground fog, with
+// bottom 0), its density falling linearly to none over `band` below the bottom and above the
+// top (the in-layer veil, MODEL.md section 5). Extinction follows the meteorological
+// visibility: 2 % contrast left after `visibility_m`, sigma = -ln(0.02) / visibility, where the
+// density is 1. Fog is unlit: it adds its own colour.
 struct Fog {
   double top_m = 100.0;
   double visibility_m = 1000.0;
   glm::dvec3 colour{0.75, 0.77, 0.80};
+  double bottom_m = 0.0;
+  double band_m = 0.0;
 };
 
 // Koschmieder: the extinction per metre that leaves 2 % contrast after `visibility_m`.
 double extinctionForVisibility(double visibility_m);
 double fogExtinction(const Fog& fog);  // per metre
 
-// Length inside the fog slab of the ray origin + s * direction for 0 <= s <= distance
-// (distance may be +infinity). `direction` must be normalised.
+// The density-weighted length of the ray origin + s * direction, 0 <= s <= distance, through
+// the fog (its length inside the slab when band is 0); distance may be +infinity, giving
+// +infinity for a level ray where the density is above 0. `direction` must be normalised.
 double fogPathLength(const Fog& fog, glm::dvec3 origin, glm::dvec3 direction, double distance);
 
 // Distance haze (MODEL.md section 5): aerosol whose extinction falls with height as
@@ -53,11 +58,12 @@ struct Haze {
 // be +infinity; `direction` must be normalised). Finite or +infinity, never NaN.
 double hazeOpticalDepth(const Haze& haze, glm::dvec3 origin, glm::dvec3 direction, double distance);
 
-// `colour` seen at `distance` along the unit `direction` from `origin` through the fog and the
-// haze of a scene (either may be absent): the two mixed in proportion to their optical depths,
-// T = exp(-(tau_fog + tau_haze)), colour T + (1 - T) (tau_fog fog + tau_haze horizon) / tau.
+// `colour` seen at `distance` along the unit `direction` from `origin` through the fog, the
+// in-layer veil and the haze of a scene (any may be absent): mixed in proportion to their
+// optical depths, T = exp(-tau), tau their sum, colour T + (1 - T) (sum of tau_i colour_i) / tau,
+// the haze's colour the horizon's.
 glm::dvec3 throughAir(glm::dvec3 colour, const std::optional<Fog>& fog,
-                      const std::optional<Haze>& haze, glm::dvec3 horizon, glm::dvec3 origin,
-                      glm::dvec3 direction, double distance);
+                      const std::optional<Fog>& veil, const std::optional<Haze>& haze,
+                      glm::dvec3 horizon, glm::dvec3 origin, glm::dvec3 direction, double distance);
 
 }  // namespace nephele

@@ -25,7 +25,7 @@ namespace {
 static_assert(std::endian::native == std::endian::little, "snapshots assume a little-endian host");
 
 constexpr char kMagic[8] = {'N', 'E', 'P', 'H', 'S', 'N', 'A', 'P'};
-constexpr std::uint32_t kFormatVersion = 8;
+constexpr std::uint32_t kFormatVersion = 9;
 constexpr std::size_t kHeaderBytes = sizeof kMagic + 4 + 8 + 8;
 
 class Writer {
@@ -183,6 +183,7 @@ template <class A>
 void io(A& a, CloudLayer& l) {
   io(a, l.name), io(a, l.altitude_m), io(a, l.colour), io(a, l.threshold), io(a, l.transition);
   io(a, l.shading), io(a, l.texture), io(a, l.region);
+  io(a, l.in_layer.top_m), io(a, l.in_layer.band_m), io(a, l.in_layer.visibility_m);
   if (std::string e = regionError(l.region); !e.empty()) a.fail("layer " + l.name + ": " + e);
 }
 template <class A>

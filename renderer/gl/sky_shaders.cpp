@@ -23,26 +23,40 @@ vec3 viewRay() {
 }
 
 #ifdef AIR
-// The air between the eye and a surface (MODEL.md section 5): ground fog and distance haze;
-// an absent one has zero extinction. world/sky.cpp's throughAir is the reference's twin.
-uniform float u_fog_top;
+// The air between the eye and a surface (MODEL.md section 5): ground fog, the in-layer veil
+// and distance haze; an absent one has zero extinction. world/sky.cpp's throughAir is the reference's twin.
+uniform vec3 u_fog_slab;  // bottom, top, band of the ground fog, metres
 uniform float u_fog_sigma;
 uniform vec3 u_fog_colour;
+uniform vec3 u_veil_slab;  // the in-layer veil's (MODEL.md section 5)
+uniform float u_veil_sigma;
+uniform vec3 u_veil_colour;
 uniform float u_haze_sigma;   // at Z = 0, per metre
 uniform float u_haze_height;  // scale height, metres
 uniform vec3 u_haze_colour;   // the sky's horizon
 
-// Length inside the slab 0 <= z <= top of the unit ray from the camera, up to `distance`.
-float fogPathLength(vec3 d, float distance) {
-  float enter = 0.0, leave = distance;
-  if (abs(d.z) < 1e-9) {
-    if (u_camera_z < 0.0 || u_camera_z > u_fog_top) return 0.0;
-  } else {
-    float s0 = -u_camera_z / d.z, s1 = (u_fog_top - u_camera_z) / d.z;
-    enter = max(enter, min(s0, s1));
-    leave = min(leave, max(s0, s1));
-  }
-  return max(leave - enter, 0.0);
+// A slab's density (1 from bottom to top, linear to 0 over the band either side) and its
+// integral from below it to height z (world/sky.cpp, fogDensity and fogColumn).
+float slabDensity(vec3 slab, float z) {
+  if (z >= slab.x && z <= slab.y) return 1.0;
+  float out_by = z < slab.x ? slab.x - z : z - slab.y;
+  return slab.z > 0.0 ? max(0.0, 1.0 - out_by / slab.z) : 0.0;
+}
+float slabColumn(vec3 slab, float z) {
+  float b = slab.z, low = slab.x - b;
+  if (!(z > low)) return 0.0;
+  if (z <= slab.x) return (z - low) * (z - low) / (2.0 * b);
+  if (z <= slab.y) return 0.5 * b + (z - slab.x);
+  float u = min(z - slab.y, b);
+  return 0.5 * b + (slab.y - slab.x) + u - (b > 0.0 ? u * u / (2.0 * b) : 0.0);
+}
+
+// The density-weighted length through a slab of the unit ray from the camera up to `distance`
+// (world/sky.cpp's fogPathLength): level rays take the density half way.
+float slabPath(vec3 slab, vec3 d, float distance) {
+  float rise = distance * d.z;
+  if (abs(rise) < 1e-3) return slabDensity(slab, u_camera_z + 0.5 * rise) * distance;
+  return abs(slabColumn(slab, u_camera_z + rise) - slabColumn(slab, u_camera_z)) / abs(d.z);
 }
 
 // The haze's optical depth along the unit ray up to `distance`: sigma0 H (e^-a - e^-(a+x)) / dz,
@@ -55,19 +69,23 @@ float hazeDepth(vec3 d, float distance) {
 }
 
 vec3 applyAir(vec3 colour, vec3 d, float distance) {
-  float tau_fog = min(u_fog_sigma * fogPathLength(d, distance), 1e3);
+  float tau_fog = u_fog_sigma > 0.0 ? min(u_fog_sigma * slabPath(u_fog_slab, d, distance), 1e3)
+                                    : 0.0;
+  float tau_veil =
+      u_veil_sigma > 0.0 ? min(u_veil_sigma * slabPath(u_veil_slab, d, distance), 1e3) : 0.0;
   float tau_haze = min(hazeDepth(d, distance), 1e3);
-  float tau = tau_fog + tau_haze;
+  float tau = tau_fog + tau_veil + tau_haze;
   if (!(tau > 0.0)) return colour;
-  vec3 air = (tau_fog * u_fog_colour + tau_haze * u_haze_colour) / tau;
+  vec3 air = (tau_fog * u_fog_colour + tau_veil * u_veil_colour + tau_haze * u_haze_colour) / tau;
   return mix(air, colour, exp(-tau));
 }
 
 // The air at the end of an endless path through it (the ground at the horizon): each medium
-// present at its cap, as applyAir weighs them there.
+// present at its cap, as applyAir weighs them there (the veil is present only around the eye).
 vec3 airAtHorizon() {
-  float f = u_fog_sigma > 0.0 ? 1.0 : 0.0, h = u_haze_sigma > 0.0 ? 1.0 : 0.0;
-  return (f * u_fog_colour + h * u_haze_colour) / max(f + h, 1.0);
+  float f = u_fog_sigma > 0.0 ? 1.0 : 0.0, v = u_veil_sigma > 0.0 ? 1.0 : 0.0;
+  float h = u_haze_sigma > 0.0 ? 1.0 : 0.0;
+  return (f * u_fog_colour + v * u_veil_colour + h * u_haze_colour) / max(f + v + h, 1.0);
 }
 #else
 vec3 applyAir(vec3 colour, vec3 d, float distance) { return colour; }

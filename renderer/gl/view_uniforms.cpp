@@ -19,11 +19,16 @@ void setViewUniforms(const GlApi& gl, GLuint p, const Camera& camera, const Scen
   gl.ProgramUniform1f(p, gl.GetUniformLocation(p, "u_camera_z"), float(camera.position.z));
   // An absent medium has zero extinction (the shaders take the air only when the scene has
   // some: sceneHasAir).
-  const std::optional<Fog>& fog = scene.fog;
-  gl.ProgramUniform1f(p, gl.GetUniformLocation(p, "u_fog_top"), fog ? float(fog->top_m) : 0.0f);
-  gl.ProgramUniform1f(p, gl.GetUniformLocation(p, "u_fog_sigma"),
-                      fog ? float(fogExtinction(*fog)) : 0.0f);
-  setUniform3(gl, p, "u_fog_colour", fog ? fog->colour : Fog{}.colour);
+  auto setSlab = [&](const char* name, const std::optional<Fog>& fog) {
+    const std::string n(name);
+    const Fog f = fog.value_or(Fog{});
+    setUniform3(gl, p, (n + "_slab").c_str(), {f.bottom_m, f.top_m, f.band_m});
+    gl.ProgramUniform1f(p, gl.GetUniformLocation(p, (n + "_sigma").c_str()),
+                        fog ? float(fogExtinction(*fog)) : 0.0f);
+    setUniform3(gl, p, (n + "_colour").c_str(), f.colour);
+  };
+  setSlab("u_fog", scene.fog);
+  setSlab("u_veil", inLayerVeil(scene));
   const std::optional<Haze>& haze = scene.haze;
   gl.ProgramUniform1f(p, gl.GetUniformLocation(p, "u_haze_sigma"),
                       haze ? float(extinctionForVisibility(haze->visibility_m)) : 0.0f);

@@ -272,8 +272,8 @@ class ReferenceTracer {
   }
 
   glm::dvec3 withAir(glm::dvec3 colour, glm::dvec3 direction, double distance) const {
-    return throughAir(colour, scene_.fog, scene_.haze, scene_.sky.horizon, scene_.camera.position,
-                      direction, distance);
+    return throughAir(colour, scene_.fog, layer_veil_, scene_.haze, scene_.sky.horizon,
+                      scene_.camera.position, direction, distance);
   }
 
   const Scene& scene_;
@@ -282,6 +282,7 @@ class ReferenceTracer {
   std::vector<SolidTexture> solid_textures_;
   std::vector<EllipsoidEntry> ellipsoids_;
   Veil veil_;
+  std::optional<Fog> layer_veil_ = inLayerVeil(scene_);  // the camera's, once per frame
 };
 
 }  // namespace

@@ -480,6 +480,32 @@ size = [4, 2, 1]
         self.assertIn("latitude 95", d.log_text())
         self.check_with_tshark()
 
+    def test_in_layer_visibility_and_transition_band_are_drawn(self):
+        """Issue 29, item 2: Weather Control's visibility within a cloud layer is the density
+        of the veil a view inside the layer looks through, and its transition band thins that
+        veil above the top and below the base (MODEL.md section 5)."""
+        d = self.start()
+        c = d.client()
+
+        def inside(z, visibility, band, frame):
+            self.frame(weather_control(1, True, 10, coverage=100.0, base=600.0, thickness=500.0,
+                                       visibility=visibility, transition=band), frame=frame)
+            # 20 km west of the scene's cumulus, whose own veil would fill the view.
+            c.ok({"cmd": "set_view", "view": "front", "position": [-20000.0, 0.0, z],
+                  "heading": 270.0, "pitch": 10.0, "vfov": 60.0})
+            _, raw = c.ok({"cmd": "render", "view": "front", "format": "raw",
+                           "channels": ["colour"]})
+            green = raw[1::3]
+            return max(green) - min(green)
+
+        # In the deck: a 50 m veil hides its planes, a 5 km one shows them.
+        self.assertLessEqual(inside(850.0, 50.0, 0.0, 1), 2)
+        self.assertGreater(inside(850.0, 5000.0, 0.0, 2), 10)
+        # 50 m above the top: a 300 m band still veils the view, no band leaves the planes.
+        self.assertLessEqual(inside(1150.0, 50.0, 300.0, 3), 2)
+        self.assertGreater(inside(1150.0, 50.0, 0.0, 4), 10)
+        self.assertNotIn("ignored", c.ok({"cmd": "stats"})["cigi"])
+
     def test_little_endian_host(self):
         d = self.start()
         c = d.client()

@@ -47,6 +47,10 @@ struct WeatherLayer {
   std::optional<glm::dvec2> wind;  // east, north m/s at this layer; unset keeps the world's
   Region region;                   // where the layer lies; the default is everywhere
   ClusterVariation clusters;       // heaps only: Gardner's macrocluster variation
+  // Stratiform genera: the visibility inside the layer (0: the genus's), and the band above
+  // its top and below its base over which it thins out (MODEL.md section 5, the in-layer veil).
+  double visibility_m = 0.0;
+  double transition_band_m = 0.0;
 };
 
 // Empty when the layer can be drawn, else what is wrong and what is allowed (ranges in

@@ -34,14 +34,21 @@ constexpr Species kCumulonimbusSpecies[] = {{"capillatus incus", 9000.0, 2.0}};
 // (docs/ACCURACY.md, "Realism"): higher than Gardner's 0.707 for the smooth veil and dark deck
 // (cirrostratus, nimbostratus), lower for the cellular stratocumulus and altocumulus (the
 // altocumulus with a softer transition); the rest keep 0.707.
+// Visibility inside a layer (MODEL.md section 5): Koschmieder's 3.9 / beta with the extinction
+// of the cloud's droplets or crystals, beta = 3 LWC / (2 rho_w r_e) (liquid water content LWC,
+// effective radius r_e): about 0.03 per metre for stratus (LWC 0.2 g/m3, r_e 10 um), 130 m;
+// wetter nimbostratus 60 m, stratocumulus 120 m, altocumulus 150 m, altostratus 250 m; ice
+// clouds, far thinner (extinction 0.1 to 1 per km): cirrus 5 km, cirrostratus 3 km,
+// cirrocumulus 1 km. The heaps' decks have none: among heaps the air is clear, and each heap
+// has its own veil (section 15).
 // Indexed by CloudType. Typical layers: the atlas's altitude bands for mid-latitudes.
 constexpr std::array<Genus, kCloudTypeCount> kGenera{{
-    {"none", 700.0, 500.0, {0, 0, 1, 0.707, 0, 0, 0, 0, 0, 0, 0, false}, false, kNoHeaps, {}},
+    {"none", 700.0, 500.0, {0, 0, 1, 0.707, 0, 0, 0, 0, 0, 0, 0, false, 0}, false, kNoHeaps, {}},
     // cells
     {"altocumulus",
      4000.0,
      700.0,
-     {3.0e-3, 3.0e-3, 6, 0.35, 0.5, 90.0, 0.20, 0.95, 0.55, 0.50, 1, false},
+     {3.0e-3, 3.0e-3, 6, 0.35, 0.5, 90.0, 0.20, 0.95, 0.55, 0.50, 1, false, 150},
      false,
      kNoHeaps,
      {}},
@@ -49,7 +56,7 @@ constexpr std::array<Genus, kCloudTypeCount> kGenera{{
     {"altostratus",
      4000.0,
      700.0,
-     {1.2e-3, 1.2e-3, 5, 0.707, 2.0, 90.0, 0.50, 0.72, 0.70, 0.35, 2, false},
+     {1.2e-3, 1.2e-3, 5, 0.707, 2.0, 90.0, 0.50, 0.72, 0.70, 0.35, 2, false, 250},
      false,
      kNoHeaps,
      {}},
@@ -57,7 +64,7 @@ constexpr std::array<Genus, kCloudTypeCount> kGenera{{
     {"cirrocumulus",
      8000.0,
      600.0,
-     {8.0e-3, 6.5e-3, 6, 0.707, 0.5, 90.0, 0.15, 1.00, 0.70, 0.50, 1, false},
+     {8.0e-3, 6.5e-3, 6, 0.707, 0.5, 90.0, 0.15, 1.00, 0.70, 0.50, 1, false, 1000},
      false,
      kNoHeaps,
      {}},
@@ -65,7 +72,7 @@ constexpr std::array<Genus, kCloudTypeCount> kGenera{{
     {"cirrostratus",
      8000.0,
      600.0,
-     {1.0e-3, 1.0e-3, 4, 0.84, 2.0, 90.0, 3.00, 1.00, 0.80, 0.30, 1, true},
+     {1.0e-3, 1.0e-3, 4, 0.84, 2.0, 90.0, 3.00, 1.00, 0.80, 0.30, 1, true, 3000},
      false,
      kNoHeaps,
      {}},
@@ -73,7 +80,7 @@ constexpr std::array<Genus, kCloudTypeCount> kGenera{{
     {"cirrus",
      8000.0,
      600.0,
-     {1.0e-3, 0.35e-3, 5, 0.707, 0.2, 30.0, 0.50, 1.00, 0.75, 0.60, 1, false},
+     {1.0e-3, 0.35e-3, 5, 0.707, 0.2, 30.0, 0.50, 1.00, 0.75, 0.60, 1, false, 5000},
      false,
      kNoHeaps,
      {}},
@@ -81,7 +88,7 @@ constexpr std::array<Genus, kCloudTypeCount> kGenera{{
     {"cumulonimbus",
      900.0,
      9000.0,
-     {1.0e-3, 1.0e-3, 4, 0.707, 2.0, 90.0, 0.80, 0.42, 0.80, 0.30, 1, false},
+     {1.0e-3, 1.0e-3, 4, 0.707, 2.0, 90.0, 0.80, 0.42, 0.80, 0.30, 1, false, 0},
      true,
      kCumulonimbusHeaps,
      kCumulonimbusSpecies},
@@ -89,7 +96,7 @@ constexpr std::array<Genus, kCloudTypeCount> kGenera{{
     {"cumulus",
      1200.0,
      1200.0,
-     {2.0e-3, 1.6e-3, 6, 0.707, 0.6, 90.0, 0.12, 0.82, 0.55, 0.55, 1, false},
+     {2.0e-3, 1.6e-3, 6, 0.707, 0.6, 90.0, 0.12, 0.82, 0.55, 0.55, 1, false, 0},
      true,
      kCumulusHeaps,
      kCumulusSpecies},
@@ -97,7 +104,7 @@ constexpr std::array<Genus, kCloudTypeCount> kGenera{{
     {"nimbostratus",
      900.0,
      2500.0,
-     {1.0e-3, 1.0e-3, 4, 0.86, 2.0, 90.0, 0.80, 0.42, 0.80, 0.30, 3, false},
+     {1.0e-3, 1.0e-3, 4, 0.86, 2.0, 90.0, 0.80, 0.42, 0.80, 0.30, 3, false, 60},
      false,
      kNoHeaps,
      {}},
@@ -105,7 +112,7 @@ constexpr std::array<Genus, kCloudTypeCount> kGenera{{
     {"stratocumulus",
      700.0,
      500.0,
-     {2.0e-3, 1.6e-3, 6, 0.55, 0.6, 90.0, 0.12, 0.82, 0.55, 0.55, 1, false},
+     {2.0e-3, 1.6e-3, 6, 0.55, 0.6, 90.0, 0.12, 0.82, 0.55, 0.55, 1, false, 120},
      false,
      kNoHeaps,
      {}},
@@ -113,7 +120,7 @@ constexpr std::array<Genus, kCloudTypeCount> kGenera{{
     {"stratus",
      700.0,
      500.0,
-     {1.5e-3, 1.5e-3, 4, 0.707, 2.5, 90.0, 0.60, 0.66, 0.75, 0.30, 2, false},
+     {1.5e-3, 1.5e-3, 4, 0.707, 2.5, 90.0, 0.60, 0.66, 0.75, 0.30, 2, false, 130},
      false,
      kNoHeaps,
      {}},

@@ -26,6 +26,7 @@ struct PlaneLook {
   double amplitude_ratio, t0, rotation_deg, transition, grey, ambient, texture_fraction;
   int planes;
   bool veil;
+  double in_layer_visibility_m;  // inside the layer (MODEL.md section 5); 0 for heaps' decks
 };
 
 // Heaps (sections 10 and 14): colour; ambient and texture fractions of eq. 8; T1, T2 and D of

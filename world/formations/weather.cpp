@@ -11,6 +11,8 @@
 
 #include "world/counter_random.h"
 #include "world/formations/genus.h"
+#include "world/scene.h"
+#include "world/shading.h"
 #include "world/textures/layer_texture.h"
 
 namespace nephele {
@@ -171,6 +173,10 @@ WeatherClouds weatherClouds(const WeatherLayer& w, const std::string& prefix, st
   const double coverage = std::min(w.coverage, 1.0);
   if (!g.heaps) {
     out.layers = planes(w, look, coverage, prefix, seed);
+    // The layer's slab rides on its base plane (MODEL.md section 5, the in-layer veil).
+    out.layers.front().in_layer = {
+        w.base_m + w.thickness_m, w.transition_band_m,
+        w.visibility_m > 0.0 ? w.visibility_m : look.in_layer_visibility_m};
     return out;
   }
   // Heaps cover up to CloudField::kMaxFieldCoverage; a deck independent of them covers the
@@ -190,6 +196,47 @@ WeatherClouds weatherClouds(const WeatherLayer& w, const std::string& prefix, st
     out.layers = planes(w, look, deck, prefix + "/deck", seed);
   }
   return out;
+}
+
+bool eyeInLayer(const Scene& scene) {
+  const double z = scene.camera.position.z;
+  for (const CloudLayer& l : scene.layers) {
+    const CloudLayer::InLayer& in = l.in_layer;
+    if (in.visibility_m > 0.0 && z >= l.altitude_m - in.band_m && z <= in.top_m + in.band_m)
+      return true;
+  }
+  return false;
+}
+
+std::optional<Fog> inLayerVeil(const Scene& scene) {
+  if (!eyeInLayer(scene)) return std::nullopt;
+  const glm::dvec3 eye = scene.camera.position;
+  const glm::dvec2 xy(eye);
+  const double lit_from_above = std::max(0.0, sunDirection(scene.sun).z);
+  std::optional<Fog> veil;
+  double densest = 0.0;
+  for (const CloudLayer& l : scene.layers) {
+    const CloudLayer::InLayer& in = l.in_layer;
+    if (!(in.visibility_m > 0.0) || eye.z < l.altitude_m - in.band_m ||
+        eye.z > in.top_m + in.band_m)
+      continue;
+    // The base plane's cover over the eye (eq. 9, its region's threshold): the layer's slab
+    // is as dense as the cloud the plane draws there.
+    const LayerTexture texture(l.texture);
+    const double t = texture.value(xy, scene.time_s);
+    const double t1 = regionThreshold(l.threshold, layerRegionWeight(l, xy, scene.time_s, xy));
+    const double cover = 1.0 - skyPlaneTranslucence(t, t1, l.transition);
+    if (!(cover > densest)) continue;  // where layers overlap, the densest
+    densest = cover;
+    Fog f;
+    f.bottom_m = l.altitude_m;
+    f.top_m = in.top_m;
+    f.band_m = in.band_m;
+    f.visibility_m = in.visibility_m / cover;
+    f.colour = gardnerIntensity(l.shading, lit_from_above, 0.0, t) * l.colour * scene.sun.colour;
+    veil = f;
+  }
+  return veil;
 }
 
 std::uint64_t weatherSeed(std::uint64_t scene_seed, int layer) {
