@@ -27,14 +27,13 @@ double fogExtinction(const Fog& fog) {
   return extinctionForVisibility(fog.visibility_m);
 }
 
-namespace {
-
-// The fog's density at height z: 1 in [bottom, top], linear to 0 over the band either side.
 double fogDensity(const Fog& fog, double z) {
   if (z >= fog.bottom_m && z <= fog.top_m) return 1.0;
   const double out = z < fog.bottom_m ? fog.bottom_m - z : z - fog.top_m;
   return fog.band_m > 0.0 ? std::max(0.0, 1.0 - out / fog.band_m) : 0.0;
 }
+
+namespace {
 
 // Its integral from below the slab to height z (+-infinity allowed).
 double fogColumn(const Fog& fog, double z) {

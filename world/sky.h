@@ -41,6 +41,9 @@ struct Fog {
 double extinctionForVisibility(double visibility_m);
 double fogExtinction(const Fog& fog);  // per metre
 
+// The fog's density at height z: 1 in [bottom, top], falling linearly to 0 over the band.
+double fogDensity(const Fog& fog, double z);
+
 // The density-weighted length of the ray origin + s * direction, 0 <= s <= distance, through
 // the fog (its length inside the slab when band is 0); distance may be +infinity, giving
 // +infinity for a level ray where the density is above 0. `direction` must be normalised.

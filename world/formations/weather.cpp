@@ -220,18 +220,21 @@ std::optional<Fog> inLayerVeil(const Scene& scene) {
     if (!(in.visibility_m > 0.0) || eye.z < l.altitude_m - in.band_m ||
         eye.z > in.top_m + in.band_m)
       continue;
-    // The base plane's cover over the eye (eq. 9, its region's threshold): the layer's slab
-    // is as dense as the cloud the plane draws there.
-    const LayerTexture texture(l.texture);
-    const double t = texture.value(xy, scene.time_s);
-    const double t1 = regionThreshold(l.threshold, layerRegionWeight(l, xy, scene.time_s, xy));
-    const double cover = 1.0 - skyPlaneTranslucence(t, t1, l.transition);
-    if (!(cover > densest)) continue;  // where layers overlap, the densest
-    densest = cover;
+    // The layer's slab is as dense as the cloud its base plane draws over the eye (eq. 9, its
+    // region's threshold)...
     Fog f;
     f.bottom_m = l.altitude_m;
     f.top_m = in.top_m;
     f.band_m = in.band_m;
+    // ... and as the band thins it at the eye's height, so that it fades out as the eye
+    // climbs out of the band (a layer without one has a sharp base and top).
+    const LayerTexture texture(l.texture);
+    const double t = texture.value(xy, scene.time_s);
+    const double t1 = regionThreshold(l.threshold, layerRegionWeight(l, xy, scene.time_s, xy));
+    const double cover =
+        (1.0 - skyPlaneTranslucence(t, t1, l.transition)) * fogDensity(f, eye.z);
+    if (!(cover > densest)) continue;  // where layers overlap, the densest
+    densest = cover;
     f.visibility_m = in.visibility_m / cover;
     f.colour = gardnerIntensity(l.shading, lit_from_above, 0.0, t) * l.colour * scene.sun.colour;
     veil = f;
