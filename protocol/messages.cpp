@@ -400,12 +400,6 @@ ChangeCloud readChangeCloud(FieldReader& r) {
   return c;
 }
 
-RemoveCloud readRemoveCloud(FieldReader& r) {
-  RemoveCloud c{r.requiredName("name")};
-  r.finish("cmd, id, name");
-  return c;
-}
-
 AddTarget readAddTarget(FieldReader& r) {
   const json* target = r.object("target");
   if (!target)
@@ -426,17 +420,6 @@ MoveTarget readMoveTarget(FieldReader& r) {
   c.roll = r.number("roll", -Limits::kMaxRoll, Limits::kMaxRoll);
   r.finish("cmd, id, name, centre, heading, pitch, roll");
   return c;
-}
-
-RemoveTarget readRemoveTarget(FieldReader& r) {
-  RemoveTarget c{r.requiredName("name")};
-  r.finish("cmd, id, name");
-  return c;
-}
-
-ListTargets readListTargets(FieldReader& r) {
-  r.finish("cmd, id");
-  return ListTargets{};
 }
 
 Tick readTick(FieldReader& r) {
@@ -473,26 +456,38 @@ Unsubscribe readUnsubscribe(FieldReader& r) {
   return c;
 }
 
+// Commands of a name alone, and of nothing.
+template <class T>
+T readNamed(FieldReader& r) {
+  T c{r.requiredName("name")};
+  r.finish("cmd, id, name");
+  return c;
+}
+template <class T>
+T readBare(FieldReader& r) {
+  r.finish("cmd, id");
+  return {};
+}
+RemoveCloud readRemoveCloud(FieldReader& r) {
+  return readNamed<RemoveCloud>(r);
+}
+RemoveTarget readRemoveTarget(FieldReader& r) {
+  return readNamed<RemoveTarget>(r);
+}
 Snapshot readSnapshot(FieldReader& r) {
-  Snapshot c{r.requiredName("name")};
-  r.finish("cmd, id, name");
-  return c;
+  return readNamed<Snapshot>(r);
 }
-
 Restore readRestore(FieldReader& r) {
-  Restore c{r.requiredName("name")};
-  r.finish("cmd, id, name");
-  return c;
+  return readNamed<Restore>(r);
 }
-
+ListTargets readListTargets(FieldReader& r) {
+  return readBare<ListTargets>(r);
+}
 Stats readStats(FieldReader& r) {
-  r.finish("cmd, id");
-  return {};
+  return readBare<Stats>(r);
 }
-
 Hash readHash(FieldReader& r) {
-  r.finish("cmd, id");
-  return {};
+  return readBare<Hash>(r);
 }
 
 // The readers by name, from the one list (protocol/commands.inc).
