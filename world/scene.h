@@ -84,10 +84,11 @@ inline std::size_t ellipsoidCount(const Scene& scene) {
   return n;
 }
 
-// The medium of the stratiform layer the camera is in, or within the transition band of
-// (MODEL.md section 5, "the in-layer veil"): the layer's slab at its in-layer visibility
-// divided by the cover of its base plane above or below the eye (clear in a gap), in the
-// colour the layer's texture and sun give it there; none elsewhere.
+// The medium of the stratiform layer the camera is in, or in the transition band of (MODEL.md
+// section 5, "the in-layer veil"): the layer's slab, its in-layer visibility divided by the
+// cover of its base plane over the eye and by the slab's density at the eye's height, in the
+// colour the layer's texture and sun give it there; none elsewhere (where layers overlap, the
+// densest).
 std::optional<Fog> inLayerVeil(const Scene& scene);
 // Whether the camera is in a layer's slab or band (where inLayerVeil may give a veil).
 bool eyeInLayer(const Scene& scene);

@@ -198,14 +198,17 @@ WeatherClouds weatherClouds(const WeatherLayer& w, const std::string& prefix, st
   return out;
 }
 
+namespace {
+// Whether height z lies in the slab of layer `l` (a stratiform layer's base plane) or its bands.
+bool inSlab(const CloudLayer& l, double z) {
+  const CloudLayer::InLayer& in = l.in_layer;
+  return in.visibility_m > 0.0 && z >= l.altitude_m - in.band_m && z <= in.top_m + in.band_m;
+}
+}  // namespace
+
 bool eyeInLayer(const Scene& scene) {
-  const double z = scene.camera.position.z;
-  for (const CloudLayer& l : scene.layers) {
-    const CloudLayer::InLayer& in = l.in_layer;
-    if (in.visibility_m > 0.0 && z >= l.altitude_m - in.band_m && z <= in.top_m + in.band_m)
-      return true;
-  }
-  return false;
+  return std::any_of(scene.layers.begin(), scene.layers.end(),
+                     [&](const CloudLayer& l) { return inSlab(l, scene.camera.position.z); });
 }
 
 std::optional<Fog> inLayerVeil(const Scene& scene) {
@@ -216,10 +219,8 @@ std::optional<Fog> inLayerVeil(const Scene& scene) {
   std::optional<Fog> veil;
   double densest = 0.0;
   for (const CloudLayer& l : scene.layers) {
+    if (!inSlab(l, eye.z)) continue;
     const CloudLayer::InLayer& in = l.in_layer;
-    if (!(in.visibility_m > 0.0) || eye.z < l.altitude_m - in.band_m ||
-        eye.z > in.top_m + in.band_m)
-      continue;
     // The layer's slab is as dense as the cloud its base plane draws over the eye (eq. 9, its
     // region's threshold)...
     Fog f;
@@ -231,8 +232,7 @@ std::optional<Fog> inLayerVeil(const Scene& scene) {
     const LayerTexture texture(l.texture);
     const double t = texture.value(xy, scene.time_s);
     const double t1 = regionThreshold(l.threshold, layerRegionWeight(l, xy, scene.time_s, xy));
-    const double cover =
-        (1.0 - skyPlaneTranslucence(t, t1, l.transition)) * fogDensity(f, eye.z);
+    const double cover = (1.0 - skyPlaneTranslucence(t, t1, l.transition)) * fogDensity(f, eye.z);
     if (!(cover > densest)) continue;  // where layers overlap, the densest
     densest = cover;
     f.visibility_m = in.visibility_m / cover;
