@@ -36,8 +36,10 @@ int main(int argc, char** argv) {
   std::vector<std::string> specs{NEPHELE_SOURCE_DIR "/bench/datasets/layers_and_cumulus.toml",
                                  NEPHELE_SOURCE_DIR "/bench/datasets/layers.toml"};
   int samples = 12;
+  bool per_sample = false;
   app.add_option("specs", specs, "Dataset descriptions")->capture_default_str();
   app.add_option("--samples", samples, "Samples timed per description")->check(CLI::Range(1, 1000));
+  app.add_flag("--per-sample", per_sample, "Print each sample's camera and render time");
   CLI11_PARSE(app, argc, argv);
 
   const auto platform = openPlatform();
@@ -66,7 +68,13 @@ int main(int argc, char** argv) {
       heaps += msSince(t);
       t = Clock::now();
       const Frame frame = gl.renderFrame(with_heaps, settings, request);
-      render += msSince(t);
+      const double render_ms = msSince(t);
+      render += render_ms;
+      if (per_sample) {
+        const Camera& c = sample.scene.camera;
+        std::printf("  sample %d: camera at %.0f m, pitch %.1f deg, vfov %.1f deg: render %.1f ms\n",
+                    i, c.position.z, c.orientation.pitch_deg, c.vfov_deg, render_ms);
+      }
       t = Clock::now();
       const std::vector<TargetLabel> labels = labelTargets(frame, sample.target_class);
       const std::string json = sampleLabelsJson(labels, spec.width, spec.height).dump() +

@@ -78,6 +78,16 @@ std::string textureKey(const SolidTextureSpec& spec, const RenderSettings& setti
   return key.str();
 }
 
+// The spec whose table a baked texture of `spec` is: the same texture at unit scale. Every
+// Gardner term runs at 2^i cycles per period whatever the base frequencies (MODEL.md section
+// 2), and a Perlin table is tiled over its period, so the table does not depend on the scale;
+// baking it at a fixed one makes it a function of its key alone, not of which cloud asked first.
+SolidTextureSpec bakedTableSpec(SolidTextureSpec spec) {
+  spec.gardner.fx1 = spec.gardner.fy1 = 1.0;
+  spec.perlin_period_m = 1.0;
+  return spec;
+}
+
 // Baked solid Gardner: 4 texels per cycle of the highest term at level 0 (at most 128 a
 // side), level l holding n - l terms. With 4 texels per cycle GL's trilinear LOD equals the
 // fade schedule of MODEL.md section 2, so trilinear filtering fades each term over its octave.
@@ -198,6 +208,7 @@ void EllipsoidRenderer::beginFrame(FrameStats& stats) {
   stats_ = &stats;
   cancelled_ = false;
   for (auto& [key, cached] : textures_) cached.used = false;
+  ++frame_;
   next_buffer_ = 0;
 }
 
@@ -222,6 +233,13 @@ void EllipsoidRenderer::bindFrameTexture(int unit, GLenum format, const void* da
 
 void EllipsoidRenderer::endFrame() {
   std::erase_if(textures_, [](const auto& entry) { return !entry.second.used; });
+  while (tables_.size() > kKeptTables) {
+    auto oldest = std::min_element(tables_.begin(), tables_.end(), [](const auto& a, const auto& b) {
+      return a.second.last_frame < b.second.last_frame;
+    });
+    if (oldest->second.last_frame == frame_) break;  // all in use this frame
+    tables_.erase(oldest);
+  }
   std::erase_if(impostors_, [](const auto& entry) { return !entry.second.used; });
   for (auto& [index, impostor] : impostors_) impostor.used = false;
 }
@@ -240,19 +258,25 @@ GLuint EllipsoidRenderer::program(const EllipsoidPassLayout& layout) {
 EllipsoidRenderer::CachedTexture& EllipsoidRenderer::cachedTexture(const SolidTextureSpec& spec,
                                                                    const RenderSettings& settings) {
   auto [entry, inserted] = textures_.try_emplace(textureKey(spec, settings));
-  if (inserted) entry->second.source = std::make_unique<SolidTexture>(spec);
+  if (inserted) {
+    entry->second.source = std::make_unique<SolidTexture>(spec);
+    entry->second.table_key = textureKey(bakedTableSpec(spec), RenderSettings{});
+  }
   entry->second.used = true;
   return entry->second;
 }
 
 GLuint EllipsoidRenderer::gpuTexture(CachedTexture& cached) {
-  if (cached.texture) return cached.texture.get();
-  cached.texture = createTexture(gl_, GL_TEXTURE_3D);
-  const GLuint t = cached.texture.get();
-  if (const GardnerTexture* gardner = cached.source->gardner())
+  BakedTable& table = tables_[cached.table_key];
+  table.last_frame = frame_;
+  if (table.texture) return table.texture.get();
+  table.texture = createTexture(gl_, GL_TEXTURE_3D);
+  const GLuint t = table.texture.get();
+  const SolidTexture unit(bakedTableSpec(cached.source->spec()));
+  if (const GardnerTexture* gardner = unit.gardner())
     uploadBakedSolid(gl_, t, *gardner);
   else
-    uploadVolume(gl_, t, *cached.source->volume());
+    uploadVolume(gl_, t, *unit.volume());
   for (GLenum wrap : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R})
     gl_.TextureParameteri(t, wrap, GL_REPEAT);
   gl_.TextureParameteri(t, GL_TEXTURE_MAG_FILTER, GL_LINEAR);

@@ -279,9 +279,13 @@ EllipsoidCloud heapCloud(const CloudField& f, std::string name) {
   cloud.shading.ambient = look.ambient;
   cloud.shading.texture_fraction = look.texture_fraction;
   cloud.light_extinction = look.light_extinction;
-  // One texture for the whole field (the renderer caches textures by their parameters); it is
-  // solid, so every heap shows a different part of it.
-  cloud.texture.seed = hashCounters(f.seed, 0x54657874ull);
+  // One of kHeapTextures textures per genus, chosen by the field's seed: the texture is solid
+  // and repeats about once per heap radius, so every heap shows a different part of it, and a
+  // few seeds give fields all the variety a seed per field did. The renderer bakes each once and
+  // keeps it while fields come and go (a dataset's samples, a host's weather), whatever their
+  // scale, where a seed per field meant a 128^3 bake per field.
+  constexpr std::uint64_t kHeapTextures = 4;
+  cloud.texture.seed = hashCounters(0x54657874ull, std::uint64_t(f.type), f.seed % kHeapTextures);
   cloud.texture.gardner.fx1 = cloud.texture.gardner.fy1 = look.texture_cycles / heapRadius(f);
   cloud.texture.gardner.t0 = look.texture_offset;
   cloud.texture.gardner.terms = look.texture_terms;
