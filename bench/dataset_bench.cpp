@@ -72,8 +72,9 @@ int main(int argc, char** argv) {
       render += render_ms;
       if (per_sample) {
         const Camera& c = sample.scene.camera;
-        std::printf("  sample %d: camera at %.0f m, pitch %.1f deg, vfov %.1f deg: render %.1f ms\n",
-                    i, c.position.z, c.orientation.pitch_deg, c.vfov_deg, render_ms);
+        std::printf(
+            "  sample %d: camera at %.0f m, pitch %.1f deg, vfov %.1f deg: render %.1f ms\n", i,
+            c.position.z, c.orientation.pitch_deg, c.vfov_deg, render_ms);
       }
       t = Clock::now();
       const std::vector<TargetLabel> labels = labelTargets(frame, sample.target_class);

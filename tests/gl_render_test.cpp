@@ -109,6 +109,79 @@ TEST_F(GlRenderTest, LatticeBreakingEqualsOneSampleReference) {
   expectPointSampledEqual(*renderer_, file.scene, "point_lattice_breaking_again");
 }
 
+// The clipmap of a texture that never repeats (MODEL.md section 2, "Clipmap") against the
+// 4x4-supersampled reference, as the per-pixel sines are held to it, and against the sines:
+// altocumulus from the ground and stratocumulus from above, at 320x240. The rings hold each
+// truncation the term filter keeps, so the two images differ only by the rings' bilinear
+// interpolation and, at ring edges, by a coarser ring than the footprint asks.
+TEST_F(GlRenderTest, ClipmapMatchesReference) {
+  struct Case {
+    const char* preset;
+    double pitch_deg, z_m;
+  };
+  for (const Case& c :
+       {Case{"genus_altocumulus", 50.0, 2.0}, Case{"genus_stratocumulus", -40.0, 4000.0}}) {
+    SceneFile file = preset(c.preset, 320, 240);
+    ASSERT_GT(file.scene.layers[0].texture.gardner.rotation_deg, 0.0) << c.preset;
+    file.scene.camera.orientation.pitch_deg = c.pitch_deg;
+    file.scene.camera.position.z = c.z_m;
+    RenderSettings clipmap = file.render, sines = file.render;
+    clipmap.texture_evaluation = TextureEvaluation::kBaked;
+    sines.texture_evaluation = TextureEvaluation::kProcedural;
+    const FloatImage a = renderer_->renderFloat(file.scene, clipmap);
+    EXPECT_GT(renderer_->lastFrameStats().layer_texels_baked, 0) << c.preset;
+    const FloatImage reference = renderReference(file.scene, file.reference);
+    const FloatImage b = renderer_->renderFloat(file.scene, sines);
+    const std::string name = std::string("clipmap_") + c.preset;
+    std::printf(
+        "%s: clipmap %.1f dB, sines %.1f dB against the reference; clipmap against sines %.1f dB\n",
+        c.preset, compareImages(a, reference).psnr_db, compareImages(b, reference).psnr_db,
+        compareImages(a, b).psnr_db);
+    expectClose(a, reference, 36.0, 0.25, name);
+    expectClose(a, b, 40.0, 0.2, name + "_sines");
+  }
+}
+
+// A clipmap carried along a flight by strips (a toroidal update: only the texels the camera
+// uncovers are evaluated) holds what a clipmap filled at the end of the flight holds. `auto`
+// waits a frame before filling anything, then fills a frame's pixels of texels a frame and
+// reads the sines until the clipmap is whole, when it draws what `baked` draws.
+TEST_F(GlRenderTest, ClipmapFollowsTheCameraByStrips) {
+  SceneFile file = preset("genus_stratocumulus", 160, 120);
+  file.scene.camera.orientation = {80.0, 20.0, 0.0};  // ahead, where the strips are filled
+  file.scene.camera.position.z = 2.0;
+  RenderSettings baked = file.render;
+  baked.texture_evaluation = TextureEvaluation::kBaked;
+  GlRenderer flyer(*platform_);
+  Scene scene = file.scene;
+  for (int frame = 0; frame < 40; ++frame) {  // at 30 Hz: west, east at 250 m/s, then faster
+    scene.camera.position.x += frame < 10 ? -60.0 : frame < 30 ? 8.3 : 150.0;
+    scene.camera.position.y += frame < 10 ? 2.0 : 5.1;
+    flyer.renderFloat(scene, baked);
+    if (frame > 0) {
+      EXPECT_LT(flyer.lastFrameStats().layer_texels_baked, 256 * 160) << frame;
+    }
+  }
+  const FloatImage carried = flyer.renderFloat(scene, baked);
+  GlRenderer fresh(*platform_);
+  expectClose(carried, fresh.renderFloat(scene, baked), 60.0, 0.01, "clipmap_strips");
+
+  GlRenderer waiting(*platform_);
+  RenderSettings automatic = file.render;
+  ASSERT_EQ(automatic.texture_evaluation, TextureEvaluation::kAuto);
+  waiting.renderFloat(scene, automatic);
+  EXPECT_EQ(waiting.lastFrameStats().layer_texels_baked, 0);
+  int frames = 1;
+  while (frames < 100) {
+    waiting.renderFloat(scene, automatic);
+    ++frames;
+    if (frames > 2 && waiting.lastFrameStats().layer_texels_baked == 0) break;
+    EXPECT_LE(waiting.lastFrameStats().layer_texels_baked, 2 * 160 * 120);
+  }
+  EXPECT_LT(frames, 100);
+  expectClose(waiting.renderFloat(scene, automatic), carried, 60.0, 0.01, "clipmap_auto");
+}
+
 // A layer bounded by a region (a turned rectangle with an edge band, one side of a front;
 // MODEL.md section 11), drifted for ten minutes: exact against the one-sample reference, and
 // the region really removes cover (less than half the unbounded layer's).

@@ -18,7 +18,8 @@ std::vector<std::pair<const char*, int>> FrameStats::fields() const {
           {"impostors_rendered", impostors_rendered},
           {"layer_terms", layer_terms},
           {"layer_terms_total", layer_terms_total},
-          {"volume_uploads", volume_uploads}};
+          {"volume_uploads", volume_uploads},
+          {"layer_texels_baked", layer_texels_baked}};
 }
 
 std::string FrameStats::line() const {

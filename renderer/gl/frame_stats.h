@@ -24,6 +24,9 @@ struct FrameStats {
   int layer_terms = 0;
   int layer_terms_total = 0;  // the layers' terms before the filter
   int volume_uploads = 0;     // automaton keyframe volumes sent to the GPU
+  // Layer texels evaluated into clipmaps (MODEL.md section 2): every ring when a clipmap is
+  // new, then only the strips the camera uncovers.
+  int layer_texels_baked = 0;
 
   int passes() const {
     return sky_passes + ellipsoid_passes + atlas_passes + automaton_passes + target_passes +

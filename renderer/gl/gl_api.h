@@ -81,6 +81,7 @@ using GlDepthMaskProc = void(APIENTRYP)(GLboolean flag);
   X(PFNGLCLIPCONTROLPROC, ClipControl)                                   \
   X(PFNGLCLEARNAMEDFRAMEBUFFERFVPROC, ClearNamedFramebufferfv)           \
   X(PFNGLNAMEDFRAMEBUFFERTEXTUREPROC, NamedFramebufferTexture)           \
+  X(PFNGLNAMEDFRAMEBUFFERTEXTURELAYERPROC, NamedFramebufferTextureLayer) \
   X(PFNGLNAMEDFRAMEBUFFERDRAWBUFFERSPROC, NamedFramebufferDrawBuffers)   \
   X(PFNGLCREATEBUFFERSPROC, CreateBuffers)                               \
   X(PFNGLDELETEBUFFERSPROC, DeleteBuffers)                               \

@@ -133,8 +133,10 @@ class CloudBands {
       const bool falling = b >= fall_first && b <= fall_last;
       if (!rising && !falling) continue;
       glm::vec4 slabs(0.0f);
-      if (rising) slabs.x = bound(rising_, b - 1, 0.0), slabs.y = bound(rising_, b, 1e38);
-      if (falling) slabs.z = bound(falling_, b, -1e38), slabs.w = bound(falling_, b - 1, 0.0);
+      if (std::size_t(b) <= rising_.size())
+        slabs.x = bound(rising_, b - 1, 0.0), slabs.y = bound(rising_, b, 1e38);
+      if (std::size_t(b) <= falling_.size())
+        slabs.z = bound(falling_, b, -1e38), slabs.w = bound(falling_, b - 1, 0.0);
       out.push_back({b, {slabs}});
     }
     return out;
@@ -165,6 +167,7 @@ GlRenderer::GlRenderer(const GlPlatform& platform)
       framebuffer_(createFramebuffer(gl_)),
       ellipsoids_(gl_),
       automata_(gl_),
+      clipmaps_(gl_),
       targets_(gl_) {}
 
 GlRenderer::~GlRenderer() = default;
@@ -412,40 +415,28 @@ void GlRenderer::setSlotUniforms(GLuint p, int slot, const LayerSlot& entry, con
 
   if (const GardnerTexture* g = texture.gardner()) {
     gl_.ProgramUniform1f(p, location("u_terms", slot), float(g->terms()));
-    if (entry.kind == LayerKind::kProceduralGardner) {
+    if (entry.kind == LayerKind::kProceduralGardner)
       // Metres inside one period; a rotated texture has none, so its phases at the point under
       // the camera are taken from the whole drifted position, in double, term by term.
-      const glm::dvec2 origin = texture.periodic()
-                                    ? origin_uv * period
-                                    : camera_xy - texture.driftOffset(scene.time_s, layer.texture);
-      for (int j = 0; j < g->terms(); ++j) {
-        auto set = [&](const char* name, int k, double v) {
-          gl_.ProgramUniform1f(p, location(name, k), float(v));
-        };
-        set("u_fx", 8 * slot + j, g->frequencyX(j));
-        set("u_fy", 8 * slot + j, g->frequencyY(j));
-        set("u_amplitude", 8 * slot + j, g->componentAmplitude(j));
-        gl_.ProgramUniform1i(p, location("u_components", 8 * slot + j), g->components(j));
-        for (int c = 0; c < g->components(j); ++c) {
-          const int k = GardnerTextureParams::kComponents * (8 * slot + j) + c;
-          const glm::dvec2 a = g->axisX(j, c), b = g->axisY(j, c);
-          const glm::dvec2 q1(a.x * origin.x + a.y * origin.y, a.x * origin.y - a.y * origin.x);
-          const glm::dvec2 q2(b.x * origin.x + b.y * origin.y, b.x * origin.y - b.y * origin.x);
-          set("u_phase_x", k, wrapPeriodic(g->frequencyX(j) * q1.x + g->phaseX(j, c), kTwoPi));
-          set("u_phase_y", k, wrapPeriodic(g->frequencyY(j) * q2.y + g->phaseY(j, c), kTwoPi));
-          set("u_half_phase_x", k, wrapPeriodic(0.5 * g->frequencyX(j) * q2.x, kTwoPi));
-          set("u_half_phase_y", k, wrapPeriodic(0.5 * g->frequencyY(j) * q1.y, kTwoPi));
-          const glm::vec2 axis_x(a), axis_y(b);
-          gl_.ProgramUniform2fv(p, location("u_axis_x", k), 1, &axis_x.x);
-          gl_.ProgramUniform2fv(p, location("u_axis_y", k), 1, &axis_y.x);
-        }
-      }
-      gl_.ProgramUniform1f(p, location("u_t0", slot), float(g->params().t0));
-      gl_.ProgramUniform1f(p, location("u_k", slot), float(g->normalisation()));
-    }
+      setLayerGardnerUniforms(gl_, p, slot, *g,
+                              texture.periodic()
+                                  ? origin_uv * period
+                                  : camera_xy - texture.driftOffset(scene.time_s, layer.texture));
+  }
+  if (entry.kind == LayerKind::kClipmapGardner) {
+    const ClipmapView& c = entry.clipmap;
+    const glm::vec2 texel(c.texel_m);
+    gl_.ProgramUniform2fv(p, location("u_clip_texel", slot), 1, &texel.x);
+    gl_.ProgramUniform2fv(p, location("u_clip_offset", 8 * slot), GLsizei(c.offset.size()),
+                          &c.offset[0].x);
+    gl_.ProgramUniform1f(p, location("u_clip_size", slot), float(c.size));
+    gl_.ProgramUniform1f(p, location("u_clip_rings", slot), float(c.rings));
+    gl_.ProgramUniform1f(p, location("u_clip_constant", slot), float(c.constant));
   }
   if (entry.kind != LayerKind::kProceduralGardner) {
-    gl_.BindTextureUnit(GLuint(slot), gpuTexture(*entry.texture, settings));
+    gl_.BindTextureUnit(GLuint(slot), entry.kind == LayerKind::kClipmapGardner
+                                          ? entry.clipmap.texture
+                                          : gpuTexture(*entry.texture, settings));
     const std::string sampler = "u_table" + std::to_string(slot);
     gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, sampler.c_str()), slot);
   }
@@ -573,11 +564,13 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
   for (auto& [key, cached] : textures_) cached.used = false;
   ellipsoids_.beginFrame(stats_);
   automata_.beginFrame(stats_);
+  clipmaps_.beginFrame();
   auto finish = [&](const Veil& veil) {
     ellipsoids_.drawVeil(veil);
     gl_.Disable(GL_BLEND);
     ellipsoids_.endFrame();
     automata_.endFrame();
+    clipmaps_.endFrame();
     std::erase_if(textures_, [](const auto& entry) { return !entry.second.used; });
   };
   // The eye deep in a cloud: its veil hides what lies behind to within the per-pixel pass's
@@ -596,13 +589,17 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
   for (const CloudLayer& layer : scene.layers) {
     if (layer.altitude_m == z) continue;  // seen edge-on: covers no pixel
     CachedTexture& texture = cachedTexture(layer.texture, settings);
-    // A rotated Gardner texture never repeats, so no periodic table can hold it.
+    // A rotated Gardner texture never repeats, so no periodic table can hold it: it is read
+    // from a clipmap around the camera, or its sines are summed per pixel when asked (and
+    // with a term filter other than the fade, which the rings are built for).
+    const bool sines = settings.texture_evaluation == TextureEvaluation::kProcedural;
     const LayerKind kind = !texture.source->gardner() ? LayerKind::kTable
-                           : settings.texture_evaluation == TextureEvaluation::kProcedural ||
-                                   !texture.source->periodic()
+                           : texture.source->periodic()
+                               ? (sines ? LayerKind::kProceduralGardner : LayerKind::kBakedGardner)
+                           : sines || settings.term_filter != TermFilter::kFade
                                ? LayerKind::kProceduralGardner
-                               : LayerKind::kBakedGardner;
-    (layer.altitude_m > z ? above : below).push_back({&layer, &texture, kind});
+                               : LayerKind::kClipmapGardner;
+    (layer.altitude_m > z ? above : below).push_back({&layer, &texture, kind, {}});
   }
   std::sort(above.begin(), above.end(), [](const LayerSlot& a, const LayerSlot& b) {
     return a.layer->altitude_m > b.layer->altitude_m;
@@ -632,6 +629,31 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
             layerTermsAtMost(*slot.layer, *slot.texture->source, camera, settings.term_filter);
         stats_.layer_terms_total += g->terms();
       }
+
+  // The clipmaps of the layers that read one, brought to this camera before any pass. `auto`
+  // fills a layer's clipmap over the frames after the first that draws it from here, about a
+  // frame's pixels of texels each, and reads the sines until it is whole (a single render never
+  // pays for one); `baked` fills it at once.
+  bool baked = false;
+  const bool wait = settings.texture_evaluation == TextureEvaluation::kAuto;
+  const std::int64_t budget =
+      wait ? std::int64_t(camera.width) * camera.height : std::numeric_limits<std::int64_t>::max();
+  for (std::vector<LayerSlot>* side : {&above, &below})
+    for (LayerSlot& slot : *side)
+      if (slot.kind == LayerKind::kClipmapGardner) {
+        const LayerTexture& t = *slot.texture->source;
+        const glm::dvec2 eye =
+            glm::dvec2(camera.position) - t.driftOffset(scene.time_s, slot.layer->texture);
+        slot.clipmap =
+            clipmaps_.prepare(textureKey(slot.layer->texture, settings), *t.gardner(), eye,
+                              LayerClipmaps::sizeFor(camera.height), budget, wait, stats_);
+        if (!slot.clipmap.complete) slot.kind = LayerKind::kProceduralGardner;
+        baked = true;
+      }
+  if (baked) {
+    gl_.BindFramebuffer(GL_FRAMEBUFFER, framebuffer_.get());
+    gl_.Viewport(0, 0, camera.width, camera.height);
+  }
 
   // Interleave clouds with the layers (docs/MODEL.md, "Compositing order"). On each side of
   // the camera, band b holds what lies beyond the b nearest layers of that side and before

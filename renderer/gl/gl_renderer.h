@@ -13,6 +13,7 @@
 #include "renderer/gl/frame_stats.h"
 #include "renderer/gl/gl_objects.h"
 #include "renderer/gl/gl_platform.h"
+#include "renderer/gl/layer_clipmap.h"
 #include "renderer/gl/sky_shaders.h"
 #include "renderer/gl/target_renderer.h"
 #include "renderer/render_settings.h"
@@ -77,6 +78,7 @@ class GlRenderer {
     const CloudLayer* layer;
     CachedTexture* texture;
     LayerKind kind;
+    ClipmapView clipmap;  // kClipmapGardner: the rings around this frame's camera
   };
 
   void drawFrame(const Scene& scene, const RenderSettings& settings, TargetFormat format);
@@ -108,6 +110,7 @@ class GlRenderer {
   FrameStats stats_;
   EllipsoidRenderer ellipsoids_;
   AutomatonRenderer automata_;
+  LayerClipmaps clipmaps_;
   TargetRenderer targets_;
 };
 

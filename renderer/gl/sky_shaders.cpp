@@ -274,18 +274,54 @@ void addTerm(int i, int j, vec2 p, inout float sx, inout float sy) {
   }
 }
 
-float proceduralValue(int i, LayerHit hit) {
-  float count = termCount(i, hit);
+// T of slot i at p (metres from the phases' origin) truncated to `count` terms, a fractional
+// count blending floor(count) and floor(count) + 1 (GardnerTexture::planar).
+float truncatedValue(int i, vec2 p, float count) {
   int whole = int(count);
   float sx = u_t0[i], sy = u_t0[i];
-  for (int j = 0; j < whole; ++j) addTerm(i, j, hit.p, sx, sy);
+  for (int j = 0; j < whole; ++j) addTerm(i, j, p, sx, sy);
   float t = u_k[i] * max(sx, 0.0) * max(sy, 0.0);
   float fraction = count - float(whole);
   if (fraction > 0.0) {
-    addTerm(i, whole, hit.p, sx, sy);
+    addTerm(i, whole, p, sx, sy);
     t = mix(t, u_k[i] * max(sx, 0.0) * max(sy, 0.0), fraction);
   }
   return t;
+}
+
+float proceduralValue(int i, LayerHit hit) { return truncatedValue(i, hit.p, termCount(i, hit)); }
+#endif
+
+#ifdef CLIPMAP
+// The clipmap of a texture that never repeats (MODEL.md section 2, "Clipmap"; LayerClipmaps):
+// ring l of slot i holds T truncated to n - l terms on a lattice of texel u_clip_texel[i] 2^l
+// metres (the footprint at which the term filter keeps exactly n - l terms), centred near the
+// camera; the texel of lattice index k is stored at k mod N. u_clip_offset[kRings i + l] is the
+// camera's lattice coordinate in ring l modulo N. A pixel reads the two rings its footprint
+// falls between, as the per-pixel fade does, or coarser ones where the finer ring does not
+// reach: a ring is read within N/4 of its centre and blended into the next out to N/2.
+const int kRings = 8;
+uniform vec2 u_clip_texel[kSlots];
+uniform vec2 u_clip_offset[kSlots * kRings];
+uniform float u_clip_size[kSlots];      // N
+uniform float u_clip_rings[kSlots];     // n: ring n and beyond hold T with no term
+uniform float u_clip_constant[kSlots];  // that T, k T0^2
+
+float clipmapValue(sampler2DArray rings, int i, LayerHit hit) {
+  float n = u_clip_rings[i], size = u_clip_size[i];
+  vec2 q = hit.p / u_clip_texel[i];  // ring 0 texels from the camera
+  float reach = log2(max(max(abs(q.x), abs(q.y)), 1.0) / (0.25 * size - 1.0));
+  float level = clamp(max(u_terms[i] - termCount(i, hit), reach), 0.0, n);
+  float l = min(floor(level), n - 1.0);
+  int k = int(l);
+  float scale = exp2(-l);
+  vec2 at = u_clip_offset[kRings * i + k] + q * scale;
+  float fine = textureLod(rings, vec3(at / size, l), 0.0).r;
+  int next = min(k + 1, int(n) - 1);
+  vec2 at_next = u_clip_offset[kRings * i + next] + q * (0.5 * scale);
+  float coarse = k + 1 < int(n) ? textureLod(rings, vec3(at_next / size, float(next)), 0.0).r
+                                 : u_clip_constant[i];
+  return mix(fine, coarse, level - l);
 }
 #endif
 
@@ -364,6 +400,9 @@ std::string slotStatement(int slot, LayerKind kind) {
     case LayerKind::kProceduralGardner:
       value = "proceduralValue(" + i + ", hit)";
       break;
+    case LayerKind::kClipmapGardner:
+      value = "clipmapValue(u_table" + i + ", " + i + ", hit)";
+      break;
   }
   // Behind a surface that is opaque to within 1/1024 nothing more is evaluated (what the
   // layers there could add is below half an 8-bit step): a full deck costs its nearest plane.
@@ -392,6 +431,26 @@ std::string viewShaderSource() {
   return kCommon;
 }
 
+std::string clipmapBakeSource() {
+  std::string s = "#version 450 core\n#define PROCEDURAL\n";
+  s += "const int kComponents = " + std::to_string(GardnerTextureParams::kComponents) + ";\n";
+  s += kCommon;
+  s += kLayers;
+  // Slot 0's phases are taken at the corner of the ring's window (lattice index `first` in
+  // absolute terms); the fragment at storage texel s holds the window's texel (s - first) mod N.
+  s += R"(
+uniform ivec2 u_bake_first;   // the window's first lattice index, modulo N
+uniform int u_bake_size;      // N
+uniform vec2 u_bake_texel;    // metres per texel of this ring
+uniform float u_bake_terms;   // n - l
+void main() {
+  ivec2 rel = (ivec2(gl_FragCoord.xy) - u_bake_first + u_bake_size) % u_bake_size;
+  o_colour = vec4(truncatedValue(0, (vec2(rel) + 0.5) * u_bake_texel, u_bake_terms));
+}
+)";
+  return s;
+}
+
 std::string polygonVertexSource() {
   return R"(#version 450 core
 uniform vec2 u_polygon[8];  // convex polygon in normalised device coordinates, a triangle fan
@@ -408,18 +467,27 @@ std::string skyFragmentSource(const SkyPassLayout& layout) {
   if (layout.regions) s += "#define REGIONS\n";
   if (layout.term_filter == TermFilter::kCut) s += "#define FILTER_CUT\n";
   if (layout.term_filter == TermFilter::kNone) s += "#define FILTER_NONE\n";
-  bool procedural = false, sampled = false;
+  bool procedural = false, clipmap = false;
   for (const auto* side : {&layout.above, &layout.below})
-    for (LayerKind kind : *side)
-      (kind == LayerKind::kProceduralGardner ? procedural : sampled) = true;
+    for (LayerKind kind : *side) {
+      procedural |= kind == LayerKind::kProceduralGardner;
+      clipmap |= kind == LayerKind::kClipmapGardner;
+    }
   if (procedural) s += "#define PROCEDURAL\n";
+  if (clipmap) s += "#define CLIPMAP\n";
   s += "const int kComponents = " + std::to_string(GardnerTextureParams::kComponents) + ";\n";
   s += kCommon;
   if (layout.slots() > 0) s += kLayers;
-  // One sampler uniform per slot: llvmpipe samples a sampler-array element far more slowly.
-  if (sampled)
-    for (int i = 0; i < layout.slots(); ++i)
-      s += "uniform sampler2D u_table" + std::to_string(i) + ";\n";
+  // One sampler uniform per sampled slot: llvmpipe samples a sampler-array element far more
+  // slowly.
+  int slot = 0;
+  for (const auto* side : {&layout.above, &layout.below})
+    for (LayerKind kind : *side) {
+      const std::string name = " u_table" + std::to_string(slot++) + ";\n";
+      if (kind == LayerKind::kClipmapGardner) s += "uniform sampler2DArray" + name;
+      if (kind == LayerKind::kBakedGardner || kind == LayerKind::kTable)
+        s += "uniform sampler2D" + name;
+    }
 
   s += "const float kClear = 1.0 / 1024.0;\n";
   s += "void main() {\n  vec3 r = viewRay();\n";

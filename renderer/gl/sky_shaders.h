@@ -10,7 +10,10 @@
 
 namespace nephele {
 
-enum class LayerKind { kBakedGardner, kProceduralGardner, kTable };
+// How a slot reads its layer's texture: a periodic table of Gardner's texture (term
+// truncations as mip levels), Gardner's sines per pixel, a clipmap of a texture that never
+// repeats (LayerClipmaps), or a tabulated noise.
+enum class LayerKind { kBakedGardner, kProceduralGardner, kTable, kClipmapGardner };
 
 inline constexpr int kMaxLayerSlots = 8;
 
@@ -36,5 +39,7 @@ struct SkyPassLayout {
 std::string viewShaderSource();
 std::string polygonVertexSource();
 std::string skyFragmentSource(const SkyPassLayout& layout);
+// The pass that fills a clipmap ring's texels from Gardner's sines (slot 0's uniforms).
+std::string clipmapBakeSource();
 
 }  // namespace nephele
