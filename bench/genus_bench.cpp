@@ -441,6 +441,11 @@ int main(int argc, char** argv) {
   std::string images;
   app.add_option("--images", images,
                  "Also write the heap views the light figures are measured on to this directory");
+  double coverage = -1.0;
+  app.add_option("--coverage", coverage,
+                 "Draw every [[weather]] layer of the presets at this cover, percent (issue 28's "
+                 "30, 50, 70 and 100), instead of the preset's own")
+      ->check(CLI::Range(0.0, 100.0));
   bool hemisphere = false;
   app.add_flag("--hemisphere", hemisphere,
                "Instead: the fraction of the sky dome covered, seen from the ground, for every "
@@ -493,7 +498,19 @@ int main(int argc, char** argv) {
 
   for (const auto& path : files) {
     SceneFile file;
-    if (!bench::loadPreset(path.string(), file)) return 1;
+    if (coverage < 0.0) {
+      if (!bench::loadPreset(path.string(), file)) return 1;
+    } else {  // the preset's text with every `coverage = ...` line replaced
+      std::ifstream in(path);
+      std::string text, line;
+      while (std::getline(in, line))
+        text += (line.starts_with("coverage =") ? "coverage = " + std::to_string(coverage) : line) +
+                "\n";
+      if (const std::string e = parseSceneText(text, path.string(), file); !e.empty()) {
+        std::fprintf(stderr, "%s\n", e.c_str());
+        return 1;
+      }
+    }
     for (const std::string& size : sizes) {
       Camera sized;
       if (!bench::parseSize(size, sized)) return 2;

@@ -8,6 +8,7 @@
 
 #include "config/daemon_config.h"
 #include "config/scene_file.h"
+#include "tests/fuzz/world_work.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace nephele;
@@ -16,7 +17,18 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string_view text(reinterpret_cast<const char*>(data + 1), size - 1);
   if (selector % 2 == 0) {
     SceneFile scene;
-    (void)parseSceneText(text, "fuzz.toml", scene);
+    // A scene that reads is then built and ticked as the daemon would (world_work.h), unless
+    // its automata's start-up work passes 1/200 of what one request may run (3 s in a release
+    // build; under the fuzzer's sanitizers a cell step costs about 0.4 us, 70 times as much,
+    // so 1/200 is about a second there): the limits allow a scene file
+    // up to about 25 s of it at start-up (world/limits.h), longer than the fuzzer's timeout,
+    // and the daemon reads its scene once, before it serves anyone.
+    if (!parseSceneText(text, "fuzz.toml", scene).empty()) return 0;
+    double work = 0.0;
+    for (const AutomatonCloudSpec& a : scene.dynamics.automata)
+      work += double(a.cells.cells()) *
+              (a.warmup_steps + 1 + a.samples_per_cell * a.samples_per_cell * a.samples_per_cell);
+    if (work <= Limits::kMaxCellStepsPerAdvance / 200.0) exerciseWorld(scene.scene, scene.dynamics);
   } else {
     // The config's scene path is resolved beside this name; presets sit in config/scenes.
     DaemonConfig config;

@@ -14,6 +14,8 @@
 #include "protocol/messages.h"
 #include "protocol/modbus_frame.h"
 #include "protocol/register_map.h"
+#include "tests/fuzz/world_work.h"
+#include "world/formations/weather.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace nephele;
@@ -86,10 +88,20 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     }
     const Command& command = std::get<Request>(result).command;
     (void)okReply(std::get<Request>(result).id, commandName(command));
-    // The objects the world thread reads later, through the scene-file readers.
+    // The objects the world thread reads later, through the scene-file readers, and what it
+    // then does with a cloud or a weather layer (world_work.h).
     if (const auto* c = std::get_if<command::AddCloud>(&command)) {
       EllipsoidCloud cloud;
-      (void)parseCloudJson(c->cloud, 1, cloud);
+      if (!parseCloudJson(c->cloud, 1, cloud).empty()) return 0;
+      Scene scene;
+      scene.clouds.push_back(std::move(cloud));
+      exerciseWorld(scene, {});
+    } else if (const auto* w = std::get_if<command::SetWeather>(&command)) {
+      WeatherClouds drawn = weatherClouds(w->weather, "weather/1", weatherSeed(1, w->layer));
+      Scene scene;
+      scene.layers = std::move(drawn.layers);
+      scene.fields = std::move(drawn.fields);
+      exerciseWorld(scene, {});
     } else if (const auto* t = std::get_if<command::AddTarget>(&command)) {
       Target target;
       (void)parseTargetJson(t->target, {}, target);
