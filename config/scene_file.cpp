@@ -469,7 +469,7 @@ WeatherLayer readWeather(TableReader& t, bool macro = false) {
                                            "centre", "size", "heading", "edge", "front",
                                            "transition", "spacing", "variation"}
                 : std::vector<std::string>{"type", "base", "thickness", "coverage", "visibility",
-                                           "transition_band"});
+                                           "transition_band", "scud"});
   std::vector<std::string> names;
   for (int i = 0; i < kCloudTypeCount; ++i) names.emplace_back(cloudTypeName(CloudType(i)));
   WeatherLayer w;
@@ -482,6 +482,9 @@ WeatherLayer readWeather(TableReader& t, bool macro = false) {
   if (!macro) {  // inside the layer (MODEL.md section 5); 0 takes the genus's visibility
     t.number("visibility", w.visibility_m, 0.0, Limits::kLayerVisibility.hi);
     t.number("transition_band", w.transition_band_m, Limits::kTransitionBand);
+    double scud = 100.0 * w.scud;
+    t.number("scud", scud, Limits::kCoveragePercent);
+    w.scud = scud / 100.0;
     checkWeather(t, w);
   }
   if (macro) readMacrocluster(t, w);

@@ -43,7 +43,8 @@ bool sameCloudLayer(const WeatherControl& a, const WeatherControl& b) {
   return a.enabled == b.enabled && a.cloud_type == b.cloud_type && a.base == b.base &&
          a.thickness == b.thickness && a.coverage == b.coverage && a.wind_speed == b.wind_speed &&
          a.wind_direction == b.wind_direction && a.visibility == b.visibility &&
-         a.transition_band == b.transition_band;
+         a.transition_band == b.transition_band && a.scud == b.scud &&
+         (!a.scud || a.scud_frequency == b.scud_frequency);
 }
 bool sameFog(const WeatherControl& a, const WeatherControl& b) {
   return a.enabled == b.enabled && a.base == b.base && a.thickness == b.thickness &&
@@ -81,6 +82,12 @@ std::variant<WeatherLayer, std::string> cloudLayerOf(const WeatherControl& w) {
   // Inside the layer (MODEL.md section 5): its visibility (0, the genus's) and transition band.
   layer.visibility_m = w.visibility;
   layer.transition_band_m = w.transition_band;
+  // Scud: fragments under the base covering the scud frequency (MODEL.md section 10).
+  if (w.scud) {
+    if (!Limits::kCoveragePercent.contains(w.scud_frequency))
+      return "scud frequency " + text(w.scud_frequency) + " (allowed: 0 to 100 %)";
+    layer.scud = w.scud_frequency / 100.0;
+  }
   if (std::string e = weatherLayerError(layer); !e.empty()) return e;
   return layer;
 }
@@ -337,7 +344,6 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
         bad(where + ": " + *e);
         continue;
       }
-      if (w->scud) frame.ignored.push_back(where + ": scud");
       if (!regional) {
         frame.commands.emplace_back(
             command::SetWeather{w->layer, std::get<WeatherLayer>(layer), std::nullopt});

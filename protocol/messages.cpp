@@ -281,6 +281,7 @@ WeatherLayer readWeather(FieldReader& r) {
   w.clusters.spacing_m = r.number("spacing", Limits::kClusterSpacing).value_or(0.0);
   if (auto v = r.number("visibility", 0.0, Limits::kLayerVisibility.hi)) w.visibility_m = *v;
   w.transition_band_m = r.number("transition_band", Limits::kTransitionBand).value_or(0.0);
+  w.scud = r.number("scud", Limits::kCoveragePercent).value_or(0.0) / 100.0;
   w.clusters.amount = r.number("variation", Limits::kClusterVariation).value_or(0.0);
   // The rules between keys are the world's, shared with scene files.
   if (std::string e = weatherLayerError(w); !e.empty()) throw FieldError{ErrorCode::kBadField, e};
@@ -321,7 +322,7 @@ SetWeather readSetWeather(FieldReader& r) {
   c.weather = readWeather(r);
   r.finish(
       "cmd, id, layer, type, base, thickness, coverage, wind, centre, size, heading, edge, "
-      "front, transition, spacing, variation, visibility, transition_band");
+      "front, transition, spacing, variation, visibility, transition_band, scud");
   return c;
 }
 

@@ -49,10 +49,12 @@ def view_definition(view, left, right, top, bottom, near=1.0, far=50000.0, bo=">
 
 def weather_control(layer, enabled, cloud_type=0, coverage=0.0, base=0.0, thickness=0.0,
                     visibility=0.0, wind=0.0, wind_from=0.0, transition=0.0, scope=0, region=0,
-                    bo=">"):
+                    scud=None, bo=">"):
+    """scud: the scud frequency, percent, with scud enabled; None leaves it disabled."""
     return struct.pack(bo + "BBHBBBB" + "f" * 12, 12, 56, region, layer, 50,
-                       int(enabled) | (cloud_type << 4), scope, 15.0, visibility, 0.0, coverage,
-                       base, thickness, transition, wind, 0.0, wind_from, 1013.0, 0.0)
+                       int(enabled) | (int(scud is not None) << 1) | (cloud_type << 4), scope,
+                       15.0, visibility, scud or 0.0, coverage, base, thickness, transition, wind,
+                       0.0, wind_from, 1013.0, 0.0)
 
 
 def region_control(region, state, lat, lon, size_x, size_y, rotation=0.0, perimeter=0.0,
@@ -504,6 +506,25 @@ size = [4, 2, 1]
         # 50 m above the top: a 300 m band still veils the view, no band leaves the planes.
         self.assertLessEqual(inside(1150.0, 50.0, 300.0, 3), 2)
         self.assertGreater(inside(1150.0, 50.0, 0.0, 4), 10)
+        self.assertNotIn("ignored", c.ok({"cmd": "stats"})["cigi"])
+        # Scud: fragments under the base (MODEL.md section 10), at the frequency asked; looking
+        # up from under them the view varies more than under the bare deck. 150 % refuses the
+        # packet, which changes nothing.
+        def under(scud, frame, send=True):
+            self.frame(weather_control(1, True, 10, coverage=100.0, base=600.0, thickness=500.0,
+                                       transition=300.0, scud=scud) if send else b"", frame=frame)
+            c.ok({"cmd": "set_view", "view": "front", "position": [-20000.0, 0.0, 2.0],
+                  "heading": 270.0, "pitch": 40.0, "vfov": 60.0})
+            _, raw = c.ok({"cmd": "render", "view": "front", "format": "raw",
+                           "channels": ["colour"]})
+            green = raw[1::3]
+            return max(green) - min(green)
+        bare = under(None, 5)
+        with_scud = under(40.0, 6)
+        self.assertGreater(with_scud, bare + 10)
+        self.frame(weather_control(1, True, 10, coverage=100.0, base=600.0, thickness=500.0,
+                                   scud=150.0), frame=7)
+        self.assertEqual(under(None, 8, send=False), with_scud)  # the refused packet: no change
         self.assertNotIn("ignored", c.ok({"cmd": "stats"})["cigi"])
 
     def test_little_endian_host(self):

@@ -295,6 +295,7 @@ class SocketProtocolTest(DaemonTest):
             ({"cmd": "set_weather", "layer": 4, "type": 1}, "bad_field", "layer"),
             ({"cmd": "set_weather", "layer": 1, "type": 7, "coverage": -5}, "bad_field",
              "coverage"),
+            ({"cmd": "set_weather", "layer": 1, "type": 10, "scud": 150}, "bad_field", "scud"),
             ({"cmd": "render", "view": "front", "format": "gif"}, "bad_field", "raw, png"),
             ({"cmd": "render", "view": "front", "format": "png", "channels": ["depth"]},
              "bad_field", "format raw or exr only"),
@@ -397,6 +398,11 @@ class SocketProtocolTest(DaemonTest):
         stratus = c.ok({"cmd": "set_weather", "layer": 1, "type": 10, "base": 800,
                         "thickness": 300, "coverage": 80})
         self.assertEqual(stratus["layers"], 2)  # a stratus sheet is a base and a top plane
+        scud = c.ok({"cmd": "set_weather", "layer": 1, "type": 10, "base": 800,
+                     "thickness": 300, "coverage": 80, "scud": 30})
+        self.assertEqual(scud["layers"], 3)  # and scud, a plane under the base
+        c.ok({"cmd": "set_weather", "layer": 1, "type": 10, "base": 800, "thickness": 300,
+              "coverage": 80})
         cumulus = c.ok({"cmd": "set_weather", "layer": 2, "type": 7, "base": 1200,
                         "thickness": 900, "coverage": 10, "wind": [8, 2]})
         self.assertEqual((cumulus["fields"], cumulus["layers"]), (1, 2))  # heaps, no deck

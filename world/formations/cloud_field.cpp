@@ -528,7 +528,8 @@ std::string weatherLayerError(const WeatherLayer& w) {
                  outside("wind y", w.wind->y, {-Limits::kMaxWind, Limits::kMaxWind})))
     return out.str();
   if ((w.visibility_m != 0.0 && outside("visibility", w.visibility_m, Limits::kLayerVisibility)) ||
-      outside("transition_band", w.transition_band_m, Limits::kTransitionBand))
+      outside("transition_band", w.transition_band_m, Limits::kTransitionBand) ||
+      outside("scud", 100.0 * w.scud, Limits::kCoveragePercent))
     return out.str() + (w.visibility_m != 0.0 ? " (0 takes the genus's visibility)" : "");
   if (std::string error = regionError(w.region); !error.empty()) return error;
   if (std::string error = clusterVariationError(w.clusters); !error.empty()) return error;

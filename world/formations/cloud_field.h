@@ -51,6 +51,9 @@ struct WeatherLayer {
   // its top and below its base over which it thins out (MODEL.md section 5, the in-layer veil).
   double visibility_m = 0.0;
   double transition_band_m = 0.0;
+  // Scud (MODEL.md section 10): the cloud fraction, 0..1, of ragged fragments drawn under the
+  // base (CIGI's scud frequency); 0 draws none.
+  double scud = 0.0;
 };
 
 // Empty when the layer can be drawn, else what is wrong and what is allowed (ranges in

@@ -164,6 +164,28 @@ std::vector<CloudLayer> planes(const WeatherLayer& w, const PlaneLook& look, dou
 
 }  // namespace
 
+// Scud (MODEL.md section 10): one plane of ragged fragments under the base, covering
+// `w.scud`: stratus fractus, the stratus look with features a third the size, a darker grey
+// and edges twice as sharp,
+// half way through the transition band below the base, or a sixth of the thickness (50 to 300
+// m) without one.
+std::vector<CloudLayer> scudPlane(const WeatherLayer& w, const std::string& prefix,
+                                  std::uint64_t seed) {
+  if (!(w.scud > 0.0)) return {};
+  PlaneLook look = genus(CloudType::kStratus).planes;
+  look.planes = 1;
+  look.fx1 *= 3.0, look.fy1 *= 3.0;
+  look.grey *= 0.65;
+  look.transition *= 0.5;
+  WeatherLayer under = w;
+  const double below = w.transition_band_m > 0.0 ? 0.5 * w.transition_band_m
+                                                 : std::clamp(w.thickness_m / 6.0, 50.0, 300.0);
+  under.base_m = std::max(w.base_m - below, 0.5 * w.base_m);
+  under.thickness_m = 0.0;
+  return planes(under, look, std::min(w.scud, 1.0), prefix + "/scud",
+                hashCounters(seed, 0x53637564ull));
+}
+
 WeatherClouds weatherClouds(const WeatherLayer& w, const std::string& prefix, std::uint64_t seed) {
   WeatherClouds out;
   if (w.type == CloudType::kNone || !(w.coverage > 0.0) || !weatherLayerError(w).empty())
@@ -171,12 +193,14 @@ WeatherClouds weatherClouds(const WeatherLayer& w, const std::string& prefix, st
   const Genus& g = genus(w.type);
   const PlaneLook& look = g.planes;
   const double coverage = std::min(w.coverage, 1.0);
+  const std::vector<CloudLayer> scud = scudPlane(w, prefix, seed);
   if (!g.heaps) {
     out.layers = planes(w, look, coverage, prefix, seed);
     // The layer's slab rides on its base plane (MODEL.md section 5, the in-layer veil).
     out.layers.front().in_layer = {
         w.base_m + w.thickness_m, w.transition_band_m,
         w.visibility_m > 0.0 ? w.visibility_m : look.in_layer_visibility_m};
+    out.layers.insert(out.layers.end(), scud.begin(), scud.end());
     return out;
   }
   // Heaps cover up to CloudField::kMaxFieldCoverage; a deck independent of them covers the
@@ -195,6 +219,7 @@ WeatherClouds weatherClouds(const WeatherLayer& w, const std::string& prefix, st
     const double deck = coverage >= 1.0 ? 1.0 : 1.0 - (1.0 - coverage) / (1.0 - field.coverage);
     out.layers = planes(w, look, deck, prefix + "/deck", seed);
   }
+  out.layers.insert(out.layers.end(), scud.begin(), scud.end());
   return out;
 }
 
