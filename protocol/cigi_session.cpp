@@ -490,13 +490,11 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
       frame.commands.emplace_back(command::MoveTarget{entityName(id), pose->position, o.heading_deg,
                                                       o.pitch_deg, o.roll_deg});
     } else {
-      nlohmann::json target{{"name", entityName(id)},
-                            {"type", *typeName(entity.packet.type)},
-                            {"centre", {pose->position.x, pose->position.y, pose->position.z}},
-                            {"heading", o.heading_deg},
-                            {"pitch", o.pitch_deg},
-                            {"roll", o.roll_deg}};
-      frame.commands.emplace_back(command::AddTarget{target, true});
+      frame.commands.emplace_back(
+          command::AddTarget{{},
+                             true,
+                             command::EntityPlacement{entityName(id), *typeName(entity.packet.type),
+                                                      pose->position, o}});
     }
   }
   for (const std::uint16_t id : refused_entities) {

@@ -407,7 +407,7 @@ AddTarget readAddTarget(FieldReader& r) {
     r.fail("target",
            "is missing (an object with the keys of a scene file's [[target]], or a type "
            "named in the daemon config's [[entity_type]])");
-  AddTarget c{*target, false};
+  AddTarget c{*target, false, std::nullopt};
   r.finish("cmd, id, target");
   return c;
 }

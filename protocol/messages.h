@@ -14,6 +14,7 @@
 #include "renderer/frame.h"
 
 #include "world/formations/weather.h"
+#include "world/frames.h"
 #include "world/solar.h"
 
 namespace nephele {
@@ -148,9 +149,17 @@ struct ChangeCloud {
 struct RemoveCloud {
   std::string name;
 };
+// A target of a configured entity type at a pose: what a CIGI entity becomes, typed, with no
+// object to read (the session has checked the pose against world/limits.h).
+struct EntityPlacement {
+  std::string name, type;  // `type`: an [[entity_type]] name of the daemon config
+  glm::dvec3 centre{0.0};
+  Orientation orientation;
+};
 struct AddTarget {
   nlohmann::json target;  // the keys of a scene file's [[target]] table, or `type` (config)
   bool replace = false;   // an existing target of that name is replaced (CIGI entities)
+  std::optional<EntityPlacement> entity;  // set instead of `target` by the CIGI session
 };
 // A target's new pose: unset fields keep their value.
 struct MoveTarget {

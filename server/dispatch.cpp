@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <filesystem>
 
 #include "config/scene_file.h"
@@ -193,8 +194,21 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
       },
       [&](const AddTarget& c) -> std::optional<Outcome> {
         Target target;
-        if (std::string e = parseTargetJson(c.target, config_.entity_types, target); !e.empty())
+        if (c.entity) {  // a CIGI entity: its type's prototype at its pose
+          const auto type =
+              std::find_if(config_.entity_types.begin(), config_.entity_types.end(),
+                           [&](const EntityType& t) { return t.name == c.entity->type; });
+          if (type == config_.entity_types.end())
+            return badField("target.type: \"" + c.entity->type +
+                            "\" is not an entity type of the daemon config");
+          target = type->prototype;
+          target.name = c.entity->name;
+          target.centre = c.entity->centre;
+          target.orientation = c.entity->orientation;
+        } else if (std::string e = parseTargetJson(c.target, config_.entity_types, target);
+                   !e.empty()) {
           return badField(e);
+        }
         std::string error = world.edit([&](Scene& now, WorldDynamics&) -> std::string {
           for (Target& other : now.targets)
             if (other.name == target.name) {
