@@ -322,6 +322,28 @@ TEST(CloudField, TilesDoNotDependOnVisitingOrder) {
 // the ellipsoids themselves: points well inside one (|W (p - c)|^2 < 1/2) all the way up the
 // vertical through the base from the middle of its flat bottom, and the extents along the shear
 // from each ellipsoid's support |W^-T d| (which sees a mistaken heading, unlike a bounding sphere).
+// The heaps drawn as ellipsoids are bounded in tiles as well as in distance (issue 31): a legal
+// 10 m cumulonimbus layer has heaps a few metres wide, and its 40 km range held millions of
+// tiles (34 s a frame); a typical field keeps its automatic range.
+TEST(CloudField, HeapRangeIsBoundedInTiles) {
+  Camera camera;
+  camera.position = {0.0, 0.0, 300.0};
+  WeatherLayer thin{CloudType::kCumulonimbus, 500.0, 10.0, 0.3};
+  const WeatherClouds drawn = weatherClouds(thin, "w", 3);
+  ASSERT_EQ(drawn.fields.size(), 1u);
+  const CloudField& f = drawn.fields[0];
+  EXPECT_LE(heapRange(f, camera), CloudField::kMaxRangeTiles * fieldTileSize(f));
+  EXPECT_LE(heapRange(f, camera, 1.0e6), CloudField::kMaxRangeTiles * fieldTileSize(f));
+  Scene scene;
+  scene.camera = camera;
+  scene.fields = drawn.fields;
+  EXPECT_LT(ellipsoidCount(withFieldClouds(scene)), 200000u);
+  const WeatherClouds typical =
+      weatherClouds(typicalWeatherLayer(CloudType::kCumulus, 0.3), "w", 3);
+  EXPECT_EQ(heapRange(typical.fields[0], camera),
+            CloudField::kRangeM + 2.0 * std::abs(300.0 - typical.fields[0].base_m));
+}
+
 TEST(CloudField, CumulonimbusIsOneTowerUnderAnAnvilCarriedDownwind) {
   CloudField f;
   f.name = "cb";

@@ -578,9 +578,11 @@ EllipsoidCloud typicalHeap(const CloudField& f, glm::dvec3 base) {
 }
 
 double heapRange(const CloudField& f, const Camera& camera, double range_m) {
-  if (range_m > 0.0) return range_m;
-  // From high up the view reaches further: the range grows with the height above the heaps.
-  return CloudField::kRangeM + 2.0 * std::abs(camera.position.z - f.base_m);
+  // From high up the view reaches further: the automatic range grows with the height above the
+  // heaps.
+  const double asked =
+      range_m > 0.0 ? range_m : CloudField::kRangeM + 2.0 * std::abs(camera.position.z - f.base_m);
+  return std::min(asked, CloudField::kMaxRangeTiles * fieldTileSize(f));
 }
 
 std::vector<EllipsoidCloud> fieldClouds(const CloudField& f, const Camera& camera,

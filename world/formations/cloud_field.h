@@ -85,6 +85,11 @@ struct CloudField {
   // Heaps are generated in tiles within this horizontal distance of the eye, plus twice the
   // eye's height above the field.
   static constexpr double kRangeM = 40000.0;
+  // And within this many tiles (four heap radii each) of it, whatever the range asked: a thin
+  // layer's small heaps would otherwise fill the range with millions of tiles (a legal 10 m
+  // cumulonimbus layer took 34 s a frame); the far deck stands for the heaps beyond. About
+  // 4,000 tiles; a mediocris field's tiles are 4 km, so its cap is 160 km.
+  static constexpr double kMaxRangeTiles = 36.0;
 };
 
 // The cover the field's heaps are drawn for at `xy` (field frame, before drift): its coverage
@@ -122,7 +127,8 @@ struct HeapDrawing {
   double detail_px = 32.0;
 };
 
-// The range of heaps drawn as ellipsoids: `range_m` when positive, else the automatic one.
+// The range of heaps drawn as ellipsoids: `range_m` when positive, else the automatic one;
+// at most CloudField::kMaxRangeTiles tiles.
 double heapRange(const CloudField& field, const Camera& camera, double range_m = 0.0);
 
 // The heaps of every tile within heapRange of the camera whose bounds meet its view, drifted
