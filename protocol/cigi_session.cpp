@@ -82,12 +82,9 @@ std::variant<WeatherLayer, std::string> cloudLayerOf(const WeatherControl& w) {
   // Inside the layer (MODEL.md section 5): its visibility (0, the genus's) and transition band.
   layer.visibility_m = w.visibility;
   layer.transition_band_m = w.transition_band;
-  // Scud: fragments under the base covering the scud frequency (MODEL.md section 10).
-  if (w.scud) {
-    if (!Limits::kCoveragePercent.contains(w.scud_frequency))
-      return "scud frequency " + text(w.scud_frequency) + " (allowed: 0 to 100 %)";
-    layer.scud = w.scud_frequency / 100.0;
-  }
+  // Scud: fragments under the base covering the scud frequency (MODEL.md section 10), its
+  // range checked with the rest of the layer's below.
+  if (w.scud) layer.scud = w.scud_frequency / 100.0;
   if (std::string e = weatherLayerError(layer); !e.empty()) return e;
   return layer;
 }

@@ -328,7 +328,9 @@ TEST(CloudField, TilesDoNotDependOnVisitingOrder) {
 TEST(CloudField, HeapRangeIsBoundedInTiles) {
   Camera camera;
   camera.position = {0.0, 0.0, 300.0};
-  WeatherLayer thin{CloudType::kCumulonimbus, 500.0, 10.0, 0.3};
+  WeatherLayer thin;
+  thin.type = CloudType::kCumulonimbus;
+  thin.base_m = 500.0, thin.thickness_m = 10.0, thin.coverage = 0.3;
   const WeatherClouds drawn = weatherClouds(thin, "w", 3);
   ASSERT_EQ(drawn.fields.size(), 1u);
   const CloudField& f = drawn.fields[0];

@@ -234,9 +234,9 @@ void EllipsoidRenderer::bindFrameTexture(int unit, GLenum format, const void* da
 void EllipsoidRenderer::endFrame() {
   std::erase_if(textures_, [](const auto& entry) { return !entry.second.used; });
   while (tables_.size() > kKeptTables) {
-    auto oldest = std::min_element(tables_.begin(), tables_.end(), [](const auto& a, const auto& b) {
-      return a.second.last_frame < b.second.last_frame;
-    });
+    auto oldest = std::min_element(
+        tables_.begin(), tables_.end(),
+        [](const auto& a, const auto& b) { return a.second.last_frame < b.second.last_frame; });
     if (oldest->second.last_frame == frame_) break;  // all in use this frame
     tables_.erase(oldest);
   }

@@ -342,7 +342,10 @@ GLuint GlRenderer::program(const SkyPassLayout& layout) {
 GlRenderer::CachedTexture& GlRenderer::cachedTexture(const LayerTextureSpec& spec,
                                                      const RenderSettings& settings) {
   auto [entry, inserted] = textures_.try_emplace(textureKey(spec, settings));
-  if (inserted) entry->second.source = std::make_unique<LayerTexture>(spec);
+  if (inserted) {
+    entry->second.source = std::make_unique<LayerTexture>(spec);
+    entry->second.key = entry->first;
+  }
   entry->second.used = true;
   return entry->second;
 }
@@ -645,7 +648,7 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
         const glm::dvec2 eye =
             glm::dvec2(camera.position) - t.driftOffset(scene.time_s, slot.layer->texture);
         slot.clipmap =
-            clipmaps_.prepare(textureKey(slot.layer->texture, settings), *t.gardner(), eye,
+            clipmaps_.prepare(slot.texture->key, *t.gardner(), eye,
                               LayerClipmaps::sizeFor(camera.height), budget, wait, stats_);
         if (!slot.clipmap.complete) slot.kind = LayerKind::kProceduralGardner;
         baked = true;

@@ -71,6 +71,7 @@ class GlRenderer {
   // A layer's texture, built once and kept while frames keep using it.
   struct CachedTexture {
     std::unique_ptr<LayerTexture> source;
+    std::string key;   // textureKey: the clipmap of a texture is kept under it too
     GlObject texture;  // made on first use by a pass that samples it
     bool used = false;
   };
