@@ -13,7 +13,7 @@
 #include <CLI/CLI.hpp>
 
 #include "bench_common.h"
-#include "config/dataset_file.h"
+#include "dataset/dataset_file.h"
 #include "image/image_encoding.h"
 #include "image/image_metrics.h"
 #include "renderer/gl/gl_renderer.h"

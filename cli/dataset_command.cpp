@@ -17,9 +17,9 @@
 #include <unistd.h>
 
 #include "cli/render_command.h"
-#include "config/dataset_file.h"
 #include "config/table_reader.h"
 #include "dataset/dataset.h"
+#include "dataset/dataset_file.h"
 #include "renderer/renderer.h"
 #include "world/counter_random.h"
 #include "world/file_output.h"

@@ -530,14 +530,16 @@ void readScene(const toml::table& root, const std::string& file, SceneFile& out)
     const WeatherClouds add = weatherClouds(w, prefix, seed);
     for (const CloudLayer& l : add.layers) {
       scene.layers.push_back(l);
-      dynamics.layers.emplace_back();
+      if (!dynamics.layers.empty()) dynamics.layers.emplace_back();  // none, or one per layer
     }
     scene.fields.insert(scene.fields.end(), add.fields.begin(), add.fields.end());
   };
   std::vector<TableReader> weather = t.tables("weather");
-  for (std::size_t i = 0; i < weather.size(); ++i)
-    addWeather(readWeather(weather[i]), "weather/" + std::to_string(i + 1),
-               weatherSeed(scene.seed, int(i + 1)));
+  for (std::size_t i = 0; i < weather.size(); ++i) {
+    const WeatherLayer w = readWeather(weather[i]);
+    if (std::string e = placeWeather(scene, dynamics, {int(i + 1), std::nullopt}, w); !e.empty())
+      weather[i].failAt("type", e);  // readWeather checked it already: not reached
+  }
   std::vector<TableReader> macro = t.tables("macrocluster");
   for (std::size_t i = 0; i < macro.size(); ++i) {
     std::uint64_t seed = hashCounters(scene.seed, 0x4d6163726full, i);

@@ -46,10 +46,6 @@ bool sameCloudLayer(const WeatherControl& a, const WeatherControl& b) {
          a.transition_band == b.transition_band && a.scud == b.scud &&
          (!a.scud || a.scud_frequency == b.scud_frequency);
 }
-bool sameFog(const WeatherControl& a, const WeatherControl& b) {
-  return a.enabled == b.enabled && a.base == b.base && a.thickness == b.thickness &&
-         a.visibility == b.visibility;
-}
 
 // A Weather Control cloud layer (1 to 3) as the layer it draws, or what is wrong with it
 // (everywhere: the caller sets a regional layer's region).
@@ -302,15 +298,14 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
         frame.ignored.push_back(where + ": ground fog is global only");
         continue;
       }
+      // The world holds the weather as set and ignores a layer set again as it is (a host
+      // repeats its packets every frame); a region's packets are also kept here, since they
+      // may come before the region is active and follow it when it moves.
       const RegionalKey key{w->entity_region_id, w->layer};
-      const WeatherControl* last = nullptr;
-      if (regional) {
-        if (auto found = s.regional_weather.find(key); found != s.regional_weather.end())
-          last = &found->second;
-      } else if (auto found = s.weather.find(w->layer); found != s.weather.end()) {
-        last = &found->second;
-      }
-      if (last && (fog ? sameFog(*last, *w) : sameCloudLayer(*last, *w))) continue;
+      if (regional)
+        if (auto last = s.regional_weather.find(key);
+            last != s.regional_weather.end() && sameCloudLayer(last->second, *w))
+          continue;
       if (!finite({w->base, w->thickness, w->coverage, w->visibility, w->wind_speed,
                    w->wind_direction})) {
         bad(where + ": a field is not a finite number");
@@ -333,7 +328,6 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
           c.visibility = w->visibility;
         }
         frame.commands.emplace_back(c);
-        s.weather[w->layer] = *w;
         continue;
       }
       auto layer = cloudLayerOf(*w);
@@ -344,7 +338,6 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
       if (!regional) {
         frame.commands.emplace_back(
             command::SetWeather{w->layer, std::get<WeatherLayer>(layer), std::nullopt});
-        s.weather[w->layer] = *w;
         continue;
       }
       // A region's layer is drawn while its region is active (Environmental Region Control),
@@ -555,7 +548,6 @@ std::variant<HostFrame, Refusal> Session::map(const Message& message) {
 void Session::forget() {
   pending_.reset();
   std::erase_if(state_.entities, [](const auto& entry) { return entry.second.target; });
-  state_.weather.clear();
   state_.atmosphere.reset();
   state_.celestial.reset();
   state_.sun_place.reset();

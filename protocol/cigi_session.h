@@ -65,8 +65,9 @@ class Session {
   std::variant<HostFrame, Refusal> map(const Message& message);
   void commit();
   // After the daemon refused a frame (a target removed over the socket, say): what the session
-  // believed applied is forgotten, so that the next packets place targets and set the weather
-  // afresh. Frame numbers, the ownship and the views stay. The frame mapped last is dropped.
+  // believed applied is forgotten, so that the next packets place targets and set the wind and
+  // sun afresh (global weather is always passed on: the world ignores a layer set again as it
+  // is). Frame numbers, the ownship and the views stay. The frame mapped last is dropped.
   // Packets refused for their values (HostFrame::refused) leave the rest of the frame applied.
   void forget();
 
@@ -98,7 +99,6 @@ class Session {
     std::optional<std::uint32_t> last_timestamp;
     std::map<std::uint16_t, Entity> entities;
     std::map<std::uint16_t, ViewState> views;
-    std::map<std::uint8_t, WeatherControl> weather;  // global, by layer, as last applied
     // Regional weather (Weather Control of regional scope), by region and layer, as last
     // accepted, and the active regions it is drawn in (Environmental Region Control).
     std::map<RegionalKey, WeatherControl> regional_weather;

@@ -11,52 +11,18 @@ namespace nephele {
 
 using namespace engine_detail;
 
-namespace {
-
-void setWindSample(WindProfile& profile, double altitude, glm::dvec2 velocity) {
-  auto& samples = profile.samples;
-  std::erase_if(samples,
-                [&](const WindSample& w) { return std::abs(w.altitude_m - altitude) < 1.0; });
-  samples.push_back({altitude, velocity});
-  std::sort(samples.begin(), samples.end(),
-            [](const WindSample& a, const WindSample& b) { return a.altitude_m < b.altitude_m; });
-}
-
-}  // namespace
-
 std::optional<ProtocolError> Engine::setWeather(int layer, const WeatherLayer& weather,
                                                 std::optional<int> region) {
   State& s = *state_;
-  // The daemon's own names hold a '/', which no user name may (world/limits.h): set_weather
-  // replaces exactly what it made before. A region's layers are its own, and seeded apart.
-  const std::string prefix =
-      (region ? "weather/region" + std::to_string(*region) + "/" : std::string("weather/")) +
-      std::to_string(layer);
-  std::uint64_t seed = weatherSeed(config_.scene.scene.seed, layer);
-  if (region) seed = hashCounters(seed, 0x526567696f6eull, std::uint64_t(*region));
-  const WeatherClouds add = weatherClouds(weather, prefix, seed);
-  std::string error = s.world->edit([&](Scene& now, WorldDynamics& d) -> std::string {
-    auto made = [&](const std::string& name) {
-      return name == prefix || name.rfind(prefix + "/", 0) == 0;
-    };
-    eraseWithDevelopment(now.layers, d.layers, [&](const CloudLayer& l) { return made(l.name); });
-    std::erase_if(now.fields, [&](const CloudField& f) { return made(f.name); });
-    now.fields.insert(now.fields.end(), add.fields.begin(), add.fields.end());
-    for (const CloudLayer& l : add.layers) {
-      now.layers.push_back(l);
-      if (!d.layers.empty()) d.layers.emplace_back();
-    }
-    if (weather.wind)
-      setWindSample(d.wind, weather.base_m + 0.5 * weather.thickness_m, *weather.wind);
-    return "";
-  });
-  if (!error.empty()) return ProtocolError{ErrorCode::kFailed, error};
-  if (!region) s.weather[std::size_t(layer - 1)] = weather;  // what a host reads back
-  spdlog::info(
-      "event=weather layer={} region={} type={} base={} thickness={} coverage={:.2f} planes={} "
-      "fields={}",
-      layer, region ? std::to_string(*region) : "global", cloudTypeName(weather.type),
-      weather.base_m, weather.thickness_m, weather.coverage, add.layers.size(), add.fields.size());
+  const WeatherKey key{
+      layer, region ? std::optional<std::uint16_t>(std::uint16_t(*region)) : std::nullopt};
+  bool changed = false;
+  if (std::string error = s.world->setWeather(key, weather, &changed); !error.empty())
+    return ProtocolError{ErrorCode::kFailed, error};
+  if (changed)
+    spdlog::info("event=weather layer={} region={} type={} base={} thickness={} coverage={:.2f}",
+                 layer, region ? std::to_string(*region) : "global", cloudTypeName(weather.type),
+                 weather.base_m, weather.thickness_m, weather.coverage);
   return std::nullopt;
 }
 
@@ -91,11 +57,8 @@ Outcome Engine::setFog(const command::SetFog& c) {
     if (c.visibility) fog->visibility_m = *c.visibility;
     if (c.colour) fog->colour = *c.colour;
   }
-  std::string error = s.world->edit([&](Scene& now, WorldDynamics&) {
-    now.fog = fog;
-    return std::string();
-  });
-  if (!error.empty()) return ProtocolError{ErrorCode::kFailed, error};
+  if (std::string error = s.world->setFog(fog); !error.empty())
+    return ProtocolError{ErrorCode::kFailed, error};
   if (!fog) return json{{"enabled", false}};
   return json{{"enabled", true},
               {"top", fog->top_m},
@@ -113,11 +76,8 @@ Outcome Engine::setHaze(const command::SetHaze& c) {
     if (c.visibility) haze->visibility_m = *c.visibility;
     if (c.scale_height) haze->scale_height_m = *c.scale_height;
   }
-  std::string error = s.world->edit([&](Scene& now, WorldDynamics&) {
-    now.haze = haze;
-    return std::string();
-  });
-  if (!error.empty()) return ProtocolError{ErrorCode::kFailed, error};
+  if (std::string error = s.world->setHaze(haze); !error.empty())
+    return ProtocolError{ErrorCode::kFailed, error};
   if (!haze) return json{{"enabled", false}};
   return json{{"enabled", true},
               {"visibility", haze->visibility_m},

@@ -20,8 +20,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "config/daemon_config.h"
 #include "protocol/messages.h"
+#include "server/daemon_config.h"
 
 namespace nephele {
 

@@ -96,21 +96,6 @@ inline double percentile(std::vector<double> values, double p) {
   return values[std::min(values.size() - 1, std::size_t(p * double(values.size())))];
 }
 
-// Removes the entries of `items` (and the matching development entries, if any) for which
-// `drop` holds.
-template <class T, class D, class Pred>
-inline void eraseWithDevelopment(std::vector<T>& items, std::vector<D>& development, Pred drop) {
-  std::vector<T> kept_items;
-  std::vector<D> kept_development;
-  for (std::size_t i = 0; i < items.size(); ++i) {
-    if (drop(items[i])) continue;
-    kept_items.push_back(std::move(items[i]));
-    if (!development.empty()) kept_development.push_back(std::move(development[i]));
-  }
-  items = std::move(kept_items);
-  development = std::move(kept_development);
-}
-
 // Latencies for Prometheus: counts per bucket of seconds (cumulative in the text format), with
 // their sum and count since the daemon started.
 struct Histogram {
@@ -249,7 +234,6 @@ struct Engine::State {
   std::unique_ptr<GlRenderer> renderer;
   std::unique_ptr<World> world;
   std::vector<ViewConfig> views;
-  std::array<WeatherLayer, ProtocolLimits::kWeatherLayers> weather;
   TickMode mode = TickMode::kRealtime;  // switchable at run time (set_time mode)
   double time_scale = 1.0;
   bool paused = false;

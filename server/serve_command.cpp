@@ -8,8 +8,8 @@
 #include <cstdio>
 #include <thread>
 
-#include "config/daemon_config.h"
 #include "server/cigi_server.h"
+#include "server/daemon_config.h"
 #include "server/engine.h"
 #include "server/modbus_server.h"
 #include "server/socket_server.h"

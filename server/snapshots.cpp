@@ -8,46 +8,22 @@
 #include "world/file_output.h"
 #include "world/limits.h"
 
-// Snapshots: the World saves its clouds, targets, sun, fog, wind and clock; beside it
-// (PATH.daemon.json) the daemon saves what the host set that the World does not hold: views,
-// the weather layers as asked, the sun's date, the clock's mode, scale and pause, and the
-// tick and frame counters. The views and weather are kept as the requests that set them, so
-// a restore reads them through the one request parser, with its checks.
+// Snapshots: the World saves its clouds, the weather layers as set, targets, sun, fog, haze,
+// wind and clock; beside it (PATH.daemon.json) the daemon saves what the host set that the
+// World does not hold: views, the sun's date, the clock's mode, scale and pause, and the tick
+// and frame counters. The views are kept as the requests that set them, so a restore reads
+// them through the one request parser, with its checks.
 namespace nephele {
 
 using namespace engine_detail;
 
 namespace {
 
-constexpr int kDaemonStateVersion = 1;
+constexpr int kDaemonStateVersion = 2;
 constexpr std::uintmax_t kMaxDaemonStateBytes = 4u << 20;
 
 std::string daemonStatePath(const std::string& snapshot) {
   return snapshot + ".daemon.json";
-}
-
-// A set_weather request that sets `w` again.
-json weatherRequest(int layer, const WeatherLayer& w) {
-  json r{{"cmd", "set_weather"},          {"layer", layer},
-         {"type", cloudTypeCode(w.type)}, {"base", w.base_m},
-         {"thickness", w.thickness_m},    {"coverage", 100.0 * w.coverage}};
-  if (w.wind) r["wind"] = {w.wind->x, w.wind->y};
-  const Region& g = w.region;
-  if (std::isfinite(g.half_size.x) && std::isfinite(g.half_size.y)) {
-    r["centre"] = {g.centre.x, g.centre.y};
-    r["size"] = {2.0 * g.half_size.x, 2.0 * g.half_size.y};
-    r["heading"] = g.heading_deg;
-    r["edge"] = g.edge_m;
-  }
-  if (g.side != 0) {
-    r["front"] = g.side < 0 ? "left" : "right";
-    r["transition"] = g.transition_m;
-  }
-  if (!w.clusters.none()) {
-    r["spacing"] = w.clusters.spacing_m;
-    r["variation"] = w.clusters.amount;
-  }
-  return r;
 }
 
 // A set_view request that sets every field of `v`.
@@ -66,9 +42,6 @@ json Engine::daemonState() const {
   const State& s = *state_;
   json requests = json::array();
   for (const ViewConfig& v : s.views) requests.push_back(viewRequest(v));
-  for (int layer = 1; layer <= ProtocolLimits::kWeatherLayers; ++layer)
-    if (s.weather[std::size_t(layer - 1)].type != CloudType::kNone)
-      requests.push_back(weatherRequest(layer, s.weather[std::size_t(layer - 1)]));
   json out{{"format", "nephele-daemon-state"},
            {"version", kDaemonStateVersion},
            {"ticks", s.ticks},
@@ -137,9 +110,8 @@ std::string Engine::restoreSnapshot(const std::string& path) {
       auto parsed = parseRequest(r.dump());
       if (auto* b = std::get_if<BadRequest>(&parsed)) return bad(b->error.message);
       Command c = std::get<Request>(parsed).command;
-      if (!std::holds_alternative<command::SetView>(c) &&
-          !std::holds_alternative<command::SetWeather>(c))
-        return bad("requests: only set_view and set_weather are restored");
+      if (!std::holds_alternative<command::SetView>(c))
+        return bad("requests: only set_view is restored");
       requests.push_back(std::move(c));
     }
     state = std::move(j);
@@ -154,7 +126,6 @@ std::string Engine::restoreSnapshot(const std::string& path) {
   s.paused = (*state)["paused"].get<bool>();
   setMode((*state)["mode"] == "lockstep" ? TickMode::kLockstep : TickMode::kRealtime);
   s.sun_utc = sun_utc;
-  s.weather = {};
   for (const Command& c : requests) {
     if (const auto* v = std::get_if<command::SetView>(&c)) {
       ViewConfig* view = s.view(v->view);
@@ -163,8 +134,6 @@ std::string Engine::restoreSnapshot(const std::string& path) {
         continue;
       }
       applyViewPatch(*view, v->patch);
-    } else if (const auto* w = std::get_if<command::SetWeather>(&c)) {
-      s.weather[std::size_t(w->layer - 1)] = w->weather;  // its clouds are in the world's part
     }
   }
   return "";

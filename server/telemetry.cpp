@@ -70,7 +70,9 @@ void Engine::publishReadings() {
   settings.sun_azimuth = world.base().sun.azimuth_deg;
   settings.sun_elevation = world.base().sun.elevation_deg;
   settings.time_scale = s.time_scale;
-  settings.layers = s.weather;
+  for (int layer = 1; layer <= ProtocolLimits::kWeatherLayers; ++layer)  // the world's, as set
+    if (auto w = world.base().weather.find({layer, std::nullopt}); w != world.base().weather.end())
+      settings.layers[std::size_t(layer - 1)] = w->second;
   if (const std::optional<Fog>& fog = world.base().fog) {
     settings.fog_top = fog->top_m;
     settings.fog_visibility = fog->visibility_m;

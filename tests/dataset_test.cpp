@@ -7,7 +7,7 @@
 
 #include <cmath>
 
-#include "config/dataset_file.h"
+#include "dataset/dataset_file.h"
 #include "renderer/renderer.h"
 #include "world/shading.h"
 

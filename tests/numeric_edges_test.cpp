@@ -17,10 +17,10 @@
 
 #include <gtest/gtest.h>
 
-#include "config/daemon_config.h"
-#include "config/dataset_file.h"
 #include "config/scene_file.h"
+#include "dataset/dataset_file.h"
 #include "protocol/messages.h"
+#include "server/daemon_config.h"
 
 namespace nephele {
 namespace {

@@ -2,6 +2,7 @@
 // rendered nadir images against the coverage asked (SPEC section 9), repetition, tiles that
 // do not depend on the order they are visited in, and refused descriptions.
 #include "world/formations/weather.h"
+#include "world/world.h"
 
 #include <gtest/gtest.h>
 
@@ -483,6 +484,29 @@ TEST(Weather, InvalidLayersAreRefusedWithTheAllowedRange) {
     EXPECT_NE(error.find("weather[0]"), std::string::npos) << bad << ": " << error;
     EXPECT_NE(error.find("allowed"), std::string::npos) << bad << ": " << error;
   }
+}
+
+// A scene file's [[weather]] is the world's weather layer 1, held as set: the world it makes
+// is the world that set_weather (or Modbus, or CIGI) makes from the same layer.
+TEST(Weather, ASceneFilesWeatherIsTheSameLayerAsAHostSets) {
+  SceneFile file;
+  ASSERT_EQ(parseSceneText("[[weather]]\ntype = \"cumulus\"\nbase = 1200\nthickness = 1500\n"
+                           "coverage = 35\n[[weather]]\ntype = \"stratocumulus\"\nbase = 2500\n"
+                           "thickness = 400\ncoverage = 60\n",
+                           "weather.toml", file),
+            "");
+  ASSERT_EQ(file.scene.weather.size(), 2u);
+  const WeatherLayer cumulus = file.scene.weather.at({1, std::nullopt});
+  EXPECT_EQ(cumulus.type, CloudType::kCumulus);
+  EXPECT_DOUBLE_EQ(cumulus.coverage, 0.35);
+  World from_file(file.scene, file.dynamics);
+  SceneFile empty;
+  ASSERT_EQ(parseSceneText("", "empty.toml", empty), "");
+  World from_host(empty.scene, empty.dynamics);
+  for (const auto& [key, layer] : file.scene.weather)
+    ASSERT_EQ(from_host.setWeather(key, layer), "");
+  EXPECT_EQ(from_host.base().weather, from_file.base().weather);
+  EXPECT_EQ(from_host.hash(), from_file.hash());
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "world/formations/weather.h"
 #include "world/limits.h"
 #include "world/textures/layer_texture.h"
 
@@ -340,6 +341,89 @@ TEST(World, HashesDifferWhenTheWorldDiffers) {
   EXPECT_EQ(a.hash(), b.hash());
   ASSERT_EQ(b.advance(1e-9), "");
   EXPECT_NE(a.hash(), b.hash());
+}
+
+// The weather is held once, in the world: a layer set as it already is changes nothing (a CIGI
+// host repeats its packets every frame), a new one replaces exactly what the old one made, a
+// region's layer is its own, and the weather as set survives a snapshot.
+TEST(World, WeatherLayersAreHeldOnceAndReplacedWhole) {
+  World world = makeWorld();
+  auto named = [&](const std::string& prefix) {
+    const Scene s = world.scene();
+    int n = 0;
+    for (const CloudLayer& l : s.layers) n += l.name.rfind(prefix, 0) == 0;
+    for (const CloudField& f : s.fields) n += f.name.rfind(prefix, 0) == 0;
+    return n;
+  };
+  const std::size_t user_layers = world.scene().layers.size();
+  WeatherLayer stratus = typicalWeatherLayer(CloudType::kStratus, 0.6);
+  bool changed = false;
+  ASSERT_EQ(world.setWeather({1, std::nullopt}, stratus, &changed), "");
+  EXPECT_TRUE(changed);
+  ASSERT_EQ(world.base().weather.size(), 1u);
+  EXPECT_EQ(world.base().weather.at({1, std::nullopt}), stratus);
+  const int stratus_items = named("weather/1");
+  EXPECT_GT(stratus_items, 0);
+  const std::uint64_t hash = world.hash();
+  ASSERT_EQ(world.setWeather({1, std::nullopt}, stratus, &changed), "");
+  EXPECT_FALSE(changed);
+  EXPECT_EQ(world.hash(), hash);
+
+  // Another genus in the same layer replaces the stratus's planes, and nothing else.
+  const WeatherLayer cumulus = typicalWeatherLayer(CloudType::kCumulus, 0.3);
+  ASSERT_EQ(world.setWeather({1, std::nullopt}, cumulus, &changed), "");
+  EXPECT_TRUE(changed);
+  EXPECT_EQ(world.scene().fields.size(), 1u);
+  EXPECT_EQ(world.scene().layers.size() - user_layers, std::size_t(named("weather/1")) - 1);
+  // A region's layer 1 is a layer of its own.
+  WeatherLayer regional = stratus;
+  regional.region.half_size = {5000.0, 5000.0};
+  ASSERT_EQ(world.setWeather({1, std::uint16_t(7)}, regional, &changed), "");
+  EXPECT_EQ(named("weather/region7/1"), stratus_items);
+  EXPECT_EQ(world.scene().fields.size(), 1u);
+
+  // Invalid: refused, nothing changes.
+  WeatherLayer bad = stratus;
+  bad.coverage = 1.5;
+  const std::uint64_t before = world.hash();
+  EXPECT_THAT(world.setWeather({2, std::nullopt}, bad, &changed), ::testing::HasSubstr("coverage"));
+  EXPECT_FALSE(changed);
+  EXPECT_EQ(world.hash(), before);
+
+  // The weather as set comes back from a snapshot with its clouds.
+  World copy = makeWorld();
+  ASSERT_EQ(copy.restore(world.snapshot()), "");
+  EXPECT_EQ(copy.base().weather, world.base().weather);
+  EXPECT_EQ(copy.hash(), world.hash());
+
+  // Type none removes the layer and all it made; the user's own layers stay.
+  ASSERT_EQ(world.setWeather({1, std::nullopt}, {}, &changed), "");
+  EXPECT_TRUE(changed);
+  EXPECT_EQ(named("weather/1"), 0);
+  EXPECT_EQ(world.scene().fields.size(), 0u);
+  EXPECT_EQ(world.base().weather.count({1, std::nullopt}), 0u);
+  EXPECT_EQ(world.base().weather.size(), 1u);  // the region's
+  ASSERT_EQ(world.setWeather({1, std::nullopt}, {}, &changed), "");
+  EXPECT_FALSE(changed);
+}
+
+// Fog and haze set as they are change nothing; set otherwise, they change the world.
+TEST(World, FogAndHazeSetAgainChangeNothing) {
+  World world = makeWorld();
+  bool changed = false;
+  Fog fog;
+  fog.top_m = 80.0;
+  ASSERT_EQ(world.setFog(fog, &changed), "");
+  EXPECT_TRUE(changed);
+  const std::uint64_t hash = world.hash();
+  ASSERT_EQ(world.setFog(fog, &changed), "");
+  EXPECT_FALSE(changed);
+  ASSERT_EQ(world.setHaze(std::nullopt, &changed), "");
+  EXPECT_FALSE(changed);
+  EXPECT_EQ(world.hash(), hash);
+  ASSERT_EQ(world.setHaze(Haze{}, &changed), "");
+  EXPECT_TRUE(changed);
+  EXPECT_NE(world.hash(), hash);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #pragma once
 // A scene: everything one rendered image depends on.
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -59,6 +60,14 @@ inline bool layerHasRegion(const CloudLayer& layer) {
   return !layer.region.everywhere() || layer.hole_radius_m > 0.0 || layer.far.side_ratio > 0.0;
 }
 
+// Which weather layer: its number (a host's 1 to 3, a scene file's [[weather]] tables in
+// order) and, for a CIGI region's own layers, the region.
+struct WeatherKey {
+  int layer = 1;
+  std::optional<std::uint16_t> region;
+  auto operator<=>(const WeatherKey&) const = default;
+};
+
 struct Scene {
   std::uint64_t seed = 1;
   double time_s = 0.0;
@@ -75,6 +84,9 @@ struct Scene {
   std::vector<Target> targets;
   // Automaton clouds as the World hands them to a render (scene files alone hold none).
   std::vector<AutomatonCloudView> automata;
+  // The weather layers as set (set_weather, Modbus, CIGI, [[weather]]), held here alone: their
+  // clouds are the layers and fields named under weatherPrefix(key) (world.h placeWeather).
+  std::map<WeatherKey, WeatherLayer> weather;
 };
 
 // Ellipsoids the scene's clouds hold (its fields' heaps are made per view and not counted).

@@ -35,6 +35,7 @@ struct Fog {
   glm::dvec3 colour{0.75, 0.77, 0.80};
   double bottom_m = 0.0;
   double band_m = 0.0;
+  bool operator==(const Fog&) const = default;
 };
 
 // Koschmieder: the extinction per metre that leaves 2 % contrast after `visibility_m`.
@@ -55,6 +56,7 @@ double fogPathLength(const Fog& fog, glm::dvec3 origin, glm::dvec3 direction, do
 struct Haze {
   double visibility_m = 40000.0;
   double scale_height_m = 1200.0;
+  bool operator==(const Haze&) const = default;
 };
 
 // The haze's optical depth along origin + s * direction for 0 <= s <= distance (distance may

@@ -2,11 +2,14 @@
 
 #include "world/limits.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
 
 #include "world/check.h"
+#include "world/counter_random.h"
+#include "world/formations/weather.h"
 
 namespace nephele {
 namespace {
@@ -143,6 +146,92 @@ void World::foldDrift(Scene& scene, const WorldDynamics& dynamics, double sign) 
     for (Ellipsoid& e : cloud.ellipsoids) e.centre += drift;
     cloud.drift_m += drift;
   }
+}
+
+std::string weatherPrefix(const WeatherKey& key) {
+  return (key.region ? "weather/region" + std::to_string(*key.region) + "/"
+                     : std::string("weather/")) +
+         std::to_string(key.layer);
+}
+
+namespace {
+
+// One wind sample per altitude (within a metre), kept in increasing altitude.
+void setWindSample(WindProfile& profile, double altitude, glm::dvec2 velocity) {
+  auto& samples = profile.samples;
+  std::erase_if(samples,
+                [&](const WindSample& w) { return std::abs(w.altitude_m - altitude) < 1.0; });
+  samples.push_back({altitude, velocity});
+  std::sort(samples.begin(), samples.end(),
+            [](const WindSample& a, const WindSample& b) { return a.altitude_m < b.altitude_m; });
+}
+
+}  // namespace
+
+std::string placeWeather(Scene& scene, WorldDynamics& dynamics, const WeatherKey& key,
+                         const WeatherLayer& weather) {
+  if (weather.type != CloudType::kNone)
+    if (std::string e = weatherLayerError(weather); !e.empty()) return e;
+  const std::string prefix = weatherPrefix(key);
+  // A region's layers are its own, and seeded apart from the global layer of that number.
+  std::uint64_t seed = weatherSeed(scene.seed, key.layer);
+  if (key.region) seed = hashCounters(seed, 0x526567696f6eull, std::uint64_t(*key.region));
+  const WeatherClouds add = weatherClouds(weather, prefix, seed);
+  auto made = [&](const std::string& name) {
+    return name == prefix || name.rfind(prefix + "/", 0) == 0;
+  };
+  eraseWithDevelopment(scene.layers, dynamics.layers,
+                       [&](const CloudLayer& l) { return made(l.name); });
+  std::erase_if(scene.fields, [&](const CloudField& f) { return made(f.name); });
+  scene.fields.insert(scene.fields.end(), add.fields.begin(), add.fields.end());
+  for (const CloudLayer& l : add.layers) {
+    scene.layers.push_back(l);
+    if (!dynamics.layers.empty()) dynamics.layers.emplace_back();
+  }
+  if (weather.type == CloudType::kNone) {
+    scene.weather.erase(key);
+    return "";
+  }
+  if (weather.wind)
+    setWindSample(dynamics.wind, weather.base_m + 0.5 * weather.thickness_m, *weather.wind);
+  scene.weather[key] = weather;
+  return "";
+}
+
+std::string World::setWeather(const WeatherKey& key, const WeatherLayer& weather, bool* changed) {
+  const auto held = base_.weather.find(key);
+  const bool same = weather.type == CloudType::kNone
+                        ? held == base_.weather.end()
+                        : held != base_.weather.end() && held->second == weather;
+  if (changed) *changed = false;
+  if (same) return "";
+  std::string error = edit([&](Scene& now, WorldDynamics& dynamics) {
+    return placeWeather(now, dynamics, key, weather);
+  });
+  if (changed) *changed = error.empty();
+  return error;
+}
+
+std::string World::setFog(const std::optional<Fog>& fog, bool* changed) {
+  if (changed) *changed = false;
+  if (fog == base_.fog) return "";
+  std::string error = edit([&](Scene& now, WorldDynamics&) {
+    now.fog = fog;
+    return std::string();
+  });
+  if (changed) *changed = error.empty();
+  return error;
+}
+
+std::string World::setHaze(const std::optional<Haze>& haze, bool* changed) {
+  if (changed) *changed = false;
+  if (haze == base_.haze) return "";
+  std::string error = edit([&](Scene& now, WorldDynamics&) {
+    now.haze = haze;
+    return std::string();
+  });
+  if (changed) *changed = error.empty();
+  return error;
 }
 
 std::string World::edit(

@@ -39,6 +39,33 @@ struct WorldDynamics {
 // Empty when `dynamics` fits `scene` and is usable, else what is wrong.
 std::string worldDynamicsError(const Scene& scene, const WorldDynamics& dynamics);
 
+// Removes the entries of `items` (and the matching development entries, if any) for which
+// `drop` holds.
+template <class T, class D, class Pred>
+void eraseWithDevelopment(std::vector<T>& items, std::vector<D>& development, Pred drop) {
+  std::vector<T> kept_items;
+  std::vector<D> kept_development;
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    if (drop(items[i])) continue;
+    kept_items.push_back(std::move(items[i]));
+    if (!development.empty()) kept_development.push_back(std::move(development[i]));
+  }
+  items = std::move(kept_items);
+  development = std::move(kept_development);
+}
+
+// The names of what weather layer `key` makes: "weather/2", or "weather/region7/2" for a CIGI
+// region's layer. Every name the world makes holds a '/', which no user name may
+// (world/limits.h), so nothing a user added is ever replaced.
+std::string weatherPrefix(const WeatherKey& key);
+// Sets weather layer `key` of `scene` to `weather` (type kNone removes it): records it in
+// scene.weather and replaces the layers and fields it made before with weatherClouds' (MODEL.md
+// section 10), seeded by the scene's seed and the key, so that the same layer from a scene
+// file, set_weather, Modbus or CIGI draws the same sky. A layer naming a wind sets the wind at
+// its middle. An invalid layer (weatherLayerError) is refused and nothing changes.
+std::string placeWeather(Scene& scene, WorldDynamics& dynamics, const WeatherKey& key,
+                         const WeatherLayer& weather);
+
 class World {
  public:
   // Simulation time is kept in whole nanoseconds, so that split advances add up exactly.
@@ -77,6 +104,14 @@ class World {
   // the drift so far) and returns an error to cancel. A layer or cloud whose wind changes
   // stays where it is and drifts on with the new wind. On any error nothing changes.
   std::string edit(const std::function<std::string(Scene& now, WorldDynamics& dynamics)>& change);
+
+  // Typed edits, through edit(): each returns an error and then changes nothing. `changed`
+  // (if given) says whether the world differs afterwards: a host repeating what it sent last
+  // changes nothing and costs a comparison.
+  std::string setWeather(const WeatherKey& key, const WeatherLayer& weather,
+                         bool* changed = nullptr);
+  std::string setFog(const std::optional<Fog>& fog, bool* changed = nullptr);
+  std::string setHaze(const std::optional<Haze>& haze, bool* changed = nullptr);
 
   // The render's view of the world now.
   Scene scene() const;

@@ -16,6 +16,7 @@
 #include <xxhash.h>
 
 #include "world/file_output.h"
+#include "world/formations/cloud_field.h"
 #include "world/limits.h"
 #include "world/world.h"
 
@@ -25,7 +26,7 @@ namespace {
 static_assert(std::endian::native == std::endian::little, "snapshots assume a little-endian host");
 
 constexpr char kMagic[8] = {'N', 'E', 'P', 'H', 'S', 'N', 'A', 'P'};
-constexpr std::uint32_t kFormatVersion = 9;
+constexpr std::uint32_t kFormatVersion = 10;
 constexpr std::size_t kHeaderBytes = sizeof kMagic + 4 + 8 + 8;
 
 class Writer {
@@ -235,10 +236,41 @@ void io(A& a, CloudField& f) {
   const WeatherLayer w{f.type, f.base_m, f.thickness_m, f.coverage, {}, f.region, f.clusters};
   if (std::string e = weatherLayerError(w); !e.empty()) a.fail("field " + f.name + ": " + e);
 }
+// The weather layers as set: their clouds are written with the rest of the scene.
+template <class A>
+void io(A& a, std::map<WeatherKey, WeatherLayer>& weather) {
+  const std::size_t n = a.count(weather.size(), 64);
+  auto put = [&](WeatherKey key, WeatherLayer w) {
+    io(a, key.layer);
+    bool regional = key.region.has_value();
+    std::uint16_t region = key.region.value_or(0);
+    io(a, regional), io(a, region);
+    if (regional) key.region = region;
+    ioEnum(a, w.type, kCloudTypeCount);
+    io(a, w.base_m), io(a, w.thickness_m), io(a, w.coverage);
+    bool windy = w.wind.has_value();
+    glm::dvec2 wind = w.wind.value_or(glm::dvec2(0.0));
+    io(a, windy), io(a, wind);
+    if (windy) w.wind = wind;
+    io(a, w.region), io(a, w.clusters);
+    io(a, w.visibility_m), io(a, w.transition_band_m), io(a, w.scud);
+    if constexpr (!A::kReading) return;
+    if (w.type == CloudType::kNone) return a.fail("a weather layer of no type");
+    if (std::string e = weatherLayerError(w); !e.empty()) return a.fail("weather layer: " + e);
+    weather[key] = w;
+  };
+  if constexpr (A::kReading) {
+    weather.clear();
+    for (std::size_t i = 0; i < n && a.ok(); ++i) put({}, {});
+  } else {
+    for (const auto& [key, w] : weather) put(key, w);
+  }
+}
 template <class A>
 void io(A& a, Scene& s) {
   io(a, s.seed), io(a, s.camera), io(a, s.sun), io(a, s.sky), io(a, s.fog), io(a, s.haze);
   io(a, s.layers, 64), io(a, s.clouds, 64), io(a, s.targets, 64), io(a, s.fields, 64);
+  io(a, s.weather);
 }
 template <class A>
 void io(A& a, Schedule& s) {

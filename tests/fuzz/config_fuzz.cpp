@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <string_view>
 
-#include "config/daemon_config.h"
 #include "config/scene_file.h"
+#include "server/daemon_config.h"
 #include "tests/fuzz/world_work.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -54,6 +54,7 @@ struct WeatherLayer {
   // Scud (MODEL.md section 10): the cloud fraction, 0..1, of ragged fragments drawn under the
   // base (CIGI's scud frequency); 0 draws none.
   double scud = 0.0;
+  bool operator==(const WeatherLayer&) const = default;
 };
 
 // Empty when the layer can be drawn, else what is wrong and what is allowed (ranges in

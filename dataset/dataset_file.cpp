@@ -1,4 +1,4 @@
-#include "config/dataset_file.h"
+#include "dataset/dataset_file.h"
 
 #include <filesystem>
 #include <memory>

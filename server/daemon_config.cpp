@@ -1,4 +1,4 @@
-#include "config/daemon_config.h"
+#include "server/daemon_config.h"
 
 #include <unistd.h>
 
