@@ -104,10 +104,7 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
         return reply;
       },
       [&](const SetWind& c) -> std::optional<Outcome> {
-        std::string error = world.edit([&](Scene&, WorldDynamics& d) {
-          d.wind.samples = {{0.0, c.velocity}};
-          return std::string();
-        });
+        std::string error = world.setWind({{{0.0, c.velocity}}});
         if (!error.empty()) return ProtocolError{ErrorCode::kFailed, error};
         return json{{"velocity", {c.velocity.x, c.velocity.y}}};
       },
@@ -153,42 +150,17 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
                                    std::to_string(config_.max_ellipsoids) +
                                    " ([world] max_ellipsoids in the daemon config; about " +
                                    std::to_string(Limits::kBytesPerEllipsoid) + " bytes each)"};
-        std::string error = world.edit([&](Scene& now, WorldDynamics& d) -> std::string {
-          for (const EllipsoidCloud& other : now.clouds)
-            if (other.name == cloud.name) return "cloud.name: \"" + cloud.name + "\" is taken";
-          now.clouds.push_back(cloud);
-          if (!d.clouds.empty()) d.clouds.emplace_back();
-          return "";
-        });
-        if (!error.empty()) return badField(error);
+        if (std::string error = world.addCloud(cloud); !error.empty()) return badField(error);
         return json{{"name", cloud.name}, {"ellipsoids", ellipsoids}};
       },
       [&](const ChangeCloud& c) -> std::optional<Outcome> {
-        std::string error = world.edit([&](Scene& now, WorldDynamics&) -> std::string {
-          for (EllipsoidCloud& cloud : now.clouds) {
-            if (cloud.name != c.name) continue;
-            if (c.move) {
-              for (Ellipsoid& e : cloud.ellipsoids) e.centre += *c.move;
-              cloud.drift_m += *c.move;  // the texture moves with the cloud
-            }
-            if (c.threshold) cloud.threshold_centre = *c.threshold;
-            if (c.limb_threshold) cloud.threshold_limb = *c.limb_threshold;
-            if (c.transition) cloud.transition = *c.transition;
-            if (c.colour) cloud.colour = *c.colour;
-            return "";
-          }
-          return "name: no cloud is called \"" + c.name + "\"";
-        });
+        std::string error = world.changeCloud(
+            c.name, {c.move, c.threshold, c.limb_threshold, c.transition, c.colour});
         if (!error.empty()) return ProtocolError{ErrorCode::kNotFound, error};
         return json{{"name", c.name}};
       },
       [&](const RemoveCloud& c) -> std::optional<Outcome> {
-        std::string error = world.edit([&](Scene& now, WorldDynamics& d) -> std::string {
-          const std::size_t before = now.clouds.size();
-          eraseWithDevelopment(now.clouds, d.clouds,
-                               [&](const EllipsoidCloud& cloud) { return cloud.name == c.name; });
-          return now.clouds.size() == before ? "name: no cloud is called \"" + c.name + "\"" : "";
-        });
+        std::string error = world.removeCloud(c.name);
         if (!error.empty()) return ProtocolError{ErrorCode::kNotFound, error};
         return json{{"name", c.name}};
       },
@@ -209,48 +181,23 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
                    !e.empty()) {
           return badField(e);
         }
-        std::string error = world.edit([&](Scene& now, WorldDynamics&) -> std::string {
-          for (Target& other : now.targets)
-            if (other.name == target.name) {
-              if (!c.replace) return "target.name: \"" + target.name + "\" is taken";
-              other = target;  // a CIGI entity the world already holds (after a restart)
-              return "";
-            }
-          if (now.targets.size() >= std::size_t(ProtocolLimits::kMaxTargets))
-            return "target: the world holds " + std::to_string(ProtocolLimits::kMaxTargets) +
-                   " targets already";
-          now.targets.push_back(target);
-          return "";
-        });
+        // A CIGI entity the world already holds (after a restart) is replaced.
+        std::string error =
+            world.addTarget(target, c.replace, std::size_t(ProtocolLimits::kMaxTargets));
         if (!error.empty()) return badField(error);
         return targetJson(target, world.base().targets.size());
       },
       [&](const MoveTarget& c) -> std::optional<Outcome> {
-        std::optional<json> moved;
-        world.edit([&](Scene& now, WorldDynamics&) -> std::string {
-          for (std::size_t i = 0; i < now.targets.size(); ++i) {
-            Target& t = now.targets[i];
-            if (t.name != c.name) continue;
-            if (c.centre) t.centre = *c.centre;
-            if (c.heading) t.orientation.heading_deg = *c.heading;
-            if (c.pitch) t.orientation.pitch_deg = *c.pitch;
-            if (c.roll) t.orientation.roll_deg = *c.roll;
-            moved = targetJson(t, i + 1);
-            return "";
-          }
-          return "not found";
-        });
-        if (!moved)
-          return ProtocolError{ErrorCode::kNotFound,
-                               "name: no target is called \"" + c.name + "\""};
-        return *moved;
+        if (std::string error = world.moveTarget(c.name, {c.centre, c.heading, c.pitch, c.roll});
+            !error.empty())
+          return ProtocolError{ErrorCode::kNotFound, error};
+        const std::vector<Target>& targets = world.base().targets;
+        const auto moved = std::find_if(targets.begin(), targets.end(),
+                                        [&](const Target& t) { return t.name == c.name; });
+        return targetJson(*moved, std::size_t(moved - targets.begin()) + 1);
       },
       [&](const RemoveTarget& c) -> std::optional<Outcome> {
-        std::string error = world.edit([&](Scene& now, WorldDynamics&) -> std::string {
-          const std::size_t before = now.targets.size();
-          std::erase_if(now.targets, [&](const Target& t) { return t.name == c.name; });
-          return now.targets.size() == before ? "name: no target is called \"" + c.name + "\"" : "";
-        });
+        std::string error = world.removeTarget(c.name);
         if (!error.empty()) return ProtocolError{ErrorCode::kNotFound, error};
         return json{{"name", c.name}};
       },

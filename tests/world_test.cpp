@@ -407,6 +407,51 @@ TEST(World, WeatherLayersAreHeldOnceAndReplacedWhole) {
   EXPECT_FALSE(changed);
 }
 
+// Clouds keep their development beside them: removing one takes its schedules with it and
+// leaves the others' schedules on the clouds they belong to. Names are unique; what is not
+// found is named.
+TEST(World, CloudsAndTargetsAreEditedByNameWithTheirDevelopment) {
+  auto [scene, d] = smallWorld();
+  scene.clouds[0].name = "first";
+  EllipsoidCloud second = scene.clouds[0];
+  second.name = "second";
+  scene.clouds.push_back(second);
+  d.clouds.push_back({});
+  d.clouds[1].threshold_centre = {{0.0, 100.0}, {0.2, 0.7}};  // the second's own schedule
+  World world(scene, d);
+  EXPECT_THAT(world.addCloud(second), ::testing::HasSubstr("is taken"));
+  ASSERT_EQ(world.removeCloud("first"), "");
+  ASSERT_EQ(world.dynamics().clouds.size(), 1u);
+  EXPECT_EQ(world.dynamics().clouds[0].threshold_centre.values,
+            (std::vector<double>{0.2, 0.7}));
+  EXPECT_EQ(world.scene().clouds[0].name, "second");
+  EXPECT_THAT(world.removeCloud("first"), ::testing::HasSubstr("no cloud is called"));
+  ASSERT_EQ(world.changeCloud("second", {glm::dvec3(10.0, 0.0, 0.0), std::nullopt,
+                                         std::nullopt, std::nullopt, std::nullopt}),
+            "");
+  EXPECT_DOUBLE_EQ(world.base().clouds[0].drift_m.x, 10.0);
+  EXPECT_THAT(world.changeCloud("third", {}), ::testing::HasSubstr("no cloud is called"));
+  second.name = "third";
+  ASSERT_EQ(world.addCloud(second), "");
+  EXPECT_EQ(world.dynamics().clouds.size(), 2u);  // the new cloud develops not at all
+
+  Target t;
+  t.name = "boat";
+  ASSERT_EQ(world.addTarget(t, false, 1), "");
+  EXPECT_THAT(world.addTarget(t, false, 1), ::testing::HasSubstr("is taken"));
+  t.centre = {5.0, 6.0, 7.0};
+  ASSERT_EQ(world.addTarget(t, true, 1), "");  // replaced, not counted again
+  EXPECT_EQ(world.base().targets.at(0).centre, t.centre);
+  t.name = "raft";
+  EXPECT_THAT(world.addTarget(t, false, 1), ::testing::HasSubstr("holds 1 targets"));
+  ASSERT_EQ(world.moveTarget("boat", {std::nullopt, 90.0, std::nullopt, std::nullopt}), "");
+  EXPECT_EQ(world.base().targets[0].orientation.heading_deg, 90.0);
+  EXPECT_EQ(world.base().targets[0].centre, glm::dvec3(5.0, 6.0, 7.0));
+  EXPECT_THAT(world.moveTarget("raft", {}), ::testing::HasSubstr("no target is called"));
+  ASSERT_EQ(world.removeTarget("boat"), "");
+  EXPECT_TRUE(world.base().targets.empty());
+}
+
 // Fog and haze set as they are change nothing; set otherwise, they change the world.
 TEST(World, FogAndHazeSetAgainChangeNothing) {
   World world = makeWorld();

@@ -234,6 +234,87 @@ std::string World::setHaze(const std::optional<Haze>& haze, bool* changed) {
   return error;
 }
 
+std::string World::setWind(const WindProfile& wind) {
+  return edit([&](Scene&, WorldDynamics& d) {
+    d.wind = wind;
+    return std::string();
+  });
+}
+
+std::string World::addCloud(const EllipsoidCloud& cloud) {
+  return edit([&](Scene& now, WorldDynamics& d) -> std::string {
+    for (const EllipsoidCloud& other : now.clouds)
+      if (other.name == cloud.name) return "cloud.name: \"" + cloud.name + "\" is taken";
+    now.clouds.push_back(cloud);
+    if (!d.clouds.empty()) d.clouds.emplace_back();  // none, or one per cloud
+    return "";
+  });
+}
+
+std::string World::changeCloud(const std::string& name, const CloudChange& c) {
+  return edit([&](Scene& now, WorldDynamics&) -> std::string {
+    for (EllipsoidCloud& cloud : now.clouds) {
+      if (cloud.name != name) continue;
+      if (c.move) {
+        for (Ellipsoid& e : cloud.ellipsoids) e.centre += *c.move;
+        cloud.drift_m += *c.move;  // the texture moves with the cloud
+      }
+      if (c.threshold) cloud.threshold_centre = *c.threshold;
+      if (c.limb_threshold) cloud.threshold_limb = *c.limb_threshold;
+      if (c.transition) cloud.transition = *c.transition;
+      if (c.colour) cloud.colour = *c.colour;
+      return "";
+    }
+    return "name: no cloud is called \"" + name + "\"";
+  });
+}
+
+std::string World::removeCloud(const std::string& name) {
+  return edit([&](Scene& now, WorldDynamics& d) -> std::string {
+    const std::size_t before = now.clouds.size();
+    eraseWithDevelopment(now.clouds, d.clouds,
+                         [&](const EllipsoidCloud& cloud) { return cloud.name == name; });
+    return now.clouds.size() == before ? "name: no cloud is called \"" + name + "\"" : "";
+  });
+}
+
+std::string World::addTarget(const Target& target, bool replace, std::size_t max_targets) {
+  return edit([&](Scene& now, WorldDynamics&) -> std::string {
+    for (Target& other : now.targets)
+      if (other.name == target.name) {
+        if (!replace) return "target.name: \"" + target.name + "\" is taken";
+        other = target;
+        return "";
+      }
+    if (now.targets.size() >= max_targets)
+      return "target: the world holds " + std::to_string(max_targets) + " targets already";
+    now.targets.push_back(target);
+    return "";
+  });
+}
+
+std::string World::moveTarget(const std::string& name, const TargetPose& pose) {
+  return edit([&](Scene& now, WorldDynamics&) -> std::string {
+    for (Target& t : now.targets) {
+      if (t.name != name) continue;
+      if (pose.centre) t.centre = *pose.centre;
+      if (pose.heading) t.orientation.heading_deg = *pose.heading;
+      if (pose.pitch) t.orientation.pitch_deg = *pose.pitch;
+      if (pose.roll) t.orientation.roll_deg = *pose.roll;
+      return "";
+    }
+    return "name: no target is called \"" + name + "\"";
+  });
+}
+
+std::string World::removeTarget(const std::string& name) {
+  return edit([&](Scene& now, WorldDynamics&) -> std::string {
+    const std::size_t before = now.targets.size();
+    std::erase_if(now.targets, [&](const Target& t) { return t.name == name; });
+    return now.targets.size() == before ? "name: no target is called \"" + name + "\"" : "";
+  });
+}
+
 std::string World::edit(
     const std::function<std::string(Scene& now, WorldDynamics& dynamics)>& change) {
   Scene now = base_;

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -53,6 +54,18 @@ void eraseWithDevelopment(std::vector<T>& items, std::vector<D>& development, Pr
   items = std::move(kept_items);
   development = std::move(kept_development);
 }
+
+// A change to an ellipsoid cloud (the socket protocol's change_cloud): what is given changes.
+struct CloudChange {
+  std::optional<glm::dvec3> move;  // metres to move by; the texture moves with the cloud
+  std::optional<double> threshold, limb_threshold, transition;
+  std::optional<glm::dvec3> colour;
+};
+// A target's pose, in part: what is given changes.
+struct TargetPose {
+  std::optional<glm::dvec3> centre;
+  std::optional<double> heading, pitch, roll;
+};
 
 // The names of what weather layer `key` makes: "weather/2", or "weather/region7/2" for a CIGI
 // region's layer. Every name the world makes holds a '/', which no user name may
@@ -112,6 +125,19 @@ class World {
                          bool* changed = nullptr);
   std::string setFog(const std::optional<Fog>& fog, bool* changed = nullptr);
   std::string setHaze(const std::optional<Haze>& haze, bool* changed = nullptr);
+  // The wind by altitude (layers, clouds and fields drift on from where they are).
+  std::string setWind(const WindProfile& wind);
+  // Ellipsoid clouds and targets by name (names are unique within each kind); a cloud keeps
+  // its development schedules beside it and loses them with it. Errors name the key.
+  std::string addCloud(const EllipsoidCloud& cloud);
+  std::string changeCloud(const std::string& name, const CloudChange& change);
+  std::string removeCloud(const std::string& name);
+  // With `replace` a target of the same name is replaced (a CIGI entity the world already
+  // holds after a restart); otherwise the name must be free and the world hold fewer than
+  // `max_targets`.
+  std::string addTarget(const Target& target, bool replace, std::size_t max_targets);
+  std::string moveTarget(const std::string& name, const TargetPose& pose);
+  std::string removeTarget(const std::string& name);
 
   // The render's view of the world now.
   Scene scene() const;
