@@ -212,26 +212,30 @@ std::string World::setWeather(const WeatherKey& key, const WeatherLayer& weather
   return error;
 }
 
-std::string World::setFog(const std::optional<Fog>& fog, bool* changed) {
+namespace {
+
+// Sets one optional part of the scene (fog, haze): nothing when it is already so.
+template <class T>
+std::string setPart(World& world, std::optional<T> Scene::*part, const std::optional<T>& value,
+                    bool* changed) {
   if (changed) *changed = false;
-  if (fog == base_.fog) return "";
-  std::string error = edit([&](Scene& now, WorldDynamics&) {
-    now.fog = fog;
+  if (world.base().*part == value) return "";
+  std::string error = world.edit([&](Scene& now, WorldDynamics&) {
+    now.*part = value;
     return std::string();
   });
   if (changed) *changed = error.empty();
   return error;
 }
 
+}  // namespace
+
+std::string World::setFog(const std::optional<Fog>& fog, bool* changed) {
+  return setPart(*this, &Scene::fog, fog, changed);
+}
+
 std::string World::setHaze(const std::optional<Haze>& haze, bool* changed) {
-  if (changed) *changed = false;
-  if (haze == base_.haze) return "";
-  std::string error = edit([&](Scene& now, WorldDynamics&) {
-    now.haze = haze;
-    return std::string();
-  });
-  if (changed) *changed = error.empty();
-  return error;
+  return setPart(*this, &Scene::haze, haze, changed);
 }
 
 std::string World::setWind(const WindProfile& wind) {
