@@ -61,10 +61,18 @@ TEST(EllipsoidBudget, KeepsTheLargestInViewAndIsDeterministic) {
                   cloud("behind", -1000.0, 500.0, 5)};
   const Scene kept = *withinEllipsoidBudget(scene, 7.0);
   EXPECT_EQ(ellipsoidCount(kept), 7u);
-  ASSERT_EQ(kept.clouds.size(), 2u);  // the cloud behind the camera is gone
+  ASSERT_EQ(kept.clouds.size(), 2u);  // the cloud behind the camera is gone, unmerged
   EXPECT_EQ(kept.clouds[0].name, "far");
-  EXPECT_EQ(kept.clouds[0].ellipsoids.size(), 3u);  // its first three: ties by lobe order
-  EXPECT_EQ(kept.clouds[0].texture.seed, 0u);       // thinned: the shared texture
+  // Its first two lobes (ties by lobe order), and the body of the three the first choice
+  // dropped (lobes 3 to 5, about their mean centre, its moments' radii times 1.5), for which
+  // the lobes are chosen again with one place fewer (lobe 2 goes unmerged).
+  ASSERT_EQ(kept.clouds[0].ellipsoids.size(), 3u);
+  EXPECT_EQ(kept.clouds[0].ellipsoids[1].centre, scene.clouds[0].ellipsoids[1].centre);
+  EXPECT_NEAR(kept.clouds[0].ellipsoids[2].centre.x, 40.0, 1e-9);
+  EXPECT_NEAR(kept.clouds[0].ellipsoids[2].centre.y, 10000.0, 1e-9);
+  EXPECT_GT(kept.clouds[0].ellipsoids[2].radii.x, 75.0);  // spread along x by the lobes
+  EXPECT_NEAR(kept.clouds[0].ellipsoids[2].radii.y, 75.0, 1e-6);
+  EXPECT_EQ(kept.clouds[0].texture.seed, 0u);  // thinned: the shared texture
   EXPECT_EQ(kept.clouds[1].name, "near");
   EXPECT_EQ(kept.clouds[1].ellipsoids.size(), 4u);  // every near lobe
   EXPECT_EQ(kept.clouds[1].texture.seed, 7u);
@@ -105,13 +113,18 @@ TEST(EllipsoidBudget, FootprintIsTheClippedBoundingSquareInViews) {
   EllipsoidCloud cloud;
   for (int i = 0; i < 10; ++i) cloud.ellipsoids.push_back(sphere({0.0, 5.0 + 1e-3 * i, 0.0}, 3.0));
   scene.clouds = {cloud};
+  // The first choice keeps three and merges the other seven into a body whose footprint (its
+  // radii 1.5 times theirs) is the whole view, half the budget; in the view left the lobes are
+  // chosen again: the nearest, and the body.
   const std::optional<Scene> kept = withinEllipsoidBudget(scene, 0.0, 2.0);
   ASSERT_TRUE(kept);
-  ASSERT_EQ(ellipsoidCount(*kept), 3u);
-  for (int i = 0; i < 3; ++i)
-    EXPECT_EQ(kept->clouds[0].ellipsoids[i].centre, cloud.ellipsoids[i].centre);
-  EXPECT_FALSE(withinEllipsoidBudget(scene, 0.0, 6.0));                    // 5.6 views: within
-  EXPECT_EQ(ellipsoidCount(*withinEllipsoidBudget(scene, 0.0, 0.1)), 1u);  // the largest always
+  ASSERT_EQ(ellipsoidCount(*kept), 2u);
+  EXPECT_EQ(kept->clouds[0].ellipsoids[0].centre, cloud.ellipsoids[0].centre);
+  EXPECT_NEAR(kept->clouds[0].ellipsoids[1].centre.y, 5.0 + 1e-3 * 6.0, 1e-9);
+  EXPECT_EQ(ellipsoidFootprint(kept->clouds[0].ellipsoids[1], camera, basis), 1.0);
+  EXPECT_FALSE(withinEllipsoidBudget(scene, 0.0, 6.0));  // 5.6 views: within
+  // The largest always, and the body of the rest.
+  EXPECT_EQ(ellipsoidCount(*withinEllipsoidBudget(scene, 0.0, 0.1)), 2u);
 }
 
 TEST(Ellipsoid, SymmetricEigenReconstructs) {

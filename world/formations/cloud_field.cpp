@@ -742,6 +742,56 @@ double ellipsoidFootprint(const Ellipsoid& e, const Camera& camera, const ViewBa
   return across * down / (4.0 * w * h);
 }
 
+namespace {
+
+// The lobes a budget drops, merged into one body per heap (a cloud's part, or the whole
+// cloud when it names none): the ellipsoid of their second moments (heap_light.h), standing
+// for their cover (MODEL.md section 15). A heap that lost one lobe loses it unmerged. More
+// bodies than `most` would have: one per cloud instead.
+constexpr double kBodyScale = 1.5;
+constexpr std::size_t kMomentSamples = 512;
+// The share of the footprint budget the bodies may take (the largest body always).
+constexpr double kBodyShare = 0.25;
+struct Body {
+  std::uint32_t cloud, part;
+  Ellipsoid ellipsoid;
+};
+std::vector<Body> mergedBodies(const Scene& scene, const std::vector<std::vector<char>>& kept,
+                               std::size_t most) {
+  for (bool per_cloud : {false, true}) {
+    std::vector<Body> bodies;
+    for (std::size_t c = 0; c < scene.clouds.size(); ++c) {
+      const EllipsoidCloud& cloud = scene.clouds[c];
+      const std::vector<char>& flags = kept[c];
+      const std::size_t lost = std::size_t(std::count(flags.begin(), flags.end(), char(0)));
+      if (lost < 2) continue;
+      // The moments of a cloud's dropped lobes from at most about kMomentSamples of them, every
+      // stride-th in order: a body needs their spread, not each of a million lobes (the 64x48
+      // frame of a world at its budget stays within a second).
+      const std::size_t stride = std::max<std::size_t>(1, lost / kMomentSamples);
+      const bool parts = !per_cloud && cloud.parts.size() == cloud.ellipsoids.size();
+      std::map<std::uint32_t, std::pair<SecondMoments, std::size_t>> dropped;  // by part
+      std::size_t seen = 0;
+      for (std::size_t i = 0; i < cloud.ellipsoids.size(); ++i) {
+        if (flags[i] != 0) continue;  // kept (1), or out of the view (2)
+        auto& [moments, count] = dropped[parts ? cloud.parts[i] : 0u];
+        if (seen++ % stride == 0 || count == 0) moments.add(cloud.ellipsoids[i]);
+        ++count;
+      }
+      for (const auto& [part, merged] : dropped)
+        if (merged.second >= 2)
+          if (std::optional<Ellipsoid> e = merged.first.ellipsoid()) {
+            e->radii *= kBodyScale;
+            bodies.push_back({std::uint32_t(c), part, *e});
+          }
+    }
+    if (bodies.size() <= most || per_cloud) return bodies;
+  }
+  return {};
+}
+
+}  // namespace
+
 std::optional<Scene> withinEllipsoidBudget(const Scene& scene, double budget, double overdraw) {
   const std::size_t total = ellipsoidCount(scene);
   const bool counted = budget > 0.0 && double(total) > budget;
@@ -773,28 +823,80 @@ std::optional<Scene> withinEllipsoidBudget(const Scene& scene, double budget, do
     if (a.size != b.size) return a.size > b.size;
     return a.cloud != b.cloud ? a.cloud < b.cloud : a.lobe < b.lobe;
   };
-  std::size_t keep = counted ? std::size_t(budget) : total;
-  if (keep < total)
-    std::nth_element(sizes.begin(), sizes.begin() + std::ptrdiff_t(keep), sizes.end(), larger);
-  if (covered) {  // the largest first while their footprints fit (the largest always)
-    std::sort(sizes.begin(), sizes.begin() + std::ptrdiff_t(keep), larger);
+  // The largest while at most `most` and their footprints within `room` (the largest always);
+  // sizes[0, keep) holds them.
+  std::size_t keep = total;
+  bool sorted = false;
+  auto choose = [&](std::size_t most, double room) {
+    if (most < keep) {
+      std::nth_element(sizes.begin(), sizes.begin() + std::ptrdiff_t(most),
+                       sizes.begin() + std::ptrdiff_t(keep), larger);
+      keep = most;
+    }
+    if (!covered) return;
+    if (!sorted) std::sort(sizes.begin(), sizes.begin() + std::ptrdiff_t(keep), larger);
+    sorted = true;
     double sum = 0.0;
     std::size_t fit = 0;
-    while (fit < keep && (fit == 0 || sum + sizes[fit].footprint <= overdraw))
+    while (fit < keep && (fit == 0 || sum + sizes[fit].footprint <= room))
       sum += sizes[fit++].footprint;
     keep = fit;
+  };
+  auto keptFlags = [&] {
+    std::vector<std::vector<char>> kept(scene.clouds.size());
+    for (std::size_t c = 0; c < scene.clouds.size(); ++c)
+      kept[c].assign(scene.clouds[c].ellipsoids.size(), 0);
+    for (std::size_t k = 0; k < keep; ++k) kept[sizes[k].cloud][sizes[k].lobe] = 1;
+    // Lobes out of the view are dropped unmerged (mergedBodies merges flags of 0).
+    for (std::size_t k = keep; k < sizes.size(); ++k)
+      if (!(sizes[k].footprint > 0.0)) kept[sizes[k].cloud][sizes[k].lobe] = 2;
+    return kept;
+  };
+  // The dropped lobes' bodies count against both parts of the budget. They are made once, from
+  // the first choice, and kept largest first while they number at most a quarter of the count
+  // and cover at most kBodyShare of the footprint budget (a pile of clouds stacked in one place
+  // gives a body per cloud, each over the whole view); the lobes are then chosen again in the room
+  // the bodies leave, those dropped by this second choice going unmerged.
+  choose(counted ? std::size_t(budget) : total, overdraw);
+  std::vector<std::vector<char>> kept = keptFlags();
+  const std::size_t most_bodies =
+      counted ? std::max<std::size_t>(std::size_t(budget) / 4, 1) : total;
+  std::vector<Body> bodies = mergedBodies(scene, kept, most_bodies);
+  if (!bodies.empty()) {
+    std::vector<std::pair<Size, std::size_t>> ranked;  // bodies by projected size
+    for (std::size_t k = 0; k < bodies.size(); ++k) {
+      const Ellipsoid& e = bodies[k].ellipsoid;
+      const double reach = std::max({e.radii.x, e.radii.y, e.radii.z});
+      const double ahead = glm::dot(e.centre - scene.camera.position, basis.forward);
+      ranked.push_back(
+          {{ahead < -reach ? 0.0 : reach / std::max(ahead, reach),
+            ellipsoidFootprint(e, scene.camera, basis), bodies[k].cloud, bodies[k].part},
+           k});
+    }
+    std::sort(ranked.begin(), ranked.end(),
+              [&](const auto& a, const auto& b) { return larger(a.first, b.first); });
+    std::vector<Body> chosen;
+    double body_footprint = 0.0;
+    for (const auto& [size, k] : ranked) {
+      if (chosen.size() >= most_bodies) break;
+      if (covered && !chosen.empty() && body_footprint + size.footprint > kBodyShare * overdraw)
+        break;
+      body_footprint += size.footprint;
+      chosen.push_back(bodies[k]);
+    }
+    bodies = std::move(chosen);
+    const std::size_t room =
+        counted ? std::size_t(budget) - std::min(bodies.size(), keep - 1) : total;
+    choose(room, overdraw - body_footprint);
+    kept = keptFlags();
   }
-  std::vector<std::vector<char>> kept(scene.clouds.size());
-  for (std::size_t c = 0; c < scene.clouds.size(); ++c)
-    kept[c].assign(scene.clouds[c].ellipsoids.size(), 0);
-  for (std::size_t k = 0; k < keep; ++k) kept[sizes[k].cloud][sizes[k].lobe] = 1;
   Scene out = scene;
   for (std::size_t c = 0; c < out.clouds.size(); ++c) {
     EllipsoidCloud& cloud = out.clouds[c];
     const std::size_t before = cloud.ellipsoids.size();
     std::size_t n = 0;
     for (std::size_t i = 0; i < before; ++i) {
-      if (!kept[c][i]) continue;
+      if (kept[c][i] != 1) continue;
       cloud.ellipsoids[n] = cloud.ellipsoids[i];
       if (!cloud.parts.empty()) cloud.parts[n] = cloud.parts[i];
       ++n;
@@ -805,6 +907,13 @@ std::optional<Scene> withinEllipsoidBudget(const Scene& scene, double budget, do
     // baked texture and one batch (a hundred clouds of their own seeds baked a hundred 128^3
     // tables, most of a heavy frame's time).
     if (n < before) cloud.texture.seed = cloud.texture.gardner.seed = 0;
+  }
+  for (const Body& b : bodies) {
+    const EllipsoidCloud& from = scene.clouds[b.cloud];
+    EllipsoidCloud& cloud = out.clouds[b.cloud];
+    cloud.ellipsoids.push_back(b.ellipsoid);
+    if (!from.parts.empty() && from.parts.size() == from.ellipsoids.size())
+      cloud.parts.push_back(b.part);  // lit with the heap it stands in
   }
   std::erase_if(out.clouds, [](const EllipsoidCloud& c) { return c.ellipsoids.empty(); });
   return out;

@@ -25,19 +25,11 @@ std::size_t groupOf(std::vector<std::size_t>& parent, std::size_t i) {
 
 }  // namespace
 
-std::vector<HeapEnvelope> heapEnvelopes(const EllipsoidCloud& cloud) {
+std::vector<std::size_t> heapGroups(const EllipsoidCloud& cloud) {
   const std::vector<Ellipsoid>& lobes = cloud.ellipsoids;
   const std::size_t n = lobes.size();
-  std::vector<HeapEnvelope> out(n);
-  if (!(cloud.light_extinction > 0.0) || n == 0) return out;
   // Heaps: the parts the cloud names, or else groups joined pairwise, the candidate pairs
   // found by a sweep along x over the ellipsoids' bounding spheres.
-  std::vector<double> reach(n);
-  std::vector<glm::dmat3> to_unit(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    reach[i] = std::max({lobes[i].radii.x, lobes[i].radii.y, lobes[i].radii.z});
-    to_unit[i] = worldToUnitSphere(lobes[i]);
-  }
   std::vector<std::size_t> parent(n), order;
   std::iota(parent.begin(), parent.end(), 0);
   if (cloud.parts.size() == n) {
@@ -48,10 +40,16 @@ std::vector<HeapEnvelope> heapEnvelopes(const EllipsoidCloud& cloud) {
       if (first[part] == n) first[part] = i;
       parent[i] = first[part];
     }
-  } else {
-    order.resize(n);
-    std::iota(order.begin(), order.end(), 0);
+    return parent;
   }
+  std::vector<double> reach(n);
+  std::vector<glm::dmat3> to_unit(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    reach[i] = std::max({lobes[i].radii.x, lobes[i].radii.y, lobes[i].radii.z});
+    to_unit[i] = worldToUnitSphere(lobes[i]);
+  }
+  order.resize(n);
+  std::iota(order.begin(), order.end(), 0);
   std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
     return lobes[a].centre.x - reach[a] < lobes[b].centre.x - reach[b];
   });
@@ -70,33 +68,48 @@ std::vector<HeapEnvelope> heapEnvelopes(const EllipsoidCloud& cloud) {
         parent[groupOf(parent, a)] = groupOf(parent, b);
     }
   }
-  // Each group's volume, centroid and second moments along the axes (a solid ellipsoid of
-  // volume V with T = body-to-world times radii has moments V T T^T / 5 about its centre).
-  struct Group {
-    double volume = 0.0;
-    glm::dvec3 first{0.0}, second{0.0};  // sums of V c and V (diag(T T^T) / 5 + c^2)
-  };
-  std::vector<Group> groups(n);
+  for (std::size_t i = 0; i < n; ++i) parent[i] = groupOf(parent, i);
+  return parent;
+}
+
+void SecondMoments::add(const Ellipsoid& e) {
+  // A solid ellipsoid of volume V with T = body-to-world times radii has moments V T T^T / 5
+  // about its centre; along the axes, V diag(T T^T) / 5.
+  const glm::dmat3 t = unitSphereToWorld(e);
+  const glm::dvec3 spread(glm::dot(glm::row(t, 0), glm::row(t, 0)),
+                          glm::dot(glm::row(t, 1), glm::row(t, 1)),
+                          glm::dot(glm::row(t, 2), glm::row(t, 2)));
+  const double v = 4.0 / 3.0 * std::numbers::pi * std::abs(glm::determinant(t));
+  volume += v;
+  first += v * e.centre;
+  second += v * (spread / 5.0 + e.centre * e.centre);
+}
+
+std::optional<Ellipsoid> SecondMoments::ellipsoid() const {
+  if (!(volume > 0.0)) return std::nullopt;
+  // The axis-aligned ellipsoid of the same second moments: semi-axes sqrt(5 variance).
+  Ellipsoid e;
+  e.centre = first / volume;
+  const glm::dvec3 variance = glm::max(second / volume - e.centre * e.centre, 0.0);
+  e.radii = glm::max(glm::sqrt(5.0 * variance), glm::dvec3(1e-3));
+  return e;
+}
+
+std::vector<HeapEnvelope> heapEnvelopes(const EllipsoidCloud& cloud) {
+  const std::vector<Ellipsoid>& lobes = cloud.ellipsoids;
+  const std::size_t n = lobes.size();
+  std::vector<HeapEnvelope> out(n);
+  if (!(cloud.light_extinction > 0.0) || n == 0) return out;
+  const std::vector<std::size_t> group = heapGroups(cloud);
+  std::vector<SecondMoments> moments(n);
+  for (std::size_t i = 0; i < n; ++i) moments[group[i]].add(lobes[i]);
   for (std::size_t i = 0; i < n; ++i) {
-    const glm::dmat3 t = unitSphereToWorld(lobes[i]);
-    const glm::dvec3 spread(glm::dot(glm::row(t, 0), glm::row(t, 0)),
-                            glm::dot(glm::row(t, 1), glm::row(t, 1)),
-                            glm::dot(glm::row(t, 2), glm::row(t, 2)));
-    const double v = 4.0 / 3.0 * std::numbers::pi * std::abs(glm::determinant(t));
-    const glm::dvec3 c = lobes[i].centre;
-    Group& g = groups[groupOf(parent, i)];
-    g.volume += v;
-    g.first += v * c;
-    g.second += v * (spread / 5.0 + c * c);
-  }
-  for (std::size_t i = 0; i < n; ++i) {
-    const Group& g = groups[groupOf(parent, i)];
+    const SecondMoments& g = moments[group[i]];
+    const std::optional<Ellipsoid> body = g.ellipsoid();
+    if (!body) continue;
     HeapEnvelope& e = out[i];
-    if (!(g.volume > 0.0)) continue;
-    // The axis-aligned ellipsoid of the same second moments: semi-axes sqrt(5 variance).
-    e.centre = g.first / g.volume;
-    const glm::dvec3 variance = glm::max(g.second / g.volume - e.centre * e.centre, 0.0);
-    e.radii = glm::max(glm::sqrt(5.0 * variance), glm::dvec3(1e-3));
+    e.centre = body->centre;
+    e.radii = body->radii;
     const double volume = 4.0 / 3.0 * std::numbers::pi * e.radii.x * e.radii.y * e.radii.z;
     e.extinction = cloud.light_extinction * std::min(g.volume / volume, 1.0);
   }

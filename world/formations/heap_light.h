@@ -4,6 +4,7 @@
 // holding its lobes, filled with their mean extinction), evaluated per surface point so that
 // the light runs on smoothly from lobe to lobe and the heap has one terminator; and the
 // forward-scattered light a thin edge gives off with the sun behind it (the silver lining).
+#include <optional>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -30,6 +31,19 @@ struct HeapEnvelope {
 // 1). All extinctions are 0 when the
 // cloud's light_extinction is 0.
 std::vector<HeapEnvelope> heapEnvelopes(const EllipsoidCloud& cloud);
+
+// The heap each ellipsoid of `cloud` belongs to, as heapEnvelopes groups them: the index of
+// one ellipsoid of its heap (the same for all of them).
+std::vector<std::size_t> heapGroups(const EllipsoidCloud& cloud);
+
+// Volume-weighted moments of solid ellipsoids, and the axis-aligned ellipsoid that has them
+// (semi-axes sqrt(5 variance) about the centroid; none while nothing was added).
+struct SecondMoments {
+  double volume = 0.0;
+  glm::dvec3 first{0.0}, second{0.0};  // sums of V c and V (diag(T T^T) / 5 + c^2)
+  void add(const Ellipsoid& e);
+  std::optional<Ellipsoid> ellipsoid() const;
+};
 
 // Length of the ray p + s dir (dir unit, s >= 0) inside the envelope, metres.
 double envelopeChord(const HeapEnvelope& envelope, glm::dvec3 p, glm::dvec3 dir);
