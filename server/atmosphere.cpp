@@ -1,7 +1,6 @@
 #include <spdlog/spdlog.h>
 
 #include "server/engine_state.h"
-#include "world/counter_random.h"
 #include "world/formations/weather.h"
 
 // Weather and atmosphere at run time: weather layers onto formations (MODEL.md section 10),

@@ -3,7 +3,6 @@
 #include <filesystem>
 
 #include "config/table_reader.h"
-#include "protocol/cloud_codes.h"
 #include "server/engine_state.h"
 #include "world/file_output.h"
 #include "world/limits.h"
