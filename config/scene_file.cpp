@@ -526,14 +526,6 @@ void readScene(const toml::table& root, const std::string& file, SceneFile& out)
     readLayer(layers[i], layer, dynamics.layers.emplace_back());
     if (layer.name.empty()) layer.name = "layer" + std::to_string(i);
   }
-  auto addWeather = [&](const WeatherLayer& w, const std::string& prefix, std::uint64_t seed) {
-    const WeatherClouds add = weatherClouds(w, prefix, seed);
-    for (const CloudLayer& l : add.layers) {
-      scene.layers.push_back(l);
-      if (!dynamics.layers.empty()) dynamics.layers.emplace_back();  // none, or one per layer
-    }
-    scene.fields.insert(scene.fields.end(), add.fields.begin(), add.fields.end());
-  };
   std::vector<TableReader> weather = t.tables("weather");
   for (std::size_t i = 0; i < weather.size(); ++i) {
     const WeatherLayer w = readWeather(weather[i]);
@@ -544,7 +536,9 @@ void readScene(const toml::table& root, const std::string& file, SceneFile& out)
   for (std::size_t i = 0; i < macro.size(); ++i) {
     std::uint64_t seed = hashCounters(scene.seed, 0x4d6163726full, i);
     macro[i].seed("seed", seed);
-    addWeather(readWeather(macro[i], true), "macrocluster/" + std::to_string(i + 1), seed);
+    appendWeatherClouds(
+        scene, dynamics,
+        weatherClouds(readWeather(macro[i], true), "macrocluster/" + std::to_string(i + 1), seed));
   }
   std::vector<TableReader> clouds = t.tables("cloud");
   for (std::size_t i = 0; i < clouds.size(); ++i) {

@@ -422,12 +422,11 @@ TEST(World, CloudsAndTargetsAreEditedByNameWithTheirDevelopment) {
   EXPECT_THAT(world.addCloud(second), ::testing::HasSubstr("is taken"));
   ASSERT_EQ(world.removeCloud("first"), "");
   ASSERT_EQ(world.dynamics().clouds.size(), 1u);
-  EXPECT_EQ(world.dynamics().clouds[0].threshold_centre.values,
-            (std::vector<double>{0.2, 0.7}));
+  EXPECT_EQ(world.dynamics().clouds[0].threshold_centre.values, (std::vector<double>{0.2, 0.7}));
   EXPECT_EQ(world.scene().clouds[0].name, "second");
   EXPECT_THAT(world.removeCloud("first"), ::testing::HasSubstr("no cloud is called"));
-  ASSERT_EQ(world.changeCloud("second", {glm::dvec3(10.0, 0.0, 0.0), std::nullopt,
-                                         std::nullopt, std::nullopt, std::nullopt}),
+  ASSERT_EQ(world.changeCloud("second", {glm::dvec3(10.0, 0.0, 0.0), std::nullopt, std::nullopt,
+                                         std::nullopt, std::nullopt}),
             "");
   EXPECT_DOUBLE_EQ(world.base().clouds[0].drift_m.x, 10.0);
   EXPECT_THAT(world.changeCloud("third", {}), ::testing::HasSubstr("no cloud is called"));

@@ -168,6 +168,14 @@ void setWindSample(WindProfile& profile, double altitude, glm::dvec2 velocity) {
 
 }  // namespace
 
+void appendWeatherClouds(Scene& scene, WorldDynamics& dynamics, const WeatherClouds& clouds) {
+  scene.fields.insert(scene.fields.end(), clouds.fields.begin(), clouds.fields.end());
+  for (const CloudLayer& l : clouds.layers) {
+    scene.layers.push_back(l);
+    if (!dynamics.layers.empty()) dynamics.layers.emplace_back();  // none, or one per layer
+  }
+}
+
 std::string placeWeather(Scene& scene, WorldDynamics& dynamics, const WeatherKey& key,
                          const WeatherLayer& weather) {
   if (weather.type != CloudType::kNone)
@@ -183,11 +191,7 @@ std::string placeWeather(Scene& scene, WorldDynamics& dynamics, const WeatherKey
   eraseWithDevelopment(scene.layers, dynamics.layers,
                        [&](const CloudLayer& l) { return made(l.name); });
   std::erase_if(scene.fields, [&](const CloudField& f) { return made(f.name); });
-  scene.fields.insert(scene.fields.end(), add.fields.begin(), add.fields.end());
-  for (const CloudLayer& l : add.layers) {
-    scene.layers.push_back(l);
-    if (!dynamics.layers.empty()) dynamics.layers.emplace_back();
-  }
+  appendWeatherClouds(scene, dynamics, add);
   if (weather.type == CloudType::kNone) {
     scene.weather.erase(key);
     return "";

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "world/automaton/automaton_cloud.h"
+#include "world/formations/weather.h"
 #include "world/limits.h"
 #include "world/scene.h"
 #include "world/schedule.h"
@@ -71,6 +72,8 @@ struct TargetPose {
 // region's layer. Every name the world makes holds a '/', which no user name may
 // (world/limits.h), so nothing a user added is ever replaced.
 std::string weatherPrefix(const WeatherKey& key);
+// Appends `clouds` (weatherClouds') to `scene`, its layers with no development beside them.
+void appendWeatherClouds(Scene& scene, WorldDynamics& dynamics, const WeatherClouds& clouds);
 // Sets weather layer `key` of `scene` to `weather` (type kNone removes it): records it in
 // scene.weather and replaces the layers and fields it made before with weatherClouds' (MODEL.md
 // section 10), seeded by the scene's seed and the key, so that the same layer from a scene

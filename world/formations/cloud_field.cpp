@@ -744,6 +744,14 @@ double ellipsoidFootprint(const Ellipsoid& e, const Camera& camera, const ViewBa
 
 namespace {
 
+// The budget's order of ellipsoids: the largest radius over the centre's distance along the
+// view (at most 1), none for an ellipsoid wholly behind the eye.
+double projectedSize(const Ellipsoid& e, const Camera& camera, const ViewBasis& basis) {
+  const double reach = std::max({e.radii.x, e.radii.y, e.radii.z});
+  const double ahead = glm::dot(e.centre - camera.position, basis.forward);
+  return ahead < -reach ? 0.0 : reach / std::max(ahead, reach);
+}
+
 // The lobes a budget drops, merged into one body per heap (a cloud's part, or the whole
 // cloud when it names none): the ellipsoid of their second moments (heap_light.h), standing
 // for their cover (MODEL.md section 15). A heap that lost one lobe loses it unmerged. More
@@ -809,12 +817,10 @@ std::optional<Scene> withinEllipsoidBudget(const Scene& scene, double budget, do
   for (std::size_t c = 0; c < scene.clouds.size(); ++c) {
     const std::vector<Ellipsoid>& lobes = scene.clouds[c].ellipsoids;
     for (std::size_t i = 0; i < lobes.size(); ++i) {
-      const double reach = std::max({lobes[i].radii.x, lobes[i].radii.y, lobes[i].radii.z});
-      const double ahead = glm::dot(lobes[i].centre - scene.camera.position, basis.forward);
       const double f = ellipsoidFootprint(lobes[i], scene.camera, basis);
       footprint += f;
-      sizes.push_back({ahead < -reach ? 0.0 : reach / std::max(ahead, reach), f, std::uint32_t(c),
-                       std::uint32_t(i)});
+      sizes.push_back(
+          {projectedSize(lobes[i], scene.camera, basis), f, std::uint32_t(c), std::uint32_t(i)});
     }
   }
   const bool covered = overdraw > 0.0 && footprint > overdraw;
@@ -866,11 +872,9 @@ std::optional<Scene> withinEllipsoidBudget(const Scene& scene, double budget, do
     std::vector<std::pair<Size, std::size_t>> ranked;  // bodies by projected size
     for (std::size_t k = 0; k < bodies.size(); ++k) {
       const Ellipsoid& e = bodies[k].ellipsoid;
-      const double reach = std::max({e.radii.x, e.radii.y, e.radii.z});
-      const double ahead = glm::dot(e.centre - scene.camera.position, basis.forward);
       ranked.push_back(
-          {{ahead < -reach ? 0.0 : reach / std::max(ahead, reach),
-            ellipsoidFootprint(e, scene.camera, basis), bodies[k].cloud, bodies[k].part},
+          {{projectedSize(e, scene.camera, basis), ellipsoidFootprint(e, scene.camera, basis),
+            bodies[k].cloud, bodies[k].part},
            k});
     }
     std::sort(ranked.begin(), ranked.end(),
