@@ -347,6 +347,8 @@ TEST(CloudField, HeapRangeIsBoundedInTiles) {
             CloudField::kRangeM + 2.0 * std::abs(300.0 - typical.fields[0].base_m));
 }
 
+// MODEL.md section 10: a cumulonimbus is one column from its base to the anvil, which spreads
+// from the tower (the incus) to several times its width, downwind of it when the wind shears.
 TEST(CloudField, CumulonimbusIsOneTowerUnderAnAnvilCarriedDownwind) {
   CloudField f;
   f.name = "cb";
@@ -390,6 +392,19 @@ TEST(CloudField, CumulonimbusIsOneTowerUnderAnAnvilCarriedDownwind) {
     const glm::dvec2 d = speed > 0.0 ? shear / speed : glm::dvec2(1.0, 0.0);
     const Extent anvil = extent(heap, d, true, anvil_z), tower = extent(heap, d, false, tower_z);
     EXPECT_GE(anvil.width(), 3.0 * tower.width());
+    // The tower spreads into the anvil (the incus) rather than standing as a stem under a
+    // plate: the cloud's width along the shear grows from the middle of the tower to the
+    // anvil, by half again at 0.72 h.
+    auto widthAt = [&](double height) {
+      double lo = 1e30, hi = -1e30;
+      for (double x = -4.0 * f.thickness_m; x <= 4.0 * f.thickness_m; x += 50.0)
+        if (insideSome(heap, glm::dvec3(x * d, f.base_m + height * f.thickness_m)))
+          lo = std::min(lo, x), hi = std::max(hi, x);
+      return hi - lo;
+    };
+    const double middle = widthAt(0.45), shoulder = widthAt(0.72), top = widthAt(0.9);
+    EXPECT_GE(shoulder, 1.5 * middle) << middle << " m at 0.45 h";
+    EXPECT_GE(top, shoulder) << shoulder << " m at 0.72 h";
     if (speed > 0.0)
       EXPECT_GT(anvil.middle() - tower.middle(), 0.25 * f.thickness_m);
     else

@@ -133,7 +133,7 @@ std::vector<Ellipsoid> cumulonimbusEllipsoids(const CloudField& f, glm::dvec3 ba
   auto axis = [&](double z) { return base + glm::dvec3(0.0, 0.0, z) + leanAt(shear, z); };
   std::vector<Ellipsoid> out;
   Ellipsoid bottom;  // flat, its bottom on the cloud base
-  bottom.radii = {0.45 * r, 0.45 * r * squash, 0.08 * h};
+  bottom.radii = {0.4 * r, 0.4 * r * squash, 0.1 * h};
   bottom.centre = base + glm::dvec3(0.0, 0.0, bottom.radii.z);
   bottom.orientation.heading_deg = 360.0 * u(1);
   out.push_back(bottom);
@@ -163,40 +163,81 @@ std::vector<Ellipsoid> cumulonimbusEllipsoids(const CloudField& f, glm::dvec3 ba
       tower.push_back(bulge);
     }
   }
+  // The incus: above 0.6 of its height the tower spreads out into the anvil, rings of
+  // lobes reaching further out (mostly downwind) at each level, their outer ends tilted up, so
+  // that the column widens into the anvil as one mass (an inverted cone under it) instead of a
+  // stem under a plate. The top ring joins the anvil and is kept at every distance, as the
+  // anvil is: from above it widens the anvil's edge, and merged into the far mound the heaps
+  // drew less cover than their measured footprint (0.444 against 0.463 over eight seeds).
+  constexpr int kRings = 3, kAround = 7;
+  std::vector<Ellipsoid> shoulder;
+  const double turn = 2.0 * std::numbers::pi * u(11);
+  for (int ring = 0; ring < kRings; ++ring) {
+    const double step = double(ring) / (kRings - 1);
+    const double reach = (0.30 + 0.40 * step) * r, size = (0.30 + 0.08 * step) * r;
+    for (int q = 0; q < kAround; ++q) {
+      const std::uint64_t k = 8 * std::uint64_t(ring) + std::uint64_t(q);
+      const double azimuth =
+          turn + 2.0 * std::numbers::pi * (q + 0.5 * ring + 0.5 * u(12, k)) / kAround;
+      const glm::dvec2 out_dir(std::cos(azimuth), std::sin(azimuth));
+      // Further out downwind, where the upper wind carries the spreading top.
+      const double stretch =
+          1.0 + 0.6 * shear.amount * std::max(glm::dot(out_dir, shear.direction), 0.0);
+      const double z = (0.63 + 0.08 * ring + 0.04 * (u(16, k) - 0.5)) * h;
+      Ellipsoid lobe;
+      lobe.radii = {size, size, 0.11 * h * (0.85 + 0.3 * u(13, k))};
+      lobe.centre =
+          axis(z) + glm::dvec3(out_dir * (reach * stretch * (0.85 + 0.3 * u(14, k))), 0.0);
+      // Body y (forward) along out_dir, pitched up by 10 to 25 degrees.
+      lobe.orientation.heading_deg = headingAlong({out_dir.y, -out_dir.x});
+      lobe.orientation.pitch_deg = 10.0 + 15.0 * u(15, k);
+      (ring + 1 < kRings ? tower : shoulder).push_back(lobe);
+    }
+  }
   if (!detailed) tower = {mound(tower)};
   out.insert(out.end(), tower.begin(), tower.end());
-  Ellipsoid dome;  // overshooting the anvil's top
-  dome.radii = {0.25 * r, 0.25 * r, 0.08 * h};
-  dome.centre = axis(0.96 * h);
-  out.push_back(dome);
-  // The anvil: a flat sheet at nine tenths of the height, longer along the shear and carried
-  // downwind, under flat lobes that make its top lumpy and thin it downwind.
+  out.insert(out.end(), shoulder.begin(), shoulder.end());
+  // The anvil: flat-topped at the tropopause (0.97 h), thickest where the tower feeds it (0.2 h)
+  // and thinning downwind to 0.07 h in full shear (upwind, where it overhangs less, to 0.12 h),
+  // longer along the shear and carried downwind; lobes hang from its flat top to a lumpy
+  // underside, over a thin sheet that fills between them. The overshooting dome, over the
+  // updraft, is sunk into it and lit with it.
   const double along = (1.5 + 0.5 * shear.amount) * r, across = 1.2 * r;
-  const glm::dvec3 middle =
-      axis(0.88 * h) + glm::dvec3(shear.direction * (0.9 * shear.amount * r), 0.0);
+  const double top = axis(0.97 * h).z;
+  const glm::dvec2 middle = glm::dvec2(axis(0.88 * h)) + shear.direction * (0.9 * shear.amount * r);
+  const glm::dvec2 axis_top(axis(0.97 * h));
+  auto thickness = [&](glm::dvec2 at) {
+    const double t = std::min(glm::length(at - axis_top) / along, 1.0);
+    const bool downwind = glm::dot(at - axis_top, shear.direction) > 0.0;
+    return h * (0.2 - (downwind ? 0.13 * shear.amount + 0.05 * (1.0 - shear.amount) : 0.08) * t);
+  };
   const double heading = headingAlong(shear.direction);
+  Ellipsoid dome;
+  dome.radii = {0.3 * r, 0.3 * r, 0.1 * h};  // sunk into the anvil, its top at 1.05 h
+  dome.centre = axis(0.95 * h);
   anvil_from = out.size();
+  out.push_back(dome);
   Ellipsoid sheet;
-  sheet.radii = {along, across, 0.06 * h};
-  sheet.centre = middle;
+  sheet.radii = {along, across, 0.05 * h};
+  sheet.centre = glm::dvec3(middle, top - sheet.radii.z);
   sheet.orientation.heading_deg = heading;
   out.push_back(sheet);
   ClusterSpec cap;
-  cap.element.radii = {0.4 * r, 0.4 * r, 0.06 * h};
-  cap.centre = glm::dvec2(middle);
+  cap.element.radii = {0.4 * r, 0.4 * r, 0.1 * h};
+  cap.centre = middle;
   cap.boundary_radii = {along - 0.35 * r, across - 0.35 * r};
   cap.boundary_heading_deg = heading;
   cap.spacing = glm::dvec2(0.45 * r);  // the anvil sets the outline: kept at every distance
-  cap.altitude_m = middle.z + 0.02 * h;
+  cap.altitude_m = top;
   cap.size_variation = 0.2;
   cap.position_variation = 0.3;
   cap.heading_variation_deg = 90.0;
   cap.seed = hashCounters(seed, kShape, 3);
   for (Ellipsoid e : clusterEllipsoids(cap)) {
-    // Thinner and lower towards its downwind edge.
-    const double t = glm::dot(glm::dvec2(e.centre - middle), shear.direction) / along;
-    e.radii.z *= 1.0 - 0.35 * std::max(t, 0.0) * shear.amount;
-    e.centre.z -= 0.03 * h * t * t;
+    // Hanging from the flat top, as thick as the anvil is there, drooping a little downwind.
+    const double t = glm::dot(glm::dvec2(e.centre) - middle, shear.direction) / along;
+    e.radii.z = 0.5 * thickness(glm::dvec2(e.centre)) * (e.radii.z / (0.1 * h));
+    e.centre.z = top - e.radii.z - 0.03 * h * std::max(t, 0.0) * t * shear.amount;
     out.push_back(e);
   }
   return out;
