@@ -7,7 +7,7 @@
 namespace nephele {
 
 enum class TextureEvaluation {
-  kAuto,        // baked, except on clouds so near that the solid table would be magnified
+  kAuto,        // baked for ellipsoids; a layer's clipmap filled over the frames after its first
   kBaked,       // Gardner's texture baked per layer into a mip chain of term truncations
   kProcedural,  // Gardner's sum of sines evaluated per fragment
 };

@@ -319,19 +319,33 @@ TEST(Ellipsoid, EyeInsideHasNoSurface) {
   EXPECT_LT(view.eyeRadius(), 1.0);
 }
 
-TEST(SolidTexture, BakedVolumeEqualsTheSolidTexture) {
+// The baked sums (MODEL.md section 2, "baked solid texture"): the first two terms over the
+// period and the last two over a quarter of it, added with T0 and multiplied, are the solid
+// texture of all four terms. Sizes 16 and 4 put the two tables' texel centres at the same
+// points, so no interpolation enters.
+TEST(SolidTexture, BakedSumsAddUpToTheSolidTexture) {
   GardnerTextureParams params{4, 0.01, 0.013, 0.2, true, 9};
   const GardnerTexture gardner(params);
-  const int size = 16;
-  const VolumeTable baked = bakeGardnerSolid(gardner, size, 3);
+  const VolumeTable coarse = bakeGardnerSums(gardner, 16, 0, 2);
+  const VolumeTable fine = bakeGardnerSums(gardner, 4, 2, 2);
+  ASSERT_EQ(coarse.channels, 2);
   const glm::dvec2 period = gardner.period();
-  for (int z = 0; z < size; z += 3)
-    for (int y = 0; y < size; y += 5)
-      for (int x = 0; x < size; ++x) {
-        const glm::dvec3 p((x + 0.5) / size * period.x, (y + 0.5) / size * period.y,
-                           (z + 0.5) / size * period.x);
-        EXPECT_NEAR(baked.at(x, y, z), gardner.solid(p, 3), 1e-6);
+  const double t0 = params.t0, k = gardner.normalisation();
+  double spread = 0.0;
+  for (int z = 0; z < 16; z += 3)
+    for (int y = 0; y < 16; y += 5)
+      for (int x = 0; x < 16; ++x) {
+        const glm::dvec3 p((x + 0.5) / 16 * period.x, (y + 0.5) / 16 * period.y,
+                           (z + 0.5) / 16 * period.x);
+        const double sx = t0 + coarse.at(x, y, z, 0) + fine.at(x, y, z, 0);
+        const double sy = t0 + coarse.at(x, y, z, 1) + fine.at(x, y, z, 1);
+        EXPECT_NEAR(k * std::max(sx, 0.0) * std::max(sy, 0.0), gardner.solid(p, 4), 1e-6);
+        spread = std::max(spread, std::abs(double(fine.at(x, y, z, 0))));
       }
+  EXPECT_GT(spread, 0.05);  // the fine terms are there
+  // No terms: zero sums.
+  const VolumeTable none = bakeGardnerSums(gardner, 4, 4, 2);
+  for (float v : none.values) EXPECT_EQ(v, 0.0f);
 }
 
 TEST(SolidTexture, PeriodicInEveryAxisAndFarAway) {

@@ -88,21 +88,35 @@ SolidTextureSpec bakedTableSpec(SolidTextureSpec spec) {
   return spec;
 }
 
-// Baked solid Gardner: 4 texels per cycle of the highest term at level 0 (at most 128 a
-// side), level l holding n - l terms. With 4 texels per cycle GL's trilinear LOD equals the
-// fade schedule of MODEL.md section 2, so trilinear filtering fades each term over its octave.
-int bakedSolidSize(const GardnerTexture& gardner) {
-  return std::min(4 << gardner.terms(), 128);
+// Baked solid Gardner (MODEL.md section 2, "baked solid texture"): the sums SX - T0 and
+// SY - T0 of the lower floor(n / 2) terms in one table over the period, of the upper terms in
+// a second over the period of its lowest term, 2^m times shorter (m the lower count), each at
+// 16 texels per cycle of its highest term (8 for a table of four terms, held to 128 a side).
+// A table of t texels per cycle holds all its c terms on its first log2(t) - 1 levels and one
+// fewer on each level above: GL's trilinear LOD then fades each term over the octave below its
+// limit (the fade of section 2), and the upper table's terms are gone before the lower
+// table's begin to fade. The shader adds the two tables' sums to T0 and takes
+// T = k max(SX, 0) max(SY, 0). Five terms: 64^3 and 128^3 RG16F; six or seven: 128^3 twice,
+// 18 MiB with their levels.
+struct BakedSolidLayout {
+  int coarse_terms, fine_terms;
+  double fine_periods;  // periods of the fine table per period of the texture
+};
+BakedSolidLayout bakedSolidLayout(const GardnerTexture& gardner) {
+  const int n = gardner.terms(), coarse = n / 2;
+  return {coarse, n - coarse, std::exp2(coarse)};
 }
 
-void uploadBakedSolid(const GlApi& gl, GLuint texture, const GardnerTexture& gardner) {
-  const int base = bakedSolidSize(gardner);
-  const int levels = int(std::log2(base)) + 1;
-  gl.TextureStorage3D(texture, levels, GL_R16, base, base, base);
+void uploadBakedSums(const GlApi& gl, GLuint texture, const GardnerTexture& gardner, int first,
+                     int count) {
+  const int base = std::min(16 << count, 128);
+  const int levels = int(std::log2(base)) + 1, full = int(std::log2(base >> count)) - 1;
+  gl.TextureStorage3D(texture, levels, GL_RG16F, base, base, base);
   for (int level = 0; level < levels; ++level) {
     const int size = base >> level;
-    const VolumeTable baked = bakeGardnerSolid(gardner, size, gardner.terms() - level);
-    gl.TextureSubImage3D(texture, level, 0, 0, 0, size, size, size, GL_RED, GL_FLOAT,
+    const VolumeTable baked =
+        bakeGardnerSums(gardner, size, first, count - std::max(0, level + 1 - full));
+    gl.TextureSubImage3D(texture, level, 0, 0, 0, size, size, size, GL_RG, GL_FLOAT,
                          baked.values.data());
   }
   gl.TextureParameteri(texture, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
@@ -115,38 +129,6 @@ void uploadVolume(const GlApi& gl, GLuint texture, const VolumeTable& table) {
                        table.values.data());
   gl.GenerateTextureMipmap(texture);
   gl.TextureParameteri(texture, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
-}
-
-// TextureEvaluation::kAuto: a baked texel may cover at most this many pixels; nearer,
-// trilinear magnification blurs the texture (a cumulus filling a 4 degree view loses 28 dB)
-// and the sines are evaluated per fragment instead. Measured by
-// `nephele bench` (docs/ACCURACY.md).
-constexpr double kMaxBakedTexelPixels = 4.0;
-
-// Where kAuto evaluates the sines: a pixel whose footprint is smaller than
-// the baked table's texel over kMaxBakedTexelPixels. The footprint of the pixel at normalised
-// device coordinates (x, y) on a surface at distance d (the shader's ray differentials) is at
-// least d a / |r|^2, a = 2 tan(vfov/2) / height the pixel's angle on the axis and |r|^2 =
-// 1 + (x tan(hfov/2))^2 + (y tan(vfov/2))^2. So a pixel can need the sines only where the
-// nearest surface is within sinesWithin() times its |r|^2.
-double sinesWithin(const SolidTexture& texture, const Camera& camera) {
-  const glm::dvec3 period = texture.period();
-  const double texel_m =
-      std::min({period.x, period.y, period.z}) / bakedSolidSize(*texture.gardner());
-  const double pixel_angle = 2.0 * std::tan(glm::radians(camera.vfov_deg) / 2.0) / camera.height;
-  return 1.001 * texel_m / (kMaxBakedTexelPixels * pixel_angle);  // 0.1 % for rounding
-}
-
-// The largest |r|^2 over pixels [x0, x1) x [y0, y1) of the view.
-double largestRaySquared(const Camera& camera, int x0, int y0, int x1, int y1) {
-  const double tan_v = std::tan(glm::radians(camera.vfov_deg) / 2.0);
-  const double tan_h = tan_v * camera.width / camera.height;
-  auto farthest = [](int from, int to, int size) {
-    return std::max(std::abs(2.0 * from / size - 1.0), std::abs(2.0 * to / size - 1.0));
-  };
-  const double x = farthest(x0, x1, camera.width) * tan_h;
-  const double y = farthest(y0, y1, camera.height) * tan_v;
-  return 1.0 + x * x + y * y;
 }
 
 // Slices for a silhouette within half a pixel of the true one: a polygon of n sides around
@@ -266,21 +248,29 @@ EllipsoidRenderer::CachedTexture& EllipsoidRenderer::cachedTexture(const SolidTe
   return entry->second;
 }
 
-GLuint EllipsoidRenderer::gpuTexture(CachedTexture& cached) {
+void EllipsoidRenderer::bindTables(CachedTexture& cached) {
   BakedTable& table = tables_[cached.table_key];
   table.last_frame = frame_;
-  if (table.texture) return table.texture.get();
-  table.texture = createTexture(gl_, GL_TEXTURE_3D);
-  const GLuint t = table.texture.get();
-  const SolidTexture unit(bakedTableSpec(cached.source->spec()));
-  if (const GardnerTexture* gardner = unit.gardner())
-    uploadBakedSolid(gl_, t, *gardner);
-  else
-    uploadVolume(gl_, t, *unit.volume());
-  for (GLenum wrap : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R})
-    gl_.TextureParameteri(t, wrap, GL_REPEAT);
-  gl_.TextureParameteri(t, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  return t;
+  if (!table.texture) {
+    table.texture = createTexture(gl_, GL_TEXTURE_3D);
+    const SolidTexture unit(bakedTableSpec(cached.source->spec()));
+    if (const GardnerTexture* gardner = unit.gardner()) {
+      table.fine = createTexture(gl_, GL_TEXTURE_3D);
+      const BakedSolidLayout layout = bakedSolidLayout(*gardner);
+      uploadBakedSums(gl_, table.texture.get(), *gardner, 0, layout.coarse_terms);
+      uploadBakedSums(gl_, table.fine.get(), *gardner, layout.coarse_terms, layout.fine_terms);
+    } else {
+      uploadVolume(gl_, table.texture.get(), *unit.volume());
+    }
+    for (const GlObject* t : {&table.texture, &table.fine}) {
+      if (!*t) continue;
+      for (GLenum wrap : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R})
+        gl_.TextureParameteri(t->get(), wrap, GL_REPEAT);
+      gl_.TextureParameteri(t->get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    }
+  }
+  gl_.BindTextureUnit(kVolumeTextureUnit, table.texture.get());
+  if (table.fine) gl_.BindTextureUnit(kFineVolumeTextureUnit, table.fine.get());
 }
 
 GLuint EllipsoidRenderer::spotlightTexture() {
@@ -334,8 +324,17 @@ void EllipsoidRenderer::setCloudUniforms(GLuint p, const Scene& scene, const Ell
   const glm::dvec3 origin_uvw = texture.periodicCoordinate(scene.camera.position - cloud.drift_m);
   setUniform3(gl_, p, "u_tex_origin", origin_uvw);
   setUniform3(gl_, p, "u_inv_period", 1.0 / texture.period());
-  if (kind != SolidTextureKind::kProcedural) return;
+  if (kind == SolidTextureKind::kTable) return;
   const GardnerTexture& g = *texture.gardner();
+  gl_.ProgramUniform1f(p, gl_.GetUniformLocation(p, "u_t0"), float(g.params().t0));
+  gl_.ProgramUniform1f(p, gl_.GetUniformLocation(p, "u_k"), float(g.normalisation()));
+  if (kind == SolidTextureKind::kBakedGardner) {
+    const double periods = bakedSolidLayout(g).fine_periods;
+    const glm::dvec3 fine_origin = origin_uvw * periods;
+    setUniform3(gl_, p, "u_fine_origin", fine_origin - glm::floor(fine_origin));
+    gl_.ProgramUniform1f(p, gl_.GetUniformLocation(p, "u_fine_periods"), float(periods));
+    return;
+  }
   const glm::dvec3 eye = origin_uvw * texture.period();
   auto set = [&](const char* name, int j, double v) {
     char element[32];
@@ -352,8 +351,6 @@ void EllipsoidRenderer::setCloudUniforms(GLuint p, const Scene& scene, const Ell
     set("u_half_y", j, wrapPeriodic(0.5 * g.frequencyY(j) * eye.y, kTwoPi));
     set("u_half_z", j, wrapPeriodic(0.5 * g.frequencyX(j) * eye.z, kTwoPi));
   }
-  gl_.ProgramUniform1f(p, gl_.GetUniformLocation(p, "u_t0"), float(g.params().t0));
-  gl_.ProgramUniform1f(p, gl_.GetUniformLocation(p, "u_k"), float(g.normalisation()));
   gl_.ProgramUniform1f(p, gl_.GetUniformLocation(p, "u_terms"), float(g.terms()));
 }
 
@@ -523,14 +520,13 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   // The clouds look alike: the first one's texture and shading stand for all of them.
   const EllipsoidCloud& cloud = scene.clouds[indices.front()];
   // Visible ellipsoids with the back-to-front key (the front-to-back key, the nearest a hit
-  // can be, is the record's order.z); the nearest surface distance.
+  // can be, is the record's order.z).
   struct Visible {
     double centre_distance;
     EllipsoidRecord record;
   };
   std::vector<Visible> visible;
   const bool spotlight = settings.limb == LimbEvaluation::kSpotlight;
-  double nearest_m = std::numeric_limits<double>::infinity();
   int total = 0;
   std::size_t seen = 0;
   for (std::size_t index : indices) {
@@ -546,7 +542,6 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
       const HeapEnvelope& e = envelopes[i];
       v.record.v[17] = glm::vec4(row(e.centre - scene.camera.position, e.extinction));
       v.record.v[18] = glm::vec4(glm::dvec4(1.0 / e.radii, 0.0));
-      nearest_m = std::min(nearest_m, double(v.record.v[16].z));
       visible.push_back(v);
     }
   }
@@ -556,17 +551,11 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
 
   CachedTexture& texture = cachedTexture(cloud.texture, settings);
   EllipsoidPassLayout base;
-  // kAuto: the baked table, unless some ellipsoid is so near that a pixel could see it
-  // magnified; then the sines, except in the per-pixel pass's bins where no pixel can (below).
-  const TextureEvaluation evaluation = settings.texture_evaluation;
-  const Camera& camera = scene.camera;
+  // kAuto is the baked sums: with 16 texels per cycle of every term they draw within 2 dB
+  // of the sines however magnified (docs/ACCURACY.md, "baked solid texture").
   const bool gardner = texture.source->gardner() != nullptr;
-  const double sines_within = gardner ? sinesWithin(*texture.source, camera) : 0.0;
-  const bool auto_near =
-      gardner && evaluation == TextureEvaluation::kAuto &&
-      nearest_m < sines_within * largestRaySquared(camera, 0, 0, camera.width, camera.height);
   base.texture = !gardner ? SolidTextureKind::kTable
-                 : evaluation == TextureEvaluation::kProcedural || auto_near
+                 : settings.texture_evaluation == TextureEvaluation::kProcedural
                      ? SolidTextureKind::kProcedural
                      : SolidTextureKind::kBakedGardner;
   base.term_filter = settings.term_filter;
@@ -574,8 +563,7 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   base.air = sceneHasAir(scene);
   base.specular = cloud.shading.specular > 0.0;
   base.targets = targets_drawn;
-  if (base.texture != SolidTextureKind::kProcedural || auto_near)
-    gl_.BindTextureUnit(kVolumeTextureUnit, gpuTexture(texture));
+  if (base.texture != SolidTextureKind::kProcedural) bindTables(texture);
   if (base.spotlight) gl_.BindTextureUnit(kSpotlightTextureUnit, spotlightTexture());
   gl_.Enable(GL_BLEND);
   gl_.BlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
@@ -655,7 +643,7 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   const std::int64_t max_listed = std::min<std::int64_t>(max_texels_, kMaxListed);
   if (listed > max_listed || std::int64_t(bins_x) * bins_y > max_listed)
     return drawByCentre(records(false));
-  // A bin is first item, count, and whether a pixel in it may need the sines (auto_near).
+  // A bin is first item and count.
   std::vector<glm::ivec4> bins(std::size_t(bins_x) * bins_y, glm::ivec4(0));
   auto binAt = [&](int x, int y) -> glm::ivec4& {
     return bins[std::size_t(y - area.y) * bins_x + (x - area.x)];
@@ -680,49 +668,14 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
         glm::ivec4& b = binAt(x, y);
         items[std::size_t(b.x + b.y++)] = GLint(i);
       }
-  // A bin is near when a pixel in it could see the baked table magnified: its first
-  // ellipsoid (the list is nearest first) is within sinesWithin() times the bin's largest
-  // |r|^2.
-  bool any_near = false, any_far = false;
-  if (auto_near)
-    for (int y = area.y; y <= area.w; ++y)
-      for (int x = area.x; x <= area.z; ++x) {
-        glm::ivec4& b = binAt(x, y);
-        const int s = kPerPixelBinSize;
-        const double within =
-            sines_within * largestRaySquared(camera, x * s, y * s, (x + 1) * s, (y + 1) * s);
-        b.z = b.y > 0 && double(ordered[std::size_t(items[std::size_t(b.x)])].v[16].z) < within;
-        (b.z ? any_near : any_far) = true;
-      }
-  // With auto_near, the bins where no pixel is near enough to see the baked table magnified
-  // are drawn by the baked program, the others by the procedural one: the sines cost only
-  // where they show. (A per-pixel choice in one program would pay for both everywhere:
-  // llvmpipe runs both sides of a branch, and a loop at least once, for every pixel group.)
-  struct BinProgram {
-    GLuint program;
-    GLint polygon_at;
-  };
-  std::vector<BinProgram> bin_programs;
-  auto addProgram = [&](SolidTextureKind kind, int bin_kind) {
-    EllipsoidPassLayout layout = base;
-    layout.program = EllipsoidProgram::kFusedPerPixel;
-    layout.texture = kind;
-    const GLuint p = program(layout);
-    setCloudUniforms(p, scene, cloud, texture, layout.texture, band);
-    gl_.ProgramUniform2i(p, gl_.GetUniformLocation(p, "u_bin_origin"), area.x, area.y);
-    gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_bins_x"), bins_x);
-    gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_bin_size"), kPerPixelBinSize);
-    gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_bin_kind"), bin_kind);
-    bin_programs.push_back({p, gl_.GetUniformLocation(p, "u_polygon")});
-  };
-  if (!auto_near || !any_far) {
-    addProgram(base.texture, -1);
-  } else if (!any_near) {
-    addProgram(SolidTextureKind::kBakedGardner, -1);
-  } else {
-    addProgram(SolidTextureKind::kBakedGardner, 0);
-    addProgram(SolidTextureKind::kProcedural, 1);
-  }
+  EllipsoidPassLayout layout = base;
+  layout.program = EllipsoidProgram::kFusedPerPixel;
+  const GLuint p = program(layout);
+  setCloudUniforms(p, scene, cloud, texture, layout.texture, band);
+  gl_.ProgramUniform2i(p, gl_.GetUniformLocation(p, "u_bin_origin"), area.x, area.y);
+  gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_bins_x"), bins_x);
+  gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_bin_size"), kPerPixelBinSize);
+  const GLint polygon_at = gl_.GetUniformLocation(p, "u_polygon");
   auto ndc = [](int bins, int size) {
     return float(2.0 * std::min(bins * kPerPixelBinSize, size) / size - 1.0);
   };
@@ -736,11 +689,9 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
     const float x0 = ndc(bx0, target.width), y0 = ndc(by0, target.height);
     const float x1 = ndc(bx1 + 1, target.width), y1 = ndc(by1 + 1, target.height);
     const glm::vec2 polygon[4] = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
-    for (const BinProgram& bp : bin_programs) {
-      gl_.UseProgram(bp.program);
-      gl_.ProgramUniform2fv(bp.program, bp.polygon_at, 4, &polygon[0].x);
-      gl_.DrawArrays(GL_TRIANGLE_FAN, 0, 4);
-    }
+    gl_.UseProgram(p);
+    gl_.ProgramUniform2fv(p, polygon_at, 4, &polygon[0].x);
+    gl_.DrawArrays(GL_TRIANGLE_FAN, 0, 4);
   };
   ++stats_->ellipsoid_passes;
   constexpr std::int64_t kBinPixels = std::int64_t(kPerPixelBinSize) * kPerPixelBinSize;

@@ -101,11 +101,12 @@ class EllipsoidRenderer {
   };
   struct BakedTable {
     GlObject texture;
+    GlObject fine;  // Gardner's upper terms (bakedSolidLayout); none for a Perlin table
     std::uint64_t last_frame = 0;  // the frame that last sampled it
   };
   // Tables kept beyond the frame that last used them (least recently used first out): a
-  // dataset's samples, or a daemon's genera coming and going, reuse them instead of baking a
-  // 128^3 table again (50 to 130 ms each here). 4.7 MiB each.
+  // dataset's samples, or a daemon's genera coming and going, reuse them instead of baking
+  // them again. Six terms: two RG16F tables of 128^3, 18 MiB with their levels.
   static constexpr std::size_t kKeptTables = 8;
   struct Tile {
     int record;  // index into the batch's records
@@ -133,7 +134,9 @@ class EllipsoidRenderer {
                     const FrameTarget& target, bool targets_drawn, const AltitudeBand& band);
   GLuint program(const EllipsoidPassLayout& layout);
   CachedTexture& cachedTexture(const SolidTextureSpec& spec, const RenderSettings& settings);
-  GLuint gpuTexture(CachedTexture& cached);
+  // Binds the texture's tables (the baked Gardner sums, or a Perlin table), baking them first
+  // if they are not kept.
+  void bindTables(CachedTexture& cached);
   const IndexedMesh& sphereMesh(int slices);  // cached per tessellation
   GLuint spotlightTexture();
   void setCloudUniforms(GLuint program, const Scene& scene, const EllipsoidCloud& cloud,

@@ -84,6 +84,9 @@ float limbG(int i, vec3 d) {
 #endif
 }
 
+uniform float u_t0;  // Gardner's T0 and k, procedural or baked
+uniform float u_k;
+
 #if defined(PROCEDURAL)
 // Gardner's solid texture per fragment (MODEL.md section 2); term j's phases at the eye are
 // reduced modulo 2 pi on the CPU in double, so p is camera-relative.
@@ -95,8 +98,6 @@ uniform float u_phase_y[8];   // FY(j) eye.y + phy(j)
 uniform float u_half_x[8];    // FX(j) eye.x / 2
 uniform float u_half_y[8];    // FY(j) eye.y / 2
 uniform float u_half_z[8];    // FX(j) eye.z / 2
-uniform float u_t0;
-uniform float u_k;
 uniform float u_terms;
 
 void addSolidTerm(int j, vec3 p, inout float sx, inout float sy) {
@@ -121,9 +122,24 @@ float solidValue(vec3 p, vec3 dpdx, vec3 dpdy) {
   }
   return t;
 }
+#elif defined(BAKED_GARDNER)
+// Gardner's sums baked (bakedSolidLayout): SX - T0 and SY - T0 of the lower terms over the
+// period, of the upper terms over a u_fine_periods-th of it; each table's levels drop its
+// terms as the term filter does, so trilinear filtering fades them out.
+layout(binding = 9) uniform sampler3D u_volume;
+layout(binding = 14) uniform sampler3D u_volume_fine;
+uniform vec3 u_fine_origin;  // the eye's coordinate in the fine table, periods, in [0, 1)
+uniform float u_fine_periods;
+float solidValue(vec3 p, vec3 dpdx, vec3 dpdy) {
+  vec3 fine = u_inv_period * u_fine_periods;
+  vec2 s = vec2(u_t0) +
+           textureGrad(u_volume, u_tex_origin + p * u_inv_period, dpdx * u_inv_period,
+                       dpdy * u_inv_period).rg +
+           textureGrad(u_volume_fine, u_fine_origin + p * fine, dpdx * fine, dpdy * fine).rg;
+  return u_k * max(s.x, 0.0) * max(s.y, 0.0);
+}
 #else
-// A periodic 3D texture: Gardner baked with level l holding n - l terms (trilinear
-// filtering fades the terms out), or Perlin noise with ordinary mipmaps.
+// A periodic 3D texture: Perlin noise with ordinary mipmaps.
 layout(binding = 9) uniform sampler3D u_volume;
 float solidValue(vec3 p, vec3 dpdx, vec3 dpdy) {
   return textureGrad(u_volume, u_tex_origin + p * u_inv_period, dpdx * u_inv_period,
@@ -223,12 +239,11 @@ const char* kFusedPerPixel = R"(
 // The batch's screen bins, kPerPixelBinSize pixels a side, from bin u_bin_origin on, u_bins_x
 // to a row: bin b lists its ellipsoids u_items[u_bins[b].x .. + u_bins[b].y) nearest first
 // by the distance no hit on them can be nearer than (the record's order.z, metres).
-layout(binding = 7) uniform isamplerBuffer u_bins;   // RGBA32I: first item, count, near, 0
+layout(binding = 7) uniform isamplerBuffer u_bins;   // RGBA32I: first item, count, 0, 0
 layout(binding = 8) uniform isamplerBuffer u_items;  // R32I
 uniform ivec2 u_bin_origin;
 uniform int u_bins_x;
 uniform int u_bin_size;
-uniform int u_bin_kind;  // -1: every bin; else only the bins whose near flag equals it
 
 // Hits are ordered by (depth, ellipsoid index), so equal depths still have one order.
 bool before(float s, int i, float t, int j) { return s < t || (s == t && i < j); }
@@ -245,7 +260,6 @@ void main() {
   float limit = opaqueDistance(r) / metres_per_unit;
   ivec2 bin = ivec2(gl_FragCoord.xy) / u_bin_size - u_bin_origin;
   ivec4 list = texelFetch(u_bins, bin.y * u_bins_x + bin.x);
-  if (u_bin_kind >= 0 && list.z != u_bin_kind) discard;  // the other program's bin
   // Front to back (MODEL.md section 15): the ellipsoids come nearest bound first, and a hit
   // that no ellipsoid still to come can be in front of is final. Up to four hits wait,
   // nearest first (depth d, ellipsoid id; empty slots at kNone). Each round tests ellipsoids
@@ -433,6 +447,7 @@ std::string ellipsoidFragmentSource(const EllipsoidPassLayout& layout) {
   if (layout.targets) s += "#define TARGETS\n";
   if (layout.spotlight) s += "#define SPOTLIGHT\n";
   if (layout.texture == SolidTextureKind::kProcedural) s += "#define PROCEDURAL\n";
+  if (layout.texture == SolidTextureKind::kBakedGardner) s += "#define BAKED_GARDNER\n";
   if (layout.term_filter == TermFilter::kCut) s += "#define FILTER_CUT\n";
   if (layout.term_filter == TermFilter::kNone) s += "#define FILTER_NONE\n";
   switch (layout.program) {

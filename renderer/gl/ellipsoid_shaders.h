@@ -48,6 +48,7 @@ inline constexpr int kVolumeTextureUnit = 9;
 inline constexpr int kSpotlightTextureUnit = 10;
 inline constexpr int kAtlasTextureUnit = 11;
 inline constexpr int kImpostorTextureUnit = 12;
+inline constexpr int kFineVolumeTextureUnit = 14;
 inline constexpr int kTargetColourUnit = 14;  // matches the view chunk's bindings
 inline constexpr int kTargetDistanceUnit = 15;
 

@@ -21,9 +21,11 @@ glm::dvec3 latticeGradient(std::uint64_t seed, int octave, int x, int y, int z) 
 }
 }  // namespace
 
-float VolumeTable::at(int x, int y, int z) const {
-  return values[(std::size_t(wrapIndex(z, size)) * size + wrapIndex(y, size)) * size +
-                wrapIndex(x, size)];
+float VolumeTable::at(int x, int y, int z, int channel) const {
+  return values[((std::size_t(wrapIndex(z, size)) * size + wrapIndex(y, size)) * size +
+                 wrapIndex(x, size)) *
+                    channels +
+                channel];
 }
 
 double VolumeTable::sampleTrilinear(glm::dvec3 uvw) const {
@@ -40,9 +42,11 @@ double VolumeTable::sampleTrilinear(glm::dvec3 uvw) const {
   return sum;
 }
 
-VolumeTable bakeGardnerSolid(const GardnerTexture& texture, int size, int terms) {
-  const int m = std::clamp(terms, 0, texture.terms());
-  const glm::dvec2 p2 = texture.period();
+VolumeTable bakeGardnerSums(const GardnerTexture& texture, int size, int first, int count) {
+  first = std::clamp(first, 0, texture.terms());
+  const int end = std::clamp(first + count, first, texture.terms());
+  const int m = end - first;
+  const glm::dvec2 p2 = texture.period() / std::exp2(first);
   const glm::dvec3 period(p2.x, p2.y, p2.x);  // Z phases run at FX / 2
   const std::size_t n = std::size_t(size);
   // Term i along X is sin(a(x) + b(y, z)), along Y sin(a'(y) + b'(x, z)) (MODEL.md section 2,
@@ -51,10 +55,11 @@ VolumeTable bakeGardnerSolid(const GardnerTexture& texture, int size, int terms)
   std::vector<double> sin_bx(m * n * n), cos_bx(m * n * n), sin_by(m * n * n), cos_by(m * n * n);
   auto coordinate = [&](std::size_t t, int axis) { return (t + 0.5) / size * period[axis]; };
   for (int i = 0; i < m; ++i) {
-    const double fx = texture.frequencyX(i), fy = texture.frequencyY(i);
+    const int term = first + i;
+    const double fx = texture.frequencyX(term), fy = texture.frequencyY(term);
     for (std::size_t t = 0; t < n; ++t) {
-      const double ax = fx * coordinate(t, 0) + texture.phaseX(i);
-      const double ay = fy * coordinate(t, 1) + texture.phaseY(i);
+      const double ax = fx * coordinate(t, 0) + texture.phaseX(term);
+      const double ay = fy * coordinate(t, 1) + texture.phaseY(term);
       sin_ax[i * n + t] = std::sin(ax), cos_ax[i * n + t] = std::cos(ax);
       sin_ay[i * n + t] = std::sin(ay), cos_ay[i * n + t] = std::cos(ay);
     }
@@ -71,19 +76,20 @@ VolumeTable bakeGardnerSolid(const GardnerTexture& texture, int size, int terms)
       }
     }
   }
-  VolumeTable out{size, std::vector<float>(n * n * n)};
-  const double t0 = texture.params().t0, k = texture.normalisation();
+  VolumeTable out{size, std::vector<float>(2 * n * n * n), 2};
   for (std::size_t z = 0; z < n; ++z)
     for (std::size_t y = 0; y < n; ++y)
       for (std::size_t x = 0; x < n; ++x) {
-        double sx = t0, sy = t0;
+        double sx = 0.0, sy = 0.0;
         for (int i = 0; i < m; ++i) {
           const std::size_t jx = (i * n + z) * n + y, jy = (i * n + z) * n + x;
-          const double c = texture.amplitude(i);
+          const double c = texture.amplitude(first + i);
           sx += c * (sin_ax[i * n + x] * cos_bx[jx] + cos_ax[i * n + x] * sin_bx[jx]);
           sy += c * (sin_ay[i * n + y] * cos_by[jy] + cos_ay[i * n + y] * sin_by[jy]);
         }
-        out.values[(z * n + y) * n + x] = float(k * std::max(sx, 0.0) * std::max(sy, 0.0));
+        const std::size_t texel = (z * n + y) * n + x;
+        out.values[2 * texel] = float(sx);
+        out.values[2 * texel + 1] = float(sy);
       }
   return out;
 }

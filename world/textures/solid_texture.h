@@ -11,19 +11,22 @@
 
 namespace nephele {
 
-// A size^3 grid of values in [0, 1] that repeats along all three axes.
+// A size^3 grid that repeats along all three axes, `channels` values per texel.
 struct VolumeTable {
   int size = 0;
-  std::vector<float> values;  // x fastest, then y, then z
+  std::vector<float> values;  // channels fastest, then x, then y, then z
+  int channels = 1;
 
-  float at(int x, int y, int z) const;  // wraps
+  float at(int x, int y, int z, int channel = 0) const;  // wraps
   // Trilinear sample at uvw in periods, texel centres at (i + 0.5) / size.
   double sampleTrilinear(glm::dvec3 uvw) const;
 };
 
-// Gardner's solid texture over one period (4 pi / FX1 in X and Z, 4 pi / FY1 in Y) at
-// size^3 texel centres, truncated to `terms` terms; k stays as for all n terms.
-VolumeTable bakeGardnerSolid(const GardnerTexture& texture, int size, int terms);
+// Part of Gardner's solid sums (MODEL.md section 2): SX - T0 and SY - T0 of terms
+// [first, first + count) only, two channels at size^3 texel centres over the period of term
+// `first` and those above it, a 2^first-th of the texture's (4 pi / FX1 in X and Z, 4 pi / FY1
+// in Y), over which they all repeat. T is k max(T0 + the parts' SX, 0) max(T0 + ..., 0).
+VolumeTable bakeGardnerSums(const GardnerTexture& texture, int size, int first, int count);
 
 // Periodic 3D gradient noise: `octaves` octaves, the first with `cells` lattice cells per
 // period, each next one with twice the cells and `persistence` times the amplitude.
