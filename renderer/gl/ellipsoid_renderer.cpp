@@ -108,16 +108,15 @@ BakedSolidLayout bakedSolidLayout(const GardnerTexture& gardner) {
 }
 
 void uploadBakedSums(const GlApi& gl, GLuint texture, const GardnerTexture& gardner, int first,
-                     int count) {
+                     int count, VolumeTable& staging) {
   const int base = std::min(16 << count, 128);
   const int levels = int(std::log2(base)) + 1, full = int(std::log2(base >> count)) - 1;
   gl.TextureStorage3D(texture, levels, GL_RG16F, base, base, base);
   for (int level = 0; level < levels; ++level) {
     const int size = base >> level;
-    const VolumeTable baked =
-        bakeGardnerSums(gardner, size, first, count - std::max(0, level + 1 - full));
+    bakeGardnerSums(gardner, size, first, count - std::max(0, level + 1 - full), staging);
     gl.TextureSubImage3D(texture, level, 0, 0, 0, size, size, size, GL_RG, GL_FLOAT,
-                         baked.values.data());
+                         staging.values.data());
   }
   gl.TextureParameteri(texture, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
 }
@@ -257,8 +256,10 @@ void EllipsoidRenderer::bindTables(CachedTexture& cached) {
     if (const GardnerTexture* gardner = unit.gardner()) {
       table.fine = createTexture(gl_, GL_TEXTURE_3D);
       const BakedSolidLayout layout = bakedSolidLayout(*gardner);
-      uploadBakedSums(gl_, table.texture.get(), *gardner, 0, layout.coarse_terms);
-      uploadBakedSums(gl_, table.fine.get(), *gardner, layout.coarse_terms, layout.fine_terms);
+      VolumeTable staging;  // one buffer for both tables and their levels
+      uploadBakedSums(gl_, table.texture.get(), *gardner, 0, layout.coarse_terms, staging);
+      uploadBakedSums(gl_, table.fine.get(), *gardner, layout.coarse_terms, layout.fine_terms,
+                      staging);
     } else {
       uploadVolume(gl_, table.texture.get(), *unit.volume());
     }

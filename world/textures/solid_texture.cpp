@@ -43,6 +43,13 @@ double VolumeTable::sampleTrilinear(glm::dvec3 uvw) const {
 }
 
 VolumeTable bakeGardnerSums(const GardnerTexture& texture, int size, int first, int count) {
+  VolumeTable out;
+  bakeGardnerSums(texture, size, first, count, out);
+  return out;
+}
+
+void bakeGardnerSums(const GardnerTexture& texture, int size, int first, int count,
+                     VolumeTable& out) {
   first = std::clamp(first, 0, texture.terms());
   const int end = std::clamp(first + count, first, texture.terms());
   const int m = end - first;
@@ -76,7 +83,9 @@ VolumeTable bakeGardnerSums(const GardnerTexture& texture, int size, int first, 
       }
     }
   }
-  VolumeTable out{size, std::vector<float>(2 * n * n * n), 2};
+  out.size = size;
+  out.channels = 2;
+  out.values.resize(2 * n * n * n);
   for (std::size_t z = 0; z < n; ++z)
     for (std::size_t y = 0; y < n; ++y)
       for (std::size_t x = 0; x < n; ++x) {
@@ -91,7 +100,6 @@ VolumeTable bakeGardnerSums(const GardnerTexture& texture, int size, int first, 
         out.values[2 * texel] = float(sx);
         out.values[2 * texel + 1] = float(sy);
       }
-  return out;
 }
 
 VolumeTable perlinVolume(int size, int cells, int octaves, double persistence, std::uint64_t seed) {
