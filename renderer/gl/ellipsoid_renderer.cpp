@@ -552,8 +552,9 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
 
   CachedTexture& texture = cachedTexture(cloud.texture, settings);
   EllipsoidPassLayout base;
-  // kAuto is the baked sums: with 16 texels per cycle of every term they draw within 2 dB
-  // of the sines however magnified (docs/ACCURACY.md, "baked solid texture").
+  // kAuto is the baked sums: with 16 texels per cycle of every term they come within 3 dB of
+  // the sines against the reference however magnified (docs/ACCURACY.md, "Baked solid
+  // texture").
   const bool gardner = texture.source->gardner() != nullptr;
   base.texture = !gardner ? SolidTextureKind::kTable
                  : settings.texture_evaluation == TextureEvaluation::kProcedural
@@ -645,15 +646,15 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   if (listed > max_listed || std::int64_t(bins_x) * bins_y > max_listed)
     return drawByCentre(records(false));
   // A bin is first item and count.
-  std::vector<glm::ivec4> bins(std::size_t(bins_x) * bins_y, glm::ivec4(0));
-  auto binAt = [&](int x, int y) -> glm::ivec4& {
+  std::vector<glm::ivec2> bins(std::size_t(bins_x) * bins_y, glm::ivec2(0));
+  auto binAt = [&](int x, int y) -> glm::ivec2& {
     return bins[std::size_t(y - area.y) * bins_x + (x - area.x)];
   };
   for (const glm::ivec4& span : spans)
     for (int y = span.y; y <= span.w; ++y)
       for (int x = span.x; x <= span.z; ++x) ++binAt(x, y).y;
   int deepest = 0, first = 0;
-  for (glm::ivec4& b : bins) {
+  for (glm::ivec2& b : bins) {
     deepest = std::max(deepest, b.y);
     b.x = first;
     first += b.y;
@@ -666,7 +667,7 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   for (std::size_t i = 0; i < spans.size(); ++i)
     for (int y = spans[i].y; y <= spans[i].w; ++y)
       for (int x = spans[i].x; x <= spans[i].z; ++x) {
-        glm::ivec4& b = binAt(x, y);
+        glm::ivec2& b = binAt(x, y);
         items[std::size_t(b.x + b.y++)] = GLint(i);
       }
   EllipsoidPassLayout layout = base;
@@ -682,7 +683,7 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   };
   bindFrameTexture(kRecordTextureUnit, GL_RGBA32F, ordered.data(),
                    ordered.size() * sizeof(EllipsoidRecord));
-  bindFrameTexture(kBinTextureUnit, GL_RGBA32I, bins.data(), bins.size() * sizeof(glm::ivec4));
+  bindFrameTexture(kBinTextureUnit, GL_RG32I, bins.data(), bins.size() * sizeof(glm::ivec2));
   bindFrameTexture(kBinItemTextureUnit, GL_R32I, items.data(), items.size() * sizeof(GLint));
   // Draws bins [bx0, bx1] x [by0, by1] (absolute bin indices): each pixel composites every
   // hit of its bin, so disjoint rectangles give the image one quad gives.

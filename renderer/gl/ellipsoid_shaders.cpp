@@ -239,7 +239,7 @@ const char* kFusedPerPixel = R"(
 // The batch's screen bins, kPerPixelBinSize pixels a side, from bin u_bin_origin on, u_bins_x
 // to a row: bin b lists its ellipsoids u_items[u_bins[b].x .. + u_bins[b].y) nearest first
 // by the distance no hit on them can be nearer than (the record's order.z, metres).
-layout(binding = 7) uniform isamplerBuffer u_bins;   // RGBA32I: first item, count, 0, 0
+layout(binding = 7) uniform isamplerBuffer u_bins;   // RG32I: first item, count
 layout(binding = 8) uniform isamplerBuffer u_items;  // R32I
 uniform ivec2 u_bin_origin;
 uniform int u_bins_x;
@@ -259,7 +259,7 @@ void main() {
   float metres_per_unit = length(r);
   float limit = opaqueDistance(r) / metres_per_unit;
   ivec2 bin = ivec2(gl_FragCoord.xy) / u_bin_size - u_bin_origin;
-  ivec4 list = texelFetch(u_bins, bin.y * u_bins_x + bin.x);
+  ivec2 list = texelFetch(u_bins, bin.y * u_bins_x + bin.x).xy;
   // Front to back (MODEL.md section 15): the ellipsoids come nearest bound first, and a hit
   // that no ellipsoid still to come can be in front of is final. Up to four hits wait,
   // nearest first (depth d, ellipsoid id; empty slots at kNone). Each round tests ellipsoids

@@ -203,12 +203,13 @@ std::vector<Ellipsoid> cumulonimbusEllipsoids(const CloudField& f, glm::dvec3 ba
   // underside, over a thin sheet that fills between them. The overshooting dome, over the
   // updraft, is sunk into it and lit with it.
   const double along = (1.5 + 0.5 * shear.amount) * r, across = 1.2 * r;
-  const double top = axis(0.97 * h).z;
+  const glm::dvec3 crown = axis(0.97 * h);  // the updraft's axis at the anvil's top
+  const double top = crown.z;
   const glm::dvec2 middle = glm::dvec2(axis(0.88 * h)) + shear.direction * (0.9 * shear.amount * r);
-  const glm::dvec2 axis_top(axis(0.97 * h));
   auto thickness = [&](glm::dvec2 at) {
-    const double t = std::min(glm::length(at - axis_top) / along, 1.0);
-    const bool downwind = glm::dot(at - axis_top, shear.direction) > 0.0;
+    const glm::dvec2 from_axis = at - glm::dvec2(crown);
+    const double t = std::min(glm::length(from_axis) / along, 1.0);
+    const bool downwind = glm::dot(from_axis, shear.direction) > 0.0;
     return h * (0.2 - (downwind ? 0.13 * shear.amount + 0.05 * (1.0 - shear.amount) : 0.08) * t);
   };
   const double heading = headingAlong(shear.direction);
@@ -223,7 +224,8 @@ std::vector<Ellipsoid> cumulonimbusEllipsoids(const CloudField& f, glm::dvec3 ba
   sheet.orientation.heading_deg = heading;
   out.push_back(sheet);
   ClusterSpec cap;
-  cap.element.radii = {0.4 * r, 0.4 * r, 0.1 * h};
+  const double cap_depth = 0.1 * h;  // before each lobe takes the anvil's thickness below
+  cap.element.radii = {0.4 * r, 0.4 * r, cap_depth};
   cap.centre = middle;
   cap.boundary_radii = {along - 0.35 * r, across - 0.35 * r};
   cap.boundary_heading_deg = heading;
@@ -236,7 +238,7 @@ std::vector<Ellipsoid> cumulonimbusEllipsoids(const CloudField& f, glm::dvec3 ba
   for (Ellipsoid e : clusterEllipsoids(cap)) {
     // Hanging from the flat top, as thick as the anvil is there, drooping a little downwind.
     const double t = glm::dot(glm::dvec2(e.centre) - middle, shear.direction) / along;
-    e.radii.z = 0.5 * thickness(glm::dvec2(e.centre)) * (e.radii.z / (0.1 * h));
+    e.radii.z = 0.5 * thickness(glm::dvec2(e.centre)) * (e.radii.z / cap_depth);
     e.centre.z = top - e.radii.z - 0.03 * h * std::max(t, 0.0) * t * shear.amount;
     out.push_back(e);
   }
