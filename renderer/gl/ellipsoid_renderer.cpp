@@ -670,71 +670,191 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
         glm::ivec2& b = binAt(x, y);
         items[std::size_t(b.x + b.y++)] = GLint(i);
       }
+  // Behind a thick veil the walk may err by what the veil hides (MODEL.md section 15, "behind
+  // the veil"): it ends at a lower coverage, and where the error allowed is large enough it
+  // runs first at one pixel in rate^2 into the samples texture, then over every pixel, which
+  // blends its samples where they agree.
+  const double shown = std::max(target.seen, 1e-6);
+  const double tolerance = kVeiledTolerance / shown;
+  const int rate = !targets_drawn && tolerance >= kVeiledSamplingFrom ? kVeiledShadingRate : 1;
   EllipsoidPassLayout layout = base;
-  layout.program = EllipsoidProgram::kFusedPerPixel;
-  const GLuint p = program(layout);
-  setCloudUniforms(p, scene, cloud, texture, layout.texture, band);
-  gl_.ProgramUniform2i(p, gl_.GetUniformLocation(p, "u_bin_origin"), area.x, area.y);
-  gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_bins_x"), bins_x);
-  gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_bin_size"), kPerPixelBinSize);
-  const GLint polygon_at = gl_.GetUniformLocation(p, "u_polygon");
-  auto ndc = [](int bins, int size) {
-    return float(2.0 * std::min(bins * kPerPixelBinSize, size) / size - 1.0);
+  layout.program = rate > 1 ? EllipsoidProgram::kFusedRest : EllipsoidProgram::kFusedPerPixel;
+  layout.shading_rate = rate;
+  auto perPixelProgram = [&](const EllipsoidPassLayout& l) {
+    const GLuint p = program(l);
+    setCloudUniforms(p, scene, cloud, texture, l.texture, band);
+    gl_.ProgramUniform2i(p, gl_.GetUniformLocation(p, "u_bin_origin"), area.x, area.y);
+    gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_bins_x"), bins_x);
+    gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_bin_size"), kPerPixelBinSize);
+    gl_.ProgramUniform1f(p, gl_.GetUniformLocation(p, "u_opaque"),
+                         float(std::max(0.0, 1.0 - (1.0 - kOpaqueCoverage) / shown)));
+    return p;
   };
+  const GLuint p = perPixelProgram(layout);
   bindFrameTexture(kRecordTextureUnit, GL_RGBA32F, ordered.data(),
                    ordered.size() * sizeof(EllipsoidRecord));
   bindFrameTexture(kBinTextureUnit, GL_RG32I, bins.data(), bins.size() * sizeof(glm::ivec2));
   bindFrameTexture(kBinItemTextureUnit, GL_R32I, items.data(), items.size() * sizeof(GLint));
-  // Draws bins [bx0, bx1] x [by0, by1] (absolute bin indices): each pixel composites every
-  // hit of its bin, so disjoint rectangles give the image one quad gives.
-  auto drawRect = [&](int bx0, int by0, int bx1, int by1) {
-    const float x0 = ndc(bx0, target.width), y0 = ndc(by0, target.height);
-    const float x1 = ndc(bx1 + 1, target.width), y1 = ndc(by1 + 1, target.height);
+  // Draws bins [bx0, bx1] x [by0, by1] (absolute bin indices) with `program` into a viewport
+  // of `size` whose pixel i stands at frame pixel i * step: each pixel composites every hit of
+  // its bin, so disjoint rectangles give the image one quad gives. Samples are drawn to the
+  // end of the last bin, past the frame's edge, for the pixels next to it.
+  auto drawRect = [&](GLuint program, glm::ivec2 size, int step, int bx0, int by0, int bx1,
+                      int by1) {
+    auto ndc = [&](int bins, int axis) {
+      const int end = step > 1 ? size[axis] * step : axis == 0 ? target.width : target.height;
+      return float(2.0 * std::min(bins * kPerPixelBinSize, end) / step / size[axis] - 1.0);
+    };
+    const float x0 = ndc(bx0, 0), y0 = ndc(by0, 1), x1 = ndc(bx1 + 1, 0), y1 = ndc(by1 + 1, 1);
     const glm::vec2 polygon[4] = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
-    gl_.UseProgram(p);
-    gl_.ProgramUniform2fv(p, polygon_at, 4, &polygon[0].x);
+    gl_.UseProgram(program);
+    gl_.ProgramUniform2fv(program, gl_.GetUniformLocation(program, "u_polygon"), 4, &polygon[0].x);
     gl_.DrawArrays(GL_TRIANGLE_FAN, 0, 4);
   };
-  ++stats_->ellipsoid_passes;
+  // Draws the batch's area with `draw(bx0, by0, bx1, by1)`; false once cancelled.
   constexpr std::int64_t kBinPixels = std::int64_t(kPerPixelBinSize) * kPerPixelBinSize;
-  if (!cancel_ || listed * kBinPixels <= kCancelWork)
-    return drawRect(area.x, area.y, area.z, area.w);
-  // Heavy: bands of whole bin rows of about kCancelWork hit tests (a row heavier than that
-  // alone in runs of its bins), each finished before the flag is read.
-  auto finished = [&] {
-    gl_.Finish();
-    return stopNow();
-  };
-  int band_from = area.y;
-  std::int64_t band_work = 0;
-  for (int y = area.y; y <= area.w; ++y) {
-    std::int64_t row_work = 0;
-    for (int x = area.x; x <= area.z; ++x) row_work += binAt(x, y).y * kBinPixels;
-    if (band_work > 0 && band_work + row_work > kCancelWork) {
-      drawRect(area.x, band_from, area.z, y - 1);
-      if (finished()) return;
-      band_from = y, band_work = 0;
+  auto drawArea = [&](auto&& draw) {
+    if (!cancel_ || listed * kBinPixels <= kCancelWork) {
+      draw(area.x, area.y, area.z, area.w);
+      return true;
     }
-    if (row_work <= kCancelWork) {
-      band_work += row_work;
-      continue;
-    }
-    int run_from = area.x;
-    std::int64_t run_work = 0;
-    for (int x = area.x; x <= area.z; ++x) {
-      const std::int64_t work = binAt(x, y).y * kBinPixels;
-      if (run_work > 0 && run_work + work > kCancelWork) {
-        drawRect(run_from, y, x - 1, y);
-        if (finished()) return;
-        run_from = x, run_work = 0;
+    // Heavy: bands of whole bin rows of about kCancelWork hit tests (a row heavier than that
+    // alone in runs of its bins), each finished before the flag is read.
+    auto finished = [&] {
+      gl_.Finish();
+      return stopNow();
+    };
+    int band_from = area.y;
+    std::int64_t band_work = 0;
+    for (int y = area.y; y <= area.w; ++y) {
+      std::int64_t row_work = 0;
+      for (int x = area.x; x <= area.z; ++x) row_work += binAt(x, y).y * kBinPixels;
+      if (band_work > 0 && band_work + row_work > kCancelWork) {
+        draw(area.x, band_from, area.z, y - 1);
+        if (finished()) return false;
+        band_from = y, band_work = 0;
       }
-      run_work += work;
+      if (row_work <= kCancelWork) {
+        band_work += row_work;
+        continue;
+      }
+      int run_from = area.x;
+      std::int64_t run_work = 0;
+      for (int x = area.x; x <= area.z; ++x) {
+        const std::int64_t work = binAt(x, y).y * kBinPixels;
+        if (run_work > 0 && run_work + work > kCancelWork) {
+          draw(run_from, y, x - 1, y);
+          if (finished()) return false;
+          run_from = x, run_work = 0;
+        }
+        run_work += work;
+      }
+      draw(run_from, y, area.z, y);
+      if (finished()) return false;
+      band_from = y + 1;
     }
-    drawRect(run_from, y, area.z, y);
-    if (finished()) return;
-    band_from = y + 1;
+    if (band_from <= area.w) draw(area.x, band_from, area.z, area.w);
+    return true;
+  };
+  ++stats_->ellipsoid_passes;
+  const glm::ivec2 frame_size(target.width, target.height);
+  if (rate == 1) {
+    drawArea([&](int bx0, int by0, int bx1, int by1) {
+      drawRect(p, frame_size, 1, bx0, by0, bx1, by1);
+    });
+    return;
   }
-  if (band_from <= area.w) drawRect(area.x, band_from, area.z, area.w);
+  // Sample c stands at pixel c * rate; one more than the frame needs on each axis, so that
+  // every pixel has samples on both sides. Those outside the area stay 0: nothing of the batch
+  // is there.
+  const glm::ivec2 size = (frame_size - 1) / rate + 2;
+  prepareSamples(size);
+  EllipsoidPassLayout sampling = layout;
+  sampling.program = EllipsoidProgram::kFusedSamples;
+  const GLuint s = perPixelProgram(sampling);
+  gl_.BindFramebuffer(GL_FRAMEBUFFER, samples_framebuffer_.get());
+  gl_.Viewport(0, 0, size.x, size.y);
+  const GLfloat nothing[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+  gl_.ClearNamedFramebufferfv(samples_framebuffer_.get(), GL_COLOR, 0, nothing);
+  gl_.Disable(GL_BLEND);
+  const bool done = drawArea(
+      [&](int bx0, int by0, int bx1, int by1) { drawRect(s, size, rate, bx0, by0, bx1, by1); });
+  gl_.Enable(GL_BLEND);
+  gl_.BindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
+  gl_.Viewport(0, 0, target.width, target.height);
+  if (!done) return;
+  // The blocks of rate x rate pixels over the area: blended where their four corner samples
+  // agree to within the tolerance, walked elsewhere, as runs along each row of blocks. A
+  // block whose far samples were not drawn (past the area) is walked.
+  std::vector<float> values(std::size_t(size.x) * size.y * 4);
+  gl_.GetTextureImage(samples_.get(), 0, GL_RGBA, GL_FLOAT, GLsizei(values.size() * sizeof(float)),
+                      values.data());
+  auto sample = [&](int x, int y) { return &values[(std::size_t(y) * size.x + x) * 4]; };
+  auto agree = [&](int x, int y) {
+    const float *a = sample(x, y), *b = sample(x + 1, y), *c = sample(x, y + 1),
+                *d = sample(x + 1, y + 1);
+    for (int k = 0; k < 4; ++k) {
+      const float lo = std::min({a[k], b[k], c[k], d[k]}), hi = std::max({a[k], b[k], c[k], d[k]});
+      if (hi - lo > tolerance) return false;
+    }
+    return true;
+  };
+  const glm::ivec2 from = glm::ivec2(area.x, area.y) * kPerPixelBinSize / rate;
+  const glm::ivec2 end = (glm::ivec2(area.z, area.w) + 1) * kPerPixelBinSize / rate;  // samples
+  std::vector<glm::ivec4> blended, walked;  // pixel rectangles
+  for (int y = from.y; y < end.y; ++y)
+    for (int x = from.x; x < end.x;) {
+      const bool blend = y + 1 < end.y && x + 1 < end.x && agree(x, y);
+      int to = x + 1;
+      while (to < end.x && (y + 1 < end.y && to + 1 < end.x && agree(to, y)) == blend) ++to;
+      (blend ? blended : walked).push_back(glm::ivec4(x, y, to, y + 1) * rate);
+      x = to;
+    }
+  // The blended runs in one draw; the walked ones, when the frame can be cancelled, in groups
+  // of about kCancelWork hit tests.
+  auto drawRuns = [&](EllipsoidProgram which, const std::vector<glm::ivec4>& runs) {
+    EllipsoidPassLayout l = layout;
+    l.program = which;
+    const GLuint q = perPixelProgram(l);
+    const bool chunked = cancel_ && which == EllipsoidProgram::kFusedRest;
+    std::size_t first = 0;
+    std::int64_t work = 0;
+    for (std::size_t i = 0; i < runs.size(); ++i) {
+      const glm::ivec4 r = runs[i];
+      for (int bx = r.x / kPerPixelBinSize; chunked && bx * kPerPixelBinSize < r.z; ++bx)
+        work += std::int64_t(binAt(bx, r.y / kPerPixelBinSize).y) * rate *
+                (std::min(r.z, (bx + 1) * kPerPixelBinSize) - std::max(r.x, bx * kPerPixelBinSize));
+      const bool last = i + 1 == runs.size();
+      if (!last && work <= kCancelWork) continue;
+      bindFrameTexture(kRectTextureUnit, GL_RGBA32I, runs.data() + first,
+                       (i + 1 - first) * sizeof(glm::ivec4));
+      gl_.UseProgram(q);
+      gl_.DrawArrays(GL_TRIANGLES, 0, GLsizei(6 * (i + 1 - first)));
+      if (last) break;
+      gl_.Finish();
+      if (stopNow()) return;
+      first = i + 1, work = 0;
+    }
+  };
+  gl_.BindTextureUnit(kSamplesTextureUnit, samples_.get());
+  if (!blended.empty()) drawRuns(EllipsoidProgram::kFusedBlend, blended);
+  if (!walked.empty()) drawRuns(EllipsoidProgram::kFusedRest, walked);
+  ++stats_->sampled_passes;
+}
+
+void EllipsoidRenderer::prepareSamples(glm::ivec2 size) {
+  if (samples_ && samples_size_ == size) return;
+  samples_ = createTexture(gl_, GL_TEXTURE_2D);
+  gl_.TextureStorage2D(samples_.get(), 1, GL_RGBA16F, size.x, size.y);
+  for (GLenum filter : {GL_TEXTURE_MIN_FILTER, GL_TEXTURE_MAG_FILTER})
+    gl_.TextureParameteri(samples_.get(), filter, GL_LINEAR);
+  for (GLenum wrap : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T})
+    gl_.TextureParameteri(samples_.get(), wrap, GL_CLAMP_TO_EDGE);
+  samples_framebuffer_ = createFramebuffer(gl_);
+  gl_.NamedFramebufferTexture(samples_framebuffer_.get(), GL_COLOR_ATTACHMENT0, samples_.get(), 0);
+  const GLenum status = gl_.CheckNamedFramebufferStatus(samples_framebuffer_.get(), GL_FRAMEBUFFER);
+  NEPHELE_CHECK(status == GL_FRAMEBUFFER_COMPLETE, "samples status 0x" << std::hex << status);
+  samples_size_ = size;
 }
 
 void EllipsoidRenderer::prepareAtlas(TileFormat format) {

@@ -19,11 +19,14 @@
 
 namespace nephele {
 
-// Where a pass draws: the framebuffer and its size.
+// Where a pass draws: the framebuffer, its size, and the fraction of what is drawn there that
+// the final image shows (the transmittance of the in-cloud veil drawn over the frame; 1 for an
+// impostor, which later frames reuse under other veils).
 struct FrameTarget {
   GLuint framebuffer = 0;
   int width = 0;
   int height = 0;
+  double seen = 1.0;
 };
 
 // One ellipsoid as the shaders see it (EllipsoidRecord in ellipsoid_shaders.cpp).
@@ -155,6 +158,8 @@ class EllipsoidRenderer {
                         std::vector<Tile>& tiles, const FrameTarget& target,
                         const AltitudeBand& band);
   void prepareAtlas(TileFormat format);
+  // The per-pixel pass's samples texture (RGBA16F) and its framebuffer, at `size`.
+  void prepareSamples(glm::ivec2 size);
 
   const GlApi& gl_;
   GlObject vertex_array_;  // empty: attribute-less draws
@@ -168,6 +173,8 @@ class EllipsoidRenderer {
   GlObject atlas_;
   GlObject atlas_framebuffer_;
   TileFormat atlas_format_ = TileFormat::kFloat;
+  GlObject samples_, samples_framebuffer_;
+  glm::ivec2 samples_size_{0};
   std::map<std::string, GlObject> programs_;
   std::map<std::string, CachedTexture> textures_;
   std::map<std::string, BakedTable> tables_;

@@ -1,7 +1,5 @@
 #include "renderer/gl/ellipsoid_shaders.h"
 
-#include <cstdio>
-
 #include "renderer/gl/sky_shaders.h"
 
 namespace nephele {
@@ -244,6 +242,7 @@ layout(binding = 8) uniform isamplerBuffer u_items;  // R32I
 uniform ivec2 u_bin_origin;
 uniform int u_bins_x;
 uniform int u_bin_size;
+uniform float u_opaque;  // the coverage past which the walk ends
 
 // Hits are ordered by (depth, ellipsoid index), so equal depths still have one order.
 bool before(float s, int i, float t, int j) { return s < t || (s == t && i < j); }
@@ -258,7 +257,7 @@ void main() {
   vec3 r = viewRay();
   float metres_per_unit = length(r);
   float limit = opaqueDistance(r) / metres_per_unit;
-  ivec2 bin = ivec2(gl_FragCoord.xy) / u_bin_size - u_bin_origin;
+  ivec2 bin = ivec2(FRAG_XY) / u_bin_size - u_bin_origin;
   ivec2 list = texelFetch(u_bins, bin.y * u_bins_x + bin.x).xy;
   // Front to back (MODEL.md section 15): the ellipsoids come nearest bound first, and a hit
   // that no ellipsoid still to come can be in front of is final. Up to four hits wait,
@@ -268,7 +267,7 @@ void main() {
   // behind would add less than 1/1024. Shading stays out of the testing loop: llvmpipe runs
   // both sides of every branch, so a loop pays for all of its body on every turn.
   const float kNone = 3.0e38;
-  const float kOpaque = OPAQUE_COVERAGE;
+  const float kOpaque = u_opaque;
   vec4 d = vec4(kNone);
   ivec4 id = ivec4(-1);
   int waiting = 0, k = 0;
@@ -305,6 +304,19 @@ void main() {
   }
   if (result.a <= 0.0) discard;
   o_colour = result;
+}
+)";
+
+// Behind a thick veil (MODEL.md section 15, "behind the veil"): the walk's result at every
+// SHADING_RATE-th pixel in x and y (sample c at pixel c * SHADING_RATE), blended over the
+// blocks of pixels whose four corner samples agree. The CPU sorts the blocks from the samples
+// it reads back; the others are walked (kFusedRest).
+const char* kFusedBlend = R"(
+layout(binding = 12) uniform sampler2D u_samples;  // bilinear: the blend in one fetch
+void main() {
+  vec2 at = floor(gl_FragCoord.xy) / float(SHADING_RATE) + 0.5;  // sample c's centre is c + 0.5
+  o_colour = textureLod(u_samples, at / vec2(textureSize(u_samples, 0)), 0.0);
+  if (o_colour.a <= 0.0) discard;
 }
 )";
 
@@ -380,6 +392,7 @@ std::string EllipsoidPassLayout::key() const {
   k += air ? 'f' : '-';
   k += specular ? 's' : '-';
   k += targets ? 't' : '-';
+  k += std::to_string(shading_rate);
   return k;
 }
 
@@ -417,6 +430,20 @@ void main() {
 }
 )";
       return s;
+    case EllipsoidProgram::kFusedBlend:
+    case EllipsoidProgram::kFusedRest:
+      return s + R"(
+// Pixel rectangles (x0, y0, x1, y1), two triangles each.
+layout(binding = 6) uniform isamplerBuffer u_rects;
+uniform vec2 u_viewport;
+void main() {
+  ivec4 q = texelFetch(u_rects, gl_VertexID / 6);
+  int corner = gl_VertexID % 6;
+  corner = corner < 3 ? corner : corner - 2;  // 0 1 2, 1 2 3
+  vec2 p = vec2((corner & 1) != 0 ? q.z : q.x, (corner & 2) != 0 ? q.w : q.y);
+  gl_Position = vec4(2.0 * p / u_viewport - 1.0, 0.0, 1.0);
+}
+)";
     case EllipsoidProgram::kImpostor:
       return s + R"(
 uniform vec3 u_corner[4];  // camera-relative billboard corners, in triangle-strip order
@@ -439,9 +466,6 @@ void main() {
 
 std::string ellipsoidFragmentSource(const EllipsoidPassLayout& layout) {
   std::string s = "#version 450 core\n";
-  char opaque[64];
-  std::snprintf(opaque, sizeof opaque, "#define OPAQUE_COVERAGE %.10f\n", kOpaqueCoverage);
-  s += opaque;
   if (layout.air) s += "#define AIR\n";
   if (layout.specular) s += "#define SPECULAR\n";
   if (layout.targets) s += "#define TARGETS\n";
@@ -460,6 +484,13 @@ std::string ellipsoidFragmentSource(const EllipsoidPassLayout& layout) {
     case EllipsoidProgram::kTileColour:
       s += "#define TILE_COLOUR\n";
       break;
+    case EllipsoidProgram::kFusedSamples:
+      s += "#define FRAG_XY (floor(gl_FragCoord.xy) * " + std::to_string(layout.shading_rate) +
+           ".0 + 0.5)\n";
+      break;
+    case EllipsoidProgram::kFusedBlend:
+      s += "#define SHADING_RATE " + std::to_string(layout.shading_rate) + "\n";
+      break;
     default:
       break;
   }
@@ -472,7 +503,11 @@ std::string ellipsoidFragmentSource(const EllipsoidPassLayout& layout) {
     case EllipsoidProgram::kFusedCentre:
       return s + kFusedCentre;
     case EllipsoidProgram::kFusedPerPixel:
+    case EllipsoidProgram::kFusedSamples:
+    case EllipsoidProgram::kFusedRest:
       return s + kFusedPerPixel;
+    case EllipsoidProgram::kFusedBlend:
+      return s + kFusedBlend;
     case EllipsoidProgram::kTileComposite:
       return s + kComposite;
     default:

@@ -10,6 +10,9 @@ namespace nephele {
 enum class EllipsoidProgram {
   kFusedCentre,    // instanced screen rectangles, one per ellipsoid, back to front
   kFusedPerPixel,  // one rectangle per batch; each pixel walks its bin's hits front to back
+  kFusedSamples,   // the same walk at one pixel in shading_rate^2, into the samples texture
+  kFusedBlend,     // the samples' blend over listed blocks whose four corner samples agree
+  kFusedRest,      // the walk over the other blocks
   kTileThreshold,  // Elinas pass 1: alpha = It - T1
   kTileLimb,       // Elinas pass 2: alpha -= (T2 - T1)(1 - g)
   kTileColour,     // Elinas colour pass: Gardner eq. 8, fogged
@@ -28,6 +31,7 @@ struct EllipsoidPassLayout {
   bool air = false;
   bool specular = false;
   bool targets = false;
+  int shading_rate = 1;  // kFusedSamples, kFusedBlend and kFusedRest: pixels between samples
 
   std::string key() const;
 };
@@ -35,6 +39,16 @@ struct EllipsoidPassLayout {
 // Coverage past which a pixel counts as opaque: the per-pixel pass stops compositing, and a
 // veil this thick hides the frame behind it (what lies behind adds under 1/1024).
 inline constexpr double kOpaqueCoverage = 1.0 - 1.0 / 1024.0;
+
+// Behind the in-cloud veil (MODEL.md section 15, "behind the veil"), which shows a fraction
+// `seen` of the frame drawn under it: the per-pixel pass may err by kVeiledTolerance / seen
+// in each premultiplied channel, so that the final image errs by at most kVeiledTolerance.
+// Where that comes to kVeiledSamplingFrom or more the pass walks one pixel in
+// kVeiledShadingRate^2 and blends those samples wherever the four around a pixel agree to
+// within it; the opacity cut moves likewise, to 1 - (1 - kOpaqueCoverage) / seen.
+inline constexpr double kVeiledTolerance = 1.0 / 256.0;
+inline constexpr double kVeiledSamplingFrom = 1.0 / 32.0;
+inline constexpr int kVeiledShadingRate = 4;
 
 // Per-ellipsoid record: RGBA32F texels of a buffer texture.
 inline constexpr int kEllipsoidRecordVec4s = 19;
@@ -48,6 +62,8 @@ inline constexpr int kVolumeTextureUnit = 9;
 inline constexpr int kSpotlightTextureUnit = 10;
 inline constexpr int kAtlasTextureUnit = 11;
 inline constexpr int kImpostorTextureUnit = 12;
+inline constexpr int kSamplesTextureUnit = 12;  // no program reads both
+inline constexpr int kRectTextureUnit = 6;
 inline constexpr int kFineVolumeTextureUnit = 14;
 inline constexpr int kTargetColourUnit = 14;  // matches the view chunk's bindings
 inline constexpr int kTargetDistanceUnit = 15;

@@ -12,6 +12,7 @@ std::vector<std::pair<const char*, int>> FrameStats::fields() const {
           {"automaton_passes", automaton_passes},
           {"target_passes", target_passes},
           {"veil_passes", veil_passes},
+          {"sampled_passes", sampled_passes},
           {"ellipsoids_drawn", ellipsoids_drawn},
           {"ellipsoids_culled", ellipsoids_culled},
           {"impostors_drawn", impostors_drawn},

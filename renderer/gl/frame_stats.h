@@ -8,12 +8,14 @@
 namespace nephele {
 
 struct FrameStats {
-  int sky_passes = 0;          // background and layer passes
-  int ellipsoid_passes = 0;    // fused draws, tile composites and impostor billboards
-  int atlas_passes = 0;        // multipass: tile passes into the atlas (Elinas)
-  int automaton_passes = 0;    // volume marches
-  int target_passes = 0;       // opaque target meshes
-  int veil_passes = 0;         // the in-cloud veil
+  int sky_passes = 0;        // background and layer passes
+  int ellipsoid_passes = 0;  // fused draws, tile composites and impostor billboards
+  int atlas_passes = 0;      // multipass: tile passes into the atlas (Elinas)
+  int automaton_passes = 0;  // volume marches
+  int target_passes = 0;     // opaque target meshes
+  int veil_passes = 0;       // the in-cloud veil
+  // Per-pixel ellipsoid passes drawn from samples behind a thick veil (MODEL.md section 15)
+  int sampled_passes = 0;
   int ellipsoids_drawn = 0;    // in view and drawn (directly or into an impostor)
   int ellipsoids_culled = 0;   // behind the eye, off screen, or with the eye inside
   int impostors_drawn = 0;     // far clouds drawn from an impostor

@@ -715,7 +715,7 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
     pending_above.clear();
     pending_below.clear();
   };
-  const FrameTarget frame{framebuffer_.get(), camera.width, camera.height};
+  const FrameTarget frame{framebuffer_.get(), camera.width, camera.height, 1.0 - veil.opacity};
   const int top_band = int(std::max(
       {above.size(), below.size(), clouds.empty() ? std::size_t(0) : std::size_t(clouds[0].band)}));
   auto next_cloud = clouds.begin();

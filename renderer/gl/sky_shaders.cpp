@@ -17,8 +17,14 @@ uniform float u_camera_z;
 layout(location = 0) out vec4 o_colour;  // premultiplied colour, coverage
 const float kFar = 1e30;
 
+// The pixel a fragment stands for: its own, or in the per-pixel pass's sample pass, the
+// full-resolution pixel its sample is taken at (MODEL.md section 15, "shading rate").
+#ifndef FRAG_XY
+#define FRAG_XY gl_FragCoord.xy
+#endif
+
 vec3 viewRay() {
-  vec2 ndc = 2.0 * gl_FragCoord.xy / u_viewport - 1.0;
+  vec2 ndc = 2.0 * FRAG_XY / u_viewport - 1.0;
   return u_right * ndc.x + u_up * ndc.y + u_forward;
 }
 
@@ -96,8 +102,9 @@ vec3 applyAir(vec3 colour, vec3 d, float distance) { return colour; }
 // (1e30 where there is none), read at this pixel.
 layout(binding = 14) uniform sampler2D u_target_colour;
 layout(binding = 15) uniform sampler2D u_target_distance;
-float targetDistance() { return texelFetch(u_target_distance, ivec2(gl_FragCoord.xy), 0).r; }
-vec3 targetColour() { return texelFetch(u_target_colour, ivec2(gl_FragCoord.xy), 0).rgb; }
+ivec2 targetTexel() { return ivec2(min(FRAG_XY, u_viewport - 0.5)); }
+float targetDistance() { return texelFetch(u_target_distance, targetTexel(), 0).r; }
+vec3 targetColour() { return texelFetch(u_target_colour, targetTexel(), 0).rgb; }
 #endif
 
 // Gardner eq. 8 (MODEL.md section 3) from its terms; shading = (a, t, s, e).
