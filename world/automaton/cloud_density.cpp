@@ -8,11 +8,18 @@
 
 namespace nephele {
 
-double metaballField(double r, double radius) {
-  if (!(r < radius)) return 0.0;
-  const double a2 = (r / radius) * (r / radius);
+namespace {
+
+// The field of a^2 = (r / R)^2, for a^2 < 1.
+double fieldOfSquare(double a2) {
   const double a4 = a2 * a2;
   return -4.0 / 9.0 * a4 * a2 + 17.0 / 9.0 * a4 - 22.0 / 9.0 * a2 + 1.0;
+}
+
+}  // namespace
+
+double metaballField(double r, double radius) {
+  return r < radius ? fieldOfSquare((r / radius) * (r / radius)) : 0.0;
 }
 
 std::vector<float> cellMeans(const CellularAutomaton& automaton, double radius_cells) {
@@ -42,20 +49,27 @@ std::vector<float> cellMeans(const CellularAutomaton& automaton, double radius_c
 
 double metaballDensity(const std::vector<float>& means, GridSize size, double cell_size,
                        glm::dvec3 x, double radius_cells) {
-  const double radius = radius_cells * cell_size;
-  const glm::dvec3 c = x / cell_size - 0.5;  // position in cell-centre units
+  // In cell units, where cell (i, j, k) is centred on (i, j, k): the field needs only the
+  // squared distance over R^2, and a row of cells beyond R is passed over whole.
+  const glm::dvec3 c = x / cell_size - 0.5;
+  const double reach2 = radius_cells * radius_cells;
   const glm::ivec3 lo = glm::max(glm::ivec3(glm::ceil(c - radius_cells)), glm::ivec3(0));
   const glm::ivec3 hi =
       glm::min(glm::ivec3(glm::floor(c + radius_cells)), glm::ivec3(size.nx, size.ny, size.nz) - 1);
   double rho = 0.0;
-  for (int k = lo.z; k <= hi.z; ++k)
-    for (int j = lo.y; j <= hi.y; ++j)
+  for (int k = lo.z; k <= hi.z; ++k) {
+    const double dz2 = (k - c.z) * (k - c.z);
+    for (int j = lo.y; j <= hi.y; ++j) {
+      const double dyz2 = dz2 + (j - c.y) * (j - c.y);
+      if (!(dyz2 < reach2)) continue;
+      const float* row = means.data() + (std::size_t(k) * size.ny + j) * size.nx;
       for (int i = lo.x; i <= hi.x; ++i) {
-        const float q = means[(std::size_t(k) * size.ny + j) * size.nx + i];
-        if (q == 0.0f) continue;
-        const glm::dvec3 centre = (glm::dvec3(i, j, k) + 0.5) * cell_size;
-        rho += q * metaballField(glm::length(x - centre), radius);
+        if (row[i] == 0.0f) continue;
+        const double d2 = dyz2 + (i - c.x) * (i - c.x);
+        if (d2 < reach2) rho += row[i] * fieldOfSquare(d2 / reach2);
       }
+    }
+  }
   return rho;
 }
 
