@@ -677,12 +677,12 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   const double shown = std::max(target.seen, 1e-6);
   const double tolerance = kVeiledTolerance / shown;
   const int rate = !targets_drawn && tolerance >= kVeiledSamplingFrom ? kVeiledShadingRate : 1;
-  EllipsoidPassLayout layout = base;
-  layout.program = rate > 1 ? EllipsoidProgram::kFusedRest : EllipsoidProgram::kFusedPerPixel;
-  layout.shading_rate = rate;
-  auto perPixelProgram = [&](const EllipsoidPassLayout& l) {
-    const GLuint p = program(l);
-    setCloudUniforms(p, scene, cloud, texture, l.texture, band);
+  auto perPixelProgram = [&](EllipsoidProgram which) {
+    EllipsoidPassLayout layout = base;
+    layout.program = which;
+    layout.shading_rate = rate;
+    const GLuint p = program(layout);
+    setCloudUniforms(p, scene, cloud, texture, layout.texture, band);
     gl_.ProgramUniform2i(p, gl_.GetUniformLocation(p, "u_bin_origin"), area.x, area.y);
     gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_bins_x"), bins_x);
     gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_bin_size"), kPerPixelBinSize);
@@ -690,7 +690,6 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
                          float(std::max(0.0, 1.0 - (1.0 - kOpaqueCoverage) / shown)));
     return p;
   };
-  const GLuint p = perPixelProgram(layout);
   bindFrameTexture(kRecordTextureUnit, GL_RGBA32F, ordered.data(),
                    ordered.size() * sizeof(EllipsoidRecord));
   bindFrameTexture(kBinTextureUnit, GL_RG32I, bins.data(), bins.size() * sizeof(glm::ivec2));
@@ -759,6 +758,7 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   ++stats_->ellipsoid_passes;
   const glm::ivec2 frame_size(target.width, target.height);
   if (rate == 1) {
+    const GLuint p = perPixelProgram(EllipsoidProgram::kFusedPerPixel);
     drawArea([&](int bx0, int by0, int bx1, int by1) {
       drawRect(p, frame_size, 1, bx0, by0, bx1, by1);
     });
@@ -769,9 +769,7 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   // is there.
   const glm::ivec2 size = (frame_size - 1) / rate + 2;
   prepareSamples(size);
-  EllipsoidPassLayout sampling = layout;
-  sampling.program = EllipsoidProgram::kFusedSamples;
-  const GLuint s = perPixelProgram(sampling);
+  const GLuint s = perPixelProgram(EllipsoidProgram::kFusedSamples);
   gl_.BindFramebuffer(GL_FRAMEBUFFER, samples_framebuffer_.get());
   gl_.Viewport(0, 0, size.x, size.y);
   const GLfloat nothing[4] = {0.0f, 0.0f, 0.0f, 0.0f};
@@ -790,7 +788,10 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   gl_.GetTextureImage(samples_.get(), 0, GL_RGBA, GL_FLOAT, GLsizei(values.size() * sizeof(float)),
                       values.data());
   auto sample = [&](int x, int y) { return &values[(std::size_t(y) * size.x + x) * 4]; };
-  auto agree = [&](int x, int y) {
+  const glm::ivec2 from = glm::ivec2(area.x, area.y) * kPerPixelBinSize / rate;
+  const glm::ivec2 end = (glm::ivec2(area.z, area.w) + 1) * kPerPixelBinSize / rate;  // samples
+  auto blends = [&](int x, int y) {
+    if (x + 1 >= end.x || y + 1 >= end.y) return false;
     const float *a = sample(x, y), *b = sample(x + 1, y), *c = sample(x, y + 1),
                 *d = sample(x + 1, y + 1);
     for (int k = 0; k < 4; ++k) {
@@ -799,23 +800,19 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
     }
     return true;
   };
-  const glm::ivec2 from = glm::ivec2(area.x, area.y) * kPerPixelBinSize / rate;
-  const glm::ivec2 end = (glm::ivec2(area.z, area.w) + 1) * kPerPixelBinSize / rate;  // samples
   std::vector<glm::ivec4> blended, walked;  // pixel rectangles
   for (int y = from.y; y < end.y; ++y)
     for (int x = from.x; x < end.x;) {
-      const bool blend = y + 1 < end.y && x + 1 < end.x && agree(x, y);
+      const bool blend = blends(x, y);
       int to = x + 1;
-      while (to < end.x && (y + 1 < end.y && to + 1 < end.x && agree(to, y)) == blend) ++to;
+      while (to < end.x && blends(to, y) == blend) ++to;
       (blend ? blended : walked).push_back(glm::ivec4(x, y, to, y + 1) * rate);
       x = to;
     }
   // The blended runs in one draw; the walked ones, when the frame can be cancelled, in groups
   // of about kCancelWork hit tests.
   auto drawRuns = [&](EllipsoidProgram which, const std::vector<glm::ivec4>& runs) {
-    EllipsoidPassLayout l = layout;
-    l.program = which;
-    const GLuint q = perPixelProgram(l);
+    const GLuint q = perPixelProgram(which);
     const bool chunked = cancel_ && which == EllipsoidProgram::kFusedRest;
     std::size_t first = 0;
     std::int64_t work = 0;
