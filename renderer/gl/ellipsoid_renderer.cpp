@@ -130,6 +130,22 @@ void uploadVolume(const GlApi& gl, GLuint texture, const VolumeTable& table) {
   gl.TextureParameteri(texture, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
 }
 
+// A colour texture of `format` and `size`, sampled bilinearly and clamped at its edges, and a
+// framebuffer that draws into it (the atlas, an impostor, the per-pixel pass's samples).
+void createColourTarget(const GlApi& gl, GLenum format, glm::ivec2 size, const char* what,
+                        GlObject& texture, GlObject& framebuffer) {
+  texture = createTexture(gl, GL_TEXTURE_2D);
+  gl.TextureStorage2D(texture.get(), 1, format, size.x, size.y);
+  for (GLenum filter : {GL_TEXTURE_MIN_FILTER, GL_TEXTURE_MAG_FILTER})
+    gl.TextureParameteri(texture.get(), filter, GL_LINEAR);
+  for (GLenum wrap : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T})
+    gl.TextureParameteri(texture.get(), wrap, GL_CLAMP_TO_EDGE);
+  framebuffer = createFramebuffer(gl);
+  gl.NamedFramebufferTexture(framebuffer.get(), GL_COLOR_ATTACHMENT0, texture.get(), 0);
+  const GLenum status = gl.CheckNamedFramebufferStatus(framebuffer.get(), GL_FRAMEBUFFER);
+  NEPHELE_CHECK(status == GL_FRAMEBUFFER_COMPLETE, what << " status 0x" << std::hex << status);
+}
+
 // Slices for a silhouette within half a pixel of the true one: a polygon of n sides around
 // a circle of r pixels strays by r (1 - cos(pi / n)).
 int adaptiveSlices(double radius_px) {
@@ -459,15 +475,8 @@ bool EllipsoidRenderer::drawImpostor(const Scene& scene, std::size_t index,
     view.camera.vfov_deg = glm::degrees(2.0 * half_angle);
     view.camera.width = view.camera.height = size;
     if (impostor.size != size || !impostor.texture) {
-      impostor.texture = createTexture(gl_, GL_TEXTURE_2D);
-      gl_.TextureStorage2D(impostor.texture.get(), 1, GL_RGBA16F, size, size);
-      gl_.TextureParameteri(impostor.texture.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-      gl_.TextureParameteri(impostor.texture.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-      gl_.TextureParameteri(impostor.texture.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-      gl_.TextureParameteri(impostor.texture.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-      impostor.framebuffer = createFramebuffer(gl_);
-      gl_.NamedFramebufferTexture(impostor.framebuffer.get(), GL_COLOR_ATTACHMENT0,
-                                  impostor.texture.get(), 0);
+      createColourTarget(gl_, GL_RGBA16F, glm::ivec2(size), "impostor", impostor.texture,
+                         impostor.framebuffer);
     }
     const float clear[4] = {0, 0, 0, 0};
     gl_.ClearNamedFramebufferfv(impostor.framebuffer.get(), GL_COLOR, 0, clear);
@@ -841,32 +850,14 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
 
 void EllipsoidRenderer::prepareSamples(glm::ivec2 size) {
   if (samples_ && samples_size_ == size) return;
-  samples_ = createTexture(gl_, GL_TEXTURE_2D);
-  gl_.TextureStorage2D(samples_.get(), 1, GL_RGBA16F, size.x, size.y);
-  for (GLenum filter : {GL_TEXTURE_MIN_FILTER, GL_TEXTURE_MAG_FILTER})
-    gl_.TextureParameteri(samples_.get(), filter, GL_LINEAR);
-  for (GLenum wrap : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T})
-    gl_.TextureParameteri(samples_.get(), wrap, GL_CLAMP_TO_EDGE);
-  samples_framebuffer_ = createFramebuffer(gl_);
-  gl_.NamedFramebufferTexture(samples_framebuffer_.get(), GL_COLOR_ATTACHMENT0, samples_.get(), 0);
-  const GLenum status = gl_.CheckNamedFramebufferStatus(samples_framebuffer_.get(), GL_FRAMEBUFFER);
-  NEPHELE_CHECK(status == GL_FRAMEBUFFER_COMPLETE, "samples status 0x" << std::hex << status);
+  createColourTarget(gl_, GL_RGBA16F, size, "samples", samples_, samples_framebuffer_);
   samples_size_ = size;
 }
 
 void EllipsoidRenderer::prepareAtlas(TileFormat format) {
   if (atlas_ && atlas_format_ == format) return;
-  atlas_ = createTexture(gl_, GL_TEXTURE_2D);
-  gl_.TextureStorage2D(atlas_.get(), 1, format == TileFormat::kFloat ? GL_RGBA16F : GL_RGBA8,
-                       kAtlasSize, kAtlasSize);
-  gl_.TextureParameteri(atlas_.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-  gl_.TextureParameteri(atlas_.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  gl_.TextureParameteri(atlas_.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-  gl_.TextureParameteri(atlas_.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-  atlas_framebuffer_ = createFramebuffer(gl_);
-  gl_.NamedFramebufferTexture(atlas_framebuffer_.get(), GL_COLOR_ATTACHMENT0, atlas_.get(), 0);
-  const GLenum status = gl_.CheckNamedFramebufferStatus(atlas_framebuffer_.get(), GL_FRAMEBUFFER);
-  NEPHELE_CHECK(status == GL_FRAMEBUFFER_COMPLETE, "atlas status 0x" << std::hex << status);
+  createColourTarget(gl_, format == TileFormat::kFloat ? GL_RGBA16F : GL_RGBA8,
+                     glm::ivec2(kAtlasSize), "atlas", atlas_, atlas_framebuffer_);
   atlas_format_ = format;
 }
 
