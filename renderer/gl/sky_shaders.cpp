@@ -18,7 +18,7 @@ layout(location = 0) out vec4 o_colour;  // premultiplied colour, coverage
 const float kFar = 1e30;
 
 // The pixel a fragment stands for: its own, or in the per-pixel pass's sample pass, the
-// full-resolution pixel its sample is taken at (MODEL.md section 15, "shading rate").
+// full-resolution pixel its sample is taken at (MODEL.md section 15, "behind the veil").
 #ifndef FRAG_XY
 #define FRAG_XY gl_FragCoord.xy
 #endif
@@ -102,9 +102,8 @@ vec3 applyAir(vec3 colour, vec3 d, float distance) { return colour; }
 // (1e30 where there is none), read at this pixel.
 layout(binding = 14) uniform sampler2D u_target_colour;
 layout(binding = 15) uniform sampler2D u_target_distance;
-ivec2 targetTexel() { return ivec2(min(FRAG_XY, u_viewport - 0.5)); }
-float targetDistance() { return texelFetch(u_target_distance, targetTexel(), 0).r; }
-vec3 targetColour() { return texelFetch(u_target_colour, targetTexel(), 0).rgb; }
+float targetDistance() { return texelFetch(u_target_distance, ivec2(FRAG_XY), 0).r; }
+vec3 targetColour() { return texelFetch(u_target_colour, ivec2(FRAG_XY), 0).rgb; }
 #endif
 
 // Gardner eq. 8 (MODEL.md section 3) from its terms; shading = (a, t, s, e).
