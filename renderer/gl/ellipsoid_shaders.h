@@ -47,7 +47,7 @@ inline constexpr double kOpaqueCoverage = 1.0 - 1.0 / 1024.0;
 // kVeiledShadingRate^2 and blends those samples wherever the four around a pixel agree to
 // within it; the opacity cut moves likewise, to 1 - (1 - kOpaqueCoverage) / seen.
 inline constexpr double kVeiledTolerance = 1.0 / 256.0;
-inline constexpr double kVeiledSamplingFrom = 1.0 / 32.0;
+inline constexpr double kVeiledSamplingFrom = 1.0 / 128.0;
 inline constexpr int kVeiledShadingRate = 4;
 
 // Per-ellipsoid record: RGBA32F texels of a buffer texture.
