@@ -99,11 +99,11 @@ uniform float u_half_z[8];    // FX(j) eye.z / 2
 uniform float u_terms;
 
 void addSolidTerm(int j, vec3 p, inout float sx, inout float sy) {
-  float pz = kPi * sin(0.5 * u_fx[j] * p.z + u_half_z[j]);
-  float px = kHalfPi * sin(0.5 * u_fy[j] * p.y + u_half_y[j]) + pz;
-  float py = kHalfPi * sin(0.5 * u_fx[j] * p.x + u_half_x[j]) + pz;
-  sx += u_amplitude[j] * sin(u_fx[j] * p.x + u_phase_x[j] + px);
-  sy += u_amplitude[j] * sin(u_fy[j] * p.y + u_phase_y[j] + py);
+  float pz = kPi * gardnerSin(0.5 * u_fx[j] * p.z + u_half_z[j]);
+  float px = kHalfPi * gardnerSin(0.5 * u_fy[j] * p.y + u_half_y[j]) + pz;
+  float py = kHalfPi * gardnerSin(0.5 * u_fx[j] * p.x + u_half_x[j]) + pz;
+  sx += u_amplitude[j] * gardnerSin(u_fx[j] * p.x + u_phase_x[j] + px);
+  sy += u_amplitude[j] * gardnerSin(u_fy[j] * p.y + u_phase_y[j] + py);
 }
 
 float solidValue(vec3 p, vec3 dpdx, vec3 dpdy) {

@@ -31,26 +31,24 @@ void setLayerGardnerUniforms(const GlApi& gl, GLuint p, int slot, const GardnerT
     std::snprintf(element, sizeof element, "%s[%d]", name, index);
     return gl.GetUniformLocation(p, element);
   };
-  auto set = [&](const char* name, int k, double v) {
-    gl.ProgramUniform1f(p, location(name, k), float(v));
-  };
+  auto angle = [](double a) { return float(wrapPeriodic(a, kTwoPi)); };
   for (int j = 0; j < g.terms(); ++j) {
-    set("u_fx", 8 * slot + j, g.frequencyX(j));
-    set("u_fy", 8 * slot + j, g.frequencyY(j));
-    set("u_amplitude", 8 * slot + j, g.componentAmplitude(j));
-    gl.ProgramUniform1i(p, location("u_components", 8 * slot + j), g.components(j));
+    const int t = 8 * slot + j;
+    const glm::vec3 term(g.frequencyX(j), g.frequencyY(j), g.componentAmplitude(j));
+    gl.ProgramUniform3fv(p, location("u_term", t), 1, &term.x);
+    gl.ProgramUniform1i(p, location("u_components", t), g.components(j));
     for (int c = 0; c < g.components(j); ++c) {
-      const int k = GardnerTextureParams::kComponents * (8 * slot + j) + c;
+      const int k = GardnerTextureParams::kComponents * t + c;
       const glm::dvec2 a = g.axisX(j, c), b = g.axisY(j, c);
       const glm::dvec2 q1(a.x * origin.x + a.y * origin.y, a.x * origin.y - a.y * origin.x);
       const glm::dvec2 q2(b.x * origin.x + b.y * origin.y, b.x * origin.y - b.y * origin.x);
-      set("u_phase_x", k, wrapPeriodic(g.frequencyX(j) * q1.x + g.phaseX(j, c), kTwoPi));
-      set("u_phase_y", k, wrapPeriodic(g.frequencyY(j) * q2.y + g.phaseY(j, c), kTwoPi));
-      set("u_half_phase_x", k, wrapPeriodic(0.5 * g.frequencyX(j) * q2.x, kTwoPi));
-      set("u_half_phase_y", k, wrapPeriodic(0.5 * g.frequencyY(j) * q1.y, kTwoPi));
-      const glm::vec2 axis_x(a), axis_y(b);
-      gl.ProgramUniform2fv(p, location("u_axis_x", k), 1, &axis_x.x);
-      gl.ProgramUniform2fv(p, location("u_axis_y", k), 1, &axis_y.x);
+      const glm::vec4 phases(angle(g.frequencyX(j) * q1.x + g.phaseX(j, c)),
+                             angle(g.frequencyY(j) * q2.y + g.phaseY(j, c)),
+                             angle(0.5 * g.frequencyX(j) * q2.x),
+                             angle(0.5 * g.frequencyY(j) * q1.y));
+      const glm::vec4 axes(a.x, a.y, b.x, b.y);
+      gl.ProgramUniform4fv(p, location("u_phases", k), 1, &phases.x);
+      gl.ProgramUniform4fv(p, location("u_axes", k), 1, &axes.x);
     }
   }
   gl.ProgramUniform1f(p, location("u_t0", slot), float(g.params().t0));
