@@ -7,7 +7,9 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -89,10 +91,16 @@ std::optional<ImageFileFormat> imageFileFormatForPath(std::string_view path) {
 }
 
 Srgb8Image toSrgb8(const FloatImage& image) {
-  // The byte of each linear value through a table of the 255 thresholds between bytes: the
-  // same rounding as toByte(srgbEncode(v)), found by binary search instead of a pow.
-  static const std::array<float, 255> thresholds = [] {
-    std::array<float, 255> t{};
+  // The byte of each linear value from the 255 thresholds between bytes, the same rounding as
+  // toByte(srgbEncode(v)). A value's top 16 bits (sign, exponent, 7 bits of mantissa) pick a
+  // bucket no more than 1/128 of the value wide, which no two thresholds share (they lie at
+  // least 0.87 % apart, near 1), so the byte is the bucket's first byte or the one after it.
+  struct Table {
+    std::array<float, 255> thresholds{};
+    std::array<std::uint8_t, 65536> first{};
+  };
+  static const Table table = [] {
+    Table t;
     for (int b = 0; b < 255; ++b) {
       // Smallest linear value encoding to byte b + 1 (bisection on the monotone encoder).
       double lo = 0.0, hi = 1.0;
@@ -100,7 +108,18 @@ Srgb8Image toSrgb8(const FloatImage& image) {
         const double mid = 0.5 * (lo + hi);
         (toByte(srgbEncode(mid)) > b ? hi : lo) = mid;
       }
-      t[b] = float(hi);
+      // The least float at or above it, so that v >= threshold holds for exactly the floats
+      // the formula takes to b + 1.
+      float up = float(hi);
+      if (double(up) < hi) up = std::nextafter(up, 2.0f);
+      t.thresholds[b] = up;
+    }
+    for (std::uint32_t bucket = 0; bucket < 65536; ++bucket) {
+      const float v = std::bit_cast<float>(bucket << 16);  // the bucket's least value
+      t.first[bucket] = std::uint8_t(
+          v >= t.thresholds[0]
+              ? std::upper_bound(t.thresholds.begin(), t.thresholds.end(), v) - t.thresholds.begin()
+              : 0);
     }
     return t;
   }();
@@ -108,10 +127,12 @@ Srgb8Image toSrgb8(const FloatImage& image) {
   for (std::size_t i = 0; i < image.rgba.size(); i += 4) {
     for (int c = 0; c < 3; ++c) {
       const float v = image.rgba[i + c];
-      out.rgba[i + c] = std::uint8_t(
-          v >= thresholds[0]
-              ? std::upper_bound(thresholds.begin(), thresholds.end(), v) - thresholds.begin()
-              : 0);
+      std::uint8_t byte = 0;
+      if (v >= table.thresholds[0]) {  // false for NaN and what rounds to 0
+        byte = table.first[std::bit_cast<std::uint32_t>(v) >> 16];
+        if (byte < 255 && v >= table.thresholds[byte]) ++byte;
+      }
+      out.rgba[i + c] = byte;
     }
     out.rgba[i + 3] = toByte(image.rgba[i + 3]);
   }

@@ -3,6 +3,8 @@
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
+#include <bit>
+#include <cmath>
 #include <filesystem>
 
 namespace nephele {
@@ -121,6 +123,24 @@ TEST(ImageEncoding, TableSrgbEqualsTheFormula) {
     for (int c = 0; c < 3; ++c)
       differing += bytes.rgba[i * 4 + c] != toByte(srgbEncode(image.rgba[i * 4 + c]));
   EXPECT_EQ(differing, 0);
+}
+
+// Every 61st float from 2^-20 to 2 (1.9 million, every bucket of the byte table and both
+// sides of every threshold many times over) encodes as the formula does.
+TEST(ImageEncoding, TableSrgbEqualsTheFormulaAcrossTheFloats) {
+  const std::uint32_t from = std::bit_cast<std::uint32_t>(std::ldexp(1.0f, -20));
+  const std::uint32_t to = std::bit_cast<std::uint32_t>(2.0f);
+  FloatImage image{0, 1, {}};
+  for (std::uint32_t bits = from; bits <= to; bits += 61) {
+    image.rgba.insert(image.rgba.end(), {std::bit_cast<float>(bits), 0.0f, 0.0f, 1.0f});
+    ++image.width;
+  }
+  const Srgb8Image bytes = toSrgb8(image);
+  int differing = 0;
+  for (int i = 0; i < image.width; ++i)
+    differing +=
+        bytes.rgba[std::size_t(i) * 4] != toByte(srgbEncode(image.rgba[std::size_t(i) * 4]));
+  EXPECT_EQ(differing, 0) << "of " << image.width;
 }
 
 }  // namespace nephele
