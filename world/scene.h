@@ -89,6 +89,17 @@ struct Scene {
   std::map<WeatherKey, WeatherLayer> weather;
 };
 
+// `scene` with `clouds` in place of its own: everything else copied, its clouds' lobes not
+// (a world's millions of lobes, where a caller keeps a few; withinEllipsoidBudget).
+inline Scene withClouds(const Scene& scene, std::vector<EllipsoidCloud> clouds) {
+  // Every member by name: this stops compiling when Scene gains one, which belongs here too.
+  const auto& [seed, time_s, camera, sun, sky, fog, haze, layers, own_clouds, fields, targets,
+               automata, weather] = scene;
+  static_cast<void>(own_clouds);
+  return Scene{seed,   time_s,  camera,   sun,    sky, fog, haze, layers, std::move(clouds),
+               fields, targets, automata, weather};
+}
+
 // Ellipsoids the scene's clouds hold (its fields' heaps are made per view and not counted).
 inline std::size_t ellipsoidCount(const Scene& scene) {
   std::size_t n = 0;

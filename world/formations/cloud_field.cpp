@@ -937,31 +937,34 @@ std::optional<Scene> withinEllipsoidBudget(const Scene& scene, double budget, do
     choose(room, overdraw - body_footprint);
     kept = keptFlags();
   }
-  Scene out = scene;
-  for (std::size_t c = 0; c < out.clouds.size(); ++c) {
-    EllipsoidCloud& cloud = out.clouds[c];
-    const std::size_t before = cloud.ellipsoids.size();
-    std::size_t n = 0;
-    for (std::size_t i = 0; i < before; ++i) {
+  // The kept lobes copied, not the world's (a world at its budget holds millions).
+  std::vector<EllipsoidCloud> clouds;
+  clouds.reserve(scene.clouds.size());
+  for (std::size_t c = 0; c < scene.clouds.size(); ++c) {
+    const EllipsoidCloud& from = scene.clouds[c];
+    const bool parts = !from.parts.empty();
+    std::vector<Ellipsoid> lobes;
+    std::vector<std::uint32_t> lobe_parts;
+    for (std::size_t i = 0; i < from.ellipsoids.size(); ++i) {
       if (kept[c][i] != 1) continue;
-      cloud.ellipsoids[n] = cloud.ellipsoids[i];
-      if (!cloud.parts.empty()) cloud.parts[n] = cloud.parts[i];
-      ++n;
+      lobes.push_back(from.ellipsoids[i]);
+      if (parts) lobe_parts.push_back(from.parts[i]);
     }
-    cloud.ellipsoids.resize(n);
-    if (!cloud.parts.empty()) cloud.parts.resize(n);
+    const bool thinned = lobes.size() < from.ellipsoids.size();
+    clouds.push_back(withLobes(from, std::move(lobes), std::move(lobe_parts)));
     // Thinned clouds share one texture seed: clouds that differ only in it then share one
     // baked texture and one batch (a hundred clouds of their own seeds baked a hundred 128^3
     // tables, most of a heavy frame's time).
-    if (n < before) cloud.texture.seed = cloud.texture.gardner.seed = 0;
+    if (thinned) clouds.back().texture.seed = clouds.back().texture.gardner.seed = 0;
   }
   for (const Body& b : bodies) {
     const EllipsoidCloud& from = scene.clouds[b.cloud];
-    EllipsoidCloud& cloud = out.clouds[b.cloud];
+    EllipsoidCloud& cloud = clouds[b.cloud];
     cloud.ellipsoids.push_back(b.ellipsoid);
     if (!from.parts.empty() && from.parts.size() == from.ellipsoids.size())
       cloud.parts.push_back(b.part);  // lit with the heap it stands in
   }
+  Scene out = withClouds(scene, std::move(clouds));
   std::erase_if(out.clouds, [](const EllipsoidCloud& c) { return c.ellipsoids.empty(); });
   return out;
 }

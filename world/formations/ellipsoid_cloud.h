@@ -38,6 +38,20 @@ struct EllipsoidCloud {
   glm::dvec3 drift_m{0.0};
 };
 
+// `cloud` with `ellipsoids` and their `parts` in place of its own, the rest copied (and its
+// own lobes not).
+inline EllipsoidCloud withLobes(const EllipsoidCloud& cloud, std::vector<Ellipsoid> ellipsoids,
+                                std::vector<std::uint32_t> parts) {
+  // Every member by name: this stops compiling when EllipsoidCloud gains one.
+  const auto& [name, colour, threshold_centre, threshold_limb, transition, shading,
+               light_extinction, texture, own_ellipsoids, own_parts, drift_m] = cloud;
+  static_cast<void>(own_ellipsoids), static_cast<void>(own_parts);
+  return EllipsoidCloud{
+      name,    colour,           threshold_centre, threshold_limb,        transition,
+      shading, light_extinction, texture,          std::move(ellipsoids), std::move(parts),
+      drift_m};
+}
+
 // An axis-aligned box holding every ellipsoid of the cloud (each taken as the ball of its
 // longest semi-axis); one pass over the ellipsoids.
 struct BoundingBox {
