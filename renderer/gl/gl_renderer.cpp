@@ -346,7 +346,7 @@ GlRenderer::CachedTexture& GlRenderer::cachedTexture(const LayerTextureSpec& spe
     entry->second.source = std::make_unique<LayerTexture>(spec);
     entry->second.key = entry->first;
   }
-  entry->second.used = true;
+  entry->second.last_frame = frame_;
   return entry->second;
 }
 
@@ -564,7 +564,7 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
     gl_.Enable(GL_FRAMEBUFFER_SRGB);  // blend in linear, store sRGB
   else
     gl_.Disable(GL_FRAMEBUFFER_SRGB);
-  for (auto& [key, cached] : textures_) cached.used = false;
+  ++frame_;
   ellipsoids_.beginFrame(stats_);
   automata_.beginFrame(stats_);
   clipmaps_.beginFrame();
@@ -574,7 +574,18 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
     ellipsoids_.endFrame();
     automata_.endFrame();
     clipmaps_.endFrame();
-    std::erase_if(textures_, [](const auto& entry) { return !entry.second.used; });
+    // Of the layer textures no layer of this frame drew, those without a baked table go,
+    // and of the baked, all but the kKeptTextures drawn most recently.
+    std::erase_if(textures_, [&](const auto& entry) {
+      return entry.second.last_frame != frame_ && !entry.second.texture;
+    });
+    while (textures_.size() > kKeptTextures) {
+      auto oldest = std::min_element(
+          textures_.begin(), textures_.end(),
+          [](const auto& a, const auto& b) { return a.second.last_frame < b.second.last_frame; });
+      if (oldest->second.last_frame == frame_) break;  // all drawn this frame
+      textures_.erase(oldest);
+    }
   };
   // The eye deep in a cloud: its veil hides what lies behind to within the per-pixel pass's
   // opacity cut, so no sky or cloud pass is drawn under it (MODEL.md section 4).

@@ -71,10 +71,14 @@ class GlRenderer {
   // A layer's texture, built once and kept while frames keep using it.
   struct CachedTexture {
     std::unique_ptr<LayerTexture> source;
-    std::string key;   // textureKey: the clipmap of a texture is kept under it too
-    GlObject texture;  // made on first use by a pass that samples it
-    bool used = false;
+    std::string key;               // textureKey: the clipmap of a texture is kept under it too
+    GlObject texture;              // made on first use by a pass that samples it
+    std::uint64_t last_frame = 0;  // the frame that last drew its layer
   };
+  // Layer textures no frame draws any more are dropped, but for the kKeptTextures drawn most
+  // recently: a dataset's samples come back to a few far-deck textures (cloud_field.h,
+  // farDeck), each a bake of tens of milliseconds.
+  static constexpr std::size_t kKeptTextures = 8;
   struct LayerSlot {
     const CloudLayer* layer;
     CachedTexture* texture;
@@ -107,6 +111,7 @@ class GlRenderer {
   TargetFormat target_format_ = TargetFormat::kFloat;
   std::map<std::string, GlObject> programs_;
   std::map<std::string, CachedTexture> textures_;
+  std::uint64_t frame_ = 0;  // frames drawn
   GlObject floor_program_;
   FrameStats stats_;
   EllipsoidRenderer ellipsoids_;

@@ -732,8 +732,13 @@ CloudLayer farDeck(const CloudField& f, double range, glm::dvec3 to_sun) {
                            {},
                            f.region,
                            {}};
+      // One of kDeckTextures textures, chosen by the field's seed, as a field's heaps take one
+      // of a few (heapCloud): the deck's periodic table is a 512^2 bake of tens of
+      // milliseconds, which a seed per field made every dataset sample pay.
+      constexpr std::uint64_t kDeckTextures = 4;
       const std::vector<CloudLayer> layers =
-          weatherClouds(w, f.name + "/far", hashCounters(f.seed, 0x466172ull)).layers;
+          weatherClouds(w, f.name + "/far", hashCounters(0x466172ull, f.seed % kDeckTextures))
+              .layers;
       if (decks.size() > 256) decks.clear();
       CloudLayer deck = layers.empty() ? CloudLayer{} : layers.front();
       // Gardner's periodic lattice, which the renderer bakes: a far deck is seen at a grazing
