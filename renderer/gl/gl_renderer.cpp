@@ -217,11 +217,15 @@ Frame GlRenderer::renderFrame(const Scene& scene, const RenderSettings& settings
     if (asked.has(Channel::kObjectId)) frame.object_id.resize(pixels);
     for (int y = 0; y < h; ++y)
       for (int x = 0; x < w; ++x) {
+        const std::size_t gl = std::size_t(h - 1 - y) * w + x;  // GL rows run bottom-up
+        const bool on_target = !distance.empty() && distance[gl] < 1e29f;
+        // The ray's ground distance, wanted for depth and where a target may stand in front
+        // of the ground: object ids alone (a dataset's masks) skip it elsewhere.
+        if (frame.depth.empty() && !on_target) continue;  // object_id stays 0
         const glm::dvec3 d = glm::normalize(rayDirection(basis, camera, x + 0.5, y + 0.5));
         const double ground =
             d.z < 0.0 ? camera.position.z / -d.z : std::numeric_limits<double>::infinity();
-        const std::size_t gl = std::size_t(h - 1 - y) * w + x;  // GL rows run bottom-up
-        const bool target = !distance.empty() && distance[gl] < 1e29f && distance[gl] < ground;
+        const bool target = on_target && distance[gl] < ground;
         const std::size_t i = std::size_t(y) * w + x;
         if (!frame.depth.empty()) frame.depth[i] = target ? distance[gl] : float(ground);
         if (!frame.object_id.empty()) frame.object_id[i] = target ? id[gl] : 0.0f;
