@@ -106,7 +106,7 @@ Srgb8Image toSrgb8(const FloatImage& image) {
   // The byte of each linear value from the 255 thresholds between bytes, the same rounding as
   // toByte(srgbEncode(v)). A value's top 16 bits (sign, exponent, 7 bits of mantissa) pick a
   // bucket no more than 1/128 of the value wide, which no two thresholds share (they lie at
-  // least 0.87 % apart, near 1), so the byte is the bucket's first byte or the one after it.
+  // least 0.89 % apart, near 1), so the byte is the bucket's first byte or the one after it.
   struct Table {
     std::array<float, 255> thresholds{};
     std::array<std::uint8_t, 65536> first{};

@@ -68,7 +68,8 @@ class GlRenderer {
 
  private:
   enum class TargetFormat { kFloat, kSrgb8 };
-  // A layer's texture, built once and kept while frames keep using it.
+  // A layer's texture, built once and kept while frames draw its layer (baked, a while longer:
+  // kKeptTextures).
   struct CachedTexture {
     std::unique_ptr<LayerTexture> source;
     std::string key;               // textureKey: the clipmap of a texture is kept under it too
