@@ -230,13 +230,7 @@ void EllipsoidRenderer::bindFrameTexture(int unit, GLenum format, const void* da
 
 void EllipsoidRenderer::endFrame() {
   std::erase_if(textures_, [](const auto& entry) { return !entry.second.used; });
-  while (tables_.size() > kKeptTables) {
-    auto oldest = std::min_element(
-        tables_.begin(), tables_.end(),
-        [](const auto& a, const auto& b) { return a.second.last_frame < b.second.last_frame; });
-    if (oldest->second.last_frame == frame_) break;  // all in use this frame
-    tables_.erase(oldest);
-  }
+  keepMostRecent(tables_, kKeptTables, frame_);
   std::erase_if(impostors_, [](const auto& entry) { return !entry.second.used; });
   for (auto& [index, impostor] : impostors_) impostor.used = false;
 }
@@ -710,8 +704,8 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   auto drawRect = [&](GLuint program, glm::ivec2 size, int step, int bx0, int by0, int bx1,
                       int by1) {
     auto ndc = [&](int bins, int axis) {
-      const int end = step > 1 ? size[axis] * step : axis == 0 ? target.width : target.height;
-      return float(2.0 * std::min(bins * kPerPixelBinSize, end) / step / size[axis] - 1.0);
+      return float(2.0 * std::min(bins * kPerPixelBinSize, size[axis] * step) / step / size[axis] -
+                   1.0);
     };
     const float x0 = ndc(bx0, 0), y0 = ndc(by0, 1), x1 = ndc(bx1 + 1, 0), y1 = ndc(by1 + 1, 1);
     const glm::vec2 polygon[4] = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};

@@ -1,6 +1,8 @@
 #pragma once
 // RAII ownership of GL object names. Every object borrows the GlApi of the context that made
 // it; the context must outlive its objects.
+#include <algorithm>
+#include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
@@ -72,6 +74,20 @@ IndexedMesh uploadMesh(const GlApi& gl, const std::vector<glm::vec3>& vertices,
 // The unit sphere, `slices` around and `slices` from pole to pole, counter-clockwise seen
 // from outside.
 void unitSphere(int slices, std::vector<glm::vec3>& vertices, std::vector<GLuint>& indices);
+
+// Drops the least recently used entries of `cache` (a map whose values carry `last_frame`)
+// until at most `keep` remain, but never one used in `frame`: the baked tables a renderer
+// keeps for the frames that come back to them.
+template <typename Map>
+void keepMostRecent(Map& cache, std::size_t keep, std::uint64_t frame) {
+  while (cache.size() > keep) {
+    auto oldest = std::min_element(cache.begin(), cache.end(), [](const auto& a, const auto& b) {
+      return a.second.last_frame < b.second.last_frame;
+    });
+    if (oldest->second.last_frame == frame) break;  // all used in this frame
+    cache.erase(oldest);
+  }
+}
 
 // Compiles and links a vertex + fragment program. On failure returns an empty object and
 // puts the driver's log in `error`.

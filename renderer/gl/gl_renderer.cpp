@@ -583,13 +583,7 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
     std::erase_if(textures_, [&](const auto& entry) {
       return entry.second.last_frame != frame_ && !entry.second.texture;
     });
-    while (textures_.size() > kKeptTextures) {
-      auto oldest = std::min_element(
-          textures_.begin(), textures_.end(),
-          [](const auto& a, const auto& b) { return a.second.last_frame < b.second.last_frame; });
-      if (oldest->second.last_frame == frame_) break;  // all drawn this frame
-      textures_.erase(oldest);
-    }
+    keepMostRecent(textures_, kKeptTextures, frame_);
   };
   // The eye deep in a cloud: its veil hides what lies behind to within the per-pixel pass's
   // opacity cut, so no sky or cloud pass is drawn under it (MODEL.md section 4).
