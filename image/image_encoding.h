@@ -1,6 +1,8 @@
 #pragma once
 // Rendered images to files through OpenImageIO, the format chosen by the file extension:
 // PNG, JPEG and TIFF as 8-bit sRGB RGB, EXR as linear float RGB plus coverage alpha.
+#include <bit>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -75,5 +77,27 @@ std::vector<std::uint8_t> packRaw(const Srgb8Image& image, bool colour, bool cov
 
 // sRGB-encodes a linear float image to bytes (top-down), keeping alpha linear.
 Srgb8Image toSrgb8(const FloatImage& image);
+
+// The IEEE 754 binary16 bits of f, rounded to the nearest half (ties to even): beyond the
+// largest half an infinity, a NaN stays a NaN, below 2^-14 a subnormal. For tables handed to
+// GL as half floats, which llvmpipe would otherwise convert a texel at a time.
+inline std::uint16_t halfFloatBits(float f) {
+  std::uint32_t x = std::bit_cast<std::uint32_t>(f);
+  const std::uint32_t sign = (x >> 16) & 0x8000u;
+  x &= 0x7fffffffu;
+  std::uint32_t h;
+  if (x >= 0x47800000u) {  // |f| >= 2^16, infinity or NaN
+    h = x > 0x7f800000u ? 0x7e00u : 0x7c00u;
+  } else if (x < 0x38800000u) {
+    // Subnormal: in 0.5 + |f| the float's last mantissa bit weighs 2^-24, the half's subnormal
+    // step, so the FPU's own rounding gives the half's mantissa.
+    h = std::bit_cast<std::uint32_t>(std::bit_cast<float>(x) + 0.5f) - 0x3f000000u;
+  } else {
+    // Exponent bias 127 -> 15; the 13 dropped bits round to even (a carry may reach the
+    // exponent, and from 65520 on gives the infinity).
+    h = (x - 0x38000000u + 0x0fffu + ((x >> 13) & 1u)) >> 13;
+  }
+  return std::uint16_t(sign | h);
+}
 
 }  // namespace nephele

@@ -6,6 +6,7 @@
 #include <bit>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 
 namespace nephele {
 namespace {
@@ -141,6 +142,40 @@ TEST(ImageEncoding, TableSrgbEqualsTheFormulaAcrossTheFloats) {
     differing +=
         bytes.rgba[std::size_t(i) * 4] != toByte(srgbEncode(image.rgba[std::size_t(i) * 4]));
   EXPECT_EQ(differing, 0) << "of " << image.width;
+}
+
+// Every finite half comes back from its own value, and the floats between two neighbours go
+// to the nearer, ties to the one with an even mantissa, the halves decoded here from their
+// fields (sign, 5 exponent bits biased by 15, 10 mantissa bits; subnormal below 2^-14).
+TEST(ImageEncoding, HalfFloatBitsRoundToTheNearestHalf) {
+  auto value = [](std::uint32_t h) {
+    const int exponent = int(h >> 10) & 31, mantissa = int(h & 1023);
+    const double magnitude = exponent == 0 ? std::ldexp(double(mantissa), -24)
+                                           : std::ldexp(1.0 + mantissa / 1024.0, exponent - 15);
+    return (h & 0x8000u) ? -magnitude : magnitude;
+  };
+  int wrong = 0;
+  for (std::uint32_t h = 0; h < 0x10000u; ++h) {
+    if (((h >> 10) & 31) == 31) continue;  // infinities and NaNs, below
+    wrong += halfFloatBits(float(value(h))) != h;
+    if ((h & 0x7fffu) == 0x7bffu) continue;  // the largest: its upper neighbour is infinity
+    const float mid = float(0.5 * (value(h) + value(h + 1)));  // exact: 12 bits of mantissa
+    const float towards_h = std::nextafter(mid, float(value(h)));
+    const float away = std::nextafter(mid, float(value(h + 1)));
+    wrong += halfFloatBits(towards_h) != h;
+    wrong += halfFloatBits(away) != h + 1;
+    wrong += halfFloatBits(mid) != ((h & 1u) ? h + 1 : h);
+  }
+  EXPECT_EQ(wrong, 0);
+  EXPECT_EQ(halfFloatBits(65519.0f), 0x7bffu);  // the largest half, 65504, is nearest
+  EXPECT_EQ(halfFloatBits(65520.0f), 0x7c00u);  // the tie goes to the even: infinity
+  EXPECT_EQ(halfFloatBits(-1.0e9f), 0xfc00u);
+  EXPECT_EQ(halfFloatBits(std::numeric_limits<float>::infinity()), 0x7c00u);
+  const std::uint16_t nan = halfFloatBits(std::numeric_limits<float>::quiet_NaN());
+  EXPECT_EQ(nan & 0x7c00u, 0x7c00u);
+  EXPECT_NE(nan & 0x3ffu, 0u);
+  EXPECT_EQ(halfFloatBits(1.0e-9f), 0u);  // under half the smallest subnormal
+  EXPECT_EQ(halfFloatBits(-0.0f), 0x8000u);
 }
 
 }  // namespace nephele

@@ -8,6 +8,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "image/image_encoding.h"
 #include "renderer/gl/sky_shaders.h"
 #include "renderer/gl/view_uniforms.h"
 #include "world/automaton/cloud_density.h"
@@ -112,11 +113,16 @@ void uploadBakedSums(const GlApi& gl, GLuint texture, const GardnerTexture& gard
   const int base = std::min(16 << count, 128);
   const int levels = int(std::log2(base)) + 1, full = int(std::log2(base >> count)) - 1;
   gl.TextureStorage3D(texture, levels, GL_RG16F, base, base, base);
+  std::vector<std::uint16_t> halves;
   for (int level = 0; level < levels; ++level) {
     const int size = base >> level;
     bakeGardnerSums(gardner, size, first, count - std::max(0, level + 1 - full), staging);
-    gl.TextureSubImage3D(texture, level, 0, 0, 0, size, size, size, GL_RG, GL_FLOAT,
-                         staging.values.data());
+    // Handed over as half floats, the texture's own format: llvmpipe converts floats texel by
+    // texel, three times as long as the bake itself.
+    halves.resize(staging.values.size());
+    for (std::size_t i = 0; i < halves.size(); ++i) halves[i] = halfFloatBits(staging.values[i]);
+    gl.TextureSubImage3D(texture, level, 0, 0, 0, size, size, size, GL_RG, GL_HALF_FLOAT,
+                         halves.data());
   }
   gl.TextureParameteri(texture, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
 }

@@ -335,17 +335,30 @@ EllipsoidCloud heapCloud(const CloudField& f, std::string name) {
   return cloud;
 }
 
+// A lobe as the quadric of its surface, computed once for the many rays across a heap.
+struct LobeQuadric {
+  glm::dmat3 m;  // (p - centre)^T m (p - centre) = 1 on the surface
+  glm::dvec3 centre;
+};
+std::vector<LobeQuadric> lobeQuadrics(const EllipsoidCloud& cloud) {
+  std::vector<LobeQuadric> out;
+  for (const Ellipsoid& e : cloud.ellipsoids) {
+    const glm::dmat3 w = worldToUnitSphere(e);
+    out.push_back({glm::transpose(w) * w, e.centre});
+  }
+  return out;
+}
+
 // Opacity of one cloud along the line through `point` seen from far away looking along unit
 // `view`: SPEC section 4 in its orthographic limit, where the limb function g of a ray is the
 // depth of the ray quadratic's minimum below zero (its discriminant over 4a), and the texture
 // is read where the ray enters.
-double orthographicOpacity(const EllipsoidCloud& cloud, const SolidTexture& texture,
-                           glm::dvec3 point, glm::dvec3 view) {
+double orthographicOpacity(const EllipsoidCloud& cloud, const std::vector<LobeQuadric>& lobes,
+                           const SolidTexture& texture, glm::dvec3 point, glm::dvec3 view) {
   double transmittance = 1.0;
-  for (const Ellipsoid& e : cloud.ellipsoids) {
-    const glm::dmat3 w = worldToUnitSphere(e);
-    const glm::dmat3 m = glm::transpose(w) * w;
-    const glm::dvec3 d = point - e.centre;
+  for (const LobeQuadric& lobe : lobes) {
+    const glm::dmat3& m = lobe.m;
+    const glm::dvec3 d = point - lobe.centre;
     // Q(s) = a s^2 + b s + c at point + s view.
     const double a = glm::dot(view, m * view);
     const double b = 2.0 * glm::dot(view, m * d);
@@ -386,6 +399,7 @@ double unitArea(const CloudField& field, bool side) {
       std::size_t anvil_from = 0;
       cloud.ellipsoids = heapEllipsoids(f, {0.0, 0.0, 1000.0}, scale.size, scale.height,
                                         hashCounters(77, k), true, anvil_from);
+      const std::vector<LobeQuadric> lobes = lobeQuadrics(cloud);
       // A square around the heap: across it (x) and down through it (y) or along its height.
       const double half = (isCb(f) ? 3.6 : 2.5) * r * scale.size, cell = 2.0 * half / kGrid;
       const double height = 2.0 * f.thickness_m * scale.height, step_up = height / kGrid;
@@ -393,12 +407,12 @@ double unitArea(const CloudField& field, bool side) {
       for (int y = 0; y < kGrid; ++y)
         for (int x = 0; x < kGrid; ++x) {
           const double across = -half + (x + 0.5) * cell;
-          inside +=
-              side ? orthographicOpacity(cloud, texture,
-                                         {across, -10.0 * r, 1000.0 + (y + 0.5) * step_up},
-                                         {0.0, 1.0, 0.0}) >= 0.5
-                   : orthographicOpacity(cloud, texture, {across, -half + (y + 0.5) * cell, 1.0e5},
-                                         {0.0, 0.0, -1.0}) >= 0.5;
+          inside += side ? orthographicOpacity(cloud, lobes, texture,
+                                               {across, -10.0 * r, 1000.0 + (y + 0.5) * step_up},
+                                               {0.0, 1.0, 0.0}) >= 0.5
+                         : orthographicOpacity(cloud, lobes, texture,
+                                               {across, -half + (y + 0.5) * cell, 1.0e5},
+                                               {0.0, 0.0, -1.0}) >= 0.5;
         }
       area += inside * cell * (side ? step_up : cell) / (r * r);
     }

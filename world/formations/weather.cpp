@@ -282,9 +282,34 @@ double thresholdForCoverage(const LayerTextureSpec& spec, double transition, int
 }
 
 void calibrateFarCover(const LayerTextureSpec& spec, double transition, FarCover& far) {
+  // The thresholds depend on the texture and the transition alone, and far decks take one of a
+  // few textures (farDeck): computed once per process for each, where a dataset sample's new
+  // field (its own cover and seed) sorted 16,384 texture values again. Any thread.
+  std::ostringstream key;
+  key.precision(17);
+  const GardnerTextureParams& g = spec.gardner;
+  key << int(spec.source) << '/' << spec.seed << '/' << transition << '/' << g.terms << '/' << g.fx1
+      << '/' << g.fy1 << '/' << g.t0 << '/' << g.seeded_phases << '/' << g.seed << '/'
+      << g.rotation_deg << '/' << g.jitter_octaves << '/' << g.amplitude_ratio;
+  using Thresholds = std::array<double, FarCover::kSteps + 1>;
+  static std::mutex mutex;
+  static std::map<std::string, Thresholds> cache;
+  {
+    std::lock_guard lock(mutex);
+    if (auto it = cache.find(key.str());
+        it != cache.end() && spec.source == TextureSource::kGardner) {
+      std::copy(it->second.begin(), it->second.end(), far.threshold);
+      return;
+    }
+  }
   const std::vector<double> samples = sortedSamples(spec);
+  Thresholds thresholds;
   for (int k = 0; k <= FarCover::kSteps; ++k)
-    far.threshold[k] = thresholdFromSamples(samples, transition, 1, double(k) / FarCover::kSteps);
+    thresholds[k] = thresholdFromSamples(samples, transition, 1, double(k) / FarCover::kSteps);
+  std::copy(thresholds.begin(), thresholds.end(), far.threshold);
+  std::lock_guard lock(mutex);
+  if (cache.size() >= 256) cache.clear();  // a bound, should a caller vary a texture continuously
+  if (spec.source == TextureSource::kGardner) cache[key.str()] = thresholds;
 }
 
 }  // namespace nephele
