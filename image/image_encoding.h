@@ -82,21 +82,24 @@ Srgb8Image toSrgb8(const FloatImage& image);
 // largest half an infinity, a NaN stays a NaN, below 2^-14 a subnormal. For tables handed to
 // GL as half floats, which llvmpipe would otherwise convert a texel at a time.
 inline std::uint16_t halfFloatBits(float f) {
-  std::uint32_t x = std::bit_cast<std::uint32_t>(f);
+  // Each case computed and the right one selected, without branches, so that loops over
+  // tables of them run in SIMD lanes. Magnitudes as signed ints, which SSE2 compares.
+  const std::uint32_t x = std::bit_cast<std::uint32_t>(f);
   const std::uint32_t sign = (x >> 16) & 0x8000u;
-  x &= 0x7fffffffu;
-  std::uint32_t h;
-  if (x >= 0x47800000u) {  // |f| >= 2^16, infinity or NaN
-    h = x > 0x7f800000u ? 0x7e00u : 0x7c00u;
-  } else if (x < 0x38800000u) {
-    // Subnormal: in 0.5 + |f| the float's last mantissa bit weighs 2^-24, the half's subnormal
-    // step, so the FPU's own rounding gives the half's mantissa.
-    h = std::bit_cast<std::uint32_t>(std::bit_cast<float>(x) + 0.5f) - 0x3f000000u;
-  } else {
-    // Exponent bias 127 -> 15; the 13 dropped bits round to even (a carry may reach the
-    // exponent, and from 65520 on gives the infinity).
-    h = (x - 0x38000000u + 0x0fffu + ((x >> 13) & 1u)) >> 13;
-  }
+  const std::int32_t a = std::int32_t(x & 0x7fffffffu);
+  // Normal: exponent bias 127 -> 15, the 13 dropped bits rounded to even (a carry may reach
+  // the exponent, and from 65520 on gives the infinity).
+  const std::uint32_t normal = (std::uint32_t(a) - 0x38000000u + 0x0fffu + ((a >> 13) & 1)) >> 13;
+  // Below 2^-14, subnormal: in 0.5 + |f| the float's last mantissa bit weighs 2^-24, the
+  // half's subnormal step, so the FPU's own rounding gives the half's mantissa.
+  const std::uint32_t subnormal =
+      std::bit_cast<std::uint32_t>(std::bit_cast<float>(a) + 0.5f) - 0x3f000000u;
+  // From 2^16 on, infinity, and a NaN stays a NaN.
+  const std::uint32_t beyond = 0x7c00u | (std::uint32_t(a > 0x7f800000) << 9);
+  const std::uint32_t is_beyond = 0u - std::uint32_t(a >= 0x47800000);  // all ones or zero
+  const std::uint32_t is_subnormal = 0u - std::uint32_t(a < 0x38800000);
+  const std::uint32_t h =
+      (is_beyond & beyond) | (~is_beyond & ((is_subnormal & subnormal) | (~is_subnormal & normal)));
   return std::uint16_t(sign | h);
 }
 

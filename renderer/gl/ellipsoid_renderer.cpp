@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <future>
 #include <limits>
 #include <numbers>
 #include <sstream>
@@ -108,21 +109,33 @@ BakedSolidLayout bakedSolidLayout(const GardnerTexture& gardner) {
   return {coarse, n - coarse, std::exp2(coarse)};
 }
 
-void uploadBakedSums(const GlApi& gl, GLuint texture, const GardnerTexture& gardner, int first,
-                     int count, VolumeTable& staging) {
-  const int base = std::min(16 << count, 128);
-  const int levels = int(std::log2(base)) + 1, full = int(std::log2(base >> count)) - 1;
-  gl.TextureStorage3D(texture, levels, GL_RG16F, base, base, base);
-  std::vector<std::uint16_t> halves;
+// One table's levels as half floats, the texture's own format (llvmpipe converts floats a
+// texel at a time, longer than the bake itself). CPU only: any thread.
+struct BakedLevels {
+  int base = 0;
+  std::vector<std::vector<std::uint16_t>> levels;
+};
+BakedLevels bakeSumLevels(const GardnerTexture& gardner, int first, int count) {
+  BakedLevels out;
+  out.base = std::min(16 << count, 128);
+  const int levels = int(std::log2(out.base)) + 1, full = int(std::log2(out.base >> count)) - 1;
+  VolumeTable staging;
   for (int level = 0; level < levels; ++level) {
-    const int size = base >> level;
-    bakeGardnerSums(gardner, size, first, count - std::max(0, level + 1 - full), staging);
-    // Handed over as half floats, the texture's own format: llvmpipe converts floats texel by
-    // texel, three times as long as the bake itself.
-    halves.resize(staging.values.size());
+    bakeGardnerSums(gardner, out.base >> level, first, count - std::max(0, level + 1 - full),
+                    staging);
+    std::vector<std::uint16_t>& halves = out.levels.emplace_back(staging.values.size());
     for (std::size_t i = 0; i < halves.size(); ++i) halves[i] = halfFloatBits(staging.values[i]);
+  }
+  return out;
+}
+
+void uploadBakedSums(const GlApi& gl, GLuint texture, const BakedLevels& baked) {
+  const int levels = int(baked.levels.size());
+  gl.TextureStorage3D(texture, levels, GL_RG16F, baked.base, baked.base, baked.base);
+  for (int level = 0; level < levels; ++level) {
+    const int size = baked.base >> level;
     gl.TextureSubImage3D(texture, level, 0, 0, 0, size, size, size, GL_RG, GL_HALF_FLOAT,
-                         halves.data());
+                         baked.levels[std::size_t(level)].data());
   }
   gl.TextureParameteri(texture, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
 }
@@ -272,10 +285,12 @@ void EllipsoidRenderer::bindTables(CachedTexture& cached) {
     if (const GardnerTexture* gardner = unit.gardner()) {
       table.fine = createTexture(gl_, GL_TEXTURE_3D);
       const BakedSolidLayout layout = bakedSolidLayout(*gardner);
-      VolumeTable staging;  // one buffer for both tables and their levels
-      uploadBakedSums(gl_, table.texture.get(), *gardner, 0, layout.coarse_terms, staging);
-      uploadBakedSums(gl_, table.fine.get(), *gardner, layout.coarse_terms, layout.fine_terms,
-                      staging);
+      // The two tables baked side by side: GL waits for them either way.
+      std::future<BakedLevels> fine = std::async(std::launch::async, [&] {
+        return bakeSumLevels(*gardner, layout.coarse_terms, layout.fine_terms);
+      });
+      uploadBakedSums(gl_, table.texture.get(), bakeSumLevels(*gardner, 0, layout.coarse_terms));
+      uploadBakedSums(gl_, table.fine.get(), fine.get());
     } else {
       uploadVolume(gl_, table.texture.get(), *unit.volume());
     }
