@@ -379,9 +379,9 @@ float layerThreshold(int i, vec3 r, vec2 p) { return u_threshold[i]; }
 // Slot i's surface under what lies in front of it: layers are composited nearest first, so
 // `colour` holds the premultiplied sum of the surfaces in front and `transmittance` what they
 // let through ("over" summed front to back, the same sum as back to front).
-void composite(int i, vec3 r, LayerHit hit, float it, inout vec3 colour,
+void composite(int i, vec3 r, LayerHit hit, float t1, float it, inout vec3 colour,
                inout float transmittance) {
-  float tr = translucence(it - layerThreshold(i, r, hit.p), u_transition[i]);  // Gardner eq. 9
+  float tr = translucence(it - t1, u_transition[i]);  // Gardner eq. 9
   vec3 normal = vec3(0.0, 0.0, u_height[i] > 0.0 ? -1.0 : 1.0);  // turned towards the viewer
   float n_dot_l = dot(normal, u_to_sun);
   float highlight = 0.0;
@@ -423,8 +423,12 @@ std::string slotStatement(int slot, LayerKind kind) {
   }
   // Behind a surface that is opaque to within 1/1024 nothing more is evaluated (what the
   // layers there could add is below half an 8-bit step): a full deck costs its nearest plane.
+  // Nor is the texture where the threshold is 1 or more, since T <= 1 (MODEL.md section 2)
+  // leaves the layer clear there: a far deck's hole around the camera, where the heaps stand,
+  // costs its threshold only.
   return "    if (transmittance > kClear) { LayerHit hit = hitLayer(" + i +
-         ", r); if (inFront(hit.distance)) composite(" + i + ", r, hit, " + value +
+         ", r); float t1 = inFront(hit.distance) ? layerThreshold(" + i +
+         ", r, hit.p) : 1.0; if (t1 < 1.0) composite(" + i + ", r, hit, t1, " + value +
          ", colour, transmittance); }\n";
 }
 
