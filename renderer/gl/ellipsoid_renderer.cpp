@@ -226,6 +226,7 @@ void EllipsoidRenderer::beginFrame(FrameStats& stats) {
   for (auto& [key, cached] : textures_) cached.used = false;
   ++frame_;
   next_buffer_ = 0;
+  queued_work_ = 0;
 }
 
 void EllipsoidRenderer::bindFrameTexture(int unit, GLenum format, const void* data,
@@ -448,6 +449,11 @@ void EllipsoidRenderer::drawClouds(const Scene& scene, const std::vector<std::si
     batch->second.push_back(index);
   }
   for (const auto& [key, members] : batches) {
+    // Light batches queue their draws without waiting for them; once about kCancelWork has
+    // gathered it is drawn to completion before the flag is read, so that a cancelled frame
+    // waits for at most that much (a world of many small clouds queued all its frame's work
+    // before the first read).
+    if (cancel_ && queued_work_ > kCancelWork) finishQueued();
     if (stopNow()) return;
     drawDirect(scene, members, settings, target, targets_drawn, band);
   }
@@ -634,13 +640,19 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
     const std::size_t group = cancellable ? std::min(max_records, kCancelInstances) : max_records;
     for (std::size_t first = 0; first < ordered.size(); first += group) {
       if (cancellable && first > 0) {
-        gl_.Finish();
+        finishQueued();
         if (stopNow()) return;
       }
       const std::size_t count = std::min(group, ordered.size() - first);
       bindFrameTexture(kRecordTextureUnit, GL_RGBA32F, ordered.data() + first,
                        count * sizeof(EllipsoidRecord));
       gl_.DrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(count));
+      for (std::size_t i = first; i < first + count; ++i) {  // a fragment per pixel of its rect
+        const glm::vec4 rect = ordered[i].v[10];
+        queued_work_ += std::int64_t(0.25 * (rect.z - rect.x) * (rect.w - rect.y) * target.width *
+                                     target.height) +
+                        1;
+      }
       ++stats_->ellipsoid_passes;
     }
   };
@@ -739,12 +751,13 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   auto drawArea = [&](auto&& draw) {
     if (!cancel_ || listed * kBinPixels <= kCancelWork) {
       draw(area.x, area.y, area.z, area.w);
+      queued_work_ += listed * kBinPixels;
       return true;
     }
     // Heavy: bands of whole bin rows of about kCancelWork hit tests (a row heavier than that
     // alone in runs of its bins), each finished before the flag is read.
     auto finished = [&] {
-      gl_.Finish();
+      finishQueued();
       return stopNow();
     };
     int band_from = area.y;
@@ -852,7 +865,7 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
       gl_.UseProgram(q);
       gl_.DrawArrays(GL_TRIANGLES, 0, GLsizei(6 * (i + 1 - first)));
       if (last) break;
-      gl_.Finish();
+      finishQueued();
       if (stopNow()) return;
       first = i + 1, work = 0;
     }

@@ -70,7 +70,8 @@ class EllipsoidRenderer {
   // docs/RELIABILITY.md). It is read between batches, every kCancelRecords ellipsoids while
   // records are made, and, in a heavy batch, after each part of it drawn to completion
   // (glFinish): the per-pixel pass in bands of about kCancelWork hit tests, the centre pass
-  // in groups of kCancelInstances. Light batches draw as without it. Once raised the rest of
+  // in groups of kCancelInstances. Light batches draw as without it, but for a glFinish
+  // between batches once their queued work reaches kCancelWork. Once raised the rest of
   // the frame's ellipsoids are skipped and cancelled() says so until the next beginFrame.
   // `alive`, if given, is called at each of those points: the frame is making progress (a
   // daemon's watchdog heartbeat).
@@ -93,6 +94,10 @@ class EllipsoidRenderer {
     if (alive_) alive_();
     if (!cancelled_ && cancel_ && cancel_->load(std::memory_order_relaxed)) cancelled_ = true;
     return cancelled_;
+  }
+  void finishQueued() {
+    gl_.Finish();
+    queued_work_ = 0;
   }
 
   // A cloud texture as the frame's clouds name it (its scale included), and the baked table it
@@ -168,6 +173,9 @@ class EllipsoidRenderer {
   };
   std::vector<FrameTexture> buffer_pool_;  // buffer textures, one per upload in a frame
   std::size_t next_buffer_ = 0;
+  // Hit tests (the centre pass: fragments) drawn since the last glFinish, which llvmpipe may
+  // not have run yet.
+  std::int64_t queued_work_ = 0;
   GLint max_texels_ = 0;  // GL_MAX_TEXTURE_BUFFER_SIZE
   GlObject spotlight_;
   GlObject atlas_;
