@@ -294,10 +294,10 @@ void calibrateFarCover(const LayerTextureSpec& spec, double transition, FarCover
   using Thresholds = std::array<double, FarCover::kSteps + 1>;
   static std::mutex mutex;
   static std::map<std::string, Thresholds> cache;
-  {
+  const bool keyed = spec.source == TextureSource::kGardner;  // the key names Gardner's only
+  if (keyed) {
     std::lock_guard lock(mutex);
-    if (auto it = cache.find(key.str());
-        it != cache.end() && spec.source == TextureSource::kGardner) {
+    if (auto it = cache.find(key.str()); it != cache.end()) {
       std::copy(it->second.begin(), it->second.end(), far.threshold);
       return;
     }
@@ -307,9 +307,10 @@ void calibrateFarCover(const LayerTextureSpec& spec, double transition, FarCover
   for (int k = 0; k <= FarCover::kSteps; ++k)
     thresholds[k] = thresholdFromSamples(samples, transition, 1, double(k) / FarCover::kSteps);
   std::copy(thresholds.begin(), thresholds.end(), far.threshold);
+  if (!keyed) return;
   std::lock_guard lock(mutex);
   if (cache.size() >= 256) cache.clear();  // a bound, should a caller vary a texture continuously
-  if (spec.source == TextureSource::kGardner) cache[key.str()] = thresholds;
+  cache[key.str()] = thresholds;
 }
 
 }  // namespace nephele
