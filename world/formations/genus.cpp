@@ -13,10 +13,14 @@ namespace {
 // of a lobe and the edge is a smooth arc; 1.15 with these). A wider band (T1 = -0.2, T2 = 0.6)
 // is rougher still (1.26) but its heaps, far away with their fine terms faded, draw less cover
 // than the far deck beyond them (docs/ACCURACY.md). The texture is finer for a cumulonimbus's
-// size, its lobes being a smaller part of its width.
+// size, its lobes being a smaller part of its width. Ambient a = 0.1: a heap's shaded side is
+// lit by the sky (K, section 14), so eq. 8's constant floor is kept low; with 0.2 the sunlit
+// half of a heap lit from the side was 1.52 times its shaded half (1.56 for a cumulonimbus),
+// with 0.1 1.76 (both), against the 1.5 asked and 2 aimed at, the bases darker under the
+// tops (0.18 of the sunlit top's luminance against 0.27).
 constexpr HeapLook kNoHeaps{1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 6.0, 5};
-constexpr HeapLook kCumulusHeaps{1.0, 0.2, 0.3, -0.4, 0.4, 0.08, 0.02, 1.0, 12.0, 6};
-constexpr HeapLook kCumulonimbusHeaps{0.9, 0.2, 0.3, -0.3, 0.6, 0.12, 0.02, 1.0, 24.0, 7};
+constexpr HeapLook kCumulusHeaps{1.0, 0.1, 0.3, -0.4, 0.4, 0.08, 0.02, 1.0, 12.0, 6};
+constexpr HeapLook kCumulonimbusHeaps{0.9, 0.1, 0.3, -0.3, 0.6, 0.12, 0.02, 1.0, 24.0, 7};
 
 // Species (the atlas): humilis, of slight vertical extent and flattened, three times as wide as
 // tall in a layer 500 m thick; mediocris, of moderate extent, 1.8 times as wide at 1,200 m (a
