@@ -80,19 +80,25 @@ class GardnerSamples {
 // seed enters in LayerTexture), since over 24 x 24 periods a seed's phases, turns and scales
 // within each octave leave the distribution of values as it is; realism_bench's drawn
 // coverage is within 0.03 of the asked for every stratiform genus. Any thread.
+// Every parameter of a Gardner texture, in full precision: the key of the caches below.
+std::string gardnerKey(const GardnerTextureParams& p) {
+  std::ostringstream key;
+  key.precision(17);
+  key << p.terms << '/' << p.fx1 << '/' << p.fy1 << '/' << p.t0 << '/' << p.seeded_phases << '/'
+      << p.seed << '/' << p.rotation_deg << '/' << p.jitter_octaves << '/' << p.amplitude_ratio;
+  return key.str();
+}
+
 std::shared_ptr<const GardnerSamples> lookSamples(const GardnerTextureParams& params) {
   GardnerTextureParams p = params;
   p.seed = 0;
   p.t0 = 0.0;
-  std::ostringstream key;
-  key.precision(17);
-  key << p.terms << '/' << p.fx1 << '/' << p.fy1 << '/' << p.seeded_phases << '/' << p.rotation_deg
-      << '/' << p.jitter_octaves << '/' << p.amplitude_ratio;
+  const std::string key = gardnerKey(p);
   static std::mutex mutex;
   static std::map<std::string, std::shared_ptr<const GardnerSamples>> cache;
   std::lock_guard lock(mutex);
   if (cache.size() >= 256) cache.clear();  // a bound, should a caller vary a look continuously
-  std::shared_ptr<const GardnerSamples>& entry = cache[key.str()];
+  std::shared_ptr<const GardnerSamples>& entry = cache[key];
   if (!entry) entry = std::make_shared<const GardnerSamples>(p);
   return entry;
 }
@@ -285,19 +291,17 @@ void calibrateFarCover(const LayerTextureSpec& spec, double transition, FarCover
   // The thresholds depend on the texture and the transition alone, and far decks take one of a
   // few textures (farDeck): computed once per process for each, where a dataset sample's new
   // field (its own cover and seed) sorted 16,384 texture values again. Any thread.
-  std::ostringstream key;
-  key.precision(17);
-  const GardnerTextureParams& g = spec.gardner;
-  key << int(spec.source) << '/' << spec.seed << '/' << transition << '/' << g.terms << '/' << g.fx1
-      << '/' << g.fy1 << '/' << g.t0 << '/' << g.seeded_phases << '/' << g.seed << '/'
-      << g.rotation_deg << '/' << g.jitter_octaves << '/' << g.amplitude_ratio;
+  std::ostringstream key_text;
+  key_text.precision(17);
+  key_text << spec.seed << '/' << transition << '/' << gardnerKey(spec.gardner);
+  const std::string key = key_text.str();
   using Thresholds = std::array<double, FarCover::kSteps + 1>;
   static std::mutex mutex;
   static std::map<std::string, Thresholds> cache;
   const bool keyed = spec.source == TextureSource::kGardner;  // the key names Gardner's only
   if (keyed) {
     std::lock_guard lock(mutex);
-    if (auto it = cache.find(key.str()); it != cache.end()) {
+    if (auto it = cache.find(key); it != cache.end()) {
       std::copy(it->second.begin(), it->second.end(), far.threshold);
       return;
     }
@@ -310,7 +314,7 @@ void calibrateFarCover(const LayerTextureSpec& spec, double transition, FarCover
   if (!keyed) return;
   std::lock_guard lock(mutex);
   if (cache.size() >= 256) cache.clear();  // a bound, should a caller vary a texture continuously
-  cache[key.str()] = thresholds;
+  cache[key] = thresholds;
 }
 
 }  // namespace nephele
