@@ -326,25 +326,6 @@ int runDatasetCommand(const DatasetCommandOptions& o) {
     return 1;
   }
 
-  RendererOptions options;
-  options.kind = o.renderer == "reference" ? RendererKind::kReference : RendererKind::kGl;
-  options.gl_backend = backendFromName(o.gl_backend);
-  options.render.channel_divisor = o.channel_divisor;
-  options.render.heaps = options.reference.heaps = spec.heaps;
-  options.reference.label_divisor = o.channel_divisor;
-  std::string error;
-  const std::unique_ptr<Renderer> renderer = createRenderer(options, error);
-  if (!renderer) {
-    spdlog::error("{}", error);
-    return 1;
-  }
-  if (std::string e = renderer->reserve(spec.width, spec.height, true, /*targets=*/true);
-      !e.empty()) {
-    spdlog::error("dataset.width/height: {}", e);
-    return 2;
-  }
-  spdlog::info("renderer: {}", renderer->description());
-
   std::vector<int> todo;
   if (!o.only.empty()) {
     todo = o.only;
@@ -367,6 +348,39 @@ int runDatasetCommand(const DatasetCommandOptions& o) {
       "dataset: {} samples to render{}{}", todo.size(),
       shards > 1 ? " (shard " + std::to_string(shard) + "/" + std::to_string(shards) + ")" : "",
       skipped > 0 ? ", " + std::to_string(skipped) + " already written" : "");
+
+  // The next kDrawAhead samples' scenes are drawn on other threads while one renders: a
+  // sample whose heaps take longer to draw (60 to 80 ms, the first of a texture) than the one
+  // before takes to render (20 to 50 ms, layers only) is then drawn before it is needed. The
+  // first ones are drawn while the renderer starts.
+  constexpr std::size_t kDrawAhead = 2;
+  auto drawAsync = [&](std::size_t n) {
+    return std::async(std::launch::async, [&spec, index = todo[n]] {
+      const auto t0 = Clock::now();
+      SampleScene sample = drawSample(spec, index);
+      return std::pair{std::move(sample), std::chrono::duration<double>(Clock::now() - t0).count()};
+    });
+  };
+  std::deque<std::future<std::pair<SampleScene, double>>> ahead;
+  for (std::size_t n = 0; n < todo.size() && n < kDrawAhead; ++n) ahead.push_back(drawAsync(n));
+  RendererOptions options;
+  options.kind = o.renderer == "reference" ? RendererKind::kReference : RendererKind::kGl;
+  options.gl_backend = backendFromName(o.gl_backend);
+  options.render.channel_divisor = o.channel_divisor;
+  options.render.heaps = options.reference.heaps = spec.heaps;
+  options.reference.label_divisor = o.channel_divisor;
+  std::string error;
+  const std::unique_ptr<Renderer> renderer = createRenderer(options, error);
+  if (!renderer) {
+    spdlog::error("{}", error);
+    return 1;
+  }
+  if (std::string e = renderer->reserve(spec.width, spec.height, true, /*targets=*/true);
+      !e.empty()) {
+    spdlog::error("dataset.width/height: {}", e);
+    return 2;
+  }
+  spdlog::info("renderer: {}", renderer->description());
 
   FrameRequest request;
   request.channels = {spec.band == Band::kLwir ? Channel::kLwir : Channel::kColour,
@@ -406,20 +420,11 @@ int runDatasetCommand(const DatasetCommandOptions& o) {
 
   const auto start = Clock::now();
   auto last_report = start;
-  // The next sample's scene is drawn on another thread while this one renders.
-  auto drawAsync = [&](std::size_t n) {
-    return std::async(std::launch::async, [&spec, index = todo[n]] {
-      const auto t0 = Clock::now();
-      SampleScene sample = drawSample(spec, index);
-      return std::pair{std::move(sample), std::chrono::duration<double>(Clock::now() - t0).count()};
-    });
-  };
-  std::future<std::pair<SampleScene, double>> next;
-  if (!todo.empty()) next = drawAsync(0);
   for (std::size_t n = 0; n < todo.size(); ++n) {
     const auto t0 = Clock::now();
-    auto [sample, draw_seconds] = next.get();
-    if (n + 1 < todo.size()) next = drawAsync(n + 1);
+    auto [sample, draw_seconds] = ahead.front().get();
+    ahead.pop_front();
+    if (n + kDrawAhead < todo.size()) ahead.push_back(drawAsync(n + kDrawAhead));
     Rendered r{todo[n], std::move(sample), {}};
     const auto t1 = Clock::now();
     request.infrared = r.sample.infrared;

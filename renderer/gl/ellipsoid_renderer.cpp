@@ -111,20 +111,30 @@ BakedSolidLayout bakedSolidLayout(const GardnerTexture& gardner) {
 
 // One table's levels as half floats, the texture's own format (llvmpipe converts floats a
 // texel at a time, longer than the bake itself). CPU only: any thread.
+// Each level is converted row by row as it is summed, into storage that is written once and
+// never cleared: a float table between, and zeroed storage, cost more than the sums in
+// first-touch page faults (a fresh process bakes each table into memory it has not used).
 struct BakedLevels {
   int base = 0;
-  std::vector<std::vector<std::uint16_t>> levels;
+  std::vector<std::unique_ptr<std::uint16_t[]>> levels;
 };
 BakedLevels bakeSumLevels(const GardnerTexture& gardner, int first, int count) {
   BakedLevels out;
   out.base = std::min(16 << count, 128);
   const int levels = int(std::log2(out.base)) + 1, full = int(std::log2(out.base >> count)) - 1;
-  VolumeTable staging;
   for (int level = 0; level < levels; ++level) {
-    bakeGardnerSums(gardner, out.base >> level, first, count - std::max(0, level + 1 - full),
-                    staging);
-    std::vector<std::uint16_t>& halves = out.levels.emplace_back(staging.values.size());
-    for (std::size_t i = 0; i < halves.size(); ++i) halves[i] = halfFloatBits(staging.values[i]);
+    const std::size_t n = std::size_t(out.base >> level);
+    std::uint16_t* halves =
+        out.levels.emplace_back(std::make_unique_for_overwrite<std::uint16_t[]>(2 * n * n * n))
+            .get();
+    bakeGardnerSums(gardner, int(n), first, count - std::max(0, level + 1 - full),
+                    [&](std::size_t z, std::size_t y, const float* sx, const float* sy) {
+                      std::uint16_t* texel = halves + 2 * (z * n + y) * n;
+                      for (std::size_t x = 0; x < n; ++x) {
+                        texel[2 * x] = halfFloatBits(sx[x]);
+                        texel[2 * x + 1] = halfFloatBits(sy[x]);
+                      }
+                    });
   }
   return out;
 }
@@ -135,7 +145,7 @@ void uploadBakedSums(const GlApi& gl, GLuint texture, const BakedLevels& baked) 
   for (int level = 0; level < levels; ++level) {
     const int size = baked.base >> level;
     gl.TextureSubImage3D(texture, level, 0, 0, 0, size, size, size, GL_RG, GL_HALF_FLOAT,
-                         baked.levels[std::size_t(level)].data());
+                         baked.levels[std::size_t(level)].get());
   }
   gl.TextureParameteri(texture, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
 }

@@ -43,13 +43,22 @@ double VolumeTable::sampleTrilinear(glm::dvec3 uvw) const {
 }
 
 VolumeTable bakeGardnerSums(const GardnerTexture& texture, int size, int first, int count) {
+  const std::size_t n = std::size_t(std::max(size, 0));
   VolumeTable out;
-  bakeGardnerSums(texture, size, first, count, out);
+  out.size = size;
+  out.channels = 2;
+  out.values.resize(2 * n * n * n);
+  bakeGardnerSums(texture, size, first, count,
+                  [&](std::size_t z, std::size_t y, const float* sx, const float* sy) {
+                    float* texel = &out.values[2 * (z * n + y) * n];
+                    for (std::size_t x = 0; x < n; ++x)
+                      texel[2 * x] = sx[x], texel[2 * x + 1] = sy[x];
+                  });
   return out;
 }
 
 void bakeGardnerSums(const GardnerTexture& texture, int size, int first, int count,
-                     VolumeTable& out) {
+                     const GardnerSumRow& row) {
   first = std::clamp(first, 0, texture.terms());
   const int end = std::clamp(first + count, first, texture.terms());
   const int m = end - first;
@@ -92,9 +101,6 @@ void bakeGardnerSums(const GardnerTexture& texture, int size, int first, int cou
         cos_by[j] = float(py[t].y * c.y - py[t].x * c.x);
       }
   }
-  out.size = size;
-  out.channels = 2;
-  out.values.resize(2 * n * n * n);
   std::vector<float> sx(n), sy(n);
   for (std::size_t z = 0; z < n; ++z)
     for (std::size_t y = 0; y < n; ++y) {
@@ -113,8 +119,7 @@ void bakeGardnerSums(const GardnerTexture& texture, int size, int first, int cou
           sy[x] += say * cby[x] + cay * sby[x];
         }
       }
-      float* texel = &out.values[2 * (z * n + y) * n];
-      for (std::size_t x = 0; x < n; ++x) texel[2 * x] = sx[x], texel[2 * x + 1] = sy[x];
+      row(z, y, sx.data(), sy.data());
     }
 }
 

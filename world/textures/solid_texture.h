@@ -1,7 +1,9 @@
 #pragma once
 // Textures of ellipsoid clouds: Gardner's texture with solid phases, or seeded periodic
 // Perlin noise in three dimensions (Elinas), evaluated at world points.
+#include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -27,11 +29,13 @@ struct VolumeTable {
 // `first` and those above it, a 2^first-th of the texture's (4 pi / FX1 in X and Z, 4 pi / FY1
 // in Y), over which they all repeat. T is k max(T0 + the parts' SX, 0) max(T0 + ..., 0).
 VolumeTable bakeGardnerSums(const GardnerTexture& texture, int size, int first, int count);
-// The same into `out`, whose storage is reused: a renderer baking two tables and their
-// levels touches fresh memory once (measured: both tables of a six-term texture 103 ms with one
-// buffer, 157 to 211 ms with a new one per level, most of the difference first-touch faults).
+// The same a row at a time: `row(z, y, sx, sy)` receives the size values of SX - T0 and of
+// SY - T0 along x at (y, z), valid during the call. For a caller that stores the table in
+// its own format (the GL's half floats), with no float table between.
+using GardnerSumRow =
+    std::function<void(std::size_t z, std::size_t y, const float* sx, const float* sy)>;
 void bakeGardnerSums(const GardnerTexture& texture, int size, int first, int count,
-                     VolumeTable& out);
+                     const GardnerSumRow& row);
 
 // Periodic 3D gradient noise: `octaves` octaves, the first with `cells` lattice cells per
 // period, each next one with twice the cells and `persistence` times the amplitude.

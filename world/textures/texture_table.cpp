@@ -116,12 +116,14 @@ GardnerTruncations bakeGardner(const GardnerTexture& texture, int size, int term
   const glm::dvec2 period = texture.period();
   const double t0 = texture.params().t0, k = texture.normalisation();
   // Each term is sin(a(x) + b(y)) along X and sin(a'(y) + b'(x)) along Y, so the sines are
-  // tabulated once per column and row: sin(a + b) = sin a cos b + cos a sin b.
-  const std::size_t cells = std::size_t(m) * size;
-  std::vector<double> sin_ax(cells), cos_ax(cells), sin_py(cells), cos_py(cells);
-  std::vector<double> sin_ay(cells), cos_ay(cells), sin_px(cells), cos_px(cells);
+  // tabulated once per column and row: sin(a + b) = sin a cos b + cos a sin b. The tables are
+  // taken in double and the sums in float, a row at a time, so that the columns run in SIMD
+  // lanes (the values are stored as 16-bit fractions, far coarser than the float sums' error).
+  const std::size_t n = std::size_t(size), cells = std::size_t(m) * n;
+  std::vector<float> sin_ax(cells), cos_ax(cells), sin_py(cells), cos_py(cells);
+  std::vector<float> sin_ay(cells), cos_ay(cells), sin_px(cells), cos_px(cells);
   for (int i = 0; i < m; ++i)
-    for (int t = 0; t < size; ++t) {
+    for (std::size_t t = 0; t < n; ++t) {
       const double x = (t + 0.5) / size * period.x, y = (t + 0.5) / size * period.y;
       const double ax = texture.frequencyX(i) * x + texture.phaseX(i);
       const double ay = texture.frequencyY(i) * y + texture.phaseY(i);
@@ -129,32 +131,40 @@ GardnerTruncations bakeGardner(const GardnerTexture& texture, int size, int term
           0.5 * std::numbers::pi * std::sin(0.5 * texture.frequencyX(i) * x);  // PY(i) at X
       const double px =
           0.5 * std::numbers::pi * std::sin(0.5 * texture.frequencyY(i) * y);  // PX(i) at Y
-      const std::size_t j = std::size_t(i) * size + t;
-      sin_ax[j] = std::sin(ax), cos_ax[j] = std::cos(ax);
-      sin_ay[j] = std::sin(ay), cos_ay[j] = std::cos(ay);
-      sin_py[j] = std::sin(py), cos_py[j] = std::cos(py);
-      sin_px[j] = std::sin(px), cos_px[j] = std::cos(px);
+      const std::size_t j = std::size_t(i) * n + t;
+      sin_ax[j] = float(std::sin(ax)), cos_ax[j] = float(std::cos(ax));
+      sin_ay[j] = float(std::sin(ay)), cos_ay[j] = float(std::cos(ay));
+      sin_py[j] = float(std::sin(py)), cos_py[j] = float(std::cos(py));
+      sin_px[j] = float(std::sin(px)), cos_px[j] = float(std::cos(px));
     }
-  const std::size_t texels = std::size_t(size) * size;
-  GardnerTruncations out{{size, size, std::vector<float>(texels)},
-                         {size, size, std::vector<float>(texels)}};
-  auto texture_value = [k](double sx, double sy) {
-    return float(k * std::max(sx, 0.0) * std::max(sy, 0.0));
+  GardnerTruncations out{{size, size, std::vector<float>(n * n)},
+                         {size, size, std::vector<float>(n * n)}};
+  const float t0f = float(t0), kf = float(k);
+  auto store = [&](float* to, const std::vector<float>& sx, const std::vector<float>& sy) {
+    for (std::size_t col = 0; col < n; ++col)
+      to[col] = kf * std::max(sx[col], 0.0f) * std::max(sy[col], 0.0f);
   };
-  for (int row = 0; row < size; ++row)
-    for (int col = 0; col < size; ++col) {
-      double sx = t0, sy = t0;
-      const std::size_t texel = std::size_t(row) * size + col;
-      out.one_fewer.values[texel] = texture_value(sx, sy);
-      for (int i = 0; i < m; ++i) {
-        const std::size_t jx = std::size_t(i) * size + col, jy = std::size_t(i) * size + row;
-        const double c = texture.amplitude(i);
-        sx += c * (sin_ax[jx] * cos_px[jy] + cos_ax[jx] * sin_px[jy]);
-        sy += c * (sin_ay[jy] * cos_py[jx] + cos_ay[jy] * sin_py[jx]);
-        if (i == m - 2) out.one_fewer.values[texel] = texture_value(sx, sy);
+  std::vector<float> sx(n), sy(n);
+  for (std::size_t row = 0; row < n; ++row) {
+    std::fill(sx.begin(), sx.end(), t0f);
+    std::fill(sy.begin(), sy.end(), t0f);
+    if (m < 2) store(&out.one_fewer.values[row * n], sx, sy);  // T0 alone
+    for (int i = 0; i < m; ++i) {
+      // Along X the row's phase is fixed, along Y its term.
+      const std::size_t first = std::size_t(i) * n, jy = first + row;
+      const float c = float(texture.amplitude(i));
+      const float cpx = c * cos_px[jy], spx = c * sin_px[jy];
+      const float say = c * sin_ay[jy], cay = c * cos_ay[jy];
+      const float *sax = &sin_ax[first], *cax = &cos_ax[first];
+      const float *cpy = &cos_py[first], *spy = &sin_py[first];
+      for (std::size_t col = 0; col < n; ++col) {
+        sx[col] += sax[col] * cpx + cax[col] * spx;
+        sy[col] += say * cpy[col] + cay * spy[col];
       }
-      out.with_terms.values[texel] = texture_value(sx, sy);
+      if (i == m - 2) store(&out.one_fewer.values[row * n], sx, sy);
     }
+    store(&out.with_terms.values[row * n], sx, sy);
+  }
   return out;
 }
 
