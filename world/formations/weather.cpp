@@ -68,6 +68,13 @@ class GardnerSamples {
     std::sort(values.begin(), values.end());
     return values;
   }
+  // The fraction of the samples where T > 0 for this T0: where both sums are positive.
+  double positiveFraction(double t0) const {
+    const auto positive = std::count_if(sums_.begin(), sums_.end(), [t0](const glm::dvec2& s) {
+      return s.x + t0 > 0.0 && s.y + t0 > 0.0;
+    });
+    return double(positive) / double(sums_.size());
+  }
 
  private:
   GardnerTextureParams params_;  // with T0 = 0
@@ -101,11 +108,6 @@ std::shared_ptr<const GardnerSamples> lookSamples(const GardnerTextureParams& pa
   std::shared_ptr<const GardnerSamples>& entry = cache[key];
   if (!entry) entry = std::make_shared<const GardnerSamples>(p);
   return entry;
-}
-
-double positiveFraction(const std::vector<double>& sorted) {
-  const auto zeros = std::upper_bound(sorted.begin(), sorted.end(), 0.0) - sorted.begin();
-  return 1.0 - double(zeros) / double(sorted.size());
 }
 
 // thresholdForCoverage on the texture's sorted samples.
@@ -148,11 +150,10 @@ std::vector<CloudLayer> planes(const WeatherLayer& w, const PlaneLook& look, dou
   // coverage is below the positive fraction.
   constexpr double kMaxT0 = 8.0;
   const std::shared_ptr<const GardnerSamples> sums = lookSamples(t.gardner);
-  std::vector<double> samples = sums->sorted(t.gardner.t0);
-  while (coverage < 1.0 && t.gardner.t0 < kMaxT0 && positiveFraction(samples) < coverage + 0.02) {
+  while (coverage < 1.0 && t.gardner.t0 < kMaxT0 &&
+         sums->positiveFraction(t.gardner.t0) < coverage + 0.02)
     t.gardner.t0 += 0.25;
-    samples = sums->sorted(t.gardner.t0);
-  }
+  const std::vector<double> samples = sums->sorted(t.gardner.t0);
   const int count = look.planes;
   layer.threshold = thresholdFromSamples(samples, layer.transition, count, coverage, look.veil);
   layer.region = w.region;
