@@ -159,5 +159,36 @@ TEST(HeapLight, EquationWithSunSkyAndForwardScattering) {
             1.2 * heapIntensity(cloud, light, 0.4, n, to_sun, d, 0.0));
 }
 
+// MODEL.md section 14, "one mass": a lobe's normal is bent towards its heap envelope's by
+// kHeapNormalBend, and left alone without heap light or at the envelope's centre.
+TEST(HeapLight, LobeNormalBendsTowardsTheHeapsOwn) {
+  HeapEnvelope envelope;
+  envelope.centre = {0.0, 0.0, 1000.0};
+  envelope.radii = {200.0, 200.0, 100.0};
+  envelope.extinction = 0.02;
+  const glm::dvec3 east(1.0, 0.0, 0.0), up(0.0, 0.0, 1.0);
+  // On the envelope's top the heap faces up: a lobe facing east there is lit as facing
+  // normalize(0.4 east + 0.6 up).
+  const glm::dvec3 top(0.0, 0.0, 1100.0);
+  const glm::dvec3 bent = heapLitNormal(envelope, top, east);
+  const glm::dvec3 expected = glm::normalize((1.0 - kHeapNormalBend) * east + kHeapNormalBend * up);
+  EXPECT_NEAR(glm::distance(bent, expected), 0.0, 1e-12);
+  EXPECT_NEAR(glm::length(bent), 1.0, 1e-12);
+  // The envelope's normal is its quadric's gradient, not the direction from its centre: at
+  // (100, 0, 1000 + 50 sqrt 3) it is along (100 / 200^2, 0, 50 sqrt 3 / 100^2).
+  const glm::dvec3 p(100.0, 0.0, 1000.0 + 50.0 * std::sqrt(3.0));
+  const glm::dvec3 gradient =
+      glm::normalize(glm::dvec3(100.0 / 4e4, 0.0, 50.0 * std::sqrt(3.0) / 1e4));
+  EXPECT_NEAR(glm::distance(heapLitNormal(envelope, p, gradient), gradient), 0.0, 1e-12);
+  // Opposite normals still give a unit normal (the blend is at least |1 - 2b| long).
+  const glm::dvec3 away = heapLitNormal(envelope, top, -up);
+  EXPECT_NEAR(glm::length(away), 1.0, 1e-12);
+  EXPECT_GT(away.z, 0.0);
+  // Unchanged at the centre and without heap light.
+  EXPECT_EQ(heapLitNormal(envelope, envelope.centre, east), east);
+  envelope.extinction = 0.0;
+  EXPECT_EQ(heapLitNormal(envelope, top, east), east);
+}
+
 }  // namespace
 }  // namespace nephele

@@ -23,9 +23,9 @@ double gardnerIntensity(const ShadingParams& shading, double diffuse, double hig
 }
 
 DiffuseHighlight diffuseHighlight(const ShadingParams& shading, glm::dvec3 normal,
-                                  glm::dvec3 to_sun, glm::dvec3 to_viewer) {
+                                  glm::dvec3 to_sun, glm::dvec3 to_viewer, bool turn) {
   glm::dvec3 n = glm::normalize(normal);
-  if (glm::dot(n, to_viewer) < 0.0) n = -n;
+  if (turn && glm::dot(n, to_viewer) < 0.0) n = -n;
   const double n_dot_l = glm::dot(n, to_sun);
   DiffuseHighlight out{std::max(0.0, n_dot_l), 0.0, n_dot_l};
   if (n_dot_l > 0.0 && shading.specular > 0.0) {

@@ -16,12 +16,13 @@ double gardnerIntensity(const ShadingParams& shading, double diffuse, double hig
                         double texture_value);
 
 // Id = max(0, N.L) and Is = max(0, R.V)^e at a surface (0 where N.L <= 0 or s = 0), N turned
-// towards the viewer; n_dot_l is N.L itself, negative on the side turned from the sun.
+// towards the viewer unless `turn` is false (a lighting normal, such as heapLitNormal's, that
+// may face away); n_dot_l is N.L itself, negative on the side turned from the sun.
 struct DiffuseHighlight {
   double diffuse = 0.0, highlight = 0.0, n_dot_l = 0.0;
 };
 DiffuseHighlight diffuseHighlight(const ShadingParams& shading, glm::dvec3 normal,
-                                  glm::dvec3 to_sun, glm::dvec3 to_viewer);
+                                  glm::dvec3 to_sun, glm::dvec3 to_viewer, bool turn = true);
 
 // Gardner eq. 8 at a surface: Id and Is from the geometry. `normal` is any surface normal
 // (it is turned towards the viewer here), `to_sun` and `to_viewer` are unit vectors.

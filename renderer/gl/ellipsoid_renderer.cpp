@@ -359,8 +359,9 @@ void EllipsoidRenderer::setCloudUniforms(GLuint p, const Scene& scene, const Ell
               {cloud.threshold_centre, cloud.threshold_limb, cloud.transition});
   setUniform3(gl_, p, "u_to_sun", sunDirection(scene.sun));
   const bool heap_lit = cloud.light_extinction > 0.0;
-  setUniform3(gl_, p, "u_scatter",
-              {heap_lit ? 1.0 : 0.0, kDiffuseAsymmetry, heap_lit ? kSkinWrap : 0.0});
+  const glm::vec4 scatter(heap_lit ? 1.0 : 0.0, kDiffuseAsymmetry, heap_lit ? kSkinWrap : 0.0,
+                          heap_lit ? kHeapNormalBend : 0.0);
+  gl_.ProgramUniform4fv(p, gl_.GetUniformLocation(p, "u_scatter"), 1, &scatter.x);
   // The precision rule of MODEL.md section 2: the texture's local origin is the eye, reduced modulo
   // the period in double; shaders see camera-relative offsets only.
   const SolidTexture& texture = *cached.source;

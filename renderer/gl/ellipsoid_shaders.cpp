@@ -38,8 +38,9 @@ uniform vec3 u_thresholds;    // T1, T2, D
 uniform vec3 u_to_sun;
 uniform vec3 u_tex_origin;    // texture coordinate of the eye, periods, in [0, 1)
 uniform vec3 u_inv_period;    // periods per metre
-uniform vec3 u_scatter;  // x: 1 with the heap's light (MODEL.md section 14), else 0; y: g;
-                         // z: the skin's wrap w (kSkinWrap) with the heap's light, else 0
+uniform vec4 u_scatter;  // x: 1 with the heap's light (MODEL.md section 14), else 0; y: g;
+                         // z: the skin's wrap w (kSkinWrap) with the heap's light, else 0;
+                         // w: the bend towards the envelope's normal (kHeapNormalBend)
 
 vec3 toUnit(int i, vec3 v) {
   return vec3(dot(record(i, 0).xyz, v), dot(record(i, 1).xyz, v), dot(record(i, 2).xyz, v));
@@ -169,12 +170,17 @@ float diffuseTransmittance(float tau) { return 1.0 / (1.0 + 0.75 * (1.0 - u_scat
 
 // Gardner eq. 8 with the light reaching surface point p of ellipsoid i through its heap
 // (heapLightAt), plus the light scattered forward through the surface's translucence tr
-// (MODEL.md section 14), times cloud and sun colour, fogged; n faces the viewer, r points at
-// the surface from the eye, p camera-relative, `distance` in metres.
+// (MODEL.md section 14), times cloud and sun colour, fogged; n faces the viewer (and is lit
+// as heapLitNormal bends it), r points at the surface from the eye, p camera-relative,
+// `distance` in metres.
 vec3 surfaceColour(int i, vec3 n, vec3 r, vec3 p, float it, float tr, float distance) {
   float extinction = record(i, 17).w;
   vec2 light = vec2(1.0);  // sun, sky
   if (extinction > 0.0) {
+    // heapLitNormal: n bent towards the envelope's outward normal, (p - c) / radii^2.
+    vec3 inv = record(i, 18).xyz;
+    vec3 gradient = (p - record(i, 17).xyz) * inv * inv;
+    if (dot(gradient, gradient) > 0.0) n = normalize(mix(n, normalize(gradient), u_scatter.w));
     float toward_sun = 0.5 * (1.0 - clamp(dot(n, u_to_sun), -1.0, 1.0));
     float toward_sky = 0.5 * (1.0 - clamp(n.z, -1.0, 1.0));
     light = vec2(diffuseTransmittance(extinction * toward_sun * envelopeChord(i, p, u_to_sun)),

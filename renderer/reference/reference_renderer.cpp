@@ -194,7 +194,10 @@ class ReferenceTracer {
     const double t = solid_textures_[entry.cloud].value(p - scene_.clouds[entry.cloud].drift_m);
     const double tr = ellipsoidTranslucence(t, cloud.threshold_centre, cloud.threshold_limb,
                                             entry.view.limb(direction), cloud.transition);
-    const glm::dvec3 normal = entry.view.normalAt(direction, s);
+    // Turned towards the viewer, then bent towards the heap's (MODEL.md section 14).
+    glm::dvec3 normal = entry.view.normalAt(direction, s);
+    if (glm::dot(normal, direction) > 0.0) normal = -normal;
+    normal = heapLitNormal(entry.envelope, p, normal);
     const double intensity = heapIntensity(cloud, heapLightAt(entry.envelope, p, normal, sun_), t,
                                            normal, sun_, direction, tr);
     return {s, withAir(intensity * cloud.colour * scene_.sun.colour, direction, s),

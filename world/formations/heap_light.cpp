@@ -141,6 +141,16 @@ HeapLight heapLightAt(const HeapEnvelope& envelope, glm::dvec3 p, glm::dvec3 nor
           0.5 + 0.5 * diffuseTransmittance(depth({0.0, 0.0, 1.0}))};
 }
 
+glm::dvec3 heapLitNormal(const HeapEnvelope& envelope, glm::dvec3 p, glm::dvec3 normal) {
+  if (!(envelope.extinction > 0.0)) return normal;
+  // The envelope's outward normal: the gradient of its quadric, (p - c) / radii^2.
+  const glm::dvec3 gradient = (p - envelope.centre) / (envelope.radii * envelope.radii);
+  const double length = glm::length(gradient);
+  if (!(length > 0.0) || !std::isfinite(length)) return normal;
+  // Both unit, and 1 - b != b: the blend is at least |1 - 2b| long, never zero.
+  return glm::normalize((1.0 - kHeapNormalBend) * normal + kHeapNormalBend * (gradient / length));
+}
+
 double skinDiffuse(double n_dot_l) {
   return std::max(0.0, (n_dot_l + kSkinWrap) / (1.0 + kSkinWrap));
 }
@@ -161,8 +171,9 @@ MeanHeapLight meanHeapLight(const EllipsoidCloud& cloud, glm::dvec3 to_sun) {
       const double z = 1.0 - (2.0 * k + 1.0) / kNormals, ring = std::sqrt(1.0 - z * z);
       const glm::dvec3 n(ring * std::cos(golden * k), ring * std::sin(golden * k), z);
       const glm::dvec3 p = e.centre + m * n / std::sqrt(glm::dot(n, m * n));
-      const HeapLight light = heapLightAt(envelopes[i], p, n, to_sun);
-      sun += w * light.sun * skinDiffuse(glm::dot(n, to_sun));
+      const glm::dvec3 lit = heapLitNormal(envelopes[i], p, n);
+      const HeapLight light = heapLightAt(envelopes[i], p, lit, to_sun);
+      sun += w * light.sun * skinDiffuse(glm::dot(lit, to_sun));
       sky += w * light.sky;
     }
     weight += w * kNormals;
@@ -178,7 +189,9 @@ double heapIntensity(const EllipsoidCloud& cloud, const HeapLight& light, double
                      glm::dvec3 normal, glm::dvec3 to_sun, glm::dvec3 direction,
                      double translucence) {
   const ShadingParams& shading = cloud.shading;
-  const DiffuseHighlight d = diffuseHighlight(shading, normal, to_sun, -direction);
+  // A heap-lit normal is turned towards the viewer before it is bent (heapLitNormal), not after.
+  const DiffuseHighlight d =
+      diffuseHighlight(shading, normal, to_sun, -direction, !(cloud.light_extinction > 0.0));
   if (!(cloud.light_extinction > 0.0))
     return gardnerIntensity(shading, d.diffuse, d.highlight, texture_value);
   // Gardner eq. 8 with the sun's terms times S and the ambient term times K.

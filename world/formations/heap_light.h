@@ -73,6 +73,13 @@ double heapIntensity(const EllipsoidCloud& cloud, const HeapLight& light, double
                      glm::dvec3 normal, glm::dvec3 to_sun, glm::dvec3 direction,
                      double translucence);
 
+// The normal a heap-lit surface point takes its light with (MODEL.md section 14, "one mass"):
+// the lobe's outward unit normal bent towards its heap envelope's at p by kHeapNormalBend,
+// normalize((1 - b) n + b n_envelope), so that the heap, not each lobe, has the terminator
+// and the lobes keep part of their relief. `normal` itself when the envelope has no
+// extinction (eq. 8 unchanged) or p is at its centre.
+inline constexpr double kHeapNormalBend = 0.6;
+glm::dvec3 heapLitNormal(const HeapEnvelope& envelope, glm::dvec3 p, glm::dvec3 normal);
 // Sunlight through a lobe's own skin (MODEL.md section 14): a heap-lit lobe takes the diffuse
 // term as max(0, (N.L + w) / (1 + w)) instead of max(0, N.L), since light entering its sunlit
 // face is scattered on round the lobe before it leaves, and the face turned from the sun is
