@@ -350,7 +350,7 @@ int runDatasetCommand(const DatasetCommandOptions& o) {
       skipped > 0 ? ", " + std::to_string(skipped) + " already written" : "");
 
   // The next kDrawAhead samples' scenes are drawn on other threads while one renders: a
-  // sample whose heaps take longer to draw (60 to 80 ms, the first of a texture) than the one
+  // sample whose heaps take longer to draw (60 to 106 ms, the first of a texture) than the one
   // before takes to render (20 to 50 ms, layers only) is then drawn before it is needed. The
   // first ones are drawn while the renderer starts.
   constexpr std::size_t kDrawAhead = 2;

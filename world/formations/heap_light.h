@@ -80,6 +80,7 @@ double heapIntensity(const EllipsoidCloud& cloud, const HeapLight& light, double
 // extinction (eq. 8 unchanged) or p is at its centre.
 inline constexpr double kHeapNormalBend = 0.6;
 glm::dvec3 heapLitNormal(const HeapEnvelope& envelope, glm::dvec3 p, glm::dvec3 normal);
+
 // Sunlight through a lobe's own skin (MODEL.md section 14): a heap-lit lobe takes the diffuse
 // term as max(0, (N.L + w) / (1 + w)) instead of max(0, N.L), since light entering its sunlit
 // face is scattered on round the lobe before it leaves, and the face turned from the sun is
