@@ -139,10 +139,9 @@ GardnerTruncations bakeGardner(const GardnerTexture& texture, int size, int term
     }
   GardnerTruncations out{{size, size, std::vector<float>(n * n)},
                          {size, size, std::vector<float>(n * n)}};
-  const float t0f = float(t0), kf = float(k);
+  const float t0f = float(t0);
   auto store = [&](float* to, const std::vector<float>& sx, const std::vector<float>& sy) {
-    for (std::size_t col = 0; col < n; ++col)
-      to[col] = kf * std::max(sx[col], 0.0f) * std::max(sy[col], 0.0f);
+    for (std::size_t col = 0; col < n; ++col) to[col] = float(textureFromSums(sx[col], sy[col], k));
   };
   std::vector<float> sx(n), sy(n);
   for (std::size_t row = 0; row < n; ++row) {
