@@ -55,6 +55,28 @@ inline double medianFrameMilliseconds(GlRenderer& renderer, const Scene& scene,
 }
 
 // Sets the camera's image size from "WxH"; false, after saying why, when it is not one.
+// A frame's budget in one line (FrameTimes): the CPU stages, the GPU passes by timer query,
+// the wait for them and the readback, in milliseconds; stages and passes at 0 left out.
+inline std::string frameBudgetLine(const FrameTimes& t) {
+  std::string out = "cpu";
+  char item[64];
+  auto add = [&](const char* name, double ms) {
+    std::snprintf(item, sizeof item, " %s %.2f", name, ms);
+    out += item;
+  };
+  for (std::size_t i = 0; i < t.cpu_ms.size(); ++i)
+    if (t.cpu_ms[i] > 0.005) add(kCpuStageNames[i], t.cpu_ms[i]);
+  add("(submit", t.submit_ms);
+  out += ") | gpu";
+  for (std::size_t i = 0; i < t.gpu_ms.size(); ++i)
+    if (t.gpu_ms[i] > 0.005) add(kGpuPassNames[i], t.gpu_ms[i]);
+  add("(sum", t.gpuTotal());
+  out += ") |";
+  add("wait", t.wait_ms);
+  add("readback", t.readback_ms);
+  return out;
+}
+
 inline bool parseSize(const std::string& size, Camera& camera) {
   int width = 0, height = 0;
   if (std::sscanf(size.c_str(), "%dx%d", &width, &height) != 2 || width < 1 || height < 1) {

@@ -446,6 +446,13 @@ int main(int argc, char** argv) {
                  "Draw every [[weather]] layer of the presets at this cover, percent (issue 28's "
                  "30, 50, 70 and 100), instead of the preset's own")
       ->check(CLI::Range(0.0, 100.0));
+  bool still_only = false;
+  app.add_flag("--still", still_only,
+               "Only the still frames and their budgets: no flights, look or body figures");
+  int shading_rate = 0;
+  app.add_option("--heap-shading-rate", shading_rate,
+                 "Draw the heaps of every preset at this shading rate (1, 2 or 4) instead of its "
+                 "own");
   bool hemisphere = false;
   app.add_flag("--hemisphere", hemisphere,
                "Instead: the fraction of the sky dome covered, seen from the ground, for every "
@@ -511,6 +518,13 @@ int main(int argc, char** argv) {
         return 1;
       }
     }
+    if (shading_rate > 0) {
+      file.render.heap_shading_rate = shading_rate;
+      if (const std::string e = validateRenderSettings(file.render); !e.empty()) {
+        std::fprintf(stderr, "--heap-shading-rate: %s\n", e.c_str());
+        return 2;
+      }
+    }
     for (const std::string& size : sizes) {
       Camera sized;
       if (!bench::parseSize(size, sized)) return 2;
@@ -540,6 +554,19 @@ int main(int argc, char** argv) {
         }
         const double still =
             medianMilliseconds(repeats, [&] { renderer.renderSrgb8(scene, file.render); });
+        const FrameTimes still_budget = renderer.lastFrameStats().times;
+        renderer.renderSrgb8(clear, file.render);
+        const FrameTimes clear_budget = renderer.lastFrameStats().times;
+        if (still_only) {
+          std::printf("%-22s %-7s %-10s %8.2f %8.2f %9.2f %7.1f %7.1f\n", path.stem().c_str(),
+                      view.name, size.c_str(), floor, clear_ms, still, still / floor,
+                      still / clear_ms);
+          std::printf("  budget, still: %s\n  budget, clear: %s\n",
+                      bench::frameBudgetLine(still_budget).c_str(),
+                      bench::frameBudgetLine(clear_budget).c_str());
+          std::fflush(stdout);
+          continue;
+        }
         // The flight's renderer has drawn the still view once, as a running daemon has drawn
         // frames before: its programs are compiled and its textures baked (one-off costs of
         // hundreds of milliseconds), while the heaps along the flight are new to it.
@@ -574,6 +601,9 @@ int main(int argc, char** argv) {
             path.stem().c_str(), view.name, size.c_str(), floor, clear_ms, still, still / floor,
             still / clear_ms, flying, flying / clear_ms, slowest, slowest / clear_ms, warm_flying,
             warm_flying / clear_ms, warm_slowest, warm_slowest / clear_ms, drawnEllipsoids(scene));
+        std::printf("  budget, still: %s\n  budget, clear: %s\n",
+                    bench::frameBudgetLine(still_budget).c_str(),
+                    bench::frameBudgetLine(clear_budget).c_str());
         if (!fill.empty()) {
           std::sort(fill.begin(), fill.end());
           std::printf(
@@ -589,12 +619,14 @@ int main(int argc, char** argv) {
           "included)\n",
           path.stem().c_str(), size.c_str(), rss, peak);
     }
+    if (still_only) continue;
     GlRenderer renderer(*platform);
     printBodyFigures(renderer, file);
     printLightFigures(renderer, file, path.stem().string(), images);
     printCumulonimbusFigures(renderer, file, path.stem().string(), images);
   }
-  if (names.empty() || std::find(names.begin(), names.end(), "harbour") != names.end()) {
+  if (!still_only &&
+      (names.empty() || std::find(names.begin(), names.end(), "harbour") != names.end())) {
     GlRenderer renderer(*platform);
     printAutomatonFigures(renderer);
   }

@@ -147,6 +147,11 @@ std::vector<Setting> settingsFor(const SceneFile& file) {
     for (double px : {0.0, 16.0, 64.0, 10000.0})
       add("heap_detail", withKnob(px), [px](RenderSettings& s) { s.heaps.detail_px = px; });
   }
+  // Heaps at a reduced shading rate (issue 46): walked every 2 or 4 pixels, blended between.
+  if (!file.scene.clouds.empty() || !file.scene.fields.empty())
+    for (int rate : {2, 4})
+      add("heap_shading_rate", std::to_string(rate),
+          [rate](RenderSettings& s) { s.heap_shading_rate = rate; });
   // The frame's work budget (issue 31): the presets hold a few thousand ellipsoids in view, so
   // budgets below that show what thinning costs (the default, 65,536, changes none of them).
   if (!file.scene.clouds.empty() || !file.scene.fields.empty())

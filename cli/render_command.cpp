@@ -69,6 +69,7 @@ std::string applyOverrides(const RenderCommandOptions& o, SceneFile& file) {
   if (o.heap_detail) r.heaps.detail_px = *o.heap_detail;
   if (o.ellipsoid_budget) r.ellipsoid_budget = *o.ellipsoid_budget;
   if (o.ellipsoid_overdraw) r.ellipsoid_overdraw = *o.ellipsoid_overdraw;
+  if (o.heap_shading_rate) r.heap_shading_rate = *o.heap_shading_rate;
   file.reference.heaps = r.heaps;  // both renderers draw the same heaps
   if (o.samples) file.reference.samples_per_axis = *o.samples;
   std::string error = validateCamera(camera);
@@ -192,6 +193,9 @@ void addRenderCommand(CLI::App& app, RenderCommandOptions& o) {
   cmd->add_option("--ellipsoid-overdraw", o.ellipsoid_overdraw,
                   "Views that the footprints of the ellipsoids a frame draws may cover, those of "
                   "largest projected size first (0..65536; default 256; 0 no bound)");
+  cmd->add_option("--heap-shading-rate", o.heap_shading_rate,
+                  "Heaps: walk one pixel in N x N and blend those samples to full size (1, 2 "
+                  "or 4; default 1, every pixel)");
   cmd->add_option("--volume-step", o.volume_step,
                   "Automaton clouds: view march step in lattice spacings (0.25..8)");
   cmd->add_option("--samples", o.samples, "Reference supersampling per pixel axis")

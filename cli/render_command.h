@@ -33,6 +33,7 @@ struct RenderCommandOptions {
   std::optional<double> heap_detail;
   std::optional<double> ellipsoid_budget;
   std::optional<double> ellipsoid_overdraw;
+  std::optional<int> heap_shading_rate;
   std::optional<double> volume_step;
   std::optional<int> samples;
   bool stats = false;

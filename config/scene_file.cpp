@@ -90,7 +90,7 @@ void readRender(TableReader& t, SceneFile& out) {
   t.allow({"texture", "term_filter", "sky_passes", "bake_texels_per_cycle", "reference_samples",
            "ellipsoid_passes", "ellipsoid_order", "limb", "tile_resolution", "tile_format",
            "tessellation", "impostor_tolerance", "volume_step", "heap_range", "heap_detail",
-           "ellipsoid_budget", "ellipsoid_overdraw"});
+           "ellipsoid_budget", "ellipsoid_overdraw", "heap_shading_rate"});
   out.render.texture_evaluation = TextureEvaluation(
       t.choice("texture", kTextureEvaluationNames, int(out.render.texture_evaluation)));
   out.render.term_filter =
@@ -116,6 +116,10 @@ void readRender(TableReader& t, SceneFile& out) {
   t.number("heap_detail", r.heaps.detail_px, Limits::kHeapDetail);
   t.number("ellipsoid_budget", r.ellipsoid_budget, Limits::kEllipsoidBudget);
   t.number("ellipsoid_overdraw", r.ellipsoid_overdraw, Limits::kEllipsoidOverdraw);
+  t.integer("heap_shading_rate", r.heap_shading_rate, int(Limits::kHeapShadingRate.lo),
+            int(Limits::kHeapShadingRate.hi));
+  if (std::string error = validateRenderSettings(r); !error.empty())
+    t.failAt(error.substr(0, error.find(':')), error.substr(error.find(':') + 2));
   out.reference.heaps = r.heaps;  // both renderers draw the same heaps
   t.finish();
 }
@@ -718,6 +722,9 @@ std::string validateRenderSettings(const RenderSettings& r) {
   if (std::ostringstream out;
       outOfRange(out, "ellipsoid_overdraw", r.ellipsoid_overdraw, Limits::kEllipsoidOverdraw))
     return out.str() + " views of footprint; 0 is no bound";
+  if (r.heap_shading_rate != 1 && r.heap_shading_rate != 2 && r.heap_shading_rate != 4)
+    return "heap_shading_rate: " + std::to_string(r.heap_shading_rate) +
+           " is not allowed (allowed: 1, 2 or 4 pixels between samples)";
   if (!(r.volume_step >= 0.25 && r.volume_step <= 8.0))
     return "volume_step: " + formatNumber(r.volume_step) +
            " is out of range (allowed: 0.25 to 8 lattice spacings)";

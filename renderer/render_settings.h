@@ -69,6 +69,11 @@ struct RenderSettings {
   double ellipsoid_budget = 65536.0;
   double ellipsoid_overdraw = 256.0;
 
+  // Heaps at a reduced shading rate (MODEL.md section 15, "reduced rate"): the per-pixel pass
+  // walks one pixel in heap_shading_rate^2 (1, 2 or 4 pixels between samples), and the samples'
+  // bilinear blend in premultiplied colour brings them to full size. 1 walks every pixel.
+  int heap_shading_rate = 1;
+
   // Automaton clouds: the view march's step in lattice spacings (the lattice holds
   // samples_per_cell samples per cell edge). Larger steps are faster and blur thin edges.
   double volume_step = 1.0;

@@ -193,10 +193,13 @@ std::optional<Outcome> Engine::renderRequest(const command::Render& c, Job& job)
     all_raw = all_raw && part.image.format == ImageFormat::kRaw && !part.image.floatPlanes();
     parts.push_back(std::move(part));
   }
-  auto send = [parts, id = job.request.id, reply = job.reply, options = config_.encode]() {
+  auto send = [parts, id = job.request.id, reply = job.reply, options = config_.encode,
+               encode_ms = &last_encode_ms_]() {
     std::vector<SharedReply> replies;
     for (std::size_t i = 0; i < parts.size(); ++i) {
+      const auto t0 = Clock::now();
       auto encoded = encodeFrame(*parts[i].frame, parts[i].image, options);
+      encode_ms->store(msSince(t0));
       if (auto* e = std::get_if<std::string>(&encoded)) {
         reply(makeReply(errorReply(id, {ErrorCode::kFailed, *e})));
         return;
@@ -268,8 +271,11 @@ void Engine::deliverFrames(Delivery which, const std::string& view_name) {
       }
       std::vector<Subscription> sinks;  // copies: the encoder may run after a change
       for (Subscription* sub : members) sinks.push_back(*sub);
-      auto send = [frame, image = image, sinks, options = config_.encode]() {
+      auto send = [frame, image = image, sinks, options = config_.encode,
+                   encode_ms = &last_encode_ms_]() {
+        const auto t0 = Clock::now();
         auto encoded = encodeFrame(*frame, image, options);
+        encode_ms->store(msSince(t0));
         if (auto* e = std::get_if<std::string>(&encoded)) {
           spdlog::error("event=encode_failed error=\"{}\"", *e);
           return;

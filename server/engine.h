@@ -233,6 +233,7 @@ class Engine {
   std::atomic<std::uint64_t> errors_{0};
   std::atomic<std::uint64_t> answered_at_once_{0};  // requests the control plane answered
   std::atomic<int> last_error_{0};
+  std::atomic<double> last_encode_ms_{0.0};  // the encoder thread's last image
   mutable std::mutex cigi_mutex_;
   std::map<std::string, std::uint64_t> cigi_counts_;
   mutable std::mutex subscribers_mutex_;

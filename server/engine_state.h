@@ -57,6 +57,8 @@ inline ProtocolError badField(std::string message) {
 inline json frameStatsJson(const FrameStats& f) {
   json out = json::object();
   for (const auto& [name, value] : f.fields()) out[name] = value;
+  json& ms = out["ms"] = json::object();  // where its time went (FrameTimes)
+  for (const auto& [name, value] : f.times.fields()) ms[name] = value;
   return out;
 }
 

@@ -176,6 +176,7 @@ json Engine::stats() const {
   out["queue"]["encoder"] = encoding;
   out["cigi"] = std::move(cigi);
   out["heartbeat_age"] = heartbeatAge();
+  out["last_frame"]["ms"]["encode"] = last_encode_ms_.load();
   if (in_hand.what.empty()) {
     out["in_hand"] = nullptr;
   } else {
@@ -232,6 +233,13 @@ std::string Engine::prometheusText() const {
   histogram("request_seconds",
             "Time from a request's queueing to its reply (images: to the "
             "render, before encoding).");
+  // The last frame's budget (FrameTimes): CPU stages, GPU passes, wait, readback, encoding.
+  out << "# HELP nephele_last_frame_seconds Where the last rendered frame's time went: CPU "
+         "stages (cpu_*), GPU passes by timer query (gpu_*), submit, wait, readback, encode.\n"
+         "# TYPE nephele_last_frame_seconds gauge\n";
+  for (const auto& [part, ms] : st["last_frame"]["ms"].items())
+    out << "nephele_last_frame_seconds{part=\"" << part << "\"} " << ms.get<double>() * 1e-3
+        << '\n';
   out << "# HELP nephele_cigi_total CIGI messages applied, refused by reason, packets ignored.\n"
          "# TYPE nephele_cigi_total counter\n";
   for (const auto& [what, n] : st["cigi"].items())

@@ -92,6 +92,10 @@ TEST_F(EllipsoidRenderTest, KnobsMatchReference) {
          s.tessellation = 10;
        },
        28.0},
+      // Heaps at a reduced shading rate (MODEL.md section 15, "reduced rate"): walked every
+      // 2 or 4 pixels, blended between (measured 38.9 and 36.9 dB).
+      {"shading_rate_2", [](RenderSettings& s) { s.heap_shading_rate = 2; }, 36.0},
+      {"shading_rate_4", [](RenderSettings& s) { s.heap_shading_rate = 4; }, 34.0},
   };
   for (const Case& c : cases) {
     RenderSettings settings = file.render;

@@ -2,6 +2,8 @@
 // and for the texture terms its pixels can resolve (renderer/gl/frame_stats.h).
 #include <gtest/gtest.h>
 
+#include <chrono>
+
 #include "tests/gl_test_fixture.h"
 #include "world/formations/weather.h"
 #include "world/world.h"
@@ -111,6 +113,42 @@ TEST_F(FrameStatsTest, AFullDeckLeavesOutTheLayersBeyondIt) {
   EXPECT_EQ(renderer_->renderSrgb8(both, {}).rgba, renderer_->renderSrgb8(deck, {}).rgba);
   both.camera.position.z = 0.5 * (stratus.base_m + stratus.thickness_m + altostratus.base_m);
   EXPECT_GT(statsOf(both).layer_terms_total, alone.layer_terms_total);
+}
+
+// Where a frame's time goes (FrameTimes): a frame of heaps charges the heaps' GPU passes, their
+// records and the readback; a clear frame charges the sky alone and no heap, record or upload.
+// On a software GL the passes are timed by the wall clock, so they cannot sum past the frame.
+TEST_F(FrameStatsTest, TimesGoToTheStagesThatRan) {
+  Scene scene = preset("cumulus").scene;
+  renderer_->renderSrgb8(scene, {});  // programs compiled, tables baked
+  const auto start = std::chrono::steady_clock::now();
+  const FrameTimes heaps = statsOf(scene).times;
+  const double wall_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_GT(heaps.gpu(GpuPass::kHeaps), 0.0);
+  EXPECT_GT(heaps.gpu(GpuPass::kSky), 0.0);
+  EXPECT_GT(heaps.cpu(CpuStage::kRecords), 0.0);
+  EXPECT_GT(heaps.readback_ms, 0.0);
+  EXPECT_EQ(heaps.gpu(GpuPass::kAutomata), 0.0);
+  EXPECT_EQ(heaps.gpu(GpuPass::kTargets), 0.0);
+  if (platform_->renderer().find("llvmpipe") != std::string::npos) {
+    EXPECT_LE(heaps.submit_ms + heaps.gpuTotal() + heaps.wait_ms + heaps.readback_ms,
+              wall_ms * 1.001 + 0.01);
+  }
+  double cpu = 0.0;
+  for (double ms : heaps.cpu_ms) cpu += ms;
+  EXPECT_NEAR(cpu, heaps.submit_ms, 1e-6);  // the stages share out the submission
+
+  scene.clouds.clear();
+  const FrameTimes clear = statsOf(scene).times;
+  EXPECT_GT(clear.gpu(GpuPass::kSky), 0.0);
+  EXPECT_EQ(clear.gpu(GpuPass::kHeaps), 0.0);
+  EXPECT_EQ(clear.cpu(CpuStage::kRecords), 0.0);
+  EXPECT_EQ(clear.cpu(CpuStage::kHeaps), 0.0);
+  // Every figure has a name, and the log line carries them.
+  const std::string line = renderer_->lastFrameStats().line();
+  for (const auto& [name, ms] : clear.fields())
+    EXPECT_NE(line.find(" " + name + "_ms="), std::string::npos) << name;
 }
 
 }  // namespace

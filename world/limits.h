@@ -103,6 +103,8 @@ struct Limits {
   static constexpr Range kClusterVariation{0.0, 1.0};  // per-cluster spread of cover, height
   static constexpr Range kHeapRange{0.0, 1.0e6};       // heaps as ellipsoids this far; 0 automatic
   static constexpr Range kHeapDetail{0.0, 1.0e4};      // every lobe of heaps this many pixels wide
+  // The heaps' shading rate (`heap_shading_rate`: 1, 2 or 4 pixels between samples).
+  static constexpr Range kHeapShadingRate{1.0, 4.0};
   // Ellipsoids a GL frame draws, those of largest projected size (`ellipsoid_budget`; 0: no
   // budget), at most what a world may hold.
   static constexpr Range kEllipsoidBudget{0.0, double(kMaxWorldEllipsoids)};

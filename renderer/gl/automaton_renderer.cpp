@@ -148,6 +148,7 @@ AutomatonRenderer::Volume& AutomatonRenderer::volume(const Scene& scene, std::si
   const DensityLattice& a = cloud.from->lattice;
   const DensityLattice& b = cloud.to->lattice;
   NEPHELE_CHECK(a.dims == b.dims, "keyframes on different lattices");
+  StageClock clock(stats_->times.cpu(CpuStage::kUploads));
   std::vector<float> texels(a.density.size() * 4), sky(a.density.size() * 2);
   for (std::size_t i = 0; i < a.density.size(); ++i) {
     texels[4 * i + 0] = a.density[i];

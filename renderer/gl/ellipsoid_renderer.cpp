@@ -1,5 +1,7 @@
 #include "renderer/gl/ellipsoid_renderer.h"
 
+#include <optional>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -7,6 +9,7 @@
 #include <future>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <sstream>
 
 #include "image/image_encoding.h"
@@ -230,8 +233,9 @@ EllipsoidRenderer::EllipsoidRenderer(const GlApi& gl)
 
 EllipsoidRenderer::~EllipsoidRenderer() = default;
 
-void EllipsoidRenderer::beginFrame(FrameStats& stats) {
+void EllipsoidRenderer::beginFrame(FrameStats& stats, GpuPassTimer& timer) {
   stats_ = &stats;
+  timer_ = &timer;
   cancelled_ = false;
   for (auto& [key, cached] : textures_) cached.used = false;
   ++frame_;
@@ -241,6 +245,7 @@ void EllipsoidRenderer::beginFrame(FrameStats& stats) {
 
 void EllipsoidRenderer::bindFrameTexture(int unit, GLenum format, const void* data,
                                          std::size_t bytes) {
+  StageClock clock(stats_->times.cpu(CpuStage::kUploads));
   // A fresh buffer for every upload in a frame: llvmpipe may still be drawing from the last
   // one (it defers rasterisation), and rewriting it in place would change earlier draws.
   if (next_buffer_ == buffer_pool_.size())
@@ -291,6 +296,7 @@ void EllipsoidRenderer::bindTables(CachedTexture& cached) {
   BakedTable& table = tables_[cached.table_key];
   table.last_frame = frame_;
   if (!table.texture) {
+    StageClock clock(stats_->times.cpu(CpuStage::kUploads));
     table.texture = createTexture(gl_, GL_TEXTURE_3D);
     const SolidTexture unit(bakedTableSpec(cached.source->spec()));
     if (const GardnerTexture* gardner = unit.gardner()) {
@@ -571,6 +577,7 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   const bool spotlight = settings.limb == LimbEvaluation::kSpotlight;
   int total = 0;
   std::size_t seen = 0;
+  std::optional<StageClock> records_clock(std::in_place, stats_->times.cpu(CpuStage::kRecords));
   for (std::size_t index : indices) {
     const EllipsoidCloud& member = scene.clouds[index];
     total += int(member.ellipsoids.size());
@@ -587,6 +594,7 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
       visible.push_back(v);
     }
   }
+  records_clock.reset();
   stats_->ellipsoids_drawn += int(visible.size());
   stats_->ellipsoids_culled += total - int(visible.size());
   if (visible.empty()) return;
@@ -619,6 +627,7 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
                          settings.ellipsoid_order == EllipsoidOrder::kPerPixel &&
                          visible.size() <= max_records;
   auto records = [&](bool front_to_back) {
+    StageClock clock(stats_->times.cpu(CpuStage::kRecords));
     if (front_to_back)  // nearest bound first: the per-pixel pass composites front to back
       std::stable_sort(visible.begin(), visible.end(), [](const Visible& a, const Visible& b) {
         return a.record.v[16].z < b.record.v[16].z;
@@ -670,6 +679,7 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   if (!per_pixel) return drawByCentre(records(false));
 
   const std::vector<EllipsoidRecord> ordered = records(true);
+  records_clock.emplace(stats_->times.cpu(CpuStage::kRecords));  // the bins, to the items' fill
   // Screen bins over the batch's rectangle, each listing the ellipsoids whose rectangles
   // overlap it, in the records' order (two passes: count, then fill).
   auto bin = [&](float ndc, int size) {
@@ -690,8 +700,10 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   const int bins_x = area.z - area.x + 1, bins_y = area.w - area.y + 1;
   // Bin lists beyond kMaxListed entries (64 MiB) fall back to the centre pass as well.
   const std::int64_t max_listed = std::min<std::int64_t>(max_texels_, kMaxListed);
-  if (listed > max_listed || std::int64_t(bins_x) * bins_y > max_listed)
+  if (listed > max_listed || std::int64_t(bins_x) * bins_y > max_listed) {
+    records_clock.reset();
     return drawByCentre(records(false));
+  }
   // A bin is first item and count.
   std::vector<glm::ivec2> bins(std::size_t(bins_x) * bins_y, glm::ivec2(0));
   auto binAt = [&](int x, int y) -> glm::ivec2& {
@@ -709,7 +721,10 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   }
   // Where no two ellipsoids share a bin, no pixel has two hits to order: the centre pass
   // draws the same image, faster.
-  if (deepest <= 1) return drawByCentre(ordered);
+  if (deepest <= 1) {
+    records_clock.reset();
+    return drawByCentre(ordered);
+  }
   std::vector<GLint> items(static_cast<std::size_t>(first));
   for (std::size_t i = 0; i < spans.size(); ++i)
     for (int y = spans[i].y; y <= spans[i].w; ++y)
@@ -717,13 +732,22 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
         glm::ivec2& b = binAt(x, y);
         items[std::size_t(b.x + b.y++)] = GLint(i);
       }
+  records_clock.reset();
   // Behind a thick veil the walk may err by what the veil hides (MODEL.md section 15, "behind
   // the veil"): it ends at a lower coverage, and where the error allowed is large enough it
   // runs first at one pixel in rate^2 into the samples texture, then over every pixel, which
   // blends its samples where they agree.
+  // Elsewhere it runs so at the heaps' own shading rate when one is asked (RenderSettings::
+  // heap_shading_rate), and the samples are blended everywhere (MODEL.md section 15, "reduced
+  // rate").
   const double shown = std::max(target.seen, 1e-6);
-  const double tolerance = kVeiledTolerance / shown;
-  const int rate = !targets_drawn && tolerance >= kVeiledSamplingFrom ? kVeiledShadingRate : 1;
+  const bool veiled = kVeiledTolerance / shown >= kVeiledSamplingFrom;
+  const bool reduced = !veiled && settings.heap_shading_rate > 1;
+  const double tolerance = reduced ? 1.0 : kVeiledTolerance / shown;
+  const int rate = targets_drawn ? 1
+                   : veiled      ? kVeiledShadingRate
+                   : reduced     ? settings.heap_shading_rate
+                                 : 1;
   auto perPixelProgram = [&](EllipsoidProgram which) {
     EllipsoidPassLayout layout = base;
     layout.program = which;
@@ -829,34 +853,9 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   gl_.BindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
   gl_.Viewport(0, 0, target.width, target.height);
   if (!done) return;
-  // The blocks of rate x rate pixels over the area: blended where their four corner samples
-  // agree to within the tolerance, walked elsewhere, as runs along each row of blocks. A
-  // block whose far samples were not drawn (past the area) is walked.
-  std::vector<float> values(std::size_t(size.x) * size.y * 4);
-  gl_.GetTextureImage(samples_.get(), 0, GL_RGBA, GL_FLOAT, GLsizei(values.size() * sizeof(float)),
-                      values.data());
-  auto sample = [&](int x, int y) { return &values[(std::size_t(y) * size.x + x) * 4]; };
+  timer_->settle();  // the samples are read next
   const glm::ivec2 from = glm::ivec2(area.x, area.y) * kPerPixelBinSize / rate;
   const glm::ivec2 end = (glm::ivec2(area.z, area.w) + 1) * kPerPixelBinSize / rate;  // samples
-  auto blends = [&](int x, int y) {
-    if (x + 1 >= end.x || y + 1 >= end.y) return false;
-    const float *a = sample(x, y), *b = sample(x + 1, y), *c = sample(x, y + 1),
-                *d = sample(x + 1, y + 1);
-    for (int k = 0; k < 4; ++k) {
-      const float lo = std::min({a[k], b[k], c[k], d[k]}), hi = std::max({a[k], b[k], c[k], d[k]});
-      if (hi - lo > tolerance) return false;
-    }
-    return true;
-  };
-  std::vector<glm::ivec4> blended, walked;  // pixel rectangles
-  for (int y = from.y; y < end.y; ++y)
-    for (int x = from.x; x < end.x;) {
-      const bool blend = blends(x, y);
-      int to = x + 1;
-      while (to < end.x && blends(to, y) == blend) ++to;
-      (blend ? blended : walked).push_back(glm::ivec4(x, y, to, y + 1) * rate);
-      x = to;
-    }
   // The blended runs in one draw; the walked ones, when the frame can be cancelled, in groups
   // of about kCancelWork hit tests.
   auto drawRuns = [&](EllipsoidProgram which, const std::vector<glm::ivec4>& runs) {
@@ -882,6 +881,39 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
     }
   };
   gl_.BindTextureUnit(kSamplesTextureUnit, samples_.get());
+  if (tolerance >= 1.0) {
+    // Every block agrees: the samples are brought to full size by their bilinear blend over
+    // the whole area, with no readback (MODEL.md section 15, "reduced rate").
+    drawRuns(EllipsoidProgram::kFusedBlend, {glm::ivec4(from * rate, end * rate)});
+    ++stats_->sampled_passes;
+    return;
+  }
+  // The blocks of rate x rate pixels over the area: blended where their four corner samples
+  // agree to within the tolerance, walked elsewhere, as runs along each row of blocks. A
+  // block whose far samples were not drawn (past the area) is walked.
+  std::vector<float> values(std::size_t(size.x) * size.y * 4);
+  gl_.GetTextureImage(samples_.get(), 0, GL_RGBA, GL_FLOAT, GLsizei(values.size() * sizeof(float)),
+                      values.data());
+  auto sample = [&](int x, int y) { return &values[(std::size_t(y) * size.x + x) * 4]; };
+  auto blends = [&](int x, int y) {
+    if (x + 1 >= end.x || y + 1 >= end.y) return false;
+    const float *a = sample(x, y), *b = sample(x + 1, y), *c = sample(x, y + 1),
+                *d = sample(x + 1, y + 1);
+    for (int k = 0; k < 4; ++k) {
+      const float lo = std::min({a[k], b[k], c[k], d[k]}), hi = std::max({a[k], b[k], c[k], d[k]});
+      if (hi - lo > tolerance) return false;
+    }
+    return true;
+  };
+  std::vector<glm::ivec4> blended, walked;  // pixel rectangles
+  for (int y = from.y; y < end.y; ++y)
+    for (int x = from.x; x < end.x;) {
+      const bool blend = blends(x, y);
+      int to = x + 1;
+      while (to < end.x && blends(to, y) == blend) ++to;
+      (blend ? blended : walked).push_back(glm::ivec4(x, y, to, y + 1) * rate);
+      x = to;
+    }
   if (!blended.empty()) drawRuns(EllipsoidProgram::kFusedBlend, blended);
   if (!walked.empty()) drawRuns(EllipsoidProgram::kFusedRest, walked);
   ++stats_->sampled_passes;

@@ -13,6 +13,7 @@
 #include "renderer/gl/ellipsoid_shaders.h"
 #include "renderer/gl/frame_stats.h"
 #include "renderer/gl/gl_objects.h"
+#include "renderer/gl/gpu_pass_timer.h"
 #include "renderer/gl/view_uniforms.h"
 #include "renderer/render_settings.h"
 #include "world/scene.h"
@@ -48,7 +49,7 @@ class EllipsoidRenderer {
 
   // Starts a frame: marks cached textures unused until a cloud asks for them again; the
   // frame's passes and ellipsoids are counted into `stats`.
-  void beginFrame(FrameStats& stats);
+  void beginFrame(FrameStats& stats, GpuPassTimer& timer);
   void endFrame();
 
   // Draws clouds `indices` of the scene (back to front by their distance) "over" what
@@ -194,6 +195,7 @@ class EllipsoidRenderer {
   std::function<void()> alive_;
   bool cancelled_ = false;
   FrameStats* stats_ = nullptr;  // the current frame's, borrowed from the GlRenderer
+  GpuPassTimer* timer_ = nullptr;  // the GlRenderer's
 };
 
 }  // namespace nephele

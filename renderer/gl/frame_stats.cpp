@@ -1,5 +1,6 @@
 #include "renderer/gl/frame_stats.h"
 
+#include <numeric>
 #include <sstream>
 
 namespace nephele {
@@ -23,10 +24,30 @@ std::vector<std::pair<const char*, int>> FrameStats::fields() const {
           {"layer_texels_baked", layer_texels_baked}};
 }
 
+double FrameTimes::gpuTotal() const {
+  return std::accumulate(gpu_ms.begin(), gpu_ms.end(), 0.0);
+}
+
+std::vector<std::pair<std::string, double>> FrameTimes::fields() const {
+  std::vector<std::pair<std::string, double>> out;
+  for (std::size_t i = 0; i < cpu_ms.size(); ++i)
+    out.emplace_back(std::string("cpu_") + kCpuStageNames[i], cpu_ms[i]);
+  for (std::size_t i = 0; i < gpu_ms.size(); ++i)
+    out.emplace_back(std::string("gpu_") + kGpuPassNames[i], gpu_ms[i]);
+  out.emplace_back("submit", submit_ms);
+  out.emplace_back("wait", wait_ms);
+  out.emplace_back("readback", readback_ms);
+  out.emplace_back("encode", encode_ms);
+  return out;
+}
+
 std::string FrameStats::line() const {
   std::ostringstream out;
   for (const auto& [name, value] : fields())
     out << (out.tellp() > 0 ? " " : "") << name << '=' << value;
+  out.precision(3);
+  out << std::fixed;
+  for (const auto& [name, ms] : times.fields()) out << ' ' << name << "_ms=" << ms;
   return out.str();
 }
 

@@ -96,7 +96,13 @@ using GlDepthMaskProc = void(APIENTRYP)(GLboolean flag);
   X(PFNGLDRAWARRAYSINSTANCEDPROC, DrawArraysInstanced)                   \
   X(PFNGLBLENDEQUATIONSEPARATEPROC, BlendEquationSeparate)               \
   X(PFNGLPROGRAMUNIFORMMATRIX3FVPROC, ProgramUniformMatrix3fv)           \
-  X(PFNGLPROGRAMUNIFORMMATRIX4FVPROC, ProgramUniformMatrix4fv)
+  X(PFNGLPROGRAMUNIFORMMATRIX4FVPROC, ProgramUniformMatrix4fv)         \
+  X(PFNGLCREATEQUERIESPROC, CreateQueries)                               \
+  X(PFNGLDELETEQUERIESPROC, DeleteQueries)                               \
+  X(PFNGLBEGINQUERYPROC, BeginQuery)                                     \
+  X(PFNGLENDQUERYPROC, EndQuery)                                         \
+  X(PFNGLGETQUERYOBJECTUI64VPROC, GetQueryObjectui64v)                   \
+  X(PFNGLFLUSHPROC, Flush)
 
 struct GlApi {
 #define NEPHELE_GL_MEMBER(type, name) type name = nullptr;

@@ -30,6 +30,9 @@ void GlObject::reset() {
     case Kind::kBuffer:
       gl_->DeleteBuffers(1, &name_);
       break;
+    case Kind::kQuery:
+      gl_->DeleteQueries(1, &name_);
+      break;
   }
   name_ = 0;
 }

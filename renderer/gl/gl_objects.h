@@ -22,7 +22,8 @@ class GlObject {
     kVertexArray,
     kProgram,
     kShader,
-    kBuffer
+    kBuffer,
+    kQuery
   };
 
   GlObject() = default;

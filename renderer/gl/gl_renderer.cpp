@@ -1,10 +1,12 @@
 #include "renderer/gl/gl_renderer.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <sstream>
 #include <vector>
 
@@ -161,10 +163,17 @@ class CloudBands {
 
 }  // namespace
 
+// Whether the GL rasterises on the CPU (Mesa's llvmpipe or softpipe).
+static bool softwareGl(const std::string& renderer) {
+  return renderer.find("llvmpipe") != std::string::npos ||
+         renderer.find("softpipe") != std::string::npos;
+}
+
 GlRenderer::GlRenderer(const GlPlatform& platform)
     : gl_(platform.gl()),
       vertex_array_(createVertexArray(gl_)),
       framebuffer_(createFramebuffer(gl_)),
+      timer_(gl_, softwareGl(platform.renderer())),
       ellipsoids_(gl_),
       automata_(gl_),
       clipmaps_(gl_),
@@ -184,12 +193,23 @@ void GlRenderer::readPixels(int w, int h, GLenum type, void* out) const {
                    static_cast<char*>(out) + std::size_t(y) * row_bytes);
 }
 
+void GlRenderer::finishAndRead(int w, int h, GLenum type, void* out) {
+  {
+    StageClock wait(stats_.times.wait_ms);
+    gl_.Finish();
+  }
+  timer_.collect(stats_.times);
+  StageClock readback(stats_.times.readback_ms);
+  readPixels(w, h, type, out);
+}
+
 FloatImage GlRenderer::renderFloat(const Scene& scene, const RenderSettings& settings) {
   drawFrame(scene, settings, TargetFormat::kFloat);
   const int w = scene.camera.width, h = scene.camera.height;
   FloatImage image{w, h, std::vector<float>(std::size_t(w) * h * 4)};
-  readPixels(w, h, GL_FLOAT, image.rgba.data());
+  finishAndRead(w, h, GL_FLOAT, image.rgba.data());
   // GL rows run bottom-up; FloatImage rows run top-down.
+  StageClock flip(stats_.times.readback_ms);
   const std::size_t row = std::size_t(w) * 4;
   for (int y = 0; y < h / 2; ++y)
     std::swap_ranges(image.rgba.begin() + y * row, image.rgba.begin() + (y + 1) * row,
@@ -207,6 +227,8 @@ Frame GlRenderer::renderFrame(const Scene& scene, const RenderSettings& settings
   const bool composite = compositeAsked(asked);
   if (composite) frame.colour = renderFloat(scene, settings);
   if (asked.has(Channel::kVisibility)) frame.visibilityFromCoverage();
+  // The channels beyond the composite are read back and converted on the CPU.
+  StageClock channels(stats_.times.readback_ms);
   if (asked.has(Channel::kDepth) || asked.has(Channel::kObjectId)) {
     // The composite pass drew the targets already; otherwise they are drawn alone.
     std::vector<float> distance, id;
@@ -251,7 +273,7 @@ Srgb8Image GlRenderer::renderSrgb8(const Scene& scene, const RenderSettings& set
   drawFrame(scene, settings, TargetFormat::kSrgb8);
   const int w = scene.camera.width, h = scene.camera.height;
   Srgb8Image image{w, h, /*bottom_up=*/true, std::vector<std::uint8_t>(std::size_t(w) * h * 4)};
-  readPixels(w, h, GL_UNSIGNED_BYTE, image.rgba.data());
+  finishAndRead(w, h, GL_UNSIGNED_BYTE, image.rgba.data());
   return image;
 }
 
@@ -356,6 +378,7 @@ GlRenderer::CachedTexture& GlRenderer::cachedTexture(const LayerTextureSpec& spe
 
 GLuint GlRenderer::gpuTexture(CachedTexture& cached, const RenderSettings& settings) {
   if (cached.texture) return cached.texture.get();
+  StageClock clock(stats_.times.cpu(CpuStage::kUploads));
   cached.texture = createTexture(gl_, GL_TEXTURE_2D);
   const GLuint t = cached.texture.get();
   if (const GardnerTexture* gardner = cached.source->gardner())
@@ -545,21 +568,49 @@ void GlRenderer::drawSkyGroup(const Scene& scene, const RenderSettings& settings
 
 void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
                            TargetFormat format) {
+  const auto start = std::chrono::steady_clock::now();
+  FrameTimes times;
+  timer_.beginFrame();
   // Fields of heaps become the clouds around this camera (MODEL.md section 10).
-  if (!scene.fields.empty())
-    return drawFrame(withFieldClouds(scene, settings.heaps), settings, format);
-  // The work budget, counted in ellipsoids and in views of their footprints (issue 31).
-  if (auto within =
-          withinEllipsoidBudget(scene, settings.ellipsoid_budget, settings.ellipsoid_overdraw)) {
-    RenderSettings rest = settings;  // the thinned scene is within it
-    rest.ellipsoid_budget = rest.ellipsoid_overdraw = 0.0;
-    return drawFrame(*within, rest, format);
+  std::optional<Scene> fielded;
+  if (!scene.fields.empty()) {
+    StageClock clock(times.cpu(CpuStage::kHeaps));
+    fielded = withFieldClouds(scene, settings.heaps);
   }
+  const Scene& drawable = fielded ? *fielded : scene;
+  // The work budget, counted in ellipsoids and in views of their footprints (issue 31).
+  std::optional<Scene> within;
+  {
+    StageClock clock(times.cpu(CpuStage::kBudget));
+    within = withinEllipsoidBudget(drawable, settings.ellipsoid_budget, settings.ellipsoid_overdraw);
+  }
+  RenderSettings rest = settings;
+  if (within) rest.ellipsoid_budget = rest.ellipsoid_overdraw = 0.0;  // the thinned scene is within it
+  stats_ = {};
+  stats_.times = times;
+  drawScene(within ? *within : drawable, rest, format);
+  timer_.enter(-1);
+  FrameTimes& t = stats_.times;
+  t.submit_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count() -
+      timer_.waitedMs();
+  // The draw list and the passes' own GL calls: what the other stages leave of the submission.
+  double staged = 0.0;
+  for (std::size_t i = 0; i < t.cpu_ms.size(); ++i)
+    if (i != std::size_t(CpuStage::kScene)) staged += t.cpu_ms[i];
+  t.cpu(CpuStage::kScene) = std::max(0.0, t.submit_ms - staged);
+}
+
+void GlRenderer::drawScene(const Scene& scene, const RenderSettings& settings,
+                           TargetFormat format) {
   const Camera& camera = scene.camera;
   prepareTarget(camera.width, camera.height, format);
-  stats_ = {};
   // Opaque targets first, into their own colour and distance textures.
-  const bool targets = targets_.draw(scene);
+  bool targets = false;
+  if (!scene.targets.empty()) {
+    GpuPassScope pass(timer_, GpuPass::kTargets);
+    targets = targets_.draw(scene);
+  }
   if (targets) stats_.target_passes = int(scene.targets.size());
   gl_.BindFramebuffer(GL_FRAMEBUFFER, framebuffer_.get());
   gl_.Viewport(0, 0, camera.width, camera.height);
@@ -569,11 +620,14 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
   else
     gl_.Disable(GL_FRAMEBUFFER_SRGB);
   ++frame_;
-  ellipsoids_.beginFrame(stats_);
+  ellipsoids_.beginFrame(stats_, timer_);
   automata_.beginFrame(stats_);
   clipmaps_.beginFrame();
   auto finish = [&](const Veil& veil) {
-    ellipsoids_.drawVeil(veil);
+    if (veil.opacity > 0.0) {
+      GpuPassScope pass(timer_, GpuPass::kVeil);
+      ellipsoids_.drawVeil(veil);
+    }
     gl_.Disable(GL_BLEND);
     ellipsoids_.endFrame();
     automata_.endFrame();
@@ -656,6 +710,8 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
         const LayerTexture& t = *slot.texture->source;
         const glm::dvec2 eye =
             glm::dvec2(camera.position) - t.driftOffset(scene.time_s, slot.layer->texture);
+        GpuPassScope pass(timer_, GpuPass::kClipmaps);
+        StageClock clock(stats_.times.cpu(CpuStage::kUploads));
         slot.clipmap =
             clipmaps_.prepare(slot.texture->key, *t.gardner(), eye,
                               LayerClipmaps::sizeFor(camera.height), budget, wait, stats_);
@@ -719,7 +775,10 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
   bool background_pending = true;
   auto flushSky = [&] {
     if (!background_pending && pending_above.empty() && pending_below.empty()) return;
-    drawSkyGroup(scene, settings, pending_above, pending_below, background_pending, targets);
+    {
+      GpuPassScope pass(timer_, GpuPass::kSky);
+      drawSkyGroup(scene, settings, pending_above, pending_below, background_pending, targets);
+    }
     background_pending = false;
     pending_above.clear();
     pending_below.clear();
@@ -734,6 +793,7 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
     // call, which batches the clouds that look alike.
     while (next_cloud != clouds.end() && next_cloud->band == band) {
       if (next_cloud->automaton) {
+        GpuPassScope pass(timer_, GpuPass::kAutomata);
         automata_.drawCloud(scene, next_cloud->index, settings, targets, next_cloud->window);
         ++next_cloud;
         continue;
@@ -744,6 +804,7 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
              next_cloud->window.slabs == window.slabs;
            ++next_cloud)
         run.push_back(next_cloud->index);
+      GpuPassScope pass(timer_, GpuPass::kHeaps);
       ellipsoids_.drawClouds(scene, run, settings, frame, targets, window);
     }
     // Then the layers of rank band - 1 (rank 0 is nearest the camera) on both sides.

@@ -13,6 +13,7 @@
 #include "renderer/gl/frame_stats.h"
 #include "renderer/gl/gl_objects.h"
 #include "renderer/gl/gl_platform.h"
+#include "renderer/gl/gpu_pass_timer.h"
 #include "renderer/gl/layer_clipmap.h"
 #include "renderer/gl/sky_shaders.h"
 #include "renderer/gl/target_renderer.h"
@@ -87,7 +88,12 @@ class GlRenderer {
     ClipmapView clipmap;  // kClipmapGardner: the rings around this frame's camera
   };
 
+  // The frame's scene made drawable (fields to heaps, the work budget), then drawn; its CPU
+  // stages and GPU passes timed into stats_.times.
   void drawFrame(const Scene& scene, const RenderSettings& settings, TargetFormat format);
+  void drawScene(const Scene& scene, const RenderSettings& settings, TargetFormat format);
+  // Waits for the frame's passes, collects their times, and reads the target back.
+  void finishAndRead(int width, int height, GLenum type, void* out);
   // Background (if asked) and the given layers, fused or one pass per layer.
   void drawSkyGroup(const Scene& scene, const RenderSettings& settings,
                     const std::vector<LayerSlot>& above, const std::vector<LayerSlot>& below,
@@ -115,6 +121,7 @@ class GlRenderer {
   std::uint64_t frame_ = 0;  // frames drawn
   GlObject floor_program_;
   FrameStats stats_;
+  GpuPassTimer timer_;
   EllipsoidRenderer ellipsoids_;
   AutomatonRenderer automata_;
   LayerClipmaps clipmaps_;
