@@ -360,6 +360,8 @@ HostFrameFigures hostFrames(const std::filesystem::path& dir, int views, int rep
       "host frames, lockstep, %s, %d view%s of 640x480 raw (%d frames each; render alone "
       "%.1f ms = %.0f x floor %.2f ms):\n",
       what, views, views > 1 ? "s" : "", repeats, render, render / floor_ms, floor_ms);
+  std::printf("  the last frame's budget (stats.last_frame.ms): %s\n",
+              stats["last_frame"]["ms"].dump().c_str());
   auto row = [&](const char* what, const std::vector<double>& ms) {
     std::printf("  %-32s p50 %7.1f ms (%4.2f x render)  p99 %7.1f ms (%4.2f x render)\n", what,
                 percentile(ms, 0.5), percentile(ms, 0.5) / render, percentile(ms, 0.99),
@@ -426,6 +428,8 @@ void asynchronousHostFrames(const std::filesystem::path& dir, int views, int rep
       "each; render alone %.1f ms = %.0f x floor %.2f ms; Start of Frame at %.1f Hz):\n",
       what, views, views > 1 ? "s" : "", repeats, render, render / floor_ms, floor_ms,
       sofs / seconds);
+  std::printf("  the last frame's budget (stats.last_frame.ms): %s\n",
+              stats["last_frame"]["ms"].dump().c_str());
   for (const auto& [row, ms] : {std::pair{"CIGI host frame to Start of Frame", &to_sof},
                                 {"CIGI host frame to frames", &to_frames}})
     std::printf("  %-32s p50 %7.1f ms (%4.2f x render)  p99 %7.1f ms (%4.2f x render)\n", row,
