@@ -194,7 +194,7 @@ class EllipsoidRenderer {
   const std::atomic<bool>* cancel_ = nullptr;
   std::function<void()> alive_;
   bool cancelled_ = false;
-  FrameStats* stats_ = nullptr;  // the current frame's, borrowed from the GlRenderer
+  FrameStats* stats_ = nullptr;    // the current frame's, borrowed from the GlRenderer
   GpuPassTimer* timer_ = nullptr;  // the GlRenderer's
 };
 

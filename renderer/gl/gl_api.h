@@ -96,7 +96,7 @@ using GlDepthMaskProc = void(APIENTRYP)(GLboolean flag);
   X(PFNGLDRAWARRAYSINSTANCEDPROC, DrawArraysInstanced)                   \
   X(PFNGLBLENDEQUATIONSEPARATEPROC, BlendEquationSeparate)               \
   X(PFNGLPROGRAMUNIFORMMATRIX3FVPROC, ProgramUniformMatrix3fv)           \
-  X(PFNGLPROGRAMUNIFORMMATRIX4FVPROC, ProgramUniformMatrix4fv)         \
+  X(PFNGLPROGRAMUNIFORMMATRIX4FVPROC, ProgramUniformMatrix4fv)           \
   X(PFNGLCREATEQUERIESPROC, CreateQueries)                               \
   X(PFNGLDELETEQUERIESPROC, DeleteQueries)                               \
   X(PFNGLBEGINQUERYPROC, BeginQuery)                                     \

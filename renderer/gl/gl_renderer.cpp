@@ -582,10 +582,12 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
   std::optional<Scene> within;
   {
     StageClock clock(times.cpu(CpuStage::kBudget));
-    within = withinEllipsoidBudget(drawable, settings.ellipsoid_budget, settings.ellipsoid_overdraw);
+    within =
+        withinEllipsoidBudget(drawable, settings.ellipsoid_budget, settings.ellipsoid_overdraw);
   }
   RenderSettings rest = settings;
-  if (within) rest.ellipsoid_budget = rest.ellipsoid_overdraw = 0.0;  // the thinned scene is within it
+  if (within)
+    rest.ellipsoid_budget = rest.ellipsoid_overdraw = 0.0;  // the thinned scene is within it
   stats_ = {};
   stats_.times = times;
   drawScene(within ? *within : drawable, rest, format);
