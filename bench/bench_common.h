@@ -54,7 +54,6 @@ inline double medianFrameMilliseconds(GlRenderer& renderer, const Scene& scene,
   });
 }
 
-// Sets the camera's image size from "WxH"; false, after saying why, when it is not one.
 // A frame's budget in one line (FrameTimes): the CPU stages, the GPU passes by timer query,
 // the wait for them and the readback, in milliseconds; stages and passes at 0 left out.
 inline std::string frameBudgetLine(const FrameTimes& t) {
@@ -77,6 +76,7 @@ inline std::string frameBudgetLine(const FrameTimes& t) {
   return out;
 }
 
+// Sets the camera's image size from "WxH"; false, after saying why, when it is not one.
 inline bool parseSize(const std::string& size, Camera& camera) {
   int width = 0, height = 0;
   if (std::sscanf(size.c_str(), "%dx%d", &width, &height) != 2 || width < 1 || height < 1) {

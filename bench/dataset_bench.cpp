@@ -57,7 +57,7 @@ int main(int argc, char** argv) {
     const FrameRequest request{{Channel::kColour, Channel::kObjectId, Channel::kVisibility}};
     gl.renderFrame(drawSample(spec, 0).scene, settings, request);  // warm-up: shaders, tables
     double draw = 0, heaps = 0, render = 0, label = 0, srgb = 0, png = 0, mask = 0;
-    FrameTimes budget;  // summed over the samples
+    FrameTimes budget;  // the mean over the samples
     int targets = 0, visible = 0;
     for (int i = 0; i < samples; ++i) {
       auto t = Clock::now();
@@ -71,12 +71,7 @@ int main(int argc, char** argv) {
       const Frame frame = gl.renderFrame(with_heaps, settings, request);
       const double render_ms = msSince(t);
       render += render_ms;
-      const FrameTimes& times = gl.lastFrameStats().times;
-      for (std::size_t k = 0; k < budget.cpu_ms.size(); ++k) budget.cpu_ms[k] += times.cpu_ms[k];
-      for (std::size_t k = 0; k < budget.gpu_ms.size(); ++k) budget.gpu_ms[k] += times.gpu_ms[k];
-      budget.submit_ms += times.submit_ms;
-      budget.wait_ms += times.wait_ms;
-      budget.readback_ms += times.readback_ms;
+      budget.accumulate(gl.lastFrameStats().times, 1.0 / samples);
       if (per_sample) {
         const Camera& c = sample.scene.camera;
         std::printf(
@@ -115,9 +110,6 @@ int main(int argc, char** argv) {
         "labels %.1f ms, sRGB %.1f ms, PNG %.1f ms, mask PNG %.1f ms\n",
         draw / n, heaps / n, render / n, render / n / floor_ms, label / n, srgb / n, png / n,
         mask / n);
-    for (double& ms : budget.cpu_ms) ms /= n;
-    for (double& ms : budget.gpu_ms) ms /= n;
-    budget.submit_ms /= n, budget.wait_ms /= n, budget.readback_ms /= n;
     std::printf("  GL render's budget, mean per sample: %s\n", frameBudgetLine(budget).c_str());
     std::printf(
         "  one thread: %.1f samples/s; three overlapped stages on 2 cores: at most %.1f "

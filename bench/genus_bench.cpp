@@ -557,13 +557,16 @@ int main(int argc, char** argv) {
         const FrameTimes still_budget = renderer.lastFrameStats().times;
         renderer.renderSrgb8(clear, file.render);
         const FrameTimes clear_budget = renderer.lastFrameStats().times;
+        auto printBudgets = [&] {
+          std::printf("  budget, still: %s\n  budget, clear: %s\n",
+                      bench::frameBudgetLine(still_budget).c_str(),
+                      bench::frameBudgetLine(clear_budget).c_str());
+        };
         if (still_only) {
           std::printf("%-22s %-7s %-10s %8.2f %8.2f %9.2f %7.1f %7.1f\n", path.stem().c_str(),
                       view.name, size.c_str(), floor, clear_ms, still, still / floor,
                       still / clear_ms);
-          std::printf("  budget, still: %s\n  budget, clear: %s\n",
-                      bench::frameBudgetLine(still_budget).c_str(),
-                      bench::frameBudgetLine(clear_budget).c_str());
+          printBudgets();
           std::fflush(stdout);
           continue;
         }
@@ -601,9 +604,7 @@ int main(int argc, char** argv) {
             path.stem().c_str(), view.name, size.c_str(), floor, clear_ms, still, still / floor,
             still / clear_ms, flying, flying / clear_ms, slowest, slowest / clear_ms, warm_flying,
             warm_flying / clear_ms, warm_slowest, warm_slowest / clear_ms, drawnEllipsoids(scene));
-        std::printf("  budget, still: %s\n  budget, clear: %s\n",
-                    bench::frameBudgetLine(still_budget).c_str(),
-                    bench::frameBudgetLine(clear_budget).c_str());
+        printBudgets();
         if (!fill.empty()) {
           std::sort(fill.begin(), fill.end());
           std::printf(

@@ -1,7 +1,5 @@
 #include "renderer/gl/ellipsoid_renderer.h"
 
-#include <optional>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -741,9 +739,9 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   // heap_shading_rate), and the samples are blended everywhere (MODEL.md section 15, "reduced
   // rate").
   const double shown = std::max(target.seen, 1e-6);
-  const bool veiled = kVeiledTolerance / shown >= kVeiledSamplingFrom;
+  const double tolerance = kVeiledTolerance / shown;
+  const bool veiled = tolerance >= kVeiledSamplingFrom;
   const bool reduced = !veiled && settings.heap_shading_rate > 1;
-  const double tolerance = reduced ? 1.0 : kVeiledTolerance / shown;
   const int rate = targets_drawn ? 1
                    : veiled      ? kVeiledShadingRate
                    : reduced     ? settings.heap_shading_rate
@@ -881,9 +879,9 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
     }
   };
   gl_.BindTextureUnit(kSamplesTextureUnit, samples_.get());
-  if (tolerance >= 1.0) {
-    // Every block agrees: the samples are brought to full size by their bilinear blend over
-    // the whole area, with no readback (MODEL.md section 15, "reduced rate").
+  if (reduced) {
+    // The samples are brought to full size by their bilinear blend over the whole area, with
+    // no readback (MODEL.md section 15, "reduced rate").
     drawRuns(EllipsoidProgram::kFusedBlend, {glm::ivec4(from * rate, end * rate)});
     ++stats_->sampled_passes;
     return;

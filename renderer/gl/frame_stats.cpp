@@ -28,6 +28,15 @@ double FrameTimes::gpuTotal() const {
   return std::accumulate(gpu_ms.begin(), gpu_ms.end(), 0.0);
 }
 
+void FrameTimes::accumulate(const FrameTimes& other, double weight) {
+  for (std::size_t i = 0; i < cpu_ms.size(); ++i) cpu_ms[i] += weight * other.cpu_ms[i];
+  for (std::size_t i = 0; i < gpu_ms.size(); ++i) gpu_ms[i] += weight * other.gpu_ms[i];
+  submit_ms += weight * other.submit_ms;
+  wait_ms += weight * other.wait_ms;
+  readback_ms += weight * other.readback_ms;
+  encode_ms += weight * other.encode_ms;
+}
+
 std::vector<std::pair<std::string, double>> FrameTimes::fields() const {
   std::vector<std::pair<std::string, double>> out;
   for (std::size_t i = 0; i < cpu_ms.size(); ++i)

@@ -51,6 +51,8 @@ struct FrameTimes {
   double cpu(CpuStage s) const { return cpu_ms[std::size_t(s)]; }
   double gpu(GpuPass p) const { return gpu_ms[std::size_t(p)]; }
   double gpuTotal() const;
+  // Adds `weight` times every figure of `other` (a mean over frames: weight 1 / frames).
+  void accumulate(const FrameTimes& other, double weight = 1.0);
   // Every figure in milliseconds with its name: cpu_<stage>, gpu_<pass>, submit, wait,
   // readback, encode.
   std::vector<std::pair<std::string, double>> fields() const;

@@ -101,8 +101,7 @@ using GlDepthMaskProc = void(APIENTRYP)(GLboolean flag);
   X(PFNGLDELETEQUERIESPROC, DeleteQueries)                               \
   X(PFNGLBEGINQUERYPROC, BeginQuery)                                     \
   X(PFNGLENDQUERYPROC, EndQuery)                                         \
-  X(PFNGLGETQUERYOBJECTUI64VPROC, GetQueryObjectui64v)                   \
-  X(PFNGLFLUSHPROC, Flush)
+  X(PFNGLGETQUERYOBJECTUI64VPROC, GetQueryObjectui64v)
 
 struct GlApi {
 #define NEPHELE_GL_MEMBER(type, name) type name = nullptr;

@@ -161,13 +161,13 @@ class CloudBands {
   std::vector<double> rising_, falling_;  // nearest first
 };
 
-}  // namespace
-
 // Whether the GL rasterises on the CPU (Mesa's llvmpipe or softpipe).
-static bool softwareGl(const std::string& renderer) {
+bool softwareGl(const std::string& renderer) {
   return renderer.find("llvmpipe") != std::string::npos ||
          renderer.find("softpipe") != std::string::npos;
 }
+
+}  // namespace
 
 GlRenderer::GlRenderer(const GlPlatform& platform)
     : gl_(platform.gl()),
