@@ -12,7 +12,10 @@
 // still view once (programs compiled, textures baked): the median and the slowest frame, so
 // the cost of generating new heap tiles and of filling new clipmaps shows. "warm flying" is
 // the same flight 2 s on: the median and slowest of the N frames after 60, when the clipmaps
-// are whole and follow the camera by strips.
+// are whole and follow the camera by strips. A flight is a continuous view, as a daemon's
+// subscription is: its heaps reuse the last frame (heap_refresh, --heap-refresh), and the frame
+// after the warm flight is compared with the exact frame of its pose. --speed 0 streams the
+// still view instead.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -29,6 +32,7 @@
 #include "image/cloud_statistics.h"
 #include "image/image.h"
 #include "image/image_encoding.h"
+#include "image/image_metrics.h"
 #include "renderer/gl/gl_renderer.h"
 #include "world/formations/cloud_field.h"
 #include "world/formations/weather.h"
@@ -450,6 +454,14 @@ int main(int argc, char** argv) {
   app.add_flag("--still", still_only,
                "Only the still frames and their budgets: no flights, look or body figures");
   int shading_rate = 0;
+  int refresh = 0;
+  double speed = 250.0;
+  app.add_option("--speed", speed,
+                 "Flights: the camera's speed east, m/s (0: a still view streamed)")
+      ->check(CLI::Range(0.0, 1000.0));
+  app.add_option("--heap-refresh", refresh,
+                 "Flights: walk one heap pixel in N anew a frame and reuse the last frame for "
+                 "the rest (1, 4 or 16) instead of the preset's own");
   app.add_option("--heap-shading-rate", shading_rate,
                  "Draw the heaps of every preset at this shading rate (1, 2 or 4) instead of its "
                  "own");
@@ -525,6 +537,13 @@ int main(int argc, char** argv) {
         return 2;
       }
     }
+    if (refresh > 0) {
+      file.render.heap_refresh = refresh;
+      if (const std::string e = validateRenderSettings(file.render); !e.empty()) {
+        std::fprintf(stderr, "--heap-refresh: %s\n", e.c_str());
+        return 2;
+      }
+    }
     for (const std::string& size : sizes) {
       Camera sized;
       if (!bench::parseSize(size, sized)) return 2;
@@ -575,10 +594,12 @@ int main(int argc, char** argv) {
         // hundreds of milliseconds), while the heaps along the flight are new to it.
         GlRenderer flyer(*platform);
         flyer.renderSrgb8(scene, file.render);
+        // A flight is a continuous view, as a daemon's subscription is (heap_refresh).
+        flyer.setContinuousView("flight");
         std::vector<double> ms;
         Scene moving = scene;
         for (int frame = 0; frame < repeats; ++frame) {
-          moving.camera.position.x = scene.camera.position.x + 250.0 / 30.0 * frame + 50000.0;
+          moving.camera.position.x = scene.camera.position.x + speed / 30.0 * frame + 50000.0;
           const auto start = Clock::now();
           flyer.renderSrgb8(moving, file.render);
           ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
@@ -586,12 +607,29 @@ int main(int argc, char** argv) {
         std::vector<double> warm;
         double strip_texels = 0.0;  // clipmap texels evaluated per warm frame
         for (int frame = repeats; frame < 60 + repeats; ++frame) {
-          moving.camera.position.x = scene.camera.position.x + 250.0 / 30.0 * frame + 50000.0;
+          moving.camera.position.x = scene.camera.position.x + speed / 30.0 * frame + 50000.0;
           const auto start = Clock::now();
           flyer.renderSrgb8(moving, file.render);
           if (frame < 60) continue;
           warm.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
           strip_texels += flyer.lastFrameStats().layer_texels_baked / double(repeats);
+        }
+        const FrameTimes flight_budget = flyer.lastFrameStats().times;
+        const std::string flight_stats = flyer.lastFrameStats().line();
+        // The next frame of the flight against the exact frame of its pose.
+        moving.camera.position.x =
+            scene.camera.position.x + speed / 30.0 * (60 + repeats) + 50000.0;
+        const FloatImage reused = flyer.renderFloat(moving, file.render);
+        flyer.setContinuousView("");
+        const FloatImage exact = flyer.renderFloat(moving, file.render);
+        const ImageError reuse_error = compareImages(reused, exact);
+        if (!images.empty()) {  // the flight's last frame and the exact one, to look at
+          std::filesystem::create_directories(images);
+          const std::string stem = images + "/" + path.stem().string() + "_" + view.name + "_";
+          for (const auto& [what, image] : {std::pair{"flight", &reused}, {"exact", &exact}})
+            if (const std::string error = writeImageFile(stem + what + ".png", *image);
+                !error.empty())
+              std::fprintf(stderr, "%s\n", error.c_str());
         }
         const double slowest = *std::max_element(ms.begin(), ms.end());
         const double warm_slowest = *std::max_element(warm.begin(), warm.end());
@@ -605,6 +643,12 @@ int main(int argc, char** argv) {
             still / clear_ms, flying, flying / clear_ms, slowest, slowest / clear_ms, warm_flying,
             warm_flying / clear_ms, warm_slowest, warm_slowest / clear_ms, drawnEllipsoids(scene));
         printBudgets();
+        std::printf(
+            "  budget, warm flight: %s\n  flight at heap_refresh %d: last frame against the exact "
+            "one %.1f dB, "
+            "largest difference %.3f\n  %s\n",
+            bench::frameBudgetLine(flight_budget).c_str(), file.render.heap_refresh,
+            reuse_error.psnr_db, reuse_error.max_abs, flight_stats.c_str());
         if (!fill.empty()) {
           std::sort(fill.begin(), fill.end());
           std::printf(

@@ -90,7 +90,7 @@ void readRender(TableReader& t, SceneFile& out) {
   t.allow({"texture", "term_filter", "sky_passes", "bake_texels_per_cycle", "reference_samples",
            "ellipsoid_passes", "ellipsoid_order", "limb", "tile_resolution", "tile_format",
            "tessellation", "impostor_tolerance", "volume_step", "heap_range", "heap_detail",
-           "ellipsoid_budget", "ellipsoid_overdraw", "heap_shading_rate"});
+           "ellipsoid_budget", "ellipsoid_overdraw", "heap_shading_rate", "heap_refresh"});
   out.render.texture_evaluation = TextureEvaluation(
       t.choice("texture", kTextureEvaluationNames, int(out.render.texture_evaluation)));
   out.render.term_filter =
@@ -118,6 +118,8 @@ void readRender(TableReader& t, SceneFile& out) {
   t.number("ellipsoid_overdraw", r.ellipsoid_overdraw, Limits::kEllipsoidOverdraw);
   t.integer("heap_shading_rate", r.heap_shading_rate, int(Limits::kHeapShadingRate.lo),
             int(Limits::kHeapShadingRate.hi));
+  t.integer("heap_refresh", r.heap_refresh, int(Limits::kHeapRefresh.lo),
+            int(Limits::kHeapRefresh.hi));
   if (std::string error = validateRenderSettings(r); !error.empty())
     t.failAt(error.substr(0, error.find(':')), error.substr(error.find(':') + 2));
   out.reference.heaps = r.heaps;  // both renderers draw the same heaps
@@ -725,6 +727,9 @@ std::string validateRenderSettings(const RenderSettings& r) {
   if (r.heap_shading_rate != 1 && r.heap_shading_rate != 2 && r.heap_shading_rate != 4)
     return "heap_shading_rate: " + std::to_string(r.heap_shading_rate) +
            " is not allowed (allowed: 1, 2 or 4 pixels between samples)";
+  if (r.heap_refresh != 1 && r.heap_refresh != 4 && r.heap_refresh != 16)
+    return "heap_refresh: " + std::to_string(r.heap_refresh) +
+           " is not allowed (allowed: 1, 4 or 16, one pixel in that many walked anew a frame)";
   if (!(r.volume_step >= 0.25 && r.volume_step <= 8.0))
     return "volume_step: " + formatNumber(r.volume_step) +
            " is out of range (allowed: 0.25 to 8 lattice spacings)";

@@ -73,6 +73,11 @@ struct RenderSettings {
   // walks one pixel in heap_shading_rate^2 (1, 2 or 4 pixels between samples), and the samples'
   // bilinear blend in premultiplied colour brings them to full size. 1 walks every pixel.
   int heap_shading_rate = 1;
+  // A continuous view's heaps (GlRenderer::setContinuousView; MODEL.md section 15, "reuse
+  // across frames"): each frame walks one pixel in heap_refresh (1, 4 or 16), a different one
+  // each frame, and reprojects the last frame to the others. 1 walks every pixel every frame.
+  // Single renders, dataset samples and the first frame after a cut are always exact.
+  int heap_refresh = 4;
 
   // Automaton clouds: the view march's step in lattice spacings (the lattice holds
   // samples_per_cell samples per cell edge). Larger steps are faster and blur thin edges.

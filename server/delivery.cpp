@@ -75,8 +75,13 @@ json imageMeta(const ViewFrame& frame, const ImageRequest& image) {
 
 }  // namespace engine_detail
 
-void Engine::renderFrame(const ViewConfig& view, const ImageRequest& image, ViewFrame& frame) {
+void Engine::renderFrame(const ViewConfig& view, const ImageRequest& image, ViewFrame& frame,
+                         bool continuous) {
   State& s = *state_;
+  // A subscription's frames are one stream: its heaps reuse the last frame until the world is
+  // edited (RenderSettings::heap_refresh); a request's frame is the exact one.
+  s.renderer->setContinuousView(continuous ? view.name + "#" + std::to_string(s.world->edits())
+                                           : std::string());
   Scene scene = s.world->scene();
   scene.camera = view.camera;
   // An off-axis view is cut from a centred render of the same focal length (exact: a pinhole
@@ -267,7 +272,7 @@ void Engine::deliverFrames(Delivery which, const std::string& view_name) {
           continue;
         }
         frame = std::make_shared<ViewFrame>();
-        renderFrame(*view, image, *frame);
+        renderFrame(*view, image, *frame, /*continuous=*/true);
       }
       std::vector<Subscription> sinks;  // copies: the encoder may run after a change
       for (Subscription* sub : members) sinks.push_back(*sub);

@@ -181,7 +181,9 @@ class Engine {
   std::optional<ProtocolError> checkAdvance(double dt_s) const;
   void advance(double dt_s);  // one tick
   // Renders a view (float for EXR, else 8-bit) and records its time.
-  void renderFrame(const ViewConfig& view, const ImageRequest& image, struct ViewFrame& frame);
+  // `continuous`: a frame of a subscription's stream, which may reuse the view's last frame.
+  void renderFrame(const ViewConfig& view, const ImageRequest& image, struct ViewFrame& frame,
+                   bool continuous = false);
   void realtimeTicks();
   enum class Delivery {
     kDue,        // realtime: subscriptions whose period has come round

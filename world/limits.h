@@ -105,6 +105,8 @@ struct Limits {
   static constexpr Range kHeapDetail{0.0, 1.0e4};      // every lobe of heaps this many pixels wide
   // The heaps' shading rate (`heap_shading_rate`: 1, 2 or 4 pixels between samples).
   static constexpr Range kHeapShadingRate{1.0, 4.0};
+  // A continuous view's heaps: one pixel in `heap_refresh` (1, 4 or 16) walked anew a frame.
+  static constexpr Range kHeapRefresh{1.0, 16.0};
   // Ellipsoids a GL frame draws, those of largest projected size (`ellipsoid_budget`; 0: no
   // budget), at most what a world may hold.
   static constexpr Range kEllipsoidBudget{0.0, double(kMaxWorldEllipsoids)};

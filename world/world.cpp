@@ -343,6 +343,7 @@ std::string World::edit(
   dynamics_.wind = dynamics.wind;
   dynamics_.layers = std::move(dynamics.layers);
   dynamics_.clouds = std::move(dynamics.clouds);
+  ++edits_;
   return {};
 }
 

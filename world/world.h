@@ -112,6 +112,10 @@ class World {
   // Sunlight sweeps recomputed after the sun moved, summed over automaton clouds.
   std::uint64_t relightsRun() const { return relights_run_; }
 
+  // Edits applied through edit() since construction: what the world holds changed (a view
+  // that reuses earlier frames starts anew after one).
+  std::uint64_t edits() const { return edits_; }
+
   // Relights automaton clouds only if the sun's direction changed.
   void setSun(const Sun& sun);
 
@@ -175,6 +179,7 @@ class World {
   std::int64_t time_ns_ = 0;
   std::uint64_t steps_run_ = 0;
   std::uint64_t relights_run_ = 0;
+  std::uint64_t edits_ = 0;
   std::vector<AutomatonCloud> automata_;
 };
 

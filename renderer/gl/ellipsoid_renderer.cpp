@@ -21,6 +21,23 @@
 namespace nephele {
 namespace {
 
+// A continuous view's samples stand rate pixels apart (heap_refresh = rate^2).
+int refreshRate(int refresh) {
+  return refresh >= 16 ? 4 : refresh >= 4 ? 2 : 1;
+}
+
+// Frame k's sample offset within the rate x rate block: the ordered-dither (Bayer) order, so
+// that the offsets of consecutive frames lie far apart and rate^2 frames visit every pixel.
+glm::ivec2 sampleOffset(std::uint64_t k, int rate) {
+  static constexpr int kBayer2[4][2] = {{0, 0}, {1, 1}, {1, 0}, {0, 1}};
+  static constexpr int kBayer4[16][2] = {{0, 0}, {2, 2}, {2, 0}, {0, 2}, {1, 1}, {3, 3},
+                                         {3, 1}, {1, 3}, {1, 0}, {3, 2}, {3, 0}, {1, 2},
+                                         {0, 1}, {2, 3}, {2, 1}, {0, 3}};
+  if (rate == 2) return {kBayer2[k % 4][0], kBayer2[k % 4][1]};
+  if (rate == 4) return {kBayer4[k % 16][0], kBayer4[k % 16][1]};
+  return glm::ivec2(0);
+}
+
 constexpr int kAtlasSize = 2048;
 constexpr int kMaxTileSize = 1024;
 constexpr int kSpotlightSize = 64;
@@ -231,9 +248,12 @@ EllipsoidRenderer::EllipsoidRenderer(const GlApi& gl)
 
 EllipsoidRenderer::~EllipsoidRenderer() = default;
 
-void EllipsoidRenderer::beginFrame(FrameStats& stats, GpuPassTimer& timer) {
+void EllipsoidRenderer::beginFrame(FrameStats& stats, GpuPassTimer& timer,
+                                   const std::string& continuous_view) {
   stats_ = &stats;
   timer_ = &timer;
+  continuous_view_ = continuous_view;
+  next_history_ = 0;
   cancelled_ = false;
   for (auto& [key, cached] : textures_) cached.used = false;
   ++frame_;
@@ -266,6 +286,42 @@ void EllipsoidRenderer::endFrame() {
   keepMostRecent(tables_, kKeptTables, frame_);
   std::erase_if(impostors_, [](const auto& entry) { return !entry.second.used; });
   for (auto& [index, impostor] : impostors_) impostor.used = false;
+  // A view's histories go once it has drawn none for kKeptHistoryFrames frames, and the
+  // batches past those this frame drew with them.
+  std::erase_if(histories_, [&](auto& entry) {
+    return std::none_of(entry.second.begin(), entry.second.end(),
+                        [&](const HeapHistory& h) { return h.used + kKeptHistoryFrames > frame_; });
+  });
+  if (auto found = histories_.find(continuous_view_); found != histories_.end())
+    found->second.resize(std::min(found->second.size(), next_history_));
+}
+
+EllipsoidRenderer::HeapHistory& EllipsoidRenderer::heapHistory(const Scene& scene,
+                                                               const std::string& batch,
+                                                               glm::ivec2 size) {
+  std::vector<HeapHistory>& view = histories_[continuous_view_];
+  if (view.size() <= next_history_) view.resize(next_history_ + 1);
+  HeapHistory& h = view[next_history_++];
+  if (h.size != size) {
+    h = HeapHistory{};
+    h.size = size;
+    for (int k = 0; k < 2; ++k)
+      createColourTarget(gl_, GL_RGBA16F, size, "heap history", h.colour[k], h.framebuffer[k]);
+  }
+  // A cut: another batch, a camera moved or turned further than a stream of frames moves it,
+  // another lens, or time gone back or far on. The frame after it is the exact one.
+  const Camera& now = scene.camera;
+  const Camera& then = h.camera;
+  const ViewBasis a = viewBasis(now), b = viewBasis(then);
+  const double dt = scene.time_s - h.time_s;
+  h.valid =
+      h.valid && h.batch == batch && h.used + kKeptHistoryFrames > frame_ &&
+      now.vfov_deg == then.vfov_deg && glm::length(now.position - then.position) <= kCutStep_m &&
+      glm::dot(a.forward, b.forward) >= std::cos(glm::radians(kCutTurn_deg)) &&
+      glm::dot(a.up, b.up) >= std::cos(glm::radians(kCutTurn_deg)) && dt >= 0.0 && dt <= kCutTime_s;
+  h.batch = batch;
+  h.used = frame_;
+  return h;
 }
 
 GLuint EllipsoidRenderer::program(const EllipsoidPassLayout& layout) {
@@ -470,7 +526,7 @@ void EllipsoidRenderer::drawClouds(const Scene& scene, const std::vector<std::si
     // before the first read).
     if (cancel_ && queued_work_ > kCancelWork) finishQueued();
     if (stopNow()) return;
-    drawDirect(scene, members, settings, target, targets_drawn, band);
+    drawDirect(scene, members, settings, target, targets_drawn, band, key);
   }
 }
 
@@ -519,7 +575,7 @@ bool EllipsoidRenderer::drawImpostor(const Scene& scene, std::size_t index,
     gl_.BindFramebuffer(GL_FRAMEBUFFER, impostor.framebuffer.get());
     gl_.Viewport(0, 0, size, size);
     const FrameTarget impostor_target{impostor.framebuffer.get(), size, size};
-    drawDirect(view, {index}, settings, impostor_target, false, AltitudeBand{});
+    drawDirect(view, {index}, settings, impostor_target, false, AltitudeBand{}, "");
     gl_.BindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
     gl_.Viewport(0, 0, target.width, target.height);
     const ViewBasis basis = viewBasis(view.camera);
@@ -562,7 +618,8 @@ bool EllipsoidRenderer::drawImpostor(const Scene& scene, std::size_t index,
 
 void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::size_t>& indices,
                                    const RenderSettings& settings, const FrameTarget& target,
-                                   bool targets_drawn, const AltitudeBand& band) {
+                                   bool targets_drawn, const AltitudeBand& band,
+                                   const std::string& batch) {
   // The clouds look alike: the first one's texture and shading stand for all of them.
   const EllipsoidCloud& cloud = scene.clouds[indices.front()];
   // Visible ellipsoids with the back-to-front key (the front-to-back key, the nearest a hit
@@ -742,14 +799,30 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   const double tolerance = kVeiledTolerance / shown;
   const bool veiled = tolerance >= kVeiledSamplingFrom;
   const bool reduced = !veiled && settings.heap_shading_rate > 1;
+  // A continuous view walks one pixel in heap_refresh each frame, at a sample offset that goes
+  // round them all, and reuses its last frame for the others; the first frame after a cut is
+  // the exact one (MODEL.md section 15, "reuse across frames").
+  const glm::ivec2 frame_size(target.width, target.height);
+  HeapHistory* history = nullptr;
+  if (!continuous_view_.empty() && !batch.empty() && !veiled && !targets_drawn &&
+      settings.heap_refresh > 1) {
+    std::ostringstream key;
+    key << batch << '|' << band.slabs.x << ',' << band.slabs.y << ',' << band.slabs.z << ','
+        << band.slabs.w;
+    history = &heapHistory(scene, key.str(), frame_size);
+  }
+  const bool reuse = history && history->valid;
   const int rate = targets_drawn ? 1
                    : veiled      ? kVeiledShadingRate
+                   : reuse       ? refreshRate(settings.heap_refresh)
+                   : history     ? 1
                    : reduced     ? settings.heap_shading_rate
                                  : 1;
-  auto perPixelProgram = [&](EllipsoidProgram which) {
+  auto perPixelProgram = [&](EllipsoidProgram which, bool history_too = false) {
     EllipsoidPassLayout layout = base;
     layout.program = which;
     layout.shading_rate = rate;
+    layout.history = history_too;
     const GLuint p = program(layout);
     setCloudUniforms(p, scene, cloud, texture, layout.texture, band);
     gl_.ProgramUniform2i(p, gl_.GetUniformLocation(p, "u_bin_origin"), area.x, area.y);
@@ -767,13 +840,17 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   // of `size` whose pixel i stands at frame pixel i * step: each pixel composites every hit of
   // its bin, so disjoint rectangles give the image one quad gives. Samples are drawn to the
   // end of the last bin, past the frame's edge, for the pixels next to it.
-  auto drawRect = [&](GLuint program, glm::ivec2 size, int step, int bx0, int by0, int bx1,
-                      int by1) {
-    auto ndc = [&](int bins, int axis) {
-      return float(2.0 * std::min(bins * kPerPixelBinSize, size[axis] * step) / step / size[axis] -
+  // `extra` more samples are drawn past the last bin (a continuous view's shifted samples).
+  auto drawRect = [&](GLuint program, glm::ivec2 size, int step, int bx0, int by0, int bx1, int by1,
+                      int extra = 0) {
+    auto ndc = [&](int bins, int axis, int more) {
+      return float(2.0 *
+                       std::min(double(bins * kPerPixelBinSize) / step + more, double(size[axis])) /
+                       size[axis] -
                    1.0);
     };
-    const float x0 = ndc(bx0, 0), y0 = ndc(by0, 1), x1 = ndc(bx1 + 1, 0), y1 = ndc(by1 + 1, 1);
+    const float x0 = ndc(bx0, 0, 0), y0 = ndc(by0, 1, 0), x1 = ndc(bx1 + 1, 0, extra),
+                y1 = ndc(by1 + 1, 1, extra);
     const glm::vec2 polygon[4] = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
     gl_.UseProgram(program);
     gl_.ProgramUniform2fv(program, gl_.GetUniformLocation(program, "u_polygon"), 4, &polygon[0].x);
@@ -826,32 +903,100 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
     return true;
   };
   ++stats_->ellipsoid_passes;
-  const glm::ivec2 frame_size(target.width, target.height);
+  const GLfloat nothing[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+  // A continuous view's batch is drawn over the frame and, as it is, into its history's other
+  // texture in the same pass; that texture is the next frame's history.
+  const glm::ivec4 area_pixels =
+      glm::ivec4(area.x, area.y, area.z + 1, area.w + 1) * kPerPixelBinSize;
+  auto withHistory = [&](auto&& draw) {
+    const GLuint f = target.framebuffer;
+    gl_.NamedFramebufferTexture(f, GL_COLOR_ATTACHMENT1, history->colour[1 - history->last].get(),
+                                0);
+    const GLenum both[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    gl_.NamedFramebufferDrawBuffers(f, 2, both);
+    gl_.ClearNamedFramebufferfv(f, GL_COLOR, 1, nothing);
+    gl_.Disablei(GL_BLEND, 1);
+    const bool done = draw();
+    gl_.Enable(GL_BLEND);
+    const GLenum colour = GL_COLOR_ATTACHMENT0;
+    gl_.NamedFramebufferDrawBuffers(f, 1, &colour);
+    gl_.NamedFramebufferTexture(f, GL_COLOR_ATTACHMENT1, 0, 0);
+    history->valid = done;
+    if (!done) return;
+    history->last = 1 - history->last;
+    history->camera = scene.camera;
+    history->time_s = scene.time_s;
+    history->drift = scene.fields.empty() ? glm::dvec2(0.0) : scene.fields.front().drift_m;
+  };
   if (rate == 1) {
-    const GLuint p = perPixelProgram(EllipsoidProgram::kFusedPerPixel);
-    drawArea([&](int bx0, int by0, int bx1, int by1) {
-      drawRect(p, frame_size, 1, bx0, by0, bx1, by1);
-    });
+    const GLuint p = perPixelProgram(EllipsoidProgram::kFusedPerPixel, history != nullptr);
+    auto draw = [&] {
+      return drawArea([&](int bx0, int by0, int bx1, int by1) {
+        drawRect(p, frame_size, 1, bx0, by0, bx1, by1);
+      });
+    };
+    if (!history) {
+      draw();
+      return;
+    }
+    history->frames = 0;
+    withHistory(draw);
     return;
   }
   // Sample c stands at pixel c * rate; one more than the frame needs on each axis, so that
   // every pixel has samples on both sides. Those outside the area stay 0: nothing of the batch
-  // is there.
-  const glm::ivec2 size = (frame_size - 1) / rate + 2;
+  // is there. A continuous view's stand one sample further back, shifted by its offset.
+  const glm::ivec2 offset = reuse ? sampleOffset(history->frames + 1, rate) : glm::ivec2(0);
+  const glm::ivec2 origin = reuse ? offset - rate : glm::ivec2(0);
+  const glm::ivec2 size = (frame_size - 1) / rate + (reuse ? 3 : 2);
   prepareSamples(size);
   const GLuint s = perPixelProgram(EllipsoidProgram::kFusedSamples);
+  gl_.ProgramUniform2i(s, gl_.GetUniformLocation(s, "u_sample_origin"), origin.x, origin.y);
+  gl_.ProgramUniform1i(s, gl_.GetUniformLocation(s, "u_bins_y"), bins_y);
   gl_.BindFramebuffer(GL_FRAMEBUFFER, samples_framebuffer_.get());
   gl_.Viewport(0, 0, size.x, size.y);
-  const GLfloat nothing[4] = {0.0f, 0.0f, 0.0f, 0.0f};
   gl_.ClearNamedFramebufferfv(samples_framebuffer_.get(), GL_COLOR, 0, nothing);
+  gl_.ClearNamedFramebufferfv(samples_framebuffer_.get(), GL_COLOR, 1, nothing);
   gl_.Disable(GL_BLEND);
-  const bool done = drawArea(
-      [&](int bx0, int by0, int bx1, int by1) { drawRect(s, size, rate, bx0, by0, bx1, by1); });
+  const bool done = drawArea([&](int bx0, int by0, int bx1, int by1) {
+    drawRect(s, size, rate, bx0, by0, bx1, by1, reuse ? 2 : 0);
+  });
   gl_.Enable(GL_BLEND);
   gl_.BindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
   gl_.Viewport(0, 0, target.width, target.height);
-  if (!done) return;
+  if (!done) {
+    if (history) history->valid = false;
+    return;
+  }
   timer_->settle();  // the samples are read next
+  if (reuse) {
+    // This frame's samples and the last frame between them, into the history, then over the
+    // frame.
+    const GLuint p = perPixelProgram(EllipsoidProgram::kFusedResolve);
+    const ViewBasis last = viewBasis(history->camera);
+    setUniform3(gl_, p, "u_prev_x", last.right / (last.tan_half_vfov * last.aspect));
+    setUniform3(gl_, p, "u_prev_y", last.up / last.tan_half_vfov);
+    setUniform3(gl_, p, "u_prev_w", last.forward);
+    const glm::dvec2 drift =
+        (scene.fields.empty() ? glm::dvec2(0.0) : scene.fields.front().drift_m) - history->drift;
+    setUniform3(gl_, p, "u_prev_shift",
+                scene.camera.position - history->camera.position - glm::dvec3(drift, 0.0));
+    gl_.ProgramUniform2i(p, gl_.GetUniformLocation(p, "u_sample_origin"), origin.x, origin.y);
+    gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_reproject"), 1);
+    gl_.BindTextureUnit(kSamplesTextureUnit, samples_.get());
+    gl_.BindTextureUnit(kSampleDistanceTextureUnit, sample_distance_.get());
+    gl_.BindTextureUnit(kHistoryTextureUnit, history->colour[history->last].get());
+    bindFrameTexture(kRectTextureUnit, GL_RGBA32I, &area_pixels, sizeof(area_pixels));
+    withHistory([&] {
+      gl_.UseProgram(p);
+      gl_.DrawArrays(GL_TRIANGLES, 0, 6);
+      return true;
+    });
+    ++history->frames;
+    ++stats_->sampled_passes;
+    ++stats_->reused_passes;
+    return;
+  }
   const glm::ivec2 from = glm::ivec2(area.x, area.y) * kPerPixelBinSize / rate;
   const glm::ivec2 end = (glm::ivec2(area.z, area.w) + 1) * kPerPixelBinSize / rate;  // samples
   // The blended runs in one draw; the walked ones, when the frame can be cancelled, in groups
@@ -920,6 +1065,12 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
 void EllipsoidRenderer::prepareSamples(glm::ivec2 size) {
   if (samples_ && samples_size_ == size) return;
   createColourTarget(gl_, GL_RGBA16F, size, "samples", samples_, samples_framebuffer_);
+  sample_distance_ = createTexture(gl_, GL_TEXTURE_2D);
+  gl_.TextureStorage2D(sample_distance_.get(), 1, GL_R32F, size.x, size.y);
+  gl_.NamedFramebufferTexture(samples_framebuffer_.get(), GL_COLOR_ATTACHMENT1,
+                              sample_distance_.get(), 0);
+  const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+  gl_.NamedFramebufferDrawBuffers(samples_framebuffer_.get(), 2, buffers);
   samples_size_ = size;
 }
 

@@ -49,7 +49,9 @@ class EllipsoidRenderer {
 
   // Starts a frame: marks cached textures unused until a cloud asks for them again; the
   // frame's passes and ellipsoids are counted into `stats`.
-  void beginFrame(FrameStats& stats, GpuPassTimer& timer);
+  // `continuous_view` names the view a continuous stream of frames is drawn for (empty: an
+  // exact frame): its heaps reuse the last frame's (RenderSettings::heap_refresh).
+  void beginFrame(FrameStats& stats, GpuPassTimer& timer, const std::string& continuous_view = {});
   void endFrame();
 
   // Draws clouds `indices` of the scene (back to front by their distance) "over" what
@@ -91,6 +93,13 @@ class EllipsoidRenderer {
   static constexpr std::size_t kCancelRecords = 65536;
   static constexpr std::int64_t kCancelWork = std::int64_t(1) << 25;
   static constexpr std::size_t kCancelInstances = 16384;
+  // A continuous view's history is kept while its view draws at least once in
+  // kKeptHistoryFrames frames of the renderer, and reused across a step of at most kCutStep_m,
+  // a turn of at most kCutTurn_deg and at most kCutTime_s of world time: more is a cut.
+  static constexpr std::uint64_t kKeptHistoryFrames = 64;
+  static constexpr double kCutStep_m = 500.0;
+  static constexpr double kCutTurn_deg = 10.0;
+  static constexpr double kCutTime_s = 2.0;
   bool stopNow() {
     if (alive_) alive_();
     if (!cancelled_ && cancel_ && cancel_->load(std::memory_order_relaxed)) cancelled_ = true;
@@ -134,10 +143,11 @@ class EllipsoidRenderer {
     bool used = false;
   };
 
-  // Clouds `indices`, which look alike, drawn from their ellipsoids in one batch.
+  // Clouds `indices`, which look alike, drawn from their ellipsoids in one batch; `batch` is
+  // their look (empty for an impostor's picture, which has no history).
   void drawDirect(const Scene& scene, const std::vector<std::size_t>& indices,
                   const RenderSettings& settings, const FrameTarget& target, bool targets_drawn,
-                  const AltitudeBand& band);
+                  const AltitudeBand& band, const std::string& batch);
   // False when the cloud is too near for an impostor; then the caller draws it directly.
   bool drawImpostor(const Scene& scene, std::size_t index, const RenderSettings& settings,
                     const FrameTarget& target, bool targets_drawn, const AltitudeBand& band);
@@ -164,8 +174,27 @@ class EllipsoidRenderer {
                         std::vector<Tile>& tiles, const FrameTarget& target,
                         const AltitudeBand& band);
   void prepareAtlas(TileFormat format);
-  // The per-pixel pass's samples texture (RGBA16F) and its framebuffer, at `size`.
+  // The per-pixel pass's samples texture (RGBA16F) and their distances (R32F), and their
+  // framebuffer, at `size`.
   void prepareSamples(glm::ivec2 size);
+  // A continuous view's heaps of one batch as last drawn (MODEL.md section 15, "reuse across
+  // frames"): the premultiplied colour and coverage of the batch alone, at the frame's size,
+  // in two textures that take turns being read and written.
+  struct HeapHistory {
+    std::string batch;  // what the batch is: its texture, shading and band
+    GlObject colour[2], framebuffer[2];
+    glm::ivec2 size{0};
+    int last = 0;              // the texture holding the last frame
+    bool valid = false;        // it holds a frame this one may reuse
+    std::uint64_t frames = 0;  // frames resolved since the exact one: the sample offset
+    std::uint64_t used = 0;    // the renderer frame that last drew it
+    Camera camera;             // the last frame's
+    double time_s = 0.0;
+    glm::dvec2 drift{0.0};  // the clouds' drift then (the first field's; 0 without fields)
+  };
+  // The history of the batch drawn `ordinal`-th in this frame of the continuous view, valid
+  // when the same batch was drawn last time from a camera near enough to reuse.
+  HeapHistory& heapHistory(const Scene& scene, const std::string& batch, glm::ivec2 size);
 
   const GlApi& gl_;
   GlObject vertex_array_;  // empty: attribute-less draws
@@ -182,7 +211,7 @@ class EllipsoidRenderer {
   GlObject atlas_;
   GlObject atlas_framebuffer_;
   TileFormat atlas_format_ = TileFormat::kFloat;
-  GlObject samples_, samples_framebuffer_;
+  GlObject samples_, sample_distance_, samples_framebuffer_;
   glm::ivec2 samples_size_{0};
   std::map<std::string, GlObject> programs_;
   std::map<std::string, CachedTexture> textures_;
@@ -191,6 +220,10 @@ class EllipsoidRenderer {
   std::map<int, IndexedMesh> meshes_;
   std::map<std::size_t, Impostor> impostors_;  // by cloud index
   int impostor_renders_ = 0;
+  // Continuous views' heap histories by view, in the order the frame draws its batches.
+  std::map<std::string, std::vector<HeapHistory>> histories_;
+  std::string continuous_view_;
+  std::size_t next_history_ = 0;
   const std::atomic<bool>* cancel_ = nullptr;
   std::function<void()> alive_;
   bool cancelled_ = false;

@@ -249,6 +249,15 @@ uniform ivec2 u_bin_origin;
 uniform int u_bins_x;
 uniform int u_bin_size;
 uniform float u_opaque;  // the coverage past which the walk ends
+#ifdef HISTORY
+layout(location = 1) out vec4 o_history;  // a continuous view's first frame, kept
+#endif
+#ifdef SAMPLE_DISTANCE
+uniform int u_bins_y;
+// The distance in metres at which the walk's coverage passes 1/2 (of the last hit if it never
+// does; 0 where nothing is hit): what a continuous view reprojects the sample by.
+layout(location = 1) out float o_distance;
+#endif
 
 // Hits are ordered by (depth, ellipsoid index), so equal depths still have one order.
 bool before(float s, int i, float t, int j) { return s < t || (s == t && i < j); }
@@ -263,7 +272,14 @@ void main() {
   vec3 r = viewRay();
   float metres_per_unit = length(r);
   float limit = opaqueDistance(r) / metres_per_unit;
-  ivec2 bin = ivec2(FRAG_XY) / u_bin_size - u_bin_origin;
+  ivec2 bin = ivec2(floor(FRAG_XY / float(u_bin_size))) - u_bin_origin;
+#ifdef SAMPLE_DISTANCE
+  // Samples shifted by a continuous view's offset reach one sample past the batch's bins on
+  // either side, where nothing of the batch is.
+  o_distance = 0.0;
+  if (any(lessThan(bin, ivec2(0))) || bin.x >= u_bins_x || bin.y >= u_bins_y) discard;
+  float depth = 0.0;
+#endif
   ivec2 list = texelFetch(u_bins, bin.y * u_bins_x + bin.x).xy;
   // Front to back (MODEL.md section 15): the ellipsoids come nearest bound first, and a hit
   // that no ellipsoid still to come can be in front of is final. Up to four hits wait,
@@ -302,6 +318,9 @@ void main() {
     if (k >= list.y) next = kNone;
     if (waiting == 0) break;
     do {
+#ifdef SAMPLE_DISTANCE
+      if (result.a < 0.5) depth = d.x;
+#endif
       result += (1.0 - result.a) * ellipsoidSurface(id.x, r, d.x);
       d = vec4(d.yzw, kNone);
       id = ivec4(id.yzw, -1);
@@ -310,6 +329,12 @@ void main() {
   }
   if (result.a <= 0.0) discard;
   o_colour = result;
+#ifdef HISTORY
+  o_history = result;
+#endif
+#ifdef SAMPLE_DISTANCE
+  o_distance = depth * metres_per_unit;
+#endif
 }
 )";
 
@@ -323,6 +348,62 @@ void main() {
   vec2 at = floor(gl_FragCoord.xy) / float(SHADING_RATE) + 0.5;  // sample c's centre is c + 0.5
   o_colour = textureLod(u_samples, at / vec2(textureSize(u_samples, 0)), 0.0);
   if (o_colour.a <= 0.0) discard;
+}
+)";
+
+// A continuous view's heaps (MODEL.md section 15, "reuse across frames"): this frame's
+// samples, at one pixel in SHADING_RATE^2 from u_sample_origin, are exact where they stand;
+// every other pixel takes the last frame's heaps reprojected to it by its samples' distance,
+// the camera's motion and the clouds' drift, kept within the range of the four samples around
+// it, or the samples' blend where the last frame cannot vouch for it. Blended over the frame
+// and written as it is to the next frame's history.
+const char* kFusedResolve = R"(
+layout(location = 1) out vec4 o_history;
+layout(binding = 12) uniform sampler2D u_samples;
+layout(binding = 4) uniform sampler2D u_sample_distance;
+layout(binding = 5) uniform sampler2D u_history;
+uniform ivec2 u_sample_origin;  // the pixel of sample (0, 0)
+uniform bool u_reproject;       // a history to reproject
+uniform vec3 u_prev_x;          // the last frame's clip rows: right / (tan(vfov/2) aspect),
+uniform vec3 u_prev_y;          // up / tan(vfov/2)
+uniform vec3 u_prev_w;          // and forward
+uniform vec3 u_prev_shift;      // a cloud point's position from the last eye, less from this one
+const float kResolveMargin = 0.05;
+vec4 resolve() {
+  ivec2 q = ivec2(gl_FragCoord.xy) - u_sample_origin;
+  ivec2 c = q / SHADING_RATE, f = q - c * SHADING_RATE;
+  ivec2 top = textureSize(u_samples, 0) - 1;
+  ivec2 c1 = min(c + 1, top);
+  vec4 s00 = texelFetch(u_samples, c, 0), s10 = texelFetch(u_samples, ivec2(c1.x, c.y), 0);
+  vec4 s01 = texelFetch(u_samples, ivec2(c.x, c1.y), 0), s11 = texelFetch(u_samples, c1, 0);
+  if (f == ivec2(0)) return s00;
+  vec2 w = vec2(f) / float(SHADING_RATE);
+  vec4 blend = mix(mix(s00, s10, w.x), mix(s01, s11, w.x), w.y);
+  if (!u_reproject) return blend;
+  // The four samples' distances in one gather (its texels c and c + 1 on each axis).
+  vec4 d = textureGather(u_sample_distance, vec2(c + 1) / vec2(top + 1), 0);
+  // The nearest of the samples that hit: an edge reprojects with its foreground.
+  vec4 hit = mix(vec4(3.0e38), d, greaterThan(d, vec4(0.0)));
+  float distance = min(min(hit.x, hit.y), min(hit.z, hit.w));
+  if (distance >= 3.0e38) return blend;
+  vec3 point = normalize(viewRay()) * distance + u_prev_shift;
+  float depth = dot(point, u_prev_w);
+  if (depth <= 0.0) return blend;
+  vec2 uv = 0.5 * vec2(dot(point, u_prev_x), dot(point, u_prev_y)) / depth + 0.5;
+  if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return blend;
+  vec4 last = textureLod(u_history, uv, 0.0);
+  // Where the last frame had nothing that this one's samples see, it cannot vouch.
+  if (last.a <= 0.0 && blend.a > 0.0) return blend;
+  // Kept within the four samples' range widened by that range and kResolveMargin either
+  // side: soft detail between the samples survives, a stale surface (a heap since moved or
+  // grown, what was hidden coming into view) does not.
+  vec4 lo = min(min(s00, s10), min(s01, s11)), hi = max(max(s00, s10), max(s01, s11));
+  vec4 margin = hi - lo + kResolveMargin;
+  return clamp(last, max(lo - margin, 0.0), hi + margin);
+}
+void main() {
+  o_colour = resolve();
+  o_history = o_colour;
 }
 )";
 
@@ -398,6 +479,7 @@ std::string EllipsoidPassLayout::key() const {
   k += air ? 'f' : '-';
   k += specular ? 's' : '-';
   k += targets ? 't' : '-';
+  k += history ? 'h' : '-';
   k += std::to_string(shading_rate);
   return k;
 }
@@ -437,6 +519,7 @@ void main() {
 )";
       return s;
     case EllipsoidProgram::kFusedBlend:
+    case EllipsoidProgram::kFusedResolve:
     case EllipsoidProgram::kFusedRest:
       return s + R"(
 // Pixel rectangles (x0, y0, x1, y1), two triangles each.
@@ -475,6 +558,7 @@ std::string ellipsoidFragmentSource(const EllipsoidPassLayout& layout) {
   if (layout.air) s += "#define AIR\n";
   if (layout.specular) s += "#define SPECULAR\n";
   if (layout.targets) s += "#define TARGETS\n";
+  if (layout.history) s += "#define HISTORY\n";
   if (layout.spotlight) s += "#define SPOTLIGHT\n";
   if (layout.texture == SolidTextureKind::kProcedural) s += "#define PROCEDURAL\n";
   if (layout.texture == SolidTextureKind::kBakedGardner) s += "#define BAKED_GARDNER\n";
@@ -491,10 +575,13 @@ std::string ellipsoidFragmentSource(const EllipsoidPassLayout& layout) {
       s += "#define TILE_COLOUR\n";
       break;
     case EllipsoidProgram::kFusedSamples:
-      s += "#define FRAG_XY (floor(gl_FragCoord.xy) * " + std::to_string(layout.shading_rate) +
-           ".0 + 0.5)\n";
+      // Sample c stands at pixel c * rate + u_sample_origin (0 but in a continuous view).
+      s += "#define SAMPLE_DISTANCE\nuniform ivec2 u_sample_origin;\n#define FRAG_XY "
+           "(floor(gl_FragCoord.xy) * " +
+           std::to_string(layout.shading_rate) + ".0 + vec2(u_sample_origin) + 0.5)\n";
       break;
     case EllipsoidProgram::kFusedBlend:
+    case EllipsoidProgram::kFusedResolve:
       s += "#define SHADING_RATE " + std::to_string(layout.shading_rate) + "\n";
       break;
     default:
@@ -514,6 +601,8 @@ std::string ellipsoidFragmentSource(const EllipsoidPassLayout& layout) {
       return s + kFusedPerPixel;
     case EllipsoidProgram::kFusedBlend:
       return s + kFusedBlend;
+    case EllipsoidProgram::kFusedResolve:
+      return s + kFusedResolve;
     case EllipsoidProgram::kTileComposite:
       return s + kComposite;
     default:

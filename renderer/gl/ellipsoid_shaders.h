@@ -13,6 +13,7 @@ enum class EllipsoidProgram {
   kFusedSamples,   // the same walk at one pixel in shading_rate^2, into the samples texture
   kFusedBlend,     // the samples' blend over listed blocks whose four corner samples agree
   kFusedRest,      // the walk over the other blocks
+  kFusedResolve,   // a continuous view: the samples, and the last frame reprojected between
   kTileThreshold,  // Elinas pass 1: alpha = It - T1
   kTileLimb,       // Elinas pass 2: alpha -= (T2 - T1)(1 - g)
   kTileColour,     // Elinas colour pass: Gardner eq. 8, fogged
@@ -31,6 +32,7 @@ struct EllipsoidPassLayout {
   bool air = false;
   bool specular = false;
   bool targets = false;
+  bool history = false;  // kFusedPerPixel: also written to a continuous view's history
   int shading_rate = 1;  // kFusedSamples, kFusedBlend and kFusedRest: pixels between samples
 
   std::string key() const;
@@ -63,6 +65,8 @@ inline constexpr int kSpotlightTextureUnit = 10;
 inline constexpr int kAtlasTextureUnit = 11;
 inline constexpr int kImpostorTextureUnit = 12;
 inline constexpr int kSamplesTextureUnit = 12;  // no program reads both
+inline constexpr int kSampleDistanceTextureUnit = 4;  // kFusedResolve's
+inline constexpr int kHistoryTextureUnit = 5;
 inline constexpr int kRectTextureUnit = 6;
 inline constexpr int kFineVolumeTextureUnit = 14;
 inline constexpr int kTargetColourUnit = 14;  // matches the view chunk's bindings

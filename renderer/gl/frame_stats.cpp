@@ -14,6 +14,7 @@ std::vector<std::pair<const char*, int>> FrameStats::fields() const {
           {"target_passes", target_passes},
           {"veil_passes", veil_passes},
           {"sampled_passes", sampled_passes},
+          {"reused_passes", reused_passes},
           {"ellipsoids_drawn", ellipsoids_drawn},
           {"ellipsoids_culled", ellipsoids_culled},
           {"impostors_drawn", impostors_drawn},

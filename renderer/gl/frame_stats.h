@@ -83,6 +83,9 @@ struct FrameStats {
   int veil_passes = 0;       // the in-cloud veil
   // Per-pixel ellipsoid passes drawn from samples behind a thick veil (MODEL.md section 15)
   int sampled_passes = 0;
+  // Of those, a continuous view's heaps resolved with its last frame (MODEL.md section 15,
+  // "reuse across frames")
+  int reused_passes = 0;
   int ellipsoids_drawn = 0;    // in view and drawn (directly or into an impostor)
   int ellipsoids_culled = 0;   // behind the eye, off screen, or with the eye inside
   int impostors_drawn = 0;     // far clouds drawn from an impostor

@@ -63,6 +63,8 @@ using GlDepthMaskProc = void(APIENTRYP)(GLboolean flag);
   X(PFNGLVIEWPORTPROC, Viewport)                                         \
   X(PFNGLENABLEPROC, Enable)                                             \
   X(PFNGLDISABLEPROC, Disable)                                           \
+  X(PFNGLENABLEIPROC, Enablei)                                           \
+  X(PFNGLDISABLEIPROC, Disablei)                                         \
   X(PFNGLBLENDFUNCSEPARATEPROC, BlendFuncSeparate)                       \
   X(GlDrawArraysProc, DrawArrays)                                        \
   X(PFNGLPIXELSTOREIPROC, PixelStorei)                                   \

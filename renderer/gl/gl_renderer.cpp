@@ -622,7 +622,7 @@ void GlRenderer::drawScene(const Scene& scene, const RenderSettings& settings,
   else
     gl_.Disable(GL_FRAMEBUFFER_SRGB);
   ++frame_;
-  ellipsoids_.beginFrame(stats_, timer_);
+  ellipsoids_.beginFrame(stats_, timer_, continuous_view_);
   automata_.beginFrame(stats_);
   clipmaps_.beginFrame();
   auto finish = [&](const Veil& veil) {

@@ -55,6 +55,12 @@ class GlRenderer {
   // which need target layers of the same size.
   std::string reserveTarget(int width, int height, bool linear, bool targets);
 
+  // The view that the frames from now on belong to, one of a stream that moves continuously
+  // (a subscription, a host's channel), or empty (the default) when every frame must be the
+  // exact one. A continuous view's heaps reuse its last frame (RenderSettings::heap_refresh,
+  // MODEL.md section 15, "reuse across frames"); its first frame, and the first after a cut,
+  // are exact.
+  void setContinuousView(std::string view) { continuous_view_ = std::move(view); }
   // Far-cloud impostors rendered since construction (each reuse saves one).
   int impostorRenders() const { return ellipsoids_.impostorRenders(); }
   // A flag another thread may raise to cancel the frame being rendered; a cancelled frame's
@@ -117,6 +123,7 @@ class GlRenderer {
   int target_height_ = 0;
   TargetFormat target_format_ = TargetFormat::kFloat;
   std::map<std::string, GlObject> programs_;
+  std::string continuous_view_;
   std::map<std::string, CachedTexture> textures_;
   std::uint64_t frame_ = 0;  // frames drawn
   GlObject floor_program_;
