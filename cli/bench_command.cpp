@@ -43,6 +43,9 @@ struct Setting {
   // The knob changes the model itself (not how closely it is drawn): its error is measured
   // against the reference image of the edited scene.
   bool changes_model = false;
+  // Drawn as a continuous view (GlRenderer::setContinuousView): its image is the frame after
+  // flying into the view at 250 m/s for 16 frames at 30 Hz, its time that of the view streamed.
+  bool stream = false;
 
   std::string name() const { return knob.empty() ? "defaults" : knob + "=" + value; }
 };
@@ -152,6 +155,16 @@ std::vector<Setting> settingsFor(const SceneFile& file) {
     for (int rate : {2, 4})
       add("heap_shading_rate", std::to_string(rate),
           [rate](RenderSettings& s) { s.heap_shading_rate = rate; });
+  // A continuous view's reuse of its last frame (issue 46): one heap pixel in 4 or 16 walked
+  // anew a frame (the other points are single renders, exact whatever heap_refresh says).
+  if (!file.scene.clouds.empty() || !file.scene.fields.empty())
+    for (int refresh : {4, 16})
+      out.push_back({"heap_refresh",
+                     std::to_string(refresh),
+                     [refresh](RenderSettings& s) { s.heap_refresh = refresh; },
+                     {},
+                     false,
+                     true});
   // The frame's work budget (issue 31): the presets hold a few thousand ellipsoids in view, so
   // budgets below that show what thinning costs (the default, 65,536, changes none of them).
   if (!file.scene.clouds.empty() || !file.scene.fields.empty())
@@ -588,7 +601,16 @@ int runBenchCommand(const BenchCommandOptions& o) {
         renderer.renderSrgb8(edited[k], renders[k]);
         if (warm > 0 && renderer.lastFrameStats().layer_texels_baked == 0) break;
       }
+      if (setting.stream) {
+        renderer.setContinuousView("sweep " + std::to_string(k));
+        Scene approach = edited[k];
+        for (int frame = 16; frame > 0; --frame) {
+          approach.camera.position.x = edited[k].camera.position.x - 250.0 / 30.0 * frame;
+          renderer.renderSrgb8(approach, renders[k]);
+        }
+      }
       const FloatImage image = renderer.renderFloat(edited[k], renders[k]);
+      renderer.setContinuousView("");
       if (setting.changes_model) {
         if (tty)
           std::fprintf(stderr, "\r%s: reference for %s", tag.c_str(), setting.name().c_str());
@@ -611,9 +633,11 @@ int runBenchCommand(const BenchCommandOptions& o) {
           std::fprintf(stderr, "\r%s: timing round %d, %zu/%zu %-50s", tag.c_str(), round, k + 1,
                        settings.size(), settings[k].name().c_str());
         Point& point = result.points[k];
+        if (settings[k].stream) renderer.setContinuousView("sweep " + std::to_string(k));
         point.ms = std::min(point.ms, medianMilliseconds(repeats, [&] {
                               renderer.renderSrgb8(edited[k], renders[k]);
                             }));
+        renderer.setContinuousView("");
         point.floor_multiple = point.ms / result.floor_ms;
       }
     std::fprintf(stderr, "%s%s: %zu settings, %.0f s since the start%40s\n", tty ? "\r" : "",

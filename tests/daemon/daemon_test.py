@@ -825,6 +825,39 @@ class HostStateTest(DaemonTest):
         self.assertEqual(c.ok({"cmd": "hash"})["ticks"], 3)
         c.ok({"cmd": "unsubscribe", "subscription": sub})
 
+    def test_a_subscription_reuses_its_last_frame_and_a_render_is_exact(self):
+        # Issue 46, item 2: a view's subscribed frames are one stream whose heaps reuse the
+        # last frame (heap_refresh, default 4), while a render reply is the exact frame; the
+        # first frame after a world edit is exact again.
+        d = self.daemon()
+        c = d.client()
+        c.ok({"cmd": "subscribe", "view": "front", "rate": 60, "format": "raw"})
+        c.read()  # the subscription's first frame: exact
+        self.assertEqual(c.ok({"cmd": "stats"})["last_frame"]["reused_passes"], 0)
+
+        def tick():
+            c.send({"cmd": "tick", "dt": 0.1})
+            frame = reply = None
+            while frame is None or reply is None:
+                header, body = c.read()
+                if header.get("event") == "frame":
+                    frame = body
+                else:
+                    reply = header
+            return frame
+
+        streamed = [tick() for _ in range(3)][-1]
+        self.assertGreater(c.ok({"cmd": "stats"})["last_frame"]["reused_passes"], 0)
+        _, exact = c.ok({"cmd": "render", "view": "front", "format": "raw"})
+        self.assertEqual(c.ok({"cmd": "stats"})["last_frame"]["reused_passes"], 0)
+        self.assertEqual(len(exact), len(streamed))
+        differences = [abs(a - b) for a, b in zip(streamed, exact)]
+        self.assertNotEqual(max(differences), 0, "the streamed frame reused nothing")
+        self.assertLess(sum(differences) / len(differences), 1.0)  # mean, of 255
+        c.ok({"cmd": "set_weather", "layer": 1, "type": 9, "base": 900, "coverage": 30})
+        tick()
+        self.assertEqual(c.ok({"cmd": "stats"})["last_frame"]["reused_passes"], 0)
+
     def test_mode_switch_and_tick_in_realtime(self):
         d = self.daemon(mode="realtime")
         c = d.client()
