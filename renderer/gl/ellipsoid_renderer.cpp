@@ -906,8 +906,6 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   const GLfloat nothing[4] = {0.0f, 0.0f, 0.0f, 0.0f};
   // A continuous view's batch is drawn over the frame and, as it is, into its history's other
   // texture in the same pass; that texture is the next frame's history.
-  const glm::ivec4 area_pixels =
-      glm::ivec4(area.x, area.y, area.z + 1, area.w + 1) * kPerPixelBinSize;
   auto withHistory = [&](auto&& draw) {
     const GLuint f = target.framebuffer;
     gl_.NamedFramebufferTexture(f, GL_COLOR_ATTACHMENT1, history->colour[1 - history->last].get(),
@@ -982,14 +980,24 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
     setUniform3(gl_, p, "u_prev_shift",
                 scene.camera.position - history->camera.position - glm::dvec3(drift, 0.0));
     gl_.ProgramUniform2i(p, gl_.GetUniformLocation(p, "u_sample_origin"), origin.x, origin.y);
-    gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_reproject"), 1);
     gl_.BindTextureUnit(kSamplesTextureUnit, samples_.get());
     gl_.BindTextureUnit(kSampleDistanceTextureUnit, sample_distance_.get());
     gl_.BindTextureUnit(kHistoryTextureUnit, history->colour[history->last].get());
-    bindFrameTexture(kRectTextureUnit, GL_RGBA32I, &area_pixels, sizeof(area_pixels));
+    // Only the bins some ellipsoid of the batch overlaps, as runs along each row of bins:
+    // elsewhere the batch has nothing, which the cleared history already holds.
+    std::vector<glm::ivec4> runs;
+    for (int y = area.y; y <= area.w; ++y)
+      for (int x = area.x; x <= area.z; ++x) {
+        if (binAt(x, y).y == 0) continue;
+        int to = x + 1;
+        while (to <= area.z && binAt(to, y).y > 0) ++to;
+        runs.push_back(glm::ivec4(x, y, to, y + 1) * kPerPixelBinSize);
+        x = to;
+      }
+    bindFrameTexture(kRectTextureUnit, GL_RGBA32I, runs.data(), runs.size() * sizeof(runs[0]));
     withHistory([&] {
       gl_.UseProgram(p);
-      gl_.DrawArrays(GL_TRIANGLES, 0, 6);
+      gl_.DrawArrays(GL_TRIANGLES, 0, GLsizei(6 * runs.size()));
       return true;
     });
     ++history->frames;

@@ -363,7 +363,6 @@ layout(binding = 12) uniform sampler2D u_samples;
 layout(binding = 4) uniform sampler2D u_sample_distance;
 layout(binding = 5) uniform sampler2D u_history;
 uniform ivec2 u_sample_origin;  // the pixel of sample (0, 0)
-uniform bool u_reproject;       // a history to reproject
 uniform vec3 u_prev_x;          // the last frame's clip rows: right / (tan(vfov/2) aspect),
 uniform vec3 u_prev_y;          // up / tan(vfov/2)
 uniform vec3 u_prev_w;          // and forward
@@ -379,7 +378,6 @@ vec4 resolve() {
   if (f == ivec2(0)) return s00;
   vec2 w = vec2(f) / float(SHADING_RATE);
   vec4 blend = mix(mix(s00, s10, w.x), mix(s01, s11, w.x), w.y);
-  if (!u_reproject) return blend;
   // The four samples' distances in one gather (its texels c and c + 1 on each axis).
   vec4 d = textureGather(u_sample_distance, vec2(c + 1) / vec2(top + 1), 0);
   // The nearest of the samples that hit: an edge reprojects with its foreground.
