@@ -26,6 +26,13 @@ int refreshRate(int refresh) {
   return refresh >= 16 ? 4 : refresh >= 4 ? 2 : 1;
 }
 
+// How far the scene's heaps have drifted with the wind (its first field's drift; explicit
+// clouds' drift is not known to a frame and counts as none): what a continuous view's history
+// moves by between frames besides the camera.
+glm::dvec2 heapDrift(const Scene& scene) {
+  return scene.fields.empty() ? glm::dvec2(0.0) : scene.fields.front().drift_m;
+}
+
 // Frame k's sample offset within the rate x rate block: the ordered-dither (Bayer) order, so
 // that the offsets of consecutive frames lie far apart and rate^2 frames visit every pixel.
 glm::ivec2 sampleOffset(std::uint64_t k, int rate) {
@@ -924,7 +931,7 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
     history->last = 1 - history->last;
     history->camera = scene.camera;
     history->time_s = scene.time_s;
-    history->drift = scene.fields.empty() ? glm::dvec2(0.0) : scene.fields.front().drift_m;
+    history->drift = heapDrift(scene);
   };
   if (rate == 1) {
     const GLuint p = perPixelProgram(EllipsoidProgram::kFusedPerPixel, history != nullptr);
@@ -975,8 +982,7 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
     setUniform3(gl_, p, "u_prev_x", last.right / (last.tan_half_vfov * last.aspect));
     setUniform3(gl_, p, "u_prev_y", last.up / last.tan_half_vfov);
     setUniform3(gl_, p, "u_prev_w", last.forward);
-    const glm::dvec2 drift =
-        (scene.fields.empty() ? glm::dvec2(0.0) : scene.fields.front().drift_m) - history->drift;
+    const glm::dvec2 drift = heapDrift(scene) - history->drift;
     setUniform3(gl_, p, "u_prev_shift",
                 scene.camera.position - history->camera.position - glm::dvec3(drift, 0.0));
     gl_.ProgramUniform2i(p, gl_.GetUniformLocation(p, "u_sample_origin"), origin.x, origin.y);

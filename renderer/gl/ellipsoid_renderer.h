@@ -190,7 +190,7 @@ class EllipsoidRenderer {
     std::uint64_t used = 0;    // the renderer frame that last drew it
     Camera camera;             // the last frame's
     double time_s = 0.0;
-    glm::dvec2 drift{0.0};  // the clouds' drift then (the first field's; 0 without fields)
+    glm::dvec2 drift{0.0};  // the heaps' drift then (heapDrift)
   };
   // The history of the batch drawn `ordinal`-th in this frame of the continuous view, valid
   // when the same batch was drawn last time from a camera near enough to reuse.
