@@ -325,6 +325,9 @@ TEST(SceneFile, BadTargetsAndKnobsAreRejected) {
               HasSubstr("(one of: centre, per-pixel)"));
   EXPECT_THAT(parseError("[render]\nheap_detail = -1\n"),
               HasSubstr("render.heap_detail: -1 is out of range (allowed: 0 to 10000)"));
+  EXPECT_THAT(parseError("[render]\nheap_refresh = 8\n"),
+              HasSubstr("render.heap_refresh: 8 is not allowed (allowed: 1, 4 or 16"));
+  EXPECT_THAT(parseError("[render]\nheap_refresh = 0\n"), HasSubstr("render.heap_refresh"));
   EXPECT_THAT(parseError("[haze]\nvisibility = 5\n"),
               HasSubstr("haze.visibility: 5 is out of range (allowed: 10 to 1e+07)"));
   EXPECT_THAT(parseError("[haze]\ncolour = [1, 1, 1]\n"), HasSubstr("colour"));
