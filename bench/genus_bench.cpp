@@ -598,8 +598,12 @@ int main(int argc, char** argv) {
         flyer.setContinuousView("flight");
         std::vector<double> ms;
         Scene moving = scene;
-        for (int frame = 0; frame < repeats; ++frame) {
+        // Frame k of the flight: east at `speed` at 30 Hz, from 50 km east of the still view.
+        auto flyTo = [&](int frame) {
           moving.camera.position.x = scene.camera.position.x + speed / 30.0 * frame + 50000.0;
+        };
+        for (int frame = 0; frame < repeats; ++frame) {
+          flyTo(frame);
           const auto start = Clock::now();
           flyer.renderSrgb8(moving, file.render);
           ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
@@ -607,7 +611,7 @@ int main(int argc, char** argv) {
         std::vector<double> warm;
         double strip_texels = 0.0;  // clipmap texels evaluated per warm frame
         for (int frame = repeats; frame < 60 + repeats; ++frame) {
-          moving.camera.position.x = scene.camera.position.x + speed / 30.0 * frame + 50000.0;
+          flyTo(frame);
           const auto start = Clock::now();
           flyer.renderSrgb8(moving, file.render);
           if (frame < 60) continue;
@@ -617,8 +621,7 @@ int main(int argc, char** argv) {
         const FrameTimes flight_budget = flyer.lastFrameStats().times;
         const std::string flight_stats = flyer.lastFrameStats().line();
         // The next frame of the flight against the exact frame of its pose.
-        moving.camera.position.x =
-            scene.camera.position.x + speed / 30.0 * (60 + repeats) + 50000.0;
+        flyTo(60 + repeats);
         const FloatImage reused = flyer.renderFloat(moving, file.render);
         flyer.setContinuousView("");
         const FloatImage exact = flyer.renderFloat(moving, file.render);
@@ -644,9 +647,10 @@ int main(int argc, char** argv) {
             warm_flying / clear_ms, warm_slowest, warm_slowest / clear_ms, drawnEllipsoids(scene));
         printBudgets();
         std::printf(
-            "  budget, warm flight: %s\n  flight at heap_refresh %d: last frame against the exact "
-            "one %.1f dB, "
-            "largest difference %.3f\n  %s\n",
+            "  budget, warm flight: %s\n"
+            "  flight at heap_refresh %d: last frame against the exact one %.1f dB, largest "
+            "difference %.3f\n"
+            "  %s\n",
             bench::frameBudgetLine(flight_budget).c_str(), file.render.heap_refresh,
             reuse_error.psnr_db, reuse_error.max_abs, flight_stats.c_str());
         if (!fill.empty()) {
