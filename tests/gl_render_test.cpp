@@ -209,6 +209,50 @@ TEST_F(GlRenderTest, RegionBoundedLayerEqualsOneSampleReference) {
   EXPECT_LT(after, 0.5 * before);
 }
 
+// A far deck's hole (CloudLayer::hole_radius_m) confines the deck to a strip along the horizon,
+// and the sky passes leave it out of the rest of the screen: exact against the one-sample
+// reference with the view rolled, from below and from above, fused and one pass a layer, with
+// a layer without a hole on the same side. The views keep the horizon out of the frame (GL
+// smooths the ground's edge over a pixel, the one-sample reference does not) and the hole's
+// edge at 45 degrees across it. The deck shows beyond its hole.
+TEST_F(GlRenderTest, FarDeckBeyondItsHoleEqualsOneSampleReference) {
+  SceneFile file = preset("stratus");
+  CloudLayer& deck = file.scene.layers[0];
+  deck.threshold = 0.2;
+  deck.hole_radius_m = 2000.0;  // the deck is 2 km above the ground and below the upper view
+  deck.hole_band_m = 500.0;
+  CloudLayer high = preset("cirrus").scene.layers[0];
+  file.scene.layers.push_back(high);
+  struct View {
+    double z_m, pitch_deg, roll_deg;
+  };
+  for (const View& v : {View{2.0, 40.0, 15.0}, View{4000.0, -40.0, -15.0}}) {
+    file.scene.camera.position.z = v.z_m;
+    file.scene.camera.orientation.pitch_deg = v.pitch_deg;
+    file.scene.camera.orientation.roll_deg = v.roll_deg;
+    for (SkyPasses passes : {SkyPasses::kFused, SkyPasses::kMultipass}) {
+      const std::string name = "far_deck_" + std::to_string(int(v.z_m)) +
+                               (passes == SkyPasses::kFused ? "_fused" : "_multipass");
+      RenderSettings settings = pointSampled();
+      settings.sky_passes = passes;
+      const FloatImage gl = renderer_->renderFloat(file.scene, settings);
+      const FloatImage reference = renderReference(file.scene, {1, 0});
+      float worst = 0.0f;
+      for (std::size_t i = 0; i < gl.rgba.size(); ++i)
+        worst = std::max(worst, std::abs(gl.rgba[i] - reference.rgba[i]));
+      EXPECT_LE(worst, 2e-3f) << name;
+      if (worst > 2e-3f) writeFailureImages(gl, reference, name);
+    }
+  }
+  // Without the layer above: the deck covers part of the view.
+  file.scene.layers.pop_back();
+  const FloatImage level = renderer_->renderFloat(file.scene, pointSampled());
+  Scene bare = file.scene;
+  bare.layers.clear();
+  const FloatImage sky = renderer_->renderFloat(bare, pointSampled());
+  EXPECT_GT(compareImages(level, sky).max_abs, 0.05);
+}
+
 // A deck below the camera and a layer above it, seen from between them: exact against the
 // one-sample reference, and filtered against the 4x4 reference. Seen from above at a slant,
 // the deck's full plaid is resolved by the 4x4 reference only partly where GL drops its

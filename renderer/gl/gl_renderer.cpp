@@ -21,18 +21,24 @@
 namespace nephele {
 namespace {
 
-// The part of the screen square [-1, 1]^2 where a * x + b * y + c >= 0, as a convex polygon
-// (Sutherland-Hodgman against one line). Empty when nothing is left.
-std::vector<glm::vec2> clipScreenToHalfPlane(double a, double b, double c) {
-  const glm::dvec2 square[4] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+// The part of convex polygon `in` where a * x + b * y + c >= 0 (Sutherland-Hodgman against one
+// line). Empty when nothing is left. The two sides of one line share their new vertices
+// exactly (negating a, b and c negates every f below, and the quotient with it).
+std::vector<glm::vec2> clipPolygon(const std::vector<glm::vec2>& in, double a, double b,
+                                   double c) {
   std::vector<glm::vec2> out;
-  for (int i = 0; i < 4; ++i) {
-    const glm::dvec2 p = square[i], q = square[(i + 1) % 4];
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    const glm::dvec2 p = in[i], q = in[(i + 1) % in.size()];
     const double fp = a * p.x + b * p.y + c, fq = a * q.x + b * q.y + c;
     if (fp >= 0.0) out.emplace_back(p);
     if ((fp >= 0.0) != (fq >= 0.0)) out.emplace_back(p + (q - p) * (fp / (fp - fq)));
   }
-  return out;
+  return out.size() >= 3 ? out : std::vector<glm::vec2>{};
+}
+
+// The part of the screen square [-1, 1]^2 where a * x + b * y + c >= 0.
+std::vector<glm::vec2> clipScreenToHalfPlane(double a, double b, double c) {
+  return clipPolygon({{-1, -1}, {1, -1}, {1, 1}, {-1, 1}}, a, b, c);
 }
 
 // The Gardner terms the sky shader's termCount lets a pixel of this layer evaluate at most:
@@ -533,19 +539,53 @@ void GlRenderer::drawSkyGroup(const Scene& scene, const RenderSettings& settings
     gl_.Disable(GL_BLEND);
   else
     gl_.Enable(GL_BLEND);
+  // A far deck is clear within its hole (CloudLayer::hole_radius_m of horizontal distance from
+  // the camera), so a ray steeper than |h| / radius never shows it. With r = forward +
+  // x right' + y up' (right' and up' scaled to the screen's half extents), |r.xy| <= |r| <=
+  // r_max over the screen, so every ray that can reach the deck beyond its hole satisfies
+  // sign r.z <= r_max |h| / radius: a half-plane of the screen along the horizon. This is the
+  // strip of slot `slot`, as the line a x + b y + c >= 0; none for a layer without a hole.
+  const double r_max = std::sqrt(1.0 + basis.tan_half_vfov * basis.tan_half_vfov *
+                                           (1.0 + basis.aspect * basis.aspect));
+  auto strip = [&](const LayerSlot& slot, double sign) -> std::optional<glm::dvec3> {
+    const CloudLayer& l = *slot.layer;
+    if (l.hole_radius_m <= 0.0) return std::nullopt;
+    const double reach = r_max * std::abs(l.altitude_m - camera.position.z) / l.hole_radius_m;
+    return glm::dvec3(-sign * basis.right.z * basis.tan_half_vfov * basis.aspect,
+                      -sign * basis.up.z * basis.tan_half_vfov, reach - sign * basis.forward.z);
+  };
   if (fused) {
     // One pass per side of the horizon, each with the background and that side's layers:
-    // pixels below the horizon never run the code of layers above the camera. The two
-    // polygons share their edge exactly, so every pixel is drawn once.
+    // pixels below the horizon never run the code of layers above the camera. Where that
+    // side has far decks, it is cut again along the widest of their strips: beyond it the
+    // pass leaves them out. The polygons share their edges exactly, so every pixel is drawn
+    // once.
     for (const auto* side : {&above, &below}) {
       if (!background && side->empty()) continue;
-      const std::vector<glm::vec2> polygon = sideOfHorizon(side == &above ? 1.0 : -1.0, 0.0);
-      if (polygon.size() < 3) continue;
-      SkyPassLayout layout = base;
-      layout.background = background;
-      for (const LayerSlot& slot : *side)
-        (side == &above ? layout.above : layout.below).push_back(slot.kind);
-      drawSkyPass(scene, settings, layout, *side, polygon);
+      const double sign = side == &above ? 1.0 : -1.0;
+      const std::vector<glm::vec2> polygon = sideOfHorizon(sign, 0.0);
+      if (polygon.empty()) continue;
+      std::optional<glm::dvec3> widest;
+      std::vector<LayerSlot> open;  // the slots drawn beyond the widest strip
+      for (const LayerSlot& slot : *side) {
+        const std::optional<glm::dvec3> line = strip(slot, sign);
+        if (!line) open.push_back(slot);
+        else if (!widest || line->z > widest->z) widest = line;
+      }
+      auto draw = [&](const std::vector<LayerSlot>& slots, const std::vector<glm::vec2>& area) {
+        if (area.empty() || (!background && slots.empty())) return;
+        SkyPassLayout layout = base;
+        layout.background = background;
+        for (const LayerSlot& slot : slots)
+          (side == &above ? layout.above : layout.below).push_back(slot.kind);
+        drawSkyPass(scene, settings, layout, slots, area);
+      };
+      if (!widest) {
+        draw(*side, polygon);
+        continue;
+      }
+      draw(*side, clipPolygon(polygon, widest->x, widest->y, widest->z));
+      draw(open, clipPolygon(polygon, -widest->x, -widest->y, -widest->z));
     }
     return;
   }
@@ -556,9 +596,15 @@ void GlRenderer::drawSkyGroup(const Scene& scene, const RenderSettings& settings
   }
   for (const auto* side : {&above, &below})
     for (const LayerSlot& slot : *side) {
-      // Only where rays meet the plane, plus two pixels the shader leaves untouched.
-      const std::vector<glm::vec2> polygon = sideOfHorizon(side == &above ? 1.0 : -1.0, 2.0);
-      if (polygon.size() < 3) continue;
+      // Only where rays meet the plane (and reach beyond a far deck's hole), plus two pixels
+      // the shader leaves untouched.
+      const double sign = side == &above ? 1.0 : -1.0;
+      std::vector<glm::vec2> polygon = sideOfHorizon(sign, 2.0);
+      if (const std::optional<glm::dvec3> line = strip(slot, sign))
+        polygon = clipPolygon(polygon, line->x, line->y,
+                              line->z + 2.0 * (std::abs(line->x) * 2.0 / camera.width +
+                                               std::abs(line->y) * 2.0 / camera.height));
+      if (polygon.empty()) continue;
       SkyPassLayout layout = base;
       layout.background = false;
       (side == &above ? layout.above : layout.below).push_back(slot.kind);
