@@ -1001,6 +1001,7 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
         x = to;
       }
     bindFrameTexture(kRectTextureUnit, GL_RGBA32I, runs.data(), runs.size() * sizeof(runs[0]));
+    GpuPassScope pass(*timer_, GpuPass::kReuse);
     withHistory([&] {
       gl_.UseProgram(p);
       gl_.DrawArrays(GL_TRIANGLES, 0, GLsizei(6 * runs.size()));

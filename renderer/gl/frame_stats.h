@@ -32,10 +32,11 @@ enum class GpuPass : std::size_t {
   kHeaps,     // ellipsoid clouds: fused, per-pixel, samples, tiles, impostors
   kAutomata,  // volume marches
   kVeil,      // the in-cloud veil
+  kReuse,     // a continuous view's last frame reprojected and merged with this frame's samples
   kCount
 };
 inline constexpr std::array<const char*, std::size_t(GpuPass::kCount)> kGpuPassNames{
-    "targets", "clipmaps", "sky", "heaps", "automata", "veil"};
+    "targets", "clipmaps", "sky", "heaps", "automata", "veil", "reuse"};
 
 struct FrameTimes {
   std::array<double, std::size_t(CpuStage::kCount)> cpu_ms{};
