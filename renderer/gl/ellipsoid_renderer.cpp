@@ -9,6 +9,7 @@
 #include <numbers>
 #include <optional>
 #include <sstream>
+#include <thread>
 
 #include "image/image_encoding.h"
 #include "renderer/gl/sky_shaders.h"
@@ -635,27 +636,48 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
     double centre_distance;
     EllipsoidRecord record;
   };
-  std::vector<Visible> visible;
   const bool spotlight = settings.limb == LimbEvaluation::kSpotlight;
-  int total = 0;
-  std::size_t seen = 0;
   std::optional<StageClock> records_clock(std::in_place, stats_->times.cpu(CpuStage::kRecords));
-  for (std::size_t index : indices) {
-    const EllipsoidCloud& member = scene.clouds[index];
-    total += int(member.ellipsoids.size());
-    const std::vector<HeapEnvelope> envelopes = heapEnvelopes(member);
-    for (std::size_t i = 0; i < member.ellipsoids.size(); ++i) {
-      if (++seen % kCancelRecords == 0 && stopNow()) return;
-      Visible v;
-      if (!makeEllipsoidRecord(member.ellipsoids[i], scene.camera, spotlight, v.record,
-                               v.centre_distance))
-        continue;
-      const HeapEnvelope& e = envelopes[i];
-      v.record.v[17] = glm::vec4(row(e.centre - scene.camera.position, e.extinction));
-      v.record.v[18] = glm::vec4(glm::dvec4(1.0 / e.radii, 0.0));
-      visible.push_back(v);
+  // The records of members [from, to) in order; each ellipsoid's is its own, so a batch of many
+  // is split over up to kRecordThreads threads by members and joined in order: the same
+  // records whatever the split.
+  auto recordsOf = [&](std::size_t from, std::size_t to, bool watch) {
+    std::vector<Visible> out;
+    std::size_t seen = 0;
+    for (std::size_t m = from; m < to; ++m) {
+      const EllipsoidCloud& member = scene.clouds[indices[m]];
+      const std::vector<HeapEnvelope> envelopes = heapEnvelopes(member);
+      for (std::size_t i = 0; i < member.ellipsoids.size(); ++i) {
+        if (++seen % kCancelRecords == 0 &&
+            (watch ? stopNow() : cancel_ && cancel_->load(std::memory_order_relaxed)))
+          return out;
+        Visible v;
+        if (!makeEllipsoidRecord(member.ellipsoids[i], scene.camera, spotlight, v.record,
+                                 v.centre_distance))
+          continue;
+        const HeapEnvelope& e = envelopes[i];
+        v.record.v[17] = glm::vec4(row(e.centre - scene.camera.position, e.extinction));
+        v.record.v[18] = glm::vec4(glm::dvec4(1.0 / e.radii, 0.0));
+        out.push_back(v);
+      }
     }
+    return out;
+  };
+  int total = 0;
+  for (std::size_t index : indices) total += int(scene.clouds[index].ellipsoids.size());
+  const int threads =
+      std::clamp(std::min(int(std::thread::hardware_concurrency()), total / kRecordsPerThread), 1,
+                 std::min(kRecordThreads, int(indices.size())));
+  std::vector<std::future<std::vector<Visible>>> parts;
+  for (int t = 1; t < threads; ++t)
+    parts.push_back(std::async(std::launch::async, recordsOf, indices.size() * t / threads,
+                               indices.size() * (t + 1) / threads, false));
+  std::vector<Visible> visible = recordsOf(0, indices.size() / threads, true);
+  for (auto& part : parts) {
+    const std::vector<Visible> more = part.get();
+    visible.insert(visible.end(), more.begin(), more.end());
   }
+  if (stopNow()) return;
   records_clock.reset();
   stats_->ellipsoids_drawn += int(visible.size());
   stats_->ellipsoids_culled += total - int(visible.size());

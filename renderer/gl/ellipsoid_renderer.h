@@ -91,6 +91,9 @@ class EllipsoidRenderer {
 
  private:
   static constexpr std::size_t kCancelRecords = 65536;
+  // A batch's records are computed on up to this many threads, one per this many ellipsoids.
+  static constexpr int kRecordThreads = 8;
+  static constexpr int kRecordsPerThread = 512;
   static constexpr std::int64_t kCancelWork = std::int64_t(1) << 25;
   static constexpr std::size_t kCancelInstances = 16384;
   // A continuous view's history is kept while its view draws at least once in
