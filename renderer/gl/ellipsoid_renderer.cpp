@@ -254,7 +254,23 @@ EllipsoidRenderer::EllipsoidRenderer(const GlApi& gl)
   gl_.GetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &max_texels_);
 }
 
-EllipsoidRenderer::~EllipsoidRenderer() = default;
+EllipsoidRenderer::~EllipsoidRenderer() { dropPartFence(); }
+
+void EllipsoidRenderer::paceQueued() {
+  const GLsync queued = gl_.FenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+  if (part_fence_)
+    while (gl_.ClientWaitSync(part_fence_, GL_SYNC_FLUSH_COMMANDS_BIT,
+                              std::numeric_limits<GLuint64>::max()) == GL_TIMEOUT_EXPIRED) {
+    }
+  dropPartFence();
+  part_fence_ = queued;
+  queued_work_ = 0;
+}
+
+void EllipsoidRenderer::dropPartFence() {
+  if (part_fence_) gl_.DeleteSync(part_fence_);
+  part_fence_ = nullptr;
+}
 
 void EllipsoidRenderer::beginFrame(FrameStats& stats, GpuPassTimer& timer,
                                    const std::string& continuous_view) {
@@ -290,6 +306,7 @@ void EllipsoidRenderer::bindFrameTexture(int unit, GLenum format, const void* da
 }
 
 void EllipsoidRenderer::endFrame() {
+  dropPartFence();  // the readback waits for the whole frame
   std::erase_if(textures_, [](const auto& entry) { return !entry.second.used; });
   keepMostRecent(tables_, kKeptTables, frame_);
   std::erase_if(impostors_, [](const auto& entry) { return !entry.second.used; });
@@ -532,7 +549,7 @@ void EllipsoidRenderer::drawClouds(const Scene& scene, const std::vector<std::si
     // gathered it is drawn to completion before the flag is read, so that a cancelled frame
     // waits for at most that much (a world of many small clouds queued all its frame's work
     // before the first read).
-    if (cancel_ && queued_work_ > kCancelWork) finishQueued();
+    if (cancel_ && queued_work_ > kCancelWork) paceQueued();
     if (stopNow()) return;
     drawDirect(scene, members, settings, target, targets_drawn, band, key);
   }
@@ -744,7 +761,7 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
     const std::size_t group = cancellable ? std::min(max_records, kCancelInstances) : max_records;
     for (std::size_t first = 0; first < ordered.size(); first += group) {
       if (cancellable && first > 0) {
-        finishQueued();
+        paceQueued();
         if (stopNow()) return;
       }
       const std::size_t count = std::min(group, ordered.size() - first);
@@ -830,11 +847,11 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   const bool reduced = !veiled && settings.heap_shading_rate > 1;
   // A continuous view walks one pixel in heap_refresh each frame, at a sample offset that goes
   // round them all, and reuses its last frame for the others; the first frame after a cut is
-  // the exact one (MODEL.md section 15, "reuse across frames").
+  // the exact one (MODEL.md section 15, "reuse across frames"). Behind a veil too: there the
+  // reuse takes the place of the veiled sampling, with the veil's lower opacity cut.
   const glm::ivec2 frame_size(target.width, target.height);
   HeapHistory* history = nullptr;
-  if (!continuous_view_.empty() && !batch.empty() && !veiled && !targets_drawn &&
-      settings.heap_refresh > 1) {
+  if (!continuous_view_.empty() && !batch.empty() && !targets_drawn && settings.heap_refresh > 1) {
     std::ostringstream key;
     key << batch << '|' << band.slabs.x << ',' << band.slabs.y << ',' << band.slabs.z << ','
         << band.slabs.w;
@@ -842,9 +859,9 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   }
   const bool reuse = history && history->valid;
   const int rate = targets_drawn ? 1
-                   : veiled      ? kVeiledShadingRate
                    : reuse       ? refreshRate(settings.heap_refresh)
                    : history     ? 1
+                   : veiled      ? kVeiledShadingRate
                    : reduced     ? settings.heap_shading_rate
                                  : 1;
   auto perPixelProgram = [&](EllipsoidProgram which, bool history_too = false) {
@@ -896,7 +913,7 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
     // Heavy: bands of whole bin rows of about kCancelWork hit tests (a row heavier than that
     // alone in runs of its bins), each finished before the flag is read.
     auto finished = [&] {
-      finishQueued();
+      paceQueued();
       return stopNow();
     };
     int band_from = area.y;
@@ -1055,7 +1072,7 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
       gl_.UseProgram(q);
       gl_.DrawArrays(GL_TRIANGLES, 0, GLsizei(6 * (i + 1 - first)));
       if (last) break;
-      finishQueued();
+      paceQueued();
       if (stopNow()) return;
       first = i + 1, work = 0;
     }

@@ -71,11 +71,13 @@ class EllipsoidRenderer {
 
   // A flag another thread may raise to cancel the frame being drawn (a daemon stopping,
   // docs/RELIABILITY.md). It is read between batches, every kCancelRecords ellipsoids while
-  // records are made, and, in a heavy batch, after each part of it drawn to completion
-  // (glFinish): the per-pixel pass in bands of about kCancelWork hit tests, the centre pass
-  // in groups of kCancelInstances. Light batches draw as without it, but for a glFinish
-  // between batches once their queued work reaches kCancelWork. Once raised the rest of
-  // the frame's ellipsoids are skipped and cancelled() says so until the next beginFrame.
+  // records are made, and, in a heavy batch, after each part of it is queued: the per-pixel
+  // pass in bands of about kCancelWork hit tests, the centre pass in groups of
+  // kCancelInstances. Light batches draw as without it, but for the same pacing between
+  // batches once their queued work reaches kCancelWork. Before the flag is read the part
+  // queued before the last has finished (paceQueued), so a cancel waits for two parts at
+  // most. Once raised the rest of the frame's ellipsoids are skipped and cancelled() says so
+  // until the next beginFrame.
   // `alive`, if given, is called at each of those points: the frame is making progress (a
   // daemon's watchdog heartbeat).
   void setCancel(const std::atomic<bool>* flag, std::function<void()> alive = {}) {
@@ -108,10 +110,11 @@ class EllipsoidRenderer {
     if (!cancelled_ && cancel_ && cancel_->load(std::memory_order_relaxed)) cancelled_ = true;
     return cancelled_;
   }
-  void finishQueued() {
-    gl_.Finish();
-    queued_work_ = 0;
-  }
+  // Waits for the part of heavy work queued before the one just queued (a fence), not for
+  // that one: the GPU has it to work on while the CPU waits and queues the next, where a
+  // glFinish would drain it between parts.
+  void paceQueued();
+  void dropPartFence();
 
   // A cloud texture as the frame's clouds name it (its scale included), and the baked table it
   // samples, which clouds differing only in scale share (bakedTableSpec).
@@ -209,6 +212,7 @@ class EllipsoidRenderer {
   // Hit tests (the centre pass: fragments) drawn since the last glFinish, which llvmpipe may
   // not have run yet.
   std::int64_t queued_work_ = 0;
+  GLsync part_fence_ = nullptr;  // the fence after the last part paceQueued saw queued
   GLint max_texels_ = 0;  // GL_MAX_TEXTURE_BUFFER_SIZE
   GlObject spotlight_;
   GlObject atlas_;

@@ -71,6 +71,9 @@ using GlDepthMaskProc = void(APIENTRYP)(GLboolean flag);
   X(PFNGLREADPIXELSPROC, ReadPixels)                                     \
   X(PFNGLGETTEXTUREIMAGEPROC, GetTextureImage)                           \
   X(PFNGLFINISHPROC, Finish)                                             \
+  X(PFNGLFENCESYNCPROC, FenceSync)                                       \
+  X(PFNGLCLIENTWAITSYNCPROC, ClientWaitSync)                             \
+  X(PFNGLDELETESYNCPROC, DeleteSync)                                     \
   X(GlDrawElementsProc, DrawElements)                                    \
   X(GlColorMaskProc, ColorMask)                                          \
   X(GlEnumProc, CullFace)                                                \
