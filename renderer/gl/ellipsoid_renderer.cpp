@@ -544,15 +544,112 @@ void EllipsoidRenderer::drawClouds(const Scene& scene, const std::vector<std::si
     if (batch == batches.end()) batch = batches.insert(batches.end(), {key, {}});
     batch->second.push_back(index);
   }
+  if (batches.empty()) return;
+  // A continuous view's batches share one history, keyed by all of them and the band.
+  if (!continuous_view_.empty() && !targets_drawn && settings.heap_refresh > 1 &&
+      settings.ellipsoid_passes == EllipsoidPasses::kFused &&
+      settings.ellipsoid_order == EllipsoidOrder::kPerPixel) {
+    std::ostringstream key;
+    for (const auto& entry : batches) key << entry.first << '|';
+    key << band.slabs.x << ',' << band.slabs.y << ',' << band.slabs.z << ',' << band.slabs.w;
+    beginBand(scene, key.str(), target, settings);
+  }
   for (const auto& [key, members] : batches) {
     // Light batches queue their draws without waiting for them; once about kCancelWork has
     // gathered it is drawn to completion before the flag is read, so that a cancelled frame
     // waits for at most that much (a world of many small clouds queued all its frame's work
     // before the first read).
     if (cancel_ && queued_work_ > kCancelWork) paceQueued();
-    if (stopNow()) return;
+    if (stopNow()) {
+      band_.cancelled = true;
+      break;
+    }
     drawDirect(scene, members, settings, target, targets_drawn, band, key);
   }
+  if (band_.history) finishBand(scene, target);
+  band_ = BandReuse{};
+}
+
+void EllipsoidRenderer::beginBand(const Scene& scene, const std::string& key,
+                                  const FrameTarget& target, const RenderSettings& settings) {
+  const glm::ivec2 frame_size(target.width, target.height);
+  HeapHistory& h = heapHistory(scene, key, frame_size);
+  band_ = BandReuse{};
+  band_.history = &h;
+  band_.reuse = h.valid;
+  band_.bins_x = (target.width + kPerPixelBinSize - 1) / kPerPixelBinSize;
+  band_.bins.assign(std::size_t(band_.bins_x) *
+                        ((target.height + kPerPixelBinSize - 1) / kPerPixelBinSize),
+                    0);
+  const GLfloat nothing[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+  gl_.ClearNamedFramebufferfv(h.framebuffer[1 - h.last].get(), GL_COLOR, 0, nothing);
+  if (!band_.reuse) return;  // the exact frame: each batch walks every pixel into the history
+  // Sample c stands at pixel r c + offset - r, one sample further back than the frame needs
+  // and one more on each axis, so that every pixel has samples on both sides; the offset goes
+  // round the r x r block frame by frame (sampleOffset).
+  band_.rate = refreshRate(settings.heap_refresh);
+  band_.origin = sampleOffset(h.frames + 1, band_.rate) - band_.rate;
+  band_.size = (frame_size - 1) / band_.rate + 3;
+  prepareSamples(band_.size);
+  // No sample yet: no colour, and the largest distance, which the batches' nearest replace.
+  const GLfloat far[4] = {kNoSampleDistance, 0.0f, 0.0f, 0.0f};
+  gl_.ClearNamedFramebufferfv(samples_framebuffer_.get(), GL_COLOR, 0, nothing);
+  gl_.ClearNamedFramebufferfv(samples_framebuffer_.get(), GL_COLOR, 1, far);
+}
+
+void EllipsoidRenderer::finishBand(const Scene& scene, const FrameTarget& target) {
+  HeapHistory& h = *band_.history;
+  h.valid = !band_.cancelled && !band_.broken;
+  if (band_.cancelled) return;
+  if (band_.reuse) {
+    // This frame's samples and the last frame between them, into the next history, then over
+    // the frame, over the bins any batch overlaps, as runs along each row of bins: elsewhere
+    // the band has nothing, which the cleared history already holds.
+    timer_->settle();  // the samples are read next
+    std::vector<glm::ivec4> runs;
+    const int bins_y = int(band_.bins.size()) / band_.bins_x;
+    for (int y = 0; y < bins_y; ++y)
+      for (int x = 0; x < band_.bins_x; ++x) {
+        if (!band_.bins[std::size_t(y) * band_.bins_x + x]) continue;
+        int to = x + 1;
+        while (to < band_.bins_x && band_.bins[std::size_t(y) * band_.bins_x + to]) ++to;
+        runs.push_back(glm::ivec4(x, y, to, y + 1) * kPerPixelBinSize);
+        x = to;
+      }
+    if (!runs.empty()) {
+      EllipsoidPassLayout layout;
+      layout.program = EllipsoidProgram::kFusedResolve;
+      layout.shading_rate = band_.rate;
+      const GLuint p = program(layout);
+      setViewUniforms(gl_, p, scene.camera, scene);
+      const ViewBasis last = viewBasis(h.camera);
+      setUniform3(gl_, p, "u_prev_x", last.right / (last.tan_half_vfov * last.aspect));
+      setUniform3(gl_, p, "u_prev_y", last.up / last.tan_half_vfov);
+      setUniform3(gl_, p, "u_prev_w", last.forward);
+      const glm::dvec2 drift = heapDrift(scene) - h.drift;
+      setUniform3(gl_, p, "u_prev_shift",
+                  scene.camera.position - h.camera.position - glm::dvec3(drift, 0.0));
+      gl_.ProgramUniform2i(p, gl_.GetUniformLocation(p, "u_sample_origin"), band_.origin.x,
+                           band_.origin.y);
+      gl_.BindTextureUnit(kSamplesTextureUnit, samples_.get());
+      gl_.BindTextureUnit(kSampleDistanceTextureUnit, sample_distance_.get());
+      gl_.BindTextureUnit(kHistoryTextureUnit, h.colour[h.last].get());
+      bindFrameTexture(kRectTextureUnit, GL_RGBA32I, runs.data(), runs.size() * sizeof(runs[0]));
+      GpuPassScope pass(*timer_, GpuPass::kReuse);
+      drawWithHistory(target, false, [&] {
+        gl_.UseProgram(p);
+        gl_.BindVertexArray(vertex_array_.get());
+        gl_.DrawArrays(GL_TRIANGLES, 0, GLsizei(6 * runs.size()));
+        return true;
+      });
+      ++stats_->reused_passes;
+    }
+  }
+  h.frames = band_.reuse ? h.frames + 1 : 0;
+  h.last = 1 - h.last;
+  h.camera = scene.camera;
+  h.time_s = scene.time_s;
+  h.drift = heapDrift(scene);
 }
 
 bool EllipsoidRenderer::drawImpostor(const Scene& scene, std::size_t index,
@@ -639,6 +736,25 @@ bool EllipsoidRenderer::drawImpostor(const Scene& scene, std::size_t index,
   ++stats_->ellipsoid_passes;
   ++stats_->impostors_drawn;
   return true;
+}
+
+bool EllipsoidRenderer::drawWithHistory(const FrameTarget& target, bool accumulate,
+                                        const std::function<bool()>& draw) {
+  // Drawn over the frame and, as it is, into the band's next history in the same pass:
+  // blended "over" what the band's batches before left there (a batch's exact walk), or
+  // written as it is (the resolve, the whole band at once).
+  HeapHistory& h = *band_.history;
+  const GLuint f = target.framebuffer;
+  gl_.NamedFramebufferTexture(f, GL_COLOR_ATTACHMENT1, h.colour[1 - h.last].get(), 0);
+  const GLenum both[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+  gl_.NamedFramebufferDrawBuffers(f, 2, both);
+  if (!accumulate) gl_.Disablei(GL_BLEND, 1);
+  const bool done = draw();
+  gl_.Enable(GL_BLEND);
+  const GLenum colour = GL_COLOR_ATTACHMENT0;
+  gl_.NamedFramebufferDrawBuffers(f, 1, &colour);
+  gl_.NamedFramebufferTexture(f, GL_COLOR_ATTACHMENT1, 0, 0);
+  return done;
 }
 
 void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::size_t>& indices,
@@ -777,7 +893,10 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
       ++stats_->ellipsoid_passes;
     }
   };
-  if (!per_pixel) return drawByCentre(records(false));
+  if (!per_pixel) {
+    if (band_.history && !batch.empty()) band_.broken = true;
+    return drawByCentre(records(false));
+  }
 
   const std::vector<EllipsoidRecord> ordered = records(true);
   records_clock.emplace(stats_->times.cpu(CpuStage::kRecords));  // the bins, to the items' fill
@@ -803,6 +922,7 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   const std::int64_t max_listed = std::min<std::int64_t>(max_texels_, kMaxListed);
   if (listed > max_listed || std::int64_t(bins_x) * bins_y > max_listed) {
     records_clock.reset();
+    if (band_.history && !batch.empty()) band_.broken = true;
     return drawByCentre(records(false));
   }
   // A bin is first item and count.
@@ -822,7 +942,8 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   }
   // Where no two ellipsoids share a bin, no pixel has two hits to order: the centre pass
   // draws the same image, faster.
-  if (deepest <= 1) {
+  // Not in a continuous view, whose batches go into one history together.
+  if (deepest <= 1 && !(band_.history && !batch.empty())) {
     records_clock.reset();
     return drawByCentre(ordered);
   }
@@ -847,19 +968,13 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   const bool reduced = !veiled && settings.heap_shading_rate > 1;
   // A continuous view walks one pixel in heap_refresh each frame, at a sample offset that goes
   // round them all, and reuses its last frame for the others; the first frame after a cut is
-  // the exact one (MODEL.md section 15, "reuse across frames"). Behind a veil too: there the
-  // reuse takes the place of the veiled sampling, with the veil's lower opacity cut.
+  // the exact one (MODEL.md section 15, "reuse across frames"; beginBand). Behind a veil too:
+  // there the reuse takes the place of the veiled sampling, with the veil's lower opacity cut.
   const glm::ivec2 frame_size(target.width, target.height);
-  HeapHistory* history = nullptr;
-  if (!continuous_view_.empty() && !batch.empty() && !targets_drawn && settings.heap_refresh > 1) {
-    std::ostringstream key;
-    key << batch << '|' << band.slabs.x << ',' << band.slabs.y << ',' << band.slabs.z << ','
-        << band.slabs.w;
-    history = &heapHistory(scene, key.str(), frame_size);
-  }
-  const bool reuse = history && history->valid;
+  HeapHistory* history = batch.empty() ? nullptr : band_.history;
+  const bool reuse = history && band_.reuse;
   const int rate = targets_drawn ? 1
-                   : reuse       ? refreshRate(settings.heap_refresh)
+                   : reuse       ? band_.rate
                    : history     ? 1
                    : veiled      ? kVeiledShadingRate
                    : reduced     ? settings.heap_shading_rate
@@ -950,28 +1065,6 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   };
   ++stats_->ellipsoid_passes;
   const GLfloat nothing[4] = {0.0f, 0.0f, 0.0f, 0.0f};
-  // A continuous view's batch is drawn over the frame and, as it is, into its history's other
-  // texture in the same pass; that texture is the next frame's history.
-  auto withHistory = [&](auto&& draw) {
-    const GLuint f = target.framebuffer;
-    gl_.NamedFramebufferTexture(f, GL_COLOR_ATTACHMENT1, history->colour[1 - history->last].get(),
-                                0);
-    const GLenum both[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-    gl_.NamedFramebufferDrawBuffers(f, 2, both);
-    gl_.ClearNamedFramebufferfv(f, GL_COLOR, 1, nothing);
-    gl_.Disablei(GL_BLEND, 1);
-    const bool done = draw();
-    gl_.Enable(GL_BLEND);
-    const GLenum colour = GL_COLOR_ATTACHMENT0;
-    gl_.NamedFramebufferDrawBuffers(f, 1, &colour);
-    gl_.NamedFramebufferTexture(f, GL_COLOR_ATTACHMENT1, 0, 0);
-    history->valid = done;
-    if (!done) return;
-    history->last = 1 - history->last;
-    history->camera = scene.camera;
-    history->time_s = scene.time_s;
-    history->drift = heapDrift(scene);
-  };
   if (rate == 1) {
     const GLuint p = perPixelProgram(EllipsoidProgram::kFusedPerPixel, history != nullptr);
     auto draw = [&] {
@@ -979,78 +1072,53 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
         drawRect(p, frame_size, 1, bx0, by0, bx1, by1);
       });
     };
-    if (!history) {
+    if (!history)
       draw();
-      return;
-    }
-    history->frames = 0;
-    withHistory(draw);
+    else if (!drawWithHistory(target, true, draw))
+      band_.cancelled = true;
     return;
   }
   // Sample c stands at pixel c * rate; one more than the frame needs on each axis, so that
   // every pixel has samples on both sides. Those outside the area stay 0: nothing of the batch
-  // is there. A continuous view's stand one sample further back, shifted by its offset.
-  const glm::ivec2 offset = reuse ? sampleOffset(history->frames + 1, rate) : glm::ivec2(0);
-  const glm::ivec2 origin = reuse ? offset - rate : glm::ivec2(0);
-  const glm::ivec2 size = (frame_size - 1) / rate + (reuse ? 3 : 2);
-  prepareSamples(size);
+  // is there. A continuous view's grid is its band's (beginBand), which every batch of the band
+  // samples over the others.
+  const glm::ivec2 origin = reuse ? band_.origin : glm::ivec2(0);
+  const glm::ivec2 size = reuse ? band_.size : (frame_size - 1) / rate + 2;
+  if (!reuse) {
+    prepareSamples(size);
+    gl_.ClearNamedFramebufferfv(samples_framebuffer_.get(), GL_COLOR, 0, nothing);
+    gl_.ClearNamedFramebufferfv(samples_framebuffer_.get(), GL_COLOR, 1, nothing);
+  }
   const GLuint s = perPixelProgram(EllipsoidProgram::kFusedSamples);
   gl_.ProgramUniform2i(s, gl_.GetUniformLocation(s, "u_sample_origin"), origin.x, origin.y);
   gl_.ProgramUniform1i(s, gl_.GetUniformLocation(s, "u_bins_y"), bins_y);
   gl_.BindFramebuffer(GL_FRAMEBUFFER, samples_framebuffer_.get());
   gl_.Viewport(0, 0, size.x, size.y);
-  gl_.ClearNamedFramebufferfv(samples_framebuffer_.get(), GL_COLOR, 0, nothing);
-  gl_.ClearNamedFramebufferfv(samples_framebuffer_.get(), GL_COLOR, 1, nothing);
-  gl_.Disable(GL_BLEND);
+  if (reuse) {
+    // Over the samples of the band's batches drawn before (farther): "over" in colour, the
+    // nearest of the distances.
+    gl_.Enable(GL_BLEND);
+    gl_.BlendEquationi(1, GL_MIN);
+  } else {
+    gl_.Disable(GL_BLEND);
+  }
   const bool done = drawArea([&](int bx0, int by0, int bx1, int by1) {
     drawRect(s, size, rate, bx0, by0, bx1, by1, reuse ? 2 : 0);
   });
+  gl_.BlendEquationi(1, GL_FUNC_ADD);
   gl_.Enable(GL_BLEND);
   gl_.BindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
   gl_.Viewport(0, 0, target.width, target.height);
-  if (!done) {
-    if (history) history->valid = false;
-    return;
-  }
-  timer_->settle();  // the samples are read next
   if (reuse) {
-    // This frame's samples and the last frame between them, into the history, then over the
-    // frame.
-    const GLuint p = perPixelProgram(EllipsoidProgram::kFusedResolve);
-    const ViewBasis last = viewBasis(history->camera);
-    setUniform3(gl_, p, "u_prev_x", last.right / (last.tan_half_vfov * last.aspect));
-    setUniform3(gl_, p, "u_prev_y", last.up / last.tan_half_vfov);
-    setUniform3(gl_, p, "u_prev_w", last.forward);
-    const glm::dvec2 drift = heapDrift(scene) - history->drift;
-    setUniform3(gl_, p, "u_prev_shift",
-                scene.camera.position - history->camera.position - glm::dvec3(drift, 0.0));
-    gl_.ProgramUniform2i(p, gl_.GetUniformLocation(p, "u_sample_origin"), origin.x, origin.y);
-    gl_.BindTextureUnit(kSamplesTextureUnit, samples_.get());
-    gl_.BindTextureUnit(kSampleDistanceTextureUnit, sample_distance_.get());
-    gl_.BindTextureUnit(kHistoryTextureUnit, history->colour[history->last].get());
-    // Only the bins some ellipsoid of the batch overlaps, as runs along each row of bins:
-    // elsewhere the batch has nothing, which the cleared history already holds.
-    std::vector<glm::ivec4> runs;
+    if (!done) band_.cancelled = true;
     for (int y = area.y; y <= area.w; ++y)
-      for (int x = area.x; x <= area.z; ++x) {
-        if (binAt(x, y).y == 0) continue;
-        int to = x + 1;
-        while (to <= area.z && binAt(to, y).y > 0) ++to;
-        runs.push_back(glm::ivec4(x, y, to, y + 1) * kPerPixelBinSize);
-        x = to;
-      }
-    bindFrameTexture(kRectTextureUnit, GL_RGBA32I, runs.data(), runs.size() * sizeof(runs[0]));
-    GpuPassScope pass(*timer_, GpuPass::kReuse);
-    withHistory([&] {
-      gl_.UseProgram(p);
-      gl_.DrawArrays(GL_TRIANGLES, 0, GLsizei(6 * runs.size()));
-      return true;
-    });
-    ++history->frames;
+      for (int x = area.x; x <= area.z; ++x)
+        if (binAt(x, y).y > 0) band_.bins[std::size_t(y) * band_.bins_x + x] = 1;
     ++stats_->sampled_passes;
-    ++stats_->reused_passes;
     return;
   }
+  if (!done) return;
+  timer_->settle();  // the samples are read next
   const glm::ivec2 from = glm::ivec2(area.x, area.y) * kPerPixelBinSize / rate;
   const glm::ivec2 end = (glm::ivec2(area.z, area.w) + 1) * kPerPixelBinSize / rate;  // samples
   // The blended runs in one draw; the walked ones, when the frame can be cancelled, in groups

@@ -198,9 +198,33 @@ class EllipsoidRenderer {
     double time_s = 0.0;
     glm::dvec2 drift{0.0};  // the heaps' drift then (heapDrift)
   };
-  // The history of the batch drawn `ordinal`-th in this frame of the continuous view, valid
-  // when the same batch was drawn last time from a camera near enough to reuse.
+  // The history of the batches drawn in the `ordinal`-th drawClouds call of this frame of the
+  // continuous view, valid when the same batches were drawn last time from a camera near
+  // enough to reuse.
   HeapHistory& heapHistory(const Scene& scene, const std::string& batch, glm::ivec2 size);
+  // A continuous view's batches of one drawClouds call share one history, one grid of samples
+  // and one resolve over the bins any of them overlaps (MODEL.md section 15, "reuse across
+  // frames"): each batch walks its samples over the others' ("over" in colour, the nearest
+  // distance), and the call ends with finishBand.
+  struct BandReuse {
+    HeapHistory* history = nullptr;  // none: not a continuous view, or targets drawn
+    bool reuse = false;              // the history is valid: this frame samples and resolves
+    int rate = 1;                    // its samples stand one pixel in rate x rate
+    glm::ivec2 origin{0}, size{0};   // the pixel of sample (0, 0), and the grid's size
+    int bins_x = 0;                  // the frame's bins a row
+    std::vector<std::uint8_t> bins;  // the frame's bins some batch's ellipsoids overlap
+    bool cancelled = false;          // a batch was cancelled: nothing is resolved or kept
+    bool broken = false;             // a batch drew straight into the frame: not kept
+  };
+  void beginBand(const Scene& scene, const std::string& key, const FrameTarget& target,
+                 const RenderSettings& settings);
+  // `draw` over the frame and into the band's next history; false when it was cancelled.
+  bool drawWithHistory(const FrameTarget& target, bool accumulate,
+                       const std::function<bool()>& draw);
+  // A sample no batch hit (its distance texture's clear value; the resolve's "no hit").
+  static constexpr float kNoSampleDistance = 3.4e38f;
+  void finishBand(const Scene& scene, const FrameTarget& target);
+  BandReuse band_;
 
   const GlApi& gl_;
   GlObject vertex_array_;  // empty: attribute-less draws

@@ -64,6 +64,7 @@ using GlDepthMaskProc = void(APIENTRYP)(GLboolean flag);
   X(PFNGLENABLEPROC, Enable)                                             \
   X(PFNGLDISABLEPROC, Disable)                                           \
   X(PFNGLENABLEIPROC, Enablei)                                           \
+  X(PFNGLBLENDEQUATIONIPROC, BlendEquationi)                             \
   X(PFNGLDISABLEIPROC, Disablei)                                         \
   X(PFNGLBLENDFUNCSEPARATEPROC, BlendFuncSeparate)                       \
   X(GlDrawArraysProc, DrawArrays)                                        \
