@@ -763,6 +763,8 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
                                    const std::string& batch) {
   // The clouds look alike: the first one's texture and shading stand for all of them.
   const EllipsoidCloud& cloud = scene.clouds[indices.front()];
+  // One of a continuous view's band of batches (an impostor's picture, `batch` empty, is not).
+  HeapHistory* history = batch.empty() ? nullptr : band_.history;
   // Visible ellipsoids with the back-to-front key (the front-to-back key, the nearest a hit
   // can be, is the record's order.z).
   struct Visible {
@@ -894,7 +896,7 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
     }
   };
   if (!per_pixel) {
-    if (band_.history && !batch.empty()) band_.broken = true;
+    if (history) band_.broken = true;
     return drawByCentre(records(false));
   }
 
@@ -922,7 +924,7 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   const std::int64_t max_listed = std::min<std::int64_t>(max_texels_, kMaxListed);
   if (listed > max_listed || std::int64_t(bins_x) * bins_y > max_listed) {
     records_clock.reset();
-    if (band_.history && !batch.empty()) band_.broken = true;
+    if (history) band_.broken = true;
     return drawByCentre(records(false));
   }
   // A bin is first item and count.
@@ -941,9 +943,8 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
     b.y = 0;
   }
   // Where no two ellipsoids share a bin, no pixel has two hits to order: the centre pass
-  // draws the same image, faster.
-  // Not in a continuous view, whose batches go into one history together.
-  if (deepest <= 1 && !(band_.history && !batch.empty())) {
+  // draws the same image, faster; but for a continuous view's, which go into its history.
+  if (deepest <= 1 && !history) {
     records_clock.reset();
     return drawByCentre(ordered);
   }
@@ -971,7 +972,6 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   // the exact one (MODEL.md section 15, "reuse across frames"; beginBand). Behind a veil too:
   // there the reuse takes the place of the veiled sampling, with the veil's lower opacity cut.
   const glm::ivec2 frame_size(target.width, target.height);
-  HeapHistory* history = batch.empty() ? nullptr : band_.history;
   const bool reuse = history && band_.reuse;
   const int rate = targets_drawn ? 1
                    : reuse       ? band_.rate

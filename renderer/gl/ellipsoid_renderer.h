@@ -187,7 +187,7 @@ class EllipsoidRenderer {
   // frames"): the premultiplied colour and coverage of the batch alone, at the frame's size,
   // in two textures that take turns being read and written.
   struct HeapHistory {
-    std::string batch;  // what the batch is: its texture, shading and band
+    std::string batch;  // what the band is: its batches' looks and its slabs
     GlObject colour[2], framebuffer[2];
     glm::ivec2 size{0};
     int last = 0;              // the texture holding the last frame
