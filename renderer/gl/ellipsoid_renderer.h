@@ -96,7 +96,8 @@ class EllipsoidRenderer {
   // A batch's records are computed on up to this many threads, one per this many ellipsoids.
   static constexpr int kRecordThreads = 8;
   static constexpr int kRecordsPerThread = 512;
-  static constexpr std::int64_t kCancelWork = std::int64_t(1) << 25;
+  // Half of the 2^25 hit tests a cancel may wait for: two parts are in flight (paceQueued).
+  static constexpr std::int64_t kCancelWork = std::int64_t(1) << 24;
   static constexpr std::size_t kCancelInstances = 16384;
   // A continuous view's history is kept while its view draws at least once in
   // kKeptHistoryFrames frames of the renderer, and reused across a step of at most kCutStep_m,
