@@ -598,9 +598,12 @@ int main(int argc, char** argv) {
         flyer.setContinuousView("flight");
         std::vector<double> ms;
         Scene moving = scene;
-        // Frame k of the flight: east at `speed` at 30 Hz, from 50 km east of the still view.
+        // Frame k of the flight: east at `speed` at 30 Hz, from 50 km east of the still view,
+        // where the heaps are new to the renderer; a still view streamed (speed 0) is the
+        // still view itself.
+        const double start_x = speed > 0.0 ? 50000.0 : 0.0;
         auto flyTo = [&](int frame) {
-          moving.camera.position.x = scene.camera.position.x + speed / 30.0 * frame + 50000.0;
+          moving.camera.position.x = scene.camera.position.x + speed / 30.0 * frame + start_x;
         };
         for (int frame = 0; frame < repeats; ++frame) {
           flyTo(frame);

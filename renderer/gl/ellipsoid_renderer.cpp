@@ -587,7 +587,10 @@ void EllipsoidRenderer::beginBand(const Scene& scene, const std::string& key,
   // Sample c stands at pixel r c + offset - r, one sample further back than the frame needs
   // and one more on each axis, so that every pixel has samples on both sides; the offset goes
   // round the r x r block frame by frame (sampleOffset).
-  band_.rate = refreshRate(settings.heap_refresh);
+  // Behind a thick veil (the frame shows half or less of what lies behind it), the band walks
+  // one pixel in kVeiledShadingRate^2 whatever heap_refresh asks, as the veiled walk does.
+  const bool veiled = kVeiledTolerance / std::max(target.seen, 1e-6) >= kVeiledSamplingFrom;
+  band_.rate = std::max(refreshRate(settings.heap_refresh), veiled ? kVeiledShadingRate : 1);
   band_.origin = sampleOffset(h.frames + 1, band_.rate) - band_.rate;
   band_.size = (frame_size - 1) / band_.rate + 3;
   prepareSamples(band_.size);
