@@ -341,6 +341,19 @@ TEST_F(EllipsoidRenderTest, BehindAThickVeilTheFrameIsSampled) {
   const FloatImage reference = renderReference(scene, {1, 0});
   expectClose(gl, reference, 55.0, 0.03, "behind_thick_veil");
   expectCoverageClose(gl, reference, 0.05f, 0, "behind_thick_veil_coverage");
+  // A continuous view there (MODEL.md section 15) walks its first frame in full, then one
+  // pixel in 4 x 4 and reuses the rest, within 50 dB of the reference moving at 30 m/s.
+  GlRenderer stream(*platform_);
+  stream.setContinuousView("veiled");
+  Scene moving = scene;
+  for (int frame = 0; frame < 4; ++frame) {
+    moving.camera.position.x += 1.0;
+    const FloatImage f = stream.renderFloat(moving, {});
+    EXPECT_EQ(stream.lastFrameStats().reused_passes, frame > 0 ? 1 : 0) << frame;
+    EXPECT_EQ(outOfRange(f), 0) << frame;
+    expectClose(f, renderReference(moving, {1, 0}), 50.0, 0.03,
+                "behind_thick_veil_stream_" + std::to_string(frame));
+  }
 }
 
 // Linked ellipsoids: the camera crosses, in 1 m steps, the plane where the two ellipsoids'
