@@ -631,7 +631,7 @@ int main(int argc, char** argv) {
         const ImageError reuse_error = compareImages(reused, exact);
         // The first frame after a weather change, as a subscription draws it: the world's
         // edit makes a new continuous view, whose first frame is exact, with the heaps of the
-        // new cover generated. The cover is 5 points more (less above 95 %).
+        // new cover generated. The cover is 5 points more (less above 90 %).
         Scene changed = moving;
         for (CloudField& f : changed.fields)
           f.coverage = f.coverage > 0.9 ? f.coverage - 0.05 : f.coverage + 0.05;

@@ -184,9 +184,9 @@ class EllipsoidRenderer {
   // The per-pixel pass's samples texture (RGBA16F) and their distances (R32F), and their
   // framebuffer, at `size`.
   void prepareSamples(glm::ivec2 size);
-  // A continuous view's heaps of one batch as last drawn (MODEL.md section 15, "reuse across
-  // frames"): the premultiplied colour and coverage of the batch alone, at the frame's size,
-  // in two textures that take turns being read and written.
+  // A continuous view's heaps of one band as last drawn (MODEL.md section 15, "reuse across
+  // frames"): the premultiplied colour and coverage of its batches without the layers, at the
+  // frame's size, in two textures that take turns being read and written.
   struct HeapHistory {
     std::string batch;  // what the band is: its batches' looks and its slabs
     GlObject colour[2], framebuffer[2];
