@@ -254,7 +254,9 @@ EllipsoidRenderer::EllipsoidRenderer(const GlApi& gl)
   gl_.GetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &max_texels_);
 }
 
-EllipsoidRenderer::~EllipsoidRenderer() { dropPartFence(); }
+EllipsoidRenderer::~EllipsoidRenderer() {
+  dropPartFence();
+}
 
 void EllipsoidRenderer::paceQueued() {
   const GLsync queued = gl_.FenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
@@ -322,7 +324,7 @@ void EllipsoidRenderer::endFrame() {
 }
 
 EllipsoidRenderer::HeapHistory& EllipsoidRenderer::heapHistory(const Scene& scene,
-                                                               const std::string& batch,
+                                                               const std::string& key,
                                                                glm::ivec2 size) {
   std::vector<HeapHistory>& view = histories_[continuous_view_];
   if (view.size() <= next_history_) view.resize(next_history_ + 1);
@@ -333,18 +335,18 @@ EllipsoidRenderer::HeapHistory& EllipsoidRenderer::heapHistory(const Scene& scen
     for (int k = 0; k < 2; ++k)
       createColourTarget(gl_, GL_RGBA16F, size, "heap history", h.colour[k], h.framebuffer[k]);
   }
-  // A cut: another batch, a camera moved or turned further than a stream of frames moves it,
+  // A cut: other batches, a camera moved or turned further than a stream of frames moves it,
   // another lens, or time gone back or far on. The frame after it is the exact one.
   const Camera& now = scene.camera;
   const Camera& then = h.camera;
   const ViewBasis a = viewBasis(now), b = viewBasis(then);
   const double dt = scene.time_s - h.time_s;
   h.valid =
-      h.valid && h.batch == batch && h.used + kKeptHistoryFrames > frame_ &&
+      h.valid && h.key == key && h.used + kKeptHistoryFrames > frame_ &&
       now.vfov_deg == then.vfov_deg && glm::length(now.position - then.position) <= kCutStep_m &&
       glm::dot(a.forward, b.forward) >= std::cos(glm::radians(kCutTurn_deg)) &&
       glm::dot(a.up, b.up) >= std::cos(glm::radians(kCutTurn_deg)) && dt >= 0.0 && dt <= kCutTime_s;
-  h.batch = batch;
+  h.key = key;
   h.used = frame_;
   return h;
 }
@@ -556,8 +558,8 @@ void EllipsoidRenderer::drawClouds(const Scene& scene, const std::vector<std::si
   }
   for (const auto& [key, members] : batches) {
     // Light batches queue their draws without waiting for them; once about kCancelWork has
-    // gathered it is drawn to completion before the flag is read, so that a cancelled frame
-    // waits for at most that much (a world of many small clouds queued all its frame's work
+    // gathered it is paced (paceQueued) before the flag is read, so that a cancelled frame
+    // waits for at most twice that much (a world of many small clouds queued all its frame's work
     // before the first read).
     if (cancel_ && queued_work_ > kCancelWork) paceQueued();
     if (stopNow()) {
@@ -578,19 +580,18 @@ void EllipsoidRenderer::beginBand(const Scene& scene, const std::string& key,
   band_.history = &h;
   band_.reuse = h.valid;
   band_.bins_x = (target.width + kPerPixelBinSize - 1) / kPerPixelBinSize;
-  band_.bins.assign(std::size_t(band_.bins_x) *
-                        ((target.height + kPerPixelBinSize - 1) / kPerPixelBinSize),
-                    0);
+  band_.bins.assign(
+      std::size_t(band_.bins_x) * ((target.height + kPerPixelBinSize - 1) / kPerPixelBinSize), 0);
   const GLfloat nothing[4] = {0.0f, 0.0f, 0.0f, 0.0f};
   gl_.ClearNamedFramebufferfv(h.framebuffer[1 - h.last].get(), GL_COLOR, 0, nothing);
   if (!band_.reuse) return;  // the exact frame: each batch walks every pixel into the history
-  // Sample c stands at pixel r c + offset - r, one sample further back than the frame needs
-  // and one more on each axis, so that every pixel has samples on both sides; the offset goes
-  // round the r x r block frame by frame (sampleOffset).
   // Behind a thick veil (the frame shows half or less of what lies behind it), the band walks
   // one pixel in kVeiledShadingRate^2 whatever heap_refresh asks, as the veiled walk does.
   const bool veiled = kVeiledTolerance / std::max(target.seen, 1e-6) >= kVeiledSamplingFrom;
   band_.rate = std::max(refreshRate(settings.heap_refresh), veiled ? kVeiledShadingRate : 1);
+  // Sample c stands at pixel r c + offset - r, one sample further back than the frame needs
+  // and one more on each axis, so that every pixel has samples on both sides; the offset goes
+  // round the r x r block frame by frame (sampleOffset).
   band_.origin = sampleOffset(h.frames + 1, band_.rate) - band_.rate;
   band_.size = (frame_size - 1) / band_.rate + 3;
   prepareSamples(band_.size);
@@ -1029,7 +1030,7 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
       return true;
     }
     // Heavy: bands of whole bin rows of about kCancelWork hit tests (a row heavier than that
-    // alone in runs of its bins), each finished before the flag is read.
+    // alone in runs of its bins), each paced (paceQueued) before the flag is read.
     auto finished = [&] {
       paceQueued();
       return stopNow();
@@ -1087,10 +1088,9 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   // samples over the others.
   const glm::ivec2 origin = reuse ? band_.origin : glm::ivec2(0);
   const glm::ivec2 size = reuse ? band_.size : (frame_size - 1) / rate + 2;
-  if (!reuse) {
+  if (!reuse) {  // only the colours are read: the distances are a continuous view's
     prepareSamples(size);
     gl_.ClearNamedFramebufferfv(samples_framebuffer_.get(), GL_COLOR, 0, nothing);
-    gl_.ClearNamedFramebufferfv(samples_framebuffer_.get(), GL_COLOR, 1, nothing);
   }
   const GLuint s = perPixelProgram(EllipsoidProgram::kFusedSamples);
   gl_.ProgramUniform2i(s, gl_.GetUniformLocation(s, "u_sample_origin"), origin.x, origin.y);

@@ -188,7 +188,7 @@ class EllipsoidRenderer {
   // frames"): the premultiplied colour and coverage of its batches without the layers, at the
   // frame's size, in two textures that take turns being read and written.
   struct HeapHistory {
-    std::string batch;  // what the band is: its batches' looks and its slabs
+    std::string key;  // what the band is: its batches' looks and its slabs
     GlObject colour[2], framebuffer[2];
     glm::ivec2 size{0};
     int last = 0;              // the texture holding the last frame
@@ -202,7 +202,7 @@ class EllipsoidRenderer {
   // The history of the batches drawn in the `ordinal`-th drawClouds call of this frame of the
   // continuous view, valid when the same batches were drawn last time from a camera near
   // enough to reuse.
-  HeapHistory& heapHistory(const Scene& scene, const std::string& batch, glm::ivec2 size);
+  HeapHistory& heapHistory(const Scene& scene, const std::string& key, glm::ivec2 size);
   // A continuous view's batches of one drawClouds call share one history, one grid of samples
   // and one resolve over the bins any of them overlaps (MODEL.md section 15, "reuse across
   // frames"): each batch walks its samples over the others' ("over" in colour, the nearest
@@ -238,7 +238,7 @@ class EllipsoidRenderer {
   // not have run yet.
   std::int64_t queued_work_ = 0;
   GLsync part_fence_ = nullptr;  // the fence after the last part paceQueued saw queued
-  GLint max_texels_ = 0;  // GL_MAX_TEXTURE_BUFFER_SIZE
+  GLint max_texels_ = 0;         // GL_MAX_TEXTURE_BUFFER_SIZE
   GlObject spotlight_;
   GlObject atlas_;
   GlObject atlas_framebuffer_;

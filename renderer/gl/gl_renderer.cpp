@@ -24,8 +24,7 @@ namespace {
 // The part of convex polygon `in` where a * x + b * y + c >= 0 (Sutherland-Hodgman against one
 // line). Empty when nothing is left. The two sides of one line share their new vertices
 // exactly (negating a, b and c negates every f below, and the quotient with it).
-std::vector<glm::vec2> clipPolygon(const std::vector<glm::vec2>& in, double a, double b,
-                                   double c) {
+std::vector<glm::vec2> clipPolygon(const std::vector<glm::vec2>& in, double a, double b, double c) {
   std::vector<glm::vec2> out;
   for (std::size_t i = 0; i < in.size(); ++i) {
     const glm::dvec2 p = in[i], q = in[(i + 1) % in.size()];
@@ -524,12 +523,14 @@ void GlRenderer::drawSkyGroup(const Scene& scene, const RenderSettings& settings
   // The screen region whose rays climb (sign = 1) or descend (sign = -1), widened by
   // `margin_pixels`: ray.z is linear across the image, so the horizon is a straight line.
   const ViewBasis basis = viewBasis(camera);
+  // How far the line a x + b y + c = 0 moves over `pixels` pixels, in c.
+  auto pixelsOf = [&](double a, double b, double pixels) {
+    return pixels * (std::abs(a) * 2.0 / camera.width + std::abs(b) * 2.0 / camera.height);
+  };
   auto sideOfHorizon = [&](double sign, double margin_pixels) {
     const double a = sign * basis.right.z * basis.tan_half_vfov * basis.aspect;
     const double b = sign * basis.up.z * basis.tan_half_vfov;
-    const double margin =
-        margin_pixels * (std::abs(a) * 2.0 / camera.width + std::abs(b) * 2.0 / camera.height);
-    return clipScreenToHalfPlane(a, b, sign * basis.forward.z + margin);
+    return clipScreenToHalfPlane(a, b, sign * basis.forward.z + pixelsOf(a, b, margin_pixels));
   };
 
   // Every pass writes premultiplied colour and coverage; a pass with the background
@@ -569,8 +570,10 @@ void GlRenderer::drawSkyGroup(const Scene& scene, const RenderSettings& settings
       std::vector<LayerSlot> open;  // the slots drawn beyond the widest strip
       for (const LayerSlot& slot : *side) {
         const std::optional<glm::dvec3> line = strip(slot, sign);
-        if (!line) open.push_back(slot);
-        else if (!widest || line->z > widest->z) widest = line;
+        if (!line)
+          open.push_back(slot);
+        else if (!widest || line->z > widest->z)
+          widest = line;
       }
       auto draw = [&](const std::vector<LayerSlot>& slots, const std::vector<glm::vec2>& area) {
         if (area.empty() || (!background && slots.empty())) return;
@@ -601,9 +604,7 @@ void GlRenderer::drawSkyGroup(const Scene& scene, const RenderSettings& settings
       const double sign = side == &above ? 1.0 : -1.0;
       std::vector<glm::vec2> polygon = sideOfHorizon(sign, 2.0);
       if (const std::optional<glm::dvec3> line = strip(slot, sign))
-        polygon = clipPolygon(polygon, line->x, line->y,
-                              line->z + 2.0 * (std::abs(line->x) * 2.0 / camera.width +
-                                               std::abs(line->y) * 2.0 / camera.height));
+        polygon = clipPolygon(polygon, line->x, line->y, line->z + pixelsOf(line->x, line->y, 2.0));
       if (polygon.empty()) continue;
       SkyPassLayout layout = base;
       layout.background = false;
