@@ -34,6 +34,7 @@
 #include "image/image_encoding.h"
 #include "image/image_metrics.h"
 #include "renderer/gl/gl_renderer.h"
+#include "renderer/reference/reference_renderer.h"
 #include "world/formations/cloud_field.h"
 #include "world/formations/weather.h"
 #include "world/world.h"
@@ -340,6 +341,62 @@ void printCumulonimbusFigures(GlRenderer& renderer, const SceneFile& file, const
 // Fraction of the sky hemisphere seen from the ground whose coverage exceeds one half, from
 // the five upper faces of a cube map (each pixel weighted by its solid angle, proportional to
 // (1 + u^2 + v^2)^-3/2 on a face at unit distance), averaged over four places 20 km apart.
+// The ground's cloud shadows (MODEL.md section 16) under the preset's first field, seen from
+// 4 km above its top at 60 degrees down with the preset's sun: how far the GL's shadow map
+// agrees with the reference's exact sunlight (shadowAgreement, image/cloud_statistics.h, at
+// 320x240 with one sample a pixel) and what the shadows cost at 640x480: the frame whose map
+// is drawn anew (every frame of a world that ticks, or whose sun moves), the frame that reuses
+// it (the other views of one eye at one tick), against the frame without shadows.
+void printShadowFigures(const GlPlatform& platform, const SceneFile& file, const std::string& name,
+                        int repeats, const std::string& images) {
+  if (file.scene.fields.empty()) return;
+  const CloudField& field = file.scene.fields.front();
+  Scene scene = World(file.scene, file.dynamics).scene();
+  Camera& c = scene.camera;
+  c.position = {0.0, 0.0, field.base_m + 1.3 * field.thickness_m + 4000.0};
+  c.orientation = {file.scene.camera.orientation.heading_deg, -60.0, 0.0};
+  c.width = 320, c.height = 240;
+  GlRenderer renderer(platform);
+  RenderSettings none = file.render;
+  none.shadow_map_size = 0;
+  RenderSettings exact = file.render;
+  exact.heap_shading_rate = 1;
+  const FloatImage gl = renderer.renderFloat(scene, exact);
+  const FloatImage unshadowed = renderer.renderFloat(scene, none);
+  const FloatImage reference = renderReference(scene, {1, 0, file.render.heaps});
+  const ShadowAgreement forward = shadowAgreement(gl, reference, unshadowed);
+  const ShadowAgreement backward = shadowAgreement(reference, gl, unshadowed);
+  if (!images.empty()) {
+    std::filesystem::create_directories(images);
+    for (const auto& [what, image] : {std::pair{"gl", &gl}, {"reference", &reference}})
+      if (const std::string e =
+              writeImageFile(images + "/" + name + "_shadows_" + what + ".png", *image);
+          !e.empty())
+        std::fprintf(stderr, "%s\n", e.c_str());
+  }
+  c.width = 640, c.height = 480;
+  renderer.renderSrgb8(scene, file.render);
+  const double without = medianMilliseconds(repeats, [&] { renderer.renderSrgb8(scene, none); });
+  const double reused =
+      medianMilliseconds(repeats, [&] { renderer.renderSrgb8(scene, file.render); });
+  int step = 0;
+  double map_ms = 0.0;
+  const double redrawn = medianMilliseconds(repeats, [&] {
+    scene.sun.azimuth_deg += 0.01 * (++step % 2 ? 1.0 : -1.0);  // the map is drawn anew
+    renderer.renderSrgb8(scene, file.render);
+    map_ms = renderer.lastFrameStats().times.gpu(GpuPass::kShadows);
+  });
+  std::printf(
+      "  shadows from above (%s, sun at %.0f degrees): of the ground the GL shadows, %.3f is "
+      "shadowed by the reference too (of the reference's, %.3f by the GL); ratio to the "
+      "unshadowed ground %.4f apart on average; %.2f of the ground in shadow\n"
+      "  shadows' cost at 640x480: map drawn anew %.2f ms (%.2f x the frame without shadows, "
+      "%.2f ms; the map's pass %.2f ms), map reused %.2f ms (%.2f x)\n",
+      name.c_str(), file.scene.sun.elevation_deg, forward.agreement, backward.agreement,
+      forward.mean_ratio_difference, forward.shadowed, redrawn, redrawn / without, without, map_ms,
+      reused, reused / without);
+}
+
 double hemisphereFraction(GlRenderer& renderer, const Scene& weather,
                           const RenderSettings& render) {
   constexpr int kFace = 128;
@@ -691,6 +748,7 @@ int main(int argc, char** argv) {
     printBodyFigures(renderer, file);
     printLightFigures(renderer, file, path.stem().string(), images);
     printCumulonimbusFigures(renderer, file, path.stem().string(), images);
+    printShadowFigures(*platform, file, path.stem().string(), repeats, images);
   }
   if (!still_only &&
       (names.empty() || std::find(names.begin(), names.end(), "harbour") != names.end())) {

@@ -165,6 +165,16 @@ std::vector<Setting> settingsFor(const SceneFile& file) {
                      {},
                      false,
                      true});
+  // The ground's cloud shadows (MODEL.md section 16): none, and maps coarser and finer than the
+  // default's 512 texels a side.
+  const bool shadows =
+      !file.scene.fields.empty() ||
+      std::any_of(file.scene.clouds.begin(), file.scene.clouds.end(),
+                  [](const EllipsoidCloud& c) { return c.light_extinction > 0.0; });
+  if (shadows)
+    for (int size : {0, 256, 2048})
+      add("shadow_map_size", std::to_string(size),
+          [size](RenderSettings& s) { s.shadow_map_size = size; });
   // The frame's work budget (issue 31): the presets hold a few thousand ellipsoids in view, so
   // budgets below that show what thinning costs (the default, 65,536, changes none of them).
   if (!file.scene.clouds.empty() || !file.scene.fields.empty())

@@ -87,10 +87,26 @@ void readFog(TableReader& t, Fog& fog) {
 }
 
 void readRender(TableReader& t, SceneFile& out) {
-  t.allow({"texture", "term_filter", "sky_passes", "bake_texels_per_cycle", "reference_samples",
-           "ellipsoid_passes", "ellipsoid_order", "limb", "tile_resolution", "tile_format",
-           "tessellation", "impostor_tolerance", "volume_step", "heap_range", "heap_detail",
-           "ellipsoid_budget", "ellipsoid_overdraw", "heap_shading_rate", "heap_refresh"});
+  t.allow({"texture",
+           "term_filter",
+           "sky_passes",
+           "bake_texels_per_cycle",
+           "reference_samples",
+           "ellipsoid_passes",
+           "ellipsoid_order",
+           "limb",
+           "tile_resolution",
+           "tile_format",
+           "tessellation",
+           "impostor_tolerance",
+           "volume_step",
+           "heap_range",
+           "heap_detail",
+           "ellipsoid_budget",
+           "ellipsoid_overdraw",
+           "heap_shading_rate",
+           "heap_refresh",
+           "shadow_map_size"});
   out.render.texture_evaluation = TextureEvaluation(
       t.choice("texture", kTextureEvaluationNames, int(out.render.texture_evaluation)));
   out.render.term_filter =
@@ -120,6 +136,7 @@ void readRender(TableReader& t, SceneFile& out) {
             int(Limits::kHeapShadingRate.hi));
   t.integer("heap_refresh", r.heap_refresh, int(Limits::kHeapRefresh.lo),
             int(Limits::kHeapRefresh.hi));
+  t.integer("shadow_map_size", r.shadow_map_size, 0, int(Limits::kShadowMapSize.hi));
   if (std::string error = validateRenderSettings(r); !error.empty())
     t.failAt(error.substr(0, error.find(':')), error.substr(error.find(':') + 2));
   out.reference.heaps = r.heaps;  // both renderers draw the same heaps
@@ -730,6 +747,10 @@ std::string validateRenderSettings(const RenderSettings& r) {
   if (r.heap_refresh != 1 && r.heap_refresh != 4 && r.heap_refresh != 16)
     return "heap_refresh: " + std::to_string(r.heap_refresh) +
            " is not allowed (allowed: 1, 4 or 16, one pixel in that many walked anew a frame)";
+  if (r.shadow_map_size != 0 && !(r.shadow_map_size >= Limits::kShadowMapSize.lo &&
+                                  r.shadow_map_size <= Limits::kShadowMapSize.hi))
+    return "shadow_map_size: " + std::to_string(r.shadow_map_size) +
+           " is out of range (allowed: 0 for no cloud shadows, or 256 to 4096 texels a side)";
   if (!(r.volume_step >= 0.25 && r.volume_step <= 8.0))
     return "volume_step: " + formatNumber(r.volume_step) +
            " is out of range (allowed: 0.25 to 8 lattice spacings)";

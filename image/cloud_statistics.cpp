@@ -234,4 +234,34 @@ OutlineFigures outlineFigures(const std::vector<int>& pixels, int width, int hei
   return out;
 }
 
+ShadowAgreement shadowAgreement(const FloatImage& actual, const FloatImage& reference,
+                                const FloatImage& unshadowed) {
+  ShadowAgreement out;
+  auto luminance = [](const FloatImage& image, std::size_t i) {
+    const float* p = &image.rgba[4 * i];
+    return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+  };
+  const std::size_t pixels = std::size_t(actual.width) * actual.height;
+  int shadowed = 0, both = 0;
+  double difference = 0.0;
+  for (std::size_t i = 0; i < pixels; ++i) {
+    if (!(actual.rgba[4 * i + 3] < 0.01f && reference.rgba[4 * i + 3] < 0.01f)) continue;
+    const double lit = luminance(unshadowed, i);
+    if (!(lit > 0.0)) continue;
+    const double a = luminance(actual, i) / lit, r = luminance(reference, i) / lit;
+    ++out.clear_pixels;
+    difference += std::abs(a - r);
+    if (a < kShadowedRatio) {
+      ++shadowed;
+      both += r < kShadowedRatio;
+    }
+  }
+  if (out.clear_pixels > 0) {
+    out.mean_ratio_difference = difference / out.clear_pixels;
+    out.shadowed = double(shadowed) / out.clear_pixels;
+  }
+  out.agreement = shadowed > 0 ? double(both) / shadowed : 1.0;
+  return out;
+}
+
 }  // namespace nephele

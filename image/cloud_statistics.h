@@ -68,4 +68,20 @@ Fitted sizeDistributionExponent(const std::vector<CloudRegion>& clouds, int min_
 Fitted transectSpectrumSlope(const std::vector<double>& field, int w, double longest_px,
                              double shortest_px);
 
+// Two renders of one view with cloud shadows on the ground (MODEL.md section 16) against a
+// render without: where both show no cloud (coverage under 0.01 in both; the ground, and the
+// sky, which is never shadowed), a pixel is in
+// shadow where its luminance is under kShadowedRatio of the unshadowed render's (halfway
+// between full sun and the sky light alone, groundLight). `agreement`: the fraction of
+// `actual`'s shadowed pixels that `reference` also shadows; `mean_ratio_difference`: the mean
+// |ratio(actual) - ratio(reference)| over those clear pixels; `shadowed`: the share of them
+// `actual` shadows.
+inline constexpr double kShadowedRatio = 0.65;
+struct ShadowAgreement {
+  double agreement = 0.0, mean_ratio_difference = 0.0, shadowed = 0.0;
+  int clear_pixels = 0;
+};
+ShadowAgreement shadowAgreement(const FloatImage& actual, const FloatImage& reference,
+                                const FloatImage& unshadowed);
+
 }  // namespace nephele

@@ -79,6 +79,11 @@ struct RenderSettings {
   // Single renders, dataset samples and the first frame after a cut are always exact.
   int heap_refresh = 4;
 
+  // The ground's cloud shadows (MODEL.md section 16): the map's texels a side (256 to 4096;
+  // 0 draws no shadows), over the ground where the clouds' shadows fall, at most
+  // ShadowMap::kMaxSide metres a side. Error against the exact shadow falls with its size.
+  int shadow_map_size = 512;
+
   // Automaton clouds: the view march's step in lattice spacings (the lattice holds
   // samples_per_cell samples per cell edge). Larger steps are faster and blur thin edges.
   double volume_step = 1.0;

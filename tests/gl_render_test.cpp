@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <numbers>
 
+#include "image/cloud_statistics.h"
 #include "tests/gl_test_fixture.h"
 
 namespace nephele {
@@ -251,6 +252,33 @@ TEST_F(GlRenderTest, FarDeckBeyondItsHoleEqualsOneSampleReference) {
   bare.layers.clear();
   const FloatImage sky = renderer_->renderFloat(bare, pointSampled());
   EXPECT_GT(compareImages(level, sky).max_abs, 0.05);
+}
+
+// The ground's cloud shadows (MODEL.md section 16) under a cumulus field seen from above, low
+// and high sun: the GL's shadow map against the reference's exact sunlight per ground point.
+// Of the ground either shadows (luminance under 0.65 of the unshadowed ground's), at least
+// 90 % is shadowed by both, and the ratio to the unshadowed ground differs by 0.03 on average.
+TEST_F(GlRenderTest, CloudShadowsMatchTheReference) {
+  SceneFile file = preset("genus_cumulus", 200, 150);
+  file.scene.camera.position = {0.0, 0.0, 6000.0};
+  file.scene.camera.orientation.pitch_deg = -60.0;
+  for (double elevation : {35.0, 70.0}) {
+    file.scene.sun.elevation_deg = elevation;
+    const std::string name = "cloud_shadows_" + std::to_string(int(elevation));
+    const FloatImage gl = renderer_->renderFloat(file.scene, pointSampled());
+    RenderSettings none = pointSampled();
+    none.shadow_map_size = 0;
+    const FloatImage unshadowed = renderer_->renderFloat(file.scene, none);
+    const FloatImage reference = renderReference(file.scene, {1, 0});
+    const ShadowAgreement forward = shadowAgreement(gl, reference, unshadowed);
+    const ShadowAgreement backward = shadowAgreement(reference, gl, unshadowed);
+    EXPECT_GT(forward.shadowed, 0.05) << name;  // the view shows shadows at all
+    EXPECT_GE(forward.agreement, 0.9) << name;
+    EXPECT_GE(backward.agreement, 0.9) << name;
+    EXPECT_LE(forward.mean_ratio_difference, 0.03) << name;
+    if (forward.agreement < 0.9 || backward.agreement < 0.9 || forward.mean_ratio_difference > 0.03)
+      writeFailureImages(gl, reference, name);
+  }
 }
 
 // A deck below the camera and a layer above it, seen from between them: exact against the

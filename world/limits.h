@@ -107,6 +107,8 @@ struct Limits {
   static constexpr Range kHeapShadingRate{1.0, 4.0};
   // A continuous view's heaps: one pixel in `heap_refresh` (1, 4 or 16) walked anew a frame.
   static constexpr Range kHeapRefresh{1.0, 16.0};
+  // The ground's shadow map, texels a side (`shadow_map_size`; 0: no cloud shadows).
+  static constexpr Range kShadowMapSize{256.0, 4096.0};
   // Ellipsoids a GL frame draws, those of largest projected size (`ellipsoid_budget`; 0: no
   // budget), at most what a world may hold.
   static constexpr Range kEllipsoidBudget{0.0, double(kMaxWorldEllipsoids)};

@@ -13,6 +13,7 @@ std::vector<std::pair<const char*, int>> FrameStats::fields() const {
           {"automaton_passes", automaton_passes},
           {"target_passes", target_passes},
           {"veil_passes", veil_passes},
+          {"shadow_maps", shadow_maps},
           {"sampled_passes", sampled_passes},
           {"reused_passes", reused_passes},
           {"ellipsoids_drawn", ellipsoids_drawn},

@@ -20,10 +20,11 @@ enum class CpuStage : std::size_t {
   kBudget,   // the frame's work budget (withinEllipsoidBudget)
   kRecords,  // ellipsoid records, heap envelopes, the per-pixel pass's screen bins
   kUploads,  // tables baked, clipmap strips evaluated, buffer textures and volumes sent
+  kShadows,  // the lobes that shadow the ground gathered, with their mean-opacity tables
   kCount
 };
 inline constexpr std::array<const char*, std::size_t(CpuStage::kCount)> kCpuStageNames{
-    "scene", "heaps", "budget", "records", "uploads"};
+    "scene", "heaps", "budget", "records", "uploads", "shadows"};
 
 enum class GpuPass : std::size_t {
   kTargets,   // opaque target meshes
@@ -33,10 +34,11 @@ enum class GpuPass : std::size_t {
   kAutomata,  // volume marches
   kVeil,      // the in-cloud veil
   kReuse,     // a continuous view's last frame reprojected and merged with this frame's samples
+  kShadows,   // the ground's shadow map (drawn when its casters or the sun changed)
   kCount
 };
 inline constexpr std::array<const char*, std::size_t(GpuPass::kCount)> kGpuPassNames{
-    "targets", "clipmaps", "sky", "heaps", "automata", "veil", "reuse"};
+    "targets", "clipmaps", "sky", "heaps", "automata", "veil", "reuse", "shadows"};
 
 struct FrameTimes {
   std::array<double, std::size_t(CpuStage::kCount)> cpu_ms{};
@@ -82,6 +84,7 @@ struct FrameStats {
   int automaton_passes = 0;  // volume marches
   int target_passes = 0;     // opaque target meshes
   int veil_passes = 0;       // the in-cloud veil
+  int shadow_maps = 0;       // the ground's shadow map drawn anew (MODEL.md section 16)
   // Per-pixel ellipsoid passes drawn from samples behind a thick veil (MODEL.md section 15)
   int sampled_passes = 0;
   // Of those, a continuous view's heaps resolved with its last frame (MODEL.md section 15,

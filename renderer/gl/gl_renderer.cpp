@@ -182,7 +182,8 @@ GlRenderer::GlRenderer(const GlPlatform& platform)
       ellipsoids_(gl_),
       automata_(gl_),
       clipmaps_(gl_),
-      targets_(gl_) {}
+      targets_(gl_),
+      shadow_map_(gl_) {}
 
 GlRenderer::~GlRenderer() = default;
 
@@ -496,6 +497,7 @@ void GlRenderer::drawSkyPass(const Scene& scene, const RenderSettings& settings,
     gl_.ProgramUniform1f(p, gl_.GetUniformLocation(p, "u_horizon_slope"),
                          float(std::max(slope, 1e-12)));
   }
+  if (layout.shadows) shadow_map_.bind(p, 11, camera.position);
   if (!slots.empty()) uniform3("u_to_sun", sunDirection(scene.sun));
   for (std::size_t i = 0; i < slots.size(); ++i)
     setSlotUniforms(p, int(i), slots[i], scene, settings);
@@ -513,6 +515,7 @@ void GlRenderer::drawSkyGroup(const Scene& scene, const RenderSettings& settings
   base.air = sceneHasAir(scene);
   base.term_filter = settings.term_filter;
   base.targets = targets;
+  base.shadows = shadow_map_.active();
   for (const CloudLayer& layer : scene.layers) {
     base.specular |= layer.shading.specular > 0.0;
     base.regions |= layerHasRegion(layer);
@@ -637,6 +640,17 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
     rest.ellipsoid_budget = rest.ellipsoid_overdraw = 0.0;  // the thinned scene is within it
   stats_ = {};
   stats_.times = times;
+  {
+    // The ground's cloud shadows (MODEL.md section 16), from the scene's own fields: their
+    // heaps that shadow the view need not be in it.
+    std::optional<CloudShadows> shadows;
+    if (settings.shadow_map_size > 0) {
+      StageClock clock(stats_.times.cpu(CpuStage::kShadows));
+      shadows.emplace(scene, settings.heaps, /*lookups=*/false);
+    }
+    shadow_map_.prepare(shadows ? *shadows : CloudShadows(), scene.camera.position,
+                        settings.shadow_map_size, stats_, timer_);
+  }
   drawScene(within ? *within : drawable, rest, format);
   timer_.enter(-1);
   FrameTimes& t = stats_.times;

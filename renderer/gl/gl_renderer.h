@@ -15,6 +15,7 @@
 #include "renderer/gl/gl_platform.h"
 #include "renderer/gl/gpu_pass_timer.h"
 #include "renderer/gl/layer_clipmap.h"
+#include "renderer/gl/shadow_map.h"
 #include "renderer/gl/sky_shaders.h"
 #include "renderer/gl/target_renderer.h"
 #include "renderer/render_settings.h"
@@ -133,6 +134,7 @@ class GlRenderer {
   AutomatonRenderer automata_;
   LayerClipmaps clipmaps_;
   TargetRenderer targets_;
+  ShadowMap shadow_map_;
 };
 
 }  // namespace nephele

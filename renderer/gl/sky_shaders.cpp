@@ -1,5 +1,6 @@
 #include "renderer/gl/sky_shaders.h"
 
+#include "world/formations/cloud_shadow.h"
 #include "world/textures/gardner_texture.h"
 
 namespace nephele {
@@ -173,6 +174,23 @@ uniform vec3 u_ground;
 
 uniform float u_horizon_slope;  // |gradient of r.z| per pixel
 
+#ifdef SHADOWS
+// The share of the sunlight reaching the ground (MODEL.md section 16, ShadowMap): the map is
+// u_shadow_half * 2 metres a side about u_shadow_centre (from the camera); 1 outside it.
+layout(binding = 11) uniform sampler2D u_shadow_map;
+uniform vec2 u_shadow_centre;
+uniform float u_shadow_half;
+vec3 groundColour(vec3 d) {
+  vec2 uv = (d.xy * (u_camera_z / -d.z) - u_shadow_centre) / (2.0 * u_shadow_half) + 0.5;
+  float sun = all(greaterThanEqual(uv, vec2(0.0))) && all(lessThanEqual(uv, vec2(1.0)))
+                  ? texture(u_shadow_map, uv).r
+                  : 1.0;
+  return u_ground * (kGroundSkyShare + (1.0 - kGroundSkyShare) * sun);
+}
+#else
+vec3 groundColour(vec3 d) { return u_ground; }
+#endif
+
 vec3 background(vec3 r) {
   vec3 d = normalize(r);
   // The ground's share of the pixel: r.z is linear across the image, so the horizon is a
@@ -182,10 +200,11 @@ vec3 background(vec3 r) {
 #ifdef AIR
   // Each part carries its own air. The ground seen at the horizon lies behind an endless
   // stretch of air (fog and haze touch the ground), so there it is the air's colour.
-  vec3 aired_ground = d.z < 0.0 ? applyAir(u_ground, d, u_camera_z / -d.z) : airAtHorizon();
+  vec3 aired_ground =
+      d.z < 0.0 ? applyAir(groundColour(d), d, u_camera_z / -d.z) : airAtHorizon();
   return mix(applyAir(sky, d, kFar), aired_ground, ground);
 #else
-  return mix(sky, u_ground, ground);
+  return mix(sky, d.z < 0.0 ? groundColour(d) : u_ground, ground);
 #endif
 }
 #endif
@@ -445,6 +464,7 @@ std::string SkyPassLayout::key() const {
   k += specular ? 's' : '-';
   k += targets ? 't' : '-';
   k += regions ? 'r' : '-';
+  k += shadows ? 'h' : '-';
   return k;
 }
 
@@ -486,6 +506,10 @@ std::string skyFragmentSource(const SkyPassLayout& layout) {
   if (layout.specular) s += "#define SPECULAR\n";
   if (layout.targets) s += "#define TARGETS\n";
   if (layout.regions) s += "#define REGIONS\n";
+  if (layout.shadows && layout.background) {
+    s += "#define SHADOWS\n";
+    s += "const float kGroundSkyShare = " + std::to_string(kGroundSkyShare) + ";\n";
+  }
   if (layout.term_filter == TermFilter::kCut) s += "#define FILTER_CUT\n";
   if (layout.term_filter == TermFilter::kNone) s += "#define FILTER_NONE\n";
   bool procedural = false, clipmap = false;

@@ -29,6 +29,7 @@ struct SkyPassLayout {
   bool specular = false;
   bool targets = false;  // opaque targets were drawn first (their colour and distance)
   bool regions = false;  // some layer lies in a bounded region (region.h)
+  bool shadows = false;  // the ground takes the clouds' shadows from the shadow map
 
   int slots() const { return int(above.size() + below.size()); }
   std::string key() const;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "world/automaton/cloud_density.h"
+#include "world/formations/cloud_shadow.h"
 #include "world/formations/ellipsoid.h"
 #include "world/formations/heap_light.h"
 #include "world/frames.h"
@@ -64,7 +65,9 @@ struct EllipsoidEntry {
 
 class ReferenceTracer {
  public:
-  explicit ReferenceTracer(const Scene& scene) : scene_(scene), sun_(sunDirection(scene.sun)) {
+  // `shadows`: the ground's cloud shadows (MODEL.md section 16), or null for none.
+  ReferenceTracer(const Scene& scene, const CloudShadows* shadows)
+      : scene_(scene), sun_(sunDirection(scene.sun)), shadows_(shadows) {
     textures_.reserve(scene.layers.size());
     for (const CloudLayer& layer : scene.layers) textures_.emplace_back(layer.texture);
     solid_textures_.reserve(scene.clouds.size());
@@ -93,6 +96,10 @@ class ReferenceTracer {
     double nearest_opaque =
         std::min(direction.z < 0.0 ? eye.z / -direction.z : kInfinity, max_distance);
     glm::dvec3 colour = skyBackground(scene_.sky, direction);
+    if (direction.z < 0.0 && shadows_ && !shadows_->empty()) {
+      const glm::dvec3 ground = eye + (eye.z / -direction.z) * direction;
+      colour *= groundLight(shadows_->sunlight(glm::dvec2(ground)));
+    }
     int object_id = 0;
     for (std::size_t t = 0; t < scene_.targets.size(); ++t) {
       const Target& target = scene_.targets[t];
@@ -281,6 +288,7 @@ class ReferenceTracer {
 
   const Scene& scene_;
   glm::dvec3 sun_;
+  const CloudShadows* shadows_;
   std::vector<LayerTexture> textures_;
   std::vector<SolidTexture> solid_textures_;
   std::vector<EllipsoidEntry> ellipsoids_;
@@ -308,7 +316,8 @@ Frame renderReferenceFrame(const Scene& scene, const ReferenceSettings& settings
   if (infrared) frame.lwir.resize(pixels);
 
   const Scene with_fields = scene.fields.empty() ? Scene{} : withFieldClouds(scene, settings.heaps);
-  const ReferenceTracer tracer(scene.fields.empty() ? scene : with_fields);
+  const CloudShadows shadows(scene, settings.heaps, /*lookups=*/true);
+  const ReferenceTracer tracer(scene.fields.empty() ? scene : with_fields, &shadows);
   const ViewBasis basis = viewBasis(camera);
   const int n = std::max(1, settings.samples_per_axis);
   const int divisor = std::max(1, settings.label_divisor);
@@ -368,7 +377,7 @@ Frame renderReferenceFrame(const Scene& scene, const ReferenceSettings& settings
 struct CloudProbe::State {
   Scene scene;
   ReferenceTracer tracer;
-  State(Scene s) : scene(std::move(s)), tracer(scene) {}
+  State(Scene s) : scene(std::move(s)), tracer(scene, nullptr) {}
 };
 
 CloudProbe::CloudProbe(const Scene& scene, const HeapDrawing& heaps)

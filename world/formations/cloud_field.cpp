@@ -642,23 +642,23 @@ double heapRange(const CloudField& f, const Camera& camera, double range_m) {
   return std::min(asked, CloudField::kMaxRangeTiles * fieldTileSize(f));
 }
 
-std::vector<EllipsoidCloud> fieldClouds(const CloudField& f, const Camera& camera,
-                                        const HeapDrawing& drawing) {
+namespace {
+
+// The heaps of the tiles within heapRange of the camera that `keep` takes, by the tile's box
+// in the field's own frame (grown by the largest heap that can reach out of it), drifted into
+// place; `detailed` says from the box whether a tile's heaps are drawn with every lobe.
+template <class Keep, class Detailed>
+std::vector<EllipsoidCloud> tilesAround(const CloudField& f, const Camera& camera,
+                                        const HeapDrawing& drawing, Keep keep, Detailed detailed) {
   std::vector<EllipsoidCloud> out;
   if (!(peakCoverage(f) > 0.0)) return out;
   const double size = fieldTileSize(f);
   // The eye in the field's own frame (the field has drifted by drift_m).
   const glm::dvec2 eye = glm::dvec2(camera.position) - f.drift_m;
   const double range = heapRange(f, camera, drawing.range_m);
-  const ViewBasis basis = viewBasis(camera);
-  // Pixels per metre at unit distance: a heap of radius r at distance d spans r focal / d.
-  const double focal_px = 0.5 * camera.height / basis.tan_half_vfov;
   const double rise = f.clusters.none() ? 1.0 : 1.0 + f.clusters.amount;
   const double top = f.base_m + 1.3 * f.thickness_m * rise;
-  // A tile is kept when its box (grown by the largest heap that can reach out of it) is not
-  // wholly outside the view frustum (the renderer's test for clouds).
   const double reach = 3.6 * heapRadius(f) * (1.0 + kSizeVariation);
-  const glm::dvec3 eye3(eye, camera.position.z);
   const std::string key = fieldKey(f);
   const auto lo = glm::floor((eye - range) / size), hi = glm::floor((eye + range) / size);
   for (double jy = lo.y; jy <= hi.y; ++jy)
@@ -671,14 +671,10 @@ std::vector<EllipsoidCloud> fieldClouds(const CloudField& f, const Camera& camer
                              std::sqrt(0.5) * size))
         continue;
       const glm::dvec3 box_min(min_xy, f.base_m), box_max(max_xy, top);
-      if (!boxMayBeInView(basis, eye3, box_min, box_max)) continue;
+      if (!keep(box_min, box_max)) continue;
       const std::int64_t i = std::int64_t(ix), j = std::int64_t(jy);
-      // The nearest point of the tile's box stands for its heaps, so a tile is detailed when its
-      // nearest heap would be.
-      const double distance = glm::length(glm::clamp(eye3, box_min, box_max) - eye3);
-      const bool detailed = heapRadius(f) * focal_px >= drawing.detail_px * distance;
-      const auto tile =
-          tileCache().get({key, i, j, detailed}, [&] { return makeTile(f, i, j, detailed); });
+      const bool fine = detailed(box_min, box_max);
+      const auto tile = tileCache().get({key, i, j, fine}, [&] { return makeTile(f, i, j, fine); });
       if (tile->ellipsoids.empty()) continue;
       EllipsoidCloud cloud = *tile;
       const glm::dvec3 drift(f.drift_m, 0.0);
@@ -687,6 +683,34 @@ std::vector<EllipsoidCloud> fieldClouds(const CloudField& f, const Camera& camer
       out.push_back(std::move(cloud));
     }
   return out;
+}
+
+}  // namespace
+
+std::vector<EllipsoidCloud> fieldClouds(const CloudField& f, const Camera& camera,
+                                        const HeapDrawing& drawing) {
+  const ViewBasis basis = viewBasis(camera);
+  const glm::dvec3 eye(glm::dvec2(camera.position) - f.drift_m, camera.position.z);
+  // Pixels per metre at unit distance: a heap of radius r at distance d spans r focal / d.
+  const double focal_px = 0.5 * camera.height / basis.tan_half_vfov;
+  return tilesAround(
+      f, camera, drawing,
+      // A tile is kept when its box is not wholly outside the view frustum (the renderer's
+      // test for clouds).
+      [&](glm::dvec3 lo, glm::dvec3 hi) { return boxMayBeInView(basis, eye, lo, hi); },
+      // The nearest point of the tile's box stands for its heaps, so a tile is detailed when
+      // its nearest heap would be.
+      [&](glm::dvec3 lo, glm::dvec3 hi) {
+        const double distance = glm::length(glm::clamp(eye, lo, hi) - eye);
+        return heapRadius(f) * focal_px >= drawing.detail_px * distance;
+      });
+}
+
+std::vector<EllipsoidCloud> fieldShadowClouds(const CloudField& f, const Camera& camera,
+                                              const HeapDrawing& drawing) {
+  return tilesAround(
+      f, camera, drawing, [](glm::dvec3, glm::dvec3) { return true; },
+      [](glm::dvec3, glm::dvec3) { return false; });
 }
 
 namespace {

@@ -136,5 +136,10 @@ double heapRange(const CloudField& field, const Camera& camera, double range_m =
 // into place.
 std::vector<EllipsoidCloud> fieldClouds(const CloudField& field, const Camera& camera,
                                         const HeapDrawing& drawing = {});
+// The heaps of every tile within heapRange of the camera, in view or not, drifted into place
+// and coarse: what shadows the ground (MODEL.md section 16), the same for every view from one
+// eye.
+std::vector<EllipsoidCloud> fieldShadowClouds(const CloudField& field, const Camera& camera,
+                                              const HeapDrawing& drawing = {});
 
 }  // namespace nephele

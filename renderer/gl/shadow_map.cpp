@@ -1,0 +1,184 @@
+#include "renderer/gl/shadow_map.h"
+
+#include <algorithm>
+#include <cstring>
+#include <string>
+
+#include "renderer/gl/gl_platform.h"
+#include "world/automaton/cloud_density.h"
+#include "world/check.h"
+
+namespace nephele {
+namespace {
+
+// Caster i is texels 4i to 4i + 3 of u_casters: its centre from the map's centre (x, y) and
+// its altitude (z), its reach (w); then the rows of W (xyz), with its extinction (row 1's w)
+// and its table's row (row 2's w).
+const char* kVertex = R"(#version 450 core
+layout(binding = 13) uniform samplerBuffer u_casters;
+uniform vec3 u_to_sun;
+uniform float u_half;
+flat out int v_caster;
+void main() {
+  vec4 c = texelFetch(u_casters, gl_InstanceID * 4);
+  // The footprint (CloudShadows::footprint): the bounding sphere's shadow in a square.
+  vec2 centre = c.xy - c.z / u_to_sun.z * u_to_sun.xy;
+  vec2 corner = vec2(gl_VertexID & 1, gl_VertexID >> 1) * 2.0 - 1.0;
+  v_caster = gl_InstanceID;
+  gl_Position = vec4((centre + corner * (c.w / u_to_sun.z)) / u_half, 0.0, 1.0);
+}
+)";
+
+// casterSunlight (world/formations/cloud_shadow.cpp) at the texel's ground point.
+const char* kFragment = R"(
+layout(binding = 13) uniform samplerBuffer u_casters;
+layout(binding = 12) uniform sampler2D u_tables;  // kTableSize x tables: C(g)
+uniform vec3 u_to_sun;
+uniform float u_half;
+uniform float u_size;
+flat in int v_caster;
+layout(location = 0) out vec4 o_light;
+void main() {
+  vec2 ground = (gl_FragCoord.xy / u_size * 2.0 - 1.0) * u_half;
+  int k = v_caster * 4;
+  vec4 c = texelFetch(u_casters, k), w0 = texelFetch(u_casters, k + 1);
+  vec4 w1 = texelFetch(u_casters, k + 2), w2 = texelFetch(u_casters, k + 3);
+  vec3 rel = vec3(ground, 0.0) - c.xyz;
+  vec3 o = vec3(dot(w0.xyz, rel), dot(w1.xyz, rel), dot(w2.xyz, rel));
+  vec3 w = vec3(dot(w0.xyz, u_to_sun), dot(w1.xyz, u_to_sun), dot(w2.xyz, u_to_sun));
+  float a = dot(w, w), b = dot(o, w), quarter = b * b - a * (dot(o, o) - 1.0);
+  float light = 1.0;
+  if (quarter > 0.0) {
+    float root = sqrt(quarter), far = (-b + root) / a;
+    if (far > 0.0) {
+      float chord = far - max(0.0, (-b - root) / a);
+      float x = clamp(quarter / a, 0.0, 1.0) * float(kTableSize - 1);
+      int i = min(int(x), kTableSize - 2), row = int(w2.w);
+      float opacity = mix(texelFetch(u_tables, ivec2(i, row), 0).r,
+                          texelFetch(u_tables, ivec2(i + 1, row), 0).r, x - float(i));
+      light = 1.0 - opacity * (1.0 - 1.0 / (1.0 + kDiffuse * w1.w * chord));
+    }
+  }
+  o_light = vec4(light);
+}
+)";
+
+// FNV-1a over raw bytes.
+void hashBytes(std::uint64_t& h, const void* data, std::size_t bytes) {
+  const auto* p = static_cast<const unsigned char*>(data);
+  for (std::size_t i = 0; i < bytes; ++i) h = (h ^ p[i]) * 0x100000001b3ull;
+}
+
+}  // namespace
+
+ShadowMap::ShadowMap(const GlApi& gl) : gl_(gl) {}
+
+void ShadowMap::prepare(const CloudShadows& shadows, glm::dvec3 camera, int size, FrameStats& stats,
+                        GpuPassTimer& timer) {
+  active_ = false;
+  if (size <= 0 || shadows.empty()) return;
+  // Everything is placed from an anchor, the first caster's centre, so that a world whose
+  // clouds only drifted together (a field in the wind) keeps its map, moved with them. The map
+  // is the casters' shadows within a square about the camera's ground point, its edges on a grid
+  // of kMaxSide / 16 in the anchor's frame: a camera that moves less than that keeps it too.
+  const glm::dvec2 anchor(shadows.casters().front().centre);
+  const double step = kMaxSide / 16.0;
+  const glm::dvec2 eye = glm::round((glm::dvec2(camera) - anchor) / step) * step;
+  const glm::dvec2 lo =
+      glm::floor(glm::max(shadows.lo() - anchor, eye - 0.5 * kMaxSide) / step) * step;
+  const glm::dvec2 hi =
+      glm::ceil(glm::min(shadows.hi() - anchor, eye + 0.5 * kMaxSide) / step) * step;
+  if (!(lo.x < hi.x && lo.y < hi.y)) return;
+  active_ = true;
+  const glm::dvec2 centre = 0.5 * (lo + hi);  // from the anchor
+  const double half = 0.5 * std::max(hi.x - lo.x, hi.y - lo.y);
+
+  std::vector<glm::vec4> records;
+  records.reserve(shadows.casters().size() * 4);
+  for (const ShadowCaster& c : shadows.casters()) {
+    const glm::dmat3 w = glm::transpose(c.to_unit);  // columns of the transpose: rows of W
+    records.emplace_back(glm::dvec2(c.centre) - anchor - centre, c.centre.z, c.reach);
+    records.emplace_back(w[0], 0.0);
+    records.emplace_back(w[1], c.extinction);
+    records.emplace_back(w[2], double(c.table));
+  }
+  std::vector<float> tables;
+  for (const ShadowTable& t : shadows.tables()) tables.insert(tables.end(), t.begin(), t.end());
+  const glm::vec3 to_sun(shadows.toSun());
+  std::uint64_t key = 0xcbf29ce484222325ull;
+  hashBytes(key, records.data(), records.size() * sizeof(glm::vec4));
+  hashBytes(key, tables.data(), tables.size() * sizeof(float));
+  hashBytes(key, &to_sun, sizeof to_sun);
+  hashBytes(key, &size, sizeof size);
+  hashBytes(key, &half, sizeof half);
+  centre_ = anchor + centre;
+  half_ = half;
+  if (key == key_ && texture_) return;
+
+  StageClock clock(stats.times.cpu(CpuStage::kUploads));
+  if (!program_) {
+    std::string error;
+    const std::string fragment =
+        "#version 450 core\nconst int kTableSize = " + std::to_string(kShadowTableSize) +
+        ";\nconst float kDiffuse = " + std::to_string(0.75 * (1.0 - kDiffuseAsymmetry)) + ";\n" +
+        kFragment;
+    program_ = createProgram(gl_, kVertex, fragment, error);
+    NEPHELE_CHECK(program_, "shadow map program: " << error);
+    vertex_array_ = createVertexArray(gl_);
+    framebuffer_ = createFramebuffer(gl_);
+    records_buffer_ = createBuffer(gl_);
+    records_ = createTexture(gl_, GL_TEXTURE_BUFFER);
+  }
+  if (size != size_) {
+    texture_ = createTexture(gl_, GL_TEXTURE_2D);
+    gl_.TextureStorage2D(texture_.get(), 1, GL_R16F, size, size);
+    gl_.TextureParameteri(texture_.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    gl_.TextureParameteri(texture_.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    gl_.TextureParameteri(texture_.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    gl_.TextureParameteri(texture_.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    gl_.NamedFramebufferTexture(framebuffer_.get(), GL_COLOR_ATTACHMENT0, texture_.get(), 0);
+    size_ = size;
+  }
+  // The tables, a row each (a fresh texture: their count changes).
+  tables_ = createTexture(gl_, GL_TEXTURE_2D);
+  const int rows = int(shadows.tables().size());
+  gl_.TextureStorage2D(tables_.get(), 1, GL_R32F, kShadowTableSize, rows);
+  gl_.TextureSubImage2D(tables_.get(), 0, 0, 0, kShadowTableSize, rows, GL_RED, GL_FLOAT,
+                        tables.data());
+  gl_.NamedBufferData(records_buffer_.get(), GLsizeiptr(records.size() * sizeof(glm::vec4)),
+                      records.data(), GL_STREAM_DRAW);
+  gl_.TextureBuffer(records_.get(), GL_RGBA32F, records_buffer_.get());
+
+  GpuPassScope pass(timer, GpuPass::kShadows);
+  const GLuint p = program_.get();
+  gl_.BindFramebuffer(GL_FRAMEBUFFER, framebuffer_.get());
+  gl_.Viewport(0, 0, size, size);
+  const GLfloat lit[4] = {1.0f, 1.0f, 1.0f, 1.0f};
+  gl_.ClearNamedFramebufferfv(framebuffer_.get(), GL_COLOR, 0, lit);
+  gl_.UseProgram(p);
+  gl_.BindVertexArray(vertex_array_.get());
+  gl_.ProgramUniform3fv(p, gl_.GetUniformLocation(p, "u_to_sun"), 1, &to_sun.x);
+  gl_.ProgramUniform1f(p, gl_.GetUniformLocation(p, "u_half"), float(half));
+  gl_.ProgramUniform1f(p, gl_.GetUniformLocation(p, "u_size"), float(size));
+  gl_.BindTextureUnit(13, records_.get());
+  gl_.BindTextureUnit(12, tables_.get());
+  // The product of every caster's share: dst = dst * src, in any order.
+  gl_.Disable(GL_FRAMEBUFFER_SRGB);
+  gl_.Enable(GL_BLEND);
+  gl_.BlendFuncSeparate(GL_ZERO, GL_SRC_COLOR, GL_ZERO, GL_SRC_ALPHA);
+  gl_.DrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(shadows.casters().size()));
+  gl_.Disable(GL_BLEND);
+  key_ = key;
+  ++draws_;
+  ++stats.shadow_maps;
+}
+
+void ShadowMap::bind(GLuint program, GLuint unit, glm::dvec3 camera) const {
+  gl_.BindTextureUnit(unit, texture_.get());
+  gl_.ProgramUniform1i(program, gl_.GetUniformLocation(program, "u_shadow_map"), GLint(unit));
+  const glm::vec2 centre(centre_ - glm::dvec2(camera));
+  gl_.ProgramUniform2fv(program, gl_.GetUniformLocation(program, "u_shadow_centre"), 1, &centre.x);
+  gl_.ProgramUniform1f(program, gl_.GetUniformLocation(program, "u_shadow_half"), float(half_));
+}
+
+}  // namespace nephele

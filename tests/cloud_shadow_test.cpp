@@ -1,0 +1,117 @@
+// The ground's cloud shadows (MODEL.md section 16): one lobe's share of the sunlight against
+// its closed form, the mean-opacity table, a field's shadows against the heaps' own cover,
+// and no NaN for any sun.
+#include "world/formations/cloud_shadow.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "world/automaton/cloud_density.h"
+#include "world/formations/ellipsoid.h"
+#include "world/formations/weather.h"
+#include "world/scene.h"
+
+namespace nephele {
+namespace {
+
+EllipsoidCloud sphereCloud(double radius, glm::dvec3 centre) {
+  EllipsoidCloud cloud;  // the cumulus genus's thresholds and texture offset (genus.cpp)
+  cloud.light_extinction = 0.02;
+  cloud.threshold_centre = -0.4;
+  cloud.threshold_limb = 0.4;
+  cloud.transition = 0.08;
+  cloud.texture.gardner.t0 = 1.0;
+  Ellipsoid e;
+  e.radii = glm::dvec3(radius);
+  e.centre = centre;
+  cloud.ellipsoids = {e};
+  return cloud;
+}
+
+TEST(CloudShadowTest, MeanOpacityRisesTowardsTheCentreWithinZeroAndOne) {
+  const ShadowTable table = meanOpacityTable(sphereCloud(300.0, {0, 0, 1500}));
+  for (int i = 0; i < kShadowTableSize; ++i) {
+    EXPECT_GE(table[std::size_t(i)], 0.0f);
+    EXPECT_LE(table[std::size_t(i)], 1.0f);
+    if (i > 0) EXPECT_GE(table[std::size_t(i)], table[std::size_t(i) - 1]) << i;
+  }
+  // Gardner eq. 11 with T1 below 0: opaque at the centre whatever the texture, clear at the
+  // limb for the texture's values below T2.
+  EXPECT_EQ(table.back(), 1.0f);
+  EXPECT_LT(table.front(), 0.5f);
+  EXPECT_NEAR(meanOpacity(table, 0.5), table[16], 1e-6);
+  EXPECT_NEAR(meanOpacity(table, 1.0 / 64.0), 0.5 * (table[0] + table[1]), 1e-6);
+}
+
+// A sphere of radius r seen along the sun from a ground point: the ray passes at rho r from
+// its centre, so g = 1 - rho^2 and the chord is 2 r sqrt(g).
+TEST(CloudShadowTest, OneLobeLetsThroughItsClosedForm) {
+  const double r = 400.0;
+  const glm::dvec3 centre(1000.0, -500.0, 1500.0);
+  const EllipsoidCloud cloud = sphereCloud(r, centre);
+  const ShadowTable table = meanOpacityTable(cloud);
+  const ShadowCaster caster{centre, worldToUnitSphere(cloud.ellipsoids[0]), r, 0.02, 0};
+  const glm::dvec3 to_sun = glm::normalize(glm::dvec3(0.3, -0.2, 1.0));
+  // The centre's shadow on the ground, then points across it.
+  const glm::dvec3 under = centre - centre.z / to_sun.z * to_sun;
+  const glm::dvec3 across = glm::normalize(glm::cross(to_sun, glm::dvec3(1.0, 0.0, 0.0)));
+  for (double rho : {0.0, 0.3, 0.7, 0.95}) {
+    // A point on the ground whose ray to the sun passes rho r from the centre.
+    const glm::dvec3 offset = rho * r * across;
+    const glm::dvec3 p = under + offset - offset.z / to_sun.z * to_sun;
+    ASSERT_NEAR(p.z, 0.0, 1e-6);
+    const double g = 1.0 - rho * rho;
+    const double expected =
+        1.0 - meanOpacity(table, g) * (1.0 - diffuseTransmittance(0.02 * 2.0 * r * std::sqrt(g)));
+    EXPECT_NEAR(casterSunlight(caster, table, p, to_sun), expected, 1e-9) << rho;
+  }
+  const glm::dvec3 beside = under + 1.2 * r / std::sqrt(1.0 - across.z * across.z) * across;
+  EXPECT_EQ(casterSunlight(caster, table, {beside.x, beside.y, 0.0}, to_sun), 1.0);
+  // Above the lobe, nothing shadows; inside it, the chord runs from the point on.
+  EXPECT_EQ(casterSunlight(caster, table, centre + glm::dvec3(0, 0, 2 * r), to_sun), 1.0);
+  const double inside = casterSunlight(caster, table, centre, to_sun);
+  EXPECT_NEAR(inside, 1.0 - table.back() * (1.0 - diffuseTransmittance(0.02 * r)), 1e-9);
+}
+
+Scene fieldScene(double elevation_deg) {
+  Scene scene;
+  WeatherLayer w = typicalWeatherLayer(CloudType::kCumulus, 0.4);
+  const WeatherClouds clouds = weatherClouds(w, "w", 7);
+  scene.fields = clouds.fields;
+  scene.sun.elevation_deg = elevation_deg;
+  scene.camera.position = {0.0, 0.0, 3000.0};
+  return scene;
+}
+
+// A cumulus field at 40 % seen from above: its shadows cover a share of the ground near the
+// heaps' own cover (larger, as a low sun stretches them; smaller, as the limbs let light by).
+TEST(CloudShadowTest, AFieldShadowsAboutItsOwnCover) {
+  const Scene scene = fieldScene(60.0);
+  const CloudShadows shadows(scene, {}, true);
+  ASSERT_FALSE(shadows.empty());
+  int shadowed = 0, n = 0;
+  for (double y = -5000.0; y < 5000.0; y += 50.0)
+    for (double x = -5000.0; x < 5000.0; x += 50.0, ++n) {
+      const double s = shadows.sunlight({x, y});
+      ASSERT_TRUE(s >= 0.0 && s <= 1.0) << x << "," << y << ": " << s;
+      shadowed += s < 0.5;
+    }
+  const double share = double(shadowed) / n;
+  EXPECT_GT(share, 0.15);
+  EXPECT_LT(share, 0.7);
+}
+
+TEST(CloudShadowTest, EverySunGivesASunlightShareWithinZeroAndOne) {
+  for (double elevation : {-10.0, 0.0, 0.99, 1.0, 3.0, 45.0, 89.9, 90.0}) {
+    const CloudShadows shadows(fieldScene(elevation), {}, true);
+    EXPECT_EQ(shadows.empty(), elevation < 1.0) << elevation;
+    for (double x = -20000.0; x <= 20000.0; x += 997.0) {
+      const double s = shadows.sunlight({x, 0.5 * x});
+      EXPECT_TRUE(s >= 0.0 && s <= 1.0) << elevation << " at " << x << ": " << s;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace nephele

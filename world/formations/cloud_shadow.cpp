@@ -1,0 +1,167 @@
+#include "world/formations/cloud_shadow.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <mutex>
+#include <sstream>
+#include <string>
+
+#include "world/automaton/cloud_density.h"
+#include "world/counter_random.h"
+#include "world/formations/cloud_field.h"
+#include "world/scene.h"
+#include "world/shading.h"
+#include "world/textures/solid_texture.h"
+
+namespace nephele {
+namespace {
+
+// The texture and thresholds a table depends on, as text.
+std::string tableKey(const EllipsoidCloud& cloud) {
+  const SolidTextureSpec& t = cloud.texture;
+  const GardnerTextureParams& g = t.gardner;
+  std::ostringstream key;
+  key.precision(17);
+  key << cloud.threshold_centre << '/' << cloud.threshold_limb << '/' << cloud.transition << '/'
+      << int(t.source) << '/' << t.seed << '/' << g.terms << ',' << g.fx1 << ',' << g.fy1 << ','
+      << g.t0 << ',' << g.seeded_phases << ',' << g.seed << ',' << g.amplitude_ratio << '/'
+      << t.perlin_period_m << ',' << t.perlin_size_log2 << ',' << t.perlin_cells << ','
+      << t.perlin_octaves << ',' << t.perlin_persistence;
+  return key.str();
+}
+
+ShadowTable computeTable(const EllipsoidCloud& cloud) {
+  const SolidTexture texture(cloud.texture);
+  const glm::dvec3 period = texture.period();
+  std::array<double, kShadowTextureSamples> values{};
+  for (int k = 0; k < kShadowTextureSamples; ++k) {
+    auto u = [&](int axis) { return unitFromBits(hashCounters(0x5ad0, std::uint64_t(k), axis)); };
+    values[std::size_t(k)] = texture.value(glm::dvec3(u(0), u(1), u(2)) * period);
+  }
+  ShadowTable table{};
+  for (int i = 0; i < kShadowTableSize; ++i) {
+    const double g = double(i) / (kShadowTableSize - 1);
+    double sum = 0.0;
+    for (double v : values)
+      sum += 1.0 - ellipsoidTranslucence(v, cloud.threshold_centre, cloud.threshold_limb, g,
+                                         cloud.transition);
+    table[std::size_t(i)] = float(sum / kShadowTextureSamples);
+  }
+  return table;
+}
+
+}  // namespace
+
+ShadowTable meanOpacityTable(const EllipsoidCloud& cloud) {
+  // A field's tiles share a texture; a bounded cache keeps a table per texture and thresholds.
+  static std::mutex mutex;
+  static std::map<std::string, ShadowTable> cache;
+  const std::string key = tableKey(cloud);
+  {
+    const std::lock_guard lock(mutex);
+    if (auto it = cache.find(key); it != cache.end()) return it->second;
+  }
+  const ShadowTable table = computeTable(cloud);
+  const std::lock_guard lock(mutex);
+  if (cache.size() >= 1024) cache.clear();
+  cache.emplace(key, table);
+  return table;
+}
+
+double meanOpacity(const ShadowTable& table, double g) {
+  const double x = std::clamp(g, 0.0, 1.0) * (kShadowTableSize - 1);
+  const int i = std::min(int(x), kShadowTableSize - 2);
+  const double f = x - i;
+  return (1.0 - f) * table[std::size_t(i)] + f * table[std::size_t(i) + 1];
+}
+
+double casterSunlight(const ShadowCaster& caster, const ShadowTable& table, glm::dvec3 p,
+                      glm::dvec3 to_sun) {
+  // |o + s w| = 1 in the unit sphere: a s^2 + 2 b s + c = 0.
+  const glm::dvec3 o = caster.to_unit * (p - caster.centre), w = caster.to_unit * to_sun;
+  const double a = glm::dot(w, w), b = glm::dot(o, w), c = glm::dot(o, o) - 1.0;
+  const double quarter = b * b - a * c;  // a (1 - |o_perp|^2)
+  if (!(quarter > 0.0)) return 1.0;
+  const double root = std::sqrt(quarter);
+  const double far = (-b + root) / a;
+  if (!(far > 0.0)) return 1.0;  // the lobe lies below p
+  const double chord = far - std::max(0.0, (-b - root) / a);
+  const double g = quarter / a;
+  return 1.0 - meanOpacity(table, g) * (1.0 - diffuseTransmittance(caster.extinction * chord));
+}
+
+CloudShadows::CloudShadows(const Scene& scene, const HeapDrawing& heaps, bool lookups) {
+  if (!(scene.sun.elevation_deg >= 1.0)) return;
+  to_sun_ = sunDirection(scene.sun);
+  std::map<std::string, int> table_of;
+  auto add = [&](const EllipsoidCloud& cloud) {
+    if (!(cloud.light_extinction > 0.0) || cloud.ellipsoids.empty()) return;
+    const std::string key = tableKey(cloud);
+    auto [it, fresh] = table_of.emplace(key, int(tables_.size()));
+    if (fresh) tables_.push_back(meanOpacityTable(cloud));
+    for (const Ellipsoid& e : cloud.ellipsoids) {
+      const double reach = std::max({e.radii.x, e.radii.y, e.radii.z});
+      if (!(e.centre.z + reach > 0.0)) continue;  // wholly underground
+      casters_.push_back(
+          {e.centre, worldToUnitSphere(e), reach, cloud.light_extinction, it->second});
+    }
+  };
+  for (const EllipsoidCloud& cloud : scene.clouds) add(cloud);
+  for (const CloudField& field : scene.fields)
+    for (const EllipsoidCloud& cloud : fieldShadowClouds(field, scene.camera, heaps)) add(cloud);
+  if (casters_.empty()) return;
+
+  lo_ = glm::dvec2(std::numeric_limits<double>::infinity());
+  hi_ = -lo_;
+  for (const ShadowCaster& caster : casters_) {
+    glm::dvec2 a, b;
+    footprint(caster, a, b);
+    lo_ = glm::min(lo_, a);
+    hi_ = glm::max(hi_, b);
+  }
+  if (!lookups) return;
+  // Cells of at least 200 m, at most 512 a side.
+  const glm::dvec2 extent = hi_ - lo_;
+  cell_ = std::max({200.0, extent.x / 512.0, extent.y / 512.0});
+  cells_ = glm::max(glm::ivec2(glm::ceil(extent / cell_)), glm::ivec2(1));
+  grid_.assign(std::size_t(cells_.x) * cells_.y, {});
+  for (std::size_t i = 0; i < casters_.size(); ++i) {
+    glm::dvec2 a, b;
+    footprint(casters_[i], a, b);
+    const glm::ivec2 c0 =
+        glm::clamp(glm::ivec2(glm::floor((a - lo_) / cell_)), glm::ivec2(0), cells_ - 1);
+    const glm::ivec2 c1 =
+        glm::clamp(glm::ivec2(glm::floor((b - lo_) / cell_)), glm::ivec2(0), cells_ - 1);
+    for (int y = c0.y; y <= c1.y; ++y)
+      for (int x = c0.x; x <= c1.x; ++x) grid_[std::size_t(y) * cells_.x + x].push_back(int(i));
+  }
+}
+
+void CloudShadows::footprint(const ShadowCaster& caster, glm::dvec2& lo, glm::dvec2& hi) const {
+  // The bounding sphere's shadow on Z = 0 is an ellipse about the centre's shadow with semi-axes
+  // reach and reach / sin(elevation); the square of half side reach / to_sun.z holds it.
+  const glm::dvec2 centre =
+      glm::dvec2(caster.centre) - caster.centre.z / to_sun_.z * glm::dvec2(to_sun_);
+  const double half = caster.reach / to_sun_.z;
+  lo = centre - half;
+  hi = centre + half;
+}
+
+double CloudShadows::sunlight(glm::dvec2 ground) const {
+  if (casters_.empty() || ground.x < lo_.x || ground.y < lo_.y || ground.x > hi_.x ||
+      ground.y > hi_.y)
+    return 1.0;
+  const glm::ivec2 c =
+      glm::clamp(glm::ivec2(glm::floor((ground - lo_) / cell_)), glm::ivec2(0), cells_ - 1);
+  double light = 1.0;
+  const glm::dvec3 p(ground, 0.0);
+  for (int i : grid_[std::size_t(c.y) * cells_.x + c.x]) {
+    const ShadowCaster& caster = casters_[std::size_t(i)];
+    light *= casterSunlight(caster, tables_[std::size_t(caster.table)], p, to_sun_);
+  }
+  return light;
+}
+
+}  // namespace nephele

@@ -1,0 +1,93 @@
+#pragma once
+// Shadows of heaps on the ground (MODEL.md section 16): the share of the sunlight that reaches
+// a ground point through the lobes on its ray to the sun, each lobe taken at its mean opacity
+// for the limb value the ray has through it and at the optical depth of its chord. Both
+// renderers evaluate it: the reference per ground sample (CloudShadows::sunlight), the GL in a
+// map along the sun built once per sun and world change (renderer/gl/shadow_map.h).
+#include <array>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "world/formations/cloud_field.h"
+#include "world/formations/ellipsoid_cloud.h"
+
+namespace nephele {
+
+struct Scene;
+
+// The mean opacity C(g) of a cloud's surface over its texture's values, at limb values
+// g = i / (kShadowTableSize - 1): a table read linearly in g.
+inline constexpr int kShadowTableSize = 33;
+using ShadowTable = std::array<float, kShadowTableSize>;
+
+// C(g) = mean over the texture's values It of 1 - TR(It, T1, T2, g, D) (Gardner eq. 11), the
+// values taken at kShadowTextureSamples points spread over one period of the cloud's solid
+// texture (the same points for every cloud). Cached by texture and thresholds.
+inline constexpr int kShadowTextureSamples = 512;
+ShadowTable meanOpacityTable(const EllipsoidCloud& cloud);
+// The table read linearly at g in [0, 1].
+double meanOpacity(const ShadowTable& table, double g);
+
+// The share of the ground's light that comes from the sky rather than straight from the sun
+// under a clear sky: a ground point in full shadow keeps this much (MODEL.md section 16).
+inline constexpr double kGroundSkyShare = 0.3;
+// The ground's brightness relative to the unshadowed ground, for sunlight share S in [0, 1].
+inline double groundLight(double sunlight) {
+  return kGroundSkyShare + (1.0 - kGroundSkyShare) * sunlight;
+}
+
+// One lobe that casts a shadow.
+struct ShadowCaster {
+  glm::dvec3 centre{0.0};
+  glm::dmat3 to_unit{1.0};  // world offsets from the centre into the unit sphere (W)
+  double reach = 0.0;       // its largest semi-axis
+  double extinction = 0.0;  // the cloud's light_extinction, per metre
+  int table = 0;            // its cloud's mean-opacity table
+};
+
+// The share of the sunlight a caster lets through along p + s to_sun, s > 0 (to_sun unit,
+// rising): 1 - C(g) (1 - T(sigma l)), g = 1 - |o_perp|^2 the ray's limb value through the
+// lobe (its unit-sphere distance from the centre, as the limb function of an eye at infinity),
+// l the chord's length beyond p and T the two-stream transmittance. 1 where the ray misses.
+double casterSunlight(const ShadowCaster& caster, const ShadowTable& table, glm::dvec3 p,
+                      glm::dvec3 to_sun);
+
+// Every lobe of a scene that may shadow the ground it shows: the lobes of its clouds with a
+// light_extinction above 0 (heap light, MODEL.md section 14) and the heaps of its fields within
+// heap range of the camera, in view or not, drawn coarse (a shadow has no use for the detail
+// lobes). None while the sun is below 1 degree of elevation (the ground is then lit by the sky
+// alone, and a shadow would reach 60 times a cloud's height).
+class CloudShadows {
+ public:
+  CloudShadows() = default;  // none
+  // `lookups`: sunlight() will be asked (the reference), which needs a grid over the casters.
+  CloudShadows(const Scene& scene, const HeapDrawing& heaps, bool lookups);
+
+  bool empty() const { return casters_.empty(); }
+  const std::vector<ShadowCaster>& casters() const { return casters_; }
+  const std::vector<ShadowTable>& tables() const { return tables_; }
+  glm::dvec3 toSun() const { return to_sun_; }
+  // The ground rectangle outside which no caster shadows: [lo, hi] in world X, Y.
+  glm::dvec2 lo() const { return lo_; }
+  glm::dvec2 hi() const { return hi_; }
+  // Where caster i's shadow can fall on the ground Z = 0: its bounding sphere projected
+  // along the sun, as a square.
+  void footprint(const ShadowCaster& caster, glm::dvec2& lo, glm::dvec2& hi) const;
+
+  // The share of the sunlight reaching ground point (x, y, 0): the product of casterSunlight
+  // over every caster. Only when made with `lookups`.
+  double sunlight(glm::dvec2 ground) const;
+
+ private:
+  glm::dvec3 to_sun_{0.0, 0.0, 1.0};
+  std::vector<ShadowCaster> casters_;
+  std::vector<ShadowTable> tables_;
+  glm::dvec2 lo_{0.0}, hi_{0.0};
+  // A grid over [lo, hi] listing the casters whose footprint meets each cell.
+  double cell_ = 1.0;
+  glm::ivec2 cells_{0};
+  std::vector<std::vector<int>> grid_;
+};
+
+}  // namespace nephele
