@@ -492,7 +492,8 @@ WeatherLayer readWeather(TableReader& t, bool macro = false) {
                                            "centre", "size", "heading", "edge", "front",
                                            "transition", "spacing", "variation"}
                 : std::vector<std::string>{"type", "base", "thickness", "coverage", "visibility",
-                                           "transition_band", "scud"});
+                                           "transition_band", "scud", "precipitation",
+                                           "precipitation_rate", "precipitation_visibility"});
   std::vector<std::string> names;
   for (int i = 0; i < kCloudTypeCount; ++i) names.emplace_back(cloudTypeName(CloudType(i)));
   WeatherLayer w;
@@ -508,6 +509,12 @@ WeatherLayer readWeather(TableReader& t, bool macro = false) {
     double scud = 100.0 * w.scud;
     t.number("scud", scud, Limits::kCoveragePercent);
     w.scud = scud / 100.0;
+    // Rain and the rest (MODEL.md section 17): from the base down, or base to top for "none".
+    Precipitation& p = w.precipitation;
+    p.kind = PrecipitationKind(
+        t.choice("precipitation", {kPrecipitationNames.begin(), kPrecipitationNames.end()}, 0));
+    t.number("precipitation_rate", p.rate_mm_h, Limits::kPrecipitationRate);
+    t.number("precipitation_visibility", p.visibility_m, 0.0, Limits::kPrecipitationVisibility.hi);
     checkWeather(t, w);
   }
   if (macro) readMacrocluster(t, w);

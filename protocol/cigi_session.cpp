@@ -85,6 +85,31 @@ std::variant<WeatherLayer, std::string> cloudLayerOf(const WeatherControl& w) {
   return layer;
 }
 
+// A Weather Control precipitation layer (4 to 9: rain, snow, sleet, hail, sand, dust) as the
+// layer it draws (MODEL.md section 17): no clouds, the precipitation from base to base +
+// thickness, its visibility the packet's, else from its severity (a rate for rain, snow, sleet
+// and hail; a visibility for sand and dust); or what is wrong with it. Disabled removes it.
+std::variant<WeatherLayer, std::string> precipitationLayerOf(const WeatherControl& w) {
+  WeatherLayer layer;
+  if (!w.enabled) return layer;
+  if (!finite({w.base, w.thickness, w.visibility}) ||
+      !(w.base >= 0.0 && w.base <= Limits::kMaxBase) || !Limits::kThickness.contains(w.thickness))
+    return "base " + text(w.base) + ", thickness " + text(w.thickness) + " (allowed: base 0 to " +
+           text(Limits::kMaxBase) + " m, thickness " + text(Limits::kThickness.lo) + " to " +
+           text(Limits::kThickness.hi) + " m)";
+  layer.base_m = w.base;
+  layer.thickness_m = w.thickness;
+  Precipitation& p = layer.precipitation;
+  p.kind = PrecipitationKind(w.layer - Layer::kCloud3);
+  const bool obscurant = w.layer >= Layer::kSand;
+  p.rate_mm_h = obscurant ? 0.0 : rateForSeverity(w.severity);
+  p.visibility_m = w.visibility > 0.0 ? w.visibility
+                   : obscurant        ? obscurantVisibilityForSeverity(w.severity)
+                                      : 0.0;
+  if (std::string e = weatherLayerError(layer); !e.empty()) return e;
+  return layer;
+}
+
 // An active Environmental Region as the region of a weather layer (world/formations/region.h):
 // its X axis (along `rotation`, clockwise from north) is the region's y axis, and CIGI's
 // transition perimeter, outside the rectangle, becomes the band the cover fades over, so the
@@ -289,8 +314,22 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
         frame.ignored.push_back(where + ": entity scope (global and regional weather are drawn)");
         continue;
       }
+      if (w->layer > Layer::kDust) {
+        frame.ignored.push_back(where + ": not one of CIGI's defined layers (0 to 9)");
+        continue;
+      }
       if (w->layer > Layer::kCloud3) {
-        frame.ignored.push_back(where + ": precipitation and obscurants are not drawn");
+        if (regional) {
+          frame.ignored.push_back(where + ": a region's precipitation is not drawn (global only)");
+          continue;
+        }
+        auto layer = precipitationLayerOf(*w);
+        if (const auto* e = std::get_if<std::string>(&layer)) {
+          bad(where + ": " + *e);
+          continue;
+        }
+        frame.commands.emplace_back(
+            command::SetWeather{w->layer, std::get<WeatherLayer>(layer), std::nullopt});
         continue;
       }
       const bool fog = w->layer == Layer::kGroundFog;

@@ -282,6 +282,18 @@ WeatherLayer readWeather(FieldReader& r) {
   if (auto v = r.number("visibility", 0.0, Limits::kLayerVisibility.hi)) w.visibility_m = *v;
   w.transition_band_m = r.number("transition_band", Limits::kTransitionBand).value_or(0.0);
   w.scud = r.number("scud", Limits::kCoveragePercent).value_or(0.0) / 100.0;
+  if (auto kind = r.string("precipitation", 8)) {
+    const auto found = std::find(kPrecipitationNames.begin(), kPrecipitationNames.end(), *kind);
+    if (found == kPrecipitationNames.end())
+      r.fail("precipitation", "\"" + *kind +
+                                  "\" is not allowed (allowed: none, rain, snow, sleet, hail, "
+                                  "sand, dust)");
+    w.precipitation.kind = PrecipitationKind(found - kPrecipitationNames.begin());
+  }
+  w.precipitation.rate_mm_h =
+      r.number("precipitation_rate", Limits::kPrecipitationRate).value_or(0.0);
+  if (auto v = r.number("precipitation_visibility", 0.0, Limits::kPrecipitationVisibility.hi))
+    w.precipitation.visibility_m = *v;
   w.clusters.amount = r.number("variation", Limits::kClusterVariation).value_or(0.0);
   // The rules between keys are the world's, shared with scene files.
   if (std::string e = weatherLayerError(w); !e.empty()) throw FieldError{ErrorCode::kBadField, e};
@@ -312,17 +324,34 @@ SetView readSetView(FieldReader& r) {
 
 SetWeather readSetWeather(FieldReader& r) {
   SetWeather c;
-  if (!r.has("layer")) r.fail("layer", "is missing (allowed: 1 to 3, the CIGI cloud layers)");
-  c.layer = int(*r.integer("layer", 1, ProtocolLimits::kWeatherLayers));
+  if (!r.has("layer"))
+    r.fail("layer",
+           "is missing (allowed: 1 to 3, the CIGI cloud layers, and 4 to 9, its precipitation "
+           "layers)");
+  c.layer = int(*r.integer("layer", 1, ProtocolLimits::kWeatherKeys));
   if (!r.has("type"))
     r.fail("type",
            "is missing (allowed: 0 to 10, CIGI cloud types: 0 none, 1 altocumulus, 2 "
            "altostratus, 3 cirrocumulus, 4 cirrostratus, 5 cirrus, 6 cumulonimbus, 7 "
            "cumulus, 8 nimbostratus, 9 stratocumulus, 10 stratus)");
+  const bool named = r.has("precipitation");
   c.weather = readWeather(r);
+  if (c.layer > ProtocolLimits::kWeatherLayers) {
+    // CIGI's precipitation layers: no clouds, and the kind is the layer's ("none" removes it).
+    const auto kind = PrecipitationKind(c.layer - ProtocolLimits::kWeatherLayers);
+    if (c.weather.type != CloudType::kNone)
+      r.fail("type", "layers 4 to 9 hold precipitation only (allowed: 0 none)");
+    if (!named) c.weather.precipitation.kind = kind;
+    if (c.weather.precipitation.kind != kind &&
+        c.weather.precipitation.kind != PrecipitationKind::kNone)
+      r.fail("precipitation", "layer " + std::to_string(c.layer) + " holds " +
+                                  std::string(kPrecipitationNames[int(kind)]) +
+                                  " (allowed: that or none)");
+  }
   r.finish(
       "cmd, id, layer, type, base, thickness, coverage, wind, centre, size, heading, edge, "
-      "front, transition, spacing, variation, visibility, transition_band, scud");
+      "front, transition, spacing, variation, visibility, transition_band, scud, precipitation, "
+      "precipitation_rate, precipitation_visibility");
   return c;
 }
 

@@ -25,6 +25,9 @@ struct ProtocolLimits {
   static constexpr double kMaxSubscriptionHz = 60.0;
   static constexpr double kMaxTimeScale = 1000.0;
   static constexpr int kWeatherLayers = 3;       // CIGI cloud layers 1 to 3
+  // set_weather's layers: the cloud layers, then CIGI's precipitation layers 4 to 9 (rain,
+  // snow, sleet, hail, sand, dust), which hold precipitation and no clouds.
+  static constexpr int kWeatherKeys = 9;
   static constexpr int kMaxViewsPerRender = 16;  // views captured from one tick by one render
   static constexpr int kMaxTargets = 4096;       // targets in the world at once
 };
@@ -101,7 +104,7 @@ struct SetView {
   ViewPatch patch;
 };
 struct SetWeather {
-  int layer = 1;  // 1 to kWeatherLayers
+  int layer = 1;  // 1 to kWeatherKeys
   WeatherLayer weather;
   // A CIGI Environmental Region's layer (0 to 65535), drawn beside the global layer of the
   // same number; unset: the global layer. Set by the CIGI session, not read from the socket.

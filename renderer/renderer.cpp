@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <ctime>
+#include <limits>
 
 #include "renderer/gl/gl_renderer.h"
 #include "renderer/reference/reference_renderer.h"
@@ -59,6 +60,24 @@ std::unique_ptr<Renderer> createRenderer(const RendererOptions& options, std::st
   std::unique_ptr<GlPlatform> platform = createGlPlatform(options.gl_backend, error);
   if (!platform) return nullptr;
   return std::make_unique<GlBackendRenderer>(std::move(platform), options.render);
+}
+
+void dimVisibilityByPrecipitation(Frame& frame, const Scene& scene) {
+  if (frame.visibility.empty()) return;
+  const std::vector<Fog> media = precipitationMedia(scene);
+  if (media.empty()) return;
+  const Camera& camera = scene.camera;
+  const ViewBasis basis = viewBasis(camera);
+  const glm::dvec3 eye = camera.position;
+  for (int y = 0; y < camera.height; ++y)
+    for (int x = 0; x < camera.width; ++x) {
+      const glm::dvec3 d = glm::normalize(rayDirection(basis, camera, x + 0.5, y + 0.5));
+      double opaque = d.z < 0.0 ? eye.z / -d.z : std::numeric_limits<double>::infinity();
+      for (const Target& t : scene.targets)
+        if (const auto hit = intersectTarget(t, eye, d)) opaque = std::min(opaque, hit->distance);
+      frame.visibility[std::size_t(y) * camera.width + x] *=
+          float(slabsTransmittance(media, eye, d, opaque));
+    }
 }
 
 std::vector<ImageAttribute> frameAttributes(const FrameInfo& info) {

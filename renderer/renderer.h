@@ -46,6 +46,11 @@ class Renderer {
 // Null and `error` set when the back end cannot start (no GL platform).
 std::unique_ptr<Renderer> createRenderer(const RendererOptions& options, std::string& error);
 
+// The visibility channel times the scene's precipitation's transmittance (MODEL.md section 17)
+// on each pixel's centre ray up to its first opaque surface, the ground or a target: a target
+// behind rain is less visible. Nothing without precipitation or without the channel.
+void dimVisibilityByPrecipitation(Frame& frame, const Scene& scene);
+
 // The frame's pose, intrinsics and clock as image attributes (docs/DATASETS.md).
 std::vector<ImageAttribute> frameAttributes(const FrameInfo& info);
 // Every channel the frame holds as named EXR layers: R, G, B (colour), A (coverage), depth,

@@ -34,7 +34,9 @@ TEST(CloudShadowTest, MeanOpacityRisesTowardsTheCentreWithinZeroAndOne) {
   for (int i = 0; i < kShadowTableSize; ++i) {
     EXPECT_GE(table[std::size_t(i)], 0.0f);
     EXPECT_LE(table[std::size_t(i)], 1.0f);
-    if (i > 0) EXPECT_GE(table[std::size_t(i)], table[std::size_t(i) - 1]) << i;
+    if (i > 0) {
+      EXPECT_GE(table[std::size_t(i)], table[std::size_t(i) - 1]) << i;
+    }
   }
   // Gardner eq. 11 with T1 below 0: opaque at the centre whatever the texture, clear at the
   // limb for the texture's values below T2.

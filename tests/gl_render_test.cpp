@@ -281,6 +281,72 @@ TEST_F(GlRenderTest, CloudShadowsMatchTheReference) {
   }
 }
 
+// Precipitation (MODEL.md section 17) under a nimbostratus deck, as slabs: rain from the base
+// down, snow, and CIGI's dust layer of its own base and top, equal to the one-sample
+// reference; without it the view is another.
+TEST_F(GlRenderTest, PrecipitationEqualsOneSampleReference) {
+  SceneFile file = preset("rain", 160, 90);
+  file.scene.targets.clear();  // their edges are the target pass's, tested on their own
+  WeatherLayer& deck = file.scene.weather.at({1, std::nullopt});
+  const Scene dry = [&] {
+    Scene s = file.scene;
+    s.weather.at({1, std::nullopt}).precipitation = {};
+    return s;
+  }();
+  WeatherLayer dust;
+  dust.base_m = 100.0;
+  dust.thickness_m = 400.0;
+  dust.precipitation = {PrecipitationKind::kDust, 0.0, 800.0};
+  struct Case {
+    const char* name;
+    Precipitation deck;
+    bool dust;
+  };
+  for (const Case& c : {Case{"rain", deck.precipitation, false},
+                        Case{"snow", {PrecipitationKind::kSnow, 1.0, 0.0}, false},
+                        Case{"rain_and_dust", deck.precipitation, true}}) {
+    Scene scene = file.scene;
+    scene.weather.at({1, std::nullopt}).precipitation = c.deck;
+    if (c.dust) scene.weather[{9, std::nullopt}] = dust;
+    const FloatImage gl = renderer_->renderFloat(scene, pointSampled());
+    const FloatImage reference = renderReference(scene, {1, 0});
+    float worst = 0.0f;
+    for (std::size_t i = 0; i < gl.rgba.size(); ++i)
+      worst = std::max(worst, std::abs(gl.rgba[i] - reference.rgba[i]));
+    EXPECT_LE(worst, 2e-3f) << c.name;
+    if (worst > 2e-3f) writeFailureImages(gl, reference, std::string("precipitation_") + c.name);
+    EXPECT_GT(compareImages(gl, renderer_->renderFloat(dry, pointSampled())).max_abs, 0.05)
+        << c.name;
+  }
+}
+
+// The visibility channel over a target behind rain (MODEL.md section 17): the rain's
+// transmittance to it, exp(-sigma depth), in both renderers; the far boat is less visible.
+TEST_F(GlRenderTest, TargetsBehindRainAreLessVisible) {
+  const SceneFile file = preset("rain", 320, 180);
+  FrameRequest request;
+  request.channels = {Channel::kVisibility, Channel::kObjectId, Channel::kDepth};
+  const Frame gl = renderer_->renderFrame(file.scene, pointSampled(), request);
+  const Frame reference = renderReferenceFrame(file.scene, {1, 0}, request);
+  const double sigma =
+      precipitationExtinction(file.scene.weather.at({1, std::nullopt}).precipitation);
+  for (const Frame* frame : {&gl, &reference}) {
+    double mean[3] = {0.0, 0.0, 0.0};
+    int pixels[3] = {0, 0, 0};
+    for (std::size_t i = 0; i < frame->visibility.size(); ++i) {
+      const int id = int(frame->object_id[i]);
+      if (id == 0) continue;
+      const double expected = std::exp(-sigma * frame->depth[i]);
+      EXPECT_NEAR(frame->visibility[i], expected, 2e-3) << "pixel " << i;
+      mean[id] += frame->visibility[i];
+      ++pixels[id];
+    }
+    ASSERT_GT(pixels[1], 0);
+    ASSERT_GT(pixels[2], 0);
+    EXPECT_GT(mean[1] / pixels[1], 4.0 * mean[2] / pixels[2]);  // about 0.27 against 0.03
+  }
+}
+
 // A deck below the camera and a layer above it, seen from between them: exact against the
 // one-sample reference, and filtered against the 4x4 reference. Seen from above at a slant,
 // the deck's full plaid is resolved by the 4x4 reference only partly where GL drops its

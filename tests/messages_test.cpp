@@ -120,6 +120,39 @@ TEST(CloudCodes, AreCigisAndEveryGenusHasOne) {
               HasSubstr("type"));
 }
 
+// Precipitation (MODEL.md section 17): on a cloud layer, and CIGI's precipitation layers 4 to 9,
+// whose kind is the layer's.
+TEST(Messages, SetWeatherCarriesPrecipitation) {
+  const auto rain = std::get<command::SetWeather>(
+      parsed(R"({"cmd":"set_weather","layer":1,"type":8,"base":900,"precipitation":"rain",)"
+             R"("precipitation_rate":4})")
+          .command);
+  EXPECT_EQ(rain.weather.precipitation.kind, PrecipitationKind::kRain);
+  EXPECT_EQ(rain.weather.precipitation.rate_mm_h, 4.0);
+  const auto snow = std::get<command::SetWeather>(
+      parsed(R"({"cmd":"set_weather","layer":5,"type":0,"base":0,"thickness":800,)"
+             R"("precipitation_rate":2})")
+          .command);
+  EXPECT_EQ(snow.layer, 5);
+  EXPECT_EQ(snow.weather.precipitation.kind, PrecipitationKind::kSnow);
+  const auto off = std::get<command::SetWeather>(
+      parsed(R"({"cmd":"set_weather","layer":5,"type":0,"precipitation":"none"})").command);
+  EXPECT_EQ(off.weather.precipitation.kind, PrecipitationKind::kNone);
+  EXPECT_THAT(rejected(R"({"cmd":"set_weather","layer":4,"type":7})").error.message,
+              HasSubstr("precipitation only"));
+  EXPECT_THAT(
+      rejected(R"({"cmd":"set_weather","layer":4,"type":0,"precipitation":"snow"})").error.message,
+      HasSubstr("holds rain"));
+  EXPECT_THAT(rejected(R"({"cmd":"set_weather","layer":1,"type":8,"precipitation":"drizzle"})")
+                  .error.message,
+              HasSubstr("allowed: none, rain"));
+  EXPECT_THAT(rejected(R"({"cmd":"set_weather","layer":4,"type":0,"precipitation_rate":501})")
+                  .error.message,
+              HasSubstr("precipitation_rate"));
+  EXPECT_THAT(rejected(R"({"cmd":"set_weather","layer":10,"type":0})").error.message,
+              HasSubstr("layer"));
+}
+
 TEST(Messages, DefaultChannelsFollowTheFormat) {
   auto image = [](std::string_view line) {
     return *std::get<command::Render>(parsed(line).command).image;

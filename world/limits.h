@@ -95,6 +95,10 @@ struct Limits {
   // beyond its base and top over which it thins (MODEL.md section 5).
   static constexpr Range kLayerVisibility{1.0, 1.0e7};
   static constexpr Range kTransitionBand{0.0, 1.0e4};
+  // Precipitation (world/precipitation.h): liquid-water rate, mm/h (the world record is about
+  // 300 in an hour), and the visibility a host may give instead, metres.
+  static constexpr Range kPrecipitationRate{0.0, 500.0};
+  static constexpr Range kPrecipitationVisibility{1.0, 1.0e6};
   static constexpr Range kCoveragePercent{0.0, 100.0};
 
   // Macroclusters and fronts (world/formations/region.h), metres.

@@ -116,9 +116,10 @@ std::optional<Fog> inLayerVeil(const Scene& scene);
 // Whether the camera is in a layer's slab or band (where inLayerVeil may give a veil).
 bool eyeInLayer(const Scene& scene);
 
-// Whether anything lies in the air between the eye and a surface (fog, haze, a layer's veil).
+// Whether anything lies in the air between the eye and a surface (fog, haze, a layer's veil,
+// precipitation).
 inline bool sceneHasAir(const Scene& scene) {
-  return scene.fog || scene.haze || eyeInLayer(scene);
+  return scene.fog || scene.haze || eyeInLayer(scene) || !precipitationMedia(scene).empty();
 }
 
 // `scene` with its fields' heaps within heapRange(drawing.range_m) of its camera added to its

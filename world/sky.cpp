@@ -80,10 +80,18 @@ double hazeOpticalDepth(const Haze& haze, glm::dvec3 origin, glm::dvec3 directio
   return sigma0 * h / direction.z * (std::exp(-a) - std::exp(-std::max(a + x, -50.0)));
 }
 
+double slabsTransmittance(std::span<const Fog> slabs, glm::dvec3 origin, glm::dvec3 direction,
+                          double distance) {
+  double tau = 0.0;
+  for (const Fog& f : slabs)
+    tau += fogExtinction(f) * fogPathLength(f, origin, direction, distance);
+  return std::isfinite(tau) ? std::exp(-tau) : 0.0;
+}
+
 glm::dvec3 throughAir(glm::dvec3 colour, const std::optional<Fog>& fog,
                       const std::optional<Fog>& veil, const std::optional<Haze>& haze,
-                      glm::dvec3 horizon, glm::dvec3 origin, glm::dvec3 direction,
-                      double distance) {
+                      glm::dvec3 horizon, glm::dvec3 origin, glm::dvec3 direction, double distance,
+                      std::span<const Fog> precipitation) {
   // Each depth is capped where its transmittance is already 0 in double, so the weights of the
   // colours stay finite.
   constexpr double kOpaque = 1.0e3;
@@ -94,11 +102,16 @@ glm::dvec3 throughAir(glm::dvec3 colour, const std::optional<Fog>& fog,
   const double tau_fog = depth(fog), tau_veil = depth(veil);
   const double tau_haze =
       haze ? std::min(hazeOpticalDepth(*haze, origin, direction, distance), kOpaque) : 0.0;
-  const double tau = tau_fog + tau_veil + tau_haze;
+  double tau = tau_fog + tau_veil + tau_haze;
+  glm::dvec3 weighted = tau_fog * (fog ? fog->colour : glm::dvec3(0.0)) +
+                        tau_veil * (veil ? veil->colour : glm::dvec3(0.0)) + tau_haze * horizon;
+  for (const Fog& p : precipitation) {
+    const double tau_p = depth(p);
+    tau += tau_p;
+    weighted += tau_p * p.colour;
+  }
   if (!(tau > 0.0)) return colour;
-  const glm::dvec3 air = (tau_fog * (fog ? fog->colour : glm::dvec3(0.0)) +
-                          tau_veil * (veil ? veil->colour : glm::dvec3(0.0)) + tau_haze * horizon) /
-                         tau;
+  const glm::dvec3 air = weighted / tau;
   const double t = std::exp(-tau);
   return t * colour + (1.0 - t) * air;
 }

@@ -3,6 +3,7 @@
 #include <glm/glm.hpp>
 
 #include <optional>
+#include <span>
 
 namespace nephele {
 
@@ -63,12 +64,19 @@ struct Haze {
 // be +infinity; `direction` must be normalised). Finite or +infinity, never NaN.
 double hazeOpticalDepth(const Haze& haze, glm::dvec3 origin, glm::dvec3 direction, double distance);
 
+// The transmittance exp(-sum sigma_i l_i) of slabs (precipitationMedia) along origin + s
+// direction, 0 <= s <= distance (+infinity allowed; `direction` unit).
+double slabsTransmittance(std::span<const Fog> slabs, glm::dvec3 origin, glm::dvec3 direction,
+                          double distance);
+
 // `colour` seen at `distance` along the unit `direction` from `origin` through the fog, the
-// in-layer veil and the haze of a scene (any may be absent): mixed in proportion to their
-// optical depths, T = exp(-tau), tau their sum, colour T + (1 - T) (sum of tau_i colour_i) / tau,
-// the haze's colour the horizon's.
+// in-layer veil, the haze and the precipitation of a scene (any may be absent; precipitation
+// as slabs, precipitationMedia): mixed in proportion to their optical depths, T = exp(-tau),
+// tau their sum, colour T + (1 - T) (sum of tau_i colour_i) / tau, the haze's colour the
+// horizon's.
 glm::dvec3 throughAir(glm::dvec3 colour, const std::optional<Fog>& fog,
                       const std::optional<Fog>& veil, const std::optional<Haze>& haze,
-                      glm::dvec3 horizon, glm::dvec3 origin, glm::dvec3 direction, double distance);
+                      glm::dvec3 horizon, glm::dvec3 origin, glm::dvec3 direction, double distance,
+                      std::span<const Fog> precipitation = {});
 
 }  // namespace nephele

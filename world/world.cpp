@@ -176,9 +176,18 @@ void appendWeatherClouds(Scene& scene, WorldDynamics& dynamics, const WeatherClo
   }
 }
 
+namespace {
+
+// Whether a layer holds anything: clouds, or precipitation of its own (CIGI's layers 4 to 9).
+bool weatherHeld(const WeatherLayer& w) {
+  return w.type != CloudType::kNone || w.precipitation.kind != PrecipitationKind::kNone;
+}
+
+}  // namespace
+
 std::string placeWeather(Scene& scene, WorldDynamics& dynamics, const WeatherKey& key,
                          const WeatherLayer& weather) {
-  if (weather.type != CloudType::kNone)
+  if (weatherHeld(weather))
     if (std::string e = weatherLayerError(weather); !e.empty()) return e;
   const std::string prefix = weatherPrefix(key);
   // A region's layers are its own, and seeded apart from the global layer of that number.
@@ -192,7 +201,7 @@ std::string placeWeather(Scene& scene, WorldDynamics& dynamics, const WeatherKey
                        [&](const CloudLayer& l) { return made(l.name); });
   std::erase_if(scene.fields, [&](const CloudField& f) { return made(f.name); });
   appendWeatherClouds(scene, dynamics, add);
-  if (weather.type == CloudType::kNone) {
+  if (!weatherHeld(weather)) {
     scene.weather.erase(key);
     return "";
   }
@@ -204,9 +213,8 @@ std::string placeWeather(Scene& scene, WorldDynamics& dynamics, const WeatherKey
 
 std::string World::setWeather(const WeatherKey& key, const WeatherLayer& weather, bool* changed) {
   const auto held = base_.weather.find(key);
-  const bool same = weather.type == CloudType::kNone
-                        ? held == base_.weather.end()
-                        : held != base_.weather.end() && held->second == weather;
+  const bool same = !weatherHeld(weather) ? held == base_.weather.end()
+                                          : held != base_.weather.end() && held->second == weather;
   if (changed) *changed = false;
   if (same) return "";
   std::string error = edit([&](Scene& now, WorldDynamics& dynamics) {

@@ -26,7 +26,7 @@ namespace {
 static_assert(std::endian::native == std::endian::little, "snapshots assume a little-endian host");
 
 constexpr char kMagic[8] = {'N', 'E', 'P', 'H', 'S', 'N', 'A', 'P'};
-constexpr std::uint32_t kFormatVersion = 10;
+constexpr std::uint32_t kFormatVersion = 11;
 constexpr std::size_t kHeaderBytes = sizeof kMagic + 4 + 8 + 8;
 
 class Writer {
@@ -254,8 +254,11 @@ void io(A& a, std::map<WeatherKey, WeatherLayer>& weather) {
     if (windy) w.wind = wind;
     io(a, w.region), io(a, w.clusters);
     io(a, w.visibility_m), io(a, w.transition_band_m), io(a, w.scud);
+    ioEnum(a, w.precipitation.kind, kPrecipitationKindCount);
+    io(a, w.precipitation.rate_mm_h), io(a, w.precipitation.visibility_m);
     if constexpr (!A::kReading) return;
-    if (w.type == CloudType::kNone) return a.fail("a weather layer of no type");
+    if (w.type == CloudType::kNone && w.precipitation.kind == PrecipitationKind::kNone)
+      return a.fail("a weather layer of no type and no precipitation");
     if (std::string e = weatherLayerError(w); !e.empty()) return a.fail("weather layer: " + e);
     weather[key] = w;
   };

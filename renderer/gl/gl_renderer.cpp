@@ -13,6 +13,7 @@
 #include "renderer/gl/sky_shaders.h"
 #include "renderer/gl/view_uniforms.h"
 #include "renderer/reference/reference_renderer.h"
+#include "renderer/renderer.h"
 #include "world/check.h"
 #include "world/shading.h"
 #include "world/textures/layer_texture.h"
@@ -232,7 +233,10 @@ Frame GlRenderer::renderFrame(const Scene& scene, const RenderSettings& settings
   Frame frame = frameFor(camera, scene.time_s, request);
   const bool composite = compositeAsked(asked);
   if (composite) frame.colour = renderFloat(scene, settings);
-  if (asked.has(Channel::kVisibility)) frame.visibilityFromCoverage();
+  if (asked.has(Channel::kVisibility)) {
+    frame.visibilityFromCoverage();
+    dimVisibilityByPrecipitation(frame, scene);
+  }
   // The channels beyond the composite are read back and converted on the CPU.
   StageClock channels(stats_.times.readback_ms);
   if (asked.has(Channel::kDepth) || asked.has(Channel::kObjectId)) {

@@ -73,21 +73,29 @@ void hashBytes(std::uint64_t& h, const void* data, std::size_t bytes) {
 
 ShadowMap::ShadowMap(const GlApi& gl) : gl_(gl) {}
 
+double ShadowMap::maxSide(double camera_z) {
+  double side = kMinSide;
+  while (side < 8.0 * camera_z && side < 64.0 * kMinSide) side *= 2.0;
+  return side;
+}
+
 void ShadowMap::prepare(const CloudShadows& shadows, glm::dvec3 camera, int size, FrameStats& stats,
                         GpuPassTimer& timer) {
   active_ = false;
   if (size <= 0 || shadows.empty()) return;
   // Everything is placed from an anchor, the first caster's centre, so that a world whose
   // clouds only drifted together (a field in the wind) keeps its map, moved with them. The map
-  // is the casters' shadows within a square about the camera's ground point, its edges on a grid
-  // of kMaxSide / 16 in the anchor's frame: a camera that moves less than that keeps it too.
+  // is the casters' shadows within a square about the camera's ground point (maxSide), its
+  // edges on a grid of a sixteenth of that in the anchor's frame: a camera that moves less keeps
+  // it too.
   const glm::dvec2 anchor(shadows.casters().front().centre);
-  const double step = kMaxSide / 16.0;
+  const double side = maxSide(camera.z), step = side / 16.0;
   const glm::dvec2 eye = glm::round((glm::dvec2(camera) - anchor) / step) * step;
+  // A step beyond the casters' shadows, so that the map's faded rim (the sky pass) holds none.
   const glm::dvec2 lo =
-      glm::floor(glm::max(shadows.lo() - anchor, eye - 0.5 * kMaxSide) / step) * step;
+      glm::floor(glm::max(shadows.lo() - anchor - step, eye - 0.5 * side) / step) * step;
   const glm::dvec2 hi =
-      glm::ceil(glm::min(shadows.hi() - anchor, eye + 0.5 * kMaxSide) / step) * step;
+      glm::ceil(glm::min(shadows.hi() - anchor + step, eye + 0.5 * side) / step) * step;
   if (!(lo.x < hi.x && lo.y < hi.y)) return;
   active_ = true;
   const glm::dvec2 centre = 0.5 * (lo + hi);  // from the anchor

@@ -1,5 +1,6 @@
 #include "renderer/gl/sky_shaders.h"
 
+#include "renderer/gl/view_uniforms.h"
 #include "world/formations/cloud_shadow.h"
 #include "world/textures/gardner_texture.h"
 
@@ -51,6 +52,11 @@ uniform vec3 u_fog_colour;
 uniform vec3 u_veil_slab;  // the in-layer veil's (MODEL.md section 5)
 uniform float u_veil_sigma;
 uniform vec3 u_veil_colour;
+// Precipitation (MODEL.md section 17, precipitationMedia): up to kPrecipitationSlabs slabs
+// (view_uniforms.h), sigma 0 for none.
+uniform vec3 u_precip_slab[kPrecipitationSlabs];
+uniform float u_precip_sigma[kPrecipitationSlabs];
+uniform vec3 u_precip_colour[kPrecipitationSlabs];
 uniform float u_haze_sigma;   // at Z = 0, per metre
 uniform float u_haze_height;  // scale height, metres
 uniform vec3 u_haze_colour;   // the sky's horizon
@@ -95,9 +101,15 @@ vec3 applyAir(vec3 colour, vec3 d, float distance) {
       u_veil_sigma > 0.0 ? min(u_veil_sigma * slabPath(u_veil_slab, d, distance), 1e3) : 0.0;
   float tau_haze = min(hazeDepth(d, distance), 1e3);
   float tau = tau_fog + tau_veil + tau_haze;
+  vec3 weighted = tau_fog * u_fog_colour + tau_veil * u_veil_colour + tau_haze * u_haze_colour;
+  for (int i = 0; i < kPrecipitationSlabs; ++i)
+    if (u_precip_sigma[i] > 0.0) {
+      float tau_p = min(u_precip_sigma[i] * slabPath(u_precip_slab[i], d, distance), 1e3);
+      tau += tau_p;
+      weighted += tau_p * u_precip_colour[i];
+    }
   if (!(tau > 0.0)) return colour;
-  vec3 air = (tau_fog * u_fog_colour + tau_veil * u_veil_colour + tau_haze * u_haze_colour) / tau;
-  return mix(air, colour, exp(-tau));
+  return mix(weighted / tau, colour, exp(-tau));
 }
 
 // The air at the end of an endless path through it (the ground at the horizon): each medium
@@ -105,7 +117,14 @@ vec3 applyAir(vec3 colour, vec3 d, float distance) {
 vec3 airAtHorizon() {
   float f = u_fog_sigma > 0.0 ? 1.0 : 0.0, v = u_veil_sigma > 0.0 ? 1.0 : 0.0;
   float h = u_haze_sigma > 0.0 ? 1.0 : 0.0;
-  return (f * u_fog_colour + v * u_veil_colour + h * u_haze_colour) / max(f + v + h, 1.0);
+  float n = f + v + h;
+  vec3 sum = f * u_fog_colour + v * u_veil_colour + h * u_haze_colour;
+  for (int i = 0; i < kPrecipitationSlabs; ++i)  // those that reach the ground
+    if (u_precip_sigma[i] > 0.0 && u_precip_slab[i].x <= 0.0) {
+      n += 1.0;
+      sum += u_precip_colour[i];
+    }
+  return sum / max(n, 1.0);
 }
 #else
 vec3 applyAir(vec3 colour, vec3 d, float distance) { return colour; }
@@ -176,15 +195,15 @@ uniform float u_horizon_slope;  // |gradient of r.z| per pixel
 
 #ifdef SHADOWS
 // The share of the sunlight reaching the ground (MODEL.md section 16, ShadowMap): the map is
-// u_shadow_half * 2 metres a side about u_shadow_centre (from the camera); 1 outside it.
+// u_shadow_half * 2 metres a side about u_shadow_centre (from the camera); it fades to 1 over
+// its outer twentieth, where the ground lies beyond its casters' range.
 layout(binding = 11) uniform sampler2D u_shadow_map;
 uniform vec2 u_shadow_centre;
 uniform float u_shadow_half;
 vec3 groundColour(vec3 d) {
   vec2 uv = (d.xy * (u_camera_z / -d.z) - u_shadow_centre) / (2.0 * u_shadow_half) + 0.5;
-  float sun = all(greaterThanEqual(uv, vec2(0.0))) && all(lessThanEqual(uv, vec2(1.0)))
-                  ? texture(u_shadow_map, uv).r
-                  : 1.0;
+  float edge = 2.0 * max(abs(uv.x - 0.5), abs(uv.y - 0.5));
+  float sun = mix(texture(u_shadow_map, uv).r, 1.0, smoothstep(0.9, 1.0, edge));
   return u_ground * (kGroundSkyShare + (1.0 - kGroundSkyShare) * sun);
 }
 #else
@@ -451,6 +470,11 @@ std::string slotStatement(int slot, LayerKind kind) {
          ", colour, transmittance); }\n";
 }
 
+// kCommon after the constants it takes from C++.
+std::string commonSource() {
+  return "const int kPrecipitationSlabs = " + std::to_string(kPrecipitationSlabs) + ";\n" + kCommon;
+}
+
 }  // namespace
 
 std::string SkyPassLayout::key() const {
@@ -469,13 +493,13 @@ std::string SkyPassLayout::key() const {
 }
 
 std::string viewShaderSource() {
-  return kCommon;
+  return commonSource();
 }
 
 std::string clipmapBakeSource() {
   std::string s = "#version 450 core\n#define PROCEDURAL\n";
   s += "const int kComponents = " + std::to_string(GardnerTextureParams::kComponents) + ";\n";
-  s += kCommon;
+  s += commonSource();
   s += kLayers;
   // Slot 0's phases are taken at the corner of the ring's window (lattice index `first` in
   // absolute terms); the fragment at storage texel s holds the window's texel (s - first) mod N.
@@ -521,7 +545,7 @@ std::string skyFragmentSource(const SkyPassLayout& layout) {
   if (procedural) s += "#define PROCEDURAL\n";
   if (clipmap) s += "#define CLIPMAP\n";
   s += "const int kComponents = " + std::to_string(GardnerTextureParams::kComponents) + ";\n";
-  s += kCommon;
+  s += commonSource();
   if (layout.slots() > 0) s += kLayers;
   // One sampler uniform per sampled slot: llvmpipe samples a sampler-array element far more
   // slowly.

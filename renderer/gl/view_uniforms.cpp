@@ -1,5 +1,9 @@
 #include "renderer/gl/view_uniforms.h"
 
+#include <algorithm>
+#include <string>
+#include <vector>
+
 namespace nephele {
 
 void setUniform3(const GlApi& gl, GLuint program, const char* name, glm::dvec3 value) {
@@ -29,6 +33,19 @@ void setViewUniforms(const GlApi& gl, GLuint p, const Camera& camera, const Scen
   };
   setSlab("u_fog", scene.fog);
   setSlab("u_veil", inLayerVeil(scene));
+  // The precipitation's slabs, the densest kPrecipitationSlabs (a scene holds at most nine).
+  std::vector<Fog> precipitation = precipitationMedia(scene);
+  std::sort(precipitation.begin(), precipitation.end(),
+            [](const Fog& a, const Fog& b) { return a.visibility_m < b.visibility_m; });
+  for (int i = 0; i < kPrecipitationSlabs; ++i) {
+    const std::string element = "[" + std::to_string(i) + "]";
+    const bool present = std::size_t(i) < precipitation.size();
+    const Fog f = present ? precipitation[std::size_t(i)] : Fog{};
+    setUniform3(gl, p, ("u_precip_slab" + element).c_str(), {f.bottom_m, f.top_m, f.band_m});
+    gl.ProgramUniform1f(p, gl.GetUniformLocation(p, ("u_precip_sigma" + element).c_str()),
+                        present ? float(fogExtinction(f)) : 0.0f);
+    setUniform3(gl, p, ("u_precip_colour" + element).c_str(), f.colour);
+  }
   const std::optional<Haze>& haze = scene.haze;
   gl.ProgramUniform1f(p, gl.GetUniformLocation(p, "u_haze_sigma"),
                       haze ? float(extinctionForVisibility(haze->visibility_m)) : 0.0f);

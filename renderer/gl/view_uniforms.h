@@ -7,6 +7,11 @@
 #include "world/scene.h"
 
 namespace nephele {
+// The precipitation slabs a view's air holds at most (the densest; setViewUniforms).
+inline constexpr int kPrecipitationSlabs = 4;
+}  // namespace nephele
+
+namespace nephele {
 
 // The altitude band a cloud pass draws, relative to the camera: surfaces at height dz above
 // it with slabs.x <= dz < slabs.y or slabs.z <= dz < slabs.w (the view chunk's inBand). The

@@ -8,6 +8,7 @@
 #include <thread>
 #include <vector>
 
+#include "renderer/renderer.h"
 #include "world/automaton/cloud_density.h"
 #include "world/formations/cloud_shadow.h"
 #include "world/formations/ellipsoid.h"
@@ -283,7 +284,7 @@ class ReferenceTracer {
 
   glm::dvec3 withAir(glm::dvec3 colour, glm::dvec3 direction, double distance) const {
     return throughAir(colour, scene_.fog, layer_veil_, scene_.haze, scene_.sky.horizon,
-                      scene_.camera.position, direction, distance);
+                      scene_.camera.position, direction, distance, precipitation_);
   }
 
   const Scene& scene_;
@@ -294,6 +295,7 @@ class ReferenceTracer {
   std::vector<EllipsoidEntry> ellipsoids_;
   Veil veil_;
   std::optional<Fog> layer_veil_ = inLayerVeil(scene_);  // the camera's, once per frame
+  std::vector<Fog> precipitation_ = precipitationMedia(scene_);
 };
 
 }  // namespace
@@ -370,7 +372,10 @@ Frame renderReferenceFrame(const Scene& scene, const ReferenceSettings& settings
   for (int i = 1; i < threads; ++i) pool.emplace_back(work, false);
   work(true);
   pool.clear();  // join before the frame is handed out
-  if (asked.has(Channel::kVisibility)) frame.visibilityFromCoverage();
+  if (asked.has(Channel::kVisibility)) {
+    frame.visibilityFromCoverage();
+    dimVisibilityByPrecipitation(frame, scene);
+  }
   return frame;
 }
 

@@ -49,10 +49,11 @@ def view_definition(view, left, right, top, bottom, near=1.0, far=50000.0, bo=">
 
 def weather_control(layer, enabled, cloud_type=0, coverage=0.0, base=0.0, thickness=0.0,
                     visibility=0.0, wind=0.0, wind_from=0.0, transition=0.0, scope=0, region=0,
-                    scud=None, bo=">"):
+                    scud=None, severity=0, bo=">"):
     """scud: the scud frequency, percent, with scud enabled; None leaves it disabled."""
     return struct.pack(bo + "BBHBBBB" + "f" * 12, 12, 56, region, layer, 50,
-                       int(enabled) | (int(scud is not None) << 1) | (cloud_type << 4), scope,
+                       int(enabled) | (int(scud is not None) << 1) | (cloud_type << 4),
+                       scope | (severity << 2),
                        15.0, visibility, scud or 0.0, coverage, base, thickness, transition, wind,
                        0.0, wind_from, 1013.0, 0.0)
 
@@ -525,6 +526,22 @@ size = [4, 2, 1]
         self.frame(weather_control(1, True, 10, coverage=100.0, base=600.0, thickness=500.0,
                                    scud=150.0), frame=7)
         self.assertEqual(under(None, 8, send=False), with_scud)  # the refused packet: no change
+        self.assertNotIn("ignored", c.ok({"cmd": "stats"})["cigi"])
+        # Precipitation (MODEL.md section 17): layer 4, rain from the ground to 600 m at the
+        # rate of severity 5 (75 mm/h, 500 m of visibility), veils the view along the ground;
+        # disabled, the view is as before.
+        def level(frame, *packets):
+            self.frame(*packets, frame=frame)
+            c.ok({"cmd": "set_view", "view": "front", "position": [-20000.0, 0.0, 2.0],
+                  "heading": 270.0, "pitch": -2.0, "vfov": 20.0})
+            _, raw = c.ok({"cmd": "render", "view": "front", "format": "raw",
+                           "channels": ["colour"]})
+            green = raw[1::3]
+            return max(green) - min(green)
+        dry = level(9, weather_control(1, False))
+        wet = level(10, weather_control(4, True, base=0.0, thickness=600.0, severity=5))
+        self.assertLess(wet, dry)
+        self.assertEqual(level(11, weather_control(4, False)), dry)
         self.assertNotIn("ignored", c.ok({"cmd": "stats"})["cigi"])
 
     def test_little_endian_host(self):

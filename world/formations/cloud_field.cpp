@@ -588,6 +588,21 @@ std::string weatherLayerError(const WeatherLayer& w) {
       outside("transition_band", w.transition_band_m, Limits::kTransitionBand) ||
       outside("scud", 100.0 * w.scud, Limits::kCoveragePercent))
     return out.str() + (w.visibility_m != 0.0 ? " (0 takes the genus's visibility)" : "");
+  const Precipitation& p = w.precipitation;
+  if (int(p.kind) < 0 || int(p.kind) >= kPrecipitationKindCount) {
+    out << "precipitation: " << int(p.kind)
+        << " is not a kind (allowed: none, rain, snow, sleet, hail, sand, dust)";
+    return out.str();
+  }
+  if (outside("precipitation_rate", p.rate_mm_h, Limits::kPrecipitationRate) ||
+      (p.visibility_m != 0.0 &&
+       outside("precipitation_visibility", p.visibility_m, Limits::kPrecipitationVisibility)))
+    return out.str() + (p.visibility_m != 0.0 ? " (0 takes the rate's visibility)" : " mm/h");
+  if ((p.kind == PrecipitationKind::kSand || p.kind == PrecipitationKind::kDust) &&
+      !(p.visibility_m > 0.0))
+    return "precipitation_visibility: " + std::string(kPrecipitationNames[int(p.kind)]) +
+           " needs one (allowed: " + formatNumber(Limits::kPrecipitationVisibility.lo) + " to " +
+           formatNumber(Limits::kPrecipitationVisibility.hi) + " m; it has no rate)";
   if (std::string error = regionError(w.region); !error.empty()) return error;
   if (std::string error = clusterVariationError(w.clusters); !error.empty()) return error;
   if (w.region.transition_m > 0.0 && w.region.side == 0)

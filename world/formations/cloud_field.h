@@ -14,6 +14,7 @@
 
 #include "world/formations/ellipsoid_cloud.h"
 #include "world/formations/region.h"
+#include "world/precipitation.h"
 #include "world/frames.h"
 
 namespace nephele {
@@ -54,6 +55,9 @@ struct WeatherLayer {
   // Scud (MODEL.md section 10): the cloud fraction, 0..1, of ragged fragments drawn under the
   // base (CIGI's scud frequency); 0 draws none.
   double scud = 0.0;
+  // Rain, snow and the rest (MODEL.md section 17): a layer of clouds lets it fall from its
+  // base to the ground; a layer of type none (CIGI's layers 4 to 9) holds it from base to top.
+  Precipitation precipitation{};
   bool operator==(const WeatherLayer&) const = default;
 };
 

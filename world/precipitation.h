@@ -1,0 +1,57 @@
+#pragma once
+// Precipitation and obscurants (MODEL.md section 17): rain, snow, sleet, hail, sand and dust as
+// a medium filling a slab of air, of an extinction set by the rate (or by the visibility a host
+// gives), seen in its own colour like the ground fog. CIGI 3.3's Weather Control layers 4 to 9
+// are these six kinds in this order.
+#include <array>
+#include <string_view>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "world/sky.h"
+
+namespace nephele {
+
+struct Scene;
+
+enum class PrecipitationKind { kNone, kRain, kSnow, kSleet, kHail, kSand, kDust };
+inline constexpr int kPrecipitationKindCount = 7;
+inline constexpr std::array<std::string_view, kPrecipitationKindCount> kPrecipitationNames{
+    "none", "rain", "snow", "sleet", "hail", "sand", "dust"};
+
+struct Precipitation {
+  PrecipitationKind kind = PrecipitationKind::kNone;
+  // Liquid-water-equivalent rate, mm/h (rain, snow, sleet, hail); sand and dust have none.
+  double rate_mm_h = 0.0;
+  // The visibility inside it, metres; 0 takes the rate's (sand and dust need one).
+  double visibility_m = 0.0;
+  bool operator==(const Precipitation&) const = default;
+};
+
+// The CIGI severity 0 to 5 as a rate: 0.5, 1, 2.5, 8, 25 and 75 mm/h, from drizzle through the
+// WMO's light (below 2.5), moderate (2.5 to 7.6), heavy (above 7.6) and violent (above 50).
+double rateForSeverity(int severity);
+// Sand and dust by severity: 5,000, 2,000, 1,000, 500, 200 and 100 m of visibility (a
+// sandstorm below 1 km, a severe one below 200 m, in the WMO's terms).
+double obscurantVisibilityForSeverity(int severity);
+
+// The extinction per metre: from the visibility when one is given (Koschmieder, 2 %), else
+// from the rate R (mm/h) over a drop-size distribution, each particle taking twice its
+// cross-section from the beam (extinction efficiency 2 for particles far larger than the
+// wavelength): rain, sleet and hail 0.365e-3 R^0.63 (Marshall and Palmer 1948), snow
+// 3.3e-3 R^0.57 (Gunn and Marshall 1958, its melted diameters widened to flakes of density
+// 0.1). 0 for none, or for sand and dust without a visibility.
+double precipitationExtinction(const Precipitation& p);
+// Its visibility, metres (infinite where the extinction is 0).
+double precipitationVisibility(const Precipitation& p);
+// The colour it is seen in (linear RGB): grey for rain, white for snow, ochre for sand.
+glm::dvec3 precipitationColour(PrecipitationKind kind);
+
+// The media the scene's precipitation fills (world-wide weather layers with a kind): a layer
+// with clouds rains from its base to the ground, one without clouds (CIGI's layers 4 to 9)
+// fills its own base to top. Each is a Fog slab with no band, at the visibility above, in the
+// kind's colour. A region's precipitation is not drawn.
+std::vector<Fog> precipitationMedia(const Scene& scene);
+
+}  // namespace nephele
