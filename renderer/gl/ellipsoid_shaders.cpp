@@ -176,6 +176,7 @@ float diffuseTransmittance(float tau) { return 1.0 / (1.0 + 0.75 * (1.0 - u_scat
 vec3 surfaceColour(int i, vec3 n, vec3 r, vec3 p, float it, float tr, float distance) {
   float extinction = record(i, 17).w;
   vec2 light = vec2(1.0);  // sun, sky
+  float direct = 1.0;      // the unscattered beam, exp(-depth towards the sun)
   if (extinction > 0.0) {
     // heapLitNormal: n bent towards the envelope's outward normal, (p - c) / radii^2.
     vec3 inv = record(i, 18).xyz;
@@ -183,9 +184,11 @@ vec3 surfaceColour(int i, vec3 n, vec3 r, vec3 p, float it, float tr, float dist
     if (dot(gradient, gradient) > 0.0) n = normalize(mix(n, normalize(gradient), u_scatter.w));
     float toward_sun = 0.5 * (1.0 - clamp(dot(n, u_to_sun), -1.0, 1.0));
     float toward_sky = 0.5 * (1.0 - clamp(n.z, -1.0, 1.0));
-    light = vec2(diffuseTransmittance(extinction * toward_sun * envelopeChord(i, p, u_to_sun)),
+    float sun_depth = extinction * toward_sun * envelopeChord(i, p, u_to_sun);
+    light = vec2(diffuseTransmittance(sun_depth),
                  0.5 + 0.5 * diffuseTransmittance(extinction * toward_sky *
                                                   envelopeChord(i, p, vec3(0.0, 0.0, 1.0))));
+    direct = exp(-sun_depth);
   }
   float n_dot_l = dot(n, u_to_sun);
   float diffuse = max((n_dot_l + u_scatter.z) / (1.0 + u_scatter.z), 0.0);
@@ -200,7 +203,7 @@ vec3 surfaceColour(int i, vec3 n, vec3 r, vec3 p, float it, float tr, float dist
   float intensity = gardnerIntensity(u_shading, sun * diffuse, sun * highlight, it) +
                     u_shading.x * (light.y - 1.0);
   vec3 d = normalize(r);
-  intensity += u_scatter.x * forwardScattered(sun, dot(d, u_to_sun)) * tr;
+  intensity += u_scatter.x * forwardScattered(direct, dot(d, u_to_sun)) * tr;
   return applyAir(intensity * u_cloud_colour, d, distance);
 }
 

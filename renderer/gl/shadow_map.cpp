@@ -73,23 +73,17 @@ void hashBytes(std::uint64_t& h, const void* data, std::size_t bytes) {
 
 ShadowMap::ShadowMap(const GlApi& gl) : gl_(gl) {}
 
-double ShadowMap::maxSide(double camera_z) {
-  double side = kMinSide;
-  while (side < 8.0 * camera_z && side < 64.0 * kMinSide) side *= 2.0;
-  return side;
-}
-
 void ShadowMap::prepare(const CloudShadows& shadows, glm::dvec3 camera, int size, FrameStats& stats,
                         GpuPassTimer& timer) {
   active_ = false;
   if (size <= 0 || shadows.empty()) return;
   // Everything is placed from an anchor, the first caster's centre, so that a world whose
   // clouds only drifted together (a field in the wind) keeps its map, moved with them. The map
-  // is the casters' shadows within a square about the camera's ground point (maxSide), its
-  // edges on a grid of a sixteenth of that in the anchor's frame: a camera that moves less keeps
-  // it too.
+  // is the casters' shadows within a square about the camera's ground point (twice shadowRange),
+  // its edges on a grid of a sixteenth of that in the anchor's frame: a camera that moves less
+  // keeps it too.
   const glm::dvec2 anchor(shadows.casters().front().centre);
-  const double side = maxSide(camera.z), step = side / 16.0;
+  const double side = 2.0 * shadowRange(camera.z), step = side / 16.0;
   const glm::dvec2 eye = glm::round((glm::dvec2(camera) - anchor) / step) * step;
   // A step beyond the casters' shadows, so that the map's faded rim (the sky pass) holds none.
   const glm::dvec2 lo =

@@ -21,10 +21,10 @@ class ShadowMap {
  public:
   explicit ShadowMap(const GlApi& gl);
 
-  // Makes the map of `shadows` at `size` texels a side (0: none), at most maxSide metres a
-  // side about the camera's ground point, unless the one held serves: the same casters from
-  // their anchor (the first one's centre), tables, sun and region. Leaves the GL's framebuffer,
-  // viewport and vertex array to the caller.
+  // Makes the map of `shadows` at `size` texels a side (0: none), at most 2 shadowRange
+  // metres a side about the camera's ground point, unless the one held serves: the same casters
+  // from their anchor (the first one's centre), tables, sun and region. Leaves the GL's
+  // framebuffer, viewport and vertex array to the caller.
   void prepare(const CloudShadows& shadows, glm::dvec3 camera, int size, FrameStats& stats,
                GpuPassTimer& timer);
   bool active() const { return active_; }
@@ -33,11 +33,6 @@ class ShadowMap {
   // side).
   void bind(GLuint program, GLuint unit, glm::dvec3 camera) const;
   int draws() const { return draws_; }  // maps drawn since construction
-
-  // The map's largest side for a camera at height z: 48 km, doubled until it is 8 z or more
-  // (a high camera sees the ground farther out), at most 64 times.
-  static constexpr double kMinSide = 48000.0;  // metres
-  static double maxSide(double camera_z);
 
  private:
   const GlApi& gl_;

@@ -92,6 +92,13 @@ double casterSunlight(const ShadowCaster& caster, const ShadowTable& table, glm:
   return 1.0 - meanOpacity(table, g) * (1.0 - diffuseTransmittance(caster.extinction * chord));
 }
 
+double shadowRange(double camera_z) {
+  constexpr double kMin = 24000.0;
+  double range = kMin;
+  while (range < 4.0 * camera_z && range < 64.0 * kMin) range *= 2.0;
+  return range;
+}
+
 CloudShadows::CloudShadows(const Scene& scene, const HeapDrawing& heaps, bool lookups) {
   if (!(scene.sun.elevation_deg >= 1.0)) return;
   to_sun_ = sunDirection(scene.sun);
@@ -109,8 +116,14 @@ CloudShadows::CloudShadows(const Scene& scene, const HeapDrawing& heaps, bool lo
     }
   };
   for (const EllipsoidCloud& cloud : scene.clouds) add(cloud);
-  for (const CloudField& field : scene.fields)
-    for (const EllipsoidCloud& cloud : fieldShadowClouds(field, scene.camera, heaps)) add(cloud);
+  for (const CloudField& field : scene.fields) {
+    HeapDrawing near = heaps;
+    const double top = field.base_m + 1.3 * field.thickness_m * (1.0 + field.clusters.amount);
+    const double reach = shadowRange(scene.camera.position.z) +
+                         top * std::sqrt(1.0 - to_sun_.z * to_sun_.z) / to_sun_.z;
+    near.range_m = std::min(heapRange(field, scene.camera, heaps.range_m), reach);
+    for (const EllipsoidCloud& cloud : fieldShadowClouds(field, scene.camera, near)) add(cloud);
+  }
   if (casters_.empty()) return;
 
   lo_ = glm::dvec2(std::numeric_limits<double>::infinity());

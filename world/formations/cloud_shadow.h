@@ -37,6 +37,11 @@ inline double groundLight(double sunlight) {
   return kGroundSkyShare + (1.0 - kGroundSkyShare) * sunlight;
 }
 
+// How far from the camera's ground point shadows are drawn: 24 km, doubled until it is at
+// least 4 times the camera's height (a high camera sees the ground farther out), at most 64
+// times. The GL's map is a square of twice this side (ShadowMap).
+double shadowRange(double camera_z);
+
 // One lobe that casts a shadow.
 struct ShadowCaster {
   glm::dvec3 centre{0.0};
@@ -55,9 +60,11 @@ double casterSunlight(const ShadowCaster& caster, const ShadowTable& table, glm:
 
 // Every lobe of a scene that may shadow the ground it shows: the lobes of its clouds with a
 // light_extinction above 0 (heap light, MODEL.md section 14) and the heaps of its fields within
-// heap range of the camera, in view or not, drawn coarse (a shadow has no use for the detail
-// lobes). None while the sun is below 1 degree of elevation (the ground is then lit by the sky
-// alone, and a shadow would reach 60 times a cloud's height).
+// heap range of the camera, in view or not, but no farther than the shadows they can cast
+// within shadowRange (a heap at height h shadows h / tan(elevation) downsun of itself), drawn
+// coarse (a shadow has no use for the detail lobes). None while the sun is below 1 degree of
+// elevation (the ground is then lit by the sky alone, and a shadow would reach 60 times a cloud's
+// height).
 class CloudShadows {
  public:
   CloudShadows() = default;  // none

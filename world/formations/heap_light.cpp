@@ -137,8 +137,9 @@ HeapLight heapLightAt(const HeapEnvelope& envelope, glm::dvec3 p, glm::dvec3 nor
     return k * envelopeChord(envelope, p, v) * 0.5 *
            (1.0 - std::clamp(glm::dot(normal, v), -1.0, 1.0));
   };
-  return {diffuseTransmittance(depth(to_sun)),
-          0.5 + 0.5 * diffuseTransmittance(depth({0.0, 0.0, 1.0}))};
+  const double sun = depth(to_sun);
+  return {diffuseTransmittance(sun), 0.5 + 0.5 * diffuseTransmittance(depth({0.0, 0.0, 1.0})),
+          std::exp(-sun)};
 }
 
 glm::dvec3 heapLitNormal(const HeapEnvelope& envelope, glm::dvec3 p, glm::dvec3 normal) {
@@ -198,7 +199,7 @@ double heapIntensity(const EllipsoidCloud& cloud, const HeapLight& light, double
   const double eq8 = gardnerIntensity(shading, light.sun * skinDiffuse(d.n_dot_l),
                                       light.sun * d.highlight, texture_value) +
                      shading.ambient * (light.sky - 1.0);
-  return eq8 + forwardScattered(light.sun, glm::dot(direction, to_sun)) * translucence;
+  return eq8 + forwardScattered(light.direct, glm::dot(direction, to_sun)) * translucence;
 }
 
 }  // namespace nephele

@@ -54,9 +54,12 @@ double envelopeChord(const HeapEnvelope& envelope, glm::dvec3 p, glm::dvec3 dir)
 // from the horizon and the ground, which it does not hide: sky = 1/2 + 1/2 T(depth straight
 // up). The depth towards v is the envelope's extinction times its chord from p along v,
 // times (1 - n.v) / 2: a face turned towards the light looks out of the heap, not through it.
+// `direct`: the share of the unscattered sunbeam, exp(-depth towards the sun), which alone
+// feeds the light a thin edge scatters forward (heapIntensity).
 struct HeapLight {
   double sun = 1.0;
   double sky = 1.0;
+  double direct = 1.0;
 };
 HeapLight heapLightAt(const HeapEnvelope& envelope, glm::dvec3 p, glm::dvec3 normal,
                       glm::dvec3 to_sun);
