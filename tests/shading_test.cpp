@@ -115,6 +115,10 @@ TEST(HeapLight, EnvelopeOfEachHeapAndTheDepthThroughIt) {
   const glm::dvec3 half_way(0.5, 0.0, std::sqrt(0.75));
   EXPECT_NEAR(heapLightAt(envelopes[0], {-100.0, 0.0, 1000.0}, half_way, east).sun,
               two_stream(0.02 * width * 0.25), 1e-9);
+  // The unscattered beam falls as exp(-depth) over the same depth.
+  EXPECT_NEAR(heapLightAt(envelopes[0], {-100.0, 0.0, 1000.0}, west, east).direct,
+              std::exp(-0.02 * width), 1e-9);
+  EXPECT_DOUBLE_EQ(top.direct, 1.0);
   // Parts named by the cloud override the grouping: three parts, three envelopes.
   EllipsoidCloud parted = cloud;
   parted.parts = {0, 1, 2};
@@ -137,22 +141,23 @@ TEST(HeapLight, EquationWithSunSkyAndForwardScattering) {
   cloud.shading = {0.3, 0.2, 0.0, 8.0};
   const glm::dvec3 to_sun = glm::normalize(glm::dvec3(0.0, 1.0, 0.2));  // behind the surface
   const glm::dvec3 d(0.0, 1.0, 0.0), n(0.0, -1.0, 0.0);  // looking north at a face turned south
-  const HeapLight light{0.5, 0.8};                       // sun and sky reaching the point
+  // Sun and sky reaching the point, and the unscattered beam B that alone is scattered forward.
+  const HeapLight light{0.5, 0.8, 0.3};
   // The skin's diffuse max(0, (n.L + w) / (1 + w)) is 0 here, so
-  // I = (1 - a) t It + a K + S P / (4 pi) TR, with P the Cornette-Shanks phase (g = 0.85) at
+  // I = (1 - a) t It + a K + B P / (4 pi) TR, with P the Cornette-Shanks phase (g = 0.85) at
   // cos theta = d . L.
   ASSERT_LT(glm::dot(n, to_sun), -kSkinWrap);
   const double c = glm::dot(d, to_sun), g = 0.85;
   const double phase = 1.5 * (1.0 - g * g) / (2.0 + g * g) * (1.0 + c * c) /
                        std::pow(1.0 + g * g - 2.0 * g * c, 1.5);
-  const double expected = 0.7 * 0.2 * 0.4 + 0.3 * 0.8 + 0.5 * phase / (4.0 * M_PI) * 0.25;
+  const double expected = 0.7 * 0.2 * 0.4 + 0.3 * 0.8 + 0.3 * phase / (4.0 * M_PI) * 0.25;
   EXPECT_NEAR(heapIntensity(cloud, light, 0.4, n, to_sun, d, 0.25), expected, 1e-12);
   // A face turned to the sun takes it through its skin; seen from the sun's side
   // (cos theta = -1, no highlight with s = 0):
-  // I = (1 - a)((1 - t) S (1 + w) / (1 + w) + t It) + a K + S P(-1) / (4 pi) TR.
+  // I = (1 - a)((1 - t) S (1 + w) / (1 + w) + t It) + a K + B P(-1) / (4 pi) TR.
   const double back_phase = 1.5 * (1.0 - g * g) / (2.0 + g * g) * 2.0 / std::pow(1.0 + g, 3.0);
   EXPECT_NEAR(heapIntensity(cloud, light, 0.4, to_sun, to_sun, -to_sun, 0.25),
-              0.7 * (0.8 * 0.5 + 0.2 * 0.4) + 0.3 * 0.8 + 0.5 * back_phase / (4.0 * M_PI) * 0.25,
+              0.7 * (0.8 * 0.5 + 0.2 * 0.4) + 0.3 * 0.8 + 0.3 * back_phase / (4.0 * M_PI) * 0.25,
               1e-12);
   // A thin edge against the sun gives off more per unit opacity than the opaque body.
   EXPECT_GT(heapIntensity(cloud, light, 0.4, n, to_sun, d, 0.9),
