@@ -319,7 +319,12 @@ void Engine::execute(Job& job) {
       }
     publishReadings();  // so that a register read right after the reply sees the change
     job.done(std::nullopt);
-    if (job.render) renderTrigger();  // the render coil reads 1 until the file is written
+    if (job.render) {
+      renderTrigger();  // the render coil reads 1 until the file is written
+      // The frame counter it moved, published before the encoder writes the file and clears the
+      // coil: a host that sees the coil at 0 reads the new count.
+      publishReadings();
+    }
     return;
   }
   std::optional<Outcome> outcome;
