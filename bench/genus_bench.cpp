@@ -367,7 +367,7 @@ void printShadowFigures(const GlPlatform& platform, const SceneFile& file, const
   const CloudField& field = file.scene.fields.front();
   Scene scene = World(file.scene, file.dynamics).scene();
   Camera& c = scene.camera;
-  c.position = {0.0, 0.0, field.base_m + 1.3 * field.thickness_m + 4000.0};
+  c.position = {0.0, 0.0, fieldTop(field) + 4000.0};
   c.orientation = {file.scene.camera.orientation.heading_deg, -60.0, 0.0};
   c.width = 320, c.height = 240;
   GlRenderer renderer(platform);

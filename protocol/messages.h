@@ -24,7 +24,7 @@ struct ProtocolLimits {
   static constexpr int kMaxJsonDepth = 16;                    // nesting of arrays and objects
   static constexpr double kMaxSubscriptionHz = 60.0;
   static constexpr double kMaxTimeScale = 1000.0;
-  static constexpr int kWeatherLayers = 3;       // CIGI cloud layers 1 to 3
+  static constexpr int kWeatherLayers = 3;  // CIGI cloud layers 1 to 3
   // set_weather's layers: the cloud layers, then CIGI's precipitation layers 4 to 9 (rain,
   // snow, sleet, hail, sand, dust), which hold precipitation and no clouds.
   static constexpr int kWeatherKeys = 9;

@@ -43,12 +43,18 @@ TEST(PrecipitationTest, RainAndSnowFollowTheirSizeDistributions) {
   EXPECT_NE(weatherLayerError(sand).find("precipitation_visibility"), std::string::npos);
 }
 
-TEST(PrecipitationTest, ALayerRainsFromItsBaseAndACloudlessOneFillsItsOwnSlab) {
-  Scene scene;
+// A nimbostratus deck at 900 m raining `rate` mm/h.
+WeatherLayer rainingDeck(double rate) {
   WeatherLayer deck;
   deck.type = CloudType::kNimbostratus;
   deck.base_m = 900.0;
-  deck.precipitation = {PrecipitationKind::kRain, 4.0, 0.0};
+  deck.precipitation = {PrecipitationKind::kRain, rate, 0.0};
+  return deck;
+}
+
+TEST(PrecipitationTest, ALayerRainsFromItsBaseAndACloudlessOneFillsItsOwnSlab) {
+  Scene scene;
+  const WeatherLayer deck = rainingDeck(4.0);
   scene.weather[{1, std::nullopt}] = deck;
   WeatherLayer dust;
   dust.base_m = 200.0;
@@ -71,10 +77,7 @@ TEST(PrecipitationTest, ALayerRainsFromItsBaseAndACloudlessOneFillsItsOwnSlab) {
 // falls as exp(-sigma d), to 2 % at the rain's visibility (Koschmieder).
 TEST(PrecipitationTest, ATargetBehindRainKeepsKoschmiedersContrast) {
   Scene scene;
-  WeatherLayer deck;
-  deck.type = CloudType::kNimbostratus;
-  deck.base_m = 900.0;
-  deck.precipitation = {PrecipitationKind::kRain, 10.0, 0.0};
+  WeatherLayer deck = rainingDeck(10.0);
   scene.weather[{1, std::nullopt}] = deck;
   const std::vector<Fog> media = precipitationMedia(scene);
   const double visibility = precipitationVisibility(deck.precipitation);

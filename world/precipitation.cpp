@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 #include "world/scene.h"
 
@@ -37,8 +36,7 @@ double precipitationExtinction(const Precipitation& p) {
 }
 
 double precipitationVisibility(const Precipitation& p) {
-  const double sigma = precipitationExtinction(p);
-  return sigma > 0.0 ? -std::log(0.02) / sigma : std::numeric_limits<double>::infinity();
+  return visibilityForExtinction(precipitationExtinction(p));
 }
 
 glm::dvec3 precipitationColour(PrecipitationKind kind) {
@@ -63,13 +61,13 @@ glm::dvec3 precipitationColour(PrecipitationKind kind) {
 std::vector<Fog> precipitationMedia(const Scene& scene) {
   std::vector<Fog> out;
   for (const auto& [key, w] : scene.weather) {
-    const double sigma = precipitationExtinction(w.precipitation);
-    if (key.region || !(sigma > 0.0)) continue;
+    const double visibility = precipitationVisibility(w.precipitation);
+    if (key.region || !std::isfinite(visibility)) continue;
     Fog f;
     const bool clouds = w.type != CloudType::kNone;
     f.bottom_m = clouds ? 0.0 : w.base_m;
     f.top_m = clouds ? w.base_m : w.base_m + w.thickness_m;
-    f.visibility_m = -std::log(0.02) / sigma;
+    f.visibility_m = visibility;
     f.colour = precipitationColour(w.precipitation.kind);
     out.push_back(f);
   }

@@ -23,6 +23,10 @@ double extinctionForVisibility(double visibility_m) {
   return -std::log(0.02) / visibility_m;
 }
 
+double visibilityForExtinction(double sigma) {
+  return sigma > 0.0 ? -std::log(0.02) / sigma : std::numeric_limits<double>::infinity();
+}
+
 double fogExtinction(const Fog& fog) {
   return extinctionForVisibility(fog.visibility_m);
 }

@@ -39,8 +39,10 @@ struct Fog {
   bool operator==(const Fog&) const = default;
 };
 
-// Koschmieder: the extinction per metre that leaves 2 % contrast after `visibility_m`.
+// Koschmieder: the extinction per metre that leaves 2 % contrast after `visibility_m`, and the
+// visibility of an extinction (infinite for 0).
 double extinctionForVisibility(double visibility_m);
+double visibilityForExtinction(double sigma);
 double fogExtinction(const Fog& fog);  // per metre
 
 // The fog's density at height z: 1 in [bottom, top], falling linearly to 0 over the band.

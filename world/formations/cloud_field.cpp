@@ -649,6 +649,11 @@ EllipsoidCloud typicalHeap(const CloudField& f, glm::dvec3 base) {
   return heap;
 }
 
+double fieldTop(const CloudField& f) {
+  const double rise = f.clusters.none() ? 1.0 : 1.0 + f.clusters.amount;
+  return f.base_m + 1.3 * f.thickness_m * rise;
+}
+
 double heapRange(const CloudField& f, const Camera& camera, double range_m) {
   // From high up the view reaches further: the automatic range grows with the height above the
   // heaps.
@@ -671,8 +676,7 @@ std::vector<EllipsoidCloud> tilesAround(const CloudField& f, const Camera& camer
   // The eye in the field's own frame (the field has drifted by drift_m).
   const glm::dvec2 eye = glm::dvec2(camera.position) - f.drift_m;
   const double range = heapRange(f, camera, drawing.range_m);
-  const double rise = f.clusters.none() ? 1.0 : 1.0 + f.clusters.amount;
-  const double top = f.base_m + 1.3 * f.thickness_m * rise;
+  const double top = fieldTop(f);
   const double reach = 3.6 * heapRadius(f) * (1.0 + kSizeVariation);
   const std::string key = fieldKey(f);
   const auto lo = glm::floor((eye - range) / size), hi = glm::floor((eye + range) / size);

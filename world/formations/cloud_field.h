@@ -14,8 +14,8 @@
 
 #include "world/formations/ellipsoid_cloud.h"
 #include "world/formations/region.h"
-#include "world/precipitation.h"
 #include "world/frames.h"
+#include "world/precipitation.h"
 
 namespace nephele {
 
@@ -131,6 +131,10 @@ struct HeapDrawing {
   double range_m = 0.0;
   double detail_px = 32.0;
 };
+
+// The highest a field's heaps reach: 1.3 times its thickness above its base, times 1 + the
+// clusters' variation (which raises the heaps of the tallest clusters).
+double fieldTop(const CloudField& field);
 
 // The range of heaps drawn as ellipsoids: `range_m` when positive, else the automatic one;
 // at most CloudField::kMaxRangeTiles tiles.

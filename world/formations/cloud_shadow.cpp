@@ -118,9 +118,8 @@ CloudShadows::CloudShadows(const Scene& scene, const HeapDrawing& heaps, bool lo
   for (const EllipsoidCloud& cloud : scene.clouds) add(cloud);
   for (const CloudField& field : scene.fields) {
     HeapDrawing near = heaps;
-    const double top = field.base_m + 1.3 * field.thickness_m * (1.0 + field.clusters.amount);
     const double reach = shadowRange(scene.camera.position.z) +
-                         top * std::sqrt(1.0 - to_sun_.z * to_sun_.z) / to_sun_.z;
+                         fieldTop(field) * std::sqrt(1.0 - to_sun_.z * to_sun_.z) / to_sun_.z;
     near.range_m = std::min(heapRange(field, scene.camera, heaps.range_m), reach);
     for (const EllipsoidCloud& cloud : fieldShadowClouds(field, scene.camera, near)) add(cloud);
   }
