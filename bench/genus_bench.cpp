@@ -350,6 +350,39 @@ void printCumulonimbusFigures(GlRenderer& renderer, const SceneFile& file, const
       "middle %.0f m downwind of the base\n",
       speed, gaps, bottom - top + 1, tower, anvil, anvil / std::max(tower, 1.0),
       (0.5 * (anvil_lo + anvil_hi) - axis) * metres_per_px);
+
+  // The base against the sunlit tower (issue 47 item 5): the cloud's own luminance
+  // (ownLuminance) straight up from the ground under the base's middle in a 20 degree view, and
+  // on the tower's face in the view above with the sun behind the camera (the tower's rows from
+  // its foot to 0.45 of its height, within its width there); medians over opaque pixels, without
+  // the haze (120 km of it would stand for the cloud's own light).
+  auto ownMedian = [&](Scene view, auto inside) {
+    view.haze.reset();
+    const FloatImage frame = renderer.renderFloat(view, file.render);
+    view.clouds.clear();
+    const FloatImage sky = renderer.renderFloat(view, file.render);
+    std::vector<double> own;
+    for (int y = 0; y < view.camera.height; ++y)
+      for (int x = 0; x < view.camera.width; ++x)
+        if (inside(x, y) && frame.pixel(x, y)[3] > 0.95f)
+          own.push_back(ownLuminance(frame, sky, y * view.camera.width + x));
+    return std::pair{median(own), own.size()};
+  };
+  Scene lit = scene;
+  lit.sun.azimuth_deg = glm::degrees(std::atan2(-forward.x, -forward.y));
+  const auto [face, face_px] = ownMedian(lit, [&](int x, int y) {
+    return y >= mid_row && y <= bottom && x >= tower_lo && x <= tower_hi;
+  });
+  Scene up = scene;
+  up.camera.position = base + glm::dvec3(0.0, 0.0, 2.0 - base.z);
+  up.camera.orientation = {0.0, 90.0, 0.0};
+  up.camera.vfov_deg = 20.0;
+  up.camera.width = up.camera.height = 64;
+  const auto [under, under_px] = ownMedian(up, [](int, int) { return true; });
+  std::printf(
+      "  cumulonimbus base from below %.3f (%zu px), sunlit tower %.3f (%zu px, sun behind the "
+      "camera): ratio %.2f (aim at most 0.3)\n",
+      under, under_px, face, face_px, under / std::max(face, 1e-9));
 }
 
 // Fraction of the sky hemisphere seen from the ground whose coverage exceeds one half, from

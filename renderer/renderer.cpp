@@ -62,9 +62,9 @@ std::unique_ptr<Renderer> createRenderer(const RendererOptions& options, std::st
   return std::make_unique<GlBackendRenderer>(std::move(platform), options.render);
 }
 
-void dimVisibilityByPrecipitation(Frame& frame, const Scene& scene) {
-  if (frame.visibility.empty()) return;
-  const std::vector<Fog> media = precipitationMedia(scene);
+void dimVisibilityByPrecipitation(Frame& frame, const Scene& scene, const HeapDrawing& heaps) {
+  if (frame.visibility.empty() || !hasPrecipitation(scene)) return;
+  const PrecipitationMedia media = precipitationMedia(scene, heaps);
   if (media.empty()) return;
   const Camera& camera = scene.camera;
   const ViewBasis basis = viewBasis(camera);
@@ -76,7 +76,7 @@ void dimVisibilityByPrecipitation(Frame& frame, const Scene& scene) {
       for (const Target& t : scene.targets)
         if (const auto hit = intersectTarget(t, eye, d)) opaque = std::min(opaque, hit->distance);
       frame.visibility[std::size_t(y) * camera.width + x] *=
-          float(slabsTransmittance(media, eye, d, opaque));
+          float(precipitationTransmittance(media.slabs, media.shafts, eye, d, opaque));
     }
 }
 

@@ -48,8 +48,9 @@ std::unique_ptr<Renderer> createRenderer(const RendererOptions& options, std::st
 
 // The visibility channel times the scene's precipitation's transmittance (MODEL.md section 17)
 // on each pixel's centre ray up to its first opaque surface, the ground or a target: a target
-// behind rain is less visible. Nothing without precipitation or without the channel.
-void dimVisibilityByPrecipitation(Frame& frame, const Scene& scene);
+// behind rain is less visible; the shafts under heaps are those of `heaps`' range, as drawn.
+// Nothing without precipitation or without the channel.
+void dimVisibilityByPrecipitation(Frame& frame, const Scene& scene, const HeapDrawing& heaps);
 
 // The frame's pose, intrinsics and clock as image attributes (docs/DATASETS.md).
 std::vector<ImageAttribute> frameAttributes(const FrameInfo& info);

@@ -320,6 +320,62 @@ TEST_F(GlRenderTest, PrecipitationEqualsOneSampleReference) {
   }
 }
 
+// Rain shafts (MODEL.md section 17) in front of the camera, one across the view's middle and
+// one it stands in, over the ground and against the sky: equal to the one-sample reference,
+// and a target behind them less visible by their optical depth in both.
+TEST_F(GlRenderTest, RainShaftsEqualOneSampleReference) {
+  SceneFile file = preset("rain", 160, 90);
+  file.scene.weather.clear();
+  file.scene.layers.clear();
+  const Scene dry = file.scene;
+  const glm::dvec2 eye(file.scene.camera.position);
+  file.scene.rain_shafts = {{eye + glm::dvec2(300.0, 2500.0), 700.0, 900.0, 3e-3,
+                             precipitationColour(PrecipitationKind::kRain)},
+                            {eye + glm::dvec2(-200.0, 100.0), 400.0, 1500.0, 1e-3,
+                             precipitationColour(PrecipitationKind::kSnow)}};
+  Scene scene = file.scene;
+  scene.targets.clear();
+  const FloatImage gl = renderer_->renderFloat(scene, pointSampled());
+  const FloatImage reference = renderReference(scene, {1, 0});
+  // Every pixel but those of the horizon's row, where ground and sky meet inside the pixel.
+  const ViewBasis basis = viewBasis(scene.camera);
+  float worst = 0.0f;
+  for (int y = 0; y < scene.camera.height; ++y) {
+    if (rayDirection(basis, scene.camera, 0.5, y).z *
+            rayDirection(basis, scene.camera, 0.5, y + 1).z <=
+        0.0)
+      continue;
+    for (std::size_t i = std::size_t(y) * scene.camera.width * 4;
+         i < std::size_t(y + 1) * scene.camera.width * 4; ++i)
+      worst = std::max(worst, std::abs(gl.rgba[i] - reference.rgba[i]));
+  }
+  EXPECT_LE(worst, 2e-3f);
+  if (worst > 2e-3f) writeFailureImages(gl, reference, "rain_shafts");
+  Scene without = dry;
+  without.targets.clear();
+  EXPECT_GT(compareImages(gl, renderer_->renderFloat(without, pointSampled())).max_abs, 0.05);
+  FrameRequest request;
+  request.channels = {Channel::kVisibility, Channel::kObjectId, Channel::kDepth};
+  const Frame gl_frame = renderer_->renderFrame(file.scene, pointSampled(), request);
+  const Frame reference_frame = renderReferenceFrame(file.scene, {1, 0}, request);
+  for (const Frame* frame : {&gl_frame, &reference_frame}) {
+    int dimmed = 0;
+    for (int y = 0; y < file.scene.camera.height; ++y)
+      for (int x = 0; x < file.scene.camera.width; ++x) {
+        const std::size_t i = std::size_t(y) * file.scene.camera.width + x;
+        if (frame->object_id[i] == 0) continue;
+        const glm::dvec3 d =
+            glm::normalize(rayDirection(basis, file.scene.camera, x + 0.5, y + 0.5));
+        double tau = 0.0;
+        for (const RainShaft& s : file.scene.rain_shafts)
+          tau += shaftOpticalDepth(s, file.scene.camera.position, d, frame->depth[i]);
+        EXPECT_NEAR(frame->visibility[i], std::exp(-tau), 2e-3) << "pixel " << i;
+        dimmed += tau > 0.1;
+      }
+    EXPECT_GT(dimmed, 0);
+  }
+}
+
 // The visibility channel over a target behind rain (MODEL.md section 17): the rain's
 // transmittance to it, exp(-sigma depth), in both renderers; the far boat is less visible.
 TEST_F(GlRenderTest, TargetsBehindRainAreLessVisible) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "world/formations/genus.h"
 #include "world/scene.h"
 
 namespace nephele {
@@ -58,20 +59,55 @@ glm::dvec3 precipitationColour(PrecipitationKind kind) {
   }
 }
 
-std::vector<Fog> precipitationMedia(const Scene& scene) {
-  std::vector<Fog> out;
+PrecipitationMedia precipitationMedia(const Scene& scene, const HeapDrawing& heaps) {
+  PrecipitationMedia out;
   for (const auto& [key, w] : scene.weather) {
     const double visibility = precipitationVisibility(w.precipitation);
-    if (key.region || !std::isfinite(visibility)) continue;
+    // Heaps rain in shafts (their fields'), a region's slab is not drawn.
+    if (key.region || !std::isfinite(visibility) || genus(w.type).heaps) continue;
     Fog f;
     const bool clouds = w.type != CloudType::kNone;
     f.bottom_m = clouds ? 0.0 : w.base_m;
     f.top_m = clouds ? w.base_m : w.base_m + w.thickness_m;
     f.visibility_m = visibility;
     f.colour = precipitationColour(w.precipitation.kind);
-    out.push_back(f);
+    out.slabs.push_back(f);
+  }
+  out.shafts = scene.rain_shafts;
+  if (!scene.fields.empty()) {
+    std::vector<RainShaft> more = rainShaftsInView(scene, heaps);
+    out.shafts.insert(out.shafts.end(), more.begin(), more.end());
   }
   return out;
+}
+
+PrecipitationMedia precipitationMedia(const Scene& scene) {
+  return precipitationMedia(scene, HeapDrawing{});
+}
+
+std::vector<RainShaft> rainShaftsInView(const Scene& scene, const HeapDrawing& heaps) {
+  std::vector<RainShaft> out;
+  for (const CloudField& field : scene.fields) {
+    std::vector<RainShaft> shafts = fieldRainShafts(field, scene.camera, heaps);
+    out.insert(out.end(), shafts.begin(), shafts.end());
+  }
+  const glm::dvec2 eye(scene.camera.position);
+  auto distance = [&](const RainShaft& s) { return glm::length(s.centre - eye) - s.radius_m; };
+  if (out.size() > std::size_t(kMaxRainShafts)) {
+    std::nth_element(
+        out.begin(), out.begin() + kMaxRainShafts, out.end(),
+        [&](const RainShaft& a, const RainShaft& b) { return distance(a) < distance(b); });
+    out.resize(std::size_t(kMaxRainShafts));
+  }
+  return out;
+}
+
+bool hasPrecipitation(const Scene& scene) {
+  if (!scene.rain_shafts.empty()) return true;
+  for (const auto& [key, w] : scene.weather)
+    if (precipitationExtinction(w.precipitation) > 0.0 && (!key.region || genus(w.type).heaps))
+      return true;
+  return false;
 }
 
 }  // namespace nephele

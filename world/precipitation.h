@@ -1,8 +1,8 @@
 #pragma once
 // Precipitation and obscurants (MODEL.md section 17): rain, snow, sleet, hail, sand and dust as
-// a medium filling a slab of air, of an extinction set by the rate (or by the visibility a host
-// gives), seen in its own colour like the ground fog. CIGI 3.3's Weather Control layers 4 to 9
-// are these six kinds in this order.
+// a medium filling a slab of air or a shaft under a heap, of an extinction set by the rate (or by
+// the visibility a host gives), seen in its own colour like the ground fog. CIGI 3.3's Weather
+// Control layers 4 to 9 are these six kinds in this order.
 #include <array>
 #include <string_view>
 #include <vector>
@@ -14,6 +14,7 @@
 namespace nephele {
 
 struct Scene;
+struct HeapDrawing;
 
 enum class PrecipitationKind { kNone, kRain, kSnow, kSleet, kHail, kSand, kDust };
 inline constexpr int kPrecipitationKindCount = 7;
@@ -48,10 +49,32 @@ double precipitationVisibility(const Precipitation& p);
 // The colour it is seen in (linear RGB): grey for rain, white for snow, ochre for sand.
 glm::dvec3 precipitationColour(PrecipitationKind kind);
 
-// The media the scene's precipitation fills (world-wide weather layers with a kind): a layer
-// with clouds rains from its base to the ground, one without clouds (CIGI's layers 4 to 9)
-// fills its own base to top. Each is a Fog slab with no band, at the visibility above, in the
-// kind's colour. A region's precipitation is not drawn.
-std::vector<Fog> precipitationMedia(const Scene& scene);
+// The rain shafts a view holds at most: those nearest the camera (rainShaftsInView). The GL's
+// uniform arrays hold this many.
+inline constexpr int kMaxRainShafts = 16;
+
+struct PrecipitationMedia {
+  std::vector<Fog> slabs;
+  std::vector<RainShaft> shafts;
+  bool empty() const { return slabs.empty() && shafts.empty(); }
+};
+
+// The media the scene's precipitation fills, at the visibility above and in the kind's colour:
+// - a stratiform layer rains from its base to the ground, and a layer without clouds (CIGI's
+//   layers 4 to 9) fills its own base to top, each a Fog slab with no band; a region's slab is
+//   not drawn;
+// - a layer of heaps rains in a shaft under each heap (fieldRainShafts): those of the scene's
+//   fields (rainShaftsInView, with `heaps`' range) and those already drawn out of them
+//   (Scene::rain_shafts, withFieldClouds).
+PrecipitationMedia precipitationMedia(const Scene& scene, const HeapDrawing& heaps);
+// The same with the automatic heap range.
+PrecipitationMedia precipitationMedia(const Scene& scene);
+
+// The shafts under the heaps of the scene's fields within heap range (HeapDrawing) whose box
+// the camera may see, the kMaxRainShafts nearest it.
+std::vector<RainShaft> rainShaftsInView(const Scene& scene, const HeapDrawing& heaps);
+
+// Whether the scene has any precipitation to draw (without walking its fields' tiles).
+bool hasPrecipitation(const Scene& scene);
 
 }  // namespace nephele

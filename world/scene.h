@@ -87,6 +87,9 @@ struct Scene {
   // The weather layers as set (set_weather, Modbus, CIGI, [[weather]]), held here alone: their
   // clouds are the layers and fields named under weatherPrefix(key) (world.h placeWeather).
   std::map<WeatherKey, WeatherLayer> weather;
+  // The rain shafts under its fields' heaps near the camera (MODEL.md section 17), drawn out of
+  // the fields with their heaps (withFieldClouds); a scene with fields has none yet.
+  std::vector<RainShaft> rain_shafts;
 };
 
 // `scene` with `clouds` in place of its own: everything else copied, its clouds' lobes not
@@ -94,10 +97,10 @@ struct Scene {
 inline Scene withClouds(const Scene& scene, std::vector<EllipsoidCloud> clouds) {
   // Every member by name: this stops compiling when Scene gains one, which belongs here too.
   const auto& [seed, time_s, camera, sun, sky, fog, haze, layers, own_clouds, fields, targets,
-               automata, weather] = scene;
+               automata, weather, rain_shafts] = scene;
   static_cast<void>(own_clouds);
-  return Scene{seed,   time_s,  camera,   sun,    sky, fog, haze, layers, std::move(clouds),
-               fields, targets, automata, weather};
+  return Scene{seed,   time_s,  camera,   sun,     sky,        fog, haze, layers, std::move(clouds),
+               fields, targets, automata, weather, rain_shafts};
 }
 
 // Ellipsoids the scene's clouds hold (its fields' heaps are made per view and not counted).
@@ -119,7 +122,7 @@ bool eyeInLayer(const Scene& scene);
 // Whether anything lies in the air between the eye and a surface (fog, haze, a layer's veil,
 // precipitation).
 inline bool sceneHasAir(const Scene& scene) {
-  return scene.fog || scene.haze || eyeInLayer(scene) || !precipitationMedia(scene).empty();
+  return scene.fog || scene.haze || eyeInLayer(scene) || hasPrecipitation(scene);
 }
 
 // `scene` with its fields' heaps within heapRange(drawing.range_m) of its camera added to its

@@ -84,18 +84,59 @@ double hazeOpticalDepth(const Haze& haze, glm::dvec3 origin, glm::dvec3 directio
   return sigma0 * h / direction.z * (std::exp(-a) - std::exp(-std::max(a + x, -50.0)));
 }
 
-double slabsTransmittance(std::span<const Fog> slabs, glm::dvec3 origin, glm::dvec3 direction,
-                          double distance) {
+double shaftOpticalDepth(const RainShaft& shaft, glm::dvec3 origin, glm::dvec3 direction,
+                         double distance) {
+  if (!(shaft.sigma > 0.0) || !(distance > 0.0) || !(shaft.top_m > 0.0)) return 0.0;
+  // The chord [t0, t1] inside the cylinder |o + t d| < R (horizontal parts) and 0 <= Z <= top.
+  const glm::dvec2 o = glm::dvec2(origin) - shaft.centre, d(direction);
+  const double r2 = shaft.radius_m * shaft.radius_m;
+  const double a = glm::dot(d, d), b = glm::dot(o, d);
+  double t0 = 0.0, t1 = distance;
+  if (a < 1e-12) {
+    if (glm::dot(o, o) >= r2) return 0.0;
+  } else {
+    // b^2 - a (|o|^2 - R^2) = a R^2 - (o x d)^2, the form that keeps far shafts' digits.
+    const double cross = o.x * d.y - o.y * d.x, quarter_delta = a * r2 - cross * cross;
+    if (quarter_delta <= 0.0) return 0.0;
+    const double root = std::sqrt(quarter_delta);
+    t0 = std::max(t0, (-b - root) / a);
+    t1 = std::min(t1, (-b + root) / a);
+  }
+  if (direction.z == 0.0) {
+    if (origin.z < 0.0 || origin.z > shaft.top_m) return 0.0;
+  } else {
+    const double at_ground = -origin.z / direction.z;
+    const double at_top = (shaft.top_m - origin.z) / direction.z;
+    t0 = std::max(t0, std::min(at_ground, at_top));
+    t1 = std::min(t1, std::max(at_ground, at_top));
+  }
+  if (!(t1 > t0)) return 0.0;
+  // About the chord's middle m, t = m + u with |u| <= h: the radial factor is
+  // G0 + G1 u + G2 u^2 and the height factor L0 + L1 u, so the odd terms of their product
+  // vanish over [-h, h]: the integral is 2 h G0 L0 + (2 h^3 / 3)(G2 L0 + G1 L1).
+  const double m = 0.5 * (t0 + t1), h = 0.5 * (t1 - t0);
+  const glm::dvec2 q = o + m * d;
+  const double g0 = 1.0 - glm::dot(q, q) / r2, g1 = -2.0 * glm::dot(q, d) / r2, g2 = -a / r2;
+  const double fade = (1.0 - kShaftGroundShare) / shaft.top_m;
+  const double l0 = kShaftGroundShare + fade * (origin.z + m * direction.z);
+  const double l1 = fade * direction.z;
+  const double column = 2.0 * h * g0 * l0 + (2.0 * h * h * h / 3.0) * (g2 * l0 + g1 * l1);
+  return shaft.sigma * std::max(column, 0.0);
+}
+
+double precipitationTransmittance(std::span<const Fog> slabs, std::span<const RainShaft> shafts,
+                                  glm::dvec3 origin, glm::dvec3 direction, double distance) {
   double tau = 0.0;
   for (const Fog& f : slabs)
     tau += fogExtinction(f) * fogPathLength(f, origin, direction, distance);
+  for (const RainShaft& s : shafts) tau += shaftOpticalDepth(s, origin, direction, distance);
   return std::isfinite(tau) ? std::exp(-tau) : 0.0;
 }
 
 glm::dvec3 throughAir(glm::dvec3 colour, const std::optional<Fog>& fog,
                       const std::optional<Fog>& veil, const std::optional<Haze>& haze,
                       glm::dvec3 horizon, glm::dvec3 origin, glm::dvec3 direction, double distance,
-                      std::span<const Fog> precipitation) {
+                      std::span<const Fog> precipitation, std::span<const RainShaft> shafts) {
   // Each depth is capped where its transmittance is already 0 in double, so the weights of the
   // colours stay finite.
   constexpr double kOpaque = 1.0e3;
@@ -113,6 +154,11 @@ glm::dvec3 throughAir(glm::dvec3 colour, const std::optional<Fog>& fog,
     const double tau_p = depth(p);
     tau += tau_p;
     weighted += tau_p * p.colour;
+  }
+  for (const RainShaft& s : shafts) {
+    const double tau_s = std::min(shaftOpticalDepth(s, origin, direction, distance), kOpaque);
+    tau += tau_s;
+    weighted += tau_s * s.colour;
   }
   if (!(tau > 0.0)) return colour;
   const glm::dvec3 air = weighted / tau;

@@ -66,19 +66,40 @@ struct Haze {
 // be +infinity; `direction` must be normalised). Finite or +infinity, never NaN.
 double hazeOpticalDepth(const Haze& haze, glm::dvec3 origin, glm::dvec3 direction, double distance);
 
-// The transmittance exp(-sum sigma_i l_i) of slabs (precipitationMedia) along origin + s
-// direction, 0 <= s <= distance (+infinity allowed; `direction` unit).
-double slabsTransmittance(std::span<const Fog> slabs, glm::dvec3 origin, glm::dvec3 direction,
-                          double distance);
+// A shaft of precipitation under a heap (MODEL.md section 17): a vertical cylinder of radius R
+// about the axis through `centre`, from the ground up to `top_m` (the heap's base), of extinction
+// sigma times its density (1 - rho^2 / R^2) (kShaftGroundShare + (1 - kShaftGroundShare) Z / top)
+// at distance rho from the axis and height Z: densest in its core under the cloud, soft at its
+// edge and thinning towards the ground, where part of it has evaporated. Unlit, like the fog.
+struct RainShaft {
+  glm::dvec2 centre{0.0};  // world X, Y of its axis
+  double radius_m = 1000.0;
+  double top_m = 1000.0;
+  double sigma = 0.0;  // per metre, at density 1
+  glm::dvec3 colour{0.45, 0.48, 0.52};
+  bool operator==(const RainShaft&) const = default;
+};
+inline constexpr double kShaftGroundShare = 0.5;
+
+// The shaft's optical depth along origin + s * direction, 0 <= s <= distance (+infinity allowed;
+// `direction` unit): exact, the density being a polynomial of degree 3 in s along the chord.
+double shaftOpticalDepth(const RainShaft& shaft, glm::dvec3 origin, glm::dvec3 direction,
+                         double distance);
+
+// The transmittance exp(-tau) of precipitation slabs and shafts (precipitationMedia) along
+// origin + s direction, 0 <= s <= distance (+infinity allowed; `direction` unit).
+double precipitationTransmittance(std::span<const Fog> slabs, std::span<const RainShaft> shafts,
+                                  glm::dvec3 origin, glm::dvec3 direction, double distance);
 
 // `colour` seen at `distance` along the unit `direction` from `origin` through the fog, the
 // in-layer veil, the haze and the precipitation of a scene (any may be absent; precipitation
-// as slabs, precipitationMedia): mixed in proportion to their optical depths, T = exp(-tau),
-// tau their sum, colour T + (1 - T) (sum of tau_i colour_i) / tau, the haze's colour the
+// as slabs and shafts, precipitationMedia): mixed in proportion to their optical depths, T =
+// exp(-tau), tau their sum, colour T + (1 - T) (sum of tau_i colour_i) / tau, the haze's colour the
 // horizon's.
 glm::dvec3 throughAir(glm::dvec3 colour, const std::optional<Fog>& fog,
                       const std::optional<Fog>& veil, const std::optional<Haze>& haze,
                       glm::dvec3 horizon, glm::dvec3 origin, glm::dvec3 direction, double distance,
-                      std::span<const Fog> precipitation = {});
+                      std::span<const Fog> precipitation = {},
+                      std::span<const RainShaft> shafts = {});
 
 }  // namespace nephele

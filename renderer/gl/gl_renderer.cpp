@@ -235,7 +235,7 @@ Frame GlRenderer::renderFrame(const Scene& scene, const RenderSettings& settings
   if (composite) frame.colour = renderFloat(scene, settings);
   if (asked.has(Channel::kVisibility)) {
     frame.visibilityFromCoverage();
-    dimVisibilityByPrecipitation(frame, scene);
+    dimVisibilityByPrecipitation(frame, scene, settings.heaps);
   }
   // The channels beyond the composite are read back and converted on the CPU.
   StageClock channels(stats_.times.readback_ms);

@@ -2,6 +2,7 @@
 
 #include "renderer/gl/view_uniforms.h"
 #include "world/formations/cloud_shadow.h"
+#include "world/precipitation.h"
 #include "world/textures/gardner_texture.h"
 
 namespace nephele {
@@ -57,6 +58,12 @@ uniform vec3 u_veil_colour;
 uniform vec3 u_precip_slab[kPrecipitationSlabs];
 uniform float u_precip_sigma[kPrecipitationSlabs];
 uniform vec3 u_precip_colour[kPrecipitationSlabs];
+// Shafts under heaps (MODEL.md section 17, RainShaft): the first u_shafts of kRainShafts, each
+// its axis's X, Y from the camera, radius and top, metres; extinction and colour.
+uniform vec4 u_shaft[kRainShafts];
+uniform float u_shaft_sigma[kRainShafts];
+uniform vec3 u_shaft_colour[kRainShafts];
+uniform int u_shafts;
 uniform float u_haze_sigma;   // at Z = 0, per metre
 uniform float u_haze_height;  // scale height, metres
 uniform vec3 u_haze_colour;   // the sky's horizon
@@ -85,6 +92,39 @@ float slabPath(vec3 slab, vec3 d, float distance) {
   return abs(slabColumn(slab, u_camera_z + rise) - slabColumn(slab, u_camera_z)) / abs(d.z);
 }
 
+// Shaft i's optical depth along the unit ray up to `distance` (world/sky.cpp's
+// shaftOpticalDepth): the chord inside its cylinder and between the ground and its top, and the
+// exact integral of its density, a cubic along the chord, about the chord's middle.
+float shaftDepth(int i, vec3 d, float distance) {
+  vec4 shaft = u_shaft[i];
+  vec2 o = -shaft.xy, dh = d.xy;
+  float r2 = shaft.z * shaft.z, a = dot(dh, dh), b = dot(o, dh);
+  float t0 = 0.0, t1 = distance;
+  if (a < 1e-8) {
+    if (dot(o, o) >= r2) return 0.0;
+  } else {
+    float cross_od = o.x * dh.y - o.y * dh.x, quarter_delta = a * r2 - cross_od * cross_od;
+    if (quarter_delta <= 0.0) return 0.0;
+    float root = sqrt(quarter_delta);
+    t0 = max(t0, (-b - root) / a);
+    t1 = min(t1, (-b + root) / a);
+  }
+  if (d.z == 0.0) {
+    if (u_camera_z < 0.0 || u_camera_z > shaft.w) return 0.0;
+  } else {
+    float at_ground = -u_camera_z / d.z, at_top = (shaft.w - u_camera_z) / d.z;
+    t0 = max(t0, min(at_ground, at_top));
+    t1 = min(t1, max(at_ground, at_top));
+  }
+  if (!(t1 > t0)) return 0.0;
+  float m = 0.5 * (t0 + t1), h = 0.5 * (t1 - t0);
+  vec2 q = o + m * dh;
+  float g0 = 1.0 - dot(q, q) / r2, g1 = -2.0 * dot(q, dh) / r2, g2 = -a / r2;
+  float fade = (1.0 - kShaftGroundShare) / shaft.w;
+  float l0 = kShaftGroundShare + fade * (u_camera_z + m * d.z), l1 = fade * d.z;
+  return u_shaft_sigma[i] * max(2.0 * h * g0 * l0 + (2.0 * h * h * h / 3.0) * (g2 * l0 + g1 * l1), 0.0);
+}
+
 // The haze's optical depth along the unit ray up to `distance`: sigma0 H (e^-a - e^-(a+x)) / dz,
 // a = z0 / H, x = s dz / H, or its series near x = 0 (hazeOpticalDepth).
 float hazeDepth(vec3 d, float distance) {
@@ -108,6 +148,11 @@ vec3 applyAir(vec3 colour, vec3 d, float distance) {
       tau += tau_p;
       weighted += tau_p * u_precip_colour[i];
     }
+  for (int i = 0; i < u_shafts; ++i) {
+    float tau_s = min(shaftDepth(i, d, distance), 1e3);
+    tau += tau_s;
+    weighted += tau_s * u_shaft_colour[i];
+  }
   if (!(tau > 0.0)) return colour;
   return mix(weighted / tau, colour, exp(-tau));
 }
@@ -472,7 +517,10 @@ std::string slotStatement(int slot, LayerKind kind) {
 
 // kCommon after the constants it takes from C++.
 std::string commonSource() {
-  return "const int kPrecipitationSlabs = " + std::to_string(kPrecipitationSlabs) + ";\n" + kCommon;
+  return "const int kPrecipitationSlabs = " + std::to_string(kPrecipitationSlabs) +
+         ";\nconst int kRainShafts = " + std::to_string(kMaxRainShafts) +
+         ";\nconst float kShaftGroundShare = " + std::to_string(kShaftGroundShare) + ";\n" +
+         kCommon;
 }
 
 }  // namespace

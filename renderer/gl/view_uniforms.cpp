@@ -33,8 +33,10 @@ void setViewUniforms(const GlApi& gl, GLuint p, const Camera& camera, const Scen
   };
   setSlab("u_fog", scene.fog);
   setSlab("u_veil", inLayerVeil(scene));
-  // The precipitation's slabs, the densest kPrecipitationSlabs (a scene holds at most nine).
-  std::vector<Fog> precipitation = precipitationMedia(scene);
+  // The precipitation's slabs, the densest kPrecipitationSlabs (a scene holds at most nine),
+  // and its shafts, camera-relative.
+  PrecipitationMedia media = precipitationMedia(scene);
+  std::vector<Fog>& precipitation = media.slabs;
   std::sort(precipitation.begin(), precipitation.end(),
             [](const Fog& a, const Fog& b) { return a.visibility_m < b.visibility_m; });
   for (int i = 0; i < kPrecipitationSlabs; ++i) {
@@ -45,6 +47,23 @@ void setViewUniforms(const GlApi& gl, GLuint p, const Camera& camera, const Scen
     gl.ProgramUniform1f(p, gl.GetUniformLocation(p, ("u_precip_sigma" + element).c_str()),
                         present ? float(fogExtinction(f)) : 0.0f);
     setUniform3(gl, p, ("u_precip_colour" + element).c_str(), f.colour);
+  }
+  const int shafts = int(std::min(media.shafts.size(), std::size_t(kMaxRainShafts)));
+  std::vector<glm::vec4> shaft(std::size_t(shafts) + 1);
+  std::vector<float> sigma(std::size_t(shafts) + 1);
+  std::vector<glm::vec3> colour(std::size_t(shafts) + 1);
+  for (int i = 0; i < shafts; ++i) {
+    const RainShaft& s = media.shafts[std::size_t(i)];
+    shaft[std::size_t(i)] = glm::vec4(glm::vec2(s.centre - glm::dvec2(camera.position)),
+                                      float(s.radius_m), float(s.top_m));
+    sigma[std::size_t(i)] = float(s.sigma);
+    colour[std::size_t(i)] = glm::vec3(s.colour);
+  }
+  gl.ProgramUniform1i(p, gl.GetUniformLocation(p, "u_shafts"), shafts);
+  if (shafts > 0) {
+    gl.ProgramUniform4fv(p, gl.GetUniformLocation(p, "u_shaft"), shafts, &shaft[0].x);
+    gl.ProgramUniform1fv(p, gl.GetUniformLocation(p, "u_shaft_sigma"), shafts, sigma.data());
+    gl.ProgramUniform3fv(p, gl.GetUniformLocation(p, "u_shaft_colour"), shafts, &colour[0].x);
   }
   const std::optional<Haze>& haze = scene.haze;
   gl.ProgramUniform1f(p, gl.GetUniformLocation(p, "u_haze_sigma"),

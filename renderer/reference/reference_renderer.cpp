@@ -284,7 +284,8 @@ class ReferenceTracer {
 
   glm::dvec3 withAir(glm::dvec3 colour, glm::dvec3 direction, double distance) const {
     return throughAir(colour, scene_.fog, layer_veil_, scene_.haze, scene_.sky.horizon,
-                      scene_.camera.position, direction, distance, precipitation_);
+                      scene_.camera.position, direction, distance, precipitation_.slabs,
+                      precipitation_.shafts);
   }
 
   const Scene& scene_;
@@ -295,7 +296,7 @@ class ReferenceTracer {
   std::vector<EllipsoidEntry> ellipsoids_;
   Veil veil_;
   std::optional<Fog> layer_veil_ = inLayerVeil(scene_);  // the camera's, once per frame
-  std::vector<Fog> precipitation_ = precipitationMedia(scene_);
+  PrecipitationMedia precipitation_ = precipitationMedia(scene_);
 };
 
 }  // namespace
@@ -374,7 +375,7 @@ Frame renderReferenceFrame(const Scene& scene, const ReferenceSettings& settings
   pool.clear();  // join before the frame is handed out
   if (asked.has(Channel::kVisibility)) {
     frame.visibilityFromCoverage();
-    dimVisibilityByPrecipitation(frame, scene);
+    dimVisibilityByPrecipitation(frame, scene, settings.heaps);
   }
   return frame;
 }

@@ -13,6 +13,7 @@
 #include <tuple>
 
 #include "world/counter_random.h"
+#include "world/formations/cloud_shadow.h"
 #include "world/formations/cluster.h"
 #include "world/formations/genus.h"
 #include "world/formations/heap_light.h"
@@ -137,6 +138,26 @@ std::vector<Ellipsoid> cumulonimbusEllipsoids(const CloudField& f, glm::dvec3 ba
   bottom.centre = base + glm::dvec3(0.0, 0.0, bottom.radii.z);
   bottom.orientation.heading_deg = 360.0 * u(1);
   out.push_back(bottom);
+  // The flat base at the condensation level: pancake lobes over the tower's foot, their middles
+  // a little above the base, so that the opaque core of each (its limb is translucent, Gardner
+  // eq. 11) ends level just above it, seen from the side and from below alike. The bottom
+  // ellipsoid above, seen from the side, ends in a translucent rounded limb 1 to 2 km up.
+  if (detailed) {
+    ClusterSpec floor;
+    floor.element.radii = {0.2 * r, 0.2 * r, 0.07 * h};
+    floor.centre = glm::dvec2(base);
+    floor.boundary_radii = {0.3 * r, 0.3 * r * squash};
+    floor.spacing = glm::dvec2(0.18 * r);
+    floor.altitude_m = base.z;
+    floor.size_variation = 0.15;
+    floor.position_variation = 0.2;
+    floor.heading_variation_deg = 90.0;
+    floor.seed = hashCounters(seed, kShape, 4);
+    for (Ellipsoid e : clusterEllipsoids(floor)) {
+      e.centre.z = base.z + 0.5 * e.radii.z;
+      out.push_back(e);
+    }
+  }
   // The tower: a column of lobes each about 0.5 h tall, 0.13 h apart from the base up, so
   // that no gap opens from the base to the anvil and no seam shows between them, with bulges
   // half sunk into its faces that grow upward.
@@ -169,8 +190,11 @@ std::vector<Ellipsoid> cumulonimbusEllipsoids(const CloudField& f, glm::dvec3 ba
   // stem under a plate. The top ring joins the anvil and is kept at every distance, as the
   // anvil is: from above it widens the anvil's edge, and merged into the far mound the heaps
   // drew less cover than their measured footprint (0.444 against 0.463 over eight seeds).
+  // The rings are lit with the anvil they spread into (its part, MODEL.md section 14): in the
+  // tower's, they widened its envelope to the anvil's width, and the sunlit tower's face took
+  // its light through kilometres of it (0.149 of the sun's luminance against 0.3 and more).
   constexpr int kRings = 3, kAround = 7;
-  std::vector<Ellipsoid> shoulder;
+  std::vector<Ellipsoid> rings, shoulder;
   const double turn = 2.0 * std::numbers::pi * u(11);
   for (int ring = 0; ring < kRings; ++ring) {
     const double step = double(ring) / (kRings - 1);
@@ -191,11 +215,17 @@ std::vector<Ellipsoid> cumulonimbusEllipsoids(const CloudField& f, glm::dvec3 ba
       // Body y (forward) along out_dir, pitched up by 10 to 25 degrees.
       lobe.orientation.heading_deg = headingAlong({out_dir.y, -out_dir.x});
       lobe.orientation.pitch_deg = 10.0 + 15.0 * u(15, k);
-      (ring + 1 < kRings ? tower : shoulder).push_back(lobe);
+      (ring + 1 < kRings ? rings : shoulder).push_back(lobe);
     }
   }
-  if (!detailed) tower = {mound(tower)};
+  if (!detailed) {
+    tower.insert(tower.end(), rings.begin(), rings.end());
+    tower = {mound(tower)};
+    rings.clear();
+  }
   out.insert(out.end(), tower.begin(), tower.end());
+  anvil_from = out.size();
+  out.insert(out.end(), rings.begin(), rings.end());
   out.insert(out.end(), shoulder.begin(), shoulder.end());
   // The anvil: flat-topped at the tropopause (0.97 h), thickest where the tower feeds it (0.2 h)
   // and thinning downwind to 0.07 h in full shear (upwind, where it overhangs less, to 0.12 h),
@@ -216,7 +246,6 @@ std::vector<Ellipsoid> cumulonimbusEllipsoids(const CloudField& f, glm::dvec3 ba
   Ellipsoid dome;
   dome.radii = {0.3 * r, 0.3 * r, 0.1 * h};  // sunk into the anvil, its top at 1.05 h
   dome.centre = axis(0.95 * h);
-  anvil_from = out.size();
   out.push_back(dome);
   Ellipsoid sheet;
   sheet.radii = {along, across, 0.05 * h};
@@ -519,7 +548,16 @@ std::string fieldKey(const CloudField& f) {
   return key.str();
 }
 
-EllipsoidCloud makeTile(const CloudField& f, std::int64_t i, std::int64_t j, bool detailed) {
+// One heap of a tile: where its flat bottom's middle stands (field frame, before drift), its
+// size and height factors, and the seed of its shape.
+struct HeapPlacement {
+  glm::dvec3 base;
+  HeapScale scale;
+  std::uint64_t seed;
+};
+
+// The heaps of tile (i, j): a pure function of (field, i, j).
+std::vector<HeapPlacement> heapPlacements(const CloudField& f, std::int64_t i, std::int64_t j) {
   const double size = fieldTileSize(f);
   const std::uint64_t tile_seed = hashCounters(f.seed, std::uint64_t(i), std::uint64_t(j));
   // Heaps are drawn for the highest cover anywhere, and each is kept with the ratio of the
@@ -529,8 +567,8 @@ EllipsoidCloud makeTile(const CloudField& f, std::int64_t i, std::int64_t j, boo
   const double peak_density = heapDensity(f, peak);
   const int count =
       poisson(peak_density * size * size, unitFromBits(hashCounters(tile_seed, kCount)));
-  EllipsoidCloud cloud = heapCloud(f, f.name + "/" + std::to_string(i) + "," + std::to_string(j));
   const bool uniform = f.region.everywhere() && f.clusters.none();
+  std::vector<HeapPlacement> out;
   for (int k = 0; k < count; ++k) {
     auto u = [&](Draw d) { return unitFromBits(hashCounters(tile_seed, d, std::uint64_t(k))); };
     const glm::dvec3 base((double(i) + u(kX)) * size, (double(j) + u(kY)) * size, f.base_m);
@@ -539,10 +577,17 @@ EllipsoidCloud makeTile(const CloudField& f, std::int64_t i, std::int64_t j, boo
       continue;
     HeapScale scale = heapScale(tile_seed, std::uint64_t(k));
     scale.height *= clusterFactor(f.clusters, f.seed, kRise, glm::dvec2(base));
+    out.push_back({base, scale, hashCounters(tile_seed, kShape, std::uint64_t(k))});
+  }
+  return out;
+}
+
+EllipsoidCloud makeTile(const CloudField& f, std::int64_t i, std::int64_t j, bool detailed) {
+  EllipsoidCloud cloud = heapCloud(f, f.name + "/" + std::to_string(i) + "," + std::to_string(j));
+  for (const HeapPlacement& p : heapPlacements(f, i, j)) {
     std::size_t anvil_from = 0;
     std::vector<Ellipsoid> heap =
-        heapEllipsoids(f, base, scale.size, scale.height,
-                       hashCounters(tile_seed, kShape, std::uint64_t(k)), detailed, anvil_from);
+        heapEllipsoids(f, p.base, p.scale.size, p.scale.height, p.seed, detailed, anvil_from);
     if (cloud.ellipsoids.size() + heap.size() > std::size_t(Limits::kMaxEllipsoidsPerCloud)) break;
     addHeap(cloud, std::move(heap), anvil_from);
   }
@@ -645,7 +690,9 @@ std::string_view heapSpecies(const CloudField& f) {
 EllipsoidCloud typicalHeap(const CloudField& f, glm::dvec3 base) {
   EllipsoidCloud heap = heapCloud(f, f.name + "/typical");
   std::size_t anvil_from = 0;
-  addHeap(heap, heapEllipsoids(f, base, 1.0, 1.0, f.seed, true, anvil_from), anvil_from);
+  // Made before addHeap reads anvil_from (an argument's order of evaluation is unspecified).
+  std::vector<Ellipsoid> lobes = heapEllipsoids(f, base, 1.0, 1.0, f.seed, true, anvil_from);
+  addHeap(heap, std::move(lobes), anvil_from);
   return heap;
 }
 
@@ -664,44 +711,67 @@ double heapRange(const CloudField& f, const Camera& camera, double range_m) {
 
 namespace {
 
-// The heaps of the tiles within heapRange of the camera that `keep` takes, by the tile's box
-// in the field's own frame (grown by the largest heap that can reach out of it), drifted into
-// place; `detailed` says from the box whether a tile's heaps are drawn with every lobe.
-template <class Keep, class Detailed>
-std::vector<EllipsoidCloud> tilesAround(const CloudField& f, const Camera& camera,
-                                        const HeapDrawing& drawing, Keep keep, Detailed detailed) {
-  std::vector<EllipsoidCloud> out;
-  if (!(peakCoverage(f) > 0.0)) return out;
+// Calls visit(i, j, lo, hi) for each tile (i, j) within heapRange of the camera where the
+// field's region leaves some cover, with the tile's box in the field's own frame (its X and Y
+// grown by the largest heap that can reach out of it, its Z from the heaps' base to their top).
+template <class Visit>
+void forTilesAround(const CloudField& f, const Camera& camera, const HeapDrawing& drawing,
+                    Visit visit) {
+  if (!(peakCoverage(f) > 0.0)) return;
   const double size = fieldTileSize(f);
   // The eye in the field's own frame (the field has drifted by drift_m).
   const glm::dvec2 eye = glm::dvec2(camera.position) - f.drift_m;
   const double range = heapRange(f, camera, drawing.range_m);
   const double top = fieldTop(f);
   const double reach = 3.6 * heapRadius(f) * (1.0 + kSizeVariation);
-  const std::string key = fieldKey(f);
   const auto lo = glm::floor((eye - range) / size), hi = glm::floor((eye + range) / size);
   for (double jy = lo.y; jy <= hi.y; ++jy)
     for (double ix = lo.x; ix <= hi.x; ++ix) {
-      const glm::dvec2 min_xy = glm::dvec2(ix, jy) * size - reach;
-      const glm::dvec2 max_xy = glm::dvec2(ix + 1.0, jy + 1.0) * size + reach;
       if (glm::length(glm::dvec2(ix + 0.5, jy + 0.5) * size - eye) > range) continue;
       // Tiles where the region leaves no cover are never built.
       if (regionExcludesDisc(f.region, glm::dvec2(ix + 0.5, jy + 0.5) * size,
                              std::sqrt(0.5) * size))
         continue;
-      const glm::dvec3 box_min(min_xy, f.base_m), box_max(max_xy, top);
-      if (!keep(box_min, box_max)) continue;
-      const std::int64_t i = std::int64_t(ix), j = std::int64_t(jy);
-      const bool fine = detailed(box_min, box_max);
-      const auto tile = tileCache().get({key, i, j, fine}, [&] { return makeTile(f, i, j, fine); });
-      if (tile->ellipsoids.empty()) continue;
-      EllipsoidCloud cloud = *tile;
-      const glm::dvec3 drift(f.drift_m, 0.0);
-      for (Ellipsoid& e : cloud.ellipsoids) e.centre += drift;
-      cloud.drift_m = drift;
-      out.push_back(std::move(cloud));
+      const glm::dvec2 min_xy = glm::dvec2(ix, jy) * size - reach;
+      const glm::dvec2 max_xy = glm::dvec2(ix + 1.0, jy + 1.0) * size + reach;
+      visit(std::int64_t(ix), std::int64_t(jy), glm::dvec3(min_xy, f.base_m),
+            glm::dvec3(max_xy, top));
     }
+}
+
+// The heaps of the tiles around the camera (forTilesAround) that `keep` takes by their box,
+// drifted into place; `detailed` says from the box whether a tile's heaps are drawn with every
+// lobe.
+template <class Keep, class Detailed>
+std::vector<EllipsoidCloud> tilesAround(const CloudField& f, const Camera& camera,
+                                        const HeapDrawing& drawing, Keep keep, Detailed detailed) {
+  std::vector<EllipsoidCloud> out;
+  const std::string key = fieldKey(f);
+  forTilesAround(f, camera, drawing,
+                 [&](std::int64_t i, std::int64_t j, glm::dvec3 box_min, glm::dvec3 box_max) {
+                   if (!keep(box_min, box_max)) return;
+                   const bool fine = detailed(box_min, box_max);
+                   const auto tile =
+                       tileCache().get({key, i, j, fine}, [&] { return makeTile(f, i, j, fine); });
+                   if (tile->ellipsoids.empty()) return;
+                   EllipsoidCloud cloud = *tile;
+                   const glm::dvec3 drift(f.drift_m, 0.0);
+                   for (Ellipsoid& e : cloud.ellipsoids) e.centre += drift;
+                   cloud.drift_m = drift;
+                   out.push_back(std::move(cloud));
+                 });
   return out;
+}
+
+// Where a heap's precipitation falls (MODEL.md section 17): a shaft of a share of the heap's
+// radius, its axis moved downwind of the heap's by another share, where the upper wind carries
+// the falling precipitation out of the updraft; a cumulonimbus's updraft keeps a rain-free base
+// upwind of its shaft.
+struct ShaftShape {
+  double radius, offset;  // times the heap's radius
+};
+ShaftShape shaftShape(const CloudField& f) {
+  return isCb(f) ? ShaftShape{0.3, 0.2} : ShaftShape{0.5, 0.1};
 }
 
 }  // namespace
@@ -730,6 +800,32 @@ std::vector<EllipsoidCloud> fieldShadowClouds(const CloudField& f, const Camera&
   return tilesAround(
       f, camera, drawing, [](glm::dvec3, glm::dvec3) { return true; },
       [](glm::dvec3, glm::dvec3) { return false; });
+}
+
+std::vector<RainShaft> fieldRainShafts(const CloudField& f, const Camera& camera,
+                                       const HeapDrawing& drawing) {
+  std::vector<RainShaft> out;
+  const double sigma = precipitationExtinction(f.precipitation);
+  if (!(sigma > 0.0)) return out;
+  const ViewBasis basis = viewBasis(camera);
+  const ShaftShape shape = shaftShape(f);
+  const glm::dvec2 downwind = shearOf(f).direction * shearOf(f).amount;
+  forTilesAround(f, camera, drawing, [&](std::int64_t i, std::int64_t j, glm::dvec3, glm::dvec3) {
+    for (const HeapPlacement& heap : heapPlacements(f, i, j)) {
+      const double r = heapRadius(f) * heap.scale.size;
+      RainShaft shaft;
+      shaft.centre = glm::dvec2(heap.base) + f.drift_m + downwind * (shape.offset * r);
+      shaft.radius_m = shape.radius * r;
+      shaft.top_m = heap.base.z;
+      shaft.sigma = sigma;
+      // In its heap's shadow, lit by the sky alone, as the ground there (MODEL.md section 16).
+      shaft.colour = kGroundSkyShare * precipitationColour(f.precipitation.kind);
+      const glm::dvec3 lo(shaft.centre - shaft.radius_m, 0.0),
+          hi(shaft.centre + shaft.radius_m, shaft.top_m);
+      if (boxMayBeInView(basis, camera.position, lo, hi)) out.push_back(shaft);
+    }
+  });
+  return out;
 }
 
 namespace {
@@ -1041,6 +1137,7 @@ Scene withFieldClouds(const Scene& scene, const HeapDrawing& drawing) {
     if (field.coverage > 0.0 && planeSeenBeyond(scene.camera, field.base_m, range))
       out.layers.push_back(farDeck(field, range, sunDirection(scene.sun)));
   }
+  out.rain_shafts = rainShaftsInView(scene, drawing);
   out.fields.clear();
   return out;
 }

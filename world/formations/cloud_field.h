@@ -82,6 +82,8 @@ struct CloudField {
   // the world's wind profile when the scene is taken): heaps lean with it and a cumulonimbus's
   // anvil spreads along it (MODEL.md section 10).
   glm::dvec2 shear{0.0, 0.0};
+  // Its weather layer's rain or snow, falling in a shaft under each heap (MODEL.md section 17).
+  Precipitation precipitation{};
 
   // Heaps are a Boolean model (Poisson centres, random sizes): the fraction they cover is
   // 1 - exp(-density * mean footprint) for any coverage up to 1, but above this their
@@ -149,5 +151,11 @@ std::vector<EllipsoidCloud> fieldClouds(const CloudField& field, const Camera& c
 // eye.
 std::vector<EllipsoidCloud> fieldShadowClouds(const CloudField& field, const Camera& camera,
                                               const HeapDrawing& drawing = {});
+
+// The shafts of the field's precipitation under its heaps within heapRange of the camera whose
+// box (ground to base) the camera may see, drifted into place (MODEL.md section 17): none
+// without precipitation.
+std::vector<RainShaft> fieldRainShafts(const CloudField& field, const Camera& camera,
+                                       const HeapDrawing& drawing = {});
 
 }  // namespace nephele

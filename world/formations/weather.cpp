@@ -221,6 +221,7 @@ WeatherClouds weatherClouds(const WeatherLayer& w, const std::string& prefix, st
   field.seed = hashCounters(seed, 0x48656170ull);
   field.region = w.region;
   field.clusters = w.clusters;
+  field.precipitation = w.precipitation;
   out.fields.push_back(field);
   if (coverage > field.coverage) {
     const double deck = coverage >= 1.0 ? 1.0 : 1.0 - (1.0 - coverage) / (1.0 - field.coverage);
