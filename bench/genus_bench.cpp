@@ -385,6 +385,56 @@ void printCumulonimbusFigures(GlRenderer& renderer, const SceneFile& file, const
       under, under_px, face, face_px, under / std::max(face, 1e-9));
 }
 
+// Rain shafts (issue 47 item 5; MODEL.md section 17): the field's typical heap raining at 1, 4
+// and 25 mm/h, and a boat 40 m long on the ground behind its shaft's axis, seen level from 50 m
+// up 6 km before the axis on the other side. The boat's mean value in the visibility channel
+// (the GL's), against exp(-tau) on the ray through the boat's middle with tau the shaft's exact
+// optical depth; and the equivalent path tau / sigma against the Koschmieder range 3.912 /
+// sigma of the rate, the visibility the same rain would leave filling the air.
+void printRainFigures(GlRenderer& renderer, const SceneFile& file) {
+  const Scene world = World(file.scene, file.dynamics).scene();
+  if (world.fields.empty()) return;
+  CloudField field = world.fields.front();
+  const glm::dvec3 base(0.0, 0.0, field.base_m);
+  for (double rate : {1.0, 4.0, 25.0}) {
+    field.precipitation = {PrecipitationKind::kRain, rate, 0.0};
+    Scene scene = file.scene;
+    scene.weather.clear();
+    scene.fields.clear();
+    scene.layers.clear();
+    scene.haze.reset();
+    scene.clouds = {typicalHeap(field, base)};
+    const RainShaft shaft = heapRainShaft(field, base);
+    scene.rain_shafts = {shaft};
+    const glm::dvec3 boat(shaft.centre + glm::dvec2(0.0, shaft.radius_m + 500.0), 4.0);
+    Target target;
+    target.name = "boat";
+    target.centre = boat;
+    target.size = {20.0, 8.0, 4.0};
+    scene.targets = {target};
+    Camera& c = scene.camera;
+    c.width = 320, c.height = 240;
+    c.position = glm::dvec3(shaft.centre - glm::dvec2(0.0, 6000.0), 50.0);
+    c.orientation = {0.0, 0.0, 0.0};
+    c.vfov_deg = 2.0;
+    FrameRequest request;
+    request.channels = {Channel::kVisibility, Channel::kObjectId};
+    const Frame frame = renderer.renderFrame(scene, file.render, request);
+    double sum = 0.0;
+    int pixels = 0;
+    for (std::size_t i = 0; i < frame.visibility.size(); ++i)
+      if (frame.object_id[i] != 0) sum += frame.visibility[i], ++pixels;
+    const glm::dvec3 ray = boat - c.position;
+    const double tau = shaftOpticalDepth(shaft, c.position, glm::normalize(ray), glm::length(ray));
+    std::printf(
+        "  rain shaft at %.0f mm/h (radius %.0f m, sigma %.2e per m): boat behind it visibility "
+        "%.4f over %d px, exp(-tau) %.4f on its middle ray; path %.0f m in the shaft's core "
+        "equivalent, Koschmieder range %.0f m\n",
+        rate, shaft.radius_m, shaft.sigma, pixels > 0 ? sum / pixels : 0.0, pixels, std::exp(-tau),
+        tau / shaft.sigma, visibilityForExtinction(shaft.sigma));
+  }
+}
+
 // Fraction of the sky hemisphere seen from the ground whose coverage exceeds one half, from
 // the five upper faces of a cube map (each pixel weighted by its solid angle, proportional to
 // (1 + u^2 + v^2)^-3/2 on a face at unit distance), averaged over four places 20 km apart.
@@ -795,6 +845,7 @@ int main(int argc, char** argv) {
     printBodyFigures(renderer, file);
     printLightFigures(renderer, file, path.stem().string(), images);
     printCumulonimbusFigures(renderer, file, path.stem().string(), images);
+    if (path.stem() == "genus_cumulonimbus") printRainFigures(renderer, file);
     printShadowFigures(*platform, file, path.stem().string(), repeats, images);
   }
   if (!still_only &&

@@ -802,24 +802,29 @@ std::vector<EllipsoidCloud> fieldShadowClouds(const CloudField& f, const Camera&
       [](glm::dvec3, glm::dvec3) { return false; });
 }
 
+RainShaft heapRainShaft(const CloudField& f, glm::dvec3 base, double size) {
+  const ShaftShape shape = shaftShape(f);
+  const Shear shear = shearOf(f);
+  const double r = heapRadius(f) * size;
+  RainShaft shaft;
+  shaft.centre = glm::dvec2(base) + shear.direction * (shear.amount * shape.offset * r);
+  shaft.radius_m = shape.radius * r;
+  shaft.top_m = base.z;
+  shaft.sigma = precipitationExtinction(f.precipitation);
+  // In its heap's shadow, lit by the sky alone, as the ground there (MODEL.md section 16).
+  shaft.colour = kGroundSkyShare * precipitationColour(f.precipitation.kind);
+  return shaft;
+}
+
 std::vector<RainShaft> fieldRainShafts(const CloudField& f, const Camera& camera,
                                        const HeapDrawing& drawing) {
   std::vector<RainShaft> out;
-  const double sigma = precipitationExtinction(f.precipitation);
-  if (!(sigma > 0.0)) return out;
+  if (!(precipitationExtinction(f.precipitation) > 0.0)) return out;
   const ViewBasis basis = viewBasis(camera);
-  const ShaftShape shape = shaftShape(f);
-  const glm::dvec2 downwind = shearOf(f).direction * shearOf(f).amount;
   forTilesAround(f, camera, drawing, [&](std::int64_t i, std::int64_t j, glm::dvec3, glm::dvec3) {
     for (const HeapPlacement& heap : heapPlacements(f, i, j)) {
-      const double r = heapRadius(f) * heap.scale.size;
-      RainShaft shaft;
-      shaft.centre = glm::dvec2(heap.base) + f.drift_m + downwind * (shape.offset * r);
-      shaft.radius_m = shape.radius * r;
-      shaft.top_m = heap.base.z;
-      shaft.sigma = sigma;
-      // In its heap's shadow, lit by the sky alone, as the ground there (MODEL.md section 16).
-      shaft.colour = kGroundSkyShare * precipitationColour(f.precipitation.kind);
+      const RainShaft shaft =
+          heapRainShaft(f, heap.base + glm::dvec3(f.drift_m, 0.0), heap.scale.size);
       const glm::dvec3 lo(shaft.centre - shaft.radius_m, 0.0),
           hi(shaft.centre + shaft.radius_m, shaft.top_m);
       if (boxMayBeInView(basis, camera.position, lo, hi)) out.push_back(shaft);

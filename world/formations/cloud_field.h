@@ -157,5 +157,8 @@ std::vector<EllipsoidCloud> fieldShadowClouds(const CloudField& field, const Cam
 // without precipitation.
 std::vector<RainShaft> fieldRainShafts(const CloudField& field, const Camera& camera,
                                        const HeapDrawing& drawing = {});
+// The shaft under one heap of the field standing on `base` (world frame) at `size` times the
+// typical radius: a share of its radius wide, downwind of its middle with the shear.
+RainShaft heapRainShaft(const CloudField& field, glm::dvec3 base, double size = 1.0);
 
 }  // namespace nephele
