@@ -190,9 +190,11 @@ std::vector<Ellipsoid> cumulonimbusEllipsoids(const CloudField& f, glm::dvec3 ba
   // stem under a plate. The top ring joins the anvil and is kept at every distance, as the
   // anvil is: from above it widens the anvil's edge, and merged into the far mound the heaps
   // drew less cover than their measured footprint (0.444 against 0.463 over eight seeds).
-  // The rings are lit with the anvil they spread into (its part, MODEL.md section 14): in the
-  // tower's, they widened its envelope to the anvil's width, and the sunlit tower's face took
-  // its light through kilometres of it (0.149 of the sun's luminance against 0.3 and more).
+  // The upper rings are lit with the anvil they spread into (its part, MODEL.md section 14):
+  // in the tower's, they widened its envelope to the anvil's width, and the sunlit tower's face
+  // took its light through kilometres of it (0.149 of the sun's luminance, 0.41 without). The
+  // lowest, within the tower's width, stays with the tower: in the anvil's, its lobes showed
+  // as dark crescents between the sunlit tower's.
   constexpr int kRings = 3, kAround = 7;
   std::vector<Ellipsoid> rings, shoulder;
   const double turn = 2.0 * std::numbers::pi * u(11);
@@ -215,7 +217,7 @@ std::vector<Ellipsoid> cumulonimbusEllipsoids(const CloudField& f, glm::dvec3 ba
       // Body y (forward) along out_dir, pitched up by 10 to 25 degrees.
       lobe.orientation.heading_deg = headingAlong({out_dir.y, -out_dir.x});
       lobe.orientation.pitch_deg = 10.0 + 15.0 * u(15, k);
-      (ring + 1 < kRings ? rings : shoulder).push_back(lobe);
+      (ring == 0 ? tower : ring + 1 < kRings ? rings : shoulder).push_back(lobe);
     }
   }
   if (!detailed) {
