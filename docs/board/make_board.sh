@@ -34,6 +34,15 @@ shot cumulus_congestus side 40 --position 0,0,1000 --pitch 8 --vfov 30
 shot genus_cumulonimbus ground 40 --position 0,0,2 --pitch 15 --vfov 60
 shot genus_cumulonimbus side 40 --position 0,-10000,700 --pitch 12 --vfov 60
 shot genus_cumulonimbus above 40 --position 0,0,12900 --pitch -20 --vfov 60
+# The storm (issue 47): the raining cumulonimbus of storm.toml, the storm at (-8173, -8141),
+# from the ground 5 and 20 km south of it, from the side at 30 km and 3 km up, and from 15 km
+# up 18 km south; the cumulus field's shadows from 6 km straight-ish down; rain.toml's view.
+shot storm ground5 0 --position -8173,-13141,2 --pitch 28 --vfov 70
+shot storm ground20 0 --position -8173,-28141,2 --pitch 14 --vfov 40
+shot storm side30 0 --position -8173,-38141,3000 --pitch 6 --vfov 40
+shot storm above 0 --position -8173,-26000,15000 --pitch -30 --vfov 60
+shot genus_cumulus shadows 40 --position 0,0,6000 --pitch -50 --vfov 60
+shot rain own 0
 shot cloudscape ground 200 --position 0,0,2 --pitch 12 --vfov 60
 shot cloudscape side 200 --position 0,0,900 --pitch 2 --vfov 30
 shot cloudscape above 200 --position 0,0,4300 --pitch -20 --vfov 60
