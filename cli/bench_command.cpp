@@ -175,6 +175,9 @@ std::vector<Setting> settingsFor(const SceneFile& file) {
     for (int size : {0, 256, 2048})
       add("shadow_map_size", std::to_string(size),
           [size](RenderSettings& s) { s.shadow_map_size = size; });
+  // Sky planes' shadows (MODEL.md section 16, "sky planes"): left out.
+  if (!file.scene.layers.empty() || !file.scene.weather.empty())
+    add("plane_shadows", "false", [](RenderSettings& s) { s.plane_shadows = false; });
   // The frame's work budget (issue 31): the presets hold a few thousand ellipsoids in view, so
   // budgets below that show what thinning costs (the default, 65,536, changes none of them).
   if (!file.scene.clouds.empty() || !file.scene.fields.empty())

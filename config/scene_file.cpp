@@ -106,7 +106,8 @@ void readRender(TableReader& t, SceneFile& out) {
            "ellipsoid_overdraw",
            "heap_shading_rate",
            "heap_refresh",
-           "shadow_map_size"});
+           "shadow_map_size",
+           "plane_shadows"});
   out.render.texture_evaluation = TextureEvaluation(
       t.choice("texture", kTextureEvaluationNames, int(out.render.texture_evaluation)));
   out.render.term_filter =
@@ -137,6 +138,7 @@ void readRender(TableReader& t, SceneFile& out) {
   t.integer("heap_refresh", r.heap_refresh, int(Limits::kHeapRefresh.lo),
             int(Limits::kHeapRefresh.hi));
   t.integer("shadow_map_size", r.shadow_map_size, 0, int(Limits::kShadowMapSize.hi));
+  t.boolean("plane_shadows", r.plane_shadows);
   if (std::string error = validateRenderSettings(r); !error.empty())
     t.failAt(error.substr(0, error.find(':')), error.substr(error.find(':') + 2));
   out.reference.heaps = r.heaps;  // both renderers draw the same heaps

@@ -83,6 +83,9 @@ struct RenderSettings {
   // 0 draws no shadows), over the ground where the clouds' shadows fall, at most
   // ShadowMap::kMaxSide metres a side. Error against the exact shadow falls with its size.
   int shadow_map_size = 512;
+  // Sky planes' shadows on the planes and the ground below them (MODEL.md section 16, "sky
+  // planes"): each receiving pixel reads every plane above it once more. false leaves them out.
+  bool plane_shadows = true;
 
   // Automaton clouds: the view march's step in lattice spacings (the lattice holds
   // samples_per_cell samples per cell edge). Larger steps are faster and blur thin edges.

@@ -115,5 +115,28 @@ TEST(CloudShadowTest, EverySunGivesASunlightShareWithinZeroAndOne) {
   }
 }
 
+// The planes that cast (MODEL.md section 16, "sky planes"): the kMaxCastingPlanes lowest,
+// lowest first, none with the sun below kMinShadowElevationDeg; the sun's crossing of a plane.
+TEST(CloudShadowTest, TheLowestPlanesCastWhileTheSunIsUp) {
+  Scene scene;
+  for (int i = 0; i < kMaxCastingPlanes + 2; ++i) {
+    CloudLayer layer;
+    layer.altitude_m = 1000.0 * double((7 * i) % (kMaxCastingPlanes + 2)) + 500.0;
+    scene.layers.push_back(layer);
+  }
+  scene.sun.elevation_deg = 30.0;
+  const std::vector<std::size_t> casting = castingPlanes(scene);
+  ASSERT_EQ(casting.size(), std::size_t(kMaxCastingPlanes));
+  for (std::size_t k = 0; k < casting.size(); ++k)
+    EXPECT_EQ(scene.layers[casting[k]].altitude_m, 1000.0 * double(k) + 500.0);
+  scene.sun.elevation_deg = 0.5 * kMinShadowElevationDeg;
+  EXPECT_TRUE(castingPlanes(scene).empty());
+  // From a point 1 km under a plane, with the sun 45 degrees up in the east, 1 km east.
+  const glm::dvec2 q =
+      sunCrossing({10.0, 20.0, 500.0}, 1500.0, glm::normalize(glm::dvec3(1.0, 0.0, 1.0)));
+  EXPECT_NEAR(q.x, 1010.0, 1e-9);
+  EXPECT_NEAR(q.y, 20.0, 1e-9);
+}
+
 }  // namespace
 }  // namespace nephele

@@ -94,6 +94,33 @@ void expectPointSampledEqual(GlRenderer& renderer, const Scene& scene, const std
   EXPECT_LE(worst, 2e-3f) << name;
 }
 
+// Sky planes shadow what lies below them (MODEL.md section 16, "sky planes"): a stratocumulus
+// deck and the ground under an altocumulus layer, seen from between the two looking down, so
+// that the upper layer shows only by its shadows. Equal to the one-sample reference; without
+// the upper layer the view is brighter wherever it differs, and differs.
+TEST_F(GlRenderTest, SkyPlanesShadowTheDeckAndTheGroundBelow) {
+  SceneFile file = preset("genus_stratocumulus", 160, 90);
+  Scene& scene = file.scene;
+  for (const CloudLayer& layer : preset("genus_altocumulus", 160, 90).scene.layers)
+    scene.layers.push_back(layer);
+  scene.camera.position = {0.0, 0.0, 2500.0};
+  scene.camera.orientation = {30.0, -40.0, 0.0};
+  scene.camera.vfov_deg = 50.0;
+  expectPointSampledEqual(*renderer_, scene, "plane_shadows");
+  Scene lone = scene;
+  std::erase_if(lone.layers, [&](const CloudLayer& l) { return l.altitude_m > 2500.0; });
+  ASSERT_LT(lone.layers.size(), scene.layers.size());
+  const FloatImage shadowed = renderer_->renderFloat(scene, pointSampled());
+  const FloatImage lit = renderer_->renderFloat(lone, pointSampled());
+  float darkest = 0.0f, brightest = 0.0f;
+  for (std::size_t i = 0; i < lit.rgba.size(); ++i) {
+    darkest = std::max(darkest, lit.rgba[i] - shadowed.rgba[i]);
+    brightest = std::max(brightest, shadowed.rgba[i] - lit.rgba[i]);
+  }
+  EXPECT_GT(darkest, 0.05f);
+  EXPECT_LE(brightest, 1e-5f);
+}
+
 // Lattice breaking (rotated, jittered components; MODEL.md section 2) as the weather mapping
 // draws altocumulus: exact against the one-sample reference. The renderer's texture state
 // follows the jitter: after the same layer without it, the jittered one is drawn right again.

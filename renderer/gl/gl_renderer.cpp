@@ -15,6 +15,7 @@
 #include "renderer/reference/reference_renderer.h"
 #include "renderer/renderer.h"
 #include "world/check.h"
+#include "world/formations/cloud_shadow.h"
 #include "world/shading.h"
 #include "world/textures/layer_texture.h"
 #include "world/textures/texture_table.h"
@@ -401,8 +402,8 @@ GLuint GlRenderer::gpuTexture(CachedTexture& cached, const RenderSettings& setti
   return t;
 }
 
-void GlRenderer::setSlotUniforms(GLuint p, int slot, const LayerSlot& entry, const Scene& scene,
-                                 const RenderSettings& settings) {
+void GlRenderer::setSlotUniforms(GLuint p, int slot, int unit, const LayerSlot& entry,
+                                 const Scene& scene, const RenderSettings& settings) {
   const CloudLayer& layer = *entry.layer;
   const LayerTexture& texture = *entry.texture->source;
   const Camera& camera = scene.camera;
@@ -474,17 +475,27 @@ void GlRenderer::setSlotUniforms(GLuint p, int slot, const LayerSlot& entry, con
     gl_.ProgramUniform1f(p, location("u_clip_constant", slot), float(c.constant));
   }
   if (entry.kind != LayerKind::kProceduralGardner) {
-    gl_.BindTextureUnit(GLuint(slot), entry.kind == LayerKind::kClipmapGardner
+    gl_.BindTextureUnit(GLuint(unit), entry.kind == LayerKind::kClipmapGardner
                                           ? entry.clipmap.texture
                                           : gpuTexture(*entry.texture, settings));
     const std::string sampler = "u_table" + std::to_string(slot);
-    gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, sampler.c_str()), slot);
+    gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, sampler.c_str()), unit);
   }
 }
 
 void GlRenderer::drawSkyPass(const Scene& scene, const RenderSettings& settings,
-                             const SkyPassLayout& layout, const std::vector<LayerSlot>& slots,
+                             const SkyPassLayout& drawn, const std::vector<LayerSlot>& slots,
                              const std::vector<glm::vec2>& polygon) {
+  // The casting planes above the lowest plane the pass draws (the ground with the background).
+  SkyPassLayout layout = drawn;
+  double lowest = layout.background ? 0.0 : std::numeric_limits<double>::infinity();
+  for (const LayerSlot& slot : slots) lowest = std::min(lowest, slot.layer->altitude_m);
+  std::vector<const LayerSlot*> casting;
+  for (const LayerSlot& caster : casters_)
+    if (caster.layer->altitude_m > lowest) {
+      casting.push_back(&caster);
+      layout.casters.push_back(caster.kind);
+    }
   const GLuint p = program(layout);
   gl_.UseProgram(p);
   const Camera& camera = scene.camera;
@@ -502,9 +513,11 @@ void GlRenderer::drawSkyPass(const Scene& scene, const RenderSettings& settings,
                          float(std::max(slope, 1e-12)));
   }
   if (layout.shadows) shadow_map_.bind(p, 11, camera.position);
-  if (!slots.empty()) uniform3("u_to_sun", sunDirection(scene.sun));
+  if (!slots.empty() || !casting.empty()) uniform3("u_to_sun", sunDirection(scene.sun));
   for (std::size_t i = 0; i < slots.size(); ++i)
-    setSlotUniforms(p, int(i), slots[i], scene, settings);
+    setSlotUniforms(p, int(i), int(i), slots[i], scene, settings);
+  for (std::size_t c = 0; c < casting.size(); ++c)
+    setSlotUniforms(p, int(slots.size() + c), kCasterUnit + int(c), *casting[c], scene, settings);
   gl_.ProgramUniform2fv(p, gl_.GetUniformLocation(p, "u_polygon"), GLsizei(polygon.size()),
                         &polygon[0].x);
   gl_.DrawArrays(GL_TRIANGLE_FAN, 0, GLsizei(polygon.size()));
@@ -740,6 +753,14 @@ void GlRenderer::drawScene(const Scene& scene, const RenderSettings& settings,
   std::sort(below.begin(), below.end(), [](const LayerSlot& a, const LayerSlot& b) {
     return a.layer->altitude_m < b.layer->altitude_m;
   });
+  // The casting planes, taken before the hidden layers leave the passes: a layer behind a
+  // full deck still shadows what lies below it.
+  casters_.clear();
+  for (std::size_t index :
+       settings.plane_shadows ? castingPlanes(scene) : std::vector<std::size_t>{})
+    for (const std::vector<LayerSlot>* side : {&above, &below})
+      for (const LayerSlot& slot : *side)
+        if (slot.layer == &scene.layers[index]) casters_.push_back(slot);
   // A layer that no texture value leaves translucent (opaque at T = 0, the least T, since
   // eq. 9's translucence falls as T rises; no region or far cover to thin it: a full deck)
   // hides every layer beyond it on its side of the camera, exactly. Those are left out of the
@@ -788,6 +809,16 @@ void GlRenderer::drawScene(const Scene& scene, const RenderSettings& settings,
   if (baked) {
     gl_.BindFramebuffer(GL_FRAMEBUFFER, framebuffer_.get());
     gl_.Viewport(0, 0, camera.width, camera.height);
+  }
+
+  // A casting plane reads the clipmap its drawn slot filled, or, left out of the passes, its
+  // sines.
+  for (LayerSlot& caster : casters_) {
+    if (caster.kind != LayerKind::kClipmapGardner) continue;
+    caster.kind = LayerKind::kProceduralGardner;
+    for (const std::vector<LayerSlot>* side : {&above, &below})
+      for (const LayerSlot& slot : *side)
+        if (slot.layer == caster.layer) caster = slot;
   }
 
   // Interleave clouds with the layers (docs/MODEL.md, "Compositing order"). On each side of

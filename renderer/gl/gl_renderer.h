@@ -107,8 +107,9 @@ class GlRenderer {
                     bool background, bool targets);
   void drawSkyPass(const Scene& scene, const RenderSettings& settings, const SkyPassLayout& layout,
                    const std::vector<LayerSlot>& slots, const std::vector<glm::vec2>& polygon);
-  void setSlotUniforms(GLuint program, int slot, const LayerSlot& layer, const Scene& scene,
-                       const RenderSettings& settings);
+  // Slot `slot` of the program's arrays, its table on texture unit `unit`.
+  void setSlotUniforms(GLuint program, int slot, int unit, const LayerSlot& layer,
+                       const Scene& scene, const RenderSettings& settings);
   void prepareTarget(int width, int height, TargetFormat format);
   bool allocateTarget(int width, int height, TargetFormat format);
   void readPixels(int width, int height, GLenum type, void* out) const;
@@ -124,6 +125,10 @@ class GlRenderer {
   int target_height_ = 0;
   TargetFormat target_format_ = TargetFormat::kFloat;
   std::map<std::string, GlObject> programs_;
+  // The frame's layers that cast shadows (castingPlanes; MODEL.md section 16, "sky planes"):
+  // every sky pass evaluates them above its planes and the ground.
+  std::vector<LayerSlot> casters_;
+  static constexpr int kCasterUnit = 16;  // their tables' texture units, up from here
   std::string continuous_view_;
   std::map<std::string, CachedTexture> textures_;
   std::uint64_t frame_ = 0;  // frames drawn

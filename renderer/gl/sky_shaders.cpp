@@ -245,15 +245,23 @@ uniform float u_horizon_slope;  // |gradient of r.z| per pixel
 layout(binding = 11) uniform sampler2D u_shadow_map;
 uniform vec2 u_shadow_centre;
 uniform float u_shadow_half;
+#endif
+// The sky planes' share of the sunlight at this pixel's ground point (planesSunlight), set by
+// main before background() where planes cast shadows.
+float g_planes_sun = 1.0;
 vec3 groundColour(vec3 d) {
+  float sun = g_planes_sun;
+#ifdef SHADOWS
   vec2 uv = (d.xy * (u_camera_z / -d.z) - u_shadow_centre) / (2.0 * u_shadow_half) + 0.5;
   float edge = 2.0 * max(abs(uv.x - 0.5), abs(uv.y - 0.5));
-  float sun = mix(texture(u_shadow_map, uv).r, 1.0, smoothstep(0.9, 1.0, edge));
-  return u_ground * (kGroundSkyShare + (1.0 - kGroundSkyShare) * sun);
-}
-#else
-vec3 groundColour(vec3 d) { return u_ground; }
+  sun *= mix(texture(u_shadow_map, uv).r, 1.0, smoothstep(0.9, 1.0, edge));
 #endif
+#if defined(SHADOWS) || defined(PLANE_SHADOWS)
+  return u_ground * (kGroundSkyShare + (1.0 - kGroundSkyShare) * sun);
+#else
+  return u_ground;
+#endif
+}
 
 vec3 background(vec3 r) {
   vec3 d = normalize(r);
@@ -275,7 +283,6 @@ vec3 background(vec3 r) {
 )";
 
 const char* kLayers = R"(
-const int kSlots = 8;
 uniform float u_height[kSlots];     // layer altitude minus camera altitude, never 0
 uniform vec3 u_colour[kSlots];      // layer colour times sun colour
 uniform vec4 u_shading[kSlots];     // Gardner eq. 8: ambient a, texture t, specular s, shininess e
@@ -301,9 +308,9 @@ struct LayerHit {
   float distance;
 };
 
-// Hit of the view ray on slot i's plane; the caller has checked that the ray meets it.
-LayerHit hitLayer(int i, vec3 r) {
-  float h = u_height[i];
+// Hit of the view ray on the plane h metres above the camera (slot i's: hitLayer); the caller
+// has checked that the ray meets it.
+LayerHit hitPlane(float h, vec3 r) {
   // Near the horizon keep the hit finite; its footprint is then far too large for any term.
   float rz = sign(h) * max(abs(r.z), 1e-6 * length(r));
   LayerHit hit;
@@ -315,6 +322,7 @@ LayerHit hitLayer(int i, vec3 r) {
   hit.distance = (h / rz) * length(r);
   return hit;
 }
+LayerHit hitLayer(int i, vec3 r) { return hitPlane(u_height[i], r); }
 
 vec2 layerCoordinate(int i, LayerHit hit) { return u_origin[i] + hit.p * u_inv_period[i]; }
 
@@ -459,12 +467,20 @@ float layerThreshold(int i, vec3 r, vec2 p) {
 float layerThreshold(int i, vec3 r, vec2 p) { return u_threshold[i]; }
 #endif
 
+#ifdef PLANE_SHADOWS
+// The share of the sunlight the sky planes above a point let through (MODEL.md section 16,
+// "sky planes"), the point `hit` on the plane `height` metres above the camera; generated
+// with the casting slots (skyFragmentSource).
+float planesSunlight(LayerHit hit, float height);
+#endif
+
 // Slot i's surface under what lies in front of it: layers are composited nearest first, so
 // `colour` holds the premultiplied sum of the surfaces in front and `transmittance` what they
 // let through ("over" summed front to back, the same sum as back to front).
 void composite(int i, vec3 r, LayerHit hit, float t1, float it, inout vec3 colour,
                inout float transmittance) {
   float tr = translucence(it - t1, u_transition[i]);  // Gardner eq. 9
+  if (tr >= 1.0) return;                                // clear here: nothing to add
   vec3 normal = vec3(0.0, 0.0, u_height[i] > 0.0 ? -1.0 : 1.0);  // turned towards the viewer
   float n_dot_l = dot(normal, u_to_sun);
   float highlight = 0.0;
@@ -479,6 +495,9 @@ void composite(int i, vec3 r, LayerHit hit, float t1, float it, inout vec3 colou
   if (u_far[i].y > 0.0) diffuse = sphereDiffuse(dot(u_to_sun, -normalize(r)));
 #endif
   vec3 surface = gardnerIntensity(u_shading[i], diffuse, highlight, it) * u_colour[i];
+#ifdef PLANE_SHADOWS
+  surface *= kGroundSkyShare + (1.0 - kGroundSkyShare) * planesSunlight(hit, u_height[i]);
+#endif
 #ifdef AIR
   surface = applyAir(surface, normalize(r), hit.distance);
 #endif
@@ -487,23 +506,43 @@ void composite(int i, vec3 r, LayerHit hit, float t1, float it, inout vec3 colou
 }
 )";
 
-std::string slotStatement(int slot, LayerKind kind) {
+// The expression for slot `slot`'s texture value at `hit`.
+std::string slotValue(int slot, LayerKind kind, const std::string& hit) {
   const std::string i = std::to_string(slot);
-  std::string value;
   switch (kind) {
     case LayerKind::kBakedGardner:
-      value = "bakedValue(u_table" + i + ", " + i + ", hit)";
-      break;
+      return "bakedValue(u_table" + i + ", " + i + ", " + hit + ")";
     case LayerKind::kTable:
-      value = "tableValue(u_table" + i + ", " + i + ", hit)";
-      break;
+      return "tableValue(u_table" + i + ", " + i + ", " + hit + ")";
     case LayerKind::kProceduralGardner:
-      value = "proceduralValue(" + i + ", hit)";
-      break;
+      return "proceduralValue(" + i + ", " + hit + ")";
     case LayerKind::kClipmapGardner:
-      value = "clipmapValue(u_table" + i + ", " + i + ", hit)";
-      break;
+      return "clipmapValue(u_table" + i + ", " + i + ", " + hit + ")";
   }
+  return "0.0";
+}
+
+// A casting slot's share of the sunlight at a point below it: its translucence (Gardner eq. 9)
+// where the sun's ray through the point crosses its plane (MODEL.md section 16, "sky planes").
+// Its threshold takes the sun's direction as the view's, for a far deck's cover. The term
+// filter reads the texture over the receiving pixel's footprint or, where wider, the shadow's
+// penumbra: the sun's disc, 0.0093 radians across, seen over the distance to the plane.
+std::string casterFunction(int caster, int slot, LayerKind kind) {
+  const std::string c = std::to_string(caster), i = std::to_string(slot);
+  return "float casterSunlight" + c + "(LayerHit hit, float height) {\n" +
+         "  float rise = u_height[" + i + "] - height;\n" + "  if (!(rise > 0.0)) return 1.0;\n" +
+         "  hit.p += (rise / u_to_sun.z) * u_to_sun.xy;\n" + "  float t1 = layerThreshold(" + i +
+         ", u_to_sun, hit.p);\n" + "  if (t1 >= 1.0) return 1.0;\n" +
+         "  float penumbra = 0.0093 * rise / u_to_sun.z;\n" +
+         "  if (length(hit.dpdx) < penumbra) hit.dpdx = vec2(penumbra, 0.0);\n" +
+         "  if (length(hit.dpdy) < penumbra) hit.dpdy = vec2(0.0, penumbra);\n" +
+         "  return translucence(" + slotValue(slot, kind, "hit") + " - t1, u_transition[" + i +
+         "]);\n}\n";
+}
+
+std::string slotStatement(int slot, LayerKind kind) {
+  const std::string i = std::to_string(slot);
+  const std::string value = slotValue(slot, kind, "hit");
   // Behind a surface that is opaque to within 1/1024 nothing more is evaluated (what the
   // layers there could add is below half an 8-bit step): a full deck costs its nearest plane.
   // Nor is the texture where the threshold is 1 or more, since T <= 1 (MODEL.md section 2)
@@ -537,6 +576,8 @@ std::string SkyPassLayout::key() const {
   k += targets ? 't' : '-';
   k += regions ? 'r' : '-';
   k += shadows ? 'h' : '-';
+  k += '/';
+  for (LayerKind kind : casters) k += char('a' + int(kind));
   return k;
 }
 
@@ -547,6 +588,7 @@ std::string viewShaderSource() {
 std::string clipmapBakeSource() {
   std::string s = "#version 450 core\n#define PROCEDURAL\n";
   s += "const int kComponents = " + std::to_string(GardnerTextureParams::kComponents) + ";\n";
+  s += "const int kSlots = 1;\n";
   s += commonSource();
   s += kLayers;
   // Slot 0's phases are taken at the corner of the ring's window (lattice index `first` in
@@ -578,14 +620,15 @@ std::string skyFragmentSource(const SkyPassLayout& layout) {
   if (layout.specular) s += "#define SPECULAR\n";
   if (layout.targets) s += "#define TARGETS\n";
   if (layout.regions) s += "#define REGIONS\n";
-  if (layout.shadows && layout.background) {
-    s += "#define SHADOWS\n";
+  if (layout.shadows && layout.background) s += "#define SHADOWS\n";
+  if (!layout.casters.empty()) s += "#define PLANE_SHADOWS\n";
+  if ((layout.shadows && layout.background) || !layout.casters.empty())
     s += "const float kGroundSkyShare = " + std::to_string(kGroundSkyShare) + ";\n";
-  }
   if (layout.term_filter == TermFilter::kCut) s += "#define FILTER_CUT\n";
   if (layout.term_filter == TermFilter::kNone) s += "#define FILTER_NONE\n";
   bool procedural = false, clipmap = false;
-  for (const auto* side : {&layout.above, &layout.below})
+  // Slots 0 .. slots() - 1 are drawn; the casters follow them.
+  for (const auto* side : {&layout.above, &layout.below, &layout.casters})
     for (LayerKind kind : *side) {
       procedural |= kind == LayerKind::kProceduralGardner;
       clipmap |= kind == LayerKind::kClipmapGardner;
@@ -593,18 +636,28 @@ std::string skyFragmentSource(const SkyPassLayout& layout) {
   if (procedural) s += "#define PROCEDURAL\n";
   if (clipmap) s += "#define CLIPMAP\n";
   s += "const int kComponents = " + std::to_string(GardnerTextureParams::kComponents) + ";\n";
+  const int slots = layout.slots() + int(layout.casters.size());
+  s += "const int kSlots = " + std::to_string(std::max(slots, 1)) + ";\n";
   s += commonSource();
-  if (layout.slots() > 0) s += kLayers;
+  if (slots > 0) s += kLayers;
   // One sampler uniform per sampled slot: llvmpipe samples a sampler-array element far more
   // slowly.
   int slot = 0;
-  for (const auto* side : {&layout.above, &layout.below})
+  for (const auto* side : {&layout.above, &layout.below, &layout.casters})
     for (LayerKind kind : *side) {
       const std::string name = " u_table" + std::to_string(slot++) + ";\n";
       if (kind == LayerKind::kClipmapGardner) s += "uniform sampler2DArray" + name;
       if (kind == LayerKind::kBakedGardner || kind == LayerKind::kTable)
         s += "uniform sampler2D" + name;
     }
+  if (!layout.casters.empty()) {
+    std::string product = "1.0";
+    for (std::size_t c = 0; c < layout.casters.size(); ++c) {
+      s += casterFunction(int(c), layout.slots() + int(c), layout.casters[c]);
+      product += " * casterSunlight" + std::to_string(c) + "(hit, height)";
+    }
+    s += "float planesSunlight(LayerHit hit, float height) { return " + product + "; }\n";
+  }
 
   s += "const float kClear = 1.0 / 1024.0;\n";
   s += "void main() {\n  vec3 r = viewRay();\n";
@@ -631,6 +684,9 @@ std::string skyFragmentSource(const SkyPassLayout& layout) {
     s += "  }\n";
   }
   if (layout.background) {
+    if (!layout.casters.empty())  // the ground, where the layers in front let it show
+      s += "  if (r.z < 0.0 && transmittance > kClear) g_planes_sun = "
+           "planesSunlight(hitPlane(-u_camera_z, r), -u_camera_z);\n";
     s += "  vec3 behind = background(r);\n";
     if (layout.targets) s += "  if (target_distance < kFar) behind = targetColour();\n";
     s += "  colour += transmittance * behind;\n";

@@ -30,6 +30,9 @@ struct SkyPassLayout {
   bool targets = false;  // opaque targets were drawn first (their colour and distance)
   bool regions = false;  // some layer lies in a bounded region (region.h)
   bool shadows = false;  // the ground takes the clouds' shadows from the shadow map
+  // Layers whose shadows fall on the ground and the slots' planes (MODEL.md section 16, "sky
+  // planes"), as slots slots() onwards: every layer of the frame while the sun is up.
+  std::vector<LayerKind> casters;
 
   int slots() const { return int(above.size() + below.size()); }
   std::string key() const;

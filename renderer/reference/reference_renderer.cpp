@@ -97,9 +97,11 @@ class ReferenceTracer {
     double nearest_opaque =
         std::min(direction.z < 0.0 ? eye.z / -direction.z : kInfinity, max_distance);
     glm::dvec3 colour = skyBackground(scene_.sky, direction);
-    if (direction.z < 0.0 && shadows_ && !shadows_->empty()) {
+    if (direction.z < 0.0 && ((shadows_ && !shadows_->empty()) || !casting_.empty())) {
       const glm::dvec3 ground = eye + (eye.z / -direction.z) * direction;
-      colour *= groundLight(shadows_->sunlight(glm::dvec2(ground)));
+      double sun = planesSunlight({ground.x, ground.y, 0.0});
+      if (shadows_ && !shadows_->empty()) sun *= shadows_->sunlight(glm::dvec2(ground));
+      colour *= groundLight(sun);
     }
     int object_id = 0;
     for (std::size_t t = 0; t < scene_.targets.size(); ++t) {
@@ -193,7 +195,30 @@ class ReferenceTracer {
         layer.far.side_ratio > 0.0
             ? gardnerIntensity(layer.shading, sphereDiffuse(glm::dot(sun_, -direction)), 0.0, t)
             : gardnerIntensity(layer.shading, t, {0.0, 0.0, 1.0}, sun_, -direction);
-    return {s, withAir(intensity * layer.colour * scene_.sun.colour, direction, s), 1.0 - tr, s};
+    const double shadow =
+        casting_.empty() ? 1.0 : groundLight(planesSunlight({p.x, p.y, layer.altitude_m}));
+    return {s, withAir(shadow * intensity * layer.colour * scene_.sun.colour, direction, s),
+            1.0 - tr, s};
+  }
+
+  // The share of the sunlight the casting planes above p let through (MODEL.md section 16,
+  // "sky planes"): each plane's translucence where the sun's ray through p crosses it, its
+  // threshold taken with the sun's direction as the view's (a far deck's cover). p.z is the
+  // receiving plane's own altitude (0 for the ground), so that a plane never shadows itself.
+  double planesSunlight(glm::dvec3 p) const {
+    double light = 1.0;
+    const glm::dvec2 eye(scene_.camera.position);
+    for (std::size_t i : casting_) {
+      const CloudLayer& layer = scene_.layers[i];
+      if (!(layer.altitude_m > p.z)) continue;
+      const glm::dvec2 q = sunCrossing(p, layer.altitude_m, sun_);
+      const double base =
+          layer.far.side_ratio > 0.0 ? farThreshold(layer.far, sun_) : layer.threshold;
+      const double t1 = regionThreshold(base, layerRegionWeight(layer, q, scene_.time_s, eye));
+      if (t1 >= 1.0) continue;
+      light *= skyPlaneTranslucence(textures_[i].value(q, scene_.time_s), t1, layer.transition);
+    }
+    return light;
   }
 
   Surface ellipsoidSurface(const EllipsoidEntry& entry, glm::dvec3 direction, double s) const {
@@ -296,6 +321,7 @@ class ReferenceTracer {
   std::vector<EllipsoidEntry> ellipsoids_;
   Veil veil_;
   std::optional<Fog> layer_veil_ = inLayerVeil(scene_);  // the camera's, once per frame
+  std::vector<std::size_t> casting_ = castingPlanes(scene_);
   PrecipitationMedia precipitation_ = precipitationMedia(scene_);
 };
 

@@ -92,6 +92,17 @@ double casterSunlight(const ShadowCaster& caster, const ShadowTable& table, glm:
   return 1.0 - meanOpacity(table, g) * (1.0 - diffuseTransmittance(caster.extinction * chord));
 }
 
+std::vector<std::size_t> castingPlanes(const Scene& scene) {
+  std::vector<std::size_t> out;
+  if (!(scene.sun.elevation_deg >= kMinShadowElevationDeg)) return out;
+  for (std::size_t i = 0; i < scene.layers.size(); ++i) out.push_back(i);
+  std::stable_sort(out.begin(), out.end(), [&](std::size_t a, std::size_t b) {
+    return scene.layers[a].altitude_m < scene.layers[b].altitude_m;
+  });
+  if (out.size() > std::size_t(kMaxCastingPlanes)) out.resize(std::size_t(kMaxCastingPlanes));
+  return out;
+}
+
 double shadowRange(double camera_z) {
   constexpr double kMin = 24000.0;
   double range = kMin;
@@ -100,7 +111,7 @@ double shadowRange(double camera_z) {
 }
 
 CloudShadows::CloudShadows(const Scene& scene, const HeapDrawing& heaps, bool lookups) {
-  if (!(scene.sun.elevation_deg >= 1.0)) return;
+  if (!(scene.sun.elevation_deg >= kMinShadowElevationDeg)) return;
   to_sun_ = sunDirection(scene.sun);
   std::map<std::string, int> table_of;
   auto add = [&](const EllipsoidCloud& cloud) {

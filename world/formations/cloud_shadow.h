@@ -37,6 +37,21 @@ inline double groundLight(double sunlight) {
   return kGroundSkyShare + (1.0 - kGroundSkyShare) * sunlight;
 }
 
+// Below this elevation of the sun no cloud casts a shadow: the ground is lit by the sky alone,
+// and a shadow would reach 60 times a cloud's height.
+inline constexpr double kMinShadowElevationDeg = 1.0;
+
+// Sky planes cast shadows too (MODEL.md section 16, "sky planes"): a point below a plane keeps
+// the plane's translucence where the sun's ray through the point crosses it. The planes that
+// cast, the kMaxCastingPlanes lowest of the scene's layers while the sun is up: indices into
+// scene.layers, lowest first.
+inline constexpr int kMaxCastingPlanes = 8;
+std::vector<std::size_t> castingPlanes(const Scene& scene);
+// Where the sun's ray through p crosses the plane Z = altitude (above p; to_sun rising).
+inline glm::dvec2 sunCrossing(glm::dvec3 p, double altitude, glm::dvec3 to_sun) {
+  return glm::dvec2(p) + ((altitude - p.z) / to_sun.z) * glm::dvec2(to_sun);
+}
+
 // How far from the camera's ground point shadows are drawn: 24 km, doubled until it is at
 // least 4 times the camera's height (a high camera sees the ground farther out), at most 64
 // times. The GL's map is a square of twice this side (ShadowMap).
@@ -62,9 +77,8 @@ double casterSunlight(const ShadowCaster& caster, const ShadowTable& table, glm:
 // light_extinction above 0 (heap light, MODEL.md section 14) and the heaps of its fields within
 // heap range of the camera, in view or not, but no farther than the shadows they can cast
 // within shadowRange (a heap at height h shadows h / tan(elevation) downsun of itself), drawn
-// coarse (a shadow has no use for the detail lobes). None while the sun is below 1 degree of
-// elevation (the ground is then lit by the sky alone, and a shadow would reach 60 times a cloud's
-// height).
+// coarse (a shadow has no use for the detail lobes). None while the sun is below
+// kMinShadowElevationDeg.
 class CloudShadows {
  public:
   CloudShadows() = default;  // none
