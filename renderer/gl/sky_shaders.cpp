@@ -311,8 +311,9 @@ struct LayerHit {
 // Hit of the view ray on the plane h metres above the camera (slot i's: hitLayer); the caller
 // has checked that the ray meets it.
 LayerHit hitPlane(float h, vec3 r) {
-  // Near the horizon keep the hit finite; its footprint is then far too large for any term.
-  float rz = sign(h) * max(abs(r.z), 1e-6 * length(r));
+  // Near the horizon keep the hit finite; its footprint is then far too large for any term. The
+  // ground from a camera on it (h = 0) is hit at the eye.
+  float rz = (h < 0.0 ? -1.0 : 1.0) * max(abs(r.z), 1e-6 * length(r));
   LayerHit hit;
   hit.p = (h / rz) * r.xy;
   // Exact derivatives of the hit point per pixel (the plane's perspective Jacobian).

@@ -95,7 +95,8 @@ double casterSunlight(const ShadowCaster& caster, const ShadowTable& table, glm:
 std::vector<std::size_t> castingPlanes(const Scene& scene) {
   std::vector<std::size_t> out;
   if (!(scene.sun.elevation_deg >= kMinShadowElevationDeg)) return out;
-  for (std::size_t i = 0; i < scene.layers.size(); ++i) out.push_back(i);
+  for (std::size_t i = 0; i < scene.layers.size(); ++i)
+    if (!(scene.layers[i].far.side_ratio > 0.0)) out.push_back(i);
   std::stable_sort(out.begin(), out.end(), [&](std::size_t a, std::size_t b) {
     return scene.layers[a].altitude_m < scene.layers[b].altitude_m;
   });

@@ -43,8 +43,10 @@ inline constexpr double kMinShadowElevationDeg = 1.0;
 
 // Sky planes cast shadows too (MODEL.md section 16, "sky planes"): a point below a plane keeps
 // the plane's translucence where the sun's ray through the point crosses it. The planes that
-// cast, the kMaxCastingPlanes lowest of the scene's layers while the sun is up: indices into
-// scene.layers, lowest first.
+// cast, the kMaxCastingPlanes lowest of the scene's layers but far decks while the sun is up:
+// indices into scene.layers, lowest first. A far deck stands for heaps, whose shadows are the
+// shadow map's within its range (CloudShadows); as a plane, its opaque cover cast shadows darker
+// than the heaps' beyond it.
 inline constexpr int kMaxCastingPlanes = 8;
 std::vector<std::size_t> castingPlanes(const Scene& scene);
 // Where the sun's ray through p crosses the plane Z = altitude (above p; to_sun rising).
