@@ -308,6 +308,54 @@ TEST_F(GlRenderTest, CloudShadowsMatchTheReference) {
   }
 }
 
+// Heaps' shadows on a deck below them (MODEL.md section 16, "planes under heaps"): the cumulus
+// field over an opaque deck at 600 m, from above, so that every shadow in view falls on the
+// deck: the GL's map read where the sun's ray through the deck lands, against the reference's
+// exact sunlight there. Over the pixels no heap covers (in a render without the deck), a pixel
+// is shadowed where its luminance is under 0.65 of the unshadowed GL's (kShadowedRatio, as
+// shadowAgreement counts the ground's): at least 90 % of either's shadowed pixels are the
+// other's, and the ratios differ by 0.03 on average.
+TEST_F(GlRenderTest, HeapShadowsFallOnADeckBelowThem) {
+  SceneFile file = preset("genus_cumulus", 200, 150);
+  file.scene.camera.position = {0.0, 0.0, 6000.0};
+  file.scene.camera.orientation.pitch_deg = -60.0;
+  const FloatImage heaps = renderer_->renderFloat(file.scene, pointSampled());
+  CloudLayer deck = preset("genus_stratocumulus").scene.layers.at(0);
+  deck.altitude_m = 600.0;
+  deck.threshold = -0.5;  // opaque everywhere: the ground is hidden
+  deck.transition = 0.1;
+  file.scene.layers.push_back(deck);
+  const FloatImage gl = renderer_->renderFloat(file.scene, pointSampled());
+  RenderSettings none = pointSampled();
+  none.shadow_map_size = 0;
+  const FloatImage unshadowed = renderer_->renderFloat(file.scene, none);
+  const FloatImage reference = renderReference(file.scene, {1, 0});
+  auto luminance = [](const FloatImage& image, std::size_t i) {
+    const float* p = &image.rgba[4 * i];
+    return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+  };
+  int open = 0, gl_shadowed = 0, reference_shadowed = 0, both = 0;
+  double difference = 0.0;
+  for (std::size_t i = 0; i < std::size_t(gl.width) * gl.height; ++i) {
+    if (heaps.rgba[4 * i + 3] > 0.01f) continue;  // a heap in front of the deck
+    const double lit = luminance(unshadowed, i);
+    const double a = luminance(gl, i) / lit, r = luminance(reference, i) / lit;
+    ++open;
+    difference += std::abs(a - r);
+    gl_shadowed += a < kShadowedRatio;
+    reference_shadowed += r < kShadowedRatio;
+    both += a < kShadowedRatio && r < kShadowedRatio;
+  }
+  ASSERT_GT(open, 0);
+  EXPECT_GT(double(gl_shadowed) / open, 0.05);  // the deck shows shadows at all
+  EXPECT_GE(double(both) / std::max(gl_shadowed, 1), 0.9);
+  EXPECT_GE(double(both) / std::max(reference_shadowed, 1), 0.9);
+  EXPECT_LE(difference / open, 0.03);
+  if (double(both) / std::max(gl_shadowed, 1) < 0.9 ||
+      double(both) / std::max(reference_shadowed, 1) < 0.9 || difference / open > 0.03)
+    writeFailureImages(gl, reference, "heap_shadows_on_a_deck");
+}
+
 // Precipitation (MODEL.md section 17) under a nimbostratus deck, as slabs: rain from the base
 // down, snow, and CIGI's dust layer of its own base and top, equal to the one-sample
 // reference; without it the view is another.

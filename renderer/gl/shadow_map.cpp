@@ -115,6 +115,7 @@ void ShadowMap::prepare(const CloudShadows& shadows, glm::dvec3 camera, int size
   hashBytes(key, &half, sizeof half);
   centre_ = anchor + centre;
   half_ = half;
+  floor_ = shadows.floor();
   if (key == key_ && texture_) return;
 
   StageClock clock(stats.times.cpu(CpuStage::kUploads));
@@ -181,6 +182,8 @@ void ShadowMap::bind(GLuint program, GLuint unit, glm::dvec3 camera) const {
   const glm::vec2 centre(centre_ - glm::dvec2(camera));
   gl_.ProgramUniform2fv(program, gl_.GetUniformLocation(program, "u_shadow_centre"), 1, &centre.x);
   gl_.ProgramUniform1f(program, gl_.GetUniformLocation(program, "u_shadow_half"), float(half_));
+  gl_.ProgramUniform1f(program, gl_.GetUniformLocation(program, "u_shadow_floor"),
+                       float(floor_ - camera.z));
 }
 
 }  // namespace nephele

@@ -29,8 +29,8 @@ class ShadowMap {
                GpuPassTimer& timer);
   bool active() const { return active_; }
   // Binds the map to texture `unit` and sets the sky pass's uniforms u_shadow_map,
-  // u_shadow_centre (the map's centre from the camera, metres) and u_shadow_half (its half
-  // side).
+  // u_shadow_centre (the map's centre from the camera, metres), u_shadow_half (its half side)
+  // and u_shadow_floor (the casters' lowest point above the camera, CloudShadows::floor).
   void bind(GLuint program, GLuint unit, glm::dvec3 camera) const;
   int draws() const { return draws_; }  // maps drawn since construction
 
@@ -41,6 +41,7 @@ class ShadowMap {
   bool active_ = false;
   glm::dvec2 centre_{0.0};
   double half_ = 0.0;
+  double floor_ = 0.0;
   std::uint64_t key_ = 0;
   int draws_ = 0;
 };

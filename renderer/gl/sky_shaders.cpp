@@ -231,6 +231,22 @@ bool inBand(float dz) {
   return (dz >= u_band.x && dz < u_band.y) || (dz >= u_band.z && dz < u_band.w);
 }
 
+#ifdef SHADOWS
+// The share of the sunlight reaching the ground (MODEL.md section 16, ShadowMap) at `ground`
+// (metres from the camera's ground point): the map is u_shadow_half * 2 metres a side about
+// u_shadow_centre; it fades to 1 over its outer twentieth, where the ground lies beyond its
+// casters' range. Below u_shadow_floor (from the camera) every caster lies above.
+layout(binding = 11) uniform sampler2D u_shadow_map;
+uniform vec2 u_shadow_centre;
+uniform float u_shadow_half;
+uniform float u_shadow_floor;
+float mapSunlight(vec2 ground) {
+  vec2 uv = (ground - u_shadow_centre) / (2.0 * u_shadow_half) + 0.5;
+  float edge = 2.0 * max(abs(uv.x - 0.5), abs(uv.y - 0.5));
+  return mix(texture(u_shadow_map, uv).r, 1.0, smoothstep(0.9, 1.0, edge));
+}
+#endif
+
 #ifdef BACKGROUND
 uniform vec3 u_zenith;
 uniform vec3 u_horizon;
@@ -238,23 +254,13 @@ uniform vec3 u_ground;
 
 uniform float u_horizon_slope;  // |gradient of r.z| per pixel
 
-#ifdef SHADOWS
-// The share of the sunlight reaching the ground (MODEL.md section 16, ShadowMap): the map is
-// u_shadow_half * 2 metres a side about u_shadow_centre (from the camera); it fades to 1 over
-// its outer twentieth, where the ground lies beyond its casters' range.
-layout(binding = 11) uniform sampler2D u_shadow_map;
-uniform vec2 u_shadow_centre;
-uniform float u_shadow_half;
-#endif
 // The sky planes' share of the sunlight at this pixel's ground point (planesSunlight), set by
 // main before background() where planes cast shadows.
 float g_planes_sun = 1.0;
 vec3 groundColour(vec3 d) {
   float sun = g_planes_sun;
 #ifdef SHADOWS
-  vec2 uv = (d.xy * (u_camera_z / -d.z) - u_shadow_centre) / (2.0 * u_shadow_half) + 0.5;
-  float edge = 2.0 * max(abs(uv.x - 0.5), abs(uv.y - 0.5));
-  sun *= mix(texture(u_shadow_map, uv).r, 1.0, smoothstep(0.9, 1.0, edge));
+  sun *= mapSunlight(d.xy * (u_camera_z / -d.z));
 #endif
 #if defined(SHADOWS) || defined(PLANE_SHADOWS)
   return u_ground * (kGroundSkyShare + (1.0 - kGroundSkyShare) * sun);
@@ -496,8 +502,18 @@ void composite(int i, vec3 r, LayerHit hit, float t1, float it, inout vec3 colou
   if (u_far[i].y > 0.0) diffuse = sphereDiffuse(dot(u_to_sun, -normalize(r)));
 #endif
   vec3 surface = gardnerIntensity(u_shading[i], diffuse, highlight, it) * u_colour[i];
+#if defined(PLANE_SHADOWS) || defined(SHADOWS)
+  float sun = 1.0;
 #ifdef PLANE_SHADOWS
-  surface *= kGroundSkyShare + (1.0 - kGroundSkyShare) * planesSunlight(hit, u_height[i]);
+  sun = planesSunlight(hit, u_height[i]);
+#endif
+#ifdef SHADOWS
+  // A plane under every heap takes the heaps' shadow where the sun's ray through it lands
+  // (MODEL.md section 16, "planes under heaps").
+  if (u_height[i] <= u_shadow_floor)
+    sun *= mapSunlight(hit.p - ((u_height[i] + u_camera_z) / u_to_sun.z) * u_to_sun.xy);
+#endif
+  surface *= kGroundSkyShare + (1.0 - kGroundSkyShare) * sun;
 #endif
 #ifdef AIR
   surface = applyAir(surface, normalize(r), hit.distance);
@@ -621,9 +637,9 @@ std::string skyFragmentSource(const SkyPassLayout& layout) {
   if (layout.specular) s += "#define SPECULAR\n";
   if (layout.targets) s += "#define TARGETS\n";
   if (layout.regions) s += "#define REGIONS\n";
-  if (layout.shadows && layout.background) s += "#define SHADOWS\n";
+  if (layout.shadows) s += "#define SHADOWS\n";
   if (!layout.casters.empty()) s += "#define PLANE_SHADOWS\n";
-  if ((layout.shadows && layout.background) || !layout.casters.empty())
+  if (layout.shadows || !layout.casters.empty())
     s += "const float kGroundSkyShare = " + std::to_string(kGroundSkyShare) + ";\n";
   if (layout.term_filter == TermFilter::kCut) s += "#define FILTER_CUT\n";
   if (layout.term_filter == TermFilter::kNone) s += "#define FILTER_NONE\n";

@@ -195,8 +195,14 @@ class ReferenceTracer {
         layer.far.side_ratio > 0.0
             ? gardnerIntensity(layer.shading, sphereDiffuse(glm::dot(sun_, -direction)), 0.0, t)
             : gardnerIntensity(layer.shading, t, {0.0, 0.0, 1.0}, sun_, -direction);
-    const double shadow =
-        casting_.empty() ? 1.0 : groundLight(planesSunlight({p.x, p.y, layer.altitude_m}));
+    // Shadows from the planes above, and from the heaps where every one lies above (MODEL.md
+    // section 16, "planes under heaps": the ground's sunlight where the sun's ray lands).
+    const glm::dvec3 at(p.x, p.y, layer.altitude_m);
+    double sun = casting_.empty() ? 1.0 : planesSunlight(at);
+    const bool under_heaps =
+        shadows_ && !shadows_->empty() && layer.altitude_m <= shadows_->floor();
+    if (under_heaps) sun *= shadows_->sunlight(sunCrossing(at, 0.0, sun_));
+    const double shadow = casting_.empty() && !under_heaps ? 1.0 : groundLight(sun);
     return {s, withAir(shadow * intensity * layer.colour * scene_.sun.colour, direction, s),
             1.0 - tr, s};
   }

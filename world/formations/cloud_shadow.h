@@ -5,6 +5,7 @@
 // renderers evaluate it: the reference per ground sample (CloudShadows::sunlight), the GL in a
 // map along the sun built once per sun and world change (renderer/gl/shadow_map.h).
 #include <array>
+#include <limits>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -94,6 +95,10 @@ class CloudShadows {
   // The ground rectangle outside which no caster shadows: [lo, hi] in world X, Y.
   glm::dvec2 lo() const { return lo_; }
   glm::dvec2 hi() const { return hi_; }
+  // The lowest point of any caster: a sky plane at or below it has every caster above it, so the
+  // sunlight its points receive is the ground's where the sun's ray through them lands
+  // (MODEL.md section 16, "planes under heaps").
+  double floor() const { return floor_; }
   // Where caster i's shadow can fall on the ground Z = 0: its bounding sphere projected
   // along the sun, as a square.
   void footprint(const ShadowCaster& caster, glm::dvec2& lo, glm::dvec2& hi) const;
@@ -107,6 +112,7 @@ class CloudShadows {
   std::vector<ShadowCaster> casters_;
   std::vector<ShadowTable> tables_;
   glm::dvec2 lo_{0.0}, hi_{0.0};
+  double floor_ = std::numeric_limits<double>::infinity();
   // A grid over [lo, hi] listing the casters whose footprint meets each cell.
   double cell_ = 1.0;
   glm::ivec2 cells_{0};
