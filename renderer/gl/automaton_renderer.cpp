@@ -17,7 +17,7 @@ constexpr int kMaxMarchSteps = 2048;
 
 const char* kVolumePass = R"(
 layout(binding = 13) uniform sampler3D u_volume;  // rho and sunlight of both keyframes
-layout(binding = 8) uniform sampler3D u_sky;      // skylight of both keyframes
+layout(binding = 8) uniform sampler3D u_sky;      // skylight and sun_diffuse of both keyframes
 uniform vec3 u_box_min;         // camera-relative box where the density can be non-zero
 uniform vec3 u_box_max;
 uniform vec3 u_lattice_origin;  // camera-relative position of lattice sample (0, 0, 0)
@@ -31,12 +31,18 @@ uniform float u_ambient;
 uniform vec3 u_to_sun;
 uniform float u_phase_g;
 
-// Density, sunlight and skylight (MODEL.md section 6) at camera-relative p.
-vec3 densityAndLight(vec3 p) {
+// Density, sunlight, skylight and the sunlight's diffuse share (MODEL.md section 6) at
+// camera-relative p.
+vec4 densityAndLight(vec3 p) {
   vec3 t = ((p - u_lattice_origin) * u_inv_spacing + 0.5) * u_inv_dims;
   vec4 v = texture(u_volume, t);
-  vec2 sky = texture(u_sky, t).rg;
-  return vec3(mix(v.xy, v.zw, u_blend), mix(sky.r, sky.g, u_blend));
+  vec4 sky = texture(u_sky, t);
+  return vec4(mix(v.xy, v.zw, u_blend), mix(sky.xz, sky.yw, u_blend));
+}
+
+// Light scattered towards the viewer per unit of the sun's: cloud_density.h scatteredLight.
+float scatteredLight(float phase, vec4 s) {
+  return phase * s.y + max(s.w - s.y, 0.0) + u_ambient * s.z;
 }
 
 float phase(float c) {
@@ -66,13 +72,13 @@ void main() {
   float scattering = phase(dot(u_to_sun, d));
   vec3 radiance = vec3(0.0);
   float transmittance = 1.0;
-  vec3 a = densityAndLight(enter * d);
+  vec4 a = densityAndLight(enter * d);
   for (int i = 1; i <= steps && transmittance > 1e-3; ++i) {
-    vec3 b = densityAndLight((enter + float(i) * ds) * d);
+    vec4 b = densityAndLight((enter + float(i) * ds) * d);
     // Exact attenuation over the step for density linear along it (MODEL.md section 6), with the source
     // held at the mean of the step's ends, as the reference does.
     float segment = exp(-u_extinction * 0.5 * (a.x + b.x) * ds);
-    float source = scattering * 0.5 * (a.y + b.y) + u_ambient * 0.5 * (a.z + b.z);
+    float source = 0.5 * (scatteredLight(scattering, a) + scatteredLight(scattering, b));
     radiance += transmittance * (1.0 - segment) * source * u_light;
     transmittance *= segment;
     a = b;
@@ -144,19 +150,22 @@ AutomatonRenderer::Volume& AutomatonRenderer::volume(const Scene& scene, std::si
   Volume& v = volumes_[std::to_string(index) + "/" + cloud.name];
   v.used = true;
   if (v.texture && v.from == cloud.from && v.to == cloud.to) return v;
-  // New keyframes: interleave both into one RGBA texture (density, sunlight, density, sunlight).
+  // New keyframes: interleave both into two RGBA textures (density, sunlight, density,
+  // sunlight) and (skylight, skylight, sun_diffuse, sun_diffuse).
   const DensityLattice& a = cloud.from->lattice;
   const DensityLattice& b = cloud.to->lattice;
   NEPHELE_CHECK(a.dims == b.dims, "keyframes on different lattices");
   StageClock clock(stats_->times.cpu(CpuStage::kUploads));
-  std::vector<float> texels(a.density.size() * 4), sky(a.density.size() * 2);
+  std::vector<float> texels(a.density.size() * 4), sky(a.density.size() * 4);
   for (std::size_t i = 0; i < a.density.size(); ++i) {
     texels[4 * i + 0] = a.density[i];
     texels[4 * i + 1] = a.sunlight[i];
     texels[4 * i + 2] = b.density[i];
     texels[4 * i + 3] = b.sunlight[i];
-    sky[2 * i + 0] = a.skylight[i];
-    sky[2 * i + 1] = b.skylight[i];
+    sky[4 * i + 0] = a.skylight[i];
+    sky[4 * i + 1] = b.skylight[i];
+    sky[4 * i + 2] = a.sun_diffuse[i];
+    sky[4 * i + 3] = b.sun_diffuse[i];
   }
   if (!v.texture || !v.from || v.from->lattice.dims != a.dims) {
     auto make = [&](GLenum format) {
@@ -169,11 +178,11 @@ AutomatonRenderer::Volume& AutomatonRenderer::volume(const Scene& scene, std::si
       return texture;
     };
     v.texture = make(GL_RGBA32F);
-    v.sky = make(GL_RG32F);
+    v.sky = make(GL_RGBA32F);
   }
   gl_.TextureSubImage3D(v.texture.get(), 0, 0, 0, 0, a.dims.x, a.dims.y, a.dims.z, GL_RGBA,
                         GL_FLOAT, texels.data());
-  gl_.TextureSubImage3D(v.sky.get(), 0, 0, 0, 0, a.dims.x, a.dims.y, a.dims.z, GL_RG, GL_FLOAT,
+  gl_.TextureSubImage3D(v.sky.get(), 0, 0, 0, 0, a.dims.x, a.dims.y, a.dims.z, GL_RGBA, GL_FLOAT,
                         sky.data());
   v.from = cloud.from;
   v.to = cloud.to;

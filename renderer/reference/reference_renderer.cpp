@@ -261,14 +261,19 @@ class ReferenceTracer {
     const double phase = cloud.phaseValue(glm::dot(sun_, direction));
     glm::dvec3 radiance(0.0);
     double transmittance = 1.0;
-    // Density, and the light reaching the point: sun (times the phase function) and sky.
+    // Density, and the light the point scatters towards the eye (cloud_density.h scatteredLight).
     auto sample = [&](double s, double& rho, double& lit) {
       const glm::dvec3 p = eye + s * direction;
       rho = cloud.exactDensity(p);
-      lit = rho > 0.0 ? phase * std::exp(-opticalDepthTowards(cloud, p, sun_)) +
-                            cloud.ambient *
-                                diffuseTransmittance(opticalDepthTowards(cloud, p, {0.0, 0.0, 1.0}))
-                      : 0.0;
+      if (!(rho > 0.0)) {
+        lit = 0.0;
+        return;
+      }
+      const double tau_sun = opticalDepthTowards(cloud, p, sun_);
+      const double tau_away = opticalDepthTowards(cloud, p, -sun_);
+      lit = scatteredLight(phase, std::exp(-tau_sun), diffuseSunlight(tau_sun, tau_away),
+                           cloud.ambient,
+                           diffuseTransmittance(opticalDepthTowards(cloud, p, {0.0, 0.0, 1.0})));
     };
     double rho_a, lit_a;
     sample(enter, rho_a, lit_a);

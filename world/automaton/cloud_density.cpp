@@ -102,6 +102,7 @@ DensityLattice densityLattice(const std::vector<float>& means, GridSize size, do
   lattice.origin = glm::dvec3(0.5 * cell_size - margin * lattice.spacing);
   lattice.density.assign(std::size_t(lattice.dims.x) * lattice.dims.y * lattice.dims.z, 0.0f);
   lattice.sunlight.assign(lattice.density.size(), 1.0f);
+  lattice.sun_diffuse.assign(lattice.density.size(), 1.0f);
 
   // Samples are aligned with cell centres, so every cell sees the same kernel of weights.
   const double radius = kMetaballRadiusCells * cell_size;
@@ -138,18 +139,24 @@ DensityLattice densityLattice(const std::vector<float>& means, GridSize size, do
   return lattice;
 }
 
-void sweepSunlight(DensityLattice& lattice, glm::dvec3 to_sun, double extinction_per_m) {
-  to_sun = glm::normalize(to_sun);
-  // Sweep along the axis the sun direction leans on most; B and C are the other two.
+namespace {
+
+// The optical depth from every sample out of the lattice along the unit direction `towards`, by
+// one sweep from that side: each sample's is that of the point one slice further along
+// (bilinear on that slice) plus the exact integral over the segment between them, with the
+// density linear along it. O(samples).
+std::vector<double> sweptOpticalDepth(const DensityLattice& lattice, glm::dvec3 towards,
+                                      double extinction_per_m) {
+  // Sweep along the axis the direction leans on most; B and C are the other two.
   int a = 0;
   for (int axis = 1; axis < 3; ++axis)
-    if (std::abs(to_sun[axis]) > std::abs(to_sun[a])) a = axis;
+    if (std::abs(towards[axis]) > std::abs(towards[a])) a = axis;
   const int b = (a + 1) % 3, c = (a + 2) % 3;
   const glm::ivec3 dims = lattice.dims;
-  const double da = std::abs(to_sun[a]);
-  const int toward_sun = to_sun[a] >= 0.0 ? 1 : -1;
-  // One slice towards the sun moves by (db, dc) samples across and `length` metres.
-  const double db = to_sun[b] / da, dc = to_sun[c] / da;
+  const double da = std::abs(towards[a]);
+  const int forward = towards[a] >= 0.0 ? 1 : -1;
+  // One slice along moves by (db, dc) samples across and `length` metres.
+  const double db = towards[b] / da, dc = towards[c] / da;
   const double length = lattice.spacing / da;
   auto at = [&](int ia, int ib, int ic) {
     glm::ivec3 s;
@@ -158,36 +165,48 @@ void sweepSunlight(DensityLattice& lattice, glm::dvec3 to_sun, double extinction
     s[c] = ic;
     return lattice.index(s.x, s.y, s.z);
   };
-  const int first = toward_sun > 0 ? dims[a] - 1 : 0;
+  std::vector<double> tau(lattice.density.size(), 0.0);
+  const int first = forward > 0 ? dims[a] - 1 : 0;
   for (int ib = 0; ib < dims[b]; ++ib)
     for (int ic = 0; ic < dims[c]; ++ic) {
       // Beyond the first slice lies empty space: its density is 0 at the lattice edge.
-      const double rho = lattice.density[at(first, ib, ic)];
-      lattice.sunlight[at(first, ib, ic)] =
-          float(segmentTransmittance(rho, 0.0, length, extinction_per_m));
+      const std::size_t here = at(first, ib, ic);
+      tau[here] = extinction_per_m * 0.5 * lattice.density[here] * length;
     }
-  for (int ia = first - toward_sun; ia >= 0 && ia < dims[a]; ia -= toward_sun) {
-    const int up = ia + toward_sun;
+  for (int ia = first - forward; ia >= 0 && ia < dims[a]; ia -= forward) {
+    const int next = ia + forward;
     for (int ib = 0; ib < dims[b]; ++ib)
       for (int ic = 0; ic < dims[c]; ++ic) {
         const double ub = ib + db, uc = ic + dc;
         const int b0 = int(std::floor(ub)), c0 = int(std::floor(uc));
         const double fb = ub - b0, fc = uc - c0;
-        double t_up = 0.0, rho_up = 0.0;
+        double tau_next = 0.0, rho_next = 0.0;
         for (int corner = 0; corner < 4; ++corner) {
           const int sb = b0 + (corner & 1), sc = c0 + (corner >> 1);
+          if (sb < 0 || sc < 0 || sb >= dims[b] || sc >= dims[c]) continue;  // open sky: 0
           const double w = ((corner & 1) ? fb : 1.0 - fb) * ((corner >> 1) ? fc : 1.0 - fc);
-          if (sb < 0 || sc < 0 || sb >= dims[b] || sc >= dims[c]) {
-            t_up += w;  // open sky: full sunlight, no density
-            continue;
-          }
-          t_up += w * lattice.sunlight[at(up, sb, sc)];
-          rho_up += w * lattice.density[at(up, sb, sc)];
+          const std::size_t s = at(next, sb, sc);
+          tau_next += w * tau[s];
+          rho_next += w * lattice.density[s];
         }
         const std::size_t here = at(ia, ib, ic);
-        lattice.sunlight[here] = float(
-            t_up * segmentTransmittance(lattice.density[here], rho_up, length, extinction_per_m));
+        tau[here] = tau_next + extinction_per_m * 0.5 * (lattice.density[here] + rho_next) * length;
       }
+  }
+  return tau;
+}
+
+}  // namespace
+
+void sweepSunlight(DensityLattice& lattice, glm::dvec3 to_sun, double extinction_per_m) {
+  to_sun = glm::normalize(to_sun);
+  const std::vector<double> towards = sweptOpticalDepth(lattice, to_sun, extinction_per_m);
+  const std::vector<double> away = sweptOpticalDepth(lattice, -to_sun, extinction_per_m);
+  lattice.sunlight.resize(lattice.density.size());
+  lattice.sun_diffuse.resize(lattice.density.size());
+  for (std::size_t i = 0; i < towards.size(); ++i) {
+    lattice.sunlight[i] = float(std::exp(-towards[i]));
+    lattice.sun_diffuse[i] = float(diffuseSunlight(towards[i], away[i]));
   }
 }
 

@@ -2,6 +2,7 @@
 // From automaton cells to light (MODEL.md section 6): metaball density, sunlight through it, and
 // the phase functions of single scattering. Grid frame: metres from the grid's lower corner,
 // cell (i, j, k) centred at ((i, j, k) + 0.5) * cell size.
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -24,6 +25,29 @@ inline double diffuseTransmittance(double tau) {
   return 1.0 / (1.0 + 0.75 * (1.0 - kDiffuseAsymmetry) * tau);
 }
 
+// The sunlight at a point in all, scattered or not, per unit of the sun's (MODEL.md section 6,
+// multiple scattering): the two-stream sum of the fluxes along and against the sun's ray in a
+// non-absorbing slab, the ray's own path through the cloud, tau_sun the optical depth from the
+// point towards the sun and tau_away that on out of the far side:
+// (1 + 2 k tau_away) / (1 + k (tau_sun + tau_away)), k = 3/4 (1 - g). Near 2 on a thick sunlit
+// face (the beam and the light scattered back out), diffuseTransmittance(tau_sun) on the far
+// face; finite and in (0, 2) for finite depths.
+inline double diffuseSunlight(double tau_sun, double tau_away) {
+  const double k = 0.75 * (1.0 - kDiffuseAsymmetry);
+  return (1.0 + 2.0 * k * tau_away) / (1.0 + k * (tau_sun + tau_away));
+}
+
+// The light a point scatters towards the viewer, per unit of the sun's (MODEL.md section 6,
+// multiple scattering): the unscattered sunlight `sun_direct` = exp(-tau_sun) through the phase
+// function, the rest of the sunlight there, `sun_diffuse` (diffuseSunlight) less sun_direct,
+// scattered evenly, and the sky light `ambient` x `sky`. The difference is clamped at 0: exact
+// values never go below it (diffuseSunlight >= 1 / (1 + k tau_sun) >= exp(-tau_sun) for
+// k <= 1), interpolated ones might.
+inline double scatteredLight(double phase, double sun_direct, double sun_diffuse, double ambient,
+                             double sky) {
+  return phase * sun_direct + std::max(sun_diffuse - sun_direct, 0.0) + ambient * sky;
+}
+
 // The metaball field f(r) = -4/9 a^6 + 17/9 a^4 - 22/9 a^2 + 1, a = r / R; 0 beyond R.
 double metaballField(double r, double radius);
 
@@ -40,11 +64,12 @@ double metaballDensity(const std::vector<float>& means, GridSize size, double ce
 // outside the lattice.
 struct DensityLattice {
   glm::ivec3 dims{0};
-  double spacing = 0.0;         // metres between samples
-  glm::dvec3 origin{0.0};       // grid-frame position of sample (0, 0, 0)
-  std::vector<float> density;   // x fastest
-  std::vector<float> sunlight;  // transmittance towards the sun, exp(-tau)
-  std::vector<float> skylight;  // share of the sky light reaching the sample (sweepSkylight)
+  double spacing = 0.0;            // metres between samples
+  glm::dvec3 origin{0.0};          // grid-frame position of sample (0, 0, 0)
+  std::vector<float> density;      // x fastest
+  std::vector<float> sunlight;     // transmittance towards the sun, exp(-tau)
+  std::vector<float> sun_diffuse;  // all the sunlight there, scattered or not (diffuseSunlight)
+  std::vector<float> skylight;     // share of the sky light reaching the sample (sweepSkylight)
   // Samples bounding every non-zero density sample, widened by one: the trilinear density is
   // 0 outside them (lo > hi when the cloud is empty).
   glm::ivec3 occupied_lo{0}, occupied_hi{-1};
@@ -63,9 +88,10 @@ struct DensityLattice {
 DensityLattice densityLattice(const std::vector<float>& means, GridSize size, double cell_size,
                               int samples_per_cell);
 
-// Fills `lattice.sunlight` by one sweep from the sun's side: each sample's transmittance is that
-// of the point one slice nearer the sun (bilinear on that slice) times the exact exponential
-// of the segment between them, with the density linear along it. O(samples).
+// Fills `lattice.sunlight` and `lattice.sun_diffuse` from the optical depths towards the sun and
+// away from it, each found by one sweep from that side: a sample's optical depth is that of the
+// point one slice further along (bilinear on that slice) plus the exact integral over the
+// segment between them, with the density linear along it. O(samples).
 void sweepSunlight(DensityLattice& lattice, glm::dvec3 to_sun,
                    double extinction_per_m = kCloudExtinctionPerMetre);
 // Fills `lattice.skylight`: how much of the sky light reaches each sample through the cloud
