@@ -186,10 +186,7 @@ class ReferenceTracer {
                        double s) const {
     const glm::dvec3 p = scene_.camera.position + s * direction;
     const double t = texture.value({p.x, p.y}, scene_.time_s);
-    const double base =
-        layer.far.side_ratio > 0.0 ? farThreshold(layer.far, direction) : layer.threshold;
-    const double t1 = regionThreshold(base, layerRegionWeight(layer, {p.x, p.y}, scene_.time_s,
-                                                              glm::dvec2(scene_.camera.position)));
+    const double t1 = layerThreshold(layer, {p.x, p.y}, direction);
     const double tr = skyPlaneTranslucence(t, t1, layer.transition);
     const double intensity =
         layer.far.side_ratio > 0.0
@@ -207,20 +204,26 @@ class ReferenceTracer {
             1.0 - tr, s};
   }
 
+  // The layer's T1 at world point xy seen along `view`: a far deck's cover for the view's
+  // elevation, raised by its region's weight there (MODEL.md section 11).
+  double layerThreshold(const CloudLayer& layer, glm::dvec2 xy, glm::dvec3 view) const {
+    const double base =
+        layer.far.side_ratio > 0.0 ? farThreshold(layer.far, view) : layer.threshold;
+    return regionThreshold(
+        base, layerRegionWeight(layer, xy, scene_.time_s, glm::dvec2(scene_.camera.position)));
+  }
+
   // The share of the sunlight the casting planes above p let through (MODEL.md section 16,
   // "sky planes"): each plane's translucence where the sun's ray through p crosses it, its
   // threshold taken with the sun's direction as the view's (a far deck's cover). p.z is the
   // receiving plane's own altitude (0 for the ground), so that a plane never shadows itself.
   double planesSunlight(glm::dvec3 p) const {
     double light = 1.0;
-    const glm::dvec2 eye(scene_.camera.position);
     for (std::size_t i : casting_) {
       const CloudLayer& layer = scene_.layers[i];
       if (!(layer.altitude_m > p.z)) continue;
       const glm::dvec2 q = sunCrossing(p, layer.altitude_m, sun_);
-      const double base =
-          layer.far.side_ratio > 0.0 ? farThreshold(layer.far, sun_) : layer.threshold;
-      const double t1 = regionThreshold(base, layerRegionWeight(layer, q, scene_.time_s, eye));
+      const double t1 = layerThreshold(layer, q, sun_);
       if (t1 >= 1.0) continue;
       light *= skyPlaneTranslucence(textures_[i].value(q, scene_.time_s), t1, layer.transition);
     }

@@ -123,13 +123,9 @@ CloudShadows::CloudShadows(const Scene& scene, const HeapDrawing& heaps, bool lo
     for (const Ellipsoid& e : cloud.ellipsoids) {
       const double reach = std::max({e.radii.x, e.radii.y, e.radii.z});
       if (!(e.centre.z + reach > 0.0)) continue;  // wholly underground
-      const glm::dmat3 to_unit = worldToUnitSphere(e);
-      // Its half height: the length of the Z row of W^-1 (unit sphere to world offsets).
-      const glm::dmat3 from_unit = glm::inverse(to_unit);
-      const double half_height =
-          glm::length(glm::dvec3(from_unit[0].z, from_unit[1].z, from_unit[2].z));
-      floor_ = std::min(floor_, e.centre.z - half_height);
-      casters_.push_back({e.centre, to_unit, reach, cloud.light_extinction, it->second});
+      floor_ = std::min(floor_, e.centre.z - verticalHalfExtent(e));
+      casters_.push_back(
+          {e.centre, worldToUnitSphere(e), reach, cloud.light_extinction, it->second});
     }
   };
   for (const EllipsoidCloud& cloud : scene.clouds) add(cloud);

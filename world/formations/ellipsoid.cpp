@@ -34,6 +34,11 @@ glm::dmat3 unitSphereToWorld(const Ellipsoid& e) {
   return {body[0] * e.radii.x, body[1] * e.radii.y, body[2] * e.radii.z};
 }
 
+double verticalHalfExtent(const Ellipsoid& e) {
+  const glm::dmat3 t = unitSphereToWorld(e);
+  return glm::length(glm::dvec3(t[0].z, t[1].z, t[2].z));
+}
+
 double quadricValue(const Ellipsoid& e, glm::dvec3 point) {
   const glm::dvec3 o = worldToUnitSphere(e) * (point - e.centre);
   return glm::dot(o, o) - 1.0;

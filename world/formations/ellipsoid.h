@@ -26,6 +26,8 @@ std::string ellipsoidError(const Ellipsoid& ellipsoid);
 glm::dmat3 worldToUnitSphere(const Ellipsoid& ellipsoid);
 // Its inverse, T = R S: the unit sphere's points to world offsets from the centre.
 glm::dmat3 unitSphereToWorld(const Ellipsoid& ellipsoid);
+// How far it reaches above and below its centre: |row z of R S|.
+double verticalHalfExtent(const Ellipsoid& ellipsoid);
 
 // The quadric Q(X) = (X - C)^T M (X - C) - 1 with M = W^T W (MODEL.md section 5).
 double quadricValue(const Ellipsoid& ellipsoid, glm::dvec3 point);

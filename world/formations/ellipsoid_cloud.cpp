@@ -39,9 +39,7 @@ BoundingSphere boundingSphere(const EllipsoidCloud& cloud) {
 std::pair<double, double> cloudVerticalExtent(const EllipsoidCloud& cloud) {
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (const Ellipsoid& e : cloud.ellipsoids) {
-    // Vertical half-extent: |row z of R S|.
-    const glm::dmat3 t = unitSphereToWorld(e);
-    const double half = glm::length(glm::dvec3(t[0].z, t[1].z, t[2].z));
+    const double half = verticalHalfExtent(e);
     lo = std::min(lo, e.centre.z - half);
     hi = std::max(hi, e.centre.z + half);
   }
