@@ -124,7 +124,9 @@ double thresholdFromSamples(const std::vector<double>& values, double transition
   // just above opacity 1/2 where it is thinnest.
   if (c >= 1.0) return values.front() - (veil ? level + 0.05 : 1.0) * transition - margin;
   if (c <= 0.0) return values.back() - shift + margin;
-  return values[std::size_t(std::floor((1.0 - c) * double(values.size())))] - shift;
+  // A coverage within rounding of 0 (1 - c == 1) takes the last sample, not one past it.
+  const auto index = std::size_t(std::floor((1.0 - c) * double(values.size())));
+  return values[std::min(index, values.size() - 1)] - shift;
 }
 
 // The planes of a stratiform layer, or the deck under heaps, covering `coverage`.
