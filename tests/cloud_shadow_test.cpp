@@ -138,5 +138,49 @@ TEST(CloudShadowTest, TheLowestPlanesCastWhileTheSunIsUp) {
   EXPECT_NEAR(q.y, 20.0, 1e-9);
 }
 
+// Shadows on what lies between the ground and the casters (MODEL.md section 16, "heaps under
+// clouds"): a point under a lobe, anywhere on the sun's line through it, takes the lobe's share
+// for the chord above it alone (none once above the lobe); the lobe's own heap, given as the
+// envelope the point lies on, is left out; an opaque plane above takes all the sunlight, one
+// below it none.
+TEST(CloudShadowTest, CloudsShadowWhatLiesBelowThemAlone) {
+  const double r = 400.0;
+  const glm::dvec3 centre(0.0, 0.0, 2000.0);
+  Scene scene;
+  scene.sun.elevation_deg = 50.0;
+  scene.clouds.push_back(sphereCloud(r, centre));
+  const CloudShadows shadows(scene, {}, true);
+  const glm::dvec3 to_sun = shadows.toSun();
+  const ShadowTable table = meanOpacityTable(scene.clouds[0]);
+  const ShadowCaster caster{centre, worldToUnitSphere(scene.clouds[0].ellipsoids[0]), r, 0.02, 0};
+  // Along the sun's line 150 m off the centre: below, inside and above the lobe.
+  const glm::dvec3 off = 150.0 * glm::normalize(glm::cross(to_sun, glm::dvec3(0.0, 0.0, 1.0)));
+  for (double s : {-3000.0, -1000.0, -100.0, 0.0, 200.0, 600.0}) {
+    const glm::dvec3 p = centre + off + s * to_sun;
+    EXPECT_NEAR(shadows.sunlightAt(p), casterSunlight(caster, table, p, to_sun), 1e-12) << s;
+  }
+  EXPECT_LT(shadows.sunlightAt(centre + off - 1000.0 * to_sun), 0.9);
+  EXPECT_EQ(shadows.sunlightAt(centre + off + 600.0 * to_sun), 1.0);
+  EXPECT_EQ(shadows.sunlight(glm::dvec2(centre + off - centre.z / to_sun.z * to_sun)),
+            shadows.sunlightAt(centre + off - centre.z / to_sun.z * to_sun));
+  const HeapEnvelope own{centre, glm::dvec3(r), 0.02};
+  EXPECT_EQ(shadows.sunlightAt(centre + off - 100.0 * to_sun, &own), 1.0);
+  const HeapEnvelope other{centre + glm::dvec3(0.0, 0.0, -2.0 * r), glm::dvec3(r), 0.02};
+  EXPECT_LT(shadows.sunlightAt(centre + off - 1000.0 * to_sun, &other), 0.9);
+
+  CloudLayer deck;
+  deck.altitude_m = 3000.0;
+  deck.threshold = -1.0;  // opaque whatever the texture
+  deck.transition = 0.1;
+  scene.layers.push_back(deck);
+  const PlaneShadows planes(scene);
+  EXPECT_EQ(planes.sunlight({0.0, 0.0, 2999.0}), 0.0);
+  EXPECT_EQ(planes.sunlight({0.0, 0.0, 3000.0}), 1.0);  // a plane never shadows itself
+  const SceneSunlight both{&planes, &shadows};
+  EXPECT_EQ(both.at({0.0, 0.0, 5.0}), 0.0);
+  scene.sun.elevation_deg = 0.5 * kMinShadowElevationDeg;
+  EXPECT_TRUE(PlaneShadows(scene).empty());
+}
+
 }  // namespace
 }  // namespace nephele

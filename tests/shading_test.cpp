@@ -123,7 +123,8 @@ TEST(HeapLight, EnvelopeOfEachHeapAndTheDepthThroughIt) {
   EllipsoidCloud parted = cloud;
   parted.parts = {0, 1, 2};
   EXPECT_NEAR(heapEnvelopes(parted)[0].radii.z, 100.0, 1e-9);
-  // Off: every point takes all the light, and the intensity is eq. 8.
+  // Off: every point takes all the light, and the intensity is eq. 8, its sun terms times the
+  // sunlight other clouds let through (MODEL.md section 16); the sky light is not used.
   cloud.light_extinction = 0.0;
   for (const HeapEnvelope& e : heapEnvelopes(cloud)) {
     const HeapLight light = heapLightAt(e, e.centre, down, up);
@@ -131,8 +132,11 @@ TEST(HeapLight, EnvelopeOfEachHeapAndTheDepthThroughIt) {
   }
   const glm::dvec3 n(0.0, -1.0, 0.0), to_sun = glm::normalize(glm::dvec3(0.3, -1.0, 0.5));
   const glm::dvec3 d(0.0, 1.0, 0.0);
-  EXPECT_DOUBLE_EQ(heapIntensity(cloud, HeapLight{0.3, 0.6}, 0.4, n, to_sun, d, 0.7),
+  EXPECT_DOUBLE_EQ(heapIntensity(cloud, HeapLight{1.0, 0.6}, 0.4, n, to_sun, d, 0.7),
                    gardnerIntensity(cloud.shading, 0.4, n, to_sun, -d));
+  const DiffuseHighlight lit = diffuseHighlight(cloud.shading, n, to_sun, -d);
+  EXPECT_DOUBLE_EQ(heapIntensity(cloud, HeapLight{0.3, 0.6}, 0.4, n, to_sun, d, 0.7),
+                   gardnerIntensity(cloud.shading, 0.3 * lit.diffuse, 0.3 * lit.highlight, 0.4));
 }
 
 TEST(HeapLight, EquationWithSunSkyAndForwardScattering) {

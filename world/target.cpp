@@ -51,9 +51,9 @@ std::optional<double> intersectTriangle(glm::dvec3 o, glm::dvec3 d, glm::dvec3 a
 }  // namespace
 
 glm::dvec3 targetRadiance(const Target& target, glm::dvec3 normal, glm::dvec3 to_sun,
-                          glm::dvec3 to_viewer, const Sun& sun) {
+                          glm::dvec3 to_viewer, const Sun& sun, double sunlight) {
   if (glm::dot(normal, to_viewer) < 0.0) normal = -normal;
-  const double diffuse = std::max(0.0, glm::dot(normal, to_sun));
+  const double diffuse = sunlight * std::max(0.0, glm::dot(normal, to_sun));
   return target.colour * sun.colour * (kTargetAmbient + (1.0 - kTargetAmbient) * diffuse);
 }
 

@@ -245,7 +245,7 @@ bool makeEllipsoidRecord(const Ellipsoid& e, const Camera& camera, bool spotligh
   const double near_bound = centre_distance - std::max({e.radii.x, e.radii.y, e.radii.z});
   out.v[16] = glm::vec4(0.0f, 0.0f, float(near_bound), 0.0f);
   out.v[17] = glm::vec4(0.0f);  // no heap envelope: eq. 8 unchanged (MODEL.md section 14)
-  out.v[18] = glm::vec4(1.0f, 1.0f, 1.0f, 0.0f);
+  out.v[18] = glm::vec4(1.0f, 1.0f, 1.0f, 0.0f);  // w: no shadow from other clouds
   return true;
 }
 
@@ -780,6 +780,7 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
   // The records of members [from, to) in order; each ellipsoid's is its own, so a batch of many
   // is split over up to kRecordThreads threads by members and joined in order: the same
   // records whatever the split.
+  const bool shadowed = sunlight_ && !sunlight_->empty();
   auto recordsOf = [&](std::size_t from, std::size_t to, bool watch) {
     std::vector<Visible> out;
     std::size_t seen = 0;
@@ -796,7 +797,14 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
           continue;
         const HeapEnvelope& e = envelopes[i];
         v.record.v[17] = glm::vec4(row(e.centre - scene.camera.position, e.extinction));
-        v.record.v[18] = glm::vec4(glm::dvec4(1.0 / e.radii, 0.0));
+        // The share of the sunlight the other clouds take, at the lobe's centre (MODEL.md
+        // section 16, "heaps under clouds").
+        const Ellipsoid& lobe = member.ellipsoids[i];
+        const double shadow =
+            shadowed
+                ? 1.0 - sunlight_->at(lobe.centre, &e, lobe.centre.z + verticalHalfExtent(lobe))
+                : 0.0;
+        v.record.v[18] = glm::vec4(glm::dvec4(1.0 / e.radii, shadow));
         out.push_back(v);
       }
     }

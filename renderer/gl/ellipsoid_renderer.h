@@ -16,6 +16,7 @@
 #include "renderer/gl/gpu_pass_timer.h"
 #include "renderer/gl/view_uniforms.h"
 #include "renderer/render_settings.h"
+#include "world/formations/cloud_shadow.h"
 #include "world/scene.h"
 
 namespace nephele {
@@ -65,6 +66,11 @@ class EllipsoidRenderer {
   void drawClouds(const Scene& scene, const std::vector<std::size_t>& indices,
                   const RenderSettings& settings, const FrameTarget& target, bool targets_drawn,
                   const AltitudeBand& band = {});
+
+  // The sunlight the clouds above let through (MODEL.md section 16), which each lobe takes at
+  // its centre, its own heap left out; null or empty: none. It must outlive the frames drawn
+  // with it.
+  void setSunlight(const SceneSunlight* sunlight) { sunlight_ = sunlight; }
 
   // Impostors rendered so far (for measurement and tests).
   int impostorRenders() const { return impostor_renders_; }
@@ -257,6 +263,7 @@ class EllipsoidRenderer {
   std::string continuous_view_;
   std::size_t next_history_ = 0;
   const std::atomic<bool>* cancel_ = nullptr;
+  const SceneSunlight* sunlight_ = nullptr;
   std::function<void()> alive_;
   bool cancelled_ = false;
   FrameStats* stats_ = nullptr;    // the current frame's, borrowed from the GlRenderer

@@ -20,7 +20,8 @@ struct EllipsoidRecord {
   vec4 tile;       // atlas tile: texel origin xy, size zw
   vec4 order;      // z: the nearest a hit on it can be, metres (front-to-back order)
   vec4 envelope;   // its heap's envelope (MODEL.md section 14): centre - eye; w extinction
-  vec4 inv_radii;  // 1 / the envelope's semi-axes
+  vec4 inv_radii;  // 1 / the envelope's semi-axes; w: the share of the sunlight the other
+                   // clouds above take (MODEL.md section 16), at its centre
 };
 // Records live in a buffer texture, kRecordTexels RGBA32F texels each: llvmpipe fetches texels
 // for eight pixels at once, where a storage buffer is read one pixel at a time.
@@ -190,6 +191,9 @@ vec3 surfaceColour(int i, vec3 n, vec3 r, vec3 p, float it, float tr, float dist
                                                   envelopeChord(i, p, vec3(0.0, 0.0, 1.0))));
     direct = exp(-sun_depth);
   }
+  float outside = 1.0 - record(i, 18).w;
+  light.x *= outside;
+  direct *= outside;
   float n_dot_l = dot(n, u_to_sun);
   float diffuse = max((n_dot_l + u_scatter.z) / (1.0 + u_scatter.z), 0.0);
   float sun = light.x;

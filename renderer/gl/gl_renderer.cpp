@@ -659,16 +659,23 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
   stats_.times = times;
   {
     // The ground's cloud shadows (MODEL.md section 16), from the scene's own fields: their
-    // heaps that shadow the view need not be in it.
-    std::optional<CloudShadows> shadows;
-    if (settings.shadow_map_size > 0) {
-      StageClock clock(stats_.times.cpu(CpuStage::kShadows));
-      shadows.emplace(scene, settings.heaps, /*lookups=*/false);
-    }
-    shadow_map_.prepare(shadows ? *shadows : CloudShadows(), scene.camera.position,
-                        settings.shadow_map_size, stats_, timer_);
+    // heaps that shadow the view need not be in it. The same casters, and the casting planes,
+    // shadow the clouds and targets below them, each lobe and target at its centre.
+    StageClock clock(stats_.times.cpu(CpuStage::kShadows));
+    if (settings.shadow_map_size > 0)
+      heap_shadows_.emplace(scene, settings.heaps, /*lookups=*/true);
+    else
+      heap_shadows_.reset();
+    plane_shadows_ = settings.plane_shadows ? PlaneShadows(scene) : PlaneShadows();
+    sunlight_ = {&plane_shadows_, heap_shadows_ ? &*heap_shadows_ : nullptr};
   }
+  shadow_map_.prepare(heap_shadows_ ? *heap_shadows_ : CloudShadows(), scene.camera.position,
+                      settings.shadow_map_size, stats_, timer_);
+  ellipsoids_.setSunlight(&sunlight_);
   drawScene(within ? *within : drawable, rest, format);
+  ellipsoids_.setSunlight(nullptr);
+  sunlight_ = {};
+  plane_shadows_ = {};  // it points into `scene`
   timer_.enter(-1);
   FrameTimes& t = stats_.times;
   t.submit_ms =
@@ -689,7 +696,7 @@ void GlRenderer::drawScene(const Scene& scene, const RenderSettings& settings,
   bool targets = false;
   if (!scene.targets.empty()) {
     GpuPassScope pass(timer_, GpuPass::kTargets);
-    targets = targets_.draw(scene);
+    targets = targets_.draw(scene, sunlight_);
   }
   if (targets) stats_.target_passes = int(scene.targets.size());
   gl_.BindFramebuffer(GL_FRAMEBUFFER, framebuffer_.get());

@@ -140,6 +140,11 @@ class GlRenderer {
   LayerClipmaps clipmaps_;
   TargetRenderer targets_;
   ShadowMap shadow_map_;
+  // The frame's shadows of the clouds on what lies below them (MODEL.md section 16), set while
+  // drawFrame draws.
+  std::optional<CloudShadows> heap_shadows_;
+  PlaneShadows plane_shadows_;
+  SceneSunlight sunlight_;
 };
 
 }  // namespace nephele

@@ -40,6 +40,7 @@ layout(location = 2) out float o_id;
 uniform float u_id;             // 1 + the target's index
 uniform vec3 u_albedo;          // colour times sun colour
 uniform vec3 u_to_sun;
+uniform float u_sunlight;       // the share the clouds above let through (MODEL.md section 16)
 uniform int u_smooth;           // 1: analytic ellipsoid normals, 0: facet normals
 uniform mat3 u_normal_matrix;   // R S^-1
 in vec3 v_position;
@@ -49,7 +50,8 @@ void main() {
   vec3 n = u_smooth != 0 ? u_normal_matrix * v_body : cross(dFdx(v_position), dFdy(v_position));
   n = normalize(n);
   if (dot(n, v_position) > 0.0) n = -n;
-  vec3 colour = u_albedo * (kAmbient + (1.0 - kAmbient) * max(dot(n, u_to_sun), 0.0));
+  vec3 colour =
+      u_albedo * (kAmbient + (1.0 - kAmbient) * u_sunlight * max(dot(n, u_to_sun), 0.0));
   float distance = length(v_position);
   o_colour = vec4(applyAir(colour, v_position / distance, distance), 1.0);
   o_distance = distance;
@@ -131,7 +133,7 @@ const IndexedMesh& TargetRenderer::mesh(const Target& target) {
   return meshes_.emplace(key, uploadMesh(gl_, vertices, indices)).first->second;
 }
 
-bool TargetRenderer::draw(const Scene& scene) {
+bool TargetRenderer::draw(const Scene& scene, const SceneSunlight& sunlight) {
   if (scene.targets.empty()) return false;
   const Camera& camera = scene.camera;
   prepare(camera.width, camera.height);
@@ -172,6 +174,9 @@ bool TargetRenderer::draw(const Scene& scene) {
                                 &normal_matrix[0][0]);
     setUniform3(gl_, p, "u_offset", target.centre - camera.position);
     setUniform3(gl_, p, "u_albedo", target.colour * scene.sun.colour);
+    // A target is small beside a cloud's shadow: it takes the sunlight at its centre.
+    gl_.ProgramUniform1f(p, gl_.GetUniformLocation(p, "u_sunlight"),
+                         float(sunlight.at(target.centre)));
     gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_smooth"),
                          target.shape == TargetShape::kEllipsoid ? 1 : 0);
     const IndexedMesh& m = mesh(target);

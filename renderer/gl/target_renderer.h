@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "renderer/gl/gl_objects.h"
+#include "world/formations/cloud_shadow.h"
 #include "world/scene.h"
 
 namespace nephele {
@@ -16,9 +17,9 @@ class TargetRenderer {
   ~TargetRenderer();
 
   // Draws the scene's targets and binds their colour (fogged, lit) and distance along the
-  // unit view ray (1e30 where none) to the view chunk's texture units. A scene without
-  // targets draws nothing and returns false.
-  bool draw(const Scene& scene);
+  // unit view ray (1e30 where none) to the view chunk's texture units, each lit with the
+  // `sunlight` at its centre. A scene without targets draws nothing and returns false.
+  bool draw(const Scene& scene, const SceneSunlight& sunlight = {});
   // After draw: the distance along each pixel's unit view ray to the nearest target (1e30 where
   // none) and 1 + that target's index (0 where none), rows bottom-up as GL stores them.
   void read(std::vector<float>* distance, std::vector<float>* id) const;

@@ -62,6 +62,7 @@ struct EllipsoidEntry {
   std::size_t cloud;
   double fade;            // in-cloud model: the surface fades as the eye nears it
   HeapEnvelope envelope;  // MODEL.md section 14
+  double top;             // its highest point's altitude
 };
 
 class ReferenceTracer {
@@ -80,7 +81,9 @@ class ReferenceTracer {
         EllipsoidView view(scene.clouds[c].ellipsoids[i], scene.camera.position);
         if (view.eyeInside()) continue;  // MODEL.md section 4: no surface to show
         const double fade = surfaceFade(view.eyeRadius());
-        if (fade > 0.0) ellipsoids_.push_back({view, c, fade, envelopes[i]});
+        const Ellipsoid& e = scene.clouds[c].ellipsoids[i];
+        if (fade > 0.0)
+          ellipsoids_.push_back({view, c, fade, envelopes[i], e.centre.z + verticalHalfExtent(e)});
       }
     }
     veil_ = inCloudVeil(
@@ -97,11 +100,9 @@ class ReferenceTracer {
     double nearest_opaque =
         std::min(direction.z < 0.0 ? eye.z / -direction.z : kInfinity, max_distance);
     glm::dvec3 colour = skyBackground(scene_.sky, direction);
-    if (direction.z < 0.0 && ((shadows_ && !shadows_->empty()) || !casting_.empty())) {
+    if (direction.z < 0.0 && !sunlight_.empty()) {
       const glm::dvec3 ground = eye + (eye.z / -direction.z) * direction;
-      double sun = planesSunlight({ground.x, ground.y, 0.0});
-      if (shadows_ && !shadows_->empty()) sun *= shadows_->sunlight(glm::dvec2(ground));
-      colour *= groundLight(sun);
+      colour *= groundLight(sunlight_.at({ground.x, ground.y, 0.0}));
     }
     int object_id = 0;
     for (std::size_t t = 0; t < scene_.targets.size(); ++t) {
@@ -110,7 +111,9 @@ class ReferenceTracer {
       if (!hit || hit->distance >= nearest_opaque) continue;
       nearest_opaque = hit->distance;
       object_id = int(t) + 1;
-      colour = targetRadiance(target, hit->normal, sun_, -direction, scene_.sun);
+      // In the clouds' shadows (MODEL.md section 16) where the ray meets it.
+      colour = targetRadiance(target, hit->normal, sun_, -direction, scene_.sun,
+                              sunlight_.at(eye + hit->distance * direction));
     }
     colour = withAir(colour, direction, nearest_opaque);
 
@@ -195,11 +198,11 @@ class ReferenceTracer {
     // Shadows from the planes above, and from the heaps where every one lies above (MODEL.md
     // section 16, "planes under heaps": the ground's sunlight where the sun's ray lands).
     const glm::dvec3 at(p.x, p.y, layer.altitude_m);
-    double sun = casting_.empty() ? 1.0 : planesSunlight(at);
+    double sun = planes_.sunlight(at);
     const bool under_heaps =
         shadows_ && !shadows_->empty() && layer.altitude_m <= shadows_->floor();
     if (under_heaps) sun *= shadows_->sunlight(sunCrossing(at, 0.0, sun_));
-    const double shadow = casting_.empty() && !under_heaps ? 1.0 : groundLight(sun);
+    const double shadow = planes_.empty() && !under_heaps ? 1.0 : groundLight(sun);
     return {s, withAir(shadow * intensity * layer.colour * scene_.sun.colour, direction, s),
             1.0 - tr, s};
   }
@@ -213,23 +216,6 @@ class ReferenceTracer {
         base, layerRegionWeight(layer, xy, scene_.time_s, glm::dvec2(scene_.camera.position)));
   }
 
-  // The share of the sunlight the casting planes above p let through (MODEL.md section 16,
-  // "sky planes"): each plane's translucence where the sun's ray through p crosses it, its
-  // threshold taken with the sun's direction as the view's (a far deck's cover). p.z is the
-  // receiving plane's own altitude (0 for the ground), so that a plane never shadows itself.
-  double planesSunlight(glm::dvec3 p) const {
-    double light = 1.0;
-    for (std::size_t i : casting_) {
-      const CloudLayer& layer = scene_.layers[i];
-      if (!(layer.altitude_m > p.z)) continue;
-      const glm::dvec2 q = sunCrossing(p, layer.altitude_m, sun_);
-      const double t1 = layerThreshold(layer, q, sun_);
-      if (t1 >= 1.0) continue;
-      light *= skyPlaneTranslucence(textures_[i].value(q, scene_.time_s), t1, layer.transition);
-    }
-    return light;
-  }
-
   Surface ellipsoidSurface(const EllipsoidEntry& entry, glm::dvec3 direction, double s) const {
     const EllipsoidCloud& cloud = scene_.clouds[entry.cloud];
     const glm::dvec3 p = scene_.camera.position + s * direction;
@@ -240,8 +226,13 @@ class ReferenceTracer {
     glm::dvec3 normal = entry.view.normalAt(direction, s);
     if (glm::dot(normal, direction) > 0.0) normal = -normal;
     normal = heapLitNormal(entry.envelope, p, normal);
-    const double intensity = heapIntensity(cloud, heapLightAt(entry.envelope, p, normal, sun_), t,
-                                           normal, sun_, direction, tr);
+    // The heap's own light, and the sunlight the other clouds above let through (MODEL.md
+    // sections 14 and 16).
+    HeapLight light = heapLightAt(entry.envelope, p, normal, sun_);
+    const double outside = sunlight_.at(p, &entry.envelope, entry.top);
+    light.sun *= outside;
+    light.direct *= outside;
+    const double intensity = heapIntensity(cloud, light, t, normal, sun_, direction, tr);
     return {s, withAir(intensity * cloud.colour * scene_.sun.colour, direction, s),
             (1.0 - tr) * entry.fade, s};
   }
@@ -335,7 +326,8 @@ class ReferenceTracer {
   std::vector<EllipsoidEntry> ellipsoids_;
   Veil veil_;
   std::optional<Fog> layer_veil_ = inLayerVeil(scene_);  // the camera's, once per frame
-  std::vector<std::size_t> casting_ = castingPlanes(scene_);
+  PlaneShadows planes_{scene_};
+  SceneSunlight sunlight_{&planes_, shadows_};
   PrecipitationMedia precipitation_ = precipitationMedia(scene_);
 };
 

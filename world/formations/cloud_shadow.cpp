@@ -174,17 +174,43 @@ void CloudShadows::footprint(const ShadowCaster& caster, glm::dvec2& lo, glm::dv
   hi = centre + half;
 }
 
-double CloudShadows::sunlight(glm::dvec2 ground) const {
-  if (casters_.empty() || ground.x < lo_.x || ground.y < lo_.y || ground.x > hi_.x ||
-      ground.y > hi_.y)
+double CloudShadows::sunlightAt(glm::dvec3 p, const HeapEnvelope* own) const {
+  if (casters_.empty() || grid_.empty()) return 1.0;
+  // Every point of the sun's line through p lands on the ground where p's does.
+  const glm::dvec2 ground = p.z == 0.0 ? glm::dvec2(p) : sunCrossing(p, 0.0, to_sun_);
+  if (!(ground.x >= lo_.x && ground.y >= lo_.y && ground.x <= hi_.x && ground.y <= hi_.y))
     return 1.0;
   const glm::ivec2 c =
       glm::clamp(glm::ivec2(glm::floor((ground - lo_) / cell_)), glm::ivec2(0), cells_ - 1);
   double light = 1.0;
-  const glm::dvec3 p(ground, 0.0);
   for (int i : grid_[std::size_t(c.y) * cells_.x + c.x]) {
     const ShadowCaster& caster = casters_[std::size_t(i)];
+    if (own && insideEnvelope(*own, caster.centre)) continue;
     light *= casterSunlight(caster, tables_[std::size_t(caster.table)], p, to_sun_);
+  }
+  return light;
+}
+
+PlaneShadows::PlaneShadows(const Scene& scene)
+    : to_sun_(sunDirection(scene.sun)),
+      time_s_(scene.time_s),
+      eye_(scene.camera.position) {
+  for (std::size_t i : castingPlanes(scene))
+    planes_.push_back({&scene.layers[i], LayerTexture(scene.layers[i].texture)});
+}
+
+double PlaneShadows::sunlight(glm::dvec3 p, double top) const {
+  double light = 1.0;
+  for (const Plane& plane : planes_) {
+    const CloudLayer& layer = *plane.layer;
+    if (!(layer.altitude_m > p.z) || !(layer.altitude_m > top)) continue;
+    const glm::dvec2 q = sunCrossing(p, layer.altitude_m, to_sun_);
+    // A casting plane is no far deck (castingPlanes): its threshold is its own, raised by its
+    // region's weight (MODEL.md section 11).
+    const double t1 =
+        regionThreshold(layer.threshold, layerRegionWeight(layer, q, time_s_, eye_));
+    if (t1 >= 1.0) continue;
+    light *= skyPlaneTranslucence(plane.texture.value(q, time_s_), t1, layer.transition);
   }
   return light;
 }

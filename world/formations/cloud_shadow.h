@@ -12,9 +12,12 @@
 
 #include "world/formations/cloud_field.h"
 #include "world/formations/ellipsoid_cloud.h"
+#include "world/formations/heap_light.h"
+#include "world/textures/layer_texture.h"
 
 namespace nephele {
 
+struct CloudLayer;
 struct Scene;
 
 // The mean opacity C(g) of a cloud's surface over its texture's values, at limb values
@@ -105,7 +108,13 @@ class CloudShadows {
 
   // The share of the sunlight reaching ground point (x, y, 0): the product of casterSunlight
   // over every caster. Only when made with `lookups`.
-  double sunlight(glm::dvec2 ground) const;
+  double sunlight(glm::dvec2 ground) const { return sunlightAt({ground, 0.0}); }
+  // The same at any point p, from the casters on p's ray to the sun above it: those along the
+  // sun's line through p (the grid cell where it lands on the ground), each counted for its
+  // chord beyond p. `own`, if given, is the envelope of the heap p lies on: casters whose
+  // centre lies inside it are its own lobes, which light it through heapLightAt, and are left
+  // out (MODEL.md section 16, "heaps under clouds").
+  double sunlightAt(glm::dvec3 p, const HeapEnvelope* own = nullptr) const;
 
  private:
   glm::dvec3 to_sun_{0.0, 0.0, 1.0};
@@ -117,6 +126,47 @@ class CloudShadows {
   double cell_ = 1.0;
   glm::ivec2 cells_{0};
   std::vector<std::vector<int>> grid_;
+};
+
+// The sky planes' shadows (MODEL.md section 16, "sky planes"): the casting planes
+// (castingPlanes) with their textures, for the share of the sunlight they let through to any
+// point below them.
+class PlaneShadows {
+ public:
+  PlaneShadows() = default;  // none
+  explicit PlaneShadows(const Scene& scene);
+
+  bool empty() const { return planes_.empty(); }
+  // The product over the casting planes above p (altitude above p.z, so that a plane never
+  // shadows itself, and above `top`) of the plane's translucence where the sun's ray through p
+  // crosses it, its threshold taken with the sun's direction as the view's.
+  double sunlight(glm::dvec3 p, double top = -std::numeric_limits<double>::infinity()) const;
+
+ private:
+  struct Plane {
+    const CloudLayer* layer;
+    LayerTexture texture;
+  };
+  std::vector<Plane> planes_;
+  glm::dvec3 to_sun_{0.0, 0.0, 1.0};
+  double time_s_ = 0.0;
+  glm::dvec2 eye_{0.0};
+};
+
+// The sunlight reaching a point of the scene through the clouds above it (MODEL.md section 16):
+// the planes' share times the heaps' (either may be missing). The scene the planes were made
+// from must outlive it.
+struct SceneSunlight {
+  const PlaneShadows* planes = nullptr;
+  const CloudShadows* heaps = nullptr;
+  bool empty() const { return (!planes || planes->empty()) && (!heaps || heaps->empty()); }
+  // At point p of anything but a lobe: the ground, a plane, a target.
+  double at(glm::dvec3 p) const { return at(p, nullptr, p.z); }
+  // At point p of a lobe, whose heap's envelope is `own` and whose highest point is `top`: a
+  // plane it reaches through does not shadow it.
+  double at(glm::dvec3 p, const HeapEnvelope* own, double top) const {
+    return (planes ? planes->sunlight(p, top) : 1.0) * (heaps ? heaps->sunlightAt(p, own) : 1.0);
+  }
 };
 
 }  // namespace nephele

@@ -45,6 +45,12 @@ struct SecondMoments {
   std::optional<Ellipsoid> ellipsoid() const;
 };
 
+// Whether point p lies inside the envelope (on its surface included).
+inline bool insideEnvelope(const HeapEnvelope& envelope, glm::dvec3 p) {
+  const glm::dvec3 o = (p - envelope.centre) / envelope.radii;
+  return glm::dot(o, o) <= 1.0;
+}
+
 // Length of the ray p + s dir (dir unit, s >= 0) inside the envelope, metres.
 double envelopeChord(const HeapEnvelope& envelope, glm::dvec3 p, glm::dvec3 dir);
 
@@ -71,7 +77,8 @@ HeapLight heapLightAt(const HeapEnvelope& envelope, glm::dvec3 p, glm::dvec3 nor
 //   I = (1 - a){(1 - t)[(1 - s) S Id' + s S Is] + t It} + a K + S P(cos theta) / (4 pi) TR,
 // P the Cornette-Shanks phase function with the droplets' asymmetry, cos theta = d . to_sun
 // for the view direction d, TR the surface's translucence (Gardner eq. 11). With the cloud's
-// light_extinction 0 it is eq. 8 unchanged.
+// light_extinction 0 it is eq. 8 with its sun terms times S (the sunlight the clouds above let
+// through, MODEL.md section 16; 1 unshadowed).
 double heapIntensity(const EllipsoidCloud& cloud, const HeapLight& light, double texture_value,
                      glm::dvec3 normal, glm::dvec3 to_sun, glm::dvec3 direction,
                      double translucence);
