@@ -356,11 +356,11 @@ void printCumulonimbusFigures(GlRenderer& renderer, const SceneFile& file, const
   // on the tower's face in the view above with the sun behind the camera (the tower's rows from
   // its foot to 0.45 of its height, within its width there); medians over opaque pixels, without
   // the haze (120 km of it would stand for the cloud's own light).
-  auto ownMedian = [&](Scene view, auto inside) {
+  auto ownMedian = [&](Scene view, auto inside, const RenderSettings& settings) {
     view.haze.reset();
-    const FloatImage frame = renderer.renderFloat(view, file.render);
+    const FloatImage frame = renderer.renderFloat(view, settings);
     view.clouds.clear();
-    const FloatImage sky = renderer.renderFloat(view, file.render);
+    const FloatImage sky = renderer.renderFloat(view, settings);
     std::vector<double> own;
     for (int y = 0; y < view.camera.height; ++y)
       for (int x = 0; x < view.camera.width; ++x)
@@ -370,19 +370,28 @@ void printCumulonimbusFigures(GlRenderer& renderer, const SceneFile& file, const
   };
   Scene lit = scene;
   lit.sun.azimuth_deg = glm::degrees(std::atan2(-forward.x, -forward.y));
-  const auto [face, face_px] = ownMedian(lit, [&](int x, int y) {
+  auto onFace = [&](int x, int y) {
     return y >= mid_row && y <= bottom && x >= tower_lo && x <= tower_hi;
-  });
+  };
+  const auto [face, face_px] = ownMedian(lit, onFace, file.render);
+  // The same without the heaps' shadows (shadow_map_size 0): the tower's own light alone, where
+  // the anvil's upwind overhang does not shadow its face.
+  RenderSettings unshadowed = file.render;
+  unshadowed.shadow_map_size = 0;
+  const double own_face = ownMedian(lit, onFace, unshadowed).first;
   Scene up = scene;
   up.camera.position = base + glm::dvec3(0.0, 0.0, 2.0 - base.z);
   up.camera.orientation = {0.0, 90.0, 0.0};
   up.camera.vfov_deg = 20.0;
   up.camera.width = up.camera.height = 64;
-  const auto [under, under_px] = ownMedian(up, [](int, int) { return true; });
+  const auto [under, under_px] = ownMedian(
+      up, [](int, int) { return true; }, file.render);
   std::printf(
       "  cumulonimbus base from below %.3f (%zu px), sunlit tower %.3f (%zu px, sun behind the "
-      "camera): ratio %.2f (aim at most 0.3)\n",
-      under, under_px, face, face_px, under / std::max(face, 1e-9));
+      "camera): ratio %.2f (aim at most 0.3); without the heaps' shadows on the tower %.3f, "
+      "ratio %.2f\n",
+      under, under_px, face, face_px, under / std::max(face, 1e-9), own_face,
+      under / std::max(own_face, 1e-9));
 }
 
 // Rain shafts (issue 47 item 5; MODEL.md section 17): the field's typical heap raining at 1, 4

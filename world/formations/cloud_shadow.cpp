@@ -147,21 +147,37 @@ CloudShadows::CloudShadows(const Scene& scene, const HeapDrawing& heaps, bool lo
     hi_ = glm::max(hi_, b);
   }
   if (!lookups) return;
-  // Cells of at least 200 m, at most 512 a side.
+  // Cells of at least 200 m, at most 512 a side, and at least a quarter of the mean footprint's
+  // side, so that a caster is listed in about 25 cells at most (a cumulonimbus's anvil lobes
+  // throw footprints of 10 km).
   const glm::dvec2 extent = hi_ - lo_;
-  cell_ = std::max({200.0, extent.x / 512.0, extent.y / 512.0});
+  double mean_side = 0.0;
+  for (const ShadowCaster& caster : casters_) mean_side += 2.0 * caster.reach / to_sun_.z;
+  mean_side /= double(casters_.size());
+  cell_ = std::max({200.0, extent.x / 512.0, extent.y / 512.0, 0.25 * mean_side});
   cells_ = glm::max(glm::ivec2(glm::ceil(extent / cell_)), glm::ivec2(1));
-  grid_.assign(std::size_t(cells_.x) * cells_.y, {});
-  for (std::size_t i = 0; i < casters_.size(); ++i) {
-    glm::dvec2 a, b;
-    footprint(casters_[i], a, b);
-    const glm::ivec2 c0 =
-        glm::clamp(glm::ivec2(glm::floor((a - lo_) / cell_)), glm::ivec2(0), cells_ - 1);
-    const glm::ivec2 c1 =
-        glm::clamp(glm::ivec2(glm::floor((b - lo_) / cell_)), glm::ivec2(0), cells_ - 1);
-    for (int y = c0.y; y <= c1.y; ++y)
-      for (int x = c0.x; x <= c1.x; ++x) grid_[std::size_t(y) * cells_.x + x].push_back(int(i));
-  }
+  first_.assign(std::size_t(cells_.x) * cells_.y + 1, 0);
+  auto each = [&](auto visit) {
+    for (std::size_t i = 0; i < casters_.size(); ++i) {
+      glm::ivec2 c0, c1;
+      footprintCells(casters_[i], c0, c1);
+      for (int y = c0.y; y <= c1.y; ++y)
+        for (int x = c0.x; x <= c1.x; ++x) visit(std::size_t(y) * cells_.x + x, int(i));
+    }
+  };
+  each([&](std::size_t k, int) { ++first_[k + 1]; });
+  for (std::size_t k = 1; k < first_.size(); ++k) first_[k] += first_[k - 1];
+  listed_.resize(std::size_t(first_.back()));
+  std::vector<int> next(first_.begin(), first_.end() - 1);
+  each([&](std::size_t k, int i) { listed_[std::size_t(next[k]++)] = i; });
+}
+
+void CloudShadows::footprintCells(const ShadowCaster& caster, glm::ivec2& c0,
+                                  glm::ivec2& c1) const {
+  glm::dvec2 a, b;
+  footprint(caster, a, b);
+  c0 = glm::clamp(glm::ivec2(glm::floor((a - lo_) / cell_)), glm::ivec2(0), cells_ - 1);
+  c1 = glm::clamp(glm::ivec2(glm::floor((b - lo_) / cell_)), glm::ivec2(0), cells_ - 1);
 }
 
 void CloudShadows::footprint(const ShadowCaster& caster, glm::dvec2& lo, glm::dvec2& hi) const {
@@ -175,7 +191,7 @@ void CloudShadows::footprint(const ShadowCaster& caster, glm::dvec2& lo, glm::dv
 }
 
 double CloudShadows::sunlightAt(glm::dvec3 p, const HeapEnvelope* own) const {
-  if (casters_.empty() || grid_.empty()) return 1.0;
+  if (casters_.empty() || first_.empty()) return 1.0;
   // Every point of the sun's line through p lands on the ground where p's does.
   const glm::dvec2 ground = p.z == 0.0 ? glm::dvec2(p) : sunCrossing(p, 0.0, to_sun_);
   if (!(ground.x >= lo_.x && ground.y >= lo_.y && ground.x <= hi_.x && ground.y <= hi_.y))
@@ -183,8 +199,9 @@ double CloudShadows::sunlightAt(glm::dvec3 p, const HeapEnvelope* own) const {
   const glm::ivec2 c =
       glm::clamp(glm::ivec2(glm::floor((ground - lo_) / cell_)), glm::ivec2(0), cells_ - 1);
   double light = 1.0;
-  for (int i : grid_[std::size_t(c.y) * cells_.x + c.x]) {
-    const ShadowCaster& caster = casters_[std::size_t(i)];
+  const std::size_t k = std::size_t(c.y) * cells_.x + c.x;
+  for (int n = first_[k]; n < first_[k + 1]; ++n) {
+    const ShadowCaster& caster = casters_[std::size_t(listed_[std::size_t(n)])];
     if (own && insideEnvelope(*own, caster.centre)) continue;
     light *= casterSunlight(caster, tables_[std::size_t(caster.table)], p, to_sun_);
   }
@@ -192,9 +209,7 @@ double CloudShadows::sunlightAt(glm::dvec3 p, const HeapEnvelope* own) const {
 }
 
 PlaneShadows::PlaneShadows(const Scene& scene)
-    : to_sun_(sunDirection(scene.sun)),
-      time_s_(scene.time_s),
-      eye_(scene.camera.position) {
+    : to_sun_(sunDirection(scene.sun)), time_s_(scene.time_s), eye_(scene.camera.position) {
   for (std::size_t i : castingPlanes(scene))
     planes_.push_back({&scene.layers[i], LayerTexture(scene.layers[i].texture)});
 }
@@ -207,8 +222,7 @@ double PlaneShadows::sunlight(glm::dvec3 p, double top) const {
     const glm::dvec2 q = sunCrossing(p, layer.altitude_m, to_sun_);
     // A casting plane is no far deck (castingPlanes): its threshold is its own, raised by its
     // region's weight (MODEL.md section 11).
-    const double t1 =
-        regionThreshold(layer.threshold, layerRegionWeight(layer, q, time_s_, eye_));
+    const double t1 = regionThreshold(layer.threshold, layerRegionWeight(layer, q, time_s_, eye_));
     if (t1 >= 1.0) continue;
     light *= skyPlaneTranslucence(plane.texture.value(q, time_s_), t1, layer.transition);
   }

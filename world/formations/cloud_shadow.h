@@ -122,10 +122,13 @@ class CloudShadows {
   std::vector<ShadowTable> tables_;
   glm::dvec2 lo_{0.0}, hi_{0.0};
   double floor_ = std::numeric_limits<double>::infinity();
-  // A grid over [lo, hi] listing the casters whose footprint meets each cell.
+  // A grid over [lo, hi] listing the casters whose footprint meets each cell: cell k's are
+  // listed_[first_[k]] to listed_[first_[k + 1]] (one array, filled in two passes).
   double cell_ = 1.0;
   glm::ivec2 cells_{0};
-  std::vector<std::vector<int>> grid_;
+  std::vector<int> first_, listed_;
+  // The cells caster i's footprint meets, [c0, c1].
+  void footprintCells(const ShadowCaster& caster, glm::ivec2& c0, glm::ivec2& c1) const;
 };
 
 // The sky planes' shadows (MODEL.md section 16, "sky planes"): the casting planes
