@@ -166,6 +166,11 @@ std::string entityName(std::uint16_t id) {
 
 }  // namespace
 
+LocalFrame Session::databaseOf(const State& state) {
+  const glm::dvec2 site = state.site.value_or(glm::dvec2(0.0));
+  return LocalFrame(site.x, site.y);
+}
+
 std::optional<Session::Pose> Session::poseOf(const State& state, std::uint16_t id,
                                              int depth) const {
   const auto it = state.entities.find(id);
@@ -183,7 +188,7 @@ std::optional<Session::Pose> Session::poseOf(const State& state, std::uint16_t i
         parent->attitude * own};
   }
   if (e.attached) return std::nullopt;  // attached to itself, or a chain deeper than 16
-  return Pose{database_.toLocal({e.latitude, e.longitude, e.altitude}), own};
+  return Pose{databaseOf(state).toLocal({e.latitude, e.longitude, e.altitude}), own};
 }
 
 std::variant<Session::State, Refusal> Session::next(const Message& message,
@@ -224,6 +229,33 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
           "not applied");
     return s;
   }
+  // With no [site] the host's first position on the Earth sets the database origin (docs/CIGI.md,
+  // "Where the database lies"): the ownship's, else the message's first active entity or region
+  // placed by latitude and longitude, whatever the packets' order.
+  if (!s.site) {
+    std::optional<glm::dvec2> ownship, other;
+    auto onEarth = [](double latitude, double longitude) {
+      return std::isfinite(latitude) && std::isfinite(longitude) && std::abs(latitude) <= 90.0 &&
+             std::abs(longitude) <= 360.0;
+    };
+    for (std::size_t i = 1; i < message.packets.size(); ++i) {
+      const Packet& packet = message.packets[i];
+      if (const auto* e = std::get_if<EntityControl>(&packet)) {
+        if (e->attached || !onEarth(e->latitude, e->longitude)) continue;
+        const glm::dvec2 place(e->latitude, std::remainder(e->longitude, 360.0));
+        if (e->entity_id == 0)
+          ownship = place;
+        else if (!other && e->state == EntityState::kActive)
+          other = place;
+      } else if (const auto* r = std::get_if<EnvironmentalRegionControl>(&packet)) {
+        if (!other && r->state == RegionState::kActive && regionControlError(*r).empty())
+          other = glm::dvec2(r->latitude, std::remainder(r->longitude, 360.0));
+      }
+    }
+    s.site = ownship ? ownship : other;
+    frame.site_adopted = s.site;
+  }
+  const LocalFrame database = databaseOf(s);
   // A packet with a value out of range is refused alone; the frame's other packets apply.
   auto bad = [&](std::string what) { frame.refused.push_back(std::move(what)); };
   bool views_moved = false;
@@ -390,7 +422,7 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
         continue;
       }
       WeatherLayer& drawn = std::get<WeatherLayer>(layer);
-      drawn.region = regionOf(region->second, database_);
+      drawn.region = regionOf(region->second, database);
       frame.commands.emplace_back(command::SetWeather{w->layer, drawn, w->entity_region_id});
     } else if (const auto* e = std::get_if<EnvironmentalRegionControl>(&packet)) {
       const std::uint16_t id = e->region_id;
@@ -401,7 +433,7 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
       if (!active && last == s.regions.end() && e->state != RegionState::kDestroyed) continue;
       if (active) {
         std::string error = regionControlError(*e);
-        if (error.empty()) error = regionError(regionOf(*e, database_));
+        if (error.empty()) error = regionError(regionOf(*e, database));
         if (!error.empty()) {
           bad(where + ": " + error);
           continue;
@@ -425,7 +457,7 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
         command::SetWeather c{it->first.layer, {}, id};
         if (active) {
           c.weather = std::get<WeatherLayer>(cloudLayerOf(it->second));  // checked when stored
-          c.weather.region = regionOf(*e, database_);
+          c.weather.region = regionOf(*e, database);
         }
         frame.commands.emplace_back(c);
         it = e->state == RegionState::kDestroyed ? s.regional_weather.erase(it) : std::next(it);
@@ -480,7 +512,7 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
   // The sun of the host's date where the ownship is (MODEL.md section 13), not at the site: a
   // long flight sees it move.
   if (s.celestial) {
-    glm::dvec2 place(settings_.latitude_deg, settings_.longitude_deg);
+    glm::dvec2 place = s.site.value_or(glm::dvec2(0.0));
     if (const auto own = s.entities.find(0);
         own != s.entities.end() && !own->second.packet.attached)
       place = {own->second.packet.latitude, std::remainder(own->second.packet.longitude, 360.0)};

@@ -18,7 +18,9 @@
 namespace nephele::cigi {
 
 struct SessionSettings {
-  double latitude_deg = 0.0, longitude_deg = 0.0;         // the database origin ([site])
+  // The database origin's latitude and longitude ([site]); none: the host's first position
+  // sets it (Session::next).
+  std::optional<glm::dvec2> site;
   std::vector<std::string> views;                         // view id n is views[n]
   std::vector<std::pair<int, std::string>> entity_types;  // CIGI entity type -> [[entity_type]]
   double default_frame_s = 1.0 / 60.0;  // host frame time when the timestamps do not tell
@@ -31,6 +33,9 @@ struct HostFrame {
   double dt_s = 0.0;                 // the host's frame time, by which a lockstep world advances
   std::vector<std::string> ignored;  // packets or fields not supported, with why
   std::vector<std::string> refused;  // packets refused for a value out of range, with why
+  // The database origin this frame took from the host (latitude, longitude), with no [site]
+  // configured: once per session.
+  std::optional<glm::dvec2> site_adopted;
 };
 
 // A message the session refuses as a whole (nothing of it is applied): "out_of_order" (late or
@@ -55,9 +60,9 @@ inline constexpr int kRestartRunBehind = 3, kRestartRunElsewhere = 2;
 
 class Session {
  public:
-  explicit Session(SessionSettings settings)
-      : settings_(std::move(settings)),
-        database_(settings_.latitude_deg, settings_.longitude_deg) {}
+  explicit Session(SessionSettings settings) : settings_(std::move(settings)) {
+    if (settings_.site) state_.site = *settings_.site;
+  }
 
   // Turns a decoded host message into commands, and keeps the state they lead to. The session
   // takes that state only once the daemon has applied the frame (commit), so that a refused
@@ -106,14 +111,17 @@ class Session {
     std::optional<AtmosphereControl> atmosphere;
     std::optional<CelestialSphereControl> celestial;
     std::optional<glm::dvec2> sun_place;  // latitude, longitude the sun was last placed for
+    // The database origin (latitude, longitude): [site], or the host's first position.
+    std::optional<glm::dvec2> site;
   };
   std::variant<State, Refusal> next(const Message& message, HostFrame& frame) const;
   std::optional<Pose> poseOf(const State& state, std::uint16_t entity, int depth = 0) const;
 
+  // Geodetic positions to the database's east, north, up metres about the state's site (MODEL.md
+  // section 13); about 0 N 0 E while it has none, when nothing geodetic has come yet.
+  static LocalFrame databaseOf(const State& state);
+
   SessionSettings settings_;
-  // Geodetic positions to the database's east, north, up metres about [site] (MODEL.md
-  // section 13).
-  LocalFrame database_;
   State state_;
   std::optional<State> pending_;  // after the last frame mapped, until commit
 };

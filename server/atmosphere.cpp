@@ -29,8 +29,9 @@ Outcome Engine::setSun(const command::SetSun& c) {
   State& s = *state_;
   Sun sun = s.world->base().sun;
   if (c.utc) {
-    const glm::dvec2 place =
-        c.place.value_or(glm::dvec2(config_.site.latitude_deg, config_.site.longitude_deg));
+    const glm::dvec2 place = c.place.value_or(
+        config_.site ? glm::dvec2(config_.site->latitude_deg, config_.site->longitude_deg)
+                     : glm::dvec2(0.0));
     const SolarPosition p = solarPosition(*c.utc, place.x, place.y);
     sun.azimuth_deg = p.azimuth_deg;
     sun.elevation_deg = p.elevation_deg;

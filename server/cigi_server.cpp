@@ -16,8 +16,7 @@ constexpr std::size_t kMaxWaiting = 64;  // datagrams held while one is with the
 
 cigi::SessionSettings sessionSettings(const DaemonConfig& config) {
   cigi::SessionSettings s;
-  s.latitude_deg = config.site.latitude_deg;
-  s.longitude_deg = config.site.longitude_deg;
+  if (config.site) s.site = glm::dvec2(config.site->latitude_deg, config.site->longitude_deg);
   s.views = config.cigi.views;
   for (const EntityType& t : config.entity_types) s.entity_types.emplace_back(t.id, t.name);
   s.default_frame_s = 1.0 / config.tick_rate_hz;
@@ -108,6 +107,11 @@ void CigiServer::next() {
     spdlog::debug("event=cigi_ignored what=\"{}\"", what);
   }
   for (const std::string& what : frame.refused) refuse("bad_value", what, d.from);
+  if (frame.site_adopted)
+    spdlog::info(
+        "event=cigi_site latitude={:.6f} longitude={:.6f} what=\"no [site] configured: the "
+        "database origin is the host's first position\"",
+        frame.site_adopted->x, frame.site_adopted->y);
   const std::uint8_t status =
       frame.refused.empty() ? cigi::IgStatus::kApplied : cigi::IgStatus::kPacketsRefused;
   // Synchronous (lockstep) mode: the world advances by the host's frame time, and the tick

@@ -140,8 +140,9 @@ void readDaemon(const toml::table& root, const std::string& file, DaemonConfig& 
     for (const ViewConfig& v : out.views) out.cigi.views.push_back(v.name);
   if (auto s = t.table("site")) {
     s->allow({"latitude", "longitude"});
-    s->number("latitude", out.site.latitude_deg, Limits::kLatitude);
-    s->number("longitude", out.site.longitude_deg, Limits::kLongitude);
+    Site& site = out.site.emplace();
+    s->number("latitude", site.latitude_deg, Limits::kLatitude);
+    s->number("longitude", site.longitude_deg, Limits::kLongitude);
     s->finish();
   }
   for (TableReader& e : t.tables("entity_type")) {

@@ -4,6 +4,7 @@
 // allowed.
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -98,7 +99,9 @@ struct DaemonConfig {
   }
 
   CigiConfig cigi;
-  Site site;
+  // [site]: where the database origin lies on the Earth. None: a CIGI host's first position sets
+  // it, and the sun of a date given without a place is at 0 N 0 E.
+  std::optional<Site> site;
   std::vector<EntityType> entity_types;  // [[entity_type]]: targets by CIGI type or name
 
   std::string output_directory = "frames";  // images written by the Modbus render coil

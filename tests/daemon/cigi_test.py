@@ -184,16 +184,14 @@ class CigiTest(DaemonTest):
         self.host.close()
         super().tearDown()
 
-    def start(self, mode="lockstep"):
+    def start(self, mode="lockstep", site=True):
+        site_table = f"[site]\nlatitude = {SITE[0]}\nlongitude = {SITE[1]}\n" if site else ""
         d = self.daemon(mode=mode, extra=f'''[cigi]
 enabled = true
 ig_port = 0
 host_port = {self.host_port}
 views = ["front", "left"]
-[site]
-latitude = {SITE[0]}
-longitude = {SITE[1]}
-[[entity_type]]
+{site_table}[[entity_type]]
 id = {ENTITY_TYPE}
 name = "rib"
 shape = "box"
@@ -348,6 +346,36 @@ size = [4, 2, 1]
             self.assertAlmostEqual(front["position"][0], east, delta=1e-3, msg=f"{km} km")
             self.assertAlmostEqual(front["position"][1], north, delta=1e-3, msg=f"{km} km")
             self.assertEqual(front["position"][2], up)
+
+    def test_without_a_site_the_hosts_first_position_is_the_origin(self):
+        """Issue 48, item 1: with no [site] the first message that places the ownship sets the
+        database origin, for every position in it whatever the packets' order (a target sent
+        before the ownship here); later motion is measured about it, 211.2 m flown north at 45 N
+        is 211.2 m in the database, and the daemon says where the origin is."""
+        d = self.start(site=False)
+        c = d.client()
+        origin = (45.0, 7.0)
+        rib = (45.01, 7.02)
+        self.frame(entity_control(5, *rib, 0.0), entity_control(0, *origin, 3000.0), frame=1)
+        front = c.ok({"cmd": "get_view", "view": "front"})
+        self.assertAlmostEqual(front["position"][0], 0.0, delta=1e-6)
+        self.assertAlmostEqual(front["position"][1], 0.0, delta=1e-6)
+        self.assertEqual(front["position"][2], 3000.0)
+        targets = {t["name"]: t for t in c.ok({"cmd": "list_targets"})["targets"]}
+        east, north, _ = enu(*rib, 0.0, *origin)
+        self.assertAlmostEqual(targets["cigi-5"]["centre"][0], east, delta=1e-3)
+        self.assertAlmostEqual(targets["cigi-5"]["centre"][1], north, delta=1e-3)
+        # 211.2 m north along the meridian (the issue's flight, which moved the view 149.3 m
+        # with the origin at 0 N 0 E).
+        lat = origin[0] + 211.2 / 111131.745
+        self.frame(entity_control(0, lat, origin[1], 3000.0), frame=2)
+        front = c.ok({"cmd": "get_view", "view": "front"})
+        east, north, _ = enu(lat, origin[1], 3000.0, *origin)
+        self.assertAlmostEqual(front["position"][1], north, delta=1e-3)
+        self.assertAlmostEqual(front["position"][1], 211.2, delta=0.2)
+        self.assertAlmostEqual(front["position"][0], 0.0, delta=1e-3)
+        self.assertEqual(d.log_text().count("event=cigi_site"), 1)
+        self.assertIn("latitude=45.000000 longitude=7.000000", d.log_text())
 
     def test_synchronous_mode_advances_by_the_host_frame_and_renders_once(self):
         d = self.start()
