@@ -193,7 +193,7 @@ void CloudShadows::footprint(const ShadowCaster& caster, glm::dvec2& lo, glm::dv
 double CloudShadows::sunlightAt(glm::dvec3 p, const HeapEnvelope* own) const {
   if (casters_.empty() || first_.empty()) return 1.0;
   // Every point of the sun's line through p lands on the ground where p's does.
-  const glm::dvec2 ground = p.z == 0.0 ? glm::dvec2(p) : sunCrossing(p, 0.0, to_sun_);
+  const glm::dvec2 ground = sunCrossing(p, 0.0, to_sun_);
   if (!(ground.x >= lo_.x && ground.y >= lo_.y && ground.x <= hi_.x && ground.y <= hi_.y))
     return 1.0;
   const glm::ivec2 c =

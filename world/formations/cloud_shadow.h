@@ -1,9 +1,10 @@
 #pragma once
-// Shadows of heaps on the ground (MODEL.md section 16): the share of the sunlight that reaches
-// a ground point through the lobes on its ray to the sun, each lobe taken at its mean opacity
-// for the limb value the ray has through it and at the optical depth of its chord. Both
-// renderers evaluate it: the reference per ground sample (CloudShadows::sunlight), the GL in a
-// map along the sun built once per sun and world change (renderer/gl/shadow_map.h).
+// Cloud shadows (MODEL.md section 16): the share of the sunlight that reaches a point through
+// the heaps' lobes on its ray to the sun, each lobe taken at its mean opacity for the limb value
+// the ray has through it and at the optical depth of its chord (CloudShadows), and through the
+// sky planes above it (PlaneShadows). On the ground the reference evaluates it per sample, the
+// GL in a map along the sun built once per sun and world change (renderer/gl/shadow_map.h); on
+// lobes and targets the reference per sample, the GL once per lobe and target (SceneSunlight).
 #include <array>
 #include <limits>
 #include <vector>
