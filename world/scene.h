@@ -56,6 +56,13 @@ inline double layerRegionWeight(const CloudLayer& layer, glm::dvec2 xy, double t
     w *= bandRamp(glm::length(xy - eye) - layer.hole_radius_m, layer.hole_band_m);
   return w;
 }
+// The layer's T1 at world point xy seen along `view` from `eye` at time t: a far deck's cover
+// for the view's elevation, raised by its region's weight there (MODEL.md section 11).
+inline double layerThreshold(const CloudLayer& layer, glm::dvec2 xy, glm::dvec3 view, double time_s,
+                             glm::dvec2 eye) {
+  const double base = layer.far.side_ratio > 0.0 ? farThreshold(layer.far, view) : layer.threshold;
+  return regionThreshold(base, layerRegionWeight(layer, xy, time_s, eye));
+}
 inline bool layerHasRegion(const CloudLayer& layer) {
   return !layer.region.everywhere() || layer.hole_radius_m > 0.0 || layer.far.side_ratio > 0.0;
 }

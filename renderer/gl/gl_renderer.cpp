@@ -676,6 +676,7 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
   ellipsoids_.setSunlight(nullptr);
   sunlight_ = {};
   plane_shadows_ = {};  // it points into `scene`
+  heap_shadows_.reset();
   timer_.enter(-1);
   FrameTimes& t = stats_.times;
   t.submit_ms =

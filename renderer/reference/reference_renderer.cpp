@@ -189,31 +189,23 @@ class ReferenceTracer {
                        double s) const {
     const glm::dvec3 p = scene_.camera.position + s * direction;
     const double t = texture.value({p.x, p.y}, scene_.time_s);
-    const double t1 = layerThreshold(layer, {p.x, p.y}, direction);
+    const double t1 = layerThreshold(layer, {p.x, p.y}, direction, scene_.time_s,
+                                     glm::dvec2(scene_.camera.position));
     const double tr = skyPlaneTranslucence(t, t1, layer.transition);
     const double intensity =
         layer.far.side_ratio > 0.0
             ? gardnerIntensity(layer.shading, sphereDiffuse(glm::dot(sun_, -direction)), 0.0, t)
             : gardnerIntensity(layer.shading, t, {0.0, 0.0, 1.0}, sun_, -direction);
     // Shadows from the planes above, and from the heaps where every one lies above (MODEL.md
-    // section 16, "planes under heaps": the ground's sunlight where the sun's ray lands).
+    // section 16, "planes under heaps").
     const glm::dvec3 at(p.x, p.y, layer.altitude_m);
     double sun = planes_.sunlight(at);
     const bool under_heaps =
         shadows_ && !shadows_->empty() && layer.altitude_m <= shadows_->floor();
-    if (under_heaps) sun *= shadows_->sunlight(sunCrossing(at, 0.0, sun_));
+    if (under_heaps) sun *= shadows_->sunlightAt(at);
     const double shadow = planes_.empty() && !under_heaps ? 1.0 : groundLight(sun);
     return {s, withAir(shadow * intensity * layer.colour * scene_.sun.colour, direction, s),
             1.0 - tr, s};
-  }
-
-  // The layer's T1 at world point xy seen along `view`: a far deck's cover for the view's
-  // elevation, raised by its region's weight there (MODEL.md section 11).
-  double layerThreshold(const CloudLayer& layer, glm::dvec2 xy, glm::dvec3 view) const {
-    const double base =
-        layer.far.side_ratio > 0.0 ? farThreshold(layer.far, view) : layer.threshold;
-    return regionThreshold(
-        base, layerRegionWeight(layer, xy, scene_.time_s, glm::dvec2(scene_.camera.position)));
   }
 
   Surface ellipsoidSurface(const EllipsoidEntry& entry, glm::dvec3 direction, double s) const {

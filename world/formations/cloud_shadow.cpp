@@ -220,9 +220,7 @@ double PlaneShadows::sunlight(glm::dvec3 p, double top) const {
     const CloudLayer& layer = *plane.layer;
     if (!(layer.altitude_m > p.z) || !(layer.altitude_m > top)) continue;
     const glm::dvec2 q = sunCrossing(p, layer.altitude_m, to_sun_);
-    // A casting plane is no far deck (castingPlanes): its threshold is its own, raised by its
-    // region's weight (MODEL.md section 11).
-    const double t1 = regionThreshold(layer.threshold, layerRegionWeight(layer, q, time_s_, eye_));
+    const double t1 = layerThreshold(layer, q, to_sun_, time_s_, eye_);
     if (t1 >= 1.0) continue;
     light *= skyPlaneTranslucence(plane.texture.value(q, time_s_), t1, layer.transition);
   }

@@ -194,8 +194,7 @@ double heapIntensity(const EllipsoidCloud& cloud, const HeapLight& light, double
   const DiffuseHighlight d =
       diffuseHighlight(shading, normal, to_sun, -direction, !(cloud.light_extinction > 0.0));
   if (!(cloud.light_extinction > 0.0))
-    return gardnerIntensity(shading, light.sun * d.diffuse, light.sun * d.highlight,
-                            texture_value);
+    return gardnerIntensity(shading, light.sun * d.diffuse, light.sun * d.highlight, texture_value);
   // Gardner eq. 8 with the sun's terms times S and the ambient term times K.
   const double eq8 = gardnerIntensity(shading, light.sun * skinDiffuse(d.n_dot_l),
                                       light.sun * d.highlight, texture_value) +
