@@ -178,6 +178,15 @@ std::vector<Setting> settingsFor(const SceneFile& file) {
   // Sky planes' shadows (MODEL.md section 16, "sky planes"): left out.
   if (!file.scene.layers.empty() || !file.scene.weather.empty())
     add("plane_shadows", "false", [](RenderSettings& s) { s.plane_shadows = false; });
+  // The sea (MODEL.md section 18): fewer and more sines than the default 64, and the probe of
+  // what it mirrors at a quarter and the whole of the view's width (the default is half).
+  if (file.scene.sea) {
+    for (int waves : {16, 32, 128})
+      add("sea_waves", std::to_string(waves), [waves](RenderSettings& s) { s.sea_waves = waves; });
+    for (double scale : {0.25, 1.0})
+      add("sea_probe_scale", withKnob(scale),
+          [scale](RenderSettings& s) { s.sea_probe_scale = scale; });
+  }
   // The frame's work budget (issue 31): the presets hold a few thousand ellipsoids in view, so
   // budgets below that show what thinning costs (the default, 65,536, changes none of them).
   if (!file.scene.clouds.empty() || !file.scene.fields.empty())
@@ -267,6 +276,7 @@ constexpr SceneEntry kScenes[] = {
     {"altocumulus", "genus_altocumulus", "altocumulus from the weather mapping, from the ground"},
     {"cumulus_field", "genus_cumulus", "a cumulus field from the weather mapping, from the ground"},
     {"cumulus_above", "genus_cumulus", "the same field from 1.5 km above its tops, 15 deg down"},
+    {"sea", "sea_search", "sea state 4 under cumulus and altocumulus, from 300 m"},
 };
 
 // "cirrus, stratus, ...": the names --scenes allows.

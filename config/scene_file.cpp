@@ -86,6 +86,54 @@ void readFog(TableReader& t, Fog& fog) {
   t.finish();
 }
 
+// A [[sea.wave]] table: one of a host's wave trains (CIGI 3.3 Wave Control) over the sea.
+void readWave(TableReader& t, WaveTrain& wave) {
+  t.allow({"id", "height", "wavelength", "period", "direction", "phase"});
+  if (!t.has("id"))
+    t.failHere("missing key id (0 to " + std::to_string(Limits::kMaxWaveId) +
+               ", one train per id)");
+  t.integer("id", wave.id, 0, Limits::kMaxWaveId);
+  t.number("height", wave.height_m, Limits::kWaveHeight);
+  t.number("wavelength", wave.wavelength_m, Limits::kWavelength);
+  t.number("period", wave.period_s, Limits::kWavePeriod);
+  t.number("direction", wave.direction_deg, Limits::kWaveDirection);
+  t.number("phase", wave.phase_deg, Limits::kWavePhase);
+  t.finish();
+}
+
+// The sea in place of the ground plane (MODEL.md section 18). Its wind is the surface wind:
+// `surface_wind` (the [[wind]] at altitude 0) unless the table gives one.
+void readSea(TableReader& t, std::optional<glm::dvec2> surface_wind, Sea& sea) {
+  t.allow({"wind", "fetch", "temperature", "clarity", "whitecaps", "seed", "wave"});
+  if (surface_wind) sea.wind = *surface_wind;
+  t.vector("wind", sea.wind, -Limits::kMaxWind, Limits::kMaxWind);
+  if (t.has("wind") && glm::length(sea.wind) > Limits::kMaxWind)
+    t.failAt("wind", formatNumber(glm::length(sea.wind)) +
+                         " m/s is out of range (allowed: a speed of at most " +
+                         formatNumber(Limits::kMaxWind) + " m/s)");
+  t.number("fetch", sea.fetch_m, Limits::kSeaFetch);
+  t.number("temperature", sea.temperature_c, Limits::kSeaTemperature);
+  t.number("clarity", sea.clarity, Limits::kSeaClarity);
+  t.boolean("whitecaps", sea.whitecaps);
+  t.seed("seed", sea.seed);
+  std::vector<TableReader> waves = t.tables("wave");
+  if (waves.size() > std::size_t(kMaxWaveTrains))
+    t.failAt("wave", std::to_string(waves.size()) + " wave trains (allowed: at most " +
+                         std::to_string(kMaxWaveTrains) + ")");
+  for (TableReader& w : waves) {
+    WaveTrain wave;
+    readWave(w, wave);
+    for (const WaveTrain& other : sea.trains)
+      if (other.id == wave.id)
+        w.failAt("id", std::to_string(wave.id) + " is given twice (allowed: one train per id)");
+    sea.trains.push_back(wave);
+  }
+  std::sort(sea.trains.begin(), sea.trains.end(),
+            [](const WaveTrain& a, const WaveTrain& b) { return a.id < b.id; });
+  if (std::string e = seaError(sea); !e.empty()) t.failHere(e);  // a backstop: not reached
+  t.finish();
+}
+
 void readRender(TableReader& t, SceneFile& out) {
   t.allow({"texture",
            "term_filter",
@@ -107,7 +155,9 @@ void readRender(TableReader& t, SceneFile& out) {
            "heap_shading_rate",
            "heap_refresh",
            "shadow_map_size",
-           "plane_shadows"});
+           "plane_shadows",
+           "sea_waves",
+           "sea_probe_scale"});
   out.render.texture_evaluation = TextureEvaluation(
       t.choice("texture", kTextureEvaluationNames, int(out.render.texture_evaluation)));
   out.render.term_filter =
@@ -139,9 +189,12 @@ void readRender(TableReader& t, SceneFile& out) {
             int(Limits::kHeapRefresh.hi));
   t.integer("shadow_map_size", r.shadow_map_size, 0, int(Limits::kShadowMapSize.hi));
   t.boolean("plane_shadows", r.plane_shadows);
+  t.integer("sea_waves", r.sea_waves, int(Limits::kSeaWaves.lo), int(Limits::kSeaWaves.hi));
+  t.number("sea_probe_scale", r.sea_probe_scale, Limits::kSeaProbeScale);
   if (std::string error = validateRenderSettings(r); !error.empty())
     t.failAt(error.substr(0, error.find(':')), error.substr(error.find(':') + 2));
-  out.reference.heaps = r.heaps;  // both renderers draw the same heaps
+  out.reference.heaps = r.heaps;          // both renderers draw the same heaps
+  out.reference.sea_waves = r.sea_waves;  // and the same sea
   t.finish();
 }
 
@@ -526,7 +579,7 @@ WeatherLayer readWeather(TableReader& t, bool macro = false) {
 
 void readScene(const toml::table& root, const std::string& file, SceneFile& out) {
   TableReader t(root, "", file);
-  t.allow({"seed", "time", "image", "camera", "sun", "sky", "fog", "haze", "render", "wind",
+  t.allow({"seed", "time", "image", "camera", "sun", "sky", "fog", "haze", "sea", "render", "wind",
            "layer", "cloud", "automaton", "target", "weather", "macrocluster"});
   Scene& scene = out.scene;
   t.seed("seed", scene.seed);
@@ -547,6 +600,9 @@ void readScene(const toml::table& root, const std::string& file, SceneFile& out)
     if (dynamics.wind.samples[i].altitude_m == dynamics.wind.samples[i - 1].altitude_m)
       t.failAt("wind", "two [[wind]] samples at altitude " +
                            formatNumber(dynamics.wind.samples[i].altitude_m));
+  if (auto sea = t.table("sea"))
+    readSea(*sea, dynamics.wind.empty() ? std::nullopt : std::optional(dynamics.wind.at(0.0)),
+            scene.sea.emplace());
   std::vector<TableReader> layers = t.tables("layer");
   for (std::size_t i = 0; i < layers.size(); ++i) {
     CloudLayer& layer = scene.layers.emplace_back();

@@ -197,6 +197,32 @@ void layout(C& c, AtmosphereControl& p) {
 }
 
 template <class C>
+void layout(C& c, MaritimeSurfaceConditionsControl& p) {
+  c.number(2, p.entity_region_id);
+  c.bits(4, 0, 1, p.surface_conditions_enabled);
+  c.bits(4, 1, 1, p.whitecaps);
+  c.bits(4, 2, 2, p.scope);
+  c.number(8, p.sea_surface_height);
+  c.number(12, p.water_temperature);
+  c.number(16, p.clarity);
+}
+
+template <class C>
+void layout(C& c, WaveControl& p) {
+  c.number(2, p.entity_region_id);
+  c.number(4, p.wave_id);
+  c.bits(5, 0, 1, p.enabled);
+  c.bits(5, 1, 2, p.scope);
+  c.bits(5, 3, 2, p.breaker);
+  c.number(8, p.height);
+  c.number(12, p.wavelength);
+  c.number(16, p.period);
+  c.number(20, p.direction);
+  c.number(24, p.phase_offset);
+  c.number(28, p.leading);
+}
+
+template <class C>
 void layout(C& c, CelestialSphereControl& p) {
   c.number(2, p.hour);
   c.number(3, p.minute);
@@ -239,6 +265,13 @@ constexpr Kind kindOf(const EnvironmentalRegionControl&) {
 constexpr Kind kindOf(const AtmosphereControl&) {
   return {Id::kAtmosphereControl, Size::kAtmosphereControl, "Atmosphere Control"};
 }
+constexpr Kind kindOf(const MaritimeSurfaceConditionsControl&) {
+  return {Id::kMaritimeSurfaceConditionsControl, Size::kMaritimeSurfaceConditionsControl,
+          "Maritime Surface Conditions Control"};
+}
+constexpr Kind kindOf(const WaveControl&) {
+  return {Id::kWaveControl, Size::kWaveControl, "Wave Control"};
+}
 constexpr Kind kindOf(const CelestialSphereControl&) {
   return {Id::kCelestialSphereControl, Size::kCelestialSphereControl, "Celestial Sphere Control"};
 }
@@ -246,9 +279,9 @@ constexpr Kind kindOf(const CelestialSphereControl&) {
 // The packet types decoded into fields; any other is kept as an OtherPacket.
 template <class... T>
 struct PacketTypes {};
-using Decoded =
-    PacketTypes<IgControl, StartOfFrame, EntityControl, ViewControl, ViewDefinition, WeatherControl,
-                EnvironmentalRegionControl, AtmosphereControl, CelestialSphereControl>;
+using Decoded = PacketTypes<IgControl, StartOfFrame, EntityControl, ViewControl, ViewDefinition,
+                            WeatherControl, EnvironmentalRegionControl, AtmosphereControl,
+                            CelestialSphereControl, MaritimeSurfaceConditionsControl, WaveControl>;
 
 template <class T>
 Packet read(const std::uint8_t* p, ByteOrder order) {

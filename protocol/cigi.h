@@ -23,13 +23,15 @@ inline constexpr std::size_t kPacketAlign = 8;  // every CIGI 3 packet size is a
 struct Id {
   static constexpr std::uint8_t kIgControl = 1, kEntityControl = 2, kCelestialSphereControl = 9,
                                 kAtmosphereControl = 10, kEnvironmentalRegionControl = 11,
-                                kWeatherControl = 12, kViewControl = 16, kViewDefinition = 21,
+                                kWeatherControl = 12, kMaritimeSurfaceConditionsControl = 13,
+                                kWaveControl = 14, kViewControl = 16, kViewDefinition = 21,
                                 kStartOfFrame = 101;
 };
 struct Size {
   static constexpr std::uint8_t kIgControl = 24, kEntityControl = 48, kCelestialSphereControl = 16,
                                 kAtmosphereControl = 32, kEnvironmentalRegionControl = 48,
-                                kWeatherControl = 56, kViewControl = 32, kViewDefinition = 32,
+                                kWeatherControl = 56, kMaritimeSurfaceConditionsControl = 24,
+                                kWaveControl = 32, kViewControl = 32, kViewDefinition = 32,
                                 kStartOfFrame = 24;
 };
 
@@ -37,6 +39,7 @@ enum class IgMode : std::uint8_t { kStandby = 0, kOperate = 1, kDebug = 2 };
 enum class EntityState : std::uint8_t { kInactive = 0, kActive = 1, kDestroyed = 2 };
 enum class WeatherScope : std::uint8_t { kGlobal = 0, kRegional = 1, kEntity = 2 };
 enum class RegionState : std::uint8_t { kInactive = 0, kActive = 1, kDestroyed = 2 };
+enum class BreakerType : std::uint8_t { kPlunging = 0, kSpilling = 1, kSurging = 2 };
 // Weather Control layer identifiers.
 struct Layer {
   static constexpr std::uint8_t kGroundFog = 0, kCloud1 = 1, kCloud3 = 3, kRain = 4, kSnow = 5,
@@ -123,6 +126,30 @@ struct WeatherControl {
   bool operator==(const WeatherControl&) const = default;
 };
 
+// The sea's surface (global scope), or a region's or an entity's: its conditions, whitecaps,
+// height above the database's Z = 0, water temperature and clarity.
+struct MaritimeSurfaceConditionsControl {
+  std::uint16_t entity_region_id = 0;
+  bool surface_conditions_enabled = false, whitecaps = false;
+  WeatherScope scope = WeatherScope::kGlobal;
+  float sea_surface_height = 0;  // metres
+  float water_temperature = 0;   // degrees Celsius
+  float clarity = 0;             // percent: 0 turbid, 100 clear
+  bool operator==(const MaritimeSurfaceConditionsControl&) const = default;
+};
+
+// One wave train: trough-to-crest height, wavelength, period, the direction it propagates in
+// (degrees from true north), its phase offset and leading (crest asymmetry) in degrees.
+struct WaveControl {
+  std::uint16_t entity_region_id = 0;
+  std::uint8_t wave_id = 0;
+  bool enabled = false;
+  WeatherScope scope = WeatherScope::kGlobal;
+  BreakerType breaker = BreakerType::kPlunging;
+  float height = 0, wavelength = 0, period = 0, direction = 0, phase_offset = 0, leading = 0;
+  bool operator==(const WaveControl&) const = default;
+};
+
 struct AtmosphereControl {
   bool model_enabled = false;
   std::uint8_t humidity = 0;
@@ -170,9 +197,10 @@ struct OtherPacket {
   bool operator==(const OtherPacket&) const = default;
 };
 
-using Packet = std::variant<IgControl, EntityControl, ViewControl, ViewDefinition, WeatherControl,
-                            EnvironmentalRegionControl, AtmosphereControl, CelestialSphereControl,
-                            StartOfFrame, OtherPacket>;
+using Packet =
+    std::variant<IgControl, EntityControl, ViewControl, ViewDefinition, WeatherControl,
+                 EnvironmentalRegionControl, AtmosphereControl, CelestialSphereControl,
+                 MaritimeSurfaceConditionsControl, WaveControl, StartOfFrame, OtherPacket>;
 
 enum class ByteOrder { kBig, kLittle };
 

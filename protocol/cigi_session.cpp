@@ -9,6 +9,7 @@
 #include "world/formations/cloud_field.h"
 #include "world/frames.h"
 #include "world/limits.h"
+#include "world/sea.h"
 #include "world/solar.h"
 
 namespace nephele::cigi {
@@ -142,6 +143,70 @@ std::string regionControlError(const EnvironmentalRegionControl& e) {
            text(Limits::kMaxHeading) + " degrees, transition perimeter " + text(band.lo) + " to " +
            text(band.hi) + " m)";
   return "";
+}
+
+// Equal, or both NaN: a field a host repeats with a NaN is not a change.
+bool same(float a, float b) {
+  return a == b || (std::isnan(a) && std::isnan(b));
+}
+
+constexpr const char* kSeaIsGlobal = "regional sea state is not modelled: the sea is global";
+
+// "of region 7" or "of entity 7": where a packet of regional or entity scope applies.
+std::string scopeOf(WeatherScope scope, std::uint16_t id) {
+  const char* kind = scope == WeatherScope::kRegional ? "region"
+                     : scope == WeatherScope::kEntity ? "entity"
+                                                      : "scope 3 id";
+  return std::string(" of ") + kind + " " + std::to_string(id);
+}
+
+// The Maritime Surface Conditions fields Nephele reads (docs/CIGI.md); a packet differing only
+// elsewhere changes nothing, and a disabled one only in being disabled.
+bool sameMaritime(const MaritimeSurfaceConditionsControl& a,
+                  const MaritimeSurfaceConditionsControl& b) {
+  if (!a.surface_conditions_enabled || !b.surface_conditions_enabled)
+    return a.surface_conditions_enabled == b.surface_conditions_enabled;
+  return a.whitecaps == b.whitecaps && same(a.water_temperature, b.water_temperature) &&
+         same(a.clarity, b.clarity) && same(a.sea_surface_height, b.sea_surface_height);
+}
+
+// The same for Wave Control: its train's fields, and those it ignores but reports.
+bool sameWave(const WaveControl& a, const WaveControl& b) {
+  if (!a.enabled || !b.enabled) return a.enabled == b.enabled;
+  return same(a.height, b.height) && same(a.wavelength, b.wavelength) && same(a.period, b.period) &&
+         same(a.direction, b.direction) && same(a.phase_offset, b.phase_offset) &&
+         a.breaker == b.breaker && same(a.leading, b.leading);
+}
+
+// What is wrong with an enabled Wave Control's train, or empty.
+std::string waveError(const WaveControl& w) {
+  if (!finite({w.height, w.wavelength, w.period, w.direction, w.phase_offset}) ||
+      !Limits::kWaveHeight.contains(w.height) || !Limits::kWavelength.contains(w.wavelength) ||
+      !Limits::kWavePeriod.contains(w.period) || !Limits::kWaveDirection.contains(w.direction) ||
+      !Limits::kWavePhase.contains(w.phase_offset))
+    return "height " + text(w.height) + ", wavelength " + text(w.wavelength) + ", period " +
+           text(w.period) + ", direction " + text(w.direction) + ", phase offset " +
+           text(w.phase_offset) + " (allowed: height " + text(Limits::kWaveHeight.lo) + " to " +
+           text(Limits::kWaveHeight.hi) + " m, wavelength " + text(Limits::kWavelength.lo) +
+           " to " + text(Limits::kWavelength.hi) + " m, period " + text(Limits::kWavePeriod.lo) +
+           " to " + text(Limits::kWavePeriod.hi) + " s, direction and phase offset " +
+           text(Limits::kWaveDirection.lo) + " to " + text(Limits::kWaveDirection.hi) + " degrees)";
+  return "";
+}
+
+// A Wave Control as set_sea's train: CIGI's direction is where the wave propagates, clockwise
+// from true north, as the sea's (world/sea.h); disabled removes the train.
+command::WavePatch wavePatchOf(const WaveControl& w) {
+  command::WavePatch p;
+  p.id = w.wave_id;
+  p.enabled = w.enabled;
+  if (!w.enabled) return p;
+  p.height = w.height;
+  p.wavelength = w.wavelength;
+  p.period = w.period;
+  p.direction = w.direction;
+  p.phase = w.phase_offset;
+  return p;
 }
 
 // The UTC moment of a Celestial Sphere Control (date MMDDYYYY, hour, minute).
@@ -505,6 +570,78 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
       }
       s.celestial = *c;
       s.sun_place.reset();  // placed below, for the ownship
+    } else if (const auto* m = std::get_if<MaritimeSurfaceConditionsControl>(&packet)) {
+      const std::string where = "Maritime Surface Conditions Control";
+      if (m->scope != WeatherScope::kGlobal) {
+        frame.ignored.push_back(where + scopeOf(m->scope, m->entity_region_id) + ": " +
+                                kSeaIsGlobal);
+        continue;
+      }
+      if (s.maritime && sameMaritime(*s.maritime, *m)) continue;
+      command::SetSea c;
+      c.enabled = m->surface_conditions_enabled;
+      if (m->surface_conditions_enabled) {
+        const Range clarity{0.0, 100.0};
+        if (!finite({m->water_temperature, m->clarity}) ||
+            !Limits::kSeaTemperature.contains(m->water_temperature) ||
+            !clarity.contains(m->clarity)) {
+          bad(where + ": surface water temperature " + text(m->water_temperature) +
+              ", surface clarity " + text(m->clarity) + " (allowed: temperature " +
+              text(Limits::kSeaTemperature.lo) + " to " + text(Limits::kSeaTemperature.hi) +
+              " degrees C, clarity 0 to 100 %)");
+          continue;
+        }
+        c.temperature = m->water_temperature;
+        c.clarity = m->clarity / 100.0;
+        c.whitecaps = m->whitecaps;
+        // The host's wave trains, which a sea it disabled lost with it.
+        for (const auto& [id, wave] : s.waves)
+          if (wave.enabled) c.waves.push_back(wavePatchOf(wave));
+        if (m->sea_surface_height != 0.0f &&
+            !(s.maritime && s.maritime->surface_conditions_enabled &&
+              same(s.maritime->sea_surface_height, m->sea_surface_height)))
+          frame.ignored.push_back(where + ": sea surface height " + text(m->sea_surface_height) +
+                                  " m (the sea lies at the database's Z = 0)");
+      }
+      frame.commands.emplace_back(std::move(c));
+      s.maritime = *m;
+    } else if (const auto* w = std::get_if<WaveControl>(&packet)) {
+      const std::string where = "Wave Control " + std::to_string(w->wave_id);
+      if (w->scope != WeatherScope::kGlobal) {
+        frame.ignored.push_back(where + scopeOf(w->scope, w->entity_region_id) + ": " +
+                                kSeaIsGlobal);
+        continue;
+      }
+      const auto last = s.waves.find(w->wave_id);
+      if (last != s.waves.end() && sameWave(last->second, *w)) continue;
+      if (w->enabled) {
+        if (std::string e = waveError(*w); !e.empty()) {
+          bad(where + ": " + e);
+          continue;
+        }
+        const auto held = std::count_if(s.waves.begin(), s.waves.end(), [&](const auto& entry) {
+          return entry.second.enabled && entry.first != w->wave_id;
+        });
+        if (held >= kMaxWaveTrains) {
+          bad(where + ": the host's " + std::to_string(held) +
+              " other wave trains are enabled (allowed: at most " + std::to_string(kMaxWaveTrains) +
+              " at once; disable one first)");
+          continue;
+        }
+        const bool was = last != s.waves.end() && last->second.enabled;
+        if (w->breaker != BreakerType::kPlunging && !(was && last->second.breaker == w->breaker))
+          frame.ignored.push_back(where + ": breaker type " + std::to_string(int(w->breaker)) +
+                                  " (not modelled: the trains are sines)");
+        if (w->leading != 0.0f && !(was && same(last->second.leading, w->leading)))
+          frame.ignored.push_back(where + ": leading " + text(w->leading) +
+                                  " degrees (not modelled: the trains are sines)");
+      }
+      s.waves[w->wave_id] = *w;
+      // A sea the host disabled takes its trains when it enables it again (above).
+      if (s.maritime && !s.maritime->surface_conditions_enabled) continue;
+      command::SetSea c;
+      c.waves.push_back(wavePatchOf(*w));
+      frame.commands.emplace_back(std::move(c));
     } else if (const auto* o = std::get_if<OtherPacket>(&packet)) {
       frame.ignored.push_back("packet " + std::to_string(o->id) + " (not used by Nephele)");
     }
@@ -620,6 +757,8 @@ void Session::forget() {
   pending_.reset();
   std::erase_if(state_.entities, [](const auto& entry) { return entry.second.target; });
   state_.atmosphere.reset();
+  state_.maritime.reset();
+  state_.waves.clear();
   state_.celestial.reset();
   state_.sun_place.reset();
 }

@@ -70,10 +70,11 @@ class Session {
   std::variant<HostFrame, Refusal> map(const Message& message);
   void commit();
   // After the daemon refused a frame (a target removed over the socket, say): what the session
-  // believed applied is forgotten, so that the next packets place targets and set the wind and
-  // sun afresh (global weather is always passed on: the world ignores a layer set again as it
-  // is). Frame numbers, the ownship and the views stay. The frame mapped last is dropped.
-  // Packets refused for their values (HostFrame::refused) leave the rest of the frame applied.
+  // believed applied is forgotten, so that the next packets place targets and set the wind,
+  // the sun and the sea afresh (global weather is always passed on: the world ignores a layer
+  // set again as it is). Frame numbers, the ownship and the views stay. The frame mapped last
+  // is dropped. Packets refused for their values (HostFrame::refused) leave the rest of the
+  // frame applied.
   void forget();
 
   std::uint32_t lastHostFrame() const { return state_.last_host_frame.value_or(0); }
@@ -109,6 +110,10 @@ class Session {
     std::map<RegionalKey, WeatherControl> regional_weather;
     std::map<std::uint16_t, EnvironmentalRegionControl> regions;
     std::optional<AtmosphereControl> atmosphere;
+    // The sea as the host last set it (global scope): its surface conditions, and its wave
+    // trains by wave id, disabled ones included (a host repeats its packets every frame).
+    std::optional<MaritimeSurfaceConditionsControl> maritime;
+    std::map<std::uint8_t, WaveControl> waves;
     std::optional<CelestialSphereControl> celestial;
     std::optional<glm::dvec2> sun_place;  // latitude, longitude the sun was last placed for
     // The database origin (latitude, longitude): [site], or the host's first position.

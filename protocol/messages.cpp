@@ -8,6 +8,7 @@
 
 #include "protocol/cloud_codes.h"
 #include "world/limits.h"
+#include "world/sea.h"
 
 namespace nephele {
 namespace {
@@ -395,6 +396,61 @@ SetHaze readSetHaze(FieldReader& r) {
   if (c.enabled == false && (c.visibility || c.scale_height))
     r.fail("enabled", "false removes the haze; give no visibility or scale_height with it");
   r.finish("cmd, id, enabled, visibility, scale_height");
+  return c;
+}
+
+// One object of set_sea's `waves`.
+WavePatch readWavePatch(FieldReader& r) {
+  if (!r.has("id"))
+    r.fail("id", "is missing (allowed: 0 to " + std::to_string(Limits::kMaxWaveId) + ")");
+  WavePatch w;
+  w.id = int(*r.integer("id", 0, Limits::kMaxWaveId));
+  w.enabled = r.boolean("enabled");
+  w.height = r.number("height", Limits::kWaveHeight);
+  w.wavelength = r.number("wavelength", Limits::kWavelength);
+  w.period = r.number("period", Limits::kWavePeriod);
+  w.direction = r.number("direction", Limits::kWaveDirection);
+  w.phase = r.number("phase", Limits::kWavePhase);
+  if (w.enabled == false && (w.height || w.wavelength || w.period || w.direction || w.phase))
+    r.fail("enabled",
+           "false removes the wave train; give no height, wavelength, period, direction or "
+           "phase with it");
+  r.finish("id, enabled, height, wavelength, period, direction, phase");
+  return w;
+}
+
+SetSea readSetSea(FieldReader& r) {
+  SetSea c;
+  c.enabled = r.boolean("enabled");
+  c.fetch = r.number("fetch", Limits::kSeaFetch);
+  c.temperature = r.number("temperature", Limits::kSeaTemperature);
+  c.clarity = r.number("clarity", Limits::kSeaClarity);
+  c.whitecaps = r.boolean("whitecaps");
+  if (auto seed = r.integer("seed", 0, INT64_MAX)) c.seed = std::uint64_t(*seed);
+  if (const json* waves = r.raw("waves")) {
+    const std::string allowed = "an array of 1 to " + std::to_string(kMaxWaveTrains) +
+                                " objects {id, enabled, height, wavelength, period, direction, "
+                                "phase} of distinct ids";
+    if (!waves->is_array() || waves->empty() || waves->size() > std::size_t(kMaxWaveTrains))
+      r.fail("waves", "must be " + allowed);
+    for (std::size_t i = 0; i < waves->size(); ++i) {
+      const json& w = (*waves)[i];
+      const std::string path = "waves[" + std::to_string(i) + "]";
+      if (!w.is_object()) r.fail(path, "must be an object (" + allowed + ")");
+      FieldReader wr(w, path);
+      const WavePatch patch = readWavePatch(wr);
+      for (const WavePatch& other : c.waves)
+        if (other.id == patch.id)
+          r.fail(path, "id " + std::to_string(patch.id) + " is repeated (" + allowed + ")");
+      c.waves.push_back(patch);
+    }
+  }
+  if (c.enabled == false &&
+      (c.fetch || c.temperature || c.clarity || c.whitecaps || c.seed || !c.waves.empty()))
+    r.fail("enabled",
+           "false removes the sea; give no fetch, temperature, clarity, whitecaps, seed or waves "
+           "with it");
+  r.finish("cmd, id, enabled, fetch, temperature, clarity, whitecaps, seed, waves");
   return c;
 }
 

@@ -134,6 +134,23 @@ struct SetFog {
   std::optional<double> top, visibility;
   std::optional<glm::dvec3> colour;
 };
+// One wave train of set_sea's `waves`, by its id: unset fields keep the train's value (a new
+// train starts from WaveTrain's, world/sea.h); `enabled` false removes it.
+struct WavePatch {
+  int id = 0;  // 0 to Limits::kMaxWaveId
+  std::optional<bool> enabled;
+  std::optional<double> height, wavelength, period, direction, phase;
+};
+// The sea in place of the ground (world/sea.h): unset fields keep their value; `enabled` false
+// removes it. A sea that was absent starts from Sea's defaults with the world's surface wind
+// once a field (or an enabled wave train) is given; with none the sea is only read back.
+struct SetSea {
+  std::optional<bool> enabled;
+  std::optional<double> fetch, temperature, clarity;  // m, Celsius, 0 turbid to 1 clear
+  std::optional<bool> whitecaps;
+  std::optional<std::uint64_t> seed;
+  std::vector<WavePatch> waves;  // distinct ids
+};
 struct SetTime {
   std::optional<double> time_scale;  // simulated seconds per real second
   std::optional<bool> paused;

@@ -20,16 +20,21 @@ enum class Channel : std::uint8_t {
   kCoverage,    // cloud opacity 1 - prod(1 - alpha): clouds only, never targets or ground
   kDepth,       // metres along the ray to the first opaque surface (ground, target); inf: sky
   kCloudDepth,  // metres along the ray where cloud opacity, front to back, first reaches 1/2
-  kObjectId,    // 1 + the index of the target covering the pixel, clouds ignored; 0: none
+  kObjectId,    // 1 + the index of the target covering the pixel, clouds ignored; 0: none;
+                // kSeaObjectId: the sea
   kVisibility,  // transmittance of the clouds in front of the first opaque surface
   kLwir,        // long-wave infrared band radiance, W m^-2 sr^-1 (world/infrared.h)
+  kGlint,       // the sun's glint on the sea as seen (luminance, colour's units); 0 elsewhere
 };
+
+// The object id of the sea's pixels (a class of its own: neither sky nor a target).
+inline constexpr float kSeaObjectId = -1.0f;
 
 struct ChannelInfo {
   Channel channel;
   const char* name;  // as the CLI, the protocol and EXR layers spell it
 };
-inline constexpr std::array<ChannelInfo, 7> kChannels{{
+inline constexpr std::array<ChannelInfo, 8> kChannels{{
     {Channel::kColour, "colour"},
     {Channel::kCoverage, "coverage"},
     {Channel::kDepth, "depth"},
@@ -37,6 +42,7 @@ inline constexpr std::array<ChannelInfo, 7> kChannels{{
     {Channel::kObjectId, "object_id"},
     {Channel::kVisibility, "visibility"},
     {Channel::kLwir, "lwir"},
+    {Channel::kGlint, "glint"},
 }};
 
 inline const char* channelName(Channel c) {
@@ -114,7 +120,7 @@ struct Frame {
   FrameInfo info;
   ChannelSet channels;
   FloatImage colour;  // RGB and coverage as alpha: present for colour or coverage
-  std::vector<float> depth, cloud_depth, object_id, visibility, lwir;
+  std::vector<float> depth, cloud_depth, object_id, visibility, lwir, glint;
 
   int width() const { return info.width; }
   // visibility = 1 - coverage, from colour's alpha (both back ends composite it there).
@@ -152,6 +158,8 @@ struct Frame {
         return &visibility;
       case Channel::kLwir:
         return &lwir;
+      case Channel::kGlint:
+        return &glint;
       case Channel::kColour:
       case Channel::kCoverage:
         break;

@@ -2,6 +2,7 @@
 // Speed-for-accuracy knobs of the GL renderer; each is measured against the CPU reference by
 // bench/render_bench.
 #include "world/formations/cloud_field.h"
+#include "world/sea.h"
 #include "world/textures/gardner_texture.h"
 
 namespace nephele {
@@ -87,6 +88,13 @@ struct RenderSettings {
   // planes"): each receiving pixel reads every plane above it once more. false leaves them out.
   bool plane_shadows = true;
 
+  // The sea (MODEL.md section 18): the sines standing for its spectrum (`sea_waves`, 16 to
+  // 128: fewer are faster, and their sum repeats sooner), and the probe of what it mirrors, its
+  // width a share of the view's (`sea_probe_scale`, 0.25 to 2: the reference traces each
+  // reflection).
+  int sea_waves = kSeaComponents;
+  double sea_probe_scale = 0.5;
+
   // Automaton clouds: the view march's step in lattice spacings (the lattice holds
   // samples_per_cell samples per cell edge). Larger steps are faster and blur thin edges.
   double volume_step = 1.0;
@@ -99,10 +107,11 @@ struct RenderSettings {
 
 // The CPU reference (MODEL.md section 7).
 struct ReferenceSettings {
-  int samples_per_axis = 4;  // supersampling grid per pixel
-  int threads = 0;           // 0: one per hardware thread
-  HeapDrawing heaps{};       // as RenderSettings::heaps
-  int label_divisor = 1;     // depth, cloud depth, object id: one centre ray per N x N block
+  int samples_per_axis = 4;        // supersampling grid per pixel
+  int threads = 0;                 // 0: one per hardware thread
+  HeapDrawing heaps{};             // as RenderSettings::heaps
+  int label_divisor = 1;           // depth, cloud depth, object id: one centre ray per N x N block
+  int sea_waves = kSeaComponents;  // as RenderSettings::sea_waves
 };
 
 }  // namespace nephele

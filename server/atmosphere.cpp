@@ -4,8 +4,9 @@
 #include "world/formations/weather.h"
 
 // Weather and atmosphere at run time: weather layers onto formations (MODEL.md section 10),
-// wind, ground fog, the sun by direction or by date and time (world/solar.h), and the clock's
-// mode. The same for every transport: the socket, Modbus and CIGI all arrive as commands.
+// wind, ground fog, haze, the sea, the sun by direction or by date and time (world/solar.h),
+// and the clock's mode. The same for every transport: the socket, Modbus and CIGI all arrive as
+// commands.
 namespace nephele {
 
 using namespace engine_detail;
@@ -82,6 +83,86 @@ Outcome Engine::setHaze(const command::SetHaze& c) {
   return json{{"enabled", true},
               {"visibility", haze->visibility_m},
               {"scale_height", haze->scale_height_m}};
+}
+
+glm::dvec2 engine_detail::surfaceWind(const World& world) {
+  const WindProfile& wind = world.dynamics().wind;
+  return wind.empty() ? Sea{}.wind : wind.at(0.0);
+}
+
+std::variant<std::optional<Sea>, ProtocolError> engine_detail::seaAfter(
+    const std::optional<Sea>& before, const command::SetSea& c, glm::dvec2 surface_wind) {
+  if (c.enabled == false) return std::optional<Sea>();
+  const bool adds_train =
+      std::any_of(c.waves.begin(), c.waves.end(),
+                  [](const command::WavePatch& w) { return w.enabled != false; });
+  const bool enables =
+      c.enabled || c.fetch || c.temperature || c.clarity || c.whitecaps || c.seed || adds_train;
+  if (!before && !enables) return before;  // read back, or trains removed from no sea
+  Sea sea;
+  if (before)
+    sea = *before;
+  else
+    sea.wind = surface_wind;
+  if (c.fetch) sea.fetch_m = *c.fetch;
+  if (c.temperature) sea.temperature_c = *c.temperature;
+  if (c.clarity) sea.clarity = *c.clarity;
+  if (c.whitecaps) sea.whitecaps = *c.whitecaps;
+  if (c.seed) sea.seed = *c.seed;
+  std::vector<WaveTrain>& trains = sea.trains;
+  for (const command::WavePatch& w : c.waves) {
+    auto train = std::find_if(trains.begin(), trains.end(),
+                              [&](const WaveTrain& t) { return t.id == w.id; });
+    if (w.enabled == false) {
+      if (train != trains.end()) trains.erase(train);
+      continue;
+    }
+    if (train == trains.end()) {  // kept in order of id
+      train = std::find_if(trains.begin(), trains.end(),
+                           [&](const WaveTrain& t) { return t.id > w.id; });
+      train = trains.insert(train, WaveTrain{});
+      train->id = w.id;
+    }
+    if (w.height) train->height_m = *w.height;
+    if (w.wavelength) train->wavelength_m = *w.wavelength;
+    if (w.period) train->period_s = *w.period;
+    if (w.direction) train->direction_deg = *w.direction;
+    if (w.phase) train->phase_deg = *w.phase;
+  }
+  if (trains.size() > std::size_t(kMaxWaveTrains))
+    return badField("waves: the sea would hold " + std::to_string(trains.size()) +
+                    " wave trains (allowed: at most " + std::to_string(kMaxWaveTrains) +
+                    "; remove one with {\"id\": ID, \"enabled\": false})");
+  return std::optional<Sea>(std::move(sea));
+}
+
+json engine_detail::seaJson(const std::optional<Sea>& sea) {
+  if (!sea) return json{{"enabled", false}};
+  json waves = json::array();
+  for (const WaveTrain& t : sea->trains)
+    waves.push_back({{"id", t.id},
+                     {"height", t.height_m},
+                     {"wavelength", t.wavelength_m},
+                     {"period", t.period_s},
+                     {"direction", t.direction_deg},
+                     {"phase", t.phase_deg}});
+  return json{{"enabled", true},         {"wind", {sea->wind.x, sea->wind.y}},
+              {"fetch", sea->fetch_m},   {"temperature", sea->temperature_c},
+              {"clarity", sea->clarity}, {"whitecaps", sea->whitecaps},
+              {"seed", sea->seed},       {"waves", waves}};
+}
+
+Outcome Engine::setSea(const command::SetSea& c) {
+  State& s = *state_;
+  auto sea = seaAfter(s.world->base().sea, c, surfaceWind(*s.world));
+  if (const auto* error = std::get_if<ProtocolError>(&sea)) return *error;
+  const std::optional<Sea>& after = std::get<std::optional<Sea>>(sea);
+  bool changed = false;
+  if (std::string error = s.world->setSea(after, &changed); !error.empty()) return badField(error);
+  if (changed)
+    spdlog::info("event=sea enabled={} trains={}", after.has_value(),
+                 after ? after->trains.size() : 0);
+  return seaJson(after);
 }
 
 void Engine::setMode(TickMode mode) {

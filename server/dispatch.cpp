@@ -54,6 +54,10 @@ std::optional<ProtocolError> Engine::check(const Command& command) const {
   }
   if (const auto* c = std::get_if<command::SetTime>(&command); c && c->advance)
     return checkAdvance(*c->advance);
+  if (const auto* c = std::get_if<command::SetSea>(&command))  // the trains it would hold
+    if (auto sea = seaAfter(s.world->base().sea, *c, surfaceWind(*s.world));
+        std::holds_alternative<ProtocolError>(sea))
+      return std::get<ProtocolError>(sea);
   return std::nullopt;
 }
 
@@ -111,6 +115,7 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
       [&](const SetSun& c) -> std::optional<Outcome> { return setSun(c); },
       [&](const SetFog& c) -> std::optional<Outcome> { return setFog(c); },
       [&](const SetHaze& c) -> std::optional<Outcome> { return setHaze(c); },
+      [&](const SetSea& c) -> std::optional<Outcome> { return setSea(c); },
       [&](const SetTime& c) -> std::optional<Outcome> {
         if (c.time_scale) s.time_scale = *c.time_scale;
         if (c.paused) s.paused = *c.paused;

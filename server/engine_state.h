@@ -273,6 +273,14 @@ struct ViewFrame {
 };
 
 namespace engine_detail {
+// The sea (atmosphere.cpp): the wind a new sea takes, the world's at altitude 0 (Sea's default
+// in a world without wind); the sea after a set_sea, or the error naming the field and what is
+// allowed; and the reply that describes it.
+glm::dvec2 surfaceWind(const World& world);
+std::variant<std::optional<Sea>, ProtocolError> seaAfter(const std::optional<Sea>& sea,
+                                                         const command::SetSea& c,
+                                                         glm::dvec2 surface_wind);
+json seaJson(const std::optional<Sea>& sea);
 // Encodes `frame` as `image` asks (delivery.cpp); on failure returns the error.
 std::variant<std::vector<std::uint8_t>, std::string> encodeFrame(const ViewFrame& frame,
                                                                  const ImageRequest& image,

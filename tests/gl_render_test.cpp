@@ -644,5 +644,64 @@ TEST(GlPlatform, EglAndOsmesaRenderTheSameImage) {
   EXPECT_GE(e.psnr_db, 60.0);
 }
 
+// The sea (MODEL.md section 18) under an altocumulus deck, sun ahead: equal to the one-sample
+// reference but for what the GL's probe of the mirrored sky resolves (half the view's
+// resolution, bilinear), and mirroring the deck in both; its pixels are the sea's class, and
+// the glint channel shows the sun's reflection.
+TEST_F(GlRenderTest, SeaEqualsOneSampleReference) {
+  SceneFile file = preset("sea_search", 160, 90);
+  Scene scene = file.scene;
+  scene.targets.clear();
+  scene.fields.clear();  // the cumulus heaps; the altocumulus deck stays
+  scene.haze.reset();
+  Scene cleared = scene;  // the same sea, with nothing to mirror but the sky
+  cleared.layers.clear();
+  const ViewBasis basis = viewBasis(scene.camera);
+  // Pixels wholly below the horizon.
+  auto sea = [&](int x, int y) { return rayDirection(basis, scene.camera, x + 0.5, y).z < 0.0; };
+  const int w = scene.camera.width, h = scene.camera.height;
+  auto meanDifference = [&](const FloatImage& a, const FloatImage& b) {
+    double sum = 0.0;
+    int n = 0;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        if (!sea(x, y)) continue;
+        const std::size_t i = (std::size_t(y) * w + x) * 4;
+        for (int c = 0; c < 3; ++c)
+          sum += std::min(std::abs(a.rgba[i + c] - b.rgba[i + c]), 1.0f);  // glints may exceed 1
+        n += 3;
+      }
+    return sum / n;
+  };
+  const FloatImage gl = renderer_->renderFloat(scene, pointSampled());
+  const FloatImage reference = renderReference(scene, {1, 0});
+  EXPECT_EQ(outOfRange(gl), 0);
+  const double error = meanDifference(gl, reference);
+  const double mirrored = meanDifference(reference, renderReference(cleared, {1, 0}));
+  std::printf("sea: GL against reference %.4f; the deck's reflection %.4f\n", error, mirrored);
+  EXPECT_LE(error, 0.02);     // 0.007 with a probe twice the view's width
+  EXPECT_GE(mirrored, 0.02);  // the deck is seen in the sea, and the bound above resolves it
+  if (error > 0.02) writeFailureImages(gl, reference, "sea");
+
+  const FrameRequest request(ChannelSet{Channel::kObjectId, Channel::kGlint});
+  const Frame gl_frame = renderer_->renderFrame(scene, pointSampled(), request);
+  const Frame ref_frame = renderReferenceFrame(scene, {1, 0}, request);
+  int sea_pixels = 0, glinting = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = std::size_t(y) * w + x;
+      const float expected = sea(x, y) ? kSeaObjectId : 0.0f;
+      if (sea(x, y) && rayDirection(basis, scene.camera, x + 0.5, y + 1.0).z < 0.0) {
+        EXPECT_EQ(gl_frame.object_id[i], expected) << x << "," << y;
+        EXPECT_EQ(ref_frame.object_id[i], expected) << x << "," << y;
+        ++sea_pixels;
+      }
+      glinting += ref_frame.glint[i] > 0.1f;
+      EXPECT_NEAR(gl_frame.glint[i], ref_frame.glint[i], 1e-6f);
+    }
+  EXPECT_GT(sea_pixels, w * h / 3);
+  EXPECT_GT(glinting, 20);
+}
+
 }  // namespace
 }  // namespace nephele

@@ -153,6 +153,82 @@ TEST(Messages, SetWeatherCarriesPrecipitation) {
               HasSubstr("layer"));
 }
 
+// set_sea: the sea's fields and wave trains by id, each range from world/limits.h.
+TEST(Messages, SetSeaCarriesTheSeaAndItsWaveTrains) {
+  const auto sea = std::get<command::SetSea>(
+      parsed(R"({"cmd":"set_sea","fetch":2e4,"temperature":-2,"clarity":1,"whitecaps":false,)"
+             R"("seed":9007199254740993,"waves":[{"id":255,"height":30,"wavelength":1,)"
+             R"("period":0,"direction":-360,"phase":360},{"id":0,"enabled":false}]})")
+          .command);
+  EXPECT_FALSE(sea.enabled.has_value());
+  EXPECT_EQ(*sea.fetch, 2e4);
+  EXPECT_EQ(*sea.temperature, -2.0);
+  EXPECT_EQ(*sea.clarity, 1.0);
+  EXPECT_EQ(*sea.whitecaps, false);
+  EXPECT_EQ(*sea.seed, 9007199254740993ull);  // a seed is an integer, held exactly
+  ASSERT_EQ(sea.waves.size(), 2u);
+  EXPECT_EQ(sea.waves[0].id, 255);
+  EXPECT_FALSE(sea.waves[0].enabled.has_value());
+  EXPECT_EQ(*sea.waves[0].height, 30.0);
+  EXPECT_EQ(*sea.waves[0].wavelength, 1.0);
+  EXPECT_EQ(*sea.waves[0].period, 0.0);
+  EXPECT_EQ(*sea.waves[0].direction, -360.0);
+  EXPECT_EQ(*sea.waves[0].phase, 360.0);
+  EXPECT_EQ(sea.waves[1].id, 0);
+  EXPECT_EQ(sea.waves[1].enabled, false);
+  EXPECT_FALSE(sea.waves[1].height.has_value());
+  // No field: the sea is read back; enabled false removes it.
+  const auto bare = std::get<command::SetSea>(parsed(R"({"cmd":"set_sea"})").command);
+  EXPECT_FALSE(bare.enabled || bare.fetch || bare.temperature || bare.clarity || bare.whitecaps ||
+               bare.seed || !bare.waves.empty());
+  EXPECT_EQ(
+      std::get<command::SetSea>(parsed(R"({"cmd":"set_sea","enabled":false})").command).enabled,
+      false);
+
+  const std::pair<const char*, const char*> errors[] = {
+      {R"({"cmd":"set_sea","fetch":-1})", "fetch: -1 is out of range (allowed: 0 to 2e+06)"},
+      {R"({"cmd":"set_sea","temperature":41})",
+       "temperature: 41 is out of range (allowed: -2 to 40)"},
+      {R"({"cmd":"set_sea","clarity":1.5})", "clarity: 1.5 is out of range (allowed: 0 to 1)"},
+      {R"({"cmd":"set_sea","whitecaps":1})", "whitecaps: must be true or false"},
+      {R"({"cmd":"set_sea","seed":-1})", "seed: -1 is out of range"},
+      {R"({"cmd":"set_sea","enabled":false,"clarity":0.5})", "false removes the sea"},
+      {R"({"cmd":"set_sea","waves":{"id":1}})", "waves: must be an array of 1 to 8 objects"},
+      {R"({"cmd":"set_sea","waves":[]})", "waves: must be an array of 1 to 8"},
+      {R"({"cmd":"set_sea","waves":[1]})", "waves[0]: must be an object"},
+      {R"({"cmd":"set_sea","waves":[{"height":1}]})",
+       "waves[0].id: is missing (allowed: 0 to 255)"},
+      {R"({"cmd":"set_sea","waves":[{"id":256}]})", "waves[0].id: 256 is out of range"},
+      {R"({"cmd":"set_sea","waves":[{"id":1},{"id":1}]})", "waves[1]: id 1 is repeated"},
+      {R"({"cmd":"set_sea","waves":[{"id":1,"height":31}]})",
+       "waves[0].height: 31 is out of range (allowed: 0 to 30)"},
+      {R"({"cmd":"set_sea","waves":[{"id":1,"wavelength":0.5}]})",
+       "waves[0].wavelength: 0.5 is out of range (allowed: 1 to 2000)"},
+      {R"({"cmd":"set_sea","waves":[{"id":1,"period":61}]})",
+       "waves[0].period: 61 is out of range (allowed: 0 to 60)"},
+      {R"({"cmd":"set_sea","waves":[{"id":1,"direction":400}]})",
+       "waves[0].direction: 400 is out of range (allowed: -360 to 360)"},
+      {R"({"cmd":"set_sea","waves":[{"id":1,"phase":-361}]})",
+       "waves[0].phase: -361 is out of range (allowed: -360 to 360)"},
+      {R"({"cmd":"set_sea","waves":[{"id":1,"enabled":false,"height":2}]})",
+       "false removes the wave train"},
+      {R"({"cmd":"set_sea","waves":[{"id":1,"leading":5}]})", "waves[0].leading: unknown field"},
+      {R"({"cmd":"set_sea","wind":[1,2]})", "wind: unknown field"},
+  };
+  for (const auto& [line, words] : errors) {
+    const BadRequest bad = rejected(line);
+    EXPECT_EQ(bad.error.code, ErrorCode::kBadField) << line;
+    EXPECT_THAT(bad.error.message, HasSubstr(words)) << line;
+  }
+  const std::string nine = [] {
+    std::string waves;
+    for (int i = 0; i < 9; ++i)
+      waves += (i ? "," : "") + std::string(R"({"id":)") + char('0' + i) + "}";
+    return R"({"cmd":"set_sea","waves":[)" + waves + "]}";
+  }();
+  EXPECT_THAT(rejected(nine).error.message, HasSubstr("1 to 8"));
+}
+
 TEST(Messages, DefaultChannelsFollowTheFormat) {
   auto image = [](std::string_view line) {
     return *std::get<command::Render>(parsed(line).command).image;

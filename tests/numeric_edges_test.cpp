@@ -123,6 +123,9 @@ std::vector<json> requests() {
       json::parse(R"({"id":1,"cmd":"set_wind","velocity":[3,4]})"),
       json::parse(R"({"id":1,"cmd":"set_sun","azimuth":120,"elevation":30})"),
       json::parse(R"({"id":1,"cmd":"set_fog","top":100,"visibility":500,"colour":[1,1,1]})"),
+      json::parse(R"({"id":1,"cmd":"set_sea","fetch":1000,"temperature":10,"clarity":0.5,)"
+                  R"("seed":3,"waves":[{"id":2,"height":1,"wavelength":50,"period":5,)"
+                  R"("direction":10,"phase":20}]})"),
       json::parse(R"({"id":1,"cmd":"set_time","time_scale":1,"advance":10})"),
       json::parse(R"({"id":1,"cmd":"change_cloud","name":"c","move":[1,2,3],"threshold":0.5,)"
                   R"("limb_threshold":0.4,"transition":0.2,"colour":[1,1,1]})"),

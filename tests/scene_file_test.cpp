@@ -505,5 +505,100 @@ TEST(SceneFile, BadWindDevelopmentAndAutomataAreRejected) {
   EXPECT_EQ(kept.scene.seed, 12345u);
 }
 
+// [sea] (world/sea.h): its keys, its wave trains in either TOML form, and its wind, which is
+// the scene's surface wind unless it gives its own.
+TEST(SceneFile, ReadsTheSeaAndItsWaveTrains) {
+  SceneFile f;
+  ASSERT_EQ(parseError(R"(
+[[wind]]
+altitude = 500.0
+velocity = [6.0, -2.0]
+[sea]
+fetch = 40000.0
+temperature = 9.5
+clarity = 0.8
+whitecaps = false
+seed = 12
+[[sea.wave]]
+id = 9
+height = 2.5
+wavelength = 180.0
+period = 0.0
+direction = -45.0
+phase = 90.0
+[[sea.wave]]
+id = 3
+)",
+                       f),
+            "");
+  ASSERT_TRUE(f.scene.sea.has_value());
+  const Sea& sea = *f.scene.sea;
+  EXPECT_EQ(sea.wind, glm::dvec2(6.0, -2.0));  // the [[wind]] held down to the surface
+  EXPECT_EQ(sea.fetch_m, 40000.0);
+  EXPECT_EQ(sea.temperature_c, 9.5);
+  EXPECT_EQ(sea.clarity, 0.8);
+  EXPECT_FALSE(sea.whitecaps);
+  EXPECT_EQ(sea.seed, 12u);
+  ASSERT_EQ(sea.trains.size(), 2u);
+  EXPECT_EQ(sea.trains[0].id, 3);  // in order of id
+  EXPECT_EQ(sea.trains[0], (WaveTrain{3}));
+  EXPECT_EQ(sea.trains[1].id, 9);
+  EXPECT_EQ(sea.trains[1].height_m, 2.5);
+  EXPECT_EQ(sea.trains[1].wavelength_m, 180.0);
+  EXPECT_EQ(sea.trains[1].period_s, 0.0);
+  EXPECT_EQ(sea.trains[1].direction_deg, -45.0);
+  EXPECT_EQ(sea.trains[1].phase_deg, 90.0);
+
+  // Its own wind, and trains as an array of inline tables; without [[wind]], Sea's defaults.
+  SceneFile g;
+  ASSERT_EQ(parseError("[[wind]]\nvelocity = [1.0, 1.0]\n[sea]\nwind = [3.0, 4.0]\n"
+                       "wave = [{id = 1, height = 0.5}, {id = 2}]\n",
+                       g),
+            "");
+  EXPECT_EQ(g.scene.sea->wind, glm::dvec2(3.0, 4.0));
+  ASSERT_EQ(g.scene.sea->trains.size(), 2u);
+  EXPECT_EQ(g.scene.sea->trains[0].height_m, 0.5);
+  SceneFile h;
+  ASSERT_EQ(parseError("[sea]\n", h), "");
+  EXPECT_EQ(*h.scene.sea, Sea{});
+  SceneFile none;
+  ASSERT_EQ(parseError("seed = 3\n", none), "");
+  EXPECT_FALSE(none.scene.sea.has_value());
+}
+
+TEST(SceneFile, BadSeasNameTheKeyAndTheAllowedRange) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"[sea]\nfetch = -1.0\n", "test.toml:2: sea.fetch: -1 is out of range (allowed: 0 to 2e+06)"},
+      {"[sea]\ntemperature = 45\n", "sea.temperature: 45 is out of range (allowed: -2 to 40)"},
+      {"[sea]\nclarity = 1.1\n", "sea.clarity: 1.1 is out of range (allowed: 0 to 1)"},
+      {"[sea]\nwhitecaps = 1\n", "sea.whitecaps: must be true or false"},
+      {"[sea]\nseed = -4\n", "sea.seed: -4 is out of range"},
+      {"[sea]\nwind = [150.0, 150.0]\n", "sea.wind: 212.132 m/s is out of range"},
+      {"[sea]\nwind = [1.0]\n", "sea.wind: must be an array of 2 numbers"},
+      {"[sea]\nswell = 2\n", "sea.swell: unknown key (allowed here: wind, fetch"},
+      {"[sea]\n[[sea.wave]]\nheight = 1.0\n", "sea.wave[0]: missing key id (0 to 255"},
+      {"[sea]\n[[sea.wave]]\nid = 256\n",
+       "sea.wave[0].id: 256 is out of range (allowed: 0 to 255)"},
+      {"[sea]\n[[sea.wave]]\nid = 1\nheight = 31\n",
+       "sea.wave[0].height: 31 is out of range (allowed: 0 to 30)"},
+      {"[sea]\n[[sea.wave]]\nid = 1\nwavelength = 0.5\n",
+       "sea.wave[0].wavelength: 0.5 is out of range (allowed: 1 to 2000)"},
+      {"[sea]\n[[sea.wave]]\nid = 1\nperiod = 90\n",
+       "sea.wave[0].period: 90 is out of range (allowed: 0 to 60)"},
+      {"[sea]\n[[sea.wave]]\nid = 1\ndirection = 361\n",
+       "sea.wave[0].direction: 361 is out of range (allowed: -360 to 360)"},
+      {"[sea]\n[[sea.wave]]\nid = 1\nphase = nan\n", "sea.wave[0].phase: nan is not a finite"},
+      {"[sea]\n[[sea.wave]]\nid = 1\nleading = 3\n", "sea.wave[0].leading: unknown key"},
+      {"[sea]\n[[sea.wave]]\nid = 1\n[[sea.wave]]\nid = 1\n",
+       "test.toml:5: sea.wave[1].id: 1 is given twice (allowed: one train per id)"},
+      {"[sea]\nwave = 3\n", "sea.wave: must be an array of tables"},
+      {"sea = 1\n", "sea: must be a table"},
+  };
+  for (const auto& [text, words] : cases) EXPECT_THAT(parseError(text), HasSubstr(words)) << text;
+  std::string nine = "[sea]\n";
+  for (int i = 0; i < 9; ++i) nine += "[[sea.wave]]\nid = " + std::to_string(i) + "\n";
+  EXPECT_THAT(parseError(nine), HasSubstr("sea.wave: 9 wave trains (allowed: at most 8)"));
+}
+
 }  // namespace
 }  // namespace nephele

@@ -470,5 +470,84 @@ TEST(World, FogAndHazeSetAgainChangeNothing) {
   EXPECT_NE(world.hash(), hash);
 }
 
+// The sea (world/sea.h): held once, refused whole when invalid, following the surface wind,
+// and kept by snapshots.
+TEST(World, TheSeaFollowsTheSurfaceWindAndSnapshotsKeepIt) {
+  World world = makeWorld();
+  ASSERT_EQ(world.advance(3.0), "");
+  Sea sea;
+  sea.wind = {2.0, 0.0};  // the world's wind at altitude 0
+  sea.fetch_m = 30000.0;
+  sea.trains.push_back({});
+  sea.trains[0].id = 7;
+  sea.trains[0].direction_deg = 45.0;
+  bool changed = false;
+  ASSERT_EQ(world.setSea(sea, &changed), "");
+  EXPECT_TRUE(changed);
+  EXPECT_EQ(world.scene().sea, sea);  // what a render sees
+  const std::uint64_t hash = world.hash();
+  ASSERT_EQ(world.setSea(sea, &changed), "");
+  EXPECT_FALSE(changed);
+  EXPECT_EQ(world.hash(), hash);
+
+  // An invalid sea is refused and changes nothing.
+  const auto refused = [&](Sea bad, const std::string& words) {
+    const std::string error = world.setSea(bad, &changed);
+    EXPECT_THAT(error, ::testing::HasSubstr(words));
+    EXPECT_FALSE(changed);
+    EXPECT_EQ(world.hash(), hash);
+  };
+  Sea bad = sea;
+  bad.clarity = 1.5;
+  refused(bad, "clarity: 1.5 is out of range (allowed: 0 to 1)");
+  bad = sea;
+  bad.temperature_c = std::nan("");
+  refused(bad, "temperature");
+  bad = sea;
+  bad.trains.push_back(sea.trains[0]);
+  refused(bad, "wave: id 7 is given twice");
+  bad = sea;
+  bad.trains[0].wavelength_m = 0.0;
+  refused(bad, "wave 7 wavelength: 0 is out of range (allowed: 1 to 2000)");
+  bad = sea;
+  bad.trains.assign(kMaxWaveTrains + 1, WaveTrain{});
+  for (int i = 0; i <= kMaxWaveTrains; ++i) bad.trains[std::size_t(i)].id = i;
+  refused(bad, "9 wave trains (allowed: at most 8)");
+  bad = sea;
+  bad.wind = {150.0, 150.0};
+  refused(bad, "wind");
+
+  // The wind at altitude 0 is the sea's, whatever changes it; an edit that leaves the wind alone
+  // leaves the sea alone.
+  ASSERT_EQ(world.setWind({{{0.0, {-6.0, 8.0}}}}), "");
+  EXPECT_EQ(world.base().sea->wind, glm::dvec2(-6.0, 8.0));
+  ASSERT_EQ(world.setWind({{{2000.0, {1.0, 1.0}}}}), "");
+  EXPECT_EQ(world.base().sea->wind, glm::dvec2(1.0, 1.0));  // held below the lowest sample
+  ASSERT_EQ(world.setWeather({1, std::nullopt},
+                             [] {
+                               WeatherLayer w;
+                               w.type = CloudType::kStratus;
+                               w.base_m = 800.0;
+                               w.thickness_m = 300.0;
+                               w.wind = glm::dvec2(3.0, 4.0);
+                               return w;
+                             }()),
+            "");
+  EXPECT_EQ(world.base().sea->wind, glm::dvec2(3.0, 4.0));  // a layer's wind, now the lowest
+  ASSERT_EQ(world.setFog(Fog{}), "");
+  EXPECT_EQ(world.base().sea->wind, glm::dvec2(3.0, 4.0));
+
+  // Snapshots keep the sea bit for bit; a snapshot's sea out of range is refused.
+  World copy = makeWorld();
+  ASSERT_EQ(copy.restore(world.snapshot()), "");
+  EXPECT_EQ(copy.base().sea, world.base().sea);
+  EXPECT_EQ(copy.hash(), world.hash());
+  ASSERT_EQ(world.setSea(std::nullopt, &changed), "");
+  EXPECT_TRUE(changed);
+  EXPECT_FALSE(world.scene().sea.has_value());
+  ASSERT_EQ(copy.restore(world.snapshot()), "");
+  EXPECT_FALSE(copy.base().sea.has_value());
+}
+
 }  // namespace
 }  // namespace nephele

@@ -113,6 +113,9 @@ struct Limits {
   static constexpr Range kHeapRefresh{1.0, 16.0};
   // The ground's shadow map, texels a side (`shadow_map_size`; 0: no cloud shadows).
   static constexpr Range kShadowMapSize{256.0, 4096.0};
+  // The sea's sines (`sea_waves`) and its probe's width over the view's (`sea_probe_scale`).
+  static constexpr Range kSeaWaves{16.0, 128.0};
+  static constexpr Range kSeaProbeScale{0.25, 2.0};
   // Ellipsoids a GL frame draws, those of largest projected size (`ellipsoid_budget`; 0: no
   // budget), at most what a world may hold.
   static constexpr Range kEllipsoidBudget{0.0, double(kMaxWorldEllipsoids)};
@@ -166,6 +169,21 @@ struct Limits {
   // metres.
   static constexpr Range kHazeVisibility{10.0, 1.0e7};
   static constexpr Range kHazeScaleHeight{10.0, 1.0e5};
+  // The sea (world/sea.h; CIGI 3.3 Maritime Surface Conditions and Wave Control): the distance
+  // the wind has blown over water, metres (0: a fully developed sea), the surface water's
+  // temperature, Celsius (sea water freezes near -2), and its clarity, 0 turbid to 1 clear.
+  static constexpr Range kSeaFetch{0.0, 2.0e6};
+  static constexpr Range kSeaTemperature{-2.0, 40.0};
+  static constexpr Range kSeaClarity{0.0, 1.0};
+  // A host's wave train: trough to crest and crest to crest, metres; its period, seconds (0:
+  // from the deep-water dispersion of its wavelength); where it travels towards and its phase
+  // offset, degrees. The sea holds at most kMaxWaveTrains (world/sea.h) of them, by id.
+  static constexpr Range kWaveHeight{0.0, 30.0};
+  static constexpr Range kWavelength{1.0, 2000.0};
+  static constexpr Range kWavePeriod{0.0, 60.0};
+  static constexpr Range kWaveDirection{-360.0, 360.0};
+  static constexpr Range kWavePhase{-360.0, 360.0};
+  static constexpr int kMaxWaveId = 255;  // CIGI's wave id is one byte
 
   // A scene file, daemon config or mesh read whole.
   static constexpr unsigned long long kMaxTextFileBytes = 64ull << 20;

@@ -13,6 +13,7 @@
 #include "world/formations/ellipsoid_cloud.h"
 #include "world/formations/region.h"
 #include "world/frames.h"
+#include "world/sea.h"
 #include "world/shading.h"
 #include "world/sky.h"
 #include "world/target.h"
@@ -97,6 +98,8 @@ struct Scene {
   // The rain shafts under its fields' heaps near the camera (MODEL.md section 17), drawn out of
   // the fields with their heaps (withFieldClouds); a scene with fields has none yet.
   std::vector<RainShaft> rain_shafts;
+  // The sea in place of the ground (MODEL.md section 18); none: the ground plane.
+  std::optional<Sea> sea;
 };
 
 // `scene` with `clouds` in place of its own: everything else copied, its clouds' lobes not
@@ -104,10 +107,21 @@ struct Scene {
 inline Scene withClouds(const Scene& scene, std::vector<EllipsoidCloud> clouds) {
   // Every member by name: this stops compiling when Scene gains one, which belongs here too.
   const auto& [seed, time_s, camera, sun, sky, fog, haze, layers, own_clouds, fields, targets,
-               automata, weather, rain_shafts] = scene;
+               automata, weather, rain_shafts, sea] = scene;
   static_cast<void>(own_clouds);
-  return Scene{seed,   time_s,  camera,   sun,     sky,        fog, haze, layers, std::move(clouds),
-               fields, targets, automata, weather, rain_shafts};
+  return Scene{
+      seed,   time_s,  camera,   sun,     sky,         fog, haze, layers, std::move(clouds),
+      fields, targets, automata, weather, rain_shafts, sea};
+}
+
+// What the sea mirrors (MODEL.md section 18): the scene seen from the sea's surface under the
+// camera, without the sea and the targets.
+inline Scene seaProbeScene(const Scene& scene) {
+  Scene probe = withClouds(scene, scene.clouds);
+  probe.sea.reset();
+  probe.targets.clear();
+  probe.camera.position.z = 0.0;
+  return probe;
 }
 
 // Ellipsoids the scene's clouds hold (its fields' heaps are made per view and not counted).

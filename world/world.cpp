@@ -14,6 +14,13 @@
 namespace nephele {
 namespace {
 
+bool sameWind(const WindProfile& a, const WindProfile& b) {
+  return std::equal(a.samples.begin(), a.samples.end(), b.samples.begin(), b.samples.end(),
+                    [](const WindSample& x, const WindSample& y) {
+                      return x.altitude_m == y.altitude_m && x.velocity == y.velocity;
+                    });
+}
+
 // Development changes T0 in steps of 1/256 so that a developing layer rebakes its texture
 // a bounded number of times rather than every frame.
 double quantisedT0(double t0) {
@@ -250,6 +257,45 @@ std::string World::setHaze(const std::optional<Haze>& haze, bool* changed) {
   return setPart(*this, &Scene::haze, haze, changed);
 }
 
+std::string seaError(const Sea& sea) {
+  std::ostringstream out;
+  if (!(glm::length(sea.wind) <= Limits::kMaxWind)) {
+    out << "wind: " << glm::length(sea.wind) << " m/s is out of range (allowed: 0 to "
+        << Limits::kMaxWind << " m/s)";
+    return out.str();
+  }
+  if (outOfRange(out, "fetch", sea.fetch_m, Limits::kSeaFetch) ||
+      outOfRange(out, "temperature", sea.temperature_c, Limits::kSeaTemperature) ||
+      outOfRange(out, "clarity", sea.clarity, Limits::kSeaClarity))
+    return out.str();
+  if (sea.trains.size() > std::size_t(kMaxWaveTrains))
+    return "waves: " + std::to_string(sea.trains.size()) + " wave trains (allowed: at most " +
+           std::to_string(kMaxWaveTrains) + ")";
+  for (auto t = sea.trains.begin(); t != sea.trains.end(); ++t) {
+    const std::string id = std::to_string(t->id);
+    if (t->id < 0 || t->id > Limits::kMaxWaveId)
+      return "wave: id " + id + " is out of range (allowed: 0 to " +
+             std::to_string(Limits::kMaxWaveId) + ")";
+    if (std::any_of(sea.trains.begin(), t, [&](const WaveTrain& o) { return o.id == t->id; }))
+      return "wave: id " + id + " is given twice (allowed: one train per id)";
+    const std::string at = "wave " + id + " ";
+    if (outOfRange(out, (at + "height").c_str(), t->height_m, Limits::kWaveHeight) ||
+        outOfRange(out, (at + "wavelength").c_str(), t->wavelength_m, Limits::kWavelength) ||
+        outOfRange(out, (at + "period").c_str(), t->period_s, Limits::kWavePeriod) ||
+        outOfRange(out, (at + "direction").c_str(), t->direction_deg, Limits::kWaveDirection) ||
+        outOfRange(out, (at + "phase").c_str(), t->phase_deg, Limits::kWavePhase))
+      return out.str();
+  }
+  return "";
+}
+
+std::string World::setSea(const std::optional<Sea>& sea, bool* changed) {
+  if (changed) *changed = false;
+  if (sea)
+    if (std::string e = seaError(*sea); !e.empty()) return e;
+  return setPart(*this, &Scene::sea, sea, changed);
+}
+
 std::string World::setWind(const WindProfile& wind) {
   return edit([&](Scene&, WorldDynamics& d) {
     d.wind = wind;
@@ -343,6 +389,9 @@ std::string World::edit(
   if (!dynamics.wind.empty())
     for (CloudLayer& layer : now.layers)
       layer.texture.drift_velocity = dynamics.wind.at(layer.altitude_m);
+  // The sea's wind is the surface wind (its waves are the wind's): it follows the wind's changes.
+  if (now.sea && !dynamics.wind.empty() && !sameWind(dynamics.wind, dynamics_.wind))
+    now.sea->wind = dynamics.wind.at(0.0);
   foldDrift(now, dynamics, -1.0);
   now.time_s = 0.0;
   now.sun = base_.sun;  // the sun changes through setSun, which relights

@@ -82,6 +82,11 @@ void appendWeatherClouds(Scene& scene, WorldDynamics& dynamics, const WeatherClo
 std::string placeWeather(Scene& scene, WorldDynamics& dynamics, const WeatherKey& key,
                          const WeatherLayer& weather);
 
+// What is wrong with `sea` (a field out of its range in world/limits.h, a wind above
+// Limits::kMaxWind, more than kMaxWaveTrains trains, two trains of one id), or empty: the one
+// check of a whole sea, shared by scene files, requests and snapshots.
+std::string seaError(const Sea& sea);
+
 class World {
  public:
   // Simulation time is kept in whole nanoseconds, so that split advances add up exactly.
@@ -132,7 +137,12 @@ class World {
                          bool* changed = nullptr);
   std::string setFog(const std::optional<Fog>& fog, bool* changed = nullptr);
   std::string setHaze(const std::optional<Haze>& haze, bool* changed = nullptr);
-  // The wind by altitude (layers, clouds and fields drift on from where they are).
+  // The sea in place of the ground (none: the ground plane); an invalid one (seaError) is
+  // refused. Its wind is the surface wind: every edit that changes the world's wind sets it to
+  // the wind at altitude 0.
+  std::string setSea(const std::optional<Sea>& sea, bool* changed = nullptr);
+  // The wind by altitude (layers, clouds and fields drift on from where they are; the sea
+  // takes the wind at altitude 0).
   std::string setWind(const WindProfile& wind);
   // Ellipsoid clouds and targets by name (names are unique within each kind); a cloud keeps
   // its development schedules beside it and loses them with it. Errors name the key.

@@ -26,7 +26,7 @@ namespace {
 static_assert(std::endian::native == std::endian::little, "snapshots assume a little-endian host");
 
 constexpr char kMagic[8] = {'N', 'E', 'P', 'H', 'S', 'N', 'A', 'P'};
-constexpr std::uint32_t kFormatVersion = 11;
+constexpr std::uint32_t kFormatVersion = 12;
 constexpr std::size_t kHeaderBytes = sizeof kMagic + 4 + 8 + 8;
 
 class Writer {
@@ -151,6 +151,21 @@ void io(A& a, std::optional<Haze>& haze) {
     a.fail("haze out of range");
 }
 template <class A>
+void io(A& a, WaveTrain& t) {
+  io(a, t.id), io(a, t.height_m), io(a, t.wavelength_m), io(a, t.period_s), io(a, t.direction_deg);
+  io(a, t.phase_deg);
+}
+template <class A>
+void io(A& a, std::optional<Sea>& sea) {
+  bool present = sea.has_value();
+  io(a, present);
+  if (!present) return sea.reset();
+  if (!sea) sea.emplace();
+  io(a, sea->wind), io(a, sea->fetch_m), io(a, sea->temperature_c), io(a, sea->clarity);
+  io(a, sea->whitecaps), io(a, sea->trains, 44), io(a, sea->seed);
+  if (std::string e = seaError(*sea); !e.empty()) a.fail("sea: " + e);
+}
+template <class A>
 void io(A& a, ShadingParams& s) {
   io(a, s.ambient), io(a, s.texture_fraction), io(a, s.specular), io(a, s.shininess);
 }
@@ -273,7 +288,7 @@ template <class A>
 void io(A& a, Scene& s) {
   io(a, s.seed), io(a, s.camera), io(a, s.sun), io(a, s.sky), io(a, s.fog), io(a, s.haze);
   io(a, s.layers, 64), io(a, s.clouds, 64), io(a, s.targets, 64), io(a, s.fields, 64);
-  io(a, s.weather);
+  io(a, s.weather), io(a, s.sea);
 }
 template <class A>
 void io(A& a, Schedule& s) {

@@ -101,6 +101,7 @@ using GlDepthMaskProc = void(APIENTRYP)(GLboolean flag);
   X(PFNGLVERTEXARRAYELEMENTBUFFERPROC, VertexArrayElementBuffer)         \
   X(PFNGLDRAWARRAYSINSTANCEDPROC, DrawArraysInstanced)                   \
   X(PFNGLBLENDEQUATIONSEPARATEPROC, BlendEquationSeparate)               \
+  X(PFNGLCOPYIMAGESUBDATAPROC, CopyImageSubData)                         \
   X(PFNGLPROGRAMUNIFORMMATRIX3FVPROC, ProgramUniformMatrix3fv)           \
   X(PFNGLPROGRAMUNIFORMMATRIX4FVPROC, ProgramUniformMatrix4fv)           \
   X(PFNGLCREATEQUERIESPROC, CreateQueries)                               \

@@ -254,28 +254,33 @@ Frame GlRenderer::renderFrame(const Scene& scene, const RenderSettings& settings
         const bool on_target = !distance.empty() && distance[gl] < 1e29f;
         // The ray's ground distance, wanted for depth and where a target may stand in front
         // of the ground: object ids alone (a dataset's masks) skip it elsewhere.
-        if (frame.depth.empty() && !on_target) continue;  // object_id stays 0
+        if (frame.depth.empty() && !on_target && !scene.sea) continue;  // object_id stays 0
         const glm::dvec3 d = glm::normalize(rayDirection(basis, camera, x + 0.5, y + 0.5));
         const double ground =
             d.z < 0.0 ? camera.position.z / -d.z : std::numeric_limits<double>::infinity();
         const bool target = on_target && distance[gl] < ground;
         const std::size_t i = std::size_t(y) * w + x;
         if (!frame.depth.empty()) frame.depth[i] = target ? distance[gl] : float(ground);
-        if (!frame.object_id.empty()) frame.object_id[i] = target ? id[gl] : 0.0f;
+        if (!frame.object_id.empty())
+          frame.object_id[i] = target                               ? id[gl]
+                               : scene.sea && std::isfinite(ground) ? kSeaObjectId
+                                                                    : 0.0f;
       }
   }
-  if (asked.has(Channel::kCloudDepth) || asked.has(Channel::kLwir)) {
+  if (asked.has(Channel::kCloudDepth) || asked.has(Channel::kLwir) || asked.has(Channel::kGlint)) {
     ReferenceSettings trace;
     trace.samples_per_axis = 1;
     trace.heaps = settings.heaps;
+    trace.sea_waves = settings.sea_waves;
     trace.label_divisor = settings.channel_divisor;
     FrameRequest traced = request;
     traced.channels = {};
-    for (Channel c : {Channel::kCloudDepth, Channel::kLwir})
+    for (Channel c : {Channel::kCloudDepth, Channel::kLwir, Channel::kGlint})
       if (asked.has(c)) traced.channels.add(c);
     Frame cpu = renderReferenceFrame(scene, trace, traced);
     frame.cloud_depth = std::move(cpu.cloud_depth);
     frame.lwir = std::move(cpu.lwir);
+    frame.glint = std::move(cpu.glint);
   }
   return frame;
 }
@@ -513,6 +518,7 @@ void GlRenderer::drawSkyPass(const Scene& scene, const RenderSettings& settings,
                          float(std::max(slope, 1e-12)));
   }
   if (layout.shadows) shadow_map_.bind(p, 11, camera.position);
+  if (layout.sea) setSeaUniforms(p, scene, settings);
   if (!slots.empty() || !casting.empty()) uniform3("u_to_sun", sunDirection(scene.sun));
   for (std::size_t i = 0; i < slots.size(); ++i)
     setSlotUniforms(p, int(i), int(i), slots[i], scene, settings);
@@ -533,6 +539,7 @@ void GlRenderer::drawSkyGroup(const Scene& scene, const RenderSettings& settings
   base.term_filter = settings.term_filter;
   base.targets = targets;
   base.shadows = shadow_map_.active();
+  base.sea = background && scene.sea && sea_probe_;
   for (const CloudLayer& layer : scene.layers) {
     base.specular |= layer.shading.specular > 0.0;
     base.regions |= layerHasRegion(layer);
@@ -672,11 +679,13 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
   shadow_map_.prepare(heap_shadows_ ? *heap_shadows_ : CloudShadows(), scene.camera.position,
                       settings.shadow_map_size, stats_, timer_);
   ellipsoids_.setSunlight(&sunlight_);
+  drawSeaProbe(within ? *within : drawable, rest);
   drawScene(within ? *within : drawable, rest, format);
   ellipsoids_.setSunlight(nullptr);
   sunlight_ = {};
   plane_shadows_ = {};  // it points into `scene`
   heap_shadows_.reset();
+  sea_probe_ = false;
   timer_.enter(-1);
   FrameTimes& t = stats_.times;
   t.submit_ms =
@@ -687,6 +696,102 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
   for (std::size_t i = 0; i < t.cpu_ms.size(); ++i)
     if (i != std::size_t(CpuStage::kScene)) staged += t.cpu_ms[i];
   t.cpu(CpuStage::kScene) = std::max(0.0, t.submit_ms - staged);
+}
+
+// The probe's camera: at the sea below the eye, looking where the view's rays are mirrored,
+// its field widened by kProbeMarginDeg for the waves' tilts, at half the view's resolution
+// (MODEL.md section 18, "what the sea mirrors").
+namespace {
+constexpr double kProbeMarginDeg = 20.0;
+Camera seaProbeCamera(const Camera& view, double scale) {
+  Camera probe = view;
+  probe.position.z = 0.0;
+  probe.orientation.pitch_deg = -view.orientation.pitch_deg;
+  probe.orientation.roll_deg = -view.orientation.roll_deg;
+  const double aspect = double(view.width) / view.height;
+  // The widened field must hold the view's diagonal: its vertical half angle from the diagonal's.
+  const double half =
+      std::atan(std::tan(0.5 * glm::radians(view.vfov_deg)) * std::sqrt(1.0 + aspect * aspect));
+  probe.vfov_deg = std::min(2.0 * glm::degrees(half) + 2.0 * kProbeMarginDeg, 160.0);
+  probe.width = std::max(32, int(std::lround(view.width * scale)));
+  probe.height = std::max(32, int(std::lround(probe.width / aspect)));
+  return probe;
+}
+}  // namespace
+
+void GlRenderer::drawSeaProbe(const Scene& scene, const RenderSettings& settings) {
+  sea_probe_ = false;
+  if (!scene.sea) return;
+  const Camera& camera = scene.camera;
+  const ViewBasis basis = viewBasis(camera);
+  // Only a view that shows the sea: some corner ray below the horizon.
+  bool below = false;
+  for (double u : {-1.0, 1.0})
+    for (double v : {-1.0, 1.0})
+      below |= basis.forward.z + u * basis.right.z * basis.tan_half_vfov * basis.aspect +
+                   v * basis.up.z * basis.tan_half_vfov <
+               0.0;
+  if (!below) return;
+  Scene probe = seaProbeScene(scene);
+  probe.camera = seaProbeCamera(camera, settings.sea_probe_scale);
+  const std::string view = continuous_view_;
+  continuous_view_ = view.empty() ? view : view + "/sea probe";
+  drawScene(probe, settings, TargetFormat::kFloat);
+  continuous_view_ = view;
+  const int w = probe.camera.width, h = probe.camera.height;
+  if (!sea_probe_texture_ || sea_probe_width_ != w || sea_probe_height_ != h) {
+    sea_probe_texture_ = createTexture(gl_, GL_TEXTURE_2D);
+    gl_.TextureStorage2D(sea_probe_texture_.get(), 1, GL_RGBA32F, w, h);
+    gl_.TextureParameteri(sea_probe_texture_.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    gl_.TextureParameteri(sea_probe_texture_.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    gl_.TextureParameteri(sea_probe_texture_.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    gl_.TextureParameteri(sea_probe_texture_.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    sea_probe_width_ = w;
+    sea_probe_height_ = h;
+  }
+  gl_.CopyImageSubData(colour_buffer_.get(), GL_RENDERBUFFER, 0, 0, 0, 0, sea_probe_texture_.get(),
+                       GL_TEXTURE_2D, 0, 0, 0, 0, w, h, 1);
+  const ViewBasis pb = viewBasis(probe.camera);
+  sea_probe_right_ = pb.right / (pb.tan_half_vfov * pb.aspect);
+  sea_probe_up_ = pb.up / pb.tan_half_vfov;
+  sea_probe_forward_ = pb.forward;
+  sea_probe_ = true;
+}
+
+void GlRenderer::setSeaUniforms(GLuint p, const Scene& scene, const RenderSettings& settings) {
+  const Sea& sea = *scene.sea;
+  if (!sea_surface_ || sea_surface_->sea != sea || sea_surface_->waves != settings.sea_waves)
+    sea_surface_.emplace(sea, settings.sea_waves, SeaSurface(sea, settings.sea_waves));
+  const SeaSurface& surface = sea_surface_->surface;
+  const std::vector<WaveComponent>& waves = surface.components();
+  const int n = int(std::min<std::size_t>(waves.size(), kMaxSeaWaves));
+  std::vector<glm::vec4> packed(std::size_t(std::max(n, 1)));
+  std::vector<glm::vec3> wobble(packed.size());
+  const glm::dvec2 eye(scene.camera.position);
+  constexpr double kTurn = 2.0 * std::numbers::pi;
+  for (int i = 0; i < n; ++i) {
+    const WaveComponent& w = waves[std::size_t(i)];
+    const double phase =
+        std::remainder(glm::dot(w.k, eye) - w.omega * scene.time_s + w.phase, kTurn);
+    packed[std::size_t(i)] = glm::vec4(glm::vec2(w.k), float(w.amplitude), float(phase));
+    wobble[std::size_t(i)] =
+        glm::vec3(glm::vec2(w.q), float(std::remainder(glm::dot(w.q, eye) + w.psi, kTurn)));
+  }
+  gl_.ProgramUniform4fv(p, gl_.GetUniformLocation(p, "u_wave"), GLsizei(n), &packed[0].x);
+  gl_.ProgramUniform3fv(p, gl_.GetUniformLocation(p, "u_wave_wobble"), GLsizei(n), &wobble[0].x);
+  gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_waves"), n);
+  const glm::vec4 params(float(surface.slopeVariance()), float(surface.heightVariance()),
+                         float(surface.whitecapFraction()),
+                         float(seaPixelAngle(scene.camera.vfov_deg, scene.camera.height)));
+  gl_.ProgramUniform4fv(p, gl_.GetUniformLocation(p, "u_sea"), 1, &params.x);
+  gl_.ProgramUniform1f(p, gl_.GetUniformLocation(p, "u_foam_height"), float(surface.foamHeight()));
+  setUniform3(gl_, p, "u_sea_body", waterBodyColour(sea.clarity) * scene.sun.colour);
+  setUniform3(gl_, p, "u_sea_sun", sunDirection(scene.sun));
+  setUniform3(gl_, p, "u_sun_colour", scene.sun.colour);
+  setUniform3(gl_, p, "u_probe_right", sea_probe_right_);
+  setUniform3(gl_, p, "u_probe_up", sea_probe_up_);
+  setUniform3(gl_, p, "u_probe_forward", sea_probe_forward_);
+  gl_.BindTextureUnit(6, sea_probe_texture_.get());
 }
 
 void GlRenderer::drawScene(const Scene& scene, const RenderSettings& settings,

@@ -99,6 +99,10 @@ class GlRenderer {
   // stages and GPU passes timed into stats_.times.
   void drawFrame(const Scene& scene, const RenderSettings& settings, TargetFormat format);
   void drawScene(const Scene& scene, const RenderSettings& settings, TargetFormat format);
+  // What the sea mirrors, drawn into sea_probe_texture_ before a view that shows the sea
+  // (MODEL.md section 18), and the sky pass's sea uniforms.
+  void drawSeaProbe(const Scene& scene, const RenderSettings& settings);
+  void setSeaUniforms(GLuint program, const Scene& scene, const RenderSettings& settings);
   // Waits for the frame's passes, collects their times, and reads the target back.
   void finishAndRead(int width, int height, GLenum type, void* out);
   // Background (if asked) and the given layers, fused or one pass per layer.
@@ -130,6 +134,18 @@ class GlRenderer {
   std::vector<LayerSlot> casters_;
   static constexpr int kCasterUnit = 16;  // their tables' texture units, up from here
   std::string continuous_view_;
+  // The sea's probe of this frame, and the last sea's waves.
+  bool sea_probe_ = false;
+  GlObject sea_probe_texture_;
+  int sea_probe_width_ = 0, sea_probe_height_ = 0;
+  glm::dvec3 sea_probe_right_{1.0, 0.0, 0.0}, sea_probe_up_{0.0, 0.0, 1.0},
+      sea_probe_forward_{0.0, 1.0, 0.0};
+  struct SeaWaves {
+    Sea sea;
+    int waves;
+    SeaSurface surface;
+  };
+  std::optional<SeaWaves> sea_surface_;
   std::map<std::string, CachedTexture> textures_;
   std::uint64_t frame_ = 0;  // frames drawn
   GlObject floor_program_;

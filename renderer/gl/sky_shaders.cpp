@@ -257,17 +257,119 @@ uniform float u_horizon_slope;  // |gradient of r.z| per pixel
 // The sky planes' share of the sunlight at this pixel's ground point (planesSunlight), set by
 // main before background() where planes cast shadows.
 float g_planes_sun = 1.0;
-vec3 groundColour(vec3 d) {
+// The share of the sunlight reaching the ground point along unit d.
+float groundSunlight(vec3 d) {
   float sun = g_planes_sun;
 #ifdef SHADOWS
   sun *= mapSunlight(d.xy * (u_camera_z / -d.z));
 #endif
+  return sun;
+}
+vec3 groundColour(vec3 d) {
 #if defined(SHADOWS) || defined(PLANE_SHADOWS)
-  return u_ground * (kGroundSkyShare + (1.0 - kGroundSkyShare) * sun);
+  return u_ground * (kGroundSkyShare + (1.0 - kGroundSkyShare) * groundSunlight(d));
 #else
   return u_ground;
 #endif
 }
+
+#ifdef SEA
+// The sea (MODEL.md section 18); world/sea.cpp is the reference's twin, function by function.
+// The surface's sines, longest first: wave vector (rad/m), amplitude, and the phase at the
+// camera's ground point now (mod 2 pi, in double on the CPU).
+uniform vec4 u_wave[kSeaWaves];
+// Each one's phase modulation: its wave vector, and its phase at the camera's ground point.
+uniform vec3 u_wave_wobble[kSeaWaves];
+uniform int u_waves;
+// Cox-Munk's slope variance, the waves' height variance, the whitecap fraction, the pixel's
+// angle in radians.
+uniform vec4 u_sea;
+uniform float u_foam_height;  // SeaSurface::foamHeight
+uniform vec3 u_sea_body;  // waterBodyColour, times the sun's colour
+uniform vec3 u_sea_sun;   // unit, towards the sun
+uniform vec3 u_sun_colour;
+// What the sea mirrors (the probe: the scene from the sea below the camera); a direction r
+// is at ((r . right, r . up) / (r . forward) + 1) / 2 in it.
+layout(binding = 6) uniform sampler2D u_sea_probe;
+uniform vec3 u_probe_right;
+uniform vec3 u_probe_up;
+uniform vec3 u_probe_forward;
+const float kSeaResolvedShare = 0.8;
+const float kFoamReflectance = 0.22;
+
+float fresnelWater(float cos_incidence) {
+  float c = clamp(cos_incidence, 0.0, 1.0), n = 1.34;
+  float g = sqrt(n * n - 1.0 + c * c);
+  float a = (g - c) / (g + c), b = (c * (g + c) - 1.0) / (c * (g - c) + 1.0);
+  return 0.5 * a * a * (1.0 + b * b);
+}
+
+float foamShare(float w, float foam_height, float height, float var_total, float var_unresolved) {
+  if (!(w > 0.0)) return 0.0;
+  if (w >= 1.0) return 1.0;
+  float resolved = var_total > 0.0 ? clamp(1.0 - var_unresolved / var_total, 0.0, 1.0) : 0.0;
+  float edge = sqrt(max(var_unresolved, 1e-4 * var_total + 1e-12));
+  float crest = 1.0 / (1.0 + exp(-1.702 * (height - foam_height) / edge));
+  return (1.0 - resolved) * w + resolved * crest;
+}
+
+float glintRadiance(vec3 d, vec3 n, float slope_var) {
+  vec3 v = -d, sun = u_sea_sun;
+  float mu_v = dot(v, n), mu_s = dot(sun, n);
+  if (!(mu_v > 0.0) || !(mu_s > 0.0)) return 0.0;
+  vec3 h = normalize(v + sun);
+  float mu_n = dot(h, n);
+  if (!(mu_n > 0.0)) return 0.0;
+  float mu_n2 = mu_n * mu_n, tan2 = (1.0 - mu_n2) / mu_n2;
+  return fresnelWater(dot(v, h)) * exp(-tan2 / slope_var) /
+         (4.0 * slope_var * max(mu_v, 1e-2) * mu_n2 * mu_n2);
+}
+
+vec3 probeRadiance(vec3 r) {
+  vec2 ndc = vec2(dot(r, u_probe_right), dot(r, u_probe_up)) / max(dot(r, u_probe_forward), 1e-6);
+  return texture(u_sea_probe, clamp(0.5 * ndc + 0.5, 0.0, 1.0)).rgb;
+}
+
+// The sea's radiance along unit d (d.z < 0), before the air.
+vec3 seaColour(vec3 d) {
+  float distance = u_camera_z / -d.z;
+  vec2 p = d.xy * distance;
+  float footprint = distance * u_sea.w / sqrt(max(abs(d.z), 1e-4));
+  float height = 0.0, resolved_height = 0.0, resolved_slope = 0.0;
+  vec2 slope = vec2(0.0);
+  for (int i = 0; i < u_waves; ++i) {
+    vec4 w = u_wave[i];
+    float k = length(w.xy);
+    float weight = clamp(6.283185307179586 / k / (4.0 * footprint) - 1.0, 0.0, 1.0);
+    if (weight <= 0.0) break;
+    vec3 m = u_wave_wobble[i];
+    float wobble = dot(m.xy, p) + m.z;
+    float phase = dot(w.xy, p) + w.w + kWaveModulation * gardnerSin(wobble);
+    height += weight * w.z * gardnerSin(phase + 1.5707963267948966);
+    slope -= (weight * w.z * gardnerSin(phase)) *
+             (w.xy + kWaveModulation * gardnerSin(wobble + 1.5707963267948966) * m.xy);
+    float variance = 0.5 * weight * weight * w.z * w.z;
+    resolved_height += variance;
+    resolved_slope += variance * k * k;
+  }
+  float slope_var = max(u_sea.x - resolved_slope, (1.0 - kSeaResolvedShare) * u_sea.x);
+  vec3 n = normalize(vec3(-slope, 1.0));
+  float cos_i = clamp(-dot(d, n), 0.0, 1.0);
+  vec3 r = d + 2.0 * cos_i * n;
+  r.z = max(r.z, 0.01);
+  r = normalize(r);
+  float foam =
+      foamShare(u_sea.z, u_foam_height, height, u_sea.y, max(u_sea.y - resolved_height, 0.0));
+  float fresnel = fresnelWater(cos_i);
+  float sun = groundSunlight(d);
+  float diffuse = max(u_sea_sun.z, 0.0) * (kGroundSkyShare + (1.0 - kGroundSkyShare) * sun);
+  vec3 colour = diffuse * ((1.0 - foam) * (1.0 - fresnel) * u_sea_body +
+                           foam * kFoamReflectance * u_sun_colour);
+  if (u_sea_sun.z > 0.0 && sun > 0.0)
+    colour += (1.0 - foam) * sun * glintRadiance(d, n, slope_var) * u_sun_colour;
+  return colour + (1.0 - foam) * fresnel * probeRadiance(r);
+}
+#endif
 
 vec3 background(vec3 r) {
   vec3 d = normalize(r);
@@ -275,14 +377,18 @@ vec3 background(vec3 r) {
   // straight edge and its box-filtered coverage is exact.
   float ground = clamp(0.5 - r.z / u_horizon_slope, 0.0, 1.0);
   vec3 sky = u_horizon + (u_zenith - u_horizon) * sqrt(max(d.z, 0.0));  // MODEL.md section 5
+#ifdef SEA
+  vec3 below = d.z < 0.0 ? seaColour(d) : u_horizon;
+#else
+  vec3 below = d.z < 0.0 ? groundColour(d) : u_ground;
+#endif
 #ifdef AIR
   // Each part carries its own air. The ground seen at the horizon lies behind an endless
   // stretch of air (fog and haze touch the ground), so there it is the air's colour.
-  vec3 aired_ground =
-      d.z < 0.0 ? applyAir(groundColour(d), d, u_camera_z / -d.z) : airAtHorizon();
+  vec3 aired_ground = d.z < 0.0 ? applyAir(below, d, u_camera_z / -d.z) : airAtHorizon();
   return mix(applyAir(sky, d, kFar), aired_ground, ground);
 #else
-  return mix(sky, d.z < 0.0 ? groundColour(d) : u_ground, ground);
+  return mix(sky, below, ground);
 #endif
 }
 #endif
@@ -593,6 +699,7 @@ std::string SkyPassLayout::key() const {
   k += targets ? 't' : '-';
   k += regions ? 'r' : '-';
   k += shadows ? 'h' : '-';
+  k += sea ? 'w' : '-';
   k += '/';
   for (LayerKind kind : casters) k += char('a' + int(kind));
   return k;
@@ -639,7 +746,10 @@ std::string skyFragmentSource(const SkyPassLayout& layout) {
   if (layout.regions) s += "#define REGIONS\n";
   if (layout.shadows) s += "#define SHADOWS\n";
   if (!layout.casters.empty()) s += "#define PLANE_SHADOWS\n";
-  if (layout.shadows || !layout.casters.empty())
+  if (layout.sea)
+    s += "#define SEA\nconst int kSeaWaves = " + std::to_string(kMaxSeaWaves) +
+         ";\nconst float kWaveModulation = " + std::to_string(kWaveModulation) + ";\n";
+  if (layout.shadows || !layout.casters.empty() || layout.sea)
     s += "const float kGroundSkyShare = " + std::to_string(kGroundSkyShare) + ";\n";
   if (layout.term_filter == TermFilter::kCut) s += "#define FILTER_CUT\n";
   if (layout.term_filter == TermFilter::kNone) s += "#define FILTER_NONE\n";

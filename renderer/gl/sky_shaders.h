@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "renderer/render_settings.h"
+#include "world/sea.h"
 
 namespace nephele {
 
@@ -16,6 +17,9 @@ namespace nephele {
 enum class LayerKind { kBakedGardner, kProceduralGardner, kTable, kClipmapGardner };
 
 inline constexpr int kMaxLayerSlots = 8;
+// The sea's sines a sky pass holds at most: the spectrum's (Limits::kSeaWaves) and the host's
+// wave trains.
+inline constexpr int kMaxSeaWaves = 128 + kMaxWaveTrains;
 
 // What one pass computes; everything a scene does not need is compiled out.
 struct SkyPassLayout {
@@ -30,6 +34,7 @@ struct SkyPassLayout {
   bool targets = false;  // opaque targets were drawn first (their colour and distance)
   bool regions = false;  // some layer lies in a bounded region (region.h)
   bool shadows = false;  // the ground takes the clouds' shadows from the shadow map
+  bool sea = false;      // the sea in place of the ground (MODEL.md section 18)
   // Layers whose shadows fall on the ground and the slots' planes (MODEL.md section 16, "sky
   // planes"), as slots slots() onwards: every layer of the frame while the sun is up.
   std::vector<LayerKind> casters;

@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <thread>
 #include <vector>
@@ -14,6 +15,7 @@
 #include "world/formations/ellipsoid.h"
 #include "world/formations/heap_light.h"
 #include "world/frames.h"
+#include "world/sea.h"
 #include "world/textures/layer_texture.h"
 
 namespace nephele {
@@ -54,7 +56,19 @@ struct RayLabels {
   double depth = kInfinity;
   double cloud_depth = kInfinity;
   int object_id = 0;
-  double lwir = 0.0;  // with an infrared model
+  double lwir = 0.0;   // with an infrared model
+  double glint = 0.0;  // the sea's sun glint, luminance as seen
+};
+
+double luminance(glm::dvec3 c) {
+  return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b;
+}
+
+// The sea where a ray meets it (MODEL.md section 18).
+struct SeaView {
+  SeaShading shading;
+  double cos_incidence = 1.0;  // on the resolved surface
+  glm::dvec3 colour{0.0};      // its radiance, before the air
 };
 
 struct EllipsoidEntry {
@@ -68,7 +82,7 @@ struct EllipsoidEntry {
 class ReferenceTracer {
  public:
   // `shadows`: the ground's cloud shadows (MODEL.md section 16), or null for none.
-  ReferenceTracer(const Scene& scene, const CloudShadows* shadows)
+  ReferenceTracer(const Scene& scene, const CloudShadows* shadows, int sea_waves = kSeaComponents)
       : scene_(scene), sun_(sunDirection(scene.sun)), shadows_(shadows) {
     textures_.reserve(scene.layers.size());
     for (const CloudLayer& layer : scene.layers) textures_.emplace_back(layer.texture);
@@ -89,6 +103,12 @@ class ReferenceTracer {
     veil_ = inCloudVeil(
         scene.clouds, [&](std::size_t c) -> const SolidTexture& { return *solid_pointers[c]; },
         scene.camera.position, scene.sun);
+    if (scene.sea) {
+      sea_.emplace(*scene.sea, sea_waves);
+      pixel_rad_ = seaPixelAngle(scene.camera.vfov_deg, scene.camera.height);
+      probe_scene_ = seaProbeScene(scene);
+      probe_ = std::make_unique<ReferenceTracer>(*probe_scene_, shadows);
+    }
   }
 
   // Colour and coverage along one ray (unit direction); the ray's labels if asked.
@@ -97,13 +117,9 @@ class ReferenceTracer {
                    RayLabels* labels = nullptr, double max_distance = kInfinity,
                    const InfraredModel* infrared = nullptr) const {
     const glm::dvec3 eye = scene_.camera.position;
-    double nearest_opaque =
-        std::min(direction.z < 0.0 ? eye.z / -direction.z : kInfinity, max_distance);
-    glm::dvec3 colour = skyBackground(scene_.sky, direction);
-    if (direction.z < 0.0 && !sunlight_.empty()) {
-      const glm::dvec3 ground = eye + (eye.z / -direction.z) * direction;
-      colour *= groundLight(sunlight_.at({ground.x, ground.y, 0.0}));
-    }
+    const double ground_distance = direction.z < 0.0 ? eye.z / -direction.z : kInfinity;
+    double nearest_opaque = std::min(ground_distance, max_distance);
+    glm::dvec3 colour(0.0);
     int object_id = 0;
     for (std::size_t t = 0; t < scene_.targets.size(); ++t) {
       const Target& target = scene_.targets[t];
@@ -114,6 +130,19 @@ class ReferenceTracer {
       // In the clouds' shadows (MODEL.md section 16) where the ray meets it.
       colour = targetRadiance(target, hit->normal, sun_, -direction, scene_.sun,
                               sunlight_.at(eye + hit->distance * direction));
+    }
+    std::optional<SeaView> sea;
+    if (object_id == 0) {
+      if (sea_ && nearest_opaque == ground_distance && std::isfinite(ground_distance)) {
+        sea = seaView(direction, ground_distance);
+        colour = sea->colour;
+      } else {
+        colour = skyBackground(scene_.sky, direction);
+        if (direction.z < 0.0 && !sunlight_.empty()) {
+          const glm::dvec3 ground = eye + (eye.z / -direction.z) * direction;
+          colour *= groundLight(sunlight_.at({ground.x, ground.y, 0.0}));
+        }
+      }
     }
     colour = withAir(colour, direction, nearest_opaque);
 
@@ -144,7 +173,14 @@ class ReferenceTracer {
     translucence_product *= 1.0 - veil_.opacity;
     if (labels) {
       labels->depth = nearest_opaque;
-      labels->object_id = object_id;
+      labels->object_id = sea ? int(kSeaObjectId) : object_id;
+      // The glint as seen: through the air (throughAir is linear in the colour behind), the
+      // clouds and the veil.
+      labels->glint = 0.0;
+      if (sea)
+        labels->glint = luminance(withAir(sea->shading.glint, direction, nearest_opaque) -
+                                  withAir(glm::dvec3(0.0), direction, nearest_opaque)) *
+                        translucence_product;
       labels->cloud_depth = kInfinity;
       // Front to back: the first surface after which the cloud opacity is 1/2 or more.
       double transmittance = 1.0 - veil_.opacity;
@@ -154,7 +190,8 @@ class ReferenceTracer {
         if (transmittance <= 0.5) labels->cloud_depth = s->half_distance;
       }
       if (infrared)
-        labels->lwir = infraredRadiance(*infrared, direction, surfaces, object_id, nearest_opaque);
+        labels->lwir = infraredRadiance(*infrared, direction, surfaces, object_id, nearest_opaque,
+                                        sea ? &*sea : nullptr);
     }
     return {colour, 1.0 - translucence_product};
   }
@@ -164,12 +201,17 @@ class ReferenceTracer {
   // to front as a grey body at the air temperature of its altitude, emissivity its opacity.
   double infraredRadiance(const InfraredModel& model, glm::dvec3 direction,
                           const std::vector<Surface>& surfaces, int object_id,
-                          double nearest_opaque) const {
+                          double nearest_opaque, const SeaView* sea) const {
     const glm::dvec3 eye = scene_.camera.position;
     const double elevation = std::asin(std::clamp(direction.z, -1.0, 1.0));
     double radiance;
     if (object_id > 0) {
       radiance = bandRadiance(model, targetTemperature(model, object_id - 1));
+    } else if (sea) {  // emissivity 1 - F by the angle on the resolved waves, the sky mirrored
+      const double e = seaEmissivity(sea->cos_incidence);
+      const double mirrored = std::asin(std::clamp(sea->shading.reflect_dir.z, 0.0, 1.0));
+      radiance = e * bandRadiance(model, scene_.sea->temperature_c + 273.15) +
+                 (1.0 - e) * clearSkyRadiance(model, mirrored, 0.0);
     } else if (std::isfinite(nearest_opaque)) {  // the ground, reflecting the sky a little
       radiance = model.ground_emissivity * bandRadiance(model, model.ground_k) +
                  (1.0 - model.ground_emissivity) * clearSkyRadiance(model, -elevation, 0.0);
@@ -304,6 +346,24 @@ class ReferenceTracer {
     return tau;
   }
 
+  // The sea along unit `direction` at `distance` (MODEL.md section 18): its waves filtered to
+  // the pixel's footprint, the sky and clouds it mirrors seen from the sea below the camera
+  // (the reflection probe, like the GL's), the water, foam and glint in the clouds' shadows.
+  SeaView seaView(glm::dvec3 direction, double distance) const {
+    const glm::dvec3 p = scene_.camera.position + distance * direction;
+    const SeaSample s =
+        sea_->sample({p.x, p.y}, scene_.time_s, seaFootprint(distance, direction.z, pixel_rad_));
+    SeaView view;
+    view.shading = shadeSea(*sea_, *scene_.sea, s, direction, sun_, scene_.sun.colour,
+                            sunlight_.at({p.x, p.y, 0.0}));
+    const glm::dvec3 n = glm::normalize(glm::dvec3(-s.slope.x, -s.slope.y, 1.0));
+    view.cos_incidence = std::clamp(-glm::dot(direction, n), 0.0, 1.0);
+    std::vector<Surface> hits;
+    const glm::dvec3 mirrored = glm::dvec3(probe_->trace(view.shading.reflect_dir, hits));
+    view.colour = view.shading.body_and_foam + view.shading.glint + view.shading.fresnel * mirrored;
+    return view;
+  }
+
   glm::dvec3 withAir(glm::dvec3 colour, glm::dvec3 direction, double distance) const {
     return throughAir(colour, scene_.fog, layer_veil_, scene_.haze, scene_.sky.horizon,
                       scene_.camera.position, direction, distance, precipitation_.slabs,
@@ -321,6 +381,11 @@ class ReferenceTracer {
   PlaneShadows planes_{scene_};
   SceneSunlight sunlight_{&planes_, shadows_};
   PrecipitationMedia precipitation_ = precipitationMedia(scene_);
+  // The sea: its waves, the pixel's angle, and the tracer of what it mirrors.
+  std::optional<SeaSurface> sea_;
+  double pixel_rad_ = 0.0;
+  std::optional<Scene> probe_scene_;
+  std::unique_ptr<ReferenceTracer> probe_;
 };
 
 }  // namespace
@@ -334,17 +399,20 @@ Frame renderReferenceFrame(const Scene& scene, const ReferenceSettings& settings
   Frame frame = frameFor(camera, scene.time_s, request);
   const bool colour = compositeAsked(asked);
   const bool labels = asked.has(Channel::kDepth) || asked.has(Channel::kCloudDepth) ||
-                      asked.has(Channel::kObjectId) || asked.has(Channel::kLwir);
+                      asked.has(Channel::kObjectId) || asked.has(Channel::kLwir) ||
+                      asked.has(Channel::kGlint);
   const InfraredModel* infrared = asked.has(Channel::kLwir) ? &request.infrared : nullptr;
   if (colour) frame.colour = {camera.width, camera.height, std::vector<float>(pixels * 4)};
   if (asked.has(Channel::kDepth)) frame.depth.resize(pixels);
   if (asked.has(Channel::kCloudDepth)) frame.cloud_depth.resize(pixels);
   if (asked.has(Channel::kObjectId)) frame.object_id.resize(pixels);
   if (infrared) frame.lwir.resize(pixels);
+  if (asked.has(Channel::kGlint)) frame.glint.resize(pixels);
 
   const Scene with_fields = scene.fields.empty() ? Scene{} : withFieldClouds(scene, settings.heaps);
   const CloudShadows shadows(scene, settings.heaps, /*lookups=*/true);
-  const ReferenceTracer tracer(scene.fields.empty() ? scene : with_fields, &shadows);
+  const ReferenceTracer tracer(scene.fields.empty() ? scene : with_fields, &shadows,
+                               settings.sea_waves);
   const ViewBasis basis = viewBasis(camera);
   const int n = std::max(1, settings.samples_per_axis);
   const int divisor = std::max(1, settings.label_divisor);
@@ -386,6 +454,7 @@ Frame renderReferenceFrame(const Scene& scene, const ReferenceSettings& settings
               if (!frame.cloud_depth.empty()) frame.cloud_depth[i] = float(ray.cloud_depth);
               if (!frame.object_id.empty()) frame.object_id[i] = float(ray.object_id);
               if (!frame.lwir.empty()) frame.lwir[i] = float(ray.lwir);
+              if (!frame.glint.empty()) frame.glint[i] = float(ray.glint);
             }
         }
       }

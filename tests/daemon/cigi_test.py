@@ -70,6 +70,23 @@ def atmosphere_control(visibility, wind, wind_from, bo=">"):
                        wind_from, 1013.0)
 
 
+def maritime_control(enabled, whitecaps, temperature, clarity, height=0.0, scope=0, region=0,
+                     bo=">"):
+    """Maritime Surface Conditions Control (13): clarity in percent; scope 0 global, 1
+    regional, 2 entity."""
+    return struct.pack(bo + "BBHB3xfff4x", 13, 24, region,
+                       int(enabled) | (int(whitecaps) << 1) | (scope << 2), height, temperature,
+                       clarity)
+
+
+def wave_control(wave, enabled, height=1.0, wavelength=100.0, period=0.0, direction=0.0,
+                 phase=0.0, leading=0.0, breaker=0, scope=0, region=0, bo=">"):
+    """Wave Control (14): direction is where the wave propagates, degrees from true north."""
+    return struct.pack(bo + "BBHBB2xffffff", 14, 32, region, wave,
+                       int(enabled) | (scope << 1) | (breaker << 3), height, wavelength, period,
+                       direction, phase, leading)
+
+
 def celestial_control(month, day, year, hour, minute, bo=">"):
     return struct.pack(bo + "BBBBB3xIf", 9, 16, hour, minute, 0x1F,
                        month * 1000000 + day * 10000 + year, 0.0)
@@ -122,6 +139,11 @@ def sun_spencer(year, month, day, hour, minute, lat, lon):
     el = math.asin(math.sin(phi) * math.sin(decl) + math.cos(phi) * math.cos(decl) * math.cos(ha))
     az = math.atan2(math.sin(ha), math.cos(ha) * math.sin(phi) - math.tan(decl) * math.cos(phi))
     return math.degrees(el), (math.degrees(az) + 180) % 360
+
+
+def dissected_number(value):
+    """A number as tshark's JSON gives it: booleans as "1"/"0" or "True"/"False"."""
+    return float({"true": 1, "false": 0}.get(str(value).lower(), value))
 
 
 def unfloat(words):
@@ -572,6 +594,69 @@ size = [4, 2, 1]
         self.assertEqual(level(11, weather_control(4, False)), dry)
         self.assertNotIn("ignored", c.ok({"cmd": "stats"})["cigi"])
 
+    def test_the_sea_from_maritime_surface_conditions_and_wave_control(self):
+        """Maritime Surface Conditions Control (13) and Wave Control (14) of global scope set
+        the sea (set_sea reads it back): clarity from percent, each wave train as sent (its
+        direction is where it travels, as the sea's), the wind the surface wind. What the sea
+        does not model is ignored with its reason; packets repeated every frame change nothing."""
+        d = self.start()
+        c = d.client()
+        self.assertEqual(c.ok({"cmd": "set_sea"}), {"enabled": False})
+        self.frame(atmosphere_control(0.0, 8.0, 270.0),  # 8 m/s from the west
+                   maritime_control(True, True, 12.5, 70.0, height=1.5),
+                   wave_control(3, True, 2.0, 150.0, 9.0, 45.0, phase=30.0, leading=10.0,
+                                breaker=1),
+                   wave_control(5, True, 0.5, 20.0, 0.0, 200.0),
+                   maritime_control(True, False, 30.0, 10.0, scope=1, region=4),
+                   wave_control(6, True, scope=2, region=7),
+                   frame=1, timestamp=100000)
+        sea = c.ok({"cmd": "set_sea"})
+        self.assertTrue(sea["enabled"])
+        self.assertAlmostEqual(sea["wind"][0], 8.0, places=9)
+        self.assertAlmostEqual(sea["wind"][1], 0.0, places=9)
+        self.assertEqual((sea["temperature"], sea["whitecaps"]), (12.5, True))
+        self.assertAlmostEqual(sea["clarity"], 0.7, places=12)
+        self.assertEqual(sea["waves"], [
+            {"id": 3, "height": 2.0, "wavelength": 150.0, "period": 9.0, "direction": 45.0,
+             "phase": 30.0},
+            {"id": 5, "height": 0.5, "wavelength": 20.0, "period": 0.0, "direction": 200.0,
+             "phase": 0.0}])
+        # Ignored, each with its reason: the surface height, breaker type and leading, and the
+        # regional and entity packets.
+        stats = c.ok({"cmd": "stats"})["cigi"]
+        self.assertEqual(stats["ignored"], 5, stats)
+        self.assertNotIn("refused_bad_value", stats)
+        # The same packets again: no change and nothing more ignored; a train disabled goes.
+        self.frame(maritime_control(True, True, 12.5, 70.0, height=1.5),
+                   wave_control(3, True, 2.0, 150.0, 9.0, 45.0, phase=30.0, leading=10.0,
+                                breaker=1),
+                   wave_control(5, False), frame=2, timestamp=101667)
+        self.assertEqual(c.ok({"cmd": "stats"})["cigi"]["ignored"], 5)
+        self.assertEqual([w["id"] for w in c.ok({"cmd": "set_sea"})["waves"]], [3])
+        # The sea's wind follows the host's wind.
+        self.frame(atmosphere_control(0.0, 6.0, 0.0), frame=3, timestamp=103334)  # from north
+        wind = c.ok({"cmd": "set_sea"})["wind"]
+        self.assertAlmostEqual(wind[0], 0.0, places=9)
+        self.assertAlmostEqual(wind[1], -6.0, places=9)
+        # Surface conditions disabled: no sea. Enabled again, the host's trains come back.
+        self.frame(maritime_control(False, False, 0.0, 0.0), frame=4, timestamp=105001)
+        self.assertEqual(c.ok({"cmd": "set_sea"}), {"enabled": False})
+        self.frame(maritime_control(True, False, 4.0, 100.0), frame=5, timestamp=106668)
+        sea = c.ok({"cmd": "set_sea"})
+        self.assertEqual((sea["temperature"], sea["clarity"], sea["whitecaps"]),
+                         (4.0, 1.0, False))
+        self.assertEqual([w["id"] for w in sea["waves"]], [3])
+        # Out of range: that packet is refused (IG status 1), the rest of the frame applies.
+        sof = self.frame(maritime_control(True, False, 50.0, 100.0),
+                         wave_control(8, True, 1.0, 0.5), wave_control(9, True, 0.25, 10.0),
+                         frame=6, timestamp=108335)
+        self.assertEqual(sof["status"], 1)
+        sea = c.ok({"cmd": "set_sea"})
+        self.assertEqual(sea["temperature"], 4.0)
+        self.assertEqual([w["id"] for w in sea["waves"]], [3, 9])
+        self.assertEqual(c.ok({"cmd": "stats"})["cigi"]["refused_bad_value"], 2)
+        self.check_with_tshark()
+
     def test_little_endian_host(self):
         d = self.start()
         c = d.client()
@@ -732,6 +817,17 @@ size = [4, 2, 1]
                   "cigi.env_region_control.size_x",
                   "cigi.env_region_control.rotation",
                   "cigi.celestial_sphere_control.date", "cigi.celestial_sphere_control.hour",
+                  "cigi.maritime_surface_conditions_control.entity_region_id",
+                  "cigi.maritime_surface_conditions_control.surface_conditions_enable",
+                  "cigi.maritime_surface_conditions_control.scope",
+                  "cigi.maritime_surface_conditions_control.sea_surface_height",
+                  "cigi.maritime_surface_conditions_control.surface_water_temp",
+                  "cigi.maritime_surface_conditions_control.surface_clarity",
+                  "cigi.wave_control.wave_id", "cigi.wave_control.wave_enable",
+                  "cigi.wave_control.scope", "cigi.wave_control.breaker_type",
+                  "cigi.wave_control.height", "cigi.wave_control.wavelength",
+                  "cigi.wave_control.period", "cigi.wave_control.direction",
+                  "cigi.wave_control.phase_offset", "cigi.wave_control.leading",
                   "cigi.sof.ig_frame_number",
                   "cigi.sof.last_host_frame_number",
                   "cigi.sof.minor_version", "cigi.sof.ig_mode"]
@@ -761,6 +857,7 @@ size = [4, 2, 1]
                 at = 24
                 entity_ids, types, yaws, weather_layers, coverages = [], [], [], [], []
                 regions = []  # Environmental Region Control: id, latitude, size X, rotation
+                maritimes, waves = [], []  # as the host wrote them, fields in the ICD's order
                 while at < len(payload):
                     pid = payload[at]
                     if pid == 2:
@@ -775,6 +872,16 @@ size = [4, 2, 1]
                         (rlat,) = struct.unpack(bo + "d", payload[at + 8:at + 16])
                         size_x, _, _, rotation = struct.unpack(bo + "4f", payload[at + 24:at + 40])
                         regions.append((rid, rlat, size_x, rotation))
+                    if pid == 13:
+                        (region,) = struct.unpack(bo + "H", payload[at + 2:at + 4])
+                        flags = payload[at + 4]
+                        maritimes.append((region, flags & 1, (flags >> 2) & 3) + struct.unpack(
+                            bo + "3f", payload[at + 8:at + 20]))
+                    if pid == 14:
+                        flags = payload[at + 5]
+                        waves.append((payload[at + 4], flags & 1, (flags >> 1) & 3,
+                                      (flags >> 3) & 3) + struct.unpack(
+                                          bo + "6f", payload[at + 8:at + 32]))
                     if pid == 12:
                         weather_layers.append(str(payload[at + 4]))
                         coverages.append(struct.unpack(bo + "f", payload[at + 20:at + 24])[0])
@@ -791,6 +898,18 @@ size = [4, 2, 1]
                               layers.get("cigi.env_region_control." + n, [])]
                              for n in names]
                 self.assertEqual(list(zip(*dissected)), [tuple(map(float, r)) for r in regions])
+                names = ["entity_region_id", "surface_conditions_enable", "scope",
+                         "sea_surface_height", "surface_water_temp", "surface_clarity"]
+                dissected = [[dissected_number(v) for v in
+                              layers.get("cigi.maritime_surface_conditions_control." + n, [])]
+                             for n in names]
+                self.assertEqual(list(zip(*dissected)),
+                                 [tuple(map(float, m)) for m in maritimes])
+                names = ["wave_id", "wave_enable", "scope", "breaker_type", "height",
+                         "wavelength", "period", "direction", "phase_offset", "leading"]
+                dissected = [[dissected_number(v) for v in
+                              layers.get("cigi.wave_control." + n, [])] for n in names]
+                self.assertEqual(list(zip(*dissected)), [tuple(map(float, w)) for w in waves])
 
 
 if __name__ == "__main__":

@@ -935,6 +935,55 @@ class HostStateTest(DaemonTest):
         self.assertIn("not both", c.error({"cmd": "set_sun", "utc": "2026-06-21T12:00Z",
                                            "azimuth": 3})["message"])
 
+    def test_the_sea_by_request_follows_the_surface_wind(self):
+        d = self.daemon()
+        c = d.client()
+        self.assertEqual(c.ok({"cmd": "set_sea"}), {"enabled": False})  # read back: none
+        # Trains removed from no sea make none.
+        self.assertEqual(c.ok({"cmd": "set_sea", "waves": [{"id": 1, "enabled": False}]}),
+                         {"enabled": False})
+        before = c.ok({"cmd": "hash"})["hash"]
+        # A first field starts from the defaults, with the world's surface wind (none in
+        # cumulus.toml: 5 m/s from the west); a new train from its own.
+        sea = c.ok({"cmd": "set_sea", "clarity": 0.9,
+                    "waves": [{"id": 4, "height": 2.0, "direction": 90}]})
+        self.assertEqual(sea, {"enabled": True, "wind": [5.0, 0.0], "fetch": 0.0,
+                               "temperature": 15.0, "clarity": 0.9, "whitecaps": True,
+                               "seed": 1,
+                               "waves": [{"id": 4, "height": 2.0, "wavelength": 100.0,
+                                          "period": 8.0, "direction": 90.0, "phase": 0.0}]})
+        self.assertNotEqual(c.ok({"cmd": "hash"})["hash"], before)
+        # Unset fields keep their values; trains are kept in order of id.
+        sea = c.ok({"cmd": "set_sea", "fetch": 50000, "whitecaps": False,
+                    "waves": [{"id": 1, "wavelength": 40}, {"id": 4, "period": 0}]})
+        self.assertEqual((sea["clarity"], sea["fetch"], sea["whitecaps"]), (0.9, 50000, False))
+        self.assertEqual([(w["id"], w["wavelength"], w["period"]) for w in sea["waves"]],
+                         [(1, 40.0, 8.0), (4, 100.0, 0.0)])
+        self.assertEqual(c.ok({"cmd": "set_sea"}), sea)
+        # The sea's wind is the surface wind: it follows set_wind.
+        c.ok({"cmd": "set_wind", "velocity": [-3.0, 4.0]})
+        self.assertEqual(c.ok({"cmd": "set_sea"})["wind"], [-3.0, 4.0])
+        # Bad input names the field and the range, and changes nothing.
+        seaed = c.ok({"cmd": "hash"})["hash"]
+        for request, words in [
+                ({"temperature": 50}, "temperature: 50 is out of range (allowed: -2 to 40)"),
+                ({"waves": [{"id": 2, "height": -1}]}, "waves[0].height: -1 is out of range"),
+                ({"waves": [{"id": 300}]}, "waves[0].id: 300 is out of range (allowed: 0 to 255)"),
+                ({"enabled": False, "fetch": 3}, "false removes the sea"),
+                ({"waves": [{"id": i} for i in range(10, 17)]},
+                 "waves: the sea would hold 9 wave trains (allowed: at most 8")]:
+            with self.subTest(request=request):
+                error = c.error(dict(request, cmd="set_sea"))
+                self.assertEqual(error["code"], "bad_field")
+                self.assertIn(words, error["message"])
+        self.assertEqual(c.ok({"cmd": "hash"})["hash"], seaed)
+        self.assertEqual(c.ok({"cmd": "set_sea"}), dict(sea, wind=[-3.0, 4.0]))
+        # A train removed, then the sea.
+        sea = c.ok({"cmd": "set_sea", "waves": [{"id": 1, "enabled": False}]})
+        self.assertEqual([w["id"] for w in sea["waves"]], [4])
+        self.assertEqual(c.ok({"cmd": "set_sea", "enabled": False}), {"enabled": False})
+        self.assertEqual(c.ok({"cmd": "set_sea", "enabled": True})["waves"], [])
+
     def test_systemd_readiness_watchdog_and_health(self):
         # Item 7: Type=notify readiness through sd_notify, watchdog beats, /healthz.
         path = os.path.join(self.tmp.name, "notify.sock")
@@ -975,12 +1024,13 @@ class HostStateTest(DaemonTest):
             c.ok({"cmd": "tick", "dt": 0.2})
         c.ok({"cmd": "render", "view": "front"})
         c.ok({"cmd": "set_time", "time_scale": 3, "paused": True})
-        state = {k: c.ok({"cmd": k}) for k in ["hash", "get_view", "list_targets"]}
+        c.ok({"cmd": "set_sea", "temperature": 8, "waves": [{"id": 2, "height": 3}]})
+        state = {k: c.ok({"cmd": k}) for k in ["hash", "get_view", "list_targets", "set_sea"]}
         stats = c.ok({"cmd": "stats"})
         self.assertEqual(d.stop(), 0)
         d.start()
         c = d.client()
-        for k in ["hash", "get_view", "list_targets"]:
+        for k in ["hash", "get_view", "list_targets", "set_sea"]:
             self.assertEqual(c.ok({"cmd": k}), state[k], k)
         after = c.ok({"cmd": "stats"})
         for k in ["ticks", "frames", "time_scale", "paused", "mode"]:
@@ -1625,7 +1675,7 @@ class AbuseTest(DaemonTest):
 
         def request():
             cmd = rng.choice(["hello", "get_view", "set_view", "set_weather", "set_wind",
-                              "set_sun", "set_time", "add_cloud", "change_cloud",
+                              "set_sun", "set_sea", "set_time", "add_cloud", "change_cloud",
                               "remove_cloud", "add_target", "move_target", "tick", "render",
                               "subscribe", "unsubscribe",
                               "snapshot", "restore", "stats", "hash", "nonsense"])
@@ -1634,6 +1684,8 @@ class AbuseTest(DaemonTest):
                                                          "vfov", "position", "format"],
                     "set_weather": ["layer", "type", "base", "thickness", "coverage", "wind"],
                     "set_wind": ["velocity"], "set_sun": ["azimuth", "elevation"],
+                    "set_sea": ["enabled", "fetch", "temperature", "clarity", "whitecaps", "seed",
+                                "waves"],
                     "set_time": ["advance", "paused", "time_scale"],
                     "change_cloud": ["name", "move", "threshold"], "remove_cloud": ["name"],
                     "move_target": ["name", "centre", "heading", "pitch"],
@@ -1668,6 +1720,11 @@ class AbuseTest(DaemonTest):
                                "size": [number(5), 5, number(5)], "heading": number(10)}
             if cmd == "set_view":
                 r.update(width=rng.randint(1, 96), height=rng.randint(1, 96))
+            if cmd == "set_sea" and rng.random() < 0.7:
+                r.pop("enabled", None)
+                r["waves"] = [{"id": number(rng.randint(0, 12)), "height": number(1.5),
+                               "wavelength": number(80), "direction": value()}
+                              for _ in range(rng.randint(1, 3))]
             if cmd == "subscribe":
                 r["rate"] = rng.choice([0.5, 60, 0, -1, "x"])
             line = json.dumps(r)

@@ -102,6 +102,26 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       scene.layers = std::move(drawn.layers);
       scene.fields = std::move(drawn.fields);
       exerciseWorld(scene, {});
+    } else if (const auto* c = std::get_if<command::SetSea>(&command)) {
+      // Every sea a request can ask for is one the world holds (the one table of ranges).
+      Sea sea;
+      sea.fetch_m = c->fetch.value_or(sea.fetch_m);
+      sea.temperature_c = c->temperature.value_or(sea.temperature_c);
+      sea.clarity = c->clarity.value_or(sea.clarity);
+      sea.seed = c->seed.value_or(sea.seed);
+      for (const command::WavePatch& w : c->waves) {
+        WaveTrain& t = sea.trains.emplace_back();
+        t.id = w.id;
+        t.height_m = w.height.value_or(t.height_m);
+        t.wavelength_m = w.wavelength.value_or(t.wavelength_m);
+        t.period_s = w.period.value_or(t.period_s);
+        t.direction_deg = w.direction.value_or(t.direction_deg);
+        t.phase_deg = w.phase.value_or(t.phase_deg);
+      }
+      if (!seaError(sea).empty()) __builtin_trap();
+      Scene scene;
+      scene.sea = sea;
+      exerciseWorld(scene, {});
     } else if (const auto* t = std::get_if<command::AddTarget>(&command)) {
       Target target;
       (void)parseTargetJson(t->target, {}, target);
