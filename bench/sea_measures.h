@@ -153,8 +153,9 @@ inline double meanFoam(const SeaSurface& surface) {
     const glm::dvec2 xy(40000.0 * unitFromBits(hashCounters(9, i, 0)),
                         40000.0 * unitFromBits(hashCounters(9, i, 1)));
     const SeaSample s = surface.sample(xy, 0.0, 0.0);
-    mean += foamShare(surface.whitecapFraction(), surface.foamHeight(), s.height,
-                      surface.heightVariance(), s.unresolved_height_var) /
+    mean += foamShare(surface.whitecapFraction(), surface.foamSteepness(),
+                      glm::dot(s.slope, s.slope), surface.drawnSlopeVariance(),
+                      surface.drawnSlopeVariance() - s.resolved_slope_var) /
             samples;
   }
   return mean;

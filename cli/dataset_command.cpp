@@ -97,8 +97,15 @@ std::string writeSample(const DatasetSpec& spec, const BandTable& band, const fs
                         const Rendered& r, const EncodeOptions& encode) {
   const std::string name = sampleName(r.index);
   const int w = r.frame.width(), h = r.frame.height();
-  const std::vector<TargetLabel> labels = labelTargets(r.frame, r.sample.target_class);
+  const std::vector<TargetLabel> labels =
+      labelTargets(r.frame, r.sample.target_class, spec.glint_threshold);
   json record = r.sample.record;
+  if (!r.frame.glint.empty()) {
+    const std::vector<std::uint16_t> glint = glintMask(r.frame, spec.glint_threshold);
+    record["glint_fraction"] =
+        double(std::count(glint.begin(), glint.end(), 65535)) / double(glint.size());
+    record["glint_file"] = "glint/" + name + ".png";
+  }
   record["file_name"] = "images/" + name + ".png";
   record["labels"] = sampleLabelsJson(labels, w, h);
   const std::string image = (dir / "images" / (name + ".png")).string();
@@ -121,6 +128,9 @@ std::string writeSample(const DatasetSpec& spec, const BandTable& band, const fs
   if (e.empty() && spec.write_masks)
     e = writeMaskPng((dir / "masks" / (name + ".png")).string(), w, h, instanceMask(r.frame),
                      encode);
+  if (e.empty() && !r.frame.glint.empty())
+    e = writeMaskPng((dir / "glint" / (name + ".png")).string(), w, h,
+                     glintMask(r.frame, spec.glint_threshold), encode);
   if (e.empty()) e = writeText(dir / "labels" / (name + ".txt"), yoloText(labels, w, h));
   if (e.empty() && (spec.write_depth || spec.write_coverage || spec.band == Band::kLwir)) {
     std::vector<Channel> order;
@@ -128,6 +138,7 @@ std::string writeSample(const DatasetSpec& spec, const BandTable& band, const fs
     if (spec.write_depth)
       order.insert(order.end(), {Channel::kDepth, Channel::kCloudDepth, Channel::kObjectId});
     if (spec.write_coverage) order.insert(order.end(), {Channel::kCoverage, Channel::kVisibility});
+    if (!r.frame.glint.empty()) order.push_back(Channel::kGlint);
     std::vector<ExrPlane> planes = exrPlanesOf(r.frame, order);
     if (spec.band == Band::kLwir)
       planes.insert(planes.begin() + 1, {"brightness_temperature", kelvin.data(), 1});
@@ -302,8 +313,9 @@ int runDatasetCommand(const DatasetCommandOptions& o) {
     spdlog::info("merged {} samples into {}/annotations.json", spec.samples, o.output_dir);
     return 0;
   }
-  for (const char* sub : {"images", "masks", "labels", "exr", "records"}) {
+  for (const char* sub : {"images", "masks", "glint", "labels", "exr", "records"}) {
     if ((std::string(sub) == "masks" && !spec.write_masks) ||
+        (std::string(sub) == "glint" && !(spec.sea_probability > 0.0)) ||
         (std::string(sub) == "exr" && !spec.write_depth && !spec.write_coverage &&
          spec.band != Band::kLwir))
       continue;
@@ -388,6 +400,7 @@ int runDatasetCommand(const DatasetCommandOptions& o) {
   if (spec.write_depth)
     for (Channel c : {Channel::kDepth, Channel::kCloudDepth}) request.channels.add(c);
   if (spec.write_coverage) request.channels.add(Channel::kCoverage);
+  if (spec.sea_probability > 0.0) request.channels.add(Channel::kGlint);
 
   // Rendering (this thread, which holds the GL context) and encoding (one worker) overlap;
   // at most two rendered samples wait.

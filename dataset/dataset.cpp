@@ -18,7 +18,8 @@ using nlohmann::json;
 
 // Independent streams of one sample's draws: changing how many targets a sample has never
 // moves its sky, and the reverse.
-enum Stream : std::uint64_t { kSky = 1, kSun, kFog, kCamera, kTargets, kInfrared };
+// Each draw its own stream, so that a new kind of draw leaves every existing one as it was.
+enum Stream : std::uint64_t { kSky = 1, kSun, kFog, kCamera, kTargets, kInfrared, kSea, kRain };
 
 // Draws from (key, counter): the n-th number of a stream is a pure function of both.
 class Draws {
@@ -65,6 +66,10 @@ std::string datasetSpecError(const DatasetSpec& spec) {
                          {"sun.elevation", spec.sun_elevation},
                          {"fog.top", spec.fog_top},
                          {"fog.visibility", spec.fog_visibility},
+                         {"sky.rain_rate", spec.rain_rate},
+                         {"sea.wind", spec.sea_wind},
+                         {"sea.direction", spec.sea_wind_direction},
+                         {"sea.clarity", spec.sea_clarity},
                          {"camera.altitude", spec.altitude},
                          {"camera.heading", spec.heading},
                          {"camera.pitch", spec.pitch},
@@ -97,23 +102,55 @@ SampleScene drawSample(const DatasetSpec& spec, int index) {
 
   Draws sky = stream(kSky);
   const int layers = spec.genera.empty() ? 0 : sky.integer(spec.layers);
-  record["layers"] = json::array();
-  for (int k = 0; k < layers; ++k) {
-    WeatherLayer w;
+  std::vector<WeatherLayer> weather(std::size_t(std::max(layers, 0)));
+  for (WeatherLayer& w : weather) {
     w.type = spec.genera[std::min(spec.genera.size() - 1,
                                   std::size_t(sky.unit() * double(spec.genera.size())))];
     w.coverage = sky.in(spec.coverage);
     w.base_m = sky.in(spec.base);
     w.thickness_m = sky.in(spec.thickness);
+  }
+  // Rain from the lowest layer: in shafts under heaps, else from its base down (MODEL.md
+  // section 17), which the scene's weather holds.
+  Draws rain = stream(kRain);
+  std::optional<std::size_t> raining;
+  if (rain.unit() < spec.rain_probability && layers > 0) {
+    raining = 0;
+    for (std::size_t k = 1; k < weather.size(); ++k)
+      if (weather[k].base_m < weather[*raining].base_m) raining = k;
+    weather[*raining].precipitation = {PrecipitationKind::kRain, rain.in(spec.rain_rate), 0.0};
+  }
+  record["layers"] = json::array();
+  for (int k = 0; k < layers; ++k) {
+    const WeatherLayer& w = weather[std::size_t(k)];
     const std::uint64_t layer_seed = weatherSeed(seed, k + 1);
     const WeatherClouds add = weatherClouds(w, "layer" + std::to_string(k + 1), layer_seed);
     scene.layers.insert(scene.layers.end(), add.layers.begin(), add.layers.end());
     scene.fields.insert(scene.fields.end(), add.fields.begin(), add.fields.end());
+    if (raining == std::size_t(k)) scene.weather[{k + 1, std::nullopt}] = w;
     record["layers"].push_back({{"genus", std::string(cloudTypeName(w.type))},
                                 {"coverage", w.coverage},
                                 {"base_m", w.base_m},
                                 {"thickness_m", w.thickness_m},
                                 {"seed", std::to_string(layer_seed)}});
+  }
+  record["rain_mm_h"] = raining ? json(weather[*raining].precipitation.rate_mm_h) : json(nullptr);
+
+  Draws water = stream(kSea);
+  if (water.unit() < spec.sea_probability) {
+    Sea& sea = scene.sea.emplace();
+    const double speed = water.in(spec.sea_wind);
+    const double towards = glm::radians(water.in(spec.sea_wind_direction));
+    sea.wind = speed * glm::dvec2(std::sin(towards), std::cos(towards));
+    sea.clarity = water.in(spec.sea_clarity);
+    sea.whitecaps = spec.sea_whitecaps;
+    sea.seed = hashCounters(seed, kSea);
+    record["sea"] = {{"wind", json::array({sea.wind.x, sea.wind.y})},
+                     {"clarity", sea.clarity},
+                     {"whitecaps", sea.whitecaps},
+                     {"significant_height_m", SeaSurface(sea).significantHeight()}};
+  } else {
+    record["sea"] = nullptr;
   }
 
   Draws sun = stream(kSun);
@@ -176,6 +213,12 @@ SampleScene drawSample(const DatasetSpec& spec, int index) {
         const double py = draw.in({0.1 * spec.height, 0.9 * spec.height});
         const glm::dvec3 d = glm::normalize(rayDirection(basis, camera, px, py));
         Span range = cls.distance;
+        if (cls.afloat) {
+          // Where the ray meets the plane of its centre, if that lies within its range.
+          const double at = (0.3 * cls.size.z - camera.position.z) / d.z;
+          if (!(d.z < 0.0 && at >= range.lo && at <= range.hi) && !last) continue;
+          range = {at, at};
+        }
         if (behind && cloudy) {
           // Behind cloud: only as far as the cloud along this ray allows. Transmittance falls
           // with distance; the nearest distance where it is below 0.9 is found by bisection
@@ -218,7 +261,15 @@ SampleScene drawSample(const DatasetSpec& spec, int index) {
   return out;
 }
 
-std::vector<TargetLabel> labelTargets(const Frame& frame, const std::vector<int>& target_class) {
+std::vector<std::uint16_t> glintMask(const Frame& frame, double threshold) {
+  std::vector<std::uint16_t> mask(frame.glint.size(), 0);
+  for (std::size_t i = 0; i < mask.size(); ++i)
+    if (frame.glint[i] >= threshold) mask[i] = 65535;
+  return mask;
+}
+
+std::vector<TargetLabel> labelTargets(const Frame& frame, const std::vector<int>& target_class,
+                                      double glint_threshold) {
   const int w = frame.width(), h = frame.height();
   std::vector<TargetLabel> labels(target_class.size());
   std::vector<double> transmittance(labels.size(), 0.0);
@@ -257,6 +308,12 @@ std::vector<TargetLabel> labelTargets(const Frame& frame, const std::vector<int>
     if (l.silhouette_px > 0) l.visibility = transmittance[k] / l.silhouette_px;
     full[k].to(l.box_full);
     visible[k].to(l.box);
+    if (!frame.glint.empty()) {
+      l.glint_px = 0;
+      for (int y = int(l.box[1]); y < int(l.box[1] + l.box[3]); ++y)
+        for (int x = int(l.box[0]); x < int(l.box[0] + l.box[2]); ++x)
+          l.glint_px += frame.glint[std::size_t(y) * w + x] >= glint_threshold;
+    }
     if (l.visible_px == 0) continue;
     // COCO's uncompressed RLE runs down the columns, starting with a run of zeros.
     bool inside = false;
@@ -298,6 +355,7 @@ json sampleLabelsJson(const std::vector<TargetLabel>& labels, int width, int hei
         {"visibility", l.visibility},
         {"occluded_fraction",
          l.silhouette_px ? 1.0 - double(l.visible_px) / l.silhouette_px : 1.0}};
+    if (l.glint_px >= 0) a["glint_px"] = l.glint_px;
     if (l.visible_px > 0) a["segmentation"] = {{"size", {height, width}}, {"counts", l.rle}};
     out.push_back(std::move(a));
   }

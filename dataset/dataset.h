@@ -32,6 +32,9 @@ struct TargetClass {
   Span distance{300.0, 3000.0};
   Span heading{0.0, 360.0}, pitch{0.0, 0.0}, roll{0.0, 0.0};
   Span temperature{300.0, 300.0};  // kelvin, the infrared band's
+  // Afloat: placed where its pixel's ray meets the sea (or the ground), a fifth of its height
+  // under water, within `distance`; samples without a sea place it on the ground alike.
+  bool afloat = false;
 };
 
 enum class Band { kVisible, kLwir };
@@ -62,6 +65,19 @@ struct DatasetSpec {
   Span sun_azimuth{0.0, 360.0}, sun_elevation{15.0, 70.0};
   double fog_probability = 0.0;
   Span fog_top{50.0, 300.0}, fog_visibility{2000.0, 20000.0};
+  // Rain from the lowest layer (MODEL.md section 17) in `rain_probability` of the samples, at
+  // a rate drawn from `rain_rate` mm/h.
+  double rain_probability = 0.0;
+  Span rain_rate{1.0, 25.0};
+
+  // The sea (MODEL.md section 18) in place of the ground in `sea_probability` of the samples,
+  // as a host sets it: its surface wind's speed and the direction it blows towards (clockwise
+  // from north), the water's clarity, whitecaps. Its glint is a channel of every such sample:
+  // masks where the glint's luminance (renderer/frame.h) is at least `glint_threshold`.
+  double sea_probability = 0.0;
+  Span sea_wind{2.0, 15.0}, sea_wind_direction{0.0, 360.0}, sea_clarity{0.3, 0.9};
+  bool sea_whitecaps = true;
+  double glint_threshold = 0.25;
 
   // Camera at (0, 0, altitude).
   Span altitude{300.0, 3000.0};
@@ -96,8 +112,15 @@ struct TargetLabel {
   double box_full[4]{};            // x, y, width, height of the silhouette, pixels
   double box[4]{};                 // of the visible part
   std::vector<std::uint32_t> rle;  // COCO uncompressed RLE of the visible part, column-major
+  int glint_px = -1;  // glint pixels in its visible box (glintMask); -1 without a glint channel
 };
-std::vector<TargetLabel> labelTargets(const Frame& frame, const std::vector<int>& target_class);
+// `frame` holds object_id and visibility, and glint when its sample has a sea.
+std::vector<TargetLabel> labelTargets(const Frame& frame, const std::vector<int>& target_class,
+                                      double glint_threshold = 0.25);
+
+// The sun's glint on the sea (a false alarm's first cause): 65535 where the frame's glint
+// luminance is at least `threshold`, 0 elsewhere; empty without a glint channel.
+std::vector<std::uint16_t> glintMask(const Frame& frame, double threshold);
 
 // The visible-part mask of every target: 1 + target index where visible, 0 elsewhere.
 std::vector<std::uint16_t> instanceMask(const Frame& frame);

@@ -57,7 +57,7 @@ void readInfrared(TableReader& t, DatasetSpec& spec) {
 }
 
 void readSky(TableReader& t, DatasetSpec& spec) {
-  t.allow({"genera", "layers", "coverage", "base", "thickness"});
+  t.allow({"genera", "layers", "coverage", "base", "thickness", "rain_probability", "rain_rate"});
   if (t.has("genera")) {
     std::vector<std::string> names;
     t.strings("genera", names, kCloudTypeCount);
@@ -75,12 +75,26 @@ void readSky(TableReader& t, DatasetSpec& spec) {
   readSpan(t, "coverage", spec.coverage, Limits::kFraction);
   readSpan(t, "base", spec.base, {0.0, Limits::kMaxBase});
   readSpan(t, "thickness", spec.thickness, Limits::kThickness);
+  t.number("rain_probability", spec.rain_probability, Limits::kFraction);
+  readSpan(t, "rain_rate", spec.rain_rate, Limits::kPrecipitationRate);
+  t.finish();
+}
+
+void readSea(TableReader& t, DatasetSpec& spec) {
+  t.allow({"probability", "wind", "direction", "clarity", "whitecaps", "glint_threshold"});
+  t.number("probability", spec.sea_probability, Limits::kFraction);
+  readSpan(t, "wind", spec.sea_wind, {0.0, Limits::kMaxWind});
+  readSpan(t, "direction", spec.sea_wind_direction, {-Limits::kMaxHeading, Limits::kMaxHeading});
+  readSpan(t, "clarity", spec.sea_clarity, Limits::kSeaClarity);
+  t.boolean("whitecaps", spec.sea_whitecaps);
+  t.number("glint_threshold", spec.glint_threshold, {0.0, 1.0e6});
   t.finish();
 }
 
 void readTargetClass(TableReader& t, const std::string& file, TargetClass& c) {
   t.allow({"name", "shape", "mesh", "size", "colour", "count", "distance", "heading", "pitch",
-           "roll", "temperature"});
+           "roll", "temperature", "afloat"});
+  t.boolean("afloat", c.afloat);
   if (!t.has("name")) t.failHere("name is missing (the category's name)");
   t.name("name", c.name);
   c.shape = TargetShape(t.choice("shape", {"box", "ellipsoid", "mesh"}, int(c.shape)));
@@ -117,7 +131,8 @@ std::string parseDatasetText(std::string_view text, const std::string& source_na
   try {
     const toml::table root = config_detail::parseToml(text, source_name);
     TableReader t(root, "", source_name);
-    t.allow({"dataset", "sky", "sun", "fog", "camera", "target", "infrared"});
+    t.allow({"dataset", "sky", "sun", "fog", "sea", "camera", "target", "infrared"});
+    if (auto sea = t.table("sea")) readSea(*sea, spec);
     if (auto d = t.table("dataset")) readDataset(*d, spec);
     if (auto sky = t.table("sky")) readSky(*sky, spec);
     if (auto infrared = t.table("infrared")) readInfrared(*infrared, spec);

@@ -85,8 +85,9 @@ TEST(SeaTest, FoamCoversMonahansFraction) {
     const double mean = meanFoam(surface);
     EXPECT_NEAR(mean / w, 1.0, 0.25) << speed;
     const SeaSample far = surface.sample({0.0, 0.0}, 0.0, 1e6);
-    EXPECT_NEAR(foamShare(w, surface.foamHeight(), far.height, surface.heightVariance(),
-                          far.unresolved_height_var),
+    EXPECT_NEAR(foamShare(w, surface.foamSteepness(), glm::dot(far.slope, far.slope),
+                          surface.drawnSlopeVariance(),
+                          surface.drawnSlopeVariance() - far.resolved_slope_var),
                 w, 1e-9);
   }
   Sea calm = windSea(15.0);

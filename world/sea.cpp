@@ -121,20 +121,27 @@ SeaSurface::SeaSurface(const Sea& sea, int count) {
                    [](const WaveComponent& a, const WaveComponent& b) {
                      return glm::length(a.k) < glm::length(b.k);
                    });
-  for (const WaveComponent& c : components_) height_var_ += 0.5 * c.amplitude * c.amplitude;
+  for (const WaveComponent& c : components_) {
+    const double k = glm::length(c.k);
+    height_var_ += 0.5 * c.amplitude * c.amplitude;
+    drawn_slope_var_ += 0.5 * c.amplitude * c.amplitude * k * k;
+  }
   if (whitecap_fraction_ > 0.0 && whitecap_fraction_ < 1.0 && !components_.empty()) {
-    // The fully resolved heights' quantile, from points scattered over 400 peak wavelengths.
+    // The fully resolved squared slopes' quantile, from points scattered over 400 peak
+    // wavelengths.
     const double reach = 400.0 * 2.0 * kPi / glm::length(components_.front().k);
-    std::vector<double> heights(65536);
-    for (std::size_t i = 0; i < heights.size(); ++i)
-      heights[i] = sample({reach * unitFromBits(hashCounters(sea.seed, 5, i, 0)),
-                           reach * unitFromBits(hashCounters(sea.seed, 5, i, 1))},
-                          0.0, 0.0)
-                       .height;
-    std::sort(heights.begin(), heights.end());
-    const auto at = std::min(heights.size() - 1,
-                             std::size_t((1.0 - whitecap_fraction_) * double(heights.size())));
-    foam_height_ = heights[at];
+    std::vector<glm::dvec2> slopes(65536);
+    for (std::size_t i = 0; i < slopes.size(); ++i)
+      slopes[i] = sample({reach * unitFromBits(hashCounters(sea.seed, 5, i, 0)),
+                          reach * unitFromBits(hashCounters(sea.seed, 5, i, 1))},
+                         0.0, 0.0)
+                      .slope;
+    std::vector<double> steepness(slopes.size());
+    for (std::size_t i = 0; i < slopes.size(); ++i) steepness[i] = glm::dot(slopes[i], slopes[i]);
+    std::sort(steepness.begin(), steepness.end());
+    const auto at = std::min(steepness.size() - 1,
+                             std::size_t((1.0 - whitecap_fraction_) * double(steepness.size())));
+    foam_steepness_ = steepness[at];
   }
 }
 
@@ -156,6 +163,7 @@ SeaSample SeaSurface::sample(glm::dvec2 xy, double time_s, double footprint_m) c
     resolved_slope_var += height_var * k * k;
   }
   s.unresolved_height_var = std::max(height_var_ - resolved_height_var, 0.0);
+  s.resolved_slope_var = resolved_slope_var;
   s.unresolved_slope_var =
       std::max(slope_var_ - resolved_slope_var, (1.0 - kResolvedSlopeShare) * slope_var_);
   return s;
@@ -177,14 +185,14 @@ glm::dvec3 waterBodyColour(double clarity) {
   return glm::mix(turbid, clear, std::clamp(clarity, 0.0, 1.0));
 }
 
-double foamShare(double whitecap_fraction, double foam_height, double resolved_height,
+double foamShare(double whitecap_fraction, double foam_steepness, double steepness,
                  double var_total, double var_unresolved) {
   if (!(whitecap_fraction > 0.0)) return 0.0;
   if (whitecap_fraction >= 1.0) return 1.0;
   const double resolved =
       var_total > 0.0 ? std::clamp(1.0 - var_unresolved / var_total, 0.0, 1.0) : 0.0;
   const double edge = std::sqrt(std::max(var_unresolved, 1e-4 * var_total + 1e-12));
-  const double crest = logistic(1.702 * (resolved_height - foam_height) / edge);
+  const double crest = logistic(1.702 * (steepness - foam_steepness) / edge);
   return (1.0 - resolved) * whitecap_fraction + resolved * crest;
 }
 
@@ -212,8 +220,9 @@ SeaShading shadeSea(const SeaSurface& surface, const Sea& sea, const SeaSample& 
   // A facet that sends the ray back down would show the sea again: the sky at the horizon.
   r.z = std::max(r.z, 0.01);
   out.reflect_dir = glm::normalize(r);
-  out.foam = foamShare(surface.whitecapFraction(), surface.foamHeight(), s.height,
-                       surface.heightVariance(), s.unresolved_height_var);
+  out.foam =
+      foamShare(surface.whitecapFraction(), surface.foamSteepness(), glm::dot(s.slope, s.slope),
+                surface.drawnSlopeVariance(), surface.drawnSlopeVariance() - s.resolved_slope_var);
   out.fresnel = (1.0 - out.foam) * fresnelWater(cos_i);
   // Diffuse light on the surface, per pi: the sun's and the sky's (the ground's share in shadow).
   const double diffuse = std::max(sun.z, 0.0) * groundLight(sunlight);

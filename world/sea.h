@@ -56,6 +56,7 @@ struct SeaSample {
   glm::dvec2 slope{0.0};              // resolved dz/dx, dz/dy
   double unresolved_slope_var = 0.0;  // sigma^2 of the slopes left to Cox-Munk's distribution
   double unresolved_height_var = 0.0;
+  double resolved_slope_var = 0.0;  // of the drawn sines' slopes, the share resolved here
 };
 
 // Spectrum, discretised once per sea: kSeaComponents sines (plus the host's trains).
@@ -73,8 +74,10 @@ class SeaSurface {
   double peakOmega() const { return peak_omega_; }
   // Monahan and O'Muircheartaigh (1980): W = 3.84e-6 U^3.41, at most 1; 0 without whitecaps.
   double whitecapFraction() const { return whitecap_fraction_; }
-  // The height that a fraction whitecapFraction() of the fully resolved surface exceeds.
-  double foamHeight() const { return foam_height_; }
+  // The drawn sines' slope variance, sum of a^2 k^2 / 2.
+  double drawnSlopeVariance() const { return drawn_slope_var_; }
+  // The squared slope that a fraction whitecapFraction() of the fully resolved surface exceeds.
+  double foamSteepness() const { return foam_steepness_; }
   const std::vector<WaveComponent>& components() const { return components_; }
 
   // At world X, Y at time t, seen with a footprint of `footprint_m` (metres a pixel covers).
@@ -82,7 +85,7 @@ class SeaSurface {
 
  private:
   double wind_speed_ = 0.0, slope_var_ = 0.0, height_var_ = 0.0, peak_omega_ = 0.0;
-  double whitecap_fraction_ = 0.0, foam_height_ = 0.0;
+  double whitecap_fraction_ = 0.0, foam_steepness_ = 0.0, drawn_slope_var_ = 0.0;
   std::vector<WaveComponent> components_;  // longest first
 };
 
@@ -106,11 +109,11 @@ glm::dvec3 waterBodyColour(double clarity);
 inline constexpr double kFoamReflectance = 0.22;
 
 // The share of a point covered by foam (MODEL.md section 18): where the surface is resolved,
-// its crests above `foam_height` (the height a fraction W of the fully resolved surface
-// exceeds), their edges softened over the unresolved waves' height; where it is not, W. The
-// two blend by the share of the height variance resolved.
-double foamShare(double whitecap_fraction, double foam_height, double resolved_height,
-                 double var_total, double var_unresolved);
+// where it is steepest, its squared slope above `foam_steepness` (what a fraction W of the
+// fully resolved surface exceeds), the edges softened over the unresolved slopes' variance;
+// where it is not, W. The two blend by the share of the drawn slope variance resolved.
+double foamShare(double whitecap_fraction, double foam_steepness, double steepness,
+                 double var_drawn, double var_unresolved);
 
 // What the sea shows along unit view ray `d` meeting it at a point: the light a renderer
 // composes. Radiances in the renderers' units (a white diffuser facing the sun has 1).

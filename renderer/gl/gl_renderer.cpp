@@ -780,11 +780,12 @@ void GlRenderer::setSeaUniforms(GLuint p, const Scene& scene, const RenderSettin
   gl_.ProgramUniform4fv(p, gl_.GetUniformLocation(p, "u_wave"), GLsizei(n), &packed[0].x);
   gl_.ProgramUniform3fv(p, gl_.GetUniformLocation(p, "u_wave_wobble"), GLsizei(n), &wobble[0].x);
   gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_waves"), n);
-  const glm::vec4 params(float(surface.slopeVariance()), float(surface.heightVariance()),
+  const glm::vec4 params(float(surface.slopeVariance()), float(surface.drawnSlopeVariance()),
                          float(surface.whitecapFraction()),
                          float(seaPixelAngle(scene.camera.vfov_deg, scene.camera.height)));
   gl_.ProgramUniform4fv(p, gl_.GetUniformLocation(p, "u_sea"), 1, &params.x);
-  gl_.ProgramUniform1f(p, gl_.GetUniformLocation(p, "u_foam_height"), float(surface.foamHeight()));
+  gl_.ProgramUniform1f(p, gl_.GetUniformLocation(p, "u_foam_steepness"),
+                       float(surface.foamSteepness()));
   setUniform3(gl_, p, "u_sea_body", waterBodyColour(sea.clarity) * scene.sun.colour);
   setUniform3(gl_, p, "u_sea_sun", sunDirection(scene.sun));
   setUniform3(gl_, p, "u_sun_colour", scene.sun.colour);

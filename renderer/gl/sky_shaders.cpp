@@ -281,10 +281,10 @@ uniform vec4 u_wave[kSeaWaves];
 // Each one's phase modulation: its wave vector, and its phase at the camera's ground point.
 uniform vec3 u_wave_wobble[kSeaWaves];
 uniform int u_waves;
-// Cox-Munk's slope variance, the waves' height variance, the whitecap fraction, the pixel's
-// angle in radians.
+// Cox-Munk's slope variance, the drawn sines' slope variance, the whitecap fraction, the
+// pixel's angle in radians.
 uniform vec4 u_sea;
-uniform float u_foam_height;  // SeaSurface::foamHeight
+uniform float u_foam_steepness;  // SeaSurface::foamSteepness
 uniform vec3 u_sea_body;  // waterBodyColour, times the sun's colour
 uniform vec3 u_sea_sun;   // unit, towards the sun
 uniform vec3 u_sun_colour;
@@ -304,12 +304,13 @@ float fresnelWater(float cos_incidence) {
   return 0.5 * a * a * (1.0 + b * b);
 }
 
-float foamShare(float w, float foam_height, float height, float var_total, float var_unresolved) {
+float foamShare(float w, float foam_steepness, float steepness, float var_total,
+                float var_unresolved) {
   if (!(w > 0.0)) return 0.0;
   if (w >= 1.0) return 1.0;
   float resolved = var_total > 0.0 ? clamp(1.0 - var_unresolved / var_total, 0.0, 1.0) : 0.0;
   float edge = sqrt(max(var_unresolved, 1e-4 * var_total + 1e-12));
-  float crest = 1.0 / (1.0 + exp(-1.702 * (height - foam_height) / edge));
+  float crest = 1.0 / (1.0 + exp(-1.702 * (steepness - foam_steepness) / edge));
   return (1.0 - resolved) * w + resolved * crest;
 }
 
@@ -335,7 +336,7 @@ vec3 seaColour(vec3 d) {
   float distance = u_camera_z / -d.z;
   vec2 p = d.xy * distance;
   float footprint = distance * u_sea.w / sqrt(max(abs(d.z), 1e-4));
-  float height = 0.0, resolved_height = 0.0, resolved_slope = 0.0;
+  float resolved_slope = 0.0;
   vec2 slope = vec2(0.0);
   for (int i = 0; i < u_waves; ++i) {
     vec4 w = u_wave[i];
@@ -345,12 +346,9 @@ vec3 seaColour(vec3 d) {
     vec3 m = u_wave_wobble[i];
     float wobble = dot(m.xy, p) + m.z;
     float phase = dot(w.xy, p) + w.w + kWaveModulation * gardnerSin(wobble);
-    height += weight * w.z * gardnerSin(phase + 1.5707963267948966);
     slope -= (weight * w.z * gardnerSin(phase)) *
              (w.xy + kWaveModulation * gardnerSin(wobble + 1.5707963267948966) * m.xy);
-    float variance = 0.5 * weight * weight * w.z * w.z;
-    resolved_height += variance;
-    resolved_slope += variance * k * k;
+    resolved_slope += 0.5 * weight * weight * w.z * w.z * k * k;
   }
   float slope_var = max(u_sea.x - resolved_slope, (1.0 - kSeaResolvedShare) * u_sea.x);
   vec3 n = normalize(vec3(-slope, 1.0));
@@ -358,8 +356,8 @@ vec3 seaColour(vec3 d) {
   vec3 r = d + 2.0 * cos_i * n;
   r.z = max(r.z, 0.01);
   r = normalize(r);
-  float foam =
-      foamShare(u_sea.z, u_foam_height, height, u_sea.y, max(u_sea.y - resolved_height, 0.0));
+  float foam = foamShare(u_sea.z, u_foam_steepness, dot(slope, slope), u_sea.y,
+                         max(u_sea.y - resolved_slope, 0.0));
   float fresnel = fresnelWater(cos_i);
   float sun = groundSunlight(d);
   float diffuse = max(u_sea_sun.z, 0.0) * (kGroundSkyShare + (1.0 - kGroundSkyShare) * sun);
