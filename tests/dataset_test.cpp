@@ -193,5 +193,45 @@ TEST(Dataset, LabelsOfAHandMadeFrame) {
   EXPECT_EQ(mask[1 * 5 + 3], 0);
 }
 
+// At sea: every sample has the sea as drawn (its wind within the spans), afloat targets float
+// on it, the draws without a sea are those of the same description without one, and the glint
+// mask and per-label glint count follow the glint channel.
+TEST(Dataset, SamplesAtSeaFloatTheirTargetsAndMaskTheGlint) {
+  const std::string afloat = std::string(kSmall) + "afloat = true\n";
+  const DatasetSpec dry = parse(kSmall);
+  const DatasetSpec wet = parse(afloat + R"(
+[sea]
+probability = 1.0
+wind = [4.0, 12.0]
+clarity = [0.2, 0.4]
+)");
+  for (int i = 0; i < 6; ++i) {
+    const SampleScene sample = drawSample(wet, i);
+    ASSERT_TRUE(sample.scene.sea) << i;
+    const double speed = glm::length(sample.scene.sea->wind);
+    EXPECT_GE(speed, 4.0);
+    EXPECT_LE(speed, 12.0);
+    EXPECT_GE(sample.scene.sea->clarity, 0.2);
+    EXPECT_LE(sample.scene.sea->clarity, 0.4);
+    for (const Target& t : sample.scene.targets) EXPECT_NEAR(t.centre.z, 0.3 * 3.0, 1e-9) << i;
+    // The sky, sun and camera draws are those of the same description without a sea.
+    const SampleScene plain = drawSample(dry, i);
+    EXPECT_EQ(plain.record["layers"].dump(), sample.record["layers"].dump());
+    EXPECT_EQ(plain.record["camera"].dump(), sample.record["camera"].dump());
+    EXPECT_FALSE(plain.scene.sea);
+  }
+  Frame frame;
+  frame.info.width = 4, frame.info.height = 2;
+  frame.object_id = {kSeaObjectId, 1, 1, kSeaObjectId, kSeaObjectId, 1, 1, kSeaObjectId};
+  frame.visibility.assign(8, 1.0f);
+  frame.glint = {0.0f, 0.3f, 0.1f, 2.0f, 0.0f, 0.0f, 0.25f, 0.0f};
+  const std::vector<std::uint16_t> mask = glintMask(frame, 0.25);
+  EXPECT_EQ(mask, (std::vector<std::uint16_t>{0, 65535, 0, 65535, 0, 0, 65535, 0}));
+  const std::vector<TargetLabel> labels = labelTargets(frame, {0}, 0.25);
+  EXPECT_EQ(labels[0].glint_px, 2);  // columns 1-2 of both rows
+  frame.glint.clear();
+  EXPECT_EQ(labelTargets(frame, {0}, 0.25)[0].glint_px, -1);
+}
+
 }  // namespace
 }  // namespace nephele

@@ -703,5 +703,29 @@ TEST_F(GlRenderTest, SeaEqualsOneSampleReference) {
   EXPECT_GT(glinting, 20);
 }
 
+// The sea at the extremes: a camera a centimetre above it looking straight down and one at
+// 20 km looking level, no wind and the strongest wind allowed, the sun just below the horizon
+// and overhead, a host's steepest short wave train: finite, non-negative light in both
+// renderers.
+TEST_F(GlRenderTest, SeaAtTheExtremesStaysFinite) {
+  SceneFile file = preset("sea_search", 64, 36);
+  Scene base = file.scene;
+  base.fields.clear();
+  for (double wind : {0.0, 200.0})
+    for (double sun : {-5.0, 89.0})
+      for (int view = 0; view < 2; ++view) {
+        Scene scene = base;
+        scene.sea->wind = {wind, 0.0};
+        scene.sea->trains = {{3, 30.0, 1.0, 0.0, 45.0, 0.0}};
+        scene.sun.elevation_deg = sun;
+        scene.camera.position.z = view == 0 ? 0.01 : 20000.0;
+        scene.camera.orientation.pitch_deg = view == 0 ? -90.0 : 0.0;
+        const std::string name = "wind " + std::to_string(wind) + ", sun " + std::to_string(sun) +
+                                 ", view " + std::to_string(view);
+        EXPECT_EQ(outOfRange(renderer_->renderFloat(scene, pointSampled())), 0) << name;
+        EXPECT_EQ(outOfRange(renderReference(scene, {1, 0})), 0) << name;
+      }
+}
+
 }  // namespace
 }  // namespace nephele

@@ -4,9 +4,15 @@
 # the sun in front of the camera (its azimuth the camera's heading) and behind it (opposite),
 # 25 degrees up. 320x180 PNG, about 3 MB in all.
 #
-#   docs/board/make_board.sh [path/to/nephele]     (default build/nephele)
+# The sea's board (issue 48): sea states 1, 3, 5 and 7, each from 300 m and 3 km, sun 60 and
+# 12 degrees up, with and without clouds, from bench/sea_bench --board, set side by side with
+# oiiotool.
+#
+#   docs/board/make_board.sh [path/to/nephele] [path/to/sea_bench]
+#                                      (default build/nephele, build/bench/sea_bench)
 set -eu
 nephele=${1:-build/nephele}
+sea_bench=${2:-build/bench/sea_bench}
 here=$(cd "$(dirname "$0")" && pwd)
 scenes="$here/../../config/scenes"
 
@@ -54,3 +60,22 @@ shot gardner_cluster own 0 --position 0,-7000,600 --pitch 10 --vfov 50
 shot gardner_cluster above 0 --position 0,-9000,5000 --pitch -30 --vfov 50
 shot harbour own 0 --position 0,-3000,150 --pitch 8 --vfov 55
 shot harbour above 0 --position 0,-3500,2500 --pitch -30 --vfov 55
+# The search at sea, its own view and from 1.5 km, sun in front and behind.
+shot sea_search own 0
+shot sea_search above 0 --position 0,-2000,1500 --pitch -35
+
+# The sea's states: one picture a state, 300 m above and 3 km below, sun 60 then 12 degrees
+# up, each without and with clouds.
+tmp=$(mktemp -d)
+"$sea_bench" --repeats 1 --board "$tmp" >/dev/null
+for state in 1 3 5 7; do
+  set --
+  for altitude in 0300m 3000m; do
+    for sun in sun60 sun12; do
+      set -- "$@" "$tmp/ss${state}_${altitude}_${sun}_clear.png" "$tmp/ss${state}_${altitude}_${sun}_clouds.png"
+    done
+  done
+  oiiotool "$@" --mosaic 4x2 --resize 1280x360 -o "$here/sea_state_$state.png"
+  echo "  sea state $state"
+done
+rm -r "$tmp"
