@@ -121,6 +121,20 @@ inline double repetition(const SeaSurface& surface, glm::dvec2 dir) {
   return worst;
 }
 
+// The mean of f(sample) over `samples` points of a `side` metre square, the surface seen at full
+// resolution at time 0; the points drawn by counter-based randomness on `stream`.
+template <typename F>
+double meanOverSquare(const SeaSurface& surface, int samples, double side, std::uint64_t stream,
+                      F f) {
+  double mean = 0.0;
+  for (int i = 0; i < samples; ++i) {
+    const glm::dvec2 xy(side * unitFromBits(hashCounters(stream, i, 0)),
+                        side * unitFromBits(hashCounters(stream, i, 1)));
+    mean += f(surface.sample(xy, 0.0, 0.0)) / samples;
+  }
+  return mean;
+}
+
 // Cox and Munk (1954): the glint radiance per unit sun irradiance, F p / (4 mu_v cos^4 beta),
 // slopes normal with mean square 0.003 + 5.12e-3 W, for the view that a facet tilted by beta
 // towards the viewer mirrors into `sun` (unit); and the drawn surface's glint for that view,
@@ -133,32 +147,20 @@ inline double glintRatio(const SeaSurface& surface, double speed, double tan_bet
   const glm::dvec3 v = -d;
   const double predicted = fresnelWater(glm::dot(v, facet)) * std::exp(-tan_beta * tan_beta / s2) /
                            (4.0 * s2 * v.z * std::pow(std::cos(beta), 4));
-  double mean = 0.0;
-  const int samples = 20000;
-  for (int i = 0; i < samples; ++i) {
-    const glm::dvec2 xy(5000.0 * unitFromBits(hashCounters(7, i, 0)),
-                        5000.0 * unitFromBits(hashCounters(7, i, 1)));
-    const SeaSample s = surface.sample(xy, 0.0, 0.0);
+  const double mean = meanOverSquare(surface, 20000, 5000.0, 7, [&](const SeaSample& s) {
     const glm::dvec3 n = glm::normalize(glm::dvec3(-s.slope.x, -s.slope.y, 1.0));
-    mean += glintRadiance(d, sun, n, s.unresolved_slope_var) / samples;
-  }
+    return glintRadiance(d, sun, n, s.unresolved_slope_var);
+  });
   return mean / predicted;
 }
 
 // The mean foam share over 100,000 points of a 40 km square, seen at full resolution.
 inline double meanFoam(const SeaSurface& surface) {
-  double mean = 0.0;
-  const int samples = 100000;
-  for (int i = 0; i < samples; ++i) {
-    const glm::dvec2 xy(40000.0 * unitFromBits(hashCounters(9, i, 0)),
-                        40000.0 * unitFromBits(hashCounters(9, i, 1)));
-    const SeaSample s = surface.sample(xy, 0.0, 0.0);
-    mean += foamShare(surface.whitecapFraction(), surface.foamSteepness(),
-                      glm::dot(s.slope, s.slope), surface.drawnSlopeVariance(),
-                      surface.drawnSlopeVariance() - s.resolved_slope_var) /
-            samples;
-  }
-  return mean;
+  return meanOverSquare(surface, 100000, 40000.0, 9, [&](const SeaSample& s) {
+    return foamShare(surface.whitecapFraction(), surface.foamSteepness(),
+                     glm::dot(s.slope, s.slope), surface.drawnSlopeVariance(),
+                     surface.drawnSlopeVariance() - s.resolved_slope_var);
+  });
 }
 
 }  // namespace nephele::sea_measures

@@ -126,23 +126,30 @@ SeaSurface::SeaSurface(const Sea& sea, int count) {
     height_var_ += 0.5 * c.amplitude * c.amplitude;
     drawn_slope_var_ += 0.5 * c.amplitude * c.amplitude * k * k;
   }
-  if (whitecap_fraction_ > 0.0 && whitecap_fraction_ < 1.0 && !components_.empty()) {
+  seed_ = sea.seed;
+}
+
+double SeaSurface::foamSteepness() const {
+  Lazy& lazy = *foam_steepness_;
+  std::call_once(lazy.once, [&] {
+    if (!(whitecap_fraction_ > 0.0 && whitecap_fraction_ < 1.0) || components_.empty()) return;
     // The fully resolved squared slopes' quantile, from points scattered over 400 peak
     // wavelengths.
     const double reach = 400.0 * 2.0 * kPi / glm::length(components_.front().k);
-    std::vector<glm::dvec2> slopes(65536);
-    for (std::size_t i = 0; i < slopes.size(); ++i)
-      slopes[i] = sample({reach * unitFromBits(hashCounters(sea.seed, 5, i, 0)),
-                          reach * unitFromBits(hashCounters(sea.seed, 5, i, 1))},
-                         0.0, 0.0)
-                      .slope;
-    std::vector<double> steepness(slopes.size());
-    for (std::size_t i = 0; i < slopes.size(); ++i) steepness[i] = glm::dot(slopes[i], slopes[i]);
+    std::vector<double> steepness(65536);
+    for (std::size_t i = 0; i < steepness.size(); ++i) {
+      const glm::dvec2 slope = sample({reach * unitFromBits(hashCounters(seed_, 5, i, 0)),
+                                       reach * unitFromBits(hashCounters(seed_, 5, i, 1))},
+                                      0.0, 0.0)
+                                   .slope;
+      steepness[i] = glm::dot(slope, slope);
+    }
     std::sort(steepness.begin(), steepness.end());
     const auto at = std::min(steepness.size() - 1,
                              std::size_t((1.0 - whitecap_fraction_) * double(steepness.size())));
-    foam_steepness_ = steepness[at];
-  }
+    lazy.value = steepness[at];
+  });
+  return lazy.value;
 }
 
 SeaSample SeaSurface::sample(glm::dvec2 xy, double time_s, double footprint_m) const {
@@ -223,13 +230,13 @@ SeaShading shadeSea(const SeaSurface& surface, const Sea& sea, const SeaSample& 
   out.foam =
       foamShare(surface.whitecapFraction(), surface.foamSteepness(), glm::dot(s.slope, s.slope),
                 surface.drawnSlopeVariance(), surface.drawnSlopeVariance() - s.resolved_slope_var);
-  out.fresnel = (1.0 - out.foam) * fresnelWater(cos_i);
+  const double fresnel = fresnelWater(cos_i);
+  out.fresnel = (1.0 - out.foam) * fresnel;
   // Diffuse light on the surface, per pi: the sun's and the sky's (the ground's share in shadow).
   const double diffuse = std::max(sun.z, 0.0) * groundLight(sunlight);
-  out.body_and_foam =
-      diffuse * sun_colour *
-      ((1.0 - out.foam) * (1.0 - fresnelWater(cos_i)) * waterBodyColour(sea.clarity) +
-       out.foam * kFoamReflectance);
+  out.body_and_foam = diffuse * sun_colour *
+                      ((1.0 - out.foam) * (1.0 - fresnel) * waterBodyColour(sea.clarity) +
+                       out.foam * kFoamReflectance);
   if (sun.z > 0.0 && sunlight > 0.0)
     out.glint =
         (1.0 - out.foam) * sunlight * glintRadiance(d, sun, n, s.unresolved_slope_var) * sun_colour;

@@ -7,6 +7,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <memory>
+#include <mutex>
+#include <optional>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -76,8 +79,9 @@ class SeaSurface {
   double whitecapFraction() const { return whitecap_fraction_; }
   // The drawn sines' slope variance, sum of a^2 k^2 / 2.
   double drawnSlopeVariance() const { return drawn_slope_var_; }
-  // The squared slope that a fraction whitecapFraction() of the fully resolved surface exceeds.
-  double foamSteepness() const { return foam_steepness_; }
+  // The squared slope that a fraction whitecapFraction() of the fully resolved surface exceeds:
+  // a quantile of 65,536 samples (about 0.3 s), taken on first use and kept.
+  double foamSteepness() const;
   const std::vector<WaveComponent>& components() const { return components_; }
 
   // At world X, Y at time t, seen with a footprint of `footprint_m` (metres a pixel covers).
@@ -85,7 +89,14 @@ class SeaSurface {
 
  private:
   double wind_speed_ = 0.0, slope_var_ = 0.0, height_var_ = 0.0, peak_omega_ = 0.0;
-  double whitecap_fraction_ = 0.0, foam_steepness_ = 0.0, drawn_slope_var_ = 0.0;
+  double whitecap_fraction_ = 0.0, drawn_slope_var_ = 0.0;
+  std::uint64_t seed_ = 1;
+  // foamSteepness, once computed (shared by copies, which draw the same surface).
+  struct Lazy {
+    std::once_flag once;
+    double value = 0.0;
+  };
+  std::shared_ptr<Lazy> foam_steepness_ = std::make_shared<Lazy>();
   std::vector<WaveComponent> components_;  // longest first
 };
 

@@ -413,15 +413,10 @@ GLuint EllipsoidRenderer::spotlightTexture() {
       const double v = 2.0 * (y + 0.5) / kSpotlightSize - 1.0;
       values[y * kSpotlightSize + x] = float(std::max(0.0, 1.0 - u * u - v * v));
     }
-  spotlight_ = createTexture(gl_, GL_TEXTURE_2D);
+  spotlight_ = createTexture2D(gl_, GL_R16, kSpotlightSize, kSpotlightSize);
   const GLuint t = spotlight_.get();
-  gl_.TextureStorage2D(t, 1, GL_R16, kSpotlightSize, kSpotlightSize);
   gl_.TextureSubImage2D(t, 0, 0, 0, kSpotlightSize, kSpotlightSize, GL_RED, GL_FLOAT,
                         values.data());
-  gl_.TextureParameteri(t, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-  gl_.TextureParameteri(t, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  gl_.TextureParameteri(t, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-  gl_.TextureParameteri(t, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
   return t;
 }
 

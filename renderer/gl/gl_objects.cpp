@@ -43,6 +43,17 @@ GlObject createTexture(const GlApi& gl, GLenum target) {
   return {gl, GlObject::Kind::kTexture, name};
 }
 
+GlObject createTexture2D(const GlApi& gl, GLenum format, int width, int height) {
+  GlObject texture = createTexture(gl, GL_TEXTURE_2D);
+  const GLuint t = texture.get();
+  gl.TextureStorage2D(t, 1, format, width, height);
+  gl.TextureParameteri(t, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  gl.TextureParameteri(t, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  gl.TextureParameteri(t, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  gl.TextureParameteri(t, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  return texture;
+}
+
 GlObject createFramebuffer(const GlApi& gl) {
   GLuint name = 0;
   gl.CreateFramebuffers(1, &name);

@@ -57,6 +57,8 @@ GlObject createFramebuffer(const GlApi& gl);
 GlObject createRenderbuffer(const GlApi& gl);
 GlObject createVertexArray(const GlApi& gl);
 GlObject createBuffer(const GlApi& gl);
+// A 2D texture of one level and this format, read bilinearly and clamped to its edges.
+GlObject createTexture2D(const GlApi& gl, GLenum format, int width, int height);
 
 // Allocating render targets: clear GL's error flags first, then, once the storage is made and
 // attached, ask whether the framebuffer is usable: complete, and no GL error since (a failed

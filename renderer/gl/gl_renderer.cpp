@@ -740,12 +740,7 @@ void GlRenderer::drawSeaProbe(const Scene& scene, const RenderSettings& settings
   continuous_view_ = view;
   const int w = probe.camera.width, h = probe.camera.height;
   if (!sea_probe_texture_ || sea_probe_width_ != w || sea_probe_height_ != h) {
-    sea_probe_texture_ = createTexture(gl_, GL_TEXTURE_2D);
-    gl_.TextureStorage2D(sea_probe_texture_.get(), 1, GL_RGBA32F, w, h);
-    gl_.TextureParameteri(sea_probe_texture_.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    gl_.TextureParameteri(sea_probe_texture_.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    gl_.TextureParameteri(sea_probe_texture_.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    gl_.TextureParameteri(sea_probe_texture_.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    sea_probe_texture_ = createTexture2D(gl_, GL_RGBA32F, w, h);
     sea_probe_width_ = w;
     sea_probe_height_ = h;
   }

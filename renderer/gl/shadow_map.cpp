@@ -133,12 +133,7 @@ void ShadowMap::prepare(const CloudShadows& shadows, glm::dvec3 camera, int size
     records_ = createTexture(gl_, GL_TEXTURE_BUFFER);
   }
   if (size != size_) {
-    texture_ = createTexture(gl_, GL_TEXTURE_2D);
-    gl_.TextureStorage2D(texture_.get(), 1, GL_R16F, size, size);
-    gl_.TextureParameteri(texture_.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    gl_.TextureParameteri(texture_.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    gl_.TextureParameteri(texture_.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    gl_.TextureParameteri(texture_.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    texture_ = createTexture2D(gl_, GL_R16F, size, size);
     gl_.NamedFramebufferTexture(framebuffer_.get(), GL_COLOR_ATTACHMENT0, texture_.get(), 0);
     size_ = size;
   }
