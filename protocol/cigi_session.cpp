@@ -34,8 +34,10 @@ glm::dvec3 fromCigiBody(double x, double y, double z) {
   return {y, x, -z};
 }
 
-// Wind blowing from `from_deg` (clockwise from north, as CIGI gives it) at `speed`: east, north.
-glm::dvec2 windVelocity(double speed, double from_deg) {
+// Wind blowing from `from_deg` (clockwise from north, as CIGI gives it) at `speed`, in the
+// database's X, Y: `north` is the database bearing of true north (LocalFrame::northBearing).
+glm::dvec2 windVelocity(double speed, double from_deg, double north) {
+  from_deg += north;
   return -speed * glm::dvec2(std::sin(from_deg * kDeg), std::cos(from_deg * kDeg));
 }
 
@@ -50,7 +52,7 @@ bool sameCloudLayer(const WeatherControl& a, const WeatherControl& b) {
 
 // A Weather Control cloud layer (1 to 3) as the layer it draws, or what is wrong with it
 // (everywhere: the caller sets a regional layer's region).
-std::variant<WeatherLayer, std::string> cloudLayerOf(const WeatherControl& w) {
+std::variant<WeatherLayer, std::string> cloudLayerOf(const WeatherControl& w, double north) {
   WeatherLayer layer;
   const std::optional<CloudType> type = cloudTypeFromCode(w.cloud_type);
   if (w.enabled && !type)
@@ -75,7 +77,7 @@ std::variant<WeatherLayer, std::string> cloudLayerOf(const WeatherControl& w) {
            text(Limits::kMaxBase) + " m, thickness " + text(Limits::kThickness.lo) + " to " +
            text(Limits::kThickness.hi) + " m, coverage 0 to 100 %, wind 0 to " +
            text(Limits::kMaxWind) + " m/s)";
-  layer.wind = windVelocity(w.wind_speed, w.wind_direction);
+  layer.wind = windVelocity(w.wind_speed, w.wind_direction, north);
   // Inside the layer (MODEL.md section 5): its visibility (0, the genus's) and transition band.
   layer.visibility_m = w.visibility;
   layer.transition_band_m = w.transition_band;
@@ -121,7 +123,7 @@ Region regionOf(const EnvironmentalRegionControl& e, const LocalFrame& database)
   r.centre = {centre.x, centre.y};
   const double band = e.transition_perimeter;
   r.half_size = 0.5 * glm::dvec2(e.size_y, e.size_x) + band;
-  r.heading_deg = e.rotation;
+  r.heading_deg = e.rotation + database.northBearing({e.latitude, e.longitude, 0.0});
   r.edge_m = band;
   return r;
 }
@@ -195,8 +197,9 @@ std::string waveError(const WaveControl& w) {
 }
 
 // A Wave Control as set_sea's train: CIGI's direction is where the wave propagates, clockwise
-// from true north, as the sea's (world/sea.h); disabled removes the train.
-command::WavePatch wavePatchOf(const WaveControl& w) {
+// from true north, the sea's from the database's north, whose bearing is `north`; disabled
+// removes the train.
+command::WavePatch wavePatchOf(const WaveControl& w, double north) {
   command::WavePatch p;
   p.id = w.wave_id;
   p.enabled = w.enabled;
@@ -204,7 +207,10 @@ command::WavePatch wavePatchOf(const WaveControl& w) {
   p.height = w.height;
   p.wavelength = w.wavelength;
   p.period = w.period;
-  p.direction = w.direction;
+  double direction = w.direction + north;  // kept in [0, 360)
+  if (direction < 0.0) direction += 360.0;
+  if (direction >= 360.0) direction -= 360.0;
+  p.direction = direction;
   p.phase = w.phase_offset;
   return p;
 }
@@ -232,8 +238,7 @@ std::string entityName(std::uint16_t id) {
 }  // namespace
 
 LocalFrame Session::databaseOf(const State& state) {
-  const glm::dvec2 site = state.site.value_or(glm::dvec2(0.0));
-  return LocalFrame(site.x, site.y);
+  return LocalFrame(state.site.value_or(Site{}));
 }
 
 std::optional<Session::Pose> Session::poseOf(const State& state, std::uint16_t id,
@@ -244,8 +249,8 @@ std::optional<Session::Pose> Session::poseOf(const State& state, std::uint16_t i
     return std::nullopt;
   }
   const EntityControl& e = it->second.packet;
-  const glm::dmat3 own = bodyToWorld({e.yaw, e.pitch, e.roll});
   if (e.attached && e.parent_id != id && depth < 16) {
+    const glm::dmat3 own = bodyToWorld({e.yaw, e.pitch, e.roll});
     const std::optional<Pose> parent = poseOf(state, e.parent_id, depth + 1);
     if (!parent) return std::nullopt;
     return Pose{
@@ -253,7 +258,11 @@ std::optional<Session::Pose> Session::poseOf(const State& state, std::uint16_t i
         parent->attitude * own};
   }
   if (e.attached) return std::nullopt;  // attached to itself, or a chain deeper than 16
-  return Pose{databaseOf(state).toLocal({e.latitude, e.longitude, e.altitude}), own};
+  // Its heading from true north there, turned to the database's north (MODEL.md section 13).
+  const LocalFrame database = databaseOf(state);
+  const Geodetic place{e.latitude, e.longitude, e.altitude};
+  return Pose{database.toLocal(place),
+              bodyToWorld({e.yaw + database.northBearing(place), e.pitch, e.roll})};
 }
 
 std::variant<Session::State, Refusal> Session::next(const Message& message,
@@ -317,10 +326,42 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
           other = glm::dvec2(r->latitude, std::remainder(r->longitude, 360.0));
       }
     }
-    s.site = ownship ? ownship : other;
+    if (const auto place = ownship ? ownship : other) s.site = Site{place->x, place->y, 0.0};
     frame.site_adopted = s.site;
   }
+  // Re-centring (MODEL.md section 13): once the ownship is farther than the settings' distance
+  // from the origin, the origin moves to it, snapped to a 1/64-degree lattice so that every
+  // flight over a place re-centres there alike.
+  if (s.site && settings_.recentre_m > 0.0) {
+    std::optional<Geodetic> own;
+    for (std::size_t i = 1; i < message.packets.size(); ++i)
+      if (const auto* e = std::get_if<EntityControl>(&message.packets[i]);
+          e && e->entity_id == 0 && !e->attached &&
+          finite({e->latitude, e->longitude, e->altitude}) && std::abs(e->latitude) <= 90.0)
+        own = Geodetic{e->latitude, e->longitude, 0.0};
+    if (const auto it = s.entities.find(0);
+        !own && it != s.entities.end() && !it->second.packet.attached)
+      own = Geodetic{it->second.packet.latitude, it->second.packet.longitude, 0.0};
+    if (own && glm::length(glm::dvec2(databaseOf(s).toLocal(*own))) > settings_.recentre_m) {
+      const double latitude = std::clamp(std::round(own->latitude_deg * 64.0) / 64.0, -90.0, 90.0);
+      const double longitude = std::remainder(std::round(own->longitude_deg * 64.0) / 64.0, 360.0);
+      s.site = recentred(*s.site, latitude, longitude).to;
+      frame.recentred = s.site;
+    }
+  }
   const LocalFrame database = databaseOf(s);
+  // The database bearing of true north at the origin, for what the host gives for the whole
+  // world (its wind, its wave trains).
+  const double north = -s.site.value_or(Site{}).grid_deg;
+  // Every frame says where its positions lie: the world adopts it, re-centres on it, or (a
+  // snapshot restored from elsewhere) moves its content there.
+  if (s.site)
+    frame.commands.emplace_back(
+        command::SetSite{s.site->latitude_deg, s.site->longitude_deg, s.site->grid_deg});
+  // The host's wind turns with the meridians at a re-centring, so that it stays true.
+  if (frame.recentred && s.atmosphere)
+    frame.commands.emplace_back(command::SetWind{
+        windVelocity(s.atmosphere->wind_speed, s.atmosphere->wind_direction, north)});
   // A packet with a value out of range is refused alone; the frame's other packets apply.
   auto bad = [&](std::string what) { frame.refused.push_back(std::move(what)); };
   bool views_moved = false;
@@ -466,7 +507,7 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
         frame.commands.emplace_back(c);
         continue;
       }
-      auto layer = cloudLayerOf(*w);
+      auto layer = cloudLayerOf(*w, north);
       if (const auto* e = std::get_if<std::string>(&layer)) {
         bad(where + ": " + *e);
         continue;
@@ -521,7 +562,8 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
         }
         command::SetWeather c{it->first.layer, {}, id};
         if (active) {
-          c.weather = std::get<WeatherLayer>(cloudLayerOf(it->second));  // checked when stored
+          c.weather =
+              std::get<WeatherLayer>(cloudLayerOf(it->second, north));  // checked when stored
           c.weather.region = regionOf(*e, database);
         }
         frame.commands.emplace_back(c);
@@ -539,7 +581,7 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
               text(Limits::kMaxWind) + " m/s)");
         } else {
           frame.commands.emplace_back(
-              command::SetWind{windVelocity(a->wind_speed, a->wind_direction)});
+              command::SetWind{windVelocity(a->wind_speed, a->wind_direction, north)});
           applied.wind_speed = a->wind_speed;
           applied.wind_direction = a->wind_direction;
         }
@@ -596,7 +638,7 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
         c.whitecaps = m->whitecaps;
         // The host's wave trains, which a sea it disabled lost with it.
         for (const auto& [id, wave] : s.waves)
-          if (wave.enabled) c.waves.push_back(wavePatchOf(wave));
+          if (wave.enabled) c.waves.push_back(wavePatchOf(wave, north));
         if (m->sea_surface_height != 0.0f &&
             !(s.maritime && s.maritime->surface_conditions_enabled &&
               same(s.maritime->sea_surface_height, m->sea_surface_height)))
@@ -640,7 +682,7 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
       // A sea the host disabled takes its trains when it enables it again (above).
       if (s.maritime && !s.maritime->surface_conditions_enabled) continue;
       command::SetSea c;
-      c.waves.push_back(wavePatchOf(*w));
+      c.waves.push_back(wavePatchOf(*w, north));
       frame.commands.emplace_back(std::move(c));
     } else if (const auto* o = std::get_if<OtherPacket>(&packet)) {
       frame.ignored.push_back("packet " + std::to_string(o->id) + " (not used by Nephele)");
@@ -649,7 +691,8 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
   // The sun of the host's date where the ownship is (MODEL.md section 13), not at the site: a
   // long flight sees it move.
   if (s.celestial) {
-    glm::dvec2 place = s.site.value_or(glm::dvec2(0.0));
+    glm::dvec2 place =
+        s.site ? glm::dvec2(s.site->latitude_deg, s.site->longitude_deg) : glm::dvec2(0.0);
     if (const auto own = s.entities.find(0);
         own != s.entities.end() && !own->second.packet.attached)
       place = {own->second.packet.latitude, std::remainder(own->second.packet.longitude, 360.0)};

@@ -14,16 +14,18 @@
 #include "protocol/cigi.h"
 #include "protocol/messages.h"
 #include "world/geodesy.h"
+#include "world/limits.h"
 
 namespace nephele::cigi {
 
 struct SessionSettings {
-  // The database origin's latitude and longitude ([site]); none: the host's first position
-  // sets it (Session::next).
-  std::optional<glm::dvec2> site;
+  // The database origin ([site]); none: the host's first position sets it (Session::next).
+  std::optional<Site> site;
   std::vector<std::string> views;                         // view id n is views[n]
   std::vector<std::pair<int, std::string>> entity_types;  // CIGI entity type -> [[entity_type]]
   double default_frame_s = 1.0 / 60.0;  // host frame time when the timestamps do not tell
+  // The origin moves to the ownship once it is this far from it (MODEL.md section 13); 0: never.
+  double recentre_m = Limits::kDefaultRecentreDistance;
 };
 
 // A host frame ready for the daemon.
@@ -33,9 +35,11 @@ struct HostFrame {
   double dt_s = 0.0;                 // the host's frame time, by which a lockstep world advances
   std::vector<std::string> ignored;  // packets or fields not supported, with why
   std::vector<std::string> refused;  // packets refused for a value out of range, with why
-  // The database origin this frame took from the host (latitude, longitude), with no [site]
-  // configured: once per session.
-  std::optional<glm::dvec2> site_adopted;
+  // The database origin this frame took from the host, with no [site] configured: once per
+  // session.
+  std::optional<Site> site_adopted;
+  // The origin this frame re-centred the world on (the ownship's place, SessionSettings).
+  std::optional<Site> recentred;
 };
 
 // A message the session refuses as a whole (nothing of it is applied): "out_of_order" (late or
@@ -116,8 +120,8 @@ class Session {
     std::map<std::uint8_t, WaveControl> waves;
     std::optional<CelestialSphereControl> celestial;
     std::optional<glm::dvec2> sun_place;  // latitude, longitude the sun was last placed for
-    // The database origin (latitude, longitude): [site], or the host's first position.
-    std::optional<glm::dvec2> site;
+    // The database origin: [site], or the host's first position, re-centred as the ownship flies.
+    std::optional<Site> site;
   };
   std::variant<State, Refusal> next(const Message& message, HostFrame& frame) const;
   std::optional<Pose> poseOf(const State& state, std::uint16_t entity, int depth = 0) const;

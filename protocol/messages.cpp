@@ -454,6 +454,17 @@ SetSea readSetSea(FieldReader& r) {
   return c;
 }
 
+SetSite readSetSite(FieldReader& r) {
+  SetSite c{r.number("latitude", Limits::kLatitude), r.number("longitude", Limits::kLongitude),
+            r.number("grid", -Limits::kMaxHeading, Limits::kMaxHeading)};
+  if (c.latitude.has_value() != c.longitude.has_value())
+    r.fail(c.latitude ? "longitude" : "latitude",
+           "is missing (give latitude and longitude together)");
+  if (c.grid && !c.latitude) r.fail("grid", "needs latitude and longitude with it");
+  r.finish("cmd, id, latitude, longitude, grid");
+  return c;
+}
+
 SetTime readSetTime(FieldReader& r) {
   SetTime c{r.number("time_scale", 0.0, ProtocolLimits::kMaxTimeScale), r.boolean("paused"),
             r.number("advance", 0.0, Limits::kMaxAdvance), std::nullopt};

@@ -151,6 +151,13 @@ struct SetSea {
   std::optional<std::uint64_t> seed;
   std::vector<WavePatch> waves;  // distinct ids
 };
+// Where the database lies on the Earth (MODEL.md section 13): a world placed nowhere takes
+// the site; a placed one re-centres on it, its content keeping its place on the Earth. `grid`
+// (degrees clockwise from true north) is the database's north at the site, by default the one
+// that keeps the content's axes. With no fields the site is only read back.
+struct SetSite {
+  std::optional<double> latitude, longitude, grid;
+};
 struct SetTime {
   std::optional<double> time_scale;  // simulated seconds per real second
   std::optional<bool> paused;

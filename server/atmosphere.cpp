@@ -30,11 +30,14 @@ Outcome Engine::setSun(const command::SetSun& c) {
   State& s = *state_;
   Sun sun = s.world->base().sun;
   if (c.utc) {
+    // At the place given, else at the database's origin; the azimuth from true north there
+    // turned to the database's north (MODEL.md section 13).
+    const std::optional<Site>& site = s.world->base().site;
     const glm::dvec2 place = c.place.value_or(
-        config_.site ? glm::dvec2(config_.site->latitude_deg, config_.site->longitude_deg)
-                     : glm::dvec2(0.0));
+        site ? glm::dvec2(site->latitude_deg, site->longitude_deg) : glm::dvec2(0.0));
     const SolarPosition p = solarPosition(*c.utc, place.x, place.y);
     sun.azimuth_deg = p.azimuth_deg;
+    if (site) sun.azimuth_deg += LocalFrame(*site).northBearing({place.x, place.y, 0.0});
     sun.elevation_deg = p.elevation_deg;
     s.sun_utc = c.utc;
   }
@@ -163,6 +166,38 @@ Outcome Engine::setSea(const command::SetSea& c) {
     spdlog::info("event=sea enabled={} trains={}", after.has_value(),
                  after ? after->trains.size() : 0);
   return seaJson(after);
+}
+
+nlohmann::json engine_detail::siteJson(const World& world) {
+  const std::optional<Site>& site = world.base().site;
+  if (!site) return json{{"placed", false}};
+  const glm::dvec2 o = world.base().content_origin;
+  return json{{"placed", true},
+              {"latitude", site->latitude_deg},
+              {"longitude", site->longitude_deg},
+              {"grid", site->grid_deg},
+              {"content_origin", {o.x, o.y}}};
+}
+
+Outcome Engine::setSite(const command::SetSite& c) {
+  State& s = *state_;
+  World& world = *s.world;
+  if (c.latitude) {
+    const std::optional<Site> before = world.base().site;
+    Site site{*c.latitude, *c.longitude, 0.0};
+    if (before) site = recentred(*before, site.latitude_deg, site.longitude_deg).to;
+    if (c.grid) site.grid_deg = *c.grid;
+    const glm::dvec2 origin = world.base().content_origin;
+    bool changed = false;
+    if (std::string error = world.setSite(site, &changed); !error.empty()) return badField(error);
+    // The views move with the world, so that each sees what it saw (a host places its own).
+    const glm::dvec3 shift(world.base().content_origin - origin, 0.0);
+    for (ViewConfig& v : s.views) v.camera.position -= shift;
+    if (changed)
+      spdlog::info("event=site latitude={:.6f} longitude={:.6f} grid={:.4f} moved={:.1f}",
+                   site.latitude_deg, site.longitude_deg, site.grid_deg, glm::length(shift));
+  }
+  return siteJson(world);
 }
 
 void Engine::setMode(TickMode mode) {

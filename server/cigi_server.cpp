@@ -16,7 +16,8 @@ constexpr std::size_t kMaxWaiting = 64;  // datagrams held while one is with the
 
 cigi::SessionSettings sessionSettings(const DaemonConfig& config) {
   cigi::SessionSettings s;
-  if (config.site) s.site = glm::dvec2(config.site->latitude_deg, config.site->longitude_deg);
+  s.site = config.site;
+  s.recentre_m = config.cigi.recentre_distance_m;
   s.views = config.cigi.views;
   for (const EntityType& t : config.entity_types) s.entity_types.emplace_back(t.id, t.name);
   s.default_frame_s = 1.0 / config.tick_rate_hz;
@@ -111,7 +112,8 @@ void CigiServer::next() {
     spdlog::info(
         "event=cigi_site latitude={:.6f} longitude={:.6f} what=\"no [site] configured: the "
         "database origin is the host's first position\"",
-        frame.site_adopted->x, frame.site_adopted->y);
+        frame.site_adopted->latitude_deg, frame.site_adopted->longitude_deg);
+  if (frame.recentred) engine_.countCigi("recentred");
   const std::uint8_t status =
       frame.refused.empty() ? cigi::IgStatus::kApplied : cigi::IgStatus::kPacketsRefused;
   // Synchronous (lockstep) mode: the world advances by the host's frame time, and the tick

@@ -122,8 +122,15 @@ void readDaemon(const toml::table& root, const std::string& file, DaemonConfig& 
                         [&](const ViewConfig& v) { return v.name == out.modbus_view; }))
     t.failHere("modbus.view: \"" + out.modbus_view + "\" is not a view");
   if (auto c = t.table("cigi")) {
-    c->allow({"enabled", "bind", "ig_port", "host_port", "views"});
+    c->allow({"enabled", "bind", "ig_port", "host_port", "views", "recentre_distance"});
     c->boolean("enabled", out.cigi.enabled);
+    c->number("recentre_distance", out.cigi.recentre_distance_m, Limits::kRecentreDistance);
+    if (out.cigi.recentre_distance_m > 0.0 &&
+        out.cigi.recentre_distance_m < Limits::kMinRecentreDistance)
+      c->failAt("recentre_distance",
+                "is below " + std::to_string(int(Limits::kMinRecentreDistance)) +
+                    " m (allowed: 0 for never, or " +
+                    std::to_string(int(Limits::kMinRecentreDistance)) + " to 1e6 m)");
     c->string("bind", out.cigi.bind);
     c->integer("ig_port", out.cigi.ig_port, 0, 65535);
     c->integer("host_port", out.cigi.host_port, 0, 65535);

@@ -11,6 +11,8 @@
 #include "config/scene_file.h"
 #include "image/image_encoding.h"
 #include "protocol/messages.h"
+#include "world/geodesy.h"
+#include "world/limits.h"
 
 namespace nephele {
 
@@ -42,12 +44,9 @@ struct CigiConfig {
   int ig_port = 8004;
   int host_port = 8005;
   std::vector<std::string> views;  // CIGI view id n is views[n]; default the config's views
-};
-
-// Where the database's origin lies on the Earth (for the sun from a date and time).
-struct Site {
-  double latitude_deg = 0.0;
-  double longitude_deg = 0.0;
+  // The world re-centres on the ownship once it is this far from the database's origin
+  // (MODEL.md section 13); 0: never.
+  double recentre_distance_m = Limits::kDefaultRecentreDistance;
 };
 
 // A quarter of the machine's physical memory in ellipsoids of Limits::kBytesPerEllipsoid,

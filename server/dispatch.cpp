@@ -116,6 +116,7 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
       [&](const SetFog& c) -> std::optional<Outcome> { return setFog(c); },
       [&](const SetHaze& c) -> std::optional<Outcome> { return setHaze(c); },
       [&](const SetSea& c) -> std::optional<Outcome> { return setSea(c); },
+      [&](const SetSite& c) -> std::optional<Outcome> { return setSite(c); },
       [&](const SetTime& c) -> std::optional<Outcome> {
         if (c.time_scale) s.time_scale = *c.time_scale;
         if (c.paused) s.paused = *c.paused;

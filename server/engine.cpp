@@ -141,6 +141,8 @@ std::string Engine::openWorld() {
       std::make_unique<World>(config_.scene.scene, config_.scene.dynamics, config_.world_threads);
   if (std::string e = s.world->advanceInPieces(config_.scene.scene.time_s); !e.empty())
     return "scene time: " + e;
+  if (config_.site)
+    s.world->setSite({config_.site->latitude_deg, config_.site->longitude_deg, 0.0});
   const std::string& snapshot = config_.snapshot_path;
   if (config_.restore_on_start && !snapshot.empty() && std::filesystem::exists(snapshot)) {
     if (std::string e = restoreSnapshot(snapshot); !e.empty())

@@ -167,6 +167,7 @@ class Engine {
   std::variant<nlohmann::json, ProtocolError> setFog(const command::SetFog& c);
   std::variant<nlohmann::json, ProtocolError> setHaze(const command::SetHaze& c);
   std::variant<nlohmann::json, ProtocolError> setSea(const command::SetSea& c);
+  std::variant<nlohmann::json, ProtocolError> setSite(const command::SetSite& c);
   void setMode(TickMode mode);
   std::optional<std::variant<nlohmann::json, ProtocolError>> renderRequest(const command::Render& c,
                                                                            Job& job);

@@ -281,6 +281,8 @@ std::variant<std::optional<Sea>, ProtocolError> seaAfter(const std::optional<Sea
                                                          const command::SetSea& c,
                                                          glm::dvec2 surface_wind);
 json seaJson(const std::optional<Sea>& sea);
+// Where the world's database lies on the Earth (set_site's reply, stats' "site").
+json siteJson(const World& world);
 // Encodes `frame` as `image` asks (delivery.cpp); on failure returns the error.
 std::variant<std::vector<std::uint8_t>, std::string> encodeFrame(const ViewFrame& frame,
                                                                  const ImageRequest& image,

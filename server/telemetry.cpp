@@ -42,6 +42,7 @@ void Engine::publish() {
       {"requests", s.requests},
       {"automaton_steps", world.automatonStepsRun()},
       {"relights", world.relightsRun()},
+      {"site", siteJson(world)},
       {"last_frame", frameStatsJson(s.renderer->lastFrameStats())},
   };
   stats["histograms"] = {{"render_seconds", s.render_seconds.toJson()},

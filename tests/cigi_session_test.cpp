@@ -141,7 +141,7 @@ TEST(CigiCodec, SeaPacketsFollowTheIcdLayoutInEitherByteOrder) {
 
 class SeaSession : public ::testing::Test {
  protected:
-  SeaSession() : session_(SessionSettings{glm::dvec2(51.5, -1.25), {"front"}, {}}) {}
+  SeaSession() : session_(SessionSettings{Site{51.5, -1.25}, {"front"}, {}}) {}
 
   // The set_sea commands of a host frame, which the daemon then applies.
   std::vector<command::SetSea> frame(std::initializer_list<std::vector<std::uint8_t>> packets) {

@@ -153,6 +153,27 @@ TEST(Messages, SetWeatherCarriesPrecipitation) {
               HasSubstr("layer"));
 }
 
+// set_site: a latitude and longitude together, a grid north only with them.
+TEST(Messages, SetSiteTakesAPlaceOnTheEarth) {
+  const auto site = std::get<command::SetSite>(
+      parsed(R"({"cmd":"set_site","latitude":60.5,"longitude":-179.5,"grid":12})").command);
+  EXPECT_EQ(site.latitude, 60.5);
+  EXPECT_EQ(site.longitude, -179.5);
+  EXPECT_EQ(site.grid, 12.0);
+  EXPECT_FALSE(std::get<command::SetSite>(parsed(R"({"cmd":"set_site"})").command).latitude);
+  const std::pair<const char*, const char*> errors[] = {
+      {R"({"cmd":"set_site","latitude":91,"longitude":0})",
+       "latitude: 91 is out of range (allowed: -90 to 90)"},
+      {R"({"cmd":"set_site","latitude":0,"longitude":181})",
+       "longitude: 181 is out of range (allowed: -180 to 180)"},
+      {R"({"cmd":"set_site","latitude":10})", "longitude: is missing"},
+      {R"({"cmd":"set_site","grid":1})", "grid: needs latitude and longitude"},
+      {R"({"cmd":"set_site","latitude":0,"longitude":0,"height":1})", "height: unknown field"},
+  };
+  for (const auto& [request, error] : errors)
+    EXPECT_THAT(rejected(request).error.message, HasSubstr(error)) << request;
+}
+
 // set_sea: the sea's fields and wave trains by id, each range from world/limits.h.
 TEST(Messages, SetSeaCarriesTheSeaAndItsWaveTrains) {
   const auto sea = std::get<command::SetSea>(

@@ -43,23 +43,56 @@ Geodetic geodeticFromEarthCentred(glm::dvec3 p) {
   return g;
 }
 
-LocalFrame::LocalFrame(double latitude_deg, double longitude_deg)
-    : origin_(earthCentred({latitude_deg, longitude_deg, 0.0})) {
+namespace {
+
+// The unit east and north at a latitude and longitude, Earth-centred.
+void eastNorth(double latitude_deg, double longitude_deg, glm::dvec3& east, glm::dvec3& north) {
   const double lat = latitude_deg * kDeg, lon = longitude_deg * kDeg;
-  east_ = {-std::sin(lon), std::cos(lon), 0.0};
-  north_ = {-std::sin(lat) * std::cos(lon), -std::sin(lat) * std::sin(lon), std::cos(lat)};
-  up_ = {std::cos(lat) * std::cos(lon), std::cos(lat) * std::sin(lon), std::sin(lat)};
+  east = {-std::sin(lon), std::cos(lon), 0.0};
+  north = {-std::sin(lat) * std::cos(lon), -std::sin(lat) * std::sin(lon), std::cos(lat)};
+}
+
+}  // namespace
+
+LocalFrame::LocalFrame(const Site& site)
+    : origin_(earthCentred({site.latitude_deg, site.longitude_deg, 0.0})) {
+  glm::dvec3 east, north;
+  eastNorth(site.latitude_deg, site.longitude_deg, east, north);
+  up_ = glm::cross(east, north);
+  // +Y points along true bearing grid_deg, +X a right angle clockwise from it.
+  const double c = std::cos(site.grid_deg * kDeg), s = std::sin(site.grid_deg * kDeg);
+  x_ = c * east - s * north;
+  y_ = s * east + c * north;
 }
 
 glm::dvec3 LocalFrame::toLocal(const Geodetic& g) const {
   const glm::dvec3 d = earthCentred({g.latitude_deg, g.longitude_deg, 0.0}) - origin_;
-  return {glm::dot(d, east_), glm::dot(d, north_), g.height_m};
+  return {glm::dot(d, x_), glm::dot(d, y_), g.height_m};
+}
+
+double LocalFrame::northBearing(const Geodetic& g) const {
+  // The foot map is linear in Earth-centred coordinates, so a step north along the ellipsoid
+  // at g maps to that step's tangent projected on the database's axes.
+  glm::dvec3 east, north;
+  eastNorth(g.latitude_deg, g.longitude_deg, east, north);
+  return std::atan2(glm::dot(north, x_), glm::dot(north, y_)) / kDeg;
+}
+
+Recentring recentred(const Site& from, double latitude_deg, double longitude_deg) {
+  const LocalFrame old(from);
+  const Geodetic origin{latitude_deg, longitude_deg, 0.0};
+  Recentring r;
+  r.shift = glm::dvec2(old.toLocal(origin));
+  // The old +Y at the new origin keeps its database bearing: the new grid north is its true
+  // bearing there, so that a heading in the old database is the same heading in the new one.
+  r.to = Site{latitude_deg, longitude_deg, -old.northBearing(origin)};
+  return r;
 }
 
 Geodetic LocalFrame::toGeodetic(glm::dvec3 local) const {
   // The point of the tangent plane, then down the site's vertical to the ellipsoid: the
   // nearer root of |S (q + t u)|^2 = 1, S = diag(1/a, 1/a, 1/b).
-  const glm::dvec3 q = origin_ + local.x * east_ + local.y * north_;
+  const glm::dvec3 q = origin_ + local.x * x_ + local.y * y_;
   const glm::dvec3 s(1.0 / kWgs84A, 1.0 / kWgs84A, 1.0 / kB);
   const glm::dvec3 sq = s * q, su = s * up_;
   const double a = glm::dot(su, su), half_b = glm::dot(sq, su), c = glm::dot(sq, sq) - 1.0;

@@ -163,6 +163,10 @@ struct Limits {
   static constexpr Range kLatitude{-90.0, 90.0};
   static constexpr Range kLongitude{-180.0, 180.0};
   static constexpr int kMinSolarYear = 1901, kMaxSolarYear = 2099;
+  // A CIGI host's world re-centres on its ownship this far from the origin (MODEL.md section
+  // 13; 0: never): the flat database's distances hold to 0.1 % within 280 km of its origin.
+  static constexpr Range kRecentreDistance{0.0, 1.0e6};
+  static constexpr double kMinRecentreDistance = 1000.0, kDefaultRecentreDistance = 50000.0;
   // Ground fog (McReynolds and Blythe): top and meteorological visibility, metres.
   static constexpr Range kFogVisibility{1.0, 1.0e7};
   // Distance haze (MODEL.md section 5): visibility at Z = 0 and the extinction's scale height,

@@ -13,6 +13,7 @@
 #include "world/formations/ellipsoid_cloud.h"
 #include "world/formations/region.h"
 #include "world/frames.h"
+#include "world/geodesy.h"
 #include "world/sea.h"
 #include "world/shading.h"
 #include "world/sky.h"
@@ -100,6 +101,12 @@ struct Scene {
   std::vector<RainShaft> rain_shafts;
   // The sea in place of the ground (MODEL.md section 18); none: the ground plane.
   std::optional<Sea> sea;
+  // Where the database lies on the Earth; none: a flat world placed nowhere (scene files, a
+  // socket host). And where the database's origin lies in the frame the world's procedural
+  // content was laid out in: the sum of its re-centrings' shifts (MODEL.md section 13), where
+  // weather and a sea set later are laid out too, so that they land where they would have.
+  std::optional<Site> site;
+  glm::dvec2 content_origin{0.0};
 };
 
 // `scene` with `clouds` in place of its own: everything else copied, its clouds' lobes not
@@ -107,11 +114,11 @@ struct Scene {
 inline Scene withClouds(const Scene& scene, std::vector<EllipsoidCloud> clouds) {
   // Every member by name: this stops compiling when Scene gains one, which belongs here too.
   const auto& [seed, time_s, camera, sun, sky, fog, haze, layers, own_clouds, fields, targets,
-               automata, weather, rain_shafts, sea] = scene;
+               automata, weather, rain_shafts, sea, site, content_origin] = scene;
   static_cast<void>(own_clouds);
   return Scene{
-      seed,   time_s,  camera,   sun,     sky,         fog, haze, layers, std::move(clouds),
-      fields, targets, automata, weather, rain_shafts, sea};
+      seed,   time_s,  camera,   sun,     sky,         fog, haze, layers,        std::move(clouds),
+      fields, targets, automata, weather, rain_shafts, sea, site, content_origin};
 }
 
 // What the sea mirrors (MODEL.md section 18): the scene seen from the sea's surface under the

@@ -127,6 +127,20 @@ SeaSurface::SeaSurface(const Sea& sea, int count) {
     drawn_slope_var_ += 0.5 * c.amplitude * c.amplitude * k * k;
   }
   seed_ = sea.seed;
+  *this = movedTo(sea.origin_m);
+}
+
+SeaSurface SeaSurface::movedTo(glm::dvec2 origin) const {
+  SeaSurface out = *this;
+  const glm::dvec2 step = origin - origin_;
+  // Each height term a cos(k.(x - o) - w t + phase + M sin(q.(x - o) + psi)) keeps its form
+  // with the offsets folded into its phases, reduced to keep them small.
+  for (WaveComponent& c : out.components_) {
+    c.phase = std::remainder(c.phase - glm::dot(c.k, step), 2.0 * kPi);
+    c.psi = std::remainder(c.psi - glm::dot(c.q, step), 2.0 * kPi);
+  }
+  out.origin_ = origin;
+  return out;
 }
 
 double SeaSurface::foamSteepness() const {
@@ -138,10 +152,11 @@ double SeaSurface::foamSteepness() const {
     const double reach = 400.0 * 2.0 * kPi / glm::length(components_.front().k);
     std::vector<double> steepness(65536);
     for (std::size_t i = 0; i < steepness.size(); ++i) {
-      const glm::dvec2 slope = sample({reach * unitFromBits(hashCounters(seed_, 5, i, 0)),
-                                       reach * unitFromBits(hashCounters(seed_, 5, i, 1))},
-                                      0.0, 0.0)
-                                   .slope;
+      const glm::dvec2 slope =
+          sample(origin_ + reach * glm::dvec2(unitFromBits(hashCounters(seed_, 5, i, 0)),
+                                              unitFromBits(hashCounters(seed_, 5, i, 1))),
+                 0.0, 0.0)
+              .slope;
       steepness[i] = glm::dot(slope, slope);
     }
     std::sort(steepness.begin(), steepness.end());

@@ -37,6 +37,9 @@ struct Sea {
   bool whitecaps = true;
   std::vector<WaveTrain> trains;  // by id, at most kMaxWaveTrains
   std::uint64_t seed = 1;         // the spectrum's directions and phases
+  // Where the waves are laid out from, in the database: re-centring the world moves it so that
+  // the waves keep their place on the Earth (MODEL.md section 13).
+  glm::dvec2 origin_m{0.0};
   bool operator==(const Sea&) const = default;
 };
 inline constexpr int kMaxWaveTrains = 8;
@@ -83,6 +86,10 @@ class SeaSurface {
   // a quantile of 65,536 samples (about 0.3 s), taken on first use and kept.
   double foamSteepness() const;
   const std::vector<WaveComponent>& components() const { return components_; }
+  // The same waves laid out from `origin` (Sea::origin_m) in place of this one's: the phases
+  // move by the wave vectors times the step, and foamSteepness, taken where the waves are laid
+  // out from, is shared.
+  SeaSurface movedTo(glm::dvec2 origin) const;
 
   // At world X, Y at time t, seen with a footprint of `footprint_m` (metres a pixel covers).
   SeaSample sample(glm::dvec2 xy, double time_s, double footprint_m) const;
@@ -91,6 +98,7 @@ class SeaSurface {
   double wind_speed_ = 0.0, slope_var_ = 0.0, height_var_ = 0.0, peak_omega_ = 0.0;
   double whitecap_fraction_ = 0.0, drawn_slope_var_ = 0.0;
   std::uint64_t seed_ = 1;
+  glm::dvec2 origin_{0.0};
   // foamSteepness, once computed (shared by copies, which draw the same surface).
   struct Lazy {
     std::once_flag once;

@@ -200,10 +200,32 @@ std::string placeWeather(Scene& scene, WorldDynamics& dynamics, const WeatherKey
   // A region's layers are its own, and seeded apart from the global layer of that number.
   std::uint64_t seed = weatherSeed(scene.seed, key.layer);
   if (key.region) seed = hashCounters(seed, 0x526567696f6eull, std::uint64_t(*key.region));
-  const WeatherClouds add = weatherClouds(weather, prefix, seed);
+  // Laid out from where the world's content was (a re-centred world's), its region where the
+  // database has it.
+  WeatherLayer laid_out = weather;
+  if (!laid_out.region.everywhere()) laid_out.region.centre += scene.content_origin;
+  WeatherClouds add = weatherClouds(laid_out, prefix, seed);
   auto made = [&](const std::string& name) {
     return name == prefix || name.rfind(prefix + "/", 0) == 0;
   };
+  // A layer or field the layer made before keeps where it has drifted to, so that a layer set
+  // again (its cover, its wind turned by a re-centring) grows and thins in place.
+  for (CloudLayer& layer : add.layers) {
+    layer.texture.drift_offset_m -= scene.content_origin;
+    for (const CloudLayer& old : scene.layers)
+      if (old.name == layer.name) {
+        layer.region.centre += layer.texture.drift_offset_m - old.texture.drift_offset_m;
+        layer.texture.drift_offset_m = old.texture.drift_offset_m;
+      }
+  }
+  for (CloudField& field : add.fields) {
+    field.drift_m -= scene.content_origin;
+    for (const CloudField& old : scene.fields)
+      if (old.name == field.name) {
+        field.region.centre += field.drift_m - old.drift_m;
+        field.drift_m = old.drift_m;
+      }
+  }
   eraseWithDevelopment(scene.layers, dynamics.layers,
                        [&](const CloudLayer& l) { return made(l.name); });
   std::erase_if(scene.fields, [&](const CloudField& f) { return made(f.name); });
@@ -293,7 +315,60 @@ std::string World::setSea(const std::optional<Sea>& sea, bool* changed) {
   if (changed) *changed = false;
   if (sea)
     if (std::string e = seaError(*sea); !e.empty()) return e;
+  if (sea && !base_.sea) {  // a new sea's waves are laid out from where the content was
+    std::optional<Sea> laid_out = sea;
+    laid_out->origin_m = -base_.content_origin;
+    return setPart(*this, &Scene::sea, laid_out, changed);
+  }
   return setPart(*this, &Scene::sea, sea, changed);
+}
+
+namespace {
+
+// Moves everything `scene` holds by -shift: the database's origin to `shift` (setSite).
+// The automata move apart (World::setSite): edit() keeps their specs.
+void moveContent(Scene& scene, glm::dvec2 shift) {
+  const glm::dvec3 by(shift, 0.0);
+  scene.camera.position -= by;
+  // A layer's texture and region, and a field's heaps and region, lie in frames that drift.
+  for (CloudLayer& layer : scene.layers) layer.texture.drift_offset_m -= shift;
+  for (CloudField& field : scene.fields) field.drift_m -= shift;
+  for (EllipsoidCloud& cloud : scene.clouds) {
+    for (Ellipsoid& e : cloud.ellipsoids) e.centre -= by;
+    cloud.drift_m -= by;  // the texture moves with the cloud
+  }
+  for (Target& target : scene.targets) target.centre -= by;
+  for (RainShaft& shaft : scene.rain_shafts) shaft.centre -= shift;
+  for (auto& [key, weather] : scene.weather)
+    if (!weather.region.everywhere()) weather.region.centre -= shift;
+  if (scene.sea) scene.sea->origin_m -= shift;
+  scene.content_origin += shift;
+}
+
+}  // namespace
+
+std::string World::setSite(const Site& site, bool* changed) {
+  if (changed) *changed = false;
+  if (!Limits::kLatitude.contains(site.latitude_deg) ||
+      !Limits::kLongitude.contains(site.longitude_deg) || !std::isfinite(site.grid_deg))
+    return "site: latitude " + std::to_string(site.latitude_deg) + ", longitude " +
+           std::to_string(site.longitude_deg) +
+           " (allowed: latitude -90 to 90, longitude -180 "
+           "to 180, a finite grid north)";
+  if (base_.site == site) return "";
+  const glm::dvec2 shift = base_.site
+                               ? recentred(*base_.site, site.latitude_deg, site.longitude_deg).shift
+                               : glm::dvec2(0.0);
+  std::string error = edit([&](Scene& now, WorldDynamics&) {
+    now.site = site;
+    moveContent(now, shift);
+    return std::string();
+  });
+  if (!error.empty()) return error;
+  for (AutomatonCloudSpec& spec : dynamics_.automata) spec.position -= glm::dvec3(shift, 0.0);
+  for (AutomatonCloud& cloud : automata_) cloud.moveBy(-shift);
+  if (changed) *changed = true;
+  return "";
 }
 
 std::string World::setWind(const WindProfile& wind) {

@@ -141,6 +141,13 @@ class World {
   // refused. Its wind is the surface wind: every edit that changes the world's wind sets it to
   // the wind at altitude 0.
   std::string setSea(const std::optional<Sea>& sea, bool* changed = nullptr);
+  // Where the database lies on the Earth (MODEL.md section 13). A world placed nowhere takes
+  // `site` as it is. Otherwise the world re-centres: everything it holds (clouds, fields,
+  // layers and their regions, weather, targets, automata, the sea, the camera) moves by the
+  // new origin's place in the old database, so that it keeps its place on the Earth; a grid
+  // north other than the one the move implies (recentred()) turns nothing. A site out of
+  // range is refused.
+  std::string setSite(const Site& site, bool* changed = nullptr);
   // The wind by altitude (layers, clouds and fields drift on from where they are; the sea
   // takes the wind at altitude 0).
   std::string setWind(const WindProfile& wind);

@@ -26,7 +26,7 @@ namespace {
 static_assert(std::endian::native == std::endian::little, "snapshots assume a little-endian host");
 
 constexpr char kMagic[8] = {'N', 'E', 'P', 'H', 'S', 'N', 'A', 'P'};
-constexpr std::uint32_t kFormatVersion = 12;
+constexpr std::uint32_t kFormatVersion = 13;
 constexpr std::size_t kHeaderBytes = sizeof kMagic + 4 + 8 + 8;
 
 class Writer {
@@ -162,7 +162,7 @@ void io(A& a, std::optional<Sea>& sea) {
   if (!present) return sea.reset();
   if (!sea) sea.emplace();
   io(a, sea->wind), io(a, sea->fetch_m), io(a, sea->temperature_c), io(a, sea->clarity);
-  io(a, sea->whitecaps), io(a, sea->trains, 44), io(a, sea->seed);
+  io(a, sea->whitecaps), io(a, sea->trains, 44), io(a, sea->seed), io(a, sea->origin_m);
   if (std::string e = seaError(*sea); !e.empty()) a.fail("sea: " + e);
 }
 template <class A>
@@ -289,6 +289,17 @@ void io(A& a, Scene& s) {
   io(a, s.seed), io(a, s.camera), io(a, s.sun), io(a, s.sky), io(a, s.fog), io(a, s.haze);
   io(a, s.layers, 64), io(a, s.clouds, 64), io(a, s.targets, 64), io(a, s.fields, 64);
   io(a, s.weather), io(a, s.sea);
+  bool placed = s.site.has_value();
+  Site site = s.site.value_or(Site{});
+  io(a, placed), io(a, site.latitude_deg), io(a, site.longitude_deg), io(a, site.grid_deg);
+  io(a, s.content_origin);
+  if constexpr (!A::kReading) return;
+  if (!placed) return s.site.reset();
+  if (!Limits::kLatitude.contains(site.latitude_deg) ||
+      !Limits::kLongitude.contains(site.longitude_deg) || !std::isfinite(site.grid_deg) ||
+      !std::isfinite(s.content_origin.x) || !std::isfinite(s.content_origin.y))
+    return a.fail("site: out of range");
+  s.site = site;
 }
 template <class A>
 void io(A& a, Schedule& s) {

@@ -755,8 +755,15 @@ void GlRenderer::drawSeaProbe(const Scene& scene, const RenderSettings& settings
 
 void GlRenderer::setSeaUniforms(GLuint p, const Scene& scene, const RenderSettings& settings) {
   const Sea& sea = *scene.sea;
-  if (!sea_surface_ || sea_surface_->sea != sea || sea_surface_->waves != settings.sea_waves)
-    sea_surface_.emplace(sea, settings.sea_waves, SeaSurface(sea, settings.sea_waves));
+  if (!sea_surface_ || sea_surface_->sea != sea || sea_surface_->waves != settings.sea_waves) {
+    // A re-centred world moves the same waves (and keeps their whitecaps' quantile).
+    Sea moved = sea_surface_ ? sea_surface_->sea : Sea{};
+    moved.origin_m = sea.origin_m;
+    if (sea_surface_ && moved == sea && sea_surface_->waves == settings.sea_waves)
+      sea_surface_.emplace(sea, settings.sea_waves, sea_surface_->surface.movedTo(sea.origin_m));
+    else
+      sea_surface_.emplace(sea, settings.sea_waves, SeaSurface(sea, settings.sea_waves));
+  }
   const SeaSurface& surface = sea_surface_->surface;
   const std::vector<WaveComponent>& waves = surface.components();
   const int n = int(std::min<std::size_t>(waves.size(), kMaxSeaWaves));

@@ -124,6 +124,28 @@ def enu(lat, lon, alt, lat0, lon0):
     return east, north, alt
 
 
+def database(lat, lon, alt, site):
+    """A point in the daemon's database about `site` (its stats' "site": latitude, longitude
+    and grid north): east and north about the origin turned by the grid north."""
+    east, north, up = enu(lat, lon, alt, site["latitude"], site["longitude"])
+    g = math.radians(site["grid"])
+    return (east * math.cos(g) - north * math.sin(g), east * math.sin(g) + north * math.cos(g),
+            up)
+
+
+def north_bearing(lat, lon, site):
+    """The database bearing of true north at a point: the unit north there, Earth-centred,
+    on the origin's east and north turned by the grid north."""
+    la, lo = math.radians(lat), math.radians(lon)
+    n = (-math.sin(la) * math.cos(lo), -math.sin(la) * math.sin(lo), math.cos(la))
+    la0, lo0 = math.radians(site["latitude"]), math.radians(site["longitude"])
+    e0 = (-math.sin(lo0), math.cos(lo0), 0.0)
+    n0 = (-math.sin(la0) * math.cos(lo0), -math.sin(la0) * math.sin(lo0), math.cos(la0))
+    east = sum(a * b for a, b in zip(n, e0))
+    north = sum(a * b for a, b in zip(n, n0))
+    return math.degrees(math.atan2(east, north)) - site["grid"]
+
+
 def sun_spencer(year, month, day, hour, minute, lat, lon):
     """Sun elevation and azimuth by Spencer's (1971) Fourier series for declination and the
     equation of time: a different method from Nephele's Meeus coordinates, good to ~0.2 deg."""
@@ -270,7 +292,11 @@ size = [4, 2, 1]
         self.assertAlmostEqual(front["position"][0], east, delta=1.0)
         self.assertAlmostEqual(front["position"][1], north, delta=1.0)
         self.assertAlmostEqual(front["position"][2], up, delta=1e-6)
-        self.assertAlmostEqual(front["heading"], 30.0, places=4)
+        # The host's heading is from true north at the ownship: the database's north there is
+        # turned by the meridians' convergence, (lon - lon0) sin(lat), 0.016 degree here.
+        site = c.ok({"cmd": "stats"})["site"]
+        self.assertEqual((site["latitude"], site["longitude"], site["grid"]), (*SITE, 0.0))
+        self.assertAlmostEqual(front["heading"], 30.0 + north_bearing(lat, lon, site), places=4)
         self.assertAlmostEqual(front["pitch"], -5.0, places=4)
         self.assertAlmostEqual(front["vfov"], 40.0, places=4)  # top 20, bottom -20
         self.assertEqual(front["width"],
@@ -294,7 +320,9 @@ size = [4, 2, 1]
         be, bn, bu = enu(*boat, *SITE)
         self.assertAlmostEqual(targets[0]["centre"][0], be, delta=1.0)
         self.assertAlmostEqual(targets[0]["centre"][1], bn, delta=1.0)
-        self.assertEqual((targets[0]["heading"], targets[0]["size"]), (90.0, [4, 2, 1]))
+        boat_north = north_bearing(boat[0], boat[1], site)
+        self.assertAlmostEqual(targets[0]["heading"], 90.0 + boat_north, places=6)
+        self.assertEqual(targets[0]["size"], [4, 2, 1])
         # The weather, fog and sun as the Modbus registers read them.
         regs = holding_registers(d)
         self.assertEqual(regs[32], 7)  # cumulus
@@ -317,14 +345,16 @@ size = [4, 2, 1]
         self.assertEqual(c.ok({"cmd": "list_targets"})["targets"], targets)
         self.assertEqual(c.ok({"cmd": "hash"})["ticks"], hash_before["ticks"] + 1)
         self.frame(entity_control(7, *boat, yaw=95.0), frame=3, timestamp=103334)
-        self.assertEqual(c.ok({"cmd": "list_targets"})["targets"][0]["heading"], 95.0)
+        self.assertAlmostEqual(c.ok({"cmd": "list_targets"})["targets"][0]["heading"],
+                               95.0 + boat_north, places=6)
         # A target removed over the socket: the next frame that moves it is refused by the
         # world (Start of Frame says so: IG status 4), and the one after places it afresh.
         c.ok({"cmd": "remove_target", "name": "cigi-7"})
         self.send(ig_control(4, 105001), entity_control(7, *boat, yaw=100.0))
         self.assertEqual(self.receive_sof()["status"], 4)
         self.frame(entity_control(7, *boat, yaw=100.0), frame=5, timestamp=106668)
-        self.assertEqual(c.ok({"cmd": "list_targets"})["targets"][0]["heading"], 100.0)
+        self.assertAlmostEqual(c.ok({"cmd": "list_targets"})["targets"][0]["heading"],
+                               100.0 + boat_north, places=6)
         self.frame(entity_control(7, *boat, state=0), frame=6, timestamp=108335)
         self.assertEqual(c.ok({"cmd": "list_targets"})["targets"], [])
         stats = c.ok({"cmd": "stats"})["cigi"]
@@ -336,7 +366,8 @@ size = [4, 2, 1]
     def test_the_sun_and_the_database_follow_the_ownship_across_the_earth(self):
         """Issue 29, item 1: the sun of the host's date is placed where the ownship is, not at
         [site], and positions 10, 100 and 1,000 km out agree with the Earth-centred
-        computation above to a millimetre (the flat-earth projection was 1 km off at 100 km)."""
+        computation above to a millimetre (the flat-earth projection was 1 km off at 100 km),
+        in the database the world re-centred on the ownship (issue 48)."""
         d = self.start()
         c = d.client()
 
@@ -351,20 +382,26 @@ size = [4, 2, 1]
             frame += 1
             el, az = sun()
             want_el, want_az = sun_spencer(2026, 6, 21, 12, 0, lat, lon)
+            # The azimuth from the database's north: the world re-centred on the ownship, its
+            # grid north turned by the meridians' convergence on the way.
+            site = c.ok({"cmd": "stats"})["site"]
+            self.assertLess(math.dist(database(lat, lon, 0.0, site)[:2], (0.0, 0.0)), 1000.0)
+            want_az += north_bearing(lat, lon, site)
             self.assertAlmostEqual(el, want_el, delta=0.3, msg=f"{lat}, {lon}")
-            self.assertAlmostEqual(az, want_az, delta=0.5, msg=f"{lat}, {lon}")
+            self.assertAlmostEqual(az % 360.0, want_az % 360.0, delta=0.5, msg=f"{lat}, {lon}")
         # The issue's case: 45 N 0 E at noon UT on 21 June, 680 km from [site].
         self.frame(entity_control(0, 45.0, 0.0, 3000.0), frame=frame)
         frame += 1
         el, az = sun()
         self.assertAlmostEqual(el, 68.4, delta=0.3)
-        self.assertAlmostEqual(az, 179.0, delta=1.0)
+        site = c.ok({"cmd": "stats"})["site"]
+        self.assertAlmostEqual(az, 179.0 + north_bearing(45.0, 0.0, site), delta=1.0)
         for km in (10.0, 100.0, 1000.0):
             lat, lon = SITE[0] + 0.6 * km / 111.2, SITE[1] + 0.8 * km / 69.2
             self.frame(entity_control(0, lat, lon, 2500.0), frame=frame)
             frame += 1
             front = c.ok({"cmd": "get_view", "view": "front"})
-            east, north, up = enu(lat, lon, 2500.0, *SITE)
+            east, north, up = database(lat, lon, 2500.0, c.ok({"cmd": "stats"})["site"])
             self.assertAlmostEqual(front["position"][0], east, delta=1e-3, msg=f"{km} km")
             self.assertAlmostEqual(front["position"][1], north, delta=1e-3, msg=f"{km} km")
             self.assertEqual(front["position"][2], up)

@@ -99,6 +99,8 @@ class AutomatonCloud {
   // Steps until the automaton holds the state after time t (the keyframe after t) and returns
   // the number of steps run. Keyframes are rebuilt only when a step ran.
   int advanceTo(std::int64_t time_ns, int threads);
+  // Moves the grid by `by` (a re-centred world, World::setSite).
+  void moveBy(glm::dvec2 by) { spec_.position += glm::dvec3(by, 0.0); }
   // Recomputes the sunlight when the sun moved; returns whether it did.
   bool setSun(glm::dvec3 to_sun);
   // Replaces both states (snapshots); false if they do not fit the grid.
