@@ -12,6 +12,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libxxhash-dev libasio-dev
   libmodbus-dev python3-pymodbus python3-serial-asyncio python3-numpy mbpoll
+  python3-venv python3-setuptools python3-wheel python3-pil  # clients/python: offline pip install
   libsystemd-dev  # sd_notify: readiness and the watchdog under systemd
   tshark  # Wireshark's CIGI dissector checks every CIGI packet in the tests
 )
