@@ -11,6 +11,8 @@ packages=(
   libtomlplusplus-dev nlohmann-json3-dev libcli11-dev libspdlog-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libxxhash-dev libasio-dev
+  libavcodec-dev libavformat-dev libavutil-dev libswscale-dev  # streamed views (H.264)
+  ffmpeg  # ffplay and ffmpeg: the stream tests decode what the daemon sends
   libmodbus-dev python3-pymodbus python3-serial-asyncio python3-numpy mbpoll
   python3-venv python3-setuptools python3-wheel python3-pil  # clients/python: offline pip install
   libsystemd-dev  # sd_notify: readiness and the watchdog under systemd

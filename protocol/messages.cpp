@@ -553,6 +553,33 @@ Unsubscribe readUnsubscribe(FieldReader& r) {
   return c;
 }
 
+Stream readStream(FieldReader& r) {
+  Stream c;
+  c.view = r.requiredName("view");
+  using L = VideoStreamLimits;
+  VideoStreamSettings& v = c.settings;
+  if (!r.has("address"))
+    r.fail("address", "is missing (udp://host:port, srt://host:port or rtp://host:port)");
+  v.address = *r.string("address", 256);
+  v.bitrate_kbps = int(r.integer("bitrate", L::kMinKbps, L::kMaxKbps).value_or(v.bitrate_kbps));
+  v.rate_hz = r.number("rate", L::kMinRate, L::kMaxRate).value_or(v.rate_hz);
+  v.keyframe_interval =
+      int(r.integer("keyframe_interval", 1, L::kMaxKeyframeInterval).value_or(v.keyframe_interval));
+  v.encoder = r.string("encoder", 32).value_or(v.encoder);
+  v.stamp = r.boolean("stamp").value_or(false);
+  if (std::string e = videoStreamSettingsError(v); !e.empty())
+    r.fail(e.substr(0, e.find(':')), e.substr(e.find(':') + 2));
+  r.finish("cmd, id, view, address, bitrate, rate, keyframe_interval, encoder, stamp");
+  return c;
+}
+
+Unstream readUnstream(FieldReader& r) {
+  if (!r.has("stream")) r.fail("stream", "is missing");
+  Unstream c{*r.integer("stream", 1, INT64_MAX)};
+  r.finish("cmd, id, stream");
+  return c;
+}
+
 // Commands of a name alone, and of nothing.
 template <class T>
 T readNamed(FieldReader& r) {

@@ -13,6 +13,7 @@
 
 #include "renderer/frame.h"
 
+#include "image/video_stream.h"
 #include "world/formations/weather.h"
 #include "world/frames.h"
 #include "world/solar.h"
@@ -23,6 +24,7 @@ struct ProtocolLimits {
   static constexpr std::size_t kMaxRequestBytes = 64 * 1024;  // one request line, newline included
   static constexpr int kMaxJsonDepth = 16;                    // nesting of arrays and objects
   static constexpr double kMaxSubscriptionHz = 60.0;
+  static constexpr int kMaxStreams = 8;  // streamed views at once (ranges: VideoStreamLimits)
   static constexpr double kMaxTimeScale = 1000.0;
   static constexpr int kWeatherLayers = 3;  // CIGI cloud layers 1 to 3
   // set_weather's layers: the cloud layers, then CIGI's precipitation layers 4 to 9 (rain,
@@ -215,6 +217,15 @@ struct Subscribe {
 };
 struct Unsubscribe {
   std::int64_t subscription = 0;
+};
+// A view as a live H.264 stream to an address (image/video_stream.h, docs/STREAMING.md), its
+// frames following the world's ticks as a subscription's do; until unstream.
+struct Stream {
+  std::string view;
+  VideoStreamSettings settings;
+};
+struct Unstream {
+  std::int64_t stream = 0;
 };
 struct Snapshot {
   std::string name;

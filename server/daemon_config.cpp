@@ -49,7 +49,7 @@ void readView(TableReader& t, const Camera& scene_camera, ViewConfig& view) {
 void readDaemon(const toml::table& root, const std::string& file, DaemonConfig& out) {
   TableReader t(root, "", file);
   t.allow({"scene", "world", "view", "socket", "modbus", "metrics", "snapshot", "output", "cigi",
-           "site", "entity_type"});
+           "stream", "site", "entity_type"});
   if (!t.has("scene")) t.failHere("missing key scene (the scene file to load)");
   t.string("scene", out.scene_path);
   const std::filesystem::path scene(out.scene_path);
@@ -164,6 +164,29 @@ void readDaemon(const toml::table& root, const std::string& file, DaemonConfig& 
         e.failAt("id", "entity type " + std::to_string(type.id) + " \"" + type.name +
                            "\" repeats an earlier id or name");
     e.finish();
+  }
+  for (TableReader& r : t.tables("stream")) {
+    r.allow({"view", "address", "bitrate", "rate", "keyframe_interval", "encoder", "stamp"});
+    command::Stream& c = out.streams.emplace_back();
+    using L = VideoStreamLimits;
+    if (!r.has("view")) r.failHere("missing key view (the [[view]] to stream)");
+    if (!r.has("address")) r.failHere("missing key address (udp://host:port, srt:// or rtp://)");
+    r.string("view", c.view);
+    if (std::none_of(out.views.begin(), out.views.end(),
+                     [&](const ViewConfig& v) { return v.name == c.view; }))
+      r.failAt("view", "\"" + c.view + "\" is not a [[view]]");
+    VideoStreamSettings& v = c.settings;
+    r.string("address", v.address);
+    r.integer("bitrate", v.bitrate_kbps, L::kMinKbps, L::kMaxKbps);
+    r.number("rate", v.rate_hz, L::kMinRate, L::kMaxRate);
+    r.integer("keyframe_interval", v.keyframe_interval, 1, L::kMaxKeyframeInterval);
+    r.string("encoder", v.encoder);
+    r.boolean("stamp", v.stamp);
+    if (std::string e = videoStreamSettingsError(v); !e.empty())
+      r.failAt(e.substr(0, e.find(':')), e.substr(e.find(':') + 2));
+    if (out.streams.size() > std::size_t(ProtocolLimits::kMaxStreams))
+      r.failHere("more than " + std::to_string(ProtocolLimits::kMaxStreams) + " streams");
+    r.finish();
   }
   if (auto m = t.table("metrics")) {
     m->allow({"enabled", "bind", "port"});

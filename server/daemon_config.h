@@ -102,6 +102,7 @@ struct DaemonConfig {
   // it, and the sun of a date given without a place is at 0 N 0 E.
   std::optional<Site> site;
   std::vector<EntityType> entity_types;  // [[entity_type]]: targets by CIGI type or name
+  std::vector<command::Stream> streams;  // [[stream]]: views streamed from the start
 
   std::string output_directory = "frames";  // images written by the Modbus render coil
   ImageFormat output_format = ImageFormat::kPng;

@@ -246,6 +246,11 @@ void Engine::deliverFrames(Delivery which, const std::string& view_name) {
       if (sub.next_due < now) sub.next_due = now + sub.period;  // a slow render: skip, never burst
     }
     sub.last_tick = s.ticks;
+    // A stream whose encoder is still busy drops this frame before it is rendered.
+    if (sub.video && sub.video->full()) {
+      sub.video->countDropped();
+      continue;
+    }
     by_view[sub.view].push_back(&sub);
   }
   for (auto& [name, subs] : by_view) {
@@ -275,7 +280,13 @@ void Engine::deliverFrames(Delivery which, const std::string& view_name) {
         renderFrame(*view, image, *frame, /*continuous=*/true);
       }
       std::vector<Subscription> sinks;  // copies: the encoder may run after a change
-      for (Subscription* sub : members) sinks.push_back(*sub);
+      for (Subscription* sub : members) {
+        if (sub->video)  // to its own encoder thread, which drops what it cannot take
+          sub->video->push(std::shared_ptr<const Srgb8Image>(frame, &frame->srgb), s.ticks);
+        else
+          sinks.push_back(*sub);
+      }
+      if (sinks.empty()) continue;
       auto send = [frame, image = image, sinks, options = config_.encode,
                    encode_ms = &last_encode_ms_]() {
         const auto t0 = Clock::now();
@@ -295,9 +306,86 @@ void Engine::deliverFrames(Delivery which, const std::string& view_name) {
       if (image.format == ImageFormat::kRaw && !image.floatPlanes())
         send();
       else if (!encoder_->post(send))
-        frames_dropped += members.size();
+        frames_dropped += sinks.size();
     }
   }
+}
+
+Outcome Engine::startStream(const command::Stream& c) {
+  State& s = *state_;
+  const ViewConfig* view = s.view(c.view);
+  if (!view) return unknownView(s.views, c.view);
+  const auto streams = std::count_if(s.subscriptions.begin(), s.subscriptions.end(),
+                                     [](const Subscription& sub) { return sub.video != nullptr; });
+  if (streams >= ProtocolLimits::kMaxStreams)
+    return ProtocolError{ErrorCode::kLimit, "stream: the daemon streams " +
+                                                std::to_string(ProtocolLimits::kMaxStreams) +
+                                                " views already (at most)"};
+  Subscription sub;
+  sub.image = ImageRequest{};
+  sub.image.coverage = false;
+  if (auto error = platformLimit(*view, sub.image)) return *error;
+  auto opened = VideoStream::open(c.settings, view->camera.width, view->camera.height);
+  if (auto* error = std::get_if<std::string>(&opened))
+    return ProtocolError{ErrorCode::kFailed, "stream: " + *error};
+  sub.video = std::move(std::get<std::unique_ptr<VideoStream>>(opened));
+  sub.id = s.next_subscription++;
+  sub.client = 0;  // the daemon's: it outlives the connection that started it
+  sub.view = c.view;
+  sub.address = c.settings.address;
+  sub.period = secondsToDuration(1.0 / c.settings.rate_hz);
+  sub.next_due = Clock::now();
+  sub.gone = std::make_shared<std::atomic<bool>>(false);
+  s.subscriptions.push_back(sub);
+  countSubscriptions();
+  const VideoStream& video = *sub.video;
+  spdlog::info("event=stream_started stream={} view={} address={} encoder={} size={}x{}", sub.id,
+               sub.view, sub.address, video.encoderName(), video.width(), video.height());
+  json out{{"stream", sub.id},
+           {"view", sub.view},
+           {"address", sub.address},
+           {"encoder", video.encoderName()},
+           {"width", video.width()},
+           {"height", video.height()},
+           {"rate", c.settings.rate_hz},
+           {"bitrate", c.settings.bitrate_kbps},
+           {"keyframe_interval", c.settings.keyframe_interval}};
+  if (!video.sdp().empty()) out["sdp"] = video.sdp();
+  return out;
+}
+
+Outcome Engine::stopStream(const command::Unstream& c) {
+  State& s = *state_;
+  const auto it =
+      std::find_if(s.subscriptions.begin(), s.subscriptions.end(),
+                   [&](const Subscription& sub) { return sub.video && sub.id == c.stream; });
+  if (it == s.subscriptions.end())
+    return ProtocolError{ErrorCode::kNotFound,
+                         "stream: " + std::to_string(c.stream) + " is not a streamed view"};
+  const VideoStreamStats counts = it->video->stats();
+  s.subscriptions.erase(it);
+  countSubscriptions();
+  spdlog::info("event=stream_stopped stream={} sent={} dropped={}", c.stream, counts.sent,
+               counts.dropped);
+  return json{{"stream", c.stream}, {"sent", counts.sent}, {"dropped", counts.dropped}};
+}
+
+json Engine::streamsJson() const {
+  json out = json::array();
+  for (const Subscription& sub : state_->subscriptions) {
+    if (!sub.video) continue;
+    const VideoStreamStats counts = sub.video->stats();
+    out.push_back({{"stream", sub.id},
+                   {"view", sub.view},
+                   {"address", sub.address},
+                   {"encoder", sub.video->encoderName()},
+                   {"sent", counts.sent},
+                   {"dropped", counts.dropped},
+                   {"bytes", counts.bytes},
+                   {"encode_ms", counts.encode_ms},
+                   {"encode_cpu_ms", counts.encode_cpu_ms}});
+  }
+  return out;
 }
 
 void Engine::renderTrigger() {

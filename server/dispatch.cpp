@@ -257,6 +257,8 @@ std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
                                    " is not one of this connection's subscriptions"};
         return json{{"subscription", c.subscription}};
       },
+      [&](const Stream& c) -> std::optional<Outcome> { return startStream(c); },
+      [&](const Unstream& c) -> std::optional<Outcome> { return stopStream(c); },
       [&](const Snapshot& c) -> std::optional<Outcome> {
         if (config_.snapshotDirectory().empty()) return noSnapshotDirectory;
         std::error_code ec;

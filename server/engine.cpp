@@ -150,6 +150,11 @@ std::string Engine::openWorld() {
     spdlog::info("event=restored snapshot={} time={:.3f} ticks={} frames={} hash={}", snapshot,
                  s.world->timeSeconds(), s.ticks, s.frames, hexHash(s.world->hash()));
   }
+  for (const command::Stream& stream : config_.streams) {
+    const Outcome started = startStream(stream);
+    if (const auto* e = std::get_if<ProtocolError>(&started))
+      return "[[stream]] of view " + stream.view + ": " + e->message;
+  }
   spdlog::info("event=world_ready gl=\"{}\" backend={} views={} mode={} tick_rate={}",
                s.platform->renderer(), s.platform->backendName(), s.views.size(), modeName(s.mode),
                config_.tick_rate_hz);

@@ -168,6 +168,10 @@ class Engine {
   std::variant<nlohmann::json, ProtocolError> setHaze(const command::SetHaze& c);
   std::variant<nlohmann::json, ProtocolError> setSea(const command::SetSea& c);
   std::variant<nlohmann::json, ProtocolError> setSite(const command::SetSite& c);
+  // A view streamed as video (delivery.cpp), and its end.
+  std::variant<nlohmann::json, ProtocolError> startStream(const command::Stream& c);
+  std::variant<nlohmann::json, ProtocolError> stopStream(const command::Unstream& c);
+  nlohmann::json streamsJson() const;  // the streamed views and their counts (stats)
   void setMode(TickMode mode);
   std::optional<std::variant<nlohmann::json, ProtocolError>> renderRequest(const command::Render& c,
                                                                            Job& job);

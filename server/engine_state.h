@@ -174,6 +174,9 @@ struct Engine::Subscription {
   std::uint64_t last_tick = UINT64_MAX;  // the tick of the last frame sent
   FrameSink sink;
   std::shared_ptr<std::atomic<bool>> gone;  // set when the sink reports its client gone
+  // A streamed view (stream): its frames go to the encoder in place of `sink`; its address.
+  std::shared_ptr<VideoStream> video;
+  std::string address;
 };
 
 // Thrown by Engine::renderFrame when the daemon's stop cancelled the render in hand; the run
@@ -283,6 +286,7 @@ std::variant<std::optional<Sea>, ProtocolError> seaAfter(const std::optional<Sea
 json seaJson(const std::optional<Sea>& sea);
 // Where the world's database lies on the Earth (set_site's reply, stats' "site").
 json siteJson(const World& world);
+
 // Encodes `frame` as `image` asks (delivery.cpp); on failure returns the error.
 std::variant<std::vector<std::uint8_t>, std::string> encodeFrame(const ViewFrame& frame,
                                                                  const ImageRequest& image,

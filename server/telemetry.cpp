@@ -43,6 +43,7 @@ void Engine::publish() {
       {"automaton_steps", world.automatonStepsRun()},
       {"relights", world.relightsRun()},
       {"site", siteJson(world)},
+      {"streams", streamsJson()},
       {"last_frame", frameStatsJson(s.renderer->lastFrameStats())},
   };
   stats["histograms"] = {{"render_seconds", s.render_seconds.toJson()},

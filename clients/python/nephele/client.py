@@ -358,6 +358,24 @@ class Client:
             ended._end()
         return result
 
+    def stream(self, view: str, address: str, bitrate: int | None = None,
+               rate: float | None = None, keyframe_interval: int | None = None,
+               encoder: str | None = None, stamp: bool | None = None) -> JsonObject:
+        """`stream`: the view as live H.264 to `address` (udp://host:port MPEG-TS,
+        srt://host:port, or rtp://host:port with the result's `sdp`), bitrate 100-100000 kbit/s
+        (4000), rate 0.5-60 Hz (30), keyframe_interval 1-600 frames (30), encoder "auto",
+        "libx264" or "h264_nvenc", stamp: each frame's tick in its top-left corner. Frames
+        follow the world's ticks as a subscription's do, until `unstream`. The result is
+        stream (its id), view, address, encoder, width, height, rate, bitrate,
+        keyframe_interval and, for RTP, sdp."""
+        return self._call("stream", view=view, address=address, bitrate=bitrate, rate=rate,
+                          keyframe_interval=keyframe_interval, encoder=encoder, stamp=stamp)
+
+    def unstream(self, stream: int) -> JsonObject:
+        """`unstream`: ends the streamed view with id `stream`; the result is stream, sent and
+        dropped (frames)."""
+        return self._call("unstream", stream=stream)
+
     def snapshot(self, name: str) -> JsonObject:
         """`snapshot`: saves the world as `name`.snap in the daemon's snapshot directory; the
         result is name, time, hash."""
