@@ -173,8 +173,8 @@ std::optional<ImageRequest> readImage(FieldReader& r) {
   image.format = readFormat(r, image.format);
   image.coverage = defaultCoverage(image.format);
   if (const json* channels = r.raw("channels")) {
-    const std::string allowed = " (allowed: a non-empty array of " + channelNames() +
-                                "; depth, cloud_depth, object_id and visibility with raw or exr)";
+    const std::string allowed = " (allowed: a non-empty array of " + channelNames() + "; " +
+                                channelNames(true) + " with raw or exr)";
     if (!channels->is_array() || channels->empty() || channels->size() > kChannels.size())
       r.fail("channels", "must be an array of channel names" + allowed);
     image.colour = image.coverage = false;
@@ -195,10 +195,9 @@ std::optional<ImageRequest> readImage(FieldReader& r) {
     }
     if (image.floatPlanes() && image.format != ImageFormat::kRaw &&
         image.format != ImageFormat::kExr)
-      r.fail("channels",
-             "depth, cloud_depth, object_id and visibility are float planes: "
-             "format raw or exr only (allowed with " +
-                 std::string(imageFormatName(image.format)) + ": colour, coverage)");
+      r.fail("channels", channelNames(true) +
+                             " are float planes: format raw or exr only (allowed with " +
+                             std::string(imageFormatName(image.format)) + ": colour, coverage)");
   }
   if (image.format == ImageFormat::kJpeg && image.coverage)
     r.fail("channels", "jpeg holds colour only (allowed with jpeg: [\"colour\"])");

@@ -53,10 +53,14 @@ inline std::optional<Channel> channelFromName(std::string_view name) {
     if (name == info.name) return info.channel;
   return std::nullopt;
 }
-inline std::string channelNames() {
+// The channels' names, or only the float planes' (every channel but colour and coverage).
+inline std::string channelNames(bool planes_only = false) {
   std::string out;
-  for (const ChannelInfo& info : kChannels)
+  for (const ChannelInfo& info : kChannels) {
+    if (planes_only && (info.channel == Channel::kColour || info.channel == Channel::kCoverage))
+      continue;
     out += (out.empty() ? "" : ", ") + std::string(info.name);
+  }
   return out;
 }
 

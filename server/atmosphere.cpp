@@ -53,7 +53,10 @@ Outcome Engine::setSun(const command::SetSun& c) {
 Outcome Engine::setFog(const command::SetFog& c) {
   State& s = *state_;
   std::optional<Fog> fog = s.world->base().fog;
-  if (c.enabled == false) {
+  const bool read_back = !c.enabled && !c.top && !c.visibility && !c.colour;
+  if (read_back) {
+    // no field: the fog as it is
+  } else if (c.enabled == false) {
     fog.reset();
   } else {
     if (!fog) fog.emplace();
@@ -73,7 +76,10 @@ Outcome Engine::setFog(const command::SetFog& c) {
 Outcome Engine::setHaze(const command::SetHaze& c) {
   State& s = *state_;
   std::optional<Haze> haze = s.world->base().haze;
-  if (c.enabled == false) {
+  const bool read_back = !c.enabled && !c.visibility && !c.scale_height;
+  if (read_back) {
+    // no field: the haze as it is
+  } else if (c.enabled == false) {
     haze.reset();
   } else {
     if (!haze) haze.emplace();

@@ -272,6 +272,15 @@ class SocketProtocolTest(DaemonTest):
         self.assertEqual(exr[:4], b"\x76\x2f\x31\x01")
         self.assertIn(b"object_id", exr[:2000])
 
+    def test_fog_and_haze_with_no_field_are_read_back_unchanged(self):
+        c = self.daemon().client()
+        hash_before = c.ok({"cmd": "hash"})["hash"]
+        self.assertEqual(c.ok({"cmd": "set_fog"}), {"enabled": False})
+        self.assertEqual(c.ok({"cmd": "set_haze"}), {"enabled": False})
+        self.assertEqual(c.ok({"cmd": "hash"})["hash"], hash_before)
+        self.assertTrue(c.ok({"cmd": "set_haze", "enabled": True})["enabled"])
+        self.assertTrue(c.ok({"cmd": "set_haze"})["enabled"])
+
     def test_set_view_changes_the_frame(self):
         d = self.daemon()
         c = d.client()

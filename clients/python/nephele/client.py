@@ -214,8 +214,8 @@ class Client:
                 visibility: float | None = None,
                 colour: Sequence[float] | None = None) -> JsonObject:
         """`set_fog`: ground fog from the ground to top m (0 to 1e5), visibility m (1 to 1e7),
-        colour [r, g, b]; enabled=False removes it. Unset fields keep their values. The result
-        is enabled, top, visibility, colour."""
+        colour [r, g, b]; enabled=False removes it. Unset fields keep their values; with none
+        the fog is only read back. The result is enabled, top, visibility, colour."""
         return self._call("set_fog", enabled=enabled, top=top, visibility=visibility,
                           colour=colour)
 
@@ -223,7 +223,8 @@ class Client:
                  scale_height: float | None = None) -> JsonObject:
         """`set_haze`: distance haze, visibility m (10 to 1e7) thinning with height over
         scale_height m (10 to 1e5); enabled=False removes it. Unset fields keep their values
-        (a first haze starts from 40,000 m and 1,200 m)."""
+        (a first haze starts from 40,000 m and 1,200 m); with none the haze is only read
+        back."""
         return self._call("set_haze", enabled=enabled, visibility=visibility,
                           scale_height=scale_height)
 
