@@ -17,6 +17,7 @@ packages=(
   python3-venv python3-setuptools python3-wheel python3-pil  # clients/python: offline pip install
   libsystemd-dev  # sd_notify: readiness and the watchdog under systemd
   tshark  # Wireshark's CIGI dissector checks every CIGI packet in the tests
+  glslang-tools  # glslangValidator checks every GLSL stage (the glsl_stages test)
 )
 
 missing=()

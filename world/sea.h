@@ -3,7 +3,7 @@
 // a host's wave trains laid over it, shaded by Fresnel reflection of the sky and clouds, the
 // sun's glint from Cox and Munk's facet slopes, Monahan's whitecaps and the water's own
 // colour. world/ only: no GL. Both renderers evaluate it through the functions below (the GL
-// through their GLSL copies in renderer/gl/sky_shaders.cpp).
+// through their GLSL copies in renderer/gl/shaders/sky/common.glsl).
 #include <algorithm>
 #include <cmath>
 #include <cstdint>

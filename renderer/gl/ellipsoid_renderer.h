@@ -31,7 +31,7 @@ struct FrameTarget {
   double seen = 1.0;
 };
 
-// One ellipsoid as the shaders see it (EllipsoidRecord in ellipsoid_shaders.cpp).
+// One ellipsoid as the shaders see it (EllipsoidRecord in shaders/ellipsoid/records.glsl).
 struct EllipsoidRecord {
   glm::vec4 v[kEllipsoidRecordVec4s];
 };

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <vector>
 
+#include "renderer/gl/shaders/floor_glsl.h"
 #include "renderer/gl/sky_shaders.h"
 #include "renderer/gl/view_uniforms.h"
 #include "renderer/reference/reference_renderer.h"
@@ -297,12 +298,8 @@ Srgb8Image GlRenderer::renderFloor(int width, int height) {
   prepareTarget(width, height, TargetFormat::kSrgb8);
   if (!floor_program_) {
     std::string error;
-    floor_program_ = createProgram(gl_, polygonVertexSource(), R"(#version 450 core
-uniform vec4 u_colour;
-layout(location = 0) out vec4 o_colour;
-void main() { o_colour = u_colour; }
-)",
-                                   error);
+    floor_program_ =
+        createProgram(gl_, polygonVertexSource(), glsl::floor_pass::kFloorFragment, error);
     NEPHELE_CHECK(floor_program_, "floor program: " << error);
   }
   const GLuint p = floor_program_.get();

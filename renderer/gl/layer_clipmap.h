@@ -28,7 +28,7 @@ struct FrameStats;
 void setLayerGardnerUniforms(const GlApi& gl, GLuint program, int slot, const GardnerTexture& g,
                              glm::dvec2 origin);
 
-// What the sky pass needs to read one clipmap (sky_shaders.cpp, clipmapValue).
+// What the sky pass needs to read one clipmap (shaders/sky/layers.glsl, clipmapValue).
 struct ClipmapView {
   GLuint texture = 0;             // GL_TEXTURE_2D_ARRAY, one layer per ring
   int size = 0;                   // N

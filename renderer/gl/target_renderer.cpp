@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "renderer/gl/ellipsoid_shaders.h"
+#include "renderer/gl/shaders/target_glsl.h"
 #include "renderer/gl/sky_shaders.h"
 #include "renderer/gl/view_uniforms.h"
 #include "world/check.h"
@@ -16,48 +17,8 @@ constexpr float kNear = 0.05f;  // metres
 constexpr int kTargetSphereSlices = 64;
 const char kBoxTag = 'b', kSphereTag = 's';  // their addresses key the shape meshes
 
-const char* kVertex = R"(#version 450 core
-layout(location = 0) in vec3 a_body;  // body coordinates before scaling
-uniform mat3 u_model;                 // R S
-uniform vec3 u_offset;                // centre - eye
-uniform vec3 u_clip_x;                // right / (tan(vfov/2) aspect)
-uniform vec3 u_clip_y;                // up / tan(vfov/2)
-uniform vec3 u_clip_w;                // forward
-out vec3 v_position;                  // camera-relative
-out vec3 v_body;
-void main() {
-  v_body = a_body;
-  v_position = u_model * a_body + u_offset;
-  // Reversed, infinite depth: with clip z in [0, w], depth = near / w.
-  gl_Position = vec4(dot(v_position, u_clip_x), dot(v_position, u_clip_y), 0.05,
-                     dot(v_position, u_clip_w));
-}
-)";
-
-const char* kFragment = R"(
-layout(location = 1) out float o_distance;
-layout(location = 2) out float o_id;
-uniform float u_id;             // 1 + the target's index
-uniform vec3 u_albedo;          // colour times sun colour
-uniform vec3 u_to_sun;
-uniform float u_sunlight;       // the share the clouds above let through (MODEL.md section 16)
-uniform int u_smooth;           // 1: analytic ellipsoid normals, 0: facet normals
-uniform mat3 u_normal_matrix;   // R S^-1
-in vec3 v_position;
-in vec3 v_body;
-const float kAmbient = 0.3;     // kTargetAmbient
-void main() {
-  vec3 n = u_smooth != 0 ? u_normal_matrix * v_body : cross(dFdx(v_position), dFdy(v_position));
-  n = normalize(n);
-  if (dot(n, v_position) > 0.0) n = -n;
-  vec3 colour =
-      u_albedo * (kAmbient + (1.0 - kAmbient) * u_sunlight * max(dot(n, u_to_sun), 0.0));
-  float distance = length(v_position);
-  o_colour = vec4(applyAir(colour, v_position / distance, distance), 1.0);
-  o_distance = distance;
-  o_id = u_id;
-}
-)";
+using glsl::target::kFragment;  // shaders/target/shading.glsl, after the view chunk
+using glsl::target::kVertex;    // shaders/target/mesh.vert
 
 }  // namespace
 

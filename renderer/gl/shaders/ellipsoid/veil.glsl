@@ -1,0 +1,3 @@
+
+uniform vec4 u_veil;  // premultiplied colour, opacity
+void main() { o_colour = u_veil; }

@@ -1,0 +1,77 @@
+# The GLSL of the GL renderer, embedded at build time (included by renderer/CMakeLists.txt).
+#
+# Each file under renderer/gl/shaders/ is one piece of a stage, exactly as the C++ passes it to
+# OpenGL: .vert and .frag files are whole stages (#version first); a .glsl file is a piece that
+# the C++ joins to others after #version, #define and constant lines it writes (sky_shaders.cpp,
+# ellipsoid_shaders.cpp, automaton_renderer.cpp, shadow_map.cpp, target_renderer.cpp). Vertex
+# pieces end in _vertex.glsl; the other .glsl pieces are fragment code.
+#
+# nephele_embed_glsl writes one header per C++ file into the build tree,
+# renderer/gl/shaders/<header> under ${NEPHELE_GLSL_INCLUDE_DIR}, that holds its pieces as
+# `inline constexpr char kName[]` in namespace nephele::glsl::<group>, and writes it again when
+# a piece changes. Nothing is read at run time: the binary carries the text.
+
+set(NEPHELE_GLSL_DIR ${CMAKE_CURRENT_LIST_DIR})
+set(NEPHELE_GLSL_INCLUDE_DIR ${PROJECT_BINARY_DIR}/generated)
+
+# nephele_embed_glsl(TARGET HEADER GROUP NAME FILE [NAME FILE ...]): the header HEADER, holding
+# each FILE (relative to renderer/gl/shaders) as constant NAME in nephele::glsl::GROUP,
+# compiled into TARGET.
+function(nephele_embed_glsl target header group)
+  set(output ${NEPHELE_GLSL_INCLUDE_DIR}/renderer/gl/shaders/${header})
+  set(pieces "")
+  set(files "")
+  set(rest ${ARGN})
+  while(rest)
+    list(POP_FRONT rest name file)
+    if(NOT file)
+      message(FATAL_ERROR "nephele_embed_glsl(${header}): ${name} has no file")
+    endif()
+    set(path ${NEPHELE_GLSL_DIR}/${file})
+    if(NOT EXISTS ${path})
+      message(FATAL_ERROR "nephele_embed_glsl(${header}): ${path} does not exist")
+    endif()
+    list(APPEND pieces "${name}=${path}")
+    list(APPEND files ${path})
+  endwhile()
+  string(REPLACE ";" "|" pieces "${pieces}")
+  add_custom_command(OUTPUT ${output}
+    COMMAND ${CMAKE_COMMAND} -DOUTPUT=${output} -DNAMESPACE=nephele::glsl::${group}
+            -DPIECES=${pieces} -P ${NEPHELE_GLSL_DIR}/embed_glsl.cmake
+    DEPENDS ${NEPHELE_GLSL_DIR}/embed_glsl.cmake ${files}
+    COMMENT "Embedding GLSL into ${header}"
+    VERBATIM)
+  target_sources(${target} PRIVATE ${output})
+  target_include_directories(${target} PRIVATE ${NEPHELE_GLSL_INCLUDE_DIR})
+endfunction()
+
+nephele_embed_glsl(nephele_renderer sky_glsl.h sky
+  kCommon sky/common.glsl             # the view, output, air, background and targets
+  kLayers sky/layers.glsl             # textured cloud layers
+  kClipmapBake sky/clipmap_bake.glsl  # main() of the clipmap ring's bake pass
+  kPolygonVertex polygon.vert)        # a convex screen polygon, for every screen-space pass
+nephele_embed_glsl(nephele_renderer ellipsoid_glsl.h ellipsoid
+  kRecords ellipsoid/records.glsl     # the per-ellipsoid record (both stages)
+  kCloud ellipsoid/cloud.glsl         # ray-quadric hit, solid texture, limb, shading
+  kFusedCentre ellipsoid/fused_centre.glsl
+  kFusedPerPixel ellipsoid/fused_per_pixel.glsl
+  kFusedBlend ellipsoid/fused_blend.glsl
+  kFusedResolve ellipsoid/fused_resolve.glsl
+  kTile ellipsoid/tile.glsl
+  kComposite ellipsoid/composite.glsl
+  kImpostor ellipsoid/impostor.glsl
+  kVeil ellipsoid/veil.glsl
+  kFusedCentreVertex ellipsoid/fused_centre_vertex.glsl
+  kTileVertex ellipsoid/tile_vertex.glsl
+  kRectsVertex ellipsoid/rects_vertex.glsl
+  kImpostorVertex ellipsoid/impostor_vertex.glsl)
+nephele_embed_glsl(nephele_renderer automaton_glsl.h automaton
+  kVolumePass automaton/volume_pass.glsl)
+nephele_embed_glsl(nephele_renderer floor_glsl.h floor_pass
+  kFloorFragment floor.frag)
+nephele_embed_glsl(nephele_renderer shadow_map_glsl.h shadow_map
+  kVertex shadow_map/footprint.vert
+  kFragment shadow_map/sunlight.glsl)
+nephele_embed_glsl(nephele_renderer target_glsl.h target
+  kVertex target/mesh.vert
+  kFragment target/shading.glsl)

@@ -1,0 +1,379 @@
+
+uniform vec3 u_right;    // image-plane basis, scaled by tan(vfov/2) * aspect
+uniform vec3 u_up;       // scaled by tan(vfov/2)
+uniform vec3 u_forward;
+uniform vec2 u_viewport;
+uniform float u_camera_z;
+layout(location = 0) out vec4 o_colour;  // premultiplied colour, coverage
+const float kFar = 1e30;
+
+// The pixel a fragment stands for: its own, or in the per-pixel pass's sample pass, the
+// full-resolution pixel its sample is taken at (MODEL.md section 15, "behind the veil").
+#ifndef FRAG_XY
+#define FRAG_XY gl_FragCoord.xy
+#endif
+
+// sin x for Gardner's sums: x in turns reduced to [-1/2, 1/2), folded to [-1/4, 1/4] by
+// sin(pi - y) = sin y, then the Taylor polynomial to y^9, within 4e-6 of sin (below float's
+// own error in x once |x| > 64). On llvmpipe it makes the frames that sum the sines about a
+// seventh faster than the built-in sin (docs/ACCURACY.md, "Per-pixel sines").
+float gardnerSin(float x) {
+  float t = x * 0.15915494309189535;
+  t -= floor(t + 0.5);
+  t = abs(t) > 0.25 ? sign(t) * 0.5 - t : t;
+  float y = 6.283185307179586 * t, y2 = y * y;
+  return y * (1.0 + y2 * (-1.0 / 6.0 + y2 * (1.0 / 120.0 + y2 * (-1.0 / 5040.0 +
+                                                                y2 * (1.0 / 362880.0)))));
+}
+
+vec3 viewRay() {
+  vec2 ndc = 2.0 * FRAG_XY / u_viewport - 1.0;
+  return u_right * ndc.x + u_up * ndc.y + u_forward;
+}
+
+#ifdef AIR
+// The air between the eye and a surface (MODEL.md section 5): ground fog, the in-layer veil
+// and distance haze; an absent one has zero extinction. world/sky.cpp's throughAir is the reference's twin.
+uniform vec3 u_fog_slab;  // bottom, top, band of the ground fog, metres
+uniform float u_fog_sigma;
+uniform vec3 u_fog_colour;
+uniform vec3 u_veil_slab;  // the in-layer veil's (MODEL.md section 5)
+uniform float u_veil_sigma;
+uniform vec3 u_veil_colour;
+// Precipitation (MODEL.md section 17, precipitationMedia): up to kPrecipitationSlabs slabs
+// (view_uniforms.h), sigma 0 for none.
+uniform vec3 u_precip_slab[kPrecipitationSlabs];
+uniform float u_precip_sigma[kPrecipitationSlabs];
+uniform vec3 u_precip_colour[kPrecipitationSlabs];
+// Shafts under heaps (MODEL.md section 17, RainShaft): the first u_shafts of kRainShafts, each
+// its axis's X, Y from the camera, radius and top, metres; extinction and colour.
+uniform vec4 u_shaft[kRainShafts];
+uniform float u_shaft_sigma[kRainShafts];
+uniform vec3 u_shaft_colour[kRainShafts];
+uniform int u_shafts;
+uniform float u_haze_sigma;   // at Z = 0, per metre
+uniform float u_haze_height;  // scale height, metres
+uniform vec3 u_haze_colour;   // the sky's horizon
+
+// A slab's density (1 from bottom to top, linear to 0 over the band either side) and its
+// integral from below it to height z (world/sky.cpp, fogDensity and fogColumn).
+float slabDensity(vec3 slab, float z) {
+  if (z >= slab.x && z <= slab.y) return 1.0;
+  float out_by = z < slab.x ? slab.x - z : z - slab.y;
+  return slab.z > 0.0 ? max(0.0, 1.0 - out_by / slab.z) : 0.0;
+}
+float slabColumn(vec3 slab, float z) {
+  float b = slab.z, low = slab.x - b;
+  if (!(z > low)) return 0.0;
+  if (z <= slab.x) return (z - low) * (z - low) / (2.0 * b);
+  if (z <= slab.y) return 0.5 * b + (z - slab.x);
+  float u = min(z - slab.y, b);
+  return 0.5 * b + (slab.y - slab.x) + u - (b > 0.0 ? u * u / (2.0 * b) : 0.0);
+}
+
+// The density-weighted length through a slab of the unit ray from the camera up to `distance`
+// (world/sky.cpp's fogPathLength): level rays take the density half way.
+float slabPath(vec3 slab, vec3 d, float distance) {
+  float rise = distance * d.z;
+  if (abs(rise) < 1e-3) return slabDensity(slab, u_camera_z + 0.5 * rise) * distance;
+  return abs(slabColumn(slab, u_camera_z + rise) - slabColumn(slab, u_camera_z)) / abs(d.z);
+}
+
+// Shaft i's optical depth along the unit ray up to `distance` (world/sky.cpp's
+// shaftOpticalDepth): the chord inside its cylinder and between the ground and its top, and the
+// exact integral of its density, a cubic along the chord, about the chord's middle.
+float shaftDepth(int i, vec3 d, float distance) {
+  vec4 shaft = u_shaft[i];
+  vec2 o = -shaft.xy, dh = d.xy;
+  float r2 = shaft.z * shaft.z, a = dot(dh, dh), b = dot(o, dh);
+  float t0 = 0.0, t1 = distance;
+  if (a < 1e-8) {
+    if (dot(o, o) >= r2) return 0.0;
+  } else {
+    float cross_od = o.x * dh.y - o.y * dh.x, quarter_delta = a * r2 - cross_od * cross_od;
+    if (quarter_delta <= 0.0) return 0.0;
+    float root = sqrt(quarter_delta);
+    t0 = max(t0, (-b - root) / a);
+    t1 = min(t1, (-b + root) / a);
+  }
+  if (d.z == 0.0) {
+    if (u_camera_z < 0.0 || u_camera_z > shaft.w) return 0.0;
+  } else {
+    float at_ground = -u_camera_z / d.z, at_top = (shaft.w - u_camera_z) / d.z;
+    t0 = max(t0, min(at_ground, at_top));
+    t1 = min(t1, max(at_ground, at_top));
+  }
+  if (!(t1 > t0)) return 0.0;
+  float m = 0.5 * (t0 + t1), h = 0.5 * (t1 - t0);
+  vec2 q = o + m * dh;
+  float g0 = 1.0 - dot(q, q) / r2, g1 = -2.0 * dot(q, dh) / r2, g2 = -a / r2;
+  float fade = (1.0 - kShaftGroundShare) / shaft.w;
+  float l0 = kShaftGroundShare + fade * (u_camera_z + m * d.z), l1 = fade * d.z;
+  return u_shaft_sigma[i] * max(2.0 * h * g0 * l0 + (2.0 * h * h * h / 3.0) * (g2 * l0 + g1 * l1), 0.0);
+}
+
+// The haze's optical depth along the unit ray up to `distance`: sigma0 H (e^-a - e^-(a+x)) / dz,
+// a = z0 / H, x = s dz / H, or its series near x = 0 (hazeOpticalDepth).
+float hazeDepth(vec3 d, float distance) {
+  float s = min(distance, 1e9), h = u_haze_height;
+  float a = u_camera_z / h, x = s * d.z / h;
+  if (abs(x) < 1e-2) return u_haze_sigma * s * exp(-a) * (1.0 - x / 2.0 + x * x / 6.0);
+  return u_haze_sigma * h / d.z * (exp(-a) - exp(-max(a + x, -50.0)));
+}
+
+vec3 applyAir(vec3 colour, vec3 d, float distance) {
+  float tau_fog = u_fog_sigma > 0.0 ? min(u_fog_sigma * slabPath(u_fog_slab, d, distance), 1e3)
+                                    : 0.0;
+  float tau_veil =
+      u_veil_sigma > 0.0 ? min(u_veil_sigma * slabPath(u_veil_slab, d, distance), 1e3) : 0.0;
+  float tau_haze = min(hazeDepth(d, distance), 1e3);
+  float tau = tau_fog + tau_veil + tau_haze;
+  vec3 weighted = tau_fog * u_fog_colour + tau_veil * u_veil_colour + tau_haze * u_haze_colour;
+  for (int i = 0; i < kPrecipitationSlabs; ++i)
+    if (u_precip_sigma[i] > 0.0) {
+      float tau_p = min(u_precip_sigma[i] * slabPath(u_precip_slab[i], d, distance), 1e3);
+      tau += tau_p;
+      weighted += tau_p * u_precip_colour[i];
+    }
+  for (int i = 0; i < u_shafts; ++i) {
+    float tau_s = min(shaftDepth(i, d, distance), 1e3);
+    tau += tau_s;
+    weighted += tau_s * u_shaft_colour[i];
+  }
+  if (!(tau > 0.0)) return colour;
+  return mix(weighted / tau, colour, exp(-tau));
+}
+
+// The air at the end of an endless path through it (the ground at the horizon): each medium
+// present at its cap, as applyAir weighs them there (the veil is present only around the eye).
+vec3 airAtHorizon() {
+  float f = u_fog_sigma > 0.0 ? 1.0 : 0.0, v = u_veil_sigma > 0.0 ? 1.0 : 0.0;
+  float h = u_haze_sigma > 0.0 ? 1.0 : 0.0;
+  float n = f + v + h;
+  vec3 sum = f * u_fog_colour + v * u_veil_colour + h * u_haze_colour;
+  for (int i = 0; i < kPrecipitationSlabs; ++i)  // those that reach the ground
+    if (u_precip_sigma[i] > 0.0 && u_precip_slab[i].x <= 0.0) {
+      n += 1.0;
+      sum += u_precip_colour[i];
+    }
+  return sum / max(n, 1.0);
+}
+#else
+vec3 applyAir(vec3 colour, vec3 d, float distance) { return colour; }
+#endif
+
+#ifdef TARGETS
+// Opaque targets drawn first: their fogged colour and their distance along the unit ray
+// (1e30 where there is none), read at this pixel.
+layout(binding = 14) uniform sampler2D u_target_colour;
+layout(binding = 15) uniform sampler2D u_target_distance;
+float targetDistance() { return texelFetch(u_target_distance, ivec2(FRAG_XY), 0).r; }
+vec3 targetColour() { return texelFetch(u_target_colour, ivec2(FRAG_XY), 0).rgb; }
+#endif
+
+// Gardner eq. 8 (MODEL.md section 3) from its terms; shading = (a, t, s, e).
+float gardnerIntensity(vec4 shading, float diffuse, float highlight, float it) {
+  float a = shading.x, t = shading.y, s = shading.z;
+  return (1.0 - a) * ((1.0 - t) * ((1.0 - s) * diffuse + s * highlight) + t * it) + a;
+}
+
+// Gardner eq. 9 and 11 (MODEL.md section 4): translucence TR for the texture's excess over
+// the threshold; D = 0 is a hard threshold.
+float translucence(float excess, float d) {
+  return d <= 0.0 ? (excess <= 0.0 ? 1.0 : 0.0) : clamp(1.0 - excess / d, 0.0, 1.0);
+}
+
+// Gardner terms a pixel resolves (MODEL.md section 2), fractional where one fades, for a
+// footprint in periods: term j (1-based) resolves while 2^j footprint <= 1/2
+// (GardnerTexture::termCountForFootprint on the CPU).
+float resolvedTerms(float footprint, float terms) {
+#if defined(FILTER_NONE)
+  return terms;
+#else
+  float highest = log2(0.5 / max(footprint, 1e-30));
+#if defined(FILTER_CUT)
+  return clamp(floor(highest), 0.0, terms);
+#else
+  return clamp(highest - 1.0, 0.0, terms);  // fade over the octave below
+#endif
+#endif
+}
+
+// Distance in metres along r (any length) to the first opaque surface: the ground plane
+// (MODEL.md section 5) or a target; kFar where the ray reaches the sky.
+float opaqueDistance(vec3 r) {
+  float distance = r.z < 0.0 ? u_camera_z * (length(r) / -r.z) : kFar;
+#ifdef TARGETS
+  distance = min(distance, targetDistance());
+#endif
+  return distance;
+}
+
+// The altitude band a cloud pass draws (docs/MODEL.md, "Compositing order"): a surface at
+// height dz above the camera belongs to this pass when u_band.x <= dz < u_band.y or
+// u_band.z <= dz < u_band.w. Layers are horizontal planes, so along every ray the surfaces
+// between two layers are exactly those between their altitudes.
+uniform vec4 u_band = vec4(-1e38, 1e38, 0.0, 0.0);
+bool inBand(float dz) {
+  return (dz >= u_band.x && dz < u_band.y) || (dz >= u_band.z && dz < u_band.w);
+}
+
+#ifdef SHADOWS
+// The share of the sunlight reaching the ground (MODEL.md section 16, ShadowMap) at `ground`
+// (metres from the camera's ground point): the map is u_shadow_half * 2 metres a side about
+// u_shadow_centre; it fades to 1 over its outer twentieth, where the ground lies beyond its
+// casters' range. Below u_shadow_floor (from the camera) every caster lies above.
+layout(binding = 11) uniform sampler2D u_shadow_map;
+uniform vec2 u_shadow_centre;
+uniform float u_shadow_half;
+uniform float u_shadow_floor;
+float mapSunlight(vec2 ground) {
+  vec2 uv = (ground - u_shadow_centre) / (2.0 * u_shadow_half) + 0.5;
+  float edge = 2.0 * max(abs(uv.x - 0.5), abs(uv.y - 0.5));
+  return mix(texture(u_shadow_map, uv).r, 1.0, smoothstep(0.9, 1.0, edge));
+}
+#endif
+
+#ifdef BACKGROUND
+uniform vec3 u_zenith;
+uniform vec3 u_horizon;
+uniform vec3 u_ground;
+
+uniform float u_horizon_slope;  // |gradient of r.z| per pixel
+
+// The sky planes' share of the sunlight at this pixel's ground point (planesSunlight), set by
+// main before background() where planes cast shadows.
+float g_planes_sun = 1.0;
+// The share of the sunlight reaching the ground point along unit d.
+float groundSunlight(vec3 d) {
+  float sun = g_planes_sun;
+#ifdef SHADOWS
+  sun *= mapSunlight(d.xy * (u_camera_z / -d.z));
+#endif
+  return sun;
+}
+vec3 groundColour(vec3 d) {
+#if defined(SHADOWS) || defined(PLANE_SHADOWS)
+  return u_ground * (kGroundSkyShare + (1.0 - kGroundSkyShare) * groundSunlight(d));
+#else
+  return u_ground;
+#endif
+}
+
+#ifdef SEA
+// The sea (MODEL.md section 18); world/sea.cpp is the reference's twin, function by function.
+// The surface's sines, longest first: wave vector (rad/m), amplitude, and the phase at the
+// camera's ground point now (mod 2 pi, in double on the CPU).
+uniform vec4 u_wave[kSeaWaves];
+// Each one's phase modulation: its wave vector, and its phase at the camera's ground point.
+uniform vec3 u_wave_wobble[kSeaWaves];
+uniform int u_waves;
+// Cox-Munk's slope variance, the drawn sines' slope variance, the whitecap fraction, the
+// pixel's angle in radians.
+uniform vec4 u_sea;
+uniform float u_foam_steepness;  // SeaSurface::foamSteepness
+uniform vec3 u_sea_body;  // waterBodyColour, times the sun's colour
+uniform vec3 u_sea_sun;   // unit, towards the sun
+uniform vec3 u_sun_colour;
+// What the sea mirrors (the probe: the scene from the sea below the camera); a direction r
+// is at ((r . right, r . up) / (r . forward) + 1) / 2 in it.
+layout(binding = 6) uniform sampler2D u_sea_probe;
+uniform vec3 u_probe_right;
+uniform vec3 u_probe_up;
+uniform vec3 u_probe_forward;
+const float kSeaResolvedShare = 0.8;
+const float kFoamReflectance = 0.22;
+
+float fresnelWater(float cos_incidence) {
+  float c = clamp(cos_incidence, 0.0, 1.0), n = 1.34;
+  float g = sqrt(n * n - 1.0 + c * c);
+  float a = (g - c) / (g + c), b = (c * (g + c) - 1.0) / (c * (g - c) + 1.0);
+  return 0.5 * a * a * (1.0 + b * b);
+}
+
+float foamShare(float w, float foam_steepness, float steepness, float var_total,
+                float var_unresolved) {
+  if (!(w > 0.0)) return 0.0;
+  if (w >= 1.0) return 1.0;
+  float resolved = var_total > 0.0 ? clamp(1.0 - var_unresolved / var_total, 0.0, 1.0) : 0.0;
+  float edge = sqrt(max(var_unresolved, 1e-4 * var_total + 1e-12));
+  float crest = 1.0 / (1.0 + exp(-1.702 * (steepness - foam_steepness) / edge));
+  return (1.0 - resolved) * w + resolved * crest;
+}
+
+float glintRadiance(vec3 d, vec3 n, float slope_var) {
+  vec3 v = -d, sun = u_sea_sun;
+  float mu_v = dot(v, n), mu_s = dot(sun, n);
+  if (!(mu_v > 0.0) || !(mu_s > 0.0)) return 0.0;
+  vec3 h = normalize(v + sun);
+  float mu_n = dot(h, n);
+  if (!(mu_n > 0.0)) return 0.0;
+  float mu_n2 = mu_n * mu_n, tan2 = (1.0 - mu_n2) / mu_n2;
+  return fresnelWater(dot(v, h)) * exp(-tan2 / slope_var) /
+         (4.0 * slope_var * max(mu_v, 1e-2) * mu_n2 * mu_n2);
+}
+
+vec3 probeRadiance(vec3 r) {
+  vec2 ndc = vec2(dot(r, u_probe_right), dot(r, u_probe_up)) / max(dot(r, u_probe_forward), 1e-6);
+  return texture(u_sea_probe, clamp(0.5 * ndc + 0.5, 0.0, 1.0)).rgb;
+}
+
+// The sea's radiance along unit d (d.z < 0), before the air.
+vec3 seaColour(vec3 d) {
+  float distance = u_camera_z / -d.z;
+  vec2 p = d.xy * distance;
+  float footprint = distance * u_sea.w / sqrt(max(abs(d.z), 1e-4));
+  float resolved_slope = 0.0;
+  vec2 slope = vec2(0.0);
+  for (int i = 0; i < u_waves; ++i) {
+    vec4 w = u_wave[i];
+    float k = length(w.xy);
+    float weight = clamp(6.283185307179586 / k / (4.0 * footprint) - 1.0, 0.0, 1.0);
+    if (weight <= 0.0) break;
+    vec3 m = u_wave_wobble[i];
+    float wobble = dot(m.xy, p) + m.z;
+    float phase = dot(w.xy, p) + w.w + kWaveModulation * gardnerSin(wobble);
+    slope -= (weight * w.z * gardnerSin(phase)) *
+             (w.xy + kWaveModulation * gardnerSin(wobble + 1.5707963267948966) * m.xy);
+    resolved_slope += 0.5 * weight * weight * w.z * w.z * k * k;
+  }
+  float slope_var = max(u_sea.x - resolved_slope, (1.0 - kSeaResolvedShare) * u_sea.x);
+  vec3 n = normalize(vec3(-slope, 1.0));
+  float cos_i = clamp(-dot(d, n), 0.0, 1.0);
+  vec3 r = d + 2.0 * cos_i * n;
+  r.z = max(r.z, 0.01);
+  r = normalize(r);
+  float foam = foamShare(u_sea.z, u_foam_steepness, dot(slope, slope), u_sea.y,
+                         max(u_sea.y - resolved_slope, 0.0));
+  float fresnel = fresnelWater(cos_i);
+  float sun = groundSunlight(d);
+  float diffuse = max(u_sea_sun.z, 0.0) * (kGroundSkyShare + (1.0 - kGroundSkyShare) * sun);
+  vec3 colour = diffuse * ((1.0 - foam) * (1.0 - fresnel) * u_sea_body +
+                           foam * kFoamReflectance * u_sun_colour);
+  if (u_sea_sun.z > 0.0 && sun > 0.0)
+    colour += (1.0 - foam) * sun * glintRadiance(d, n, slope_var) * u_sun_colour;
+  return colour + (1.0 - foam) * fresnel * probeRadiance(r);
+}
+#endif
+
+vec3 background(vec3 r) {
+  vec3 d = normalize(r);
+  // The ground's share of the pixel: r.z is linear across the image, so the horizon is a
+  // straight edge and its box-filtered coverage is exact.
+  float ground = clamp(0.5 - r.z / u_horizon_slope, 0.0, 1.0);
+  vec3 sky = u_horizon + (u_zenith - u_horizon) * sqrt(max(d.z, 0.0));  // MODEL.md section 5
+#ifdef SEA
+  vec3 below = d.z < 0.0 ? seaColour(d) : u_horizon;
+#else
+  vec3 below = d.z < 0.0 ? groundColour(d) : u_ground;
+#endif
+#ifdef AIR
+  // Each part carries its own air. The ground seen at the horizon lies behind an endless
+  // stretch of air (fog and haze touch the ground), so there it is the air's colour.
+  vec3 aired_ground = d.z < 0.0 ? applyAir(below, d, u_camera_z / -d.z) : airAtHorizon();
+  return mix(applyAir(sky, d, kFar), aired_ground, ground);
+#else
+  return mix(sky, below, ground);
+#endif
+}
+#endif
