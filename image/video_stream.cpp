@@ -150,8 +150,11 @@ std::variant<std::unique_ptr<VideoStream>, std::string> VideoStream::open(
   avcodec_parameters_from_context(c.stream->codecpar, c.context);
   c.stream->time_base = c.context->time_base;
   std::string url = address;
-  if (scheme == "udp")
-    url += (url.find('?') == std::string::npos ? "?" : "&") + std::string("pkt_size=1316");
+  const std::string join = url.find('?') == std::string::npos ? "?" : "&";
+  if (scheme == "udp") url += join + "pkt_size=1316";
+  // An SRT caller waits for its listener on the caller's thread: at most a second.
+  if (scheme == "srt" && url.find("connect_timeout") == std::string::npos)
+    url += join + "connect_timeout=1000";
   if (const int r = avio_open(&c.format->pb, url.c_str(), AVIO_FLAG_WRITE); r < 0)
     return "address: \"" + address + "\": " + avError(r);
   AVDictionary* options = nullptr;
