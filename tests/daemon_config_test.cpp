@@ -55,6 +55,17 @@ TEST(DaemonConfig, ErrorsNameTheKey) {
       {"scene = \"/nonexistent.toml\"\n", "cannot read scene file"},
       {kScene + "[world]\nmode = \"fast\"\n", "world.mode: \"fast\" is not allowed"},
       {kScene + "[world]\ntick_rate = 0\n", "world.tick_rate"},
+      {kScene + "[cigi]\nrecentre_distance = 10\n", "recentre_distance: is below 1000 m"},
+      {kScene + "[[stream]]\nview = \"front\"\n", "missing key address"},
+      {kScene + "[[stream]]\nview = \"back\"\naddress = \"udp://127.0.0.1:5600\"\n",
+       "\"back\" is not a [[view]]"},
+      {kScene +
+           "[[view]]\nname = \"front\"\n[[stream]]\nview = \"front\"\naddress = \"http://x:1\"\n",
+       "address: \"http://x:1\" (allowed: udp://"},
+      {kScene +
+           "[[view]]\nname = \"front\"\n[[stream]]\nview = \"front\"\naddress = \"udp://x:1\"\n"
+           "bitrate = 50\n",
+       "bitrate"},
       {kScene + "[[view]]\nwidth = 10\n", "missing key name"},
       {kScene + "[[view]]\nname = \"a\"\n[[view]]\nname = \"a\"\n", "names two views"},
       {kScene + "[[view]]\nname = \"a\"\nformat = \"jpeg\"\ncoverage = true\n", "jpeg"},
