@@ -188,8 +188,9 @@ VideoStream::~VideoStream() {
     stop_ = true;
   }
   cv_.notify_all();
-  if (thread_.joinable()) thread_.join();
-  if (codec_ && codec_->format && codec_->format->pb) {
+  const bool started = thread_.joinable();
+  if (started) thread_.join();
+  if (started) {  // the header is written: flush the encoder, end the stream
     avcodec_send_frame(codec_->context, nullptr);  // flush
     codec_->drain();
     av_write_trailer(codec_->format);
