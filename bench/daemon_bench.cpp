@@ -49,16 +49,9 @@
 namespace {
 
 using Clock = std::chrono::steady_clock;
+using nephele::millisecondsBetween;
+using nephele::percentile;
 using nlohmann::json;
-
-double msBetween(Clock::time_point a, Clock::time_point b) {
-  return std::chrono::duration<double, std::milli>(b - a).count();
-}
-
-double percentile(std::vector<double> v, double p) {
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, std::size_t(p * double(v.size())))];
-}
 
 // The daemon as a child process; the ports come from its ready line.
 struct Daemon {
@@ -179,7 +172,7 @@ void latency(Client& client, const char* format, int repeats) {
         client.request({{"id", i}, {"cmd", "render"}, {"view", "front"}, {"format", format}}, body);
     const auto t1 = Clock::now();
     if (!reply["ok"]) throw std::runtime_error(reply.dump());
-    if (i >= 3) ms.push_back(msBetween(t0, t1));  // after the warm-up
+    if (i >= 3) ms.push_back(millisecondsBetween(t0, t1));  // after the warm-up
     bytes = body.size();
   }
   std::printf("render %-4s 640x480: p50 %6.2f ms  p99 %6.2f ms  (%zu bytes, %d requests)\n", format,
@@ -212,7 +205,7 @@ void modbusLatency(const Daemon& daemon, int repeats) {
       if (event.value("event", "") != "frame") continue;
       if ((meanCoverage(body) > 0.01) == (heading == 0.0f)) break;
     }
-    ms.push_back(msBetween(t0, Clock::now()));
+    ms.push_back(millisecondsBetween(t0, Clock::now()));
   }
   std::printf(
       "modbus write to visible frame (60 Hz subscription, 640x480 raw): p50 %.1f ms  "
@@ -338,8 +331,8 @@ HostFrameFigures hostFrames(const std::filesystem::path& dir, int views, int rep
     frames();
     const auto t_frames = Clock::now();
     if (i >= 3) {
-      to_sof.push_back(msBetween(t0, t_sof));
-      cigi_frames.push_back(msBetween(t0, t_frames));
+      to_sof.push_back(millisecondsBetween(t0, t_sof));
+      cigi_frames.push_back(millisecondsBetween(t0, t_frames));
     }
   }
   for (int i = 0; i < repeats + 3; ++i) {
@@ -349,8 +342,8 @@ HostFrameFigures hostFrames(const std::filesystem::path& dir, int views, int rep
     const auto t_reply = Clock::now();
     frames();
     if (i >= 3) {
-      to_reply.push_back(msBetween(t0, t_reply));
-      socket_frames.push_back(msBetween(t0, Clock::now()));
+      to_reply.push_back(millisecondsBetween(t0, t_reply));
+      socket_frames.push_back(millisecondsBetween(t0, Clock::now()));
     }
   }
   json stats = control.request({{"cmd", "stats"}}, body)["result"];
@@ -415,11 +408,11 @@ void asynchronousHostFrames(const std::filesystem::path& dir, int views, int rep
         ++got;
     }
     if (n > 3) {
-      to_sof.push_back(msBetween(t0, t_sof));
-      to_frames.push_back(msBetween(t0, Clock::now()));
+      to_sof.push_back(millisecondsBetween(t0, t_sof));
+      to_frames.push_back(millisecondsBetween(t0, Clock::now()));
     }
   }
-  const double seconds = msBetween(start, Clock::now()) / 1000.0;
+  const double seconds = millisecondsBetween(start, Clock::now()) / 1000.0;
   json stats = control.request({{"cmd", "stats"}}, body)["result"];
   const double render = stats["render_ms"]["p50"].get<double>() * views;
   close(udp);
@@ -495,13 +488,13 @@ void heavyWorlds(const std::filesystem::path& dir) {
       while (!done) {
         const auto t0 = Clock::now();
         other.request({{"cmd", "hello"}}, b);
-        longest_hello = std::max(longest_hello, msBetween(t0, Clock::now()));
+        longest_hello = std::max(longest_hello, millisecondsBetween(t0, Clock::now()));
         std::this_thread::sleep_for(std::chrono::milliseconds(20));
       }
     });
     const auto t0 = Clock::now();
     const json reply = c.request(renderRequest(width, height), body);
-    const double ms = msBetween(t0, Clock::now());
+    const double ms = millisecondsBetween(t0, Clock::now());
     done = true;
     asker.join();
     if (!reply["ok"]) throw std::runtime_error(reply.dump());
@@ -543,7 +536,7 @@ void heavyWorlds(const std::filesystem::path& dir) {
   waitpid(daemon.pid, &status, 0);
   std::printf("  SIGTERM 0.3 s into a 640x480 render of %ld ellipsoids: exit %d after %.2f s\n",
               ellipsoids, WIFEXITED(status) ? WEXITSTATUS(status) : -1,
-              msBetween(t0, Clock::now()) / 1000.0);
+              millisecondsBetween(t0, Clock::now()) / 1000.0);
   daemon.pid = 0;  // already reaped
 }
 

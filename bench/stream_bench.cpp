@@ -36,16 +36,6 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-double msBetween(Clock::time_point a, Clock::time_point b) {
-  return std::chrono::duration<double, std::milli>(b - a).count();
-}
-
-double percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, std::size_t(p * double(v.size())))];
-}
-
 // What the receiver saw of each tick: when it was decoded, and its PSNR.
 struct Decoded {
   Clock::time_point at;
@@ -110,7 +100,7 @@ int main(int argc, char** argv) {
     scene.camera.orientation.heading_deg = heading + 30.0 * i / distinct;
     const auto t0 = Clock::now();
     frames.push_back(std::make_shared<const Srgb8Image>(renderer.renderSrgb8(scene, file.render)));
-    render_ms.push_back(msBetween(t0, Clock::now()));
+    render_ms.push_back(millisecondsBetween(t0, Clock::now()));
   }
   const double render = percentile(render_ms, 0.5);
   const double floor = medianMilliseconds(9, [&] { renderer.renderFloor(w, h); });
@@ -211,7 +201,7 @@ int main(int argc, char** argv) {
   std::vector<double> latency, quality;
   for (const auto& [tick, d] : decoded) {
     if (tick >= std::uint32_t(count)) continue;
-    latency.push_back(msBetween(ready[tick], d.at));
+    latency.push_back(millisecondsBetween(ready[tick], d.at));
     quality.push_back(d.psnr);
   }
   const double period = 1000.0 / rate;

@@ -22,4 +22,18 @@ double medianMilliseconds(int repeats, Frame&& frame) {
   return ms[ms.size() / 2];
 }
 
+// Milliseconds from a to b.
+inline double millisecondsBetween(std::chrono::steady_clock::time_point a,
+                                  std::chrono::steady_clock::time_point b) {
+  return std::chrono::duration<double, std::milli>(b - a).count();
+}
+
+// The p-quantile (0 to 1) of `values` by rank, 0 for none: what the benches print and the
+// daemon's stats report.
+inline double percentile(std::vector<double> values, double p) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  return values[std::min(values.size() - 1, std::size_t(p * double(values.size())))];
+}
+
 }  // namespace nephele

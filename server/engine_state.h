@@ -20,6 +20,7 @@
 
 #include "image/image_encoding.h"
 #include "renderer/frame.h"
+#include "renderer/frame_timing.h"
 #include "renderer/gl/gl_platform.h"
 #include "renderer/gl/gl_renderer.h"
 #include "server/engine.h"
@@ -90,12 +91,6 @@ inline ProtocolError unknownView(const std::vector<ViewConfig>& views, const std
   std::string names;
   for (const ViewConfig& v : views) names += (names.empty() ? "" : ", ") + v.name;
   return {ErrorCode::kNotFound, "view: \"" + name + "\" is not a view (allowed: " + names + ")"};
-}
-
-inline double percentile(std::vector<double> values, double p) {
-  if (values.empty()) return 0.0;
-  std::sort(values.begin(), values.end());
-  return values[std::min(values.size() - 1, std::size_t(p * double(values.size())))];
 }
 
 // Latencies for Prometheus: counts per bucket of seconds (cumulative in the text format), with
