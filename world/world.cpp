@@ -347,14 +347,18 @@ void moveContent(Scene& scene, glm::dvec2 shift) {
 
 }  // namespace
 
+std::string siteError(const Site& site) {
+  if (Limits::kLatitude.contains(site.latitude_deg) &&
+      Limits::kLongitude.contains(site.longitude_deg) && std::isfinite(site.grid_deg))
+    return "";
+  return "site: latitude " + std::to_string(site.latitude_deg) + ", longitude " +
+         std::to_string(site.longitude_deg) +
+         " (allowed: latitude -90 to 90, longitude -180 to 180, a finite grid north)";
+}
+
 std::string World::setSite(const Site& site, bool* changed) {
   if (changed) *changed = false;
-  if (!Limits::kLatitude.contains(site.latitude_deg) ||
-      !Limits::kLongitude.contains(site.longitude_deg) || !std::isfinite(site.grid_deg))
-    return "site: latitude " + std::to_string(site.latitude_deg) + ", longitude " +
-           std::to_string(site.longitude_deg) +
-           " (allowed: latitude -90 to 90, longitude -180 "
-           "to 180, a finite grid north)";
+  if (std::string e = siteError(site); !e.empty()) return e;
   if (base_.site == site) return "";
   const glm::dvec2 shift = base_.site
                                ? recentred(*base_.site, site.latitude_deg, site.longitude_deg).shift

@@ -87,6 +87,11 @@ std::string placeWeather(Scene& scene, WorldDynamics& dynamics, const WeatherKey
 // check of a whole sea, shared by scene files, requests and snapshots.
 std::string seaError(const Sea& sea);
 
+// What is wrong with `site` (a latitude or longitude out of world/limits.h's range, a grid
+// north that is not a finite number), or empty: the one check of a site, shared by set_site
+// and snapshots.
+std::string siteError(const Site& site);
+
 class World {
  public:
   // Simulation time is kept in whole nanoseconds, so that split advances add up exactly.

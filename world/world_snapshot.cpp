@@ -295,10 +295,9 @@ void io(A& a, Scene& s) {
   io(a, s.content_origin);
   if constexpr (!A::kReading) return;
   if (!placed) return s.site.reset();
-  if (!Limits::kLatitude.contains(site.latitude_deg) ||
-      !Limits::kLongitude.contains(site.longitude_deg) || !std::isfinite(site.grid_deg) ||
-      !std::isfinite(s.content_origin.x) || !std::isfinite(s.content_origin.y))
-    return a.fail("site: out of range");
+  if (std::string e = siteError(site); !e.empty()) return a.fail(e);
+  if (!std::isfinite(s.content_origin.x) || !std::isfinite(s.content_origin.y))
+    return a.fail("site: the content origin is not finite");
   s.site = site;
 }
 template <class A>
