@@ -303,44 +303,46 @@ std::variant<Session::State, Refusal> Session::next(const Message& message,
           "not applied");
     return s;
   }
+  // The message's ownship (Entity Control 0, not attached) placed on the Earth: the last one.
+  auto onEarth = [](double latitude, double longitude) {
+    return std::isfinite(latitude) && std::isfinite(longitude) && std::abs(latitude) <= 90.0 &&
+           std::abs(longitude) <= 360.0;
+  };
+  const EntityControl* ownship = nullptr;
+  for (std::size_t i = 1; i < message.packets.size(); ++i)
+    if (const auto* e = std::get_if<EntityControl>(&message.packets[i]);
+        e && e->entity_id == 0 && !e->attached && onEarth(e->latitude, e->longitude))
+      ownship = e;
   // With no [site] the host's first position on the Earth sets the database origin (docs/CIGI.md,
   // "Where the database lies"): the ownship's, else the message's first active entity or region
   // placed by latitude and longitude, whatever the packets' order.
   if (!s.site) {
-    std::optional<glm::dvec2> ownship, other;
-    auto onEarth = [](double latitude, double longitude) {
-      return std::isfinite(latitude) && std::isfinite(longitude) && std::abs(latitude) <= 90.0 &&
-             std::abs(longitude) <= 360.0;
-    };
-    for (std::size_t i = 1; i < message.packets.size(); ++i) {
+    std::optional<glm::dvec2> place;
+    if (ownship) place = glm::dvec2(ownship->latitude, std::remainder(ownship->longitude, 360.0));
+    for (std::size_t i = 1; i < message.packets.size() && !place; ++i) {
       const Packet& packet = message.packets[i];
       if (const auto* e = std::get_if<EntityControl>(&packet)) {
-        if (e->attached || !onEarth(e->latitude, e->longitude)) continue;
-        const glm::dvec2 place(e->latitude, std::remainder(e->longitude, 360.0));
-        if (e->entity_id == 0)
-          ownship = place;
-        else if (!other && e->state == EntityState::kActive)
-          other = place;
+        if (e->entity_id != 0 && !e->attached && e->state == EntityState::kActive &&
+            onEarth(e->latitude, e->longitude))
+          place = glm::dvec2(e->latitude, std::remainder(e->longitude, 360.0));
       } else if (const auto* r = std::get_if<EnvironmentalRegionControl>(&packet)) {
-        if (!other && r->state == RegionState::kActive && regionControlError(*r).empty())
-          other = glm::dvec2(r->latitude, std::remainder(r->longitude, 360.0));
+        if (r->state == RegionState::kActive && regionControlError(*r).empty())
+          place = glm::dvec2(r->latitude, std::remainder(r->longitude, 360.0));
       }
     }
-    if (const auto place = ownship ? ownship : other) s.site = Site{place->x, place->y, 0.0};
+    if (place) s.site = Site{place->x, place->y, 0.0};
     frame.site_adopted = s.site;
   }
   // Re-centring (MODEL.md section 13): once the ownship is farther than the settings' distance
   // from the origin, the origin moves to it, snapped to a 1/64-degree lattice so that every
-  // flight over a place re-centres there alike.
+  // flight over a place re-centres there alike. The ownship is this message's, unless its
+  // altitude is refused, else the one last applied.
   if (s.site && settings_.recentre_m > 0.0) {
     std::optional<Geodetic> own;
-    for (std::size_t i = 1; i < message.packets.size(); ++i)
-      if (const auto* e = std::get_if<EntityControl>(&message.packets[i]);
-          e && e->entity_id == 0 && !e->attached &&
-          finite({e->latitude, e->longitude, e->altitude}) && std::abs(e->latitude) <= 90.0)
-        own = Geodetic{e->latitude, e->longitude, 0.0};
-    if (const auto it = s.entities.find(0);
-        !own && it != s.entities.end() && !it->second.packet.attached)
+    if (ownship && std::isfinite(ownship->altitude))
+      own = Geodetic{ownship->latitude, ownship->longitude, 0.0};
+    else if (const auto it = s.entities.find(0);
+             it != s.entities.end() && !it->second.packet.attached)
       own = Geodetic{it->second.packet.latitude, it->second.packet.longitude, 0.0};
     if (own && glm::length(glm::dvec2(databaseOf(s).toLocal(*own))) > settings_.recentre_m) {
       const double latitude = std::clamp(std::round(own->latitude_deg * 64.0) / 64.0, -90.0, 90.0);
