@@ -42,7 +42,8 @@ struct Fitted {
 // edges, which makes D = 1 for squares and biases it upwards for clouds a few pixels across.
 Fitted perimeterAreaDimension(const std::vector<CloudRegion>& clouds, int min_pixels);
 
-// The outline of one silhouette (issue 27 item 5a), given as its pixels in a w x h image:
+// The outline of one silhouette, given as its pixels in a w x h image (docs/ACCURACY.md,
+// "Outline figures"):
 // - dimension: the outline's divider dimension, D = 1 - d log P / d log s, where P(s) is the
 //   perimeter (pixel edges times s) of the silhouette coarse-grained into s x s blocks (a block
 //   is in it when at least half its pixels are), for s = 1, 2, 4, 8: a smooth outline keeps its
@@ -70,9 +71,9 @@ Fitted transectSpectrumSlope(const std::vector<double>& field, int w, double lon
 
 // Two renders of one view with cloud shadows on the ground (MODEL.md section 16) against a
 // render without: where both show no cloud (coverage under 0.01 in both; the ground, and the
-// sky, which is never shadowed), a pixel is in
-// shadow where its luminance is under kShadowedRatio of the unshadowed render's (halfway
-// between full sun and the sky light alone, groundLight). `agreement`: the fraction of
+// sky, which is never shadowed), a pixel is in shadow where its luminance is under
+// kShadowedRatio of the unshadowed render's (halfway between full sun and the sky light alone,
+// groundLight). `agreement`: the fraction of
 // `actual`'s shadowed pixels that `reference` also shadows; `mean_ratio_difference`: the mean
 // |ratio(actual) - ratio(reference)| over those clear pixels; `shadowed`: the share of them
 // `actual` shadows.

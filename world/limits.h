@@ -81,8 +81,8 @@ struct Limits {
   static constexpr int kMaxEllipsoidsPerCloud = 4096;
   // Ellipsoids one world may hold (the daemon's `[world] max_ellipsoids`, whose default
   // follows the machine's memory: defaultMaxEllipsoids). Held and rendered, an ellipsoid
-  // costs the daemon about 1.1 KB (issue 31: 1,638,400 of them took it from 1,020 to
-  // 2,748 MiB, 1,106 bytes each).
+  // costs the daemon about 1.1 KB: 1,638,400 of them raise it from 1,020 to 2,748 MiB, 1,106
+  // bytes each (docs/RELIABILITY.md).
   static constexpr int kMaxWorldEllipsoids = 4096 * kMaxEllipsoidsPerCloud;
   static constexpr int kBytesPerEllipsoid = 1106;
 

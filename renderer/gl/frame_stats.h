@@ -10,9 +10,9 @@
 
 namespace nephele {
 
-// Where a frame's time goes (issue 46): the CPU's stages before and between the passes, the
-// GPU's passes by kind (GL timer queries), and the readback. One table of names serves the
-// log line, the daemon's stats and /metrics, and the benchmarks.
+// Where a frame's time goes (docs/ACCURACY.md, "Frame budget"): the CPU's stages before and
+// between the passes, the GPU's passes by kind (GL timer queries), and the readback. One table
+// of names serves the log line, the daemon's stats and /metrics, and the benchmarks.
 enum class CpuStage : std::size_t {
   kScene,    // the rest: the draw list (layers banded, clouds culled and ordered) and the
              // passes' own GL calls
@@ -45,7 +45,7 @@ struct FrameTimes {
   // GL_TIME_ELAPSED per kind of pass, summed over the frame; 0 where the GL has no timer.
   std::array<double, std::size_t(GpuPass::kCount)> gpu_ms{};
   double submit_ms = 0.0;    // the CPU's whole part, from the scene to the last pass queued
-  double wait_ms = 0.0;      // then until the GPU had finished the passes (glFinish)
+  double wait_ms = 0.0;      // then until the GPU has finished the passes (glFinish)
   double readback_ms = 0.0;  // glReadPixels and the conversion to the frame's layout
   double encode_ms = 0.0;    // PNG, JPEG, EXR or raw packing; set by whoever encodes
 

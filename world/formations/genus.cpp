@@ -8,16 +8,14 @@ namespace {
 // Heaps: 20 per km of light extinction puts the sky light under a heap's middle at about a
 // third of the open sky's (MODEL.md section 14). T0 = 1 keeps the texture's product positive
 // nearly everywhere, so with T2 - T1 = 0.8 its variation moves a lobe's edge across the outer
-// part of its radius: the outline is ragged down to the finest term the pixel shows (outline
-// dimension 1.10 with T0 = 0, T1 = -0.4, T2 = 1.1, where the product is zero on three quarters
-// of a lobe and the edge is a smooth arc; 1.15 with these). A wider band (T1 = -0.2, T2 = 0.6)
-// is rougher still (1.26) but its heaps, far away with their fine terms faded, draw less cover
-// than the far deck beyond them (docs/ACCURACY.md). The texture is finer for a cumulonimbus's
-// size, its lobes being a smaller part of its width. Ambient a = 0.1: a heap's shaded side is
-// lit by the sky (K, section 14), so eq. 8's constant floor is kept low; with 0.2 the sunlit
-// half of a heap lit from the side was 1.52 times its shaded half (1.56 for a cumulonimbus),
-// with 0.1 1.76 (both), against the 1.5 asked and 2 aimed at, the bases darker under the
-// tops (0.18 of the sunlit top's luminance against 0.27).
+// part of its radius: the outline is ragged down to the finest term the pixel shows (divider
+// dimension 1.19 at 640x480; docs/ACCURACY.md, "Outline figures"). The band is as wide as the
+// far deck allows: with a wider one, far heaps, their fine terms faded, draw less cover than
+// the deck beyond them ("Tried and not kept"). The texture is finer for a cumulonimbus's size,
+// its lobes being a smaller part of its width. Ambient a = 0.1: a heap's shaded side is lit by
+// the sky (K, section 14), so eq. 8's constant floor is kept low: lit from the side, a heap's
+// sunlit half is 1.94 times its shaded half (2.71 for a cumulonimbus; 1.5 asked, 2 aimed at)
+// and its base 0.19 of its sunlit top's luminance ("Look figures").
 constexpr HeapLook kNoHeaps{1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 6.0, 5};
 constexpr HeapLook kCumulusHeaps{1.0, 0.1, 0.3, -0.4, 0.4, 0.08, 0.02, 1.0, 12.0, 6};
 constexpr HeapLook kCumulonimbusHeaps{0.9, 0.1, 0.3, -0.3, 0.6, 0.12, 0.02, 1.0, 24.0, 7};

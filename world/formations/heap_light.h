@@ -28,8 +28,7 @@ struct HeapEnvelope {
 // solids (semi-axes sqrt(5 variance) about their centroid, which is an ellipsoid itself when
 // alone and axis-aligned), and its extinction the cloud's light_extinction times the share
 // of the envelope its ellipsoids fill (the sum of their volumes over the envelope's, at most
-// 1). All extinctions are 0 when the
-// cloud's light_extinction is 0.
+// 1). All extinctions are 0 when the cloud's light_extinction is 0.
 std::vector<HeapEnvelope> heapEnvelopes(const EllipsoidCloud& cloud);
 
 // The heap each ellipsoid of `cloud` belongs to, as heapEnvelopes groups them: the index of

@@ -21,7 +21,7 @@ namespace {
 // Every genus's texture breaks Gardner's lattice by rotation (PlaneLook) and by scale, each
 // component spread over half an octave either side of its term's frequency: the highest
 // secondary autocorrelation peak of the drawn coverage stays near 0.2 (cirrus 0.25) for any
-// seed, where rotation alone left 0.3 to 0.4 (docs/ACCURACY.md, "Knobs of the model").
+// seed, against 0.44 to 0.85 on Gardner's lattice (docs/ACCURACY.md, "Knobs of the model").
 constexpr double kJitterOctaves = 0.5;
 
 // Seeded points spread over 24 x 24 texture periods (the texture has no period once rotated).
@@ -81,12 +81,6 @@ class GardnerSamples {
   std::vector<glm::dvec2> sums_;
 };
 
-// GardnerSamples of a look, computed once per process and shared by every layer of it (a
-// dataset draws new skies for every sample, a daemon on every set_weather). The calibration
-// never depended on the layer's seed: it reads the look's texture with seed 0 (the layer's
-// seed enters in LayerTexture), since over 24 x 24 periods a seed's phases, turns and scales
-// within each octave leave the distribution of values as it is; realism_bench's drawn
-// coverage is within 0.03 of the asked for every stratiform genus. Any thread.
 // Every parameter of a Gardner texture, in full precision: the key of the caches below.
 std::string gardnerKey(const GardnerTextureParams& p) {
   std::ostringstream key;
@@ -96,6 +90,12 @@ std::string gardnerKey(const GardnerTextureParams& p) {
   return key.str();
 }
 
+// GardnerSamples of a look, computed once per process and shared by every layer of it (a
+// dataset draws new skies for every sample, a daemon on every set_weather). The calibration
+// does not depend on the layer's seed: it reads the look's texture with seed 0 (the layer's
+// seed enters in LayerTexture), since over 24 x 24 periods a seed's phases, turns and scales
+// within each octave leave the distribution of values as it is; realism_bench's drawn
+// coverage is within 0.03 of the asked for every stratiform genus. Any thread.
 std::shared_ptr<const GardnerSamples> lookSamples(const GardnerTextureParams& params) {
   GardnerTextureParams p = params;
   p.seed = 0;
@@ -175,9 +175,8 @@ std::vector<CloudLayer> planes(const WeatherLayer& w, const PlaneLook& look, dou
 
 // Scud (MODEL.md section 10): one plane of ragged fragments under the base, covering
 // `w.scud`: stratus fractus, the stratus look with features a third the size, a darker grey
-// and edges twice as sharp,
-// half way through the transition band below the base, or a sixth of the thickness (50 to 300
-// m) without one.
+// and edges twice as sharp, half way through the transition band below the base, or a sixth
+// of the thickness (50 to 300 m) without one.
 std::vector<CloudLayer> scudPlane(const WeatherLayer& w, const std::string& prefix,
                                   std::uint64_t seed) {
   if (!(w.scud > 0.0)) return {};
@@ -293,8 +292,8 @@ double thresholdForCoverage(const LayerTextureSpec& spec, double transition, int
 
 void calibrateFarCover(const LayerTextureSpec& spec, double transition, FarCover& far) {
   // The thresholds depend on the texture and the transition alone, and far decks take one of a
-  // few textures (farDeck): computed once per process for each, where a dataset sample's new
-  // field (its own cover and seed) sorted 16,384 texture values again. Any thread.
+  // few textures (farDeck): computed once per process for each, not sorting 16,384 texture
+  // values again for each dataset sample's new field (its own cover and seed). Any thread.
   std::ostringstream key_text;
   key_text.precision(17);
   key_text << spec.seed << '/' << transition << '/' << gardnerKey(spec.gardner);
