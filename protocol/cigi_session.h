@@ -28,17 +28,17 @@ struct SessionSettings {
   double recentre_m = Limits::kDefaultRecentreDistance;
 };
 
-// A host frame ready for the daemon.
-struct HostFrame {
+// A host message mapped for the daemon: the commands of one host frame.
+struct MappedMessage {
   IgControl control;
   std::vector<Command> commands;     // in order
   double dt_s = 0.0;                 // the host's frame time, by which a lockstep world advances
   std::vector<std::string> ignored;  // packets or fields not supported, with why
   std::vector<std::string> refused;  // packets refused for a value out of range, with why
-  // The database origin this frame took from the host, with no [site] configured: once per
+  // The database origin this message took from the host, with no [site] configured: once per
   // session.
   std::optional<Site> site_adopted;
-  // The origin this frame re-centred the world on (the ownship's place, SessionSettings).
+  // The origin this message re-centred the world on (the ownship's place, SessionSettings).
   std::optional<Site> recentred;
 };
 
@@ -71,13 +71,13 @@ class Session {
   // Turns a decoded host message into commands, and keeps the state they lead to. The session
   // takes that state only once the daemon has applied the frame (commit), so that a refused
   // batch is sent again in full.
-  std::variant<HostFrame, Refusal> map(const Message& message);
+  std::variant<MappedMessage, Refusal> map(const Message& message);
   void commit();
   // After the daemon refused a frame (a target removed over the socket, say): what the session
   // believed applied is forgotten, so that the next packets place targets and set the wind,
   // the sun and the sea afresh (global weather is always passed on: the world ignores a layer
   // set again as it is). Frame numbers, the ownship and the views stay. The frame mapped last
-  // is dropped. Packets refused for their values (HostFrame::refused) leave the rest of the
+  // is dropped. Packets refused for their values (MappedMessage::refused) leave the rest of the
   // frame applied.
   void forget();
 
@@ -123,7 +123,12 @@ class Session {
     // The database origin: [site], or the host's first position, re-centred as the ownship flies.
     std::optional<Site> site;
   };
-  std::variant<State, Refusal> next(const Message& message, HostFrame& frame) const;
+  class Mapping;  // one message's packets onto the state and commands they lead to
+
+  std::variant<State, Refusal> next(const Message& message, MappedMessage& mapped) const;
+  std::optional<Refusal> takeFrameNumber(const IgControl& control, State& s,
+                                         MappedMessage& mapped) const;
+  std::optional<Site> recentredSite(const State& s, const EntityControl* ownship) const;
   std::optional<Pose> poseOf(const State& state, std::uint16_t entity, int depth = 0) const;
 
   // Geodetic positions to the database's east, north, up metres about the state's site (MODEL.md

@@ -102,7 +102,7 @@ void CigiServer::next() {
     answer(r->control, message.order, d.from, r->status);
     return next();
   }
-  cigi::HostFrame& frame = std::get<cigi::HostFrame>(mapped);
+  cigi::MappedMessage& frame = std::get<cigi::MappedMessage>(mapped);
   for (const std::string& what : frame.ignored) {
     engine_.countCigi("ignored");
     spdlog::debug("event=cigi_ignored what=\"{}\"", what);

@@ -146,9 +146,9 @@ class SeaSession : public ::testing::Test {
   // The set_sea commands of a host frame, which the daemon then applies.
   std::vector<command::SetSea> frame(std::initializer_list<std::vector<std::uint8_t>> packets) {
     auto mapped = session_.map(decoded(message(++frame_, packets)));
-    EXPECT_TRUE(std::holds_alternative<HostFrame>(mapped));
-    if (!std::holds_alternative<HostFrame>(mapped)) return {};
-    last_ = std::get<HostFrame>(mapped);
+    EXPECT_TRUE(std::holds_alternative<MappedMessage>(mapped));
+    if (!std::holds_alternative<MappedMessage>(mapped)) return {};
+    last_ = std::get<MappedMessage>(mapped);
     session_.commit();
     std::vector<command::SetSea> out;
     for (const Command& c : last_.commands)
@@ -158,7 +158,7 @@ class SeaSession : public ::testing::Test {
 
   Session session_;
   std::uint32_t frame_ = 0;
-  HostFrame last_;
+  MappedMessage last_;
 };
 
 TEST_F(SeaSession, MaritimeSurfaceConditionsSetTheSeaWhenTheyChange) {

@@ -82,8 +82,8 @@ class HostedWorld {
     a.wind_direction = 270.0f;
     m.packets.push_back(a);
     auto mapped = session_.map(m);
-    ASSERT_TRUE(std::holds_alternative<cigi::HostFrame>(mapped));
-    const cigi::HostFrame& f = std::get<cigi::HostFrame>(mapped);
+    ASSERT_TRUE(std::holds_alternative<cigi::MappedMessage>(mapped));
+    const cigi::MappedMessage& f = std::get<cigi::MappedMessage>(mapped);
     ASSERT_TRUE(f.refused.empty()) << f.refused.front();
     if (f.recentred) ++recentrings_;
     for (const Command& c : f.commands) {
