@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "protocol/messages.h"
-#include "protocol/modbus_frame.h"
+#include "protocol/modbus_adu.h"
 
 namespace nephele {
 

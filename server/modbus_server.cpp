@@ -34,6 +34,35 @@ bool sendAll(int fd, const std::vector<std::uint8_t>& bytes) {
   return true;
 }
 
+// A client that does not read its replies is dropped rather than blocking its thread.
+void setSendTimeout(int fd, double seconds) {
+  const auto send_timeout = secondsToDuration(seconds);
+  timeval tv{};
+  tv.tv_sec = std::chrono::duration_cast<std::chrono::seconds>(send_timeout).count();
+  tv.tv_usec =
+      long(std::chrono::duration_cast<std::chrono::microseconds>(send_timeout).count() % 1000000);
+  setsockopt(fd, SOL_SOCKET, SO_SNDTIMEO, &tv, sizeof tv);
+}
+
+// One ADU arriving from a stream: the MBAP header first, then exactly the PDU it announces,
+// reading no further (the next request stays in the socket).
+struct AduAssembly {
+  std::array<std::uint8_t, ModbusAdu::kMaxAduBytes> bytes{};
+  std::size_t have = 0;  // bytes received
+  MbapHeader header;     // once `have` reaches the header's size
+
+  std::size_t wanted() const {
+    return have < ModbusAdu::kHeaderBytes ? ModbusAdu::kHeaderBytes
+                                          : ModbusAdu::kHeaderBytes + header.pduBytes();
+  }
+  bool complete() const {
+    return have >= ModbusAdu::kHeaderBytes && have >= ModbusAdu::kHeaderBytes + header.pduBytes();
+  }
+  std::span<const std::uint8_t> pdu() const {
+    return {bytes.data() + ModbusAdu::kHeaderBytes, header.pduBytes()};
+  }
+};
+
 }  // namespace
 
 bool ModbusServer::ClientState::connectionOver() {
@@ -178,18 +207,9 @@ void ModbusServer::serveClient(int fd, const std::string& peer, ClientState& sta
   ++engine_.modbus_clients;
   if (listenerLog().admit("modbus_connected")) spdlog::info("event=modbus_connected peer={}", peer);
   const Timeouts& timeouts = engine_.config().modbus_timeouts;
-  // A client that does not read its replies is dropped rather than blocking this thread.
-  const auto send_timeout = secondsToDuration(timeouts.request_s);
-  timeval tv{};
-  tv.tv_sec = std::chrono::duration_cast<std::chrono::seconds>(send_timeout).count();
-  tv.tv_usec =
-      long(std::chrono::duration_cast<std::chrono::microseconds>(send_timeout).count() % 1000000);
-  setsockopt(fd, SOL_SOCKET, SO_SNDTIMEO, &tv, sizeof tv);
-
-  std::array<std::uint8_t, ModbusFrame::kMaxAduBytes> frame{};
-  std::size_t have = 0;  // bytes of the current frame received
-  MbapHeader header;
-  Clock::time_point started;  // when the current frame's first byte arrived
+  setSendTimeout(fd, timeouts.request_s);
+  AduAssembly adu;
+  Clock::time_point started;  // when the current ADU's first byte arrived
   Clock::time_point last_activity = Clock::now();
   const char* why = "stop";
   while (!stop_) {
@@ -198,34 +218,31 @@ void ModbusServer::serveClient(int fd, const std::string& peer, ClientState& sta
       break;
     }
     const auto now = Clock::now();
-    if (have > 0 && now - started > secondsToDuration(timeouts.request_s)) {
+    if (adu.have > 0 && now - started > secondsToDuration(timeouts.request_s)) {
       why = "request_timeout";
       break;
     }
-    if (have == 0 && timeouts.idle_s > 0.0 &&
+    if (adu.have == 0 && timeouts.idle_s > 0.0 &&
         now - last_activity > secondsToDuration(timeouts.idle_s)) {
       why = "idle_timeout";
       break;
     }
     pollfd p{fd, POLLIN, 0};
     if (poll(&p, 1, kPollMs) <= 0) continue;
-    // Read no further than the frame: the header first, then exactly what it announces.
-    const std::size_t wanted =
-        have < ModbusFrame::kHeaderBytes ? ModbusFrame::kHeaderBytes : 7 + header.pduBytes();
-    const ssize_t n = ::recv(fd, frame.data() + have, wanted - have, 0);
+    const ssize_t n = ::recv(fd, adu.bytes.data() + adu.have, adu.wanted() - adu.have, 0);
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) {
       why = n == 0 ? "closed" : "read_error";
       break;
     }
-    if (have == 0) {
+    if (adu.have == 0) {
       started = Clock::now();
       state.mid_request = true;
     }
-    have += std::size_t(n);
-    if (have == ModbusFrame::kHeaderBytes) {
+    adu.have += std::size_t(n);
+    if (adu.have == ModbusAdu::kHeaderBytes) {
       auto decoded = decodeMbapHeader(
-          std::span<const std::uint8_t, ModbusFrame::kHeaderBytes>(frame.data(), 7));
+          std::span<const std::uint8_t, ModbusAdu::kHeaderBytes>(adu.bytes.data(), 7));
       if (auto* e = std::get_if<std::string>(&decoded)) {
         // The stream cannot be framed past this header: close rather than guess.
         if (listenerLog().admit("modbus_bad_frame"))
@@ -234,16 +251,15 @@ void ModbusServer::serveClient(int fd, const std::string& peer, ClientState& sta
         why = "bad_frame";
         break;
       }
-      header = std::get<MbapHeader>(decoded);
+      adu.header = std::get<MbapHeader>(decoded);
     }
-    if (have < ModbusFrame::kHeaderBytes || have < 7 + header.pduBytes()) continue;
-    const std::span<const std::uint8_t> pdu(frame.data() + 7, header.pduBytes());
-    auto request = decodeModbusPdu(header, pdu);
+    if (!adu.complete()) continue;
+    auto request = decodeModbusPdu(adu.header, adu.pdu());
     const std::vector<std::uint8_t> reply =
         std::holds_alternative<ModbusRequest>(request)
             ? answer(std::get<ModbusRequest>(request))
-            : refuse(header, std::get<ModbusException>(request));
-    have = 0;
+            : refuse(adu.header, std::get<ModbusException>(request));
+    adu.have = 0;
     state.mid_request = false;
     last_activity = Clock::now();
     state.last_activity = last_activity.time_since_epoch().count();

@@ -1,6 +1,6 @@
 #pragma once
 // Modbus TCP for the host simulator, register map in protocol/MODBUS.md, frames decoded by
-// protocol/modbus_frame.h. Each client has its own thread, so a slow or half-written request
+// protocol/modbus_adu.h. Each client has its own thread, so a slow or half-written request
 // holds up only its sender; request and idle timeouts, and room made at the client limit by
 // ending connections whose peer has closed them and then the idlest, keep a few clients from
 // starving the rest (docs/RELIABILITY.md). Writes are decoded and checked before anything
@@ -14,7 +14,7 @@
 #include <thread>
 #include <vector>
 
-#include "protocol/modbus_frame.h"
+#include "protocol/modbus_adu.h"
 #include "protocol/register_map.h"
 #include "server/engine.h"
 

@@ -12,7 +12,7 @@
 #include "protocol/cigi.h"
 #include "protocol/cigi_session.h"
 #include "protocol/messages.h"
-#include "protocol/modbus_frame.h"
+#include "protocol/modbus_adu.h"
 #include "protocol/register_map.h"
 #include "tests/fuzz/world_work.h"
 #include "world/formations/weather.h"
@@ -49,14 +49,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   if (selector % 4 == 3) {
     // A stream of Modbus TCP frames, framed the way the server frames them.
-    while (size >= ModbusFrame::kHeaderBytes) {
-      auto header = decodeMbapHeader(std::span<const std::uint8_t, ModbusFrame::kHeaderBytes>(
-          data, ModbusFrame::kHeaderBytes));
+    while (size >= ModbusAdu::kHeaderBytes) {
+      auto header = decodeMbapHeader(std::span<const std::uint8_t, ModbusAdu::kHeaderBytes>(
+          data, ModbusAdu::kHeaderBytes));
       if (std::holds_alternative<std::string>(header)) return 0;  // the server closes
       const MbapHeader& h = std::get<MbapHeader>(header);
-      if (size < ModbusFrame::kHeaderBytes + h.pduBytes()) return 0;
+      if (size < ModbusAdu::kHeaderBytes + h.pduBytes()) return 0;
       const auto request =
-          decodeModbusPdu(h, std::span(data + ModbusFrame::kHeaderBytes, h.pduBytes()));
+          decodeModbusPdu(h, std::span(data + ModbusAdu::kHeaderBytes, h.pduBytes()));
       std::vector<std::uint8_t> reply;
       if (const auto* r = std::get_if<ModbusRequest>(&request)) {
         const std::vector<std::uint16_t> registers(std::size_t(r->count), 0x1234);
@@ -72,10 +72,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         reply = encodeModbusException(h, std::get<ModbusException>(request));
       }
       // Every reply is one well-formed ADU no longer than the protocol allows.
-      if (reply.size() < ModbusFrame::kHeaderBytes + 2 || reply.size() > ModbusFrame::kMaxAduBytes)
+      if (reply.size() < ModbusAdu::kHeaderBytes + 2 || reply.size() > ModbusAdu::kMaxAduBytes)
         __builtin_trap();
-      data += ModbusFrame::kHeaderBytes + h.pduBytes();
-      size -= ModbusFrame::kHeaderBytes + h.pduBytes();
+      data += ModbusAdu::kHeaderBytes + h.pduBytes();
+      size -= ModbusAdu::kHeaderBytes + h.pduBytes();
     }
     return 0;
   }

@@ -16,7 +16,8 @@
 
 namespace nephele {
 
-struct ModbusFrame {
+// The sizes of an ADU (Implementation Guide section 3.1.3) and the quantities of its PDU.
+struct ModbusAdu {
   static constexpr std::size_t kHeaderBytes = 7;
   static constexpr std::size_t kMaxAduBytes = 260;
   static constexpr int kMinLength = 2;    // unit id and a function code
@@ -55,7 +56,7 @@ struct MbapHeader {
 // other than 0 or a length outside 2..254): then nothing after it can be trusted and the
 // connection must close.
 std::variant<MbapHeader, std::string> decodeMbapHeader(
-    std::span<const std::uint8_t, ModbusFrame::kHeaderBytes> bytes);
+    std::span<const std::uint8_t, ModbusAdu::kHeaderBytes> bytes);
 
 struct ModbusRequest {
   MbapHeader header;
