@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <map>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -121,16 +122,6 @@ inline Scene withClouds(const Scene& scene, std::vector<EllipsoidCloud> clouds) 
       fields, targets, automata, weather, rain_shafts, sea, site, content_origin};
 }
 
-// What the sea mirrors (MODEL.md section 18): the scene seen from the sea's surface under the
-// camera, without the sea and the targets.
-inline Scene seaProbeScene(const Scene& scene) {
-  Scene probe = withClouds(scene, scene.clouds);
-  probe.sea.reset();
-  probe.targets.clear();
-  probe.camera.position.z = 0.0;
-  return probe;
-}
-
 // Ellipsoids the scene's clouds hold (its fields' heaps are made per view and not counted).
 inline std::size_t ellipsoidCount(const Scene& scene) {
   std::size_t n = 0;
@@ -153,9 +144,17 @@ inline bool sceneHasAir(const Scene& scene) {
   return scene.fog || scene.haze || eyeInLayer(scene) || hasPrecipitation(scene);
 }
 
-// `scene` with its fields' heaps within heapRange(drawing.range_m) of its camera added to its
-// clouds, and, where the view reaches beyond that, a far deck standing for the rest
-// (MODEL.md sections 10 and 11); what every renderer draws.
+// What a scene's fields make for its camera (MODEL.md sections 10, 11 and 17): their heaps within
+// heapRange(drawing.range_m) of it, where the view reaches beyond that a far deck standing for
+// the rest, and the rain shafts in view (rainShaftsInView).
+struct FieldContent {
+  std::vector<EllipsoidCloud> heaps;
+  std::vector<CloudLayer> far_decks;
+  std::vector<RainShaft> rain_shafts;
+};
+FieldContent fieldContent(const Scene& scene, const HeapDrawing& drawing = {});
+// `scene` with its fields' content in their place: the heaps after its clouds, the far decks
+// after its layers (renderer/frame_plan.h borrows the scene instead of copying it).
 Scene withFieldClouds(const Scene& scene, const HeapDrawing& drawing = {});
 
 // A frame's work budget (issue 31; MODEL.md section 15), in two parts, both counted in
@@ -169,6 +168,11 @@ Scene withFieldClouds(const Scene& scene, const HeapDrawing& drawing = {});
 // dropped, and the clouds thinned share one texture seed. Nothing when the scene is within both.
 std::optional<Scene> withinEllipsoidBudget(const Scene& scene, double budget,
                                            double overdraw = 0.0);
+// The same for a list of clouds seen by `camera`: the clouds the budget leaves (copies, in the
+// list's order, empty ones dropped), or nothing when the list is within it.
+std::optional<std::vector<EllipsoidCloud>> cloudsWithinBudget(
+    std::span<const EllipsoidCloud* const> clouds, const Camera& camera, double budget,
+    double overdraw = 0.0);
 // The footprint of `e` in views of `camera` (the projected bounding square of its largest
 // radius, clipped to the view; 1 when it reaches the eye's plane; 0 behind or outside).
 double ellipsoidFootprint(const Ellipsoid& e, const Camera& camera, const ViewBasis& basis);

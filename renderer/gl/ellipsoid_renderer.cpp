@@ -526,16 +526,16 @@ std::string impostorKey(const Scene& scene, const EllipsoidCloud& cloud,
 
 }  // namespace
 
-void EllipsoidRenderer::drawClouds(const Scene& scene, const std::vector<std::size_t>& indices,
-                                   const RenderSettings& settings, const FrameTarget& target,
+void EllipsoidRenderer::drawClouds(const ViewPlan& view, const std::vector<std::size_t>& indices,
+                                   const RenderSettings& settings, const PassTarget& target,
                                    bool targets_drawn, const AltitudeBand& band) {
   // Batches in the order of their farthest cloud; impostors first, being far.
   std::vector<std::pair<std::string, std::vector<std::size_t>>> batches;
   for (std::size_t index : indices) {
     if (settings.impostor_tolerance_px > 0.0 &&
-        drawImpostor(scene, index, settings, target, targets_drawn, band))
+        drawImpostor(view, index, settings, target, targets_drawn, band))
       continue;
-    const std::string key = cloudLookKey(scene.clouds[index], settings);
+    const std::string key = cloudLookKey(view.cloud(index), settings);
     auto batch = std::find_if(batches.begin(), batches.end(),
                               [&](const auto& entry) { return entry.first == key; });
     if (batch == batches.end()) batch = batches.insert(batches.end(), {key, {}});
@@ -549,7 +549,7 @@ void EllipsoidRenderer::drawClouds(const Scene& scene, const std::vector<std::si
     std::ostringstream key;
     for (const auto& entry : batches) key << entry.first << '|';
     key << band.slabs.x << ',' << band.slabs.y << ',' << band.slabs.z << ',' << band.slabs.w;
-    beginBand(scene, key.str(), target, settings);
+    beginBand(*view.scene, key.str(), target, settings);
   }
   for (const auto& [key, members] : batches) {
     // Light batches queue their draws without waiting for them; once about kCancelWork has
@@ -561,14 +561,14 @@ void EllipsoidRenderer::drawClouds(const Scene& scene, const std::vector<std::si
       band_.cancelled = true;
       break;
     }
-    drawDirect(scene, members, settings, target, targets_drawn, band, key);
+    drawDirect(view, members, settings, target, targets_drawn, band, key);
   }
-  if (band_.history) finishBand(scene, target);
+  if (band_.history) finishBand(*view.scene, target);
   band_ = BandReuse{};
 }
 
 void EllipsoidRenderer::beginBand(const Scene& scene, const std::string& key,
-                                  const FrameTarget& target, const RenderSettings& settings) {
+                                  const PassTarget& target, const RenderSettings& settings) {
   const glm::ivec2 frame_size(target.width, target.height);
   HeapHistory& h = heapHistory(scene, key, frame_size);
   band_ = BandReuse{};
@@ -596,7 +596,7 @@ void EllipsoidRenderer::beginBand(const Scene& scene, const std::string& key,
   gl_.ClearNamedFramebufferfv(samples_framebuffer_.get(), GL_COLOR, 1, far);
 }
 
-void EllipsoidRenderer::finishBand(const Scene& scene, const FrameTarget& target) {
+void EllipsoidRenderer::finishBand(const Scene& scene, const PassTarget& target) {
   HeapHistory& h = *band_.history;
   h.valid = !band_.cancelled && !band_.broken;
   if (band_.cancelled) return;
@@ -651,10 +651,11 @@ void EllipsoidRenderer::finishBand(const Scene& scene, const FrameTarget& target
   h.drift = heapDrift(scene);
 }
 
-bool EllipsoidRenderer::drawImpostor(const Scene& scene, std::size_t index,
-                                     const RenderSettings& settings, const FrameTarget& target,
+bool EllipsoidRenderer::drawImpostor(const ViewPlan& plan, std::size_t index,
+                                     const RenderSettings& settings, const PassTarget& target,
                                      bool targets_drawn, const AltitudeBand& band) {
-  const EllipsoidCloud& cloud = scene.clouds[index];
+  const Scene& scene = *plan.scene;
+  const EllipsoidCloud& cloud = plan.cloud(index);
   const Camera& camera = scene.camera;
   const auto [centre, radius] = boundingSphere(cloud);
   const double distance = glm::length(centre - camera.position);
@@ -679,14 +680,20 @@ bool EllipsoidRenderer::drawImpostor(const Scene& scene, std::size_t index,
                      impostor.size >= size && parallax_px <= settings.impostor_tolerance_px;
   if (!fresh) {
     // Render the cloud alone from here, looking at its centre, into a square texture.
-    Scene view = scene;
+    // The plan's clouds, borrowed, seen from that camera.
+    auto own = std::make_unique<Scene>(withClouds(scene, {}));
+    Camera& looking = own->camera;
     const glm::dvec3 d = glm::normalize(centre - camera.position);
-    view.camera.position = camera.position;
-    view.camera.orientation = {glm::degrees(std::atan2(d.x, d.y)),
-                               glm::degrees(std::asin(std::clamp(d.z, -1.0, 1.0))), 0.0};
+    looking.position = camera.position;
+    looking.orientation = {glm::degrees(std::atan2(d.x, d.y)),
+                           glm::degrees(std::asin(std::clamp(d.z, -1.0, 1.0))), 0.0};
     const double half_angle = std::asin(std::min(1.0, radius / distance)) * 1.02;
-    view.camera.vfov_deg = glm::degrees(2.0 * half_angle);
-    view.camera.width = view.camera.height = size;
+    looking.vfov_deg = glm::degrees(2.0 * half_angle);
+    looking.width = looking.height = size;
+    ViewPlan view;
+    view.scene = own.get();
+    view.own = std::move(own);
+    view.clouds = plan.clouds;
     if (impostor.size != size || !impostor.texture) {
       createColourTarget(gl_, GL_RGBA16F, glm::ivec2(size), "impostor", impostor.texture,
                          impostor.framebuffer);
@@ -695,11 +702,11 @@ bool EllipsoidRenderer::drawImpostor(const Scene& scene, std::size_t index,
     gl_.ClearNamedFramebufferfv(impostor.framebuffer.get(), GL_COLOR, 0, clear);
     gl_.BindFramebuffer(GL_FRAMEBUFFER, impostor.framebuffer.get());
     gl_.Viewport(0, 0, size, size);
-    const FrameTarget impostor_target{impostor.framebuffer.get(), size, size};
+    const PassTarget impostor_target{impostor.framebuffer.get(), size, size};
     drawDirect(view, {index}, settings, impostor_target, false, AltitudeBand{}, "");
     gl_.BindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
     gl_.Viewport(0, 0, target.width, target.height);
-    const ViewBasis basis = viewBasis(view.camera);
+    const ViewBasis basis = viewBasis(view.camera());
     impostor.key = key;
     impostor.eye = camera.position;
     impostor.centre = centre;
@@ -737,7 +744,7 @@ bool EllipsoidRenderer::drawImpostor(const Scene& scene, std::size_t index,
   return true;
 }
 
-bool EllipsoidRenderer::drawWithHistory(const FrameTarget& target, bool accumulate,
+bool EllipsoidRenderer::drawWithHistory(const PassTarget& target, bool accumulate,
                                         const std::function<bool()>& draw) {
   // Drawn over the frame and, as it is, into the band's next history in the same pass:
   // blended "over" what the band's batches before left there (a batch's exact walk), or
@@ -756,12 +763,13 @@ bool EllipsoidRenderer::drawWithHistory(const FrameTarget& target, bool accumula
   return done;
 }
 
-void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::size_t>& indices,
-                                   const RenderSettings& settings, const FrameTarget& target,
+void EllipsoidRenderer::drawDirect(const ViewPlan& view, const std::vector<std::size_t>& indices,
+                                   const RenderSettings& settings, const PassTarget& target,
                                    bool targets_drawn, const AltitudeBand& band,
                                    const std::string& batch) {
+  const Scene& scene = *view.scene;
   // The clouds look alike: the first one's texture and shading stand for all of them.
-  const EllipsoidCloud& cloud = scene.clouds[indices.front()];
+  const EllipsoidCloud& cloud = view.cloud(indices.front());
   // One of a continuous view's band of batches (an impostor's picture, `batch` empty, is not).
   HeapHistory* history = batch.empty() ? nullptr : band_.history;
   // Visible ellipsoids with the back-to-front key (the front-to-back key, the nearest a hit
@@ -780,7 +788,7 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
     std::vector<Visible> out;
     std::size_t seen = 0;
     for (std::size_t m = from; m < to; ++m) {
-      const EllipsoidCloud& member = scene.clouds[indices[m]];
+      const EllipsoidCloud& member = view.cloud(indices[m]);
       const std::vector<HeapEnvelope> envelopes = heapEnvelopes(member);
       for (std::size_t i = 0; i < member.ellipsoids.size(); ++i) {
         if (++seen % kCancelRecords == 0 &&
@@ -806,7 +814,7 @@ void EllipsoidRenderer::drawDirect(const Scene& scene, const std::vector<std::si
     return out;
   };
   int total = 0;
-  for (std::size_t index : indices) total += int(scene.clouds[index].ellipsoids.size());
+  for (std::size_t index : indices) total += int(view.cloud(index).ellipsoids.size());
   const int threads =
       std::clamp(std::min(int(std::thread::hardware_concurrency()), total / kRecordsPerThread), 1,
                  std::min(kRecordThreads, int(indices.size())));
@@ -1212,7 +1220,7 @@ void EllipsoidRenderer::prepareAtlas(TileFormat format) {
 void EllipsoidRenderer::drawTiles(const Scene& scene, const EllipsoidCloud& cloud,
                                   CachedTexture& texture, const EllipsoidPassLayout& base,
                                   const RenderSettings& settings,
-                                  std::vector<EllipsoidRecord>& records, const FrameTarget& target,
+                                  std::vector<EllipsoidRecord>& records, const PassTarget& target,
                                   const AltitudeBand& band) {
   prepareAtlas(settings.tile_format);
   // Tile sizes: the screen rectangle rounded up to powers of two, or the fixed knob.
@@ -1265,7 +1273,7 @@ void EllipsoidRenderer::renderAtlasBatch(const Scene& scene, const EllipsoidClou
                                          const EllipsoidPassLayout& base,
                                          const RenderSettings& settings,
                                          std::vector<EllipsoidRecord>& records,
-                                         std::vector<Tile>& tiles, const FrameTarget& target,
+                                         std::vector<Tile>& tiles, const PassTarget& target,
                                          const AltitudeBand& band) {
   for (const Tile& t : tiles) records[t.record].v[15] = glm::vec4(t.x, t.y, t.width, t.height);
   uploadRecords(records);
@@ -1351,14 +1359,14 @@ void EllipsoidRenderer::renderAtlasBatch(const Scene& scene, const EllipsoidClou
   }
 }
 
-Veil EllipsoidRenderer::veil(const Scene& scene, const RenderSettings& settings) {
-  if (scene.clouds.empty()) return {};
+Veil EllipsoidRenderer::veil(const ViewPlan& view, const RenderSettings& settings) {
+  if (view.clouds.empty()) return {};
   return inCloudVeil(
-      scene.clouds,
+      view.clouds,
       [&](std::size_t c) -> const SolidTexture& {
-        return *cachedTexture(scene.clouds[c].texture, settings).source;
+        return *cachedTexture(view.cloud(c).texture, settings).source;
       },
-      scene.camera.position, scene.sun);
+      view.camera().position, view.scene->sun);
 }
 
 void EllipsoidRenderer::drawVeil(const Veil& veil) {

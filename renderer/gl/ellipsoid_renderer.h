@@ -10,6 +10,7 @@
 
 #include <glm/glm.hpp>
 
+#include "renderer/frame_plan.h"
 #include "renderer/gl/ellipsoid_shaders.h"
 #include "renderer/gl/frame_stats.h"
 #include "renderer/gl/gl_objects.h"
@@ -24,7 +25,7 @@ namespace nephele {
 // Where a pass draws: the framebuffer, its size, and the fraction of what is drawn there that
 // the final image shows (the transmittance of the in-cloud veil drawn over the frame; 1 for an
 // impostor, which later frames reuse under other veils).
-struct FrameTarget {
+struct PassTarget {
   GLuint framebuffer = 0;
   int width = 0;
   int height = 0;
@@ -55,7 +56,7 @@ class EllipsoidRenderer {
   void beginFrame(FrameStats& stats, GpuPassTimer& timer, const std::string& continuous_view = {});
   void endFrame();
 
-  // Draws clouds `indices` of the scene (back to front by their distance) "over" what
+  // Draws clouds `indices` of the view's list (back to front by their distance) "over" what
   // `target` holds, blending premultiplied. `targets_drawn`: the target colour and distance
   // textures are bound. A far cloud may be drawn from its impostor
   // (RenderSettings::impostor_tolerance_px); the others are drawn in batches of clouds that
@@ -63,8 +64,8 @@ class EllipsoidRenderer {
   // composites every hit of the batch in depth order; the centre and multipass passes blend
   // its ellipsoids back to front). Only the surfaces in `band` are drawn, so that a layer
   // can cut through the clouds.
-  void drawClouds(const Scene& scene, const std::vector<std::size_t>& indices,
-                  const RenderSettings& settings, const FrameTarget& target, bool targets_drawn,
+  void drawClouds(const ViewPlan& view, const std::vector<std::size_t>& indices,
+                  const RenderSettings& settings, const PassTarget& target, bool targets_drawn,
                   const AltitudeBand& band = {});
 
   // The sunlight the clouds above let through (MODEL.md section 16), which each lobe takes at
@@ -94,7 +95,7 @@ class EllipsoidRenderer {
 
   // The in-cloud veil at the eye (MODEL.md section 4), and the pass that draws it over the
   // whole frame (none when its opacity is 0).
-  Veil veil(const Scene& scene, const RenderSettings& settings);
+  Veil veil(const ViewPlan& view, const RenderSettings& settings);
   void drawVeil(const Veil& veil);
 
  private:
@@ -158,12 +159,12 @@ class EllipsoidRenderer {
 
   // Clouds `indices`, which look alike, drawn from their ellipsoids in one batch; `batch` is
   // their look (empty for an impostor's picture, which has no history).
-  void drawDirect(const Scene& scene, const std::vector<std::size_t>& indices,
-                  const RenderSettings& settings, const FrameTarget& target, bool targets_drawn,
+  void drawDirect(const ViewPlan& view, const std::vector<std::size_t>& indices,
+                  const RenderSettings& settings, const PassTarget& target, bool targets_drawn,
                   const AltitudeBand& band, const std::string& batch);
   // False when the cloud is too near for an impostor; then the caller draws it directly.
-  bool drawImpostor(const Scene& scene, std::size_t index, const RenderSettings& settings,
-                    const FrameTarget& target, bool targets_drawn, const AltitudeBand& band);
+  bool drawImpostor(const ViewPlan& view, std::size_t index, const RenderSettings& settings,
+                    const PassTarget& target, bool targets_drawn, const AltitudeBand& band);
   GLuint program(const EllipsoidPassLayout& layout);
   CachedTexture& cachedTexture(const SolidTextureSpec& spec, const RenderSettings& settings);
   // Binds the texture's tables (the baked Gardner sums, or a Perlin table), baking them first
@@ -179,12 +180,12 @@ class EllipsoidRenderer {
   void uploadRecords(const std::vector<EllipsoidRecord>& records);
   void drawTiles(const Scene& scene, const EllipsoidCloud& cloud, CachedTexture& texture,
                  const EllipsoidPassLayout& base, const RenderSettings& settings,
-                 std::vector<EllipsoidRecord>& records, const FrameTarget& target,
+                 std::vector<EllipsoidRecord>& records, const PassTarget& target,
                  const AltitudeBand& band);
   void renderAtlasBatch(const Scene& scene, const EllipsoidCloud& cloud,
                         const CachedTexture& texture, const EllipsoidPassLayout& base,
                         const RenderSettings& settings, std::vector<EllipsoidRecord>& records,
-                        std::vector<Tile>& tiles, const FrameTarget& target,
+                        std::vector<Tile>& tiles, const PassTarget& target,
                         const AltitudeBand& band);
   void prepareAtlas(TileFormat format);
   // The per-pixel pass's samples texture (RGBA16F) and their distances (R32F), and their
@@ -223,14 +224,14 @@ class EllipsoidRenderer {
     bool cancelled = false;          // a batch was cancelled: nothing is resolved or kept
     bool broken = false;             // a batch drew straight into the frame: not kept
   };
-  void beginBand(const Scene& scene, const std::string& key, const FrameTarget& target,
+  void beginBand(const Scene& scene, const std::string& key, const PassTarget& target,
                  const RenderSettings& settings);
   // `draw` over the frame and into the band's next history; false when it was cancelled.
-  bool drawWithHistory(const FrameTarget& target, bool accumulate,
+  bool drawWithHistory(const PassTarget& target, bool accumulate,
                        const std::function<bool()>& draw);
   // A sample no batch hit (its distance texture's clear value; the resolve's "no hit").
   static constexpr float kNoSampleDistance = 3.4e38f;
-  void finishBand(const Scene& scene, const FrameTarget& target);
+  void finishBand(const Scene& scene, const PassTarget& target);
   BandReuse band_;
 
   const GlApi& gl_;

@@ -169,6 +169,18 @@ class CloudBands {
   std::vector<double> rising_, falling_;  // nearest first
 };
 
+// How a layer's sky passes read its texture. A rotated Gardner texture never repeats, so no
+// periodic table can hold it: it is read from a clipmap around the camera, or its sines are
+// summed per pixel when asked (and with a term filter other than the fade, which the rings are
+// built for).
+LayerKind layerKind(const LayerTexture& texture, const RenderSettings& settings) {
+  const bool sines = settings.texture_evaluation == TextureEvaluation::kProcedural;
+  return !texture.gardner()   ? LayerKind::kTable
+         : texture.periodic() ? (sines ? LayerKind::kProceduralGardner : LayerKind::kBakedGardner)
+         : sines || settings.term_filter != TermFilter::kFade ? LayerKind::kProceduralGardner
+                                                              : LayerKind::kClipmapGardner;
+}
+
 // Whether the GL rasterises on the CPU (Mesa's llvmpipe or softpipe).
 bool softwareGl(const std::string& renderer) {
   return renderer.find("llvmpipe") != std::string::npos ||
@@ -640,51 +652,37 @@ void GlRenderer::drawSkyGroup(const Scene& scene, const RenderSettings& settings
 void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
                            TargetFormat format) {
   const auto start = std::chrono::steady_clock::now();
-  FrameTimes times;
   timer_.beginFrame();
-  // Fields of heaps become the clouds around this camera (MODEL.md section 10).
-  std::optional<Scene> fielded;
-  if (!scene.fields.empty()) {
-    StageClock clock(times.cpu(CpuStage::kHeaps));
-    fielded = withFieldClouds(scene, settings.heaps);
-  }
-  const Scene& drawable = fielded ? *fielded : scene;
-  // The work budget, counted in ellipsoids and in views of their footprints (issue 31).
-  std::optional<Scene> within;
-  {
-    StageClock clock(times.cpu(CpuStage::kBudget));
-    within =
-        withinEllipsoidBudget(drawable, settings.ellipsoid_budget, settings.ellipsoid_overdraw);
-  }
+  FramePlanRequest request;
+  request.heaps = settings.heaps;
+  request.ellipsoid_budget = settings.ellipsoid_budget;
+  request.ellipsoid_overdraw = settings.ellipsoid_overdraw;
+  request.sea_probe = SeaProbe::kView;
+  request.sea_probe_scale = settings.sea_probe_scale;
+  request.cull = true;
+  request.heap_shadows = settings.shadow_map_size > 0;
+  request.plane_shadows = settings.plane_shadows;
+  const FramePlan plan(scene, request);
   RenderSettings rest = settings;
-  if (within)
-    rest.ellipsoid_budget = rest.ellipsoid_overdraw = 0.0;  // the thinned scene is within it
+  if (plan.thinned)
+    rest.ellipsoid_budget = rest.ellipsoid_overdraw = 0.0;  // the plan's clouds are within it
   stats_ = {};
-  stats_.times = times;
-  {
-    // The ground's cloud shadows (MODEL.md section 16), from the scene's own fields: their
-    // heaps that shadow the view need not be in it. The same casters, and the casting planes,
-    // shadow the clouds and targets below them, each lobe and target at its centre.
-    StageClock clock(stats_.times.cpu(CpuStage::kShadows));
-    if (settings.shadow_map_size > 0)
-      heap_shadows_.emplace(scene, settings.heaps, /*lookups=*/true);
-    else
-      heap_shadows_.reset();
-    plane_shadows_ = settings.plane_shadows ? PlaneShadows(scene) : PlaneShadows();
-    sunlight_ = {&plane_shadows_, heap_shadows_ ? &*heap_shadows_ : nullptr};
-  }
-  shadow_map_.prepare(heap_shadows_ ? *heap_shadows_ : CloudShadows(), scene.camera.position,
-                      settings.shadow_map_size, stats_, timer_);
+  FrameTimes& t = stats_.times;
+  t.cpu(CpuStage::kHeaps) = plan.heaps_ms;
+  t.cpu(CpuStage::kBudget) = plan.budget_ms;
+  t.cpu(CpuStage::kShadows) = plan.shadows_ms;
+  // The ground's cloud shadows (MODEL.md section 16) and, with the casting planes, the shadows
+  // on the clouds and targets below them, each lobe and target at its centre.
+  sunlight_ = {&plan.plane_shadows, plan.heap_shadows ? &*plan.heap_shadows : nullptr};
+  shadow_map_.prepare(plan.heap_shadows ? *plan.heap_shadows : CloudShadows(),
+                      scene.camera.position, settings.shadow_map_size, stats_, timer_);
   ellipsoids_.setSunlight(&sunlight_);
-  drawSeaProbe(within ? *within : drawable, rest);
-  drawScene(within ? *within : drawable, rest, format);
+  drawSeaProbe(plan, rest);
+  drawView(plan.view, rest, format);
   ellipsoids_.setSunlight(nullptr);
-  sunlight_ = {};
-  plane_shadows_ = {};  // it points into `scene`
-  heap_shadows_.reset();
+  sunlight_ = {};  // it points into the plan
   sea_probe_ = false;
   timer_.enter(-1);
-  FrameTimes& t = stats_.times;
   t.submit_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count() -
       timer_.waitedMs();
@@ -695,47 +693,15 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
   t.cpu(CpuStage::kScene) = std::max(0.0, t.submit_ms - staged);
 }
 
-// The probe's camera: at the sea below the eye, looking where the view's rays are mirrored,
-// its field widened by kProbeMarginDeg for the waves' tilts, at half the view's resolution
-// (MODEL.md section 18, "what the sea mirrors").
-namespace {
-constexpr double kProbeMarginDeg = 20.0;
-Camera seaProbeCamera(const Camera& view, double scale) {
-  Camera probe = view;
-  probe.position.z = 0.0;
-  probe.orientation.pitch_deg = -view.orientation.pitch_deg;
-  probe.orientation.roll_deg = -view.orientation.roll_deg;
-  const double aspect = double(view.width) / view.height;
-  // The widened field must hold the view's diagonal: its vertical half angle from the diagonal's.
-  const double half =
-      std::atan(std::tan(0.5 * glm::radians(view.vfov_deg)) * std::sqrt(1.0 + aspect * aspect));
-  probe.vfov_deg = std::min(2.0 * glm::degrees(half) + 2.0 * kProbeMarginDeg, 160.0);
-  probe.width = std::max(32, int(std::lround(view.width * scale)));
-  probe.height = std::max(32, int(std::lround(probe.width / aspect)));
-  return probe;
-}
-}  // namespace
-
-void GlRenderer::drawSeaProbe(const Scene& scene, const RenderSettings& settings) {
+void GlRenderer::drawSeaProbe(const FramePlan& plan, const RenderSettings& settings) {
   sea_probe_ = false;
-  if (!scene.sea) return;
-  const Camera& camera = scene.camera;
-  const ViewBasis basis = viewBasis(camera);
-  // Only a view that shows the sea: some corner ray below the horizon.
-  bool below = false;
-  for (double u : {-1.0, 1.0})
-    for (double v : {-1.0, 1.0})
-      below |= basis.forward.z + u * basis.right.z * basis.tan_half_vfov * basis.aspect +
-                   v * basis.up.z * basis.tan_half_vfov <
-               0.0;
-  if (!below) return;
-  Scene probe = seaProbeScene(scene);
-  probe.camera = seaProbeCamera(camera, settings.sea_probe_scale);
+  if (!plan.sea_probe) return;
+  const ViewPlan& probe = *plan.sea_probe;
   const std::string view = continuous_view_;
   continuous_view_ = view.empty() ? view : view + "/sea probe";
-  drawScene(probe, settings, TargetFormat::kFloat);
+  drawView(probe, settings, TargetFormat::kFloat);
   continuous_view_ = view;
-  const int w = probe.camera.width, h = probe.camera.height;
+  const int w = probe.camera().width, h = probe.camera().height;
   if (!sea_probe_texture_ || sea_probe_width_ != w || sea_probe_height_ != h) {
     sea_probe_texture_ = createTexture2D(gl_, GL_RGBA32F, w, h);
     sea_probe_width_ = w;
@@ -743,7 +709,7 @@ void GlRenderer::drawSeaProbe(const Scene& scene, const RenderSettings& settings
   }
   gl_.CopyImageSubData(colour_buffer_.get(), GL_RENDERBUFFER, 0, 0, 0, 0, sea_probe_texture_.get(),
                        GL_TEXTURE_2D, 0, 0, 0, 0, w, h, 1);
-  const ViewBasis pb = viewBasis(probe.camera);
+  const ViewBasis pb = viewBasis(probe.camera());
   sea_probe_right_ = pb.right / (pb.tan_half_vfov * pb.aspect);
   sea_probe_up_ = pb.up / pb.tan_half_vfov;
   sea_probe_forward_ = pb.forward;
@@ -794,17 +760,40 @@ void GlRenderer::setSeaUniforms(GLuint p, const Scene& scene, const RenderSettin
   gl_.BindTextureUnit(6, sea_probe_texture_.get());
 }
 
-void GlRenderer::drawScene(const Scene& scene, const RenderSettings& settings,
-                           TargetFormat format) {
-  const Camera& camera = scene.camera;
+void GlRenderer::drawView(const ViewPlan& view, const RenderSettings& settings,
+                          TargetFormat format) {
+  const Camera& camera = view.camera();
   prepareTarget(camera.width, camera.height, format);
+  const bool targets = drawTargetsPass(view);
+  beginView(camera, format);
+  // The eye deep in a cloud: its veil hides what lies behind to within the per-pixel pass's
+  // opacity cut, so no sky or cloud pass is drawn under it (MODEL.md section 4).
+  const Veil veil = ellipsoids_.veil(view, settings);
+  if (veil.opacity >= kOpaqueCoverage) {
+    const GLfloat nothing[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+    gl_.ClearNamedFramebufferfv(framebuffer_.get(), GL_COLOR, 0, nothing);
+    return endView(veil);
+  }
+  LayerSides sides = layerSides(view, settings);
+  prepareClipmaps(view, settings, sides);
+  drawBands(view, settings, sides, cloudOrder(view, sides), veil, targets);
+  endView(veil);
+}
+
+bool GlRenderer::drawTargetsPass(const ViewPlan& view) {
   // Opaque targets first, into their own colour and distance textures.
+  const Scene& scene = *view.scene;
+  if (scene.targets.empty()) return false;
   bool targets = false;
-  if (!scene.targets.empty()) {
+  {
     GpuPassScope pass(timer_, GpuPass::kTargets);
     targets = targets_.draw(scene, sunlight_);
   }
   if (targets) stats_.target_passes = int(scene.targets.size());
+  return targets;
+}
+
+void GlRenderer::beginView(const Camera& camera, TargetFormat format) {
   gl_.BindFramebuffer(GL_FRAMEBUFFER, framebuffer_.get());
   gl_.Viewport(0, 0, camera.width, camera.height);
   gl_.BindVertexArray(vertex_array_.get());
@@ -816,54 +805,43 @@ void GlRenderer::drawScene(const Scene& scene, const RenderSettings& settings,
   ellipsoids_.beginFrame(stats_, timer_, continuous_view_);
   automata_.beginFrame(stats_);
   clipmaps_.beginFrame();
-  auto finish = [&](const Veil& veil) {
-    if (veil.opacity > 0.0) {
-      GpuPassScope pass(timer_, GpuPass::kVeil);
-      ellipsoids_.drawVeil(veil);
-    }
-    gl_.Disable(GL_BLEND);
-    ellipsoids_.endFrame();
-    automata_.endFrame();
-    clipmaps_.endFrame();
-    // Of the layer textures no layer of this frame drew, those without a baked table go,
-    // and of the baked, all but the kKeptTextures drawn most recently.
-    std::erase_if(textures_, [&](const auto& entry) {
-      return entry.second.last_frame != frame_ && !entry.second.texture;
-    });
-    keepMostRecent(textures_, kKeptTextures, frame_);
-  };
-  // The eye deep in a cloud: its veil hides what lies behind to within the per-pixel pass's
-  // opacity cut, so no sky or cloud pass is drawn under it (MODEL.md section 4).
-  const Veil veil = ellipsoids_.veil(scene, settings);
-  if (veil.opacity >= kOpaqueCoverage) {
-    const GLfloat nothing[4] = {0.0f, 0.0f, 0.0f, 0.0f};
-    gl_.ClearNamedFramebufferfv(framebuffer_.get(), GL_COLOR, 0, nothing);
-    return finish(veil);
-  }
+}
 
+void GlRenderer::endView(const Veil& veil) {
+  if (veil.opacity > 0.0) {
+    GpuPassScope pass(timer_, GpuPass::kVeil);
+    ellipsoids_.drawVeil(veil);
+  }
+  gl_.Disable(GL_BLEND);
+  ellipsoids_.endFrame();
+  automata_.endFrame();
+  clipmaps_.endFrame();
+  // Of the layer textures no layer of this frame drew, those without a baked table go,
+  // and of the baked, all but the kKeptTextures drawn most recently.
+  std::erase_if(textures_, [&](const auto& entry) {
+    return entry.second.last_frame != frame_ && !entry.second.texture;
+  });
+  keepMostRecent(textures_, kKeptTextures, frame_);
+}
+
+GlRenderer::LayerSides GlRenderer::layerSides(const ViewPlan& view,
+                                              const RenderSettings& settings) {
   // A ray meets only the layers on one side of the camera: above it from the highest down,
   // below it from the lowest up. Those orders are back to front.
+  const Scene& scene = *view.scene;
+  const Camera& camera = scene.camera;
   const double z = camera.position.z;
-  std::vector<LayerSlot> above, below;
+  LayerSides sides;
   for (const CloudLayer& layer : scene.layers) {
     if (layer.altitude_m == z) continue;  // seen edge-on: covers no pixel
     CachedTexture& texture = cachedTexture(layer.texture, settings);
-    // A rotated Gardner texture never repeats, so no periodic table can hold it: it is read
-    // from a clipmap around the camera, or its sines are summed per pixel when asked (and
-    // with a term filter other than the fade, which the rings are built for).
-    const bool sines = settings.texture_evaluation == TextureEvaluation::kProcedural;
-    const LayerKind kind = !texture.source->gardner() ? LayerKind::kTable
-                           : texture.source->periodic()
-                               ? (sines ? LayerKind::kProceduralGardner : LayerKind::kBakedGardner)
-                           : sines || settings.term_filter != TermFilter::kFade
-                               ? LayerKind::kProceduralGardner
-                               : LayerKind::kClipmapGardner;
-    (layer.altitude_m > z ? above : below).push_back({&layer, &texture, kind, {}});
+    (layer.altitude_m > z ? sides.above : sides.below)
+        .push_back({&layer, &texture, layerKind(*texture.source, settings), {}});
   }
-  std::sort(above.begin(), above.end(), [](const LayerSlot& a, const LayerSlot& b) {
+  std::sort(sides.above.begin(), sides.above.end(), [](const LayerSlot& a, const LayerSlot& b) {
     return a.layer->altitude_m > b.layer->altitude_m;
   });
-  std::sort(below.begin(), below.end(), [](const LayerSlot& a, const LayerSlot& b) {
+  std::sort(sides.below.begin(), sides.below.end(), [](const LayerSlot& a, const LayerSlot& b) {
     return a.layer->altitude_m < b.layer->altitude_m;
   });
   // The casting planes, taken before the hidden layers leave the passes: a layer behind a
@@ -871,7 +849,7 @@ void GlRenderer::drawScene(const Scene& scene, const RenderSettings& settings,
   casters_.clear();
   for (std::size_t index :
        settings.plane_shadows ? castingPlanes(scene) : std::vector<std::size_t>{})
-    for (const std::vector<LayerSlot>* side : {&above, &below})
+    for (const std::vector<LayerSlot>* side : {&sides.above, &sides.below})
       for (const LayerSlot& slot : *side)
         if (slot.layer == &scene.layers[index]) casters_.push_back(slot);
   // A layer that no texture value leaves translucent (opaque at T = 0, the least T, since
@@ -883,34 +861,39 @@ void GlRenderer::drawScene(const Scene& scene, const RenderSettings& settings,
     const CloudLayer& l = *slot.layer;
     return !layerHasRegion(l) && skyPlaneTranslucence(0.0, l.threshold, l.transition) == 0.0;
   };
-  for (std::vector<LayerSlot>* side : {&above, &below})  // each is nearest last
+  for (std::vector<LayerSlot>* side : {&sides.above, &sides.below})  // each is nearest last
     for (std::size_t k = side->size(); k-- > 1;)
       if (opaqueEverywhere((*side)[k])) {
         side->erase(side->begin(), side->begin() + std::ptrdiff_t(k));
         break;
       }
-  for (const std::vector<LayerSlot>* side : {&above, &below})
+  for (const std::vector<LayerSlot>* side : {&sides.above, &sides.below})
     for (const LayerSlot& slot : *side)
       if (const GardnerTexture* g = slot.texture->source->gardner()) {
         stats_.layer_terms +=
             layerTermsAtMost(*slot.layer, *slot.texture->source, camera, settings.term_filter);
         stats_.layer_terms_total += g->terms();
       }
+  return sides;
+}
 
+void GlRenderer::prepareClipmaps(const ViewPlan& view, const RenderSettings& settings,
+                                 LayerSides& sides) {
   // The clipmaps of the layers that read one, brought to this camera before any pass. `auto`
   // fills a layer's clipmap over the frames after the first that draws it from here, about a
   // frame's pixels of texels each, and reads the sines until it is whole (a single render never
   // pays for one); `baked` fills it at once.
+  const Camera& camera = view.camera();
   bool baked = false;
   const bool wait = settings.texture_evaluation == TextureEvaluation::kAuto;
   const std::int64_t budget =
       wait ? std::int64_t(camera.width) * camera.height : std::numeric_limits<std::int64_t>::max();
-  for (std::vector<LayerSlot>* side : {&above, &below})
+  for (std::vector<LayerSlot>* side : {&sides.above, &sides.below})
     for (LayerSlot& slot : *side)
       if (slot.kind == LayerKind::kClipmapGardner) {
         const LayerTexture& t = *slot.texture->source;
         const glm::dvec2 eye =
-            glm::dvec2(camera.position) - t.driftOffset(scene.time_s, slot.layer->texture);
+            glm::dvec2(camera.position) - t.driftOffset(view.scene->time_s, slot.layer->texture);
         GpuPassScope pass(timer_, GpuPass::kClipmaps);
         StageClock clock(stats_.times.cpu(CpuStage::kUploads));
         slot.clipmap =
@@ -923,31 +906,27 @@ void GlRenderer::drawScene(const Scene& scene, const RenderSettings& settings,
     gl_.BindFramebuffer(GL_FRAMEBUFFER, framebuffer_.get());
     gl_.Viewport(0, 0, camera.width, camera.height);
   }
-
   // A casting plane reads the clipmap its drawn slot filled, or, left out of the passes, its
   // sines.
   for (LayerSlot& caster : casters_) {
     if (caster.kind != LayerKind::kClipmapGardner) continue;
     caster.kind = LayerKind::kProceduralGardner;
-    for (const std::vector<LayerSlot>* side : {&above, &below})
+    for (const std::vector<LayerSlot>* side : {&sides.above, &sides.below})
       for (const LayerSlot& slot : *side)
         if (slot.layer == caster.layer) caster = slot;
   }
+}
 
+std::vector<GlRenderer::CloudEntry> GlRenderer::cloudOrder(const ViewPlan& view,
+                                                           const LayerSides& sides) {
   // Interleave clouds with the layers (docs/MODEL.md, "Compositing order"). On each side of
   // the camera, band b holds what lies beyond the b nearest layers of that side and before
   // the next; surfaces in band b are drawn after the layers beyond them and before the b
   // layers in front. A cloud whose altitudes span several bands is drawn once per band,
   // each time keeping only its surfaces in that band, so a layer cuts through it. Clouds
   // in one band go back to front by distance.
-  const CloudBands bands(above, below, z);
-  struct CloudEntry {
-    bool automaton;
-    std::size_t index;
-    int band;
-    double distance;
-    AltitudeBand window;
-  };
+  const Camera& camera = view.camera();
+  const CloudBands bands(sides.above, sides.below, camera.position.z);
   std::vector<CloudEntry> clouds;
   auto addCloud = [&](bool automaton, std::size_t index, glm::dvec3 centre, double z_lo,
                       double z_hi) {
@@ -956,32 +935,32 @@ void GlRenderer::drawScene(const Scene& scene, const RenderSettings& settings,
     for (const CloudBands::Piece& piece : pieces)
       clouds.push_back({automaton, index, piece.band, distance, piece.window});
   };
-  // A cloud whose bounding box is wholly outside the view frustum is left out before any of
-  // its ellipsoids is projected (the eye inside one is the veil's business, drawn below).
-  const ViewBasis basis = viewBasis(camera);
-  for (std::size_t i = 0; i < scene.clouds.size(); ++i) {
-    const EllipsoidCloud& cloud = scene.clouds[i];
-    if (cloud.ellipsoids.empty()) continue;
-    if (const BoundingBox box = boundingBox(cloud);
-        !boxMayBeInView(basis, camera.position, box.lo, box.hi)) {
-      stats_.ellipsoids_culled += int(cloud.ellipsoids.size());
-      continue;
-    }
+  // The plan left out the clouds wholly outside the view frustum.
+  stats_.ellipsoids_culled += view.ellipsoids_culled;
+  for (std::size_t i : view.in_view) {
+    const EllipsoidCloud& cloud = view.cloud(i);
     glm::dvec3 centre(0.0);
     for (const Ellipsoid& e : cloud.ellipsoids) centre += e.centre;
     centre /= double(cloud.ellipsoids.size());
     const auto [z_lo, z_hi] = cloudVerticalExtent(cloud);
     addCloud(false, i, centre, z_lo, z_hi);
   }
-  for (std::size_t i = 0; i < scene.automata.size(); ++i) {
-    const AutomatonCloudView& cloud = scene.automata[i];
-    const glm::dvec3 lo = cloud.lowerBound(), hi = cloud.upperBound();
+  const std::vector<AutomatonCloudView>& automata = view.scene->automata;
+  for (std::size_t i = 0; i < automata.size(); ++i) {
+    const glm::dvec3 lo = automata[i].lowerBound(), hi = automata[i].upperBound();
     addCloud(true, i, 0.5 * (lo + hi), lo.z, hi.z);
   }
   std::sort(clouds.begin(), clouds.end(), [](const CloudEntry& a, const CloudEntry& b) {
     return a.band != b.band ? a.band > b.band : a.distance > b.distance;
   });
+  return clouds;
+}
 
+void GlRenderer::drawBands(const ViewPlan& view, const RenderSettings& settings,
+                           const LayerSides& sides, const std::vector<CloudEntry>& clouds,
+                           const Veil& veil, bool targets) {
+  const Scene& scene = *view.scene;
+  const std::vector<LayerSlot>&above = sides.above, &below = sides.below;
   std::vector<LayerSlot> pending_above, pending_below;
   bool background_pending = true;
   auto flushSky = [&] {
@@ -994,7 +973,8 @@ void GlRenderer::drawScene(const Scene& scene, const RenderSettings& settings,
     pending_above.clear();
     pending_below.clear();
   };
-  const FrameTarget frame{framebuffer_.get(), camera.width, camera.height, 1.0 - veil.opacity};
+  const Camera& camera = scene.camera;
+  const PassTarget frame{framebuffer_.get(), camera.width, camera.height, 1.0 - veil.opacity};
   const int top_band = int(std::max(
       {above.size(), below.size(), clouds.empty() ? std::size_t(0) : std::size_t(clouds[0].band)}));
   auto next_cloud = clouds.begin();
@@ -1016,7 +996,7 @@ void GlRenderer::drawScene(const Scene& scene, const RenderSettings& settings,
            ++next_cloud)
         run.push_back(next_cloud->index);
       GpuPassScope pass(timer_, GpuPass::kHeaps);
-      ellipsoids_.drawClouds(scene, run, settings, frame, targets, window);
+      ellipsoids_.drawClouds(view, run, settings, frame, targets, window);
     }
     // Then the layers of rank band - 1 (rank 0 is nearest the camera) on both sides.
     if (band >= 1) {
@@ -1025,7 +1005,6 @@ void GlRenderer::drawScene(const Scene& scene, const RenderSettings& settings,
     }
   }
   flushSky();
-  finish(veil);
 }
 
 }  // namespace nephele

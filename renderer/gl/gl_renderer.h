@@ -8,6 +8,7 @@
 
 #include "image/image.h"
 #include "renderer/frame.h"
+#include "renderer/frame_plan.h"
 #include "renderer/gl/automaton_renderer.h"
 #include "renderer/gl/ellipsoid_renderer.h"
 #include "renderer/gl/frame_stats.h"
@@ -95,13 +96,37 @@ class GlRenderer {
     ClipmapView clipmap;  // kClipmapGardner: the rings around this frame's camera
   };
 
-  // The frame's scene made drawable (fields to heaps, the work budget), then drawn; its CPU
-  // stages and GPU passes timed into stats_.times.
+  // Which layers a view's sky passes draw on each side of the camera, back to front.
+  struct LayerSides {
+    std::vector<LayerSlot> above, below;
+  };
+  // A cloud (an ellipsoid cloud of the view's list, or an automaton) in one band of the
+  // compositing order, with the band's window.
+  struct CloudEntry {
+    bool automaton;
+    std::size_t index;
+    int band;
+    double distance;
+    AltitudeBand window;
+  };
+
+  // The frame's plan (renderer/frame_plan.h), then its views drawn: the sea's probe, then the
+  // view; its CPU stages and GPU passes timed into stats_.times.
   void drawFrame(const Scene& scene, const RenderSettings& settings, TargetFormat format);
-  void drawScene(const Scene& scene, const RenderSettings& settings, TargetFormat format);
   // What the sea mirrors, drawn into sea_probe_texture_ before a view that shows the sea
-  // (MODEL.md section 18), and the sky pass's sea uniforms.
-  void drawSeaProbe(const Scene& scene, const RenderSettings& settings);
+  // (MODEL.md section 18); the sky pass's sea uniforms read it.
+  void drawSeaProbe(const FramePlan& plan, const RenderSettings& settings);
+  // One view of a plan, in its passes: targets, the in-cloud veil, the layers and their
+  // clipmaps, then the sky and the clouds band by band (drawBands).
+  void drawView(const ViewPlan& view, const RenderSettings& settings, TargetFormat format);
+  bool drawTargetsPass(const ViewPlan& view);  // false: none drawn
+  void beginView(const Camera& camera, TargetFormat format);
+  void endView(const Veil& veil);
+  LayerSides layerSides(const ViewPlan& view, const RenderSettings& settings);
+  void prepareClipmaps(const ViewPlan& view, const RenderSettings& settings, LayerSides& sides);
+  std::vector<CloudEntry> cloudOrder(const ViewPlan& view, const LayerSides& sides);
+  void drawBands(const ViewPlan& view, const RenderSettings& settings, const LayerSides& sides,
+                 const std::vector<CloudEntry>& clouds, const Veil& veil, bool targets);
   void setSeaUniforms(GLuint program, const Scene& scene, const RenderSettings& settings);
   // Waits for the frame's passes, collects their times, and reads the target back.
   void finishAndRead(int width, int height, GLenum type, void* out);
@@ -156,10 +181,8 @@ class GlRenderer {
   LayerClipmaps clipmaps_;
   TargetRenderer targets_;
   ShadowMap shadow_map_;
-  // The frame's shadows of the clouds on what lies below them (MODEL.md section 16), set while
-  // drawFrame draws.
-  std::optional<CloudShadows> heap_shadows_;
-  PlaneShadows plane_shadows_;
+  // The frame's shadows of the clouds on what lies below them (MODEL.md section 16), the plan's,
+  // set while drawFrame draws.
   SceneSunlight sunlight_;
 };
 

@@ -9,6 +9,7 @@
 #include <thread>
 #include <vector>
 
+#include "renderer/frame_plan.h"
 #include "renderer/renderer.h"
 #include "world/automaton/cloud_density.h"
 #include "world/formations/cloud_shadow.h"
@@ -81,33 +82,41 @@ struct EllipsoidEntry {
 
 class ReferenceTracer {
  public:
-  // `shadows`: the ground's cloud shadows (MODEL.md section 16), or null for none.
-  ReferenceTracer(const Scene& scene, const CloudShadows* shadows, int sea_waves = kSeaComponents)
-      : scene_(scene), sun_(sunDirection(scene.sun)), shadows_(shadows) {
+  // `view`: what the camera sees (renderer/frame_plan.h); `probe`: what the sea mirrors, the
+  // view's probe, or null for none; `shadows`: the ground's cloud shadows (MODEL.md section 16),
+  // or null for none.
+  ReferenceTracer(const ViewPlan& view, const ViewPlan* probe, const CloudShadows* shadows,
+                  int sea_waves = kSeaComponents)
+      : scene_(*view.scene),
+        clouds_(view.clouds),
+        sun_(sunDirection(scene_.sun)),
+        shadows_(shadows) {
+    const Scene& scene = scene_;
     textures_.reserve(scene.layers.size());
     for (const CloudLayer& layer : scene.layers) textures_.emplace_back(layer.texture);
-    solid_textures_.reserve(scene.clouds.size());
+    solid_textures_.reserve(clouds_.size());
     std::vector<const SolidTexture*> solid_pointers;
-    for (std::size_t c = 0; c < scene.clouds.size(); ++c) {
-      solid_pointers.push_back(&solid_textures_.emplace_back(scene.clouds[c].texture));
-      const std::vector<HeapEnvelope> envelopes = heapEnvelopes(scene.clouds[c]);
+    for (std::size_t c = 0; c < clouds_.size(); ++c) {
+      const EllipsoidCloud& cloud = view.cloud(c);
+      solid_pointers.push_back(&solid_textures_.emplace_back(cloud.texture));
+      const std::vector<HeapEnvelope> envelopes = heapEnvelopes(cloud);
       for (std::size_t i = 0; i < envelopes.size(); ++i) {
-        EllipsoidView view(scene.clouds[c].ellipsoids[i], scene.camera.position);
-        if (view.eyeInside()) continue;  // MODEL.md section 4: no surface to show
-        const double fade = surfaceFade(view.eyeRadius());
-        const Ellipsoid& e = scene.clouds[c].ellipsoids[i];
+        EllipsoidView ellipsoid(cloud.ellipsoids[i], scene.camera.position);
+        if (ellipsoid.eyeInside()) continue;  // MODEL.md section 4: no surface to show
+        const double fade = surfaceFade(ellipsoid.eyeRadius());
+        const Ellipsoid& e = cloud.ellipsoids[i];
         if (fade > 0.0)
-          ellipsoids_.push_back({view, c, fade, envelopes[i], e.centre.z + verticalHalfExtent(e)});
+          ellipsoids_.push_back(
+              {ellipsoid, c, fade, envelopes[i], e.centre.z + verticalHalfExtent(e)});
       }
     }
     veil_ = inCloudVeil(
-        scene.clouds, [&](std::size_t c) -> const SolidTexture& { return *solid_pointers[c]; },
+        clouds_, [&](std::size_t c) -> const SolidTexture& { return *solid_pointers[c]; },
         scene.camera.position, scene.sun);
     if (scene.sea) {
       sea_.emplace(*scene.sea, sea_waves);
       pixel_rad_ = seaPixelAngle(scene.camera.vfov_deg, scene.camera.height);
-      probe_scene_ = seaProbeScene(scene);
-      probe_ = std::make_unique<ReferenceTracer>(*probe_scene_, shadows);
+      if (probe) probe_ = std::make_unique<ReferenceTracer>(*probe, nullptr, shadows);
     }
   }
 
@@ -251,9 +260,9 @@ class ReferenceTracer {
   }
 
   Surface ellipsoidSurface(const EllipsoidEntry& entry, glm::dvec3 direction, double s) const {
-    const EllipsoidCloud& cloud = scene_.clouds[entry.cloud];
+    const EllipsoidCloud& cloud = *clouds_[entry.cloud];
     const glm::dvec3 p = scene_.camera.position + s * direction;
-    const double t = solid_textures_[entry.cloud].value(p - scene_.clouds[entry.cloud].drift_m);
+    const double t = solid_textures_[entry.cloud].value(p - cloud.drift_m);
     const double tr = ellipsoidTranslucence(t, cloud.threshold_centre, cloud.threshold_limb,
                                             entry.view.limb(direction), cloud.transition);
     // Turned towards the viewer, then bent towards the heap's (MODEL.md section 14).
@@ -371,6 +380,7 @@ class ReferenceTracer {
   }
 
   const Scene& scene_;
+  const std::vector<const EllipsoidCloud*>& clouds_;
   glm::dvec3 sun_;
   const CloudShadows* shadows_;
   std::vector<LayerTexture> textures_;
@@ -384,7 +394,6 @@ class ReferenceTracer {
   // The sea: its waves, the pixel's angle, and the tracer of what it mirrors.
   std::optional<SeaSurface> sea_;
   double pixel_rad_ = 0.0;
-  std::optional<Scene> probe_scene_;
   std::unique_ptr<ReferenceTracer> probe_;
 };
 
@@ -409,10 +418,12 @@ Frame renderReferenceFrame(const Scene& scene, const ReferenceSettings& settings
   if (infrared) frame.lwir.resize(pixels);
   if (asked.has(Channel::kGlint)) frame.glint.resize(pixels);
 
-  const Scene with_fields = scene.fields.empty() ? Scene{} : withFieldClouds(scene, settings.heaps);
-  const CloudShadows shadows(scene, settings.heaps, /*lookups=*/true);
-  const ReferenceTracer tracer(scene.fields.empty() ? scene : with_fields, &shadows,
-                               settings.sea_waves);
+  FramePlanRequest plan_request;
+  plan_request.heaps = settings.heaps;
+  plan_request.heap_shadows = true;
+  const FramePlan plan(scene, plan_request);
+  const ReferenceTracer tracer(plan.view, plan.sea_probe ? &*plan.sea_probe : nullptr,
+                               &*plan.heap_shadows, settings.sea_waves);
   const ViewBasis basis = viewBasis(camera);
   const int n = std::max(1, settings.samples_per_axis);
   const int divisor = std::max(1, settings.label_divisor);
@@ -473,17 +484,31 @@ Frame renderReferenceFrame(const Scene& scene, const ReferenceSettings& settings
   return frame;
 }
 
+namespace {
+FramePlanRequest drawingHeaps(const HeapDrawing& heaps) {
+  FramePlanRequest request;
+  request.heaps = heaps;
+  return request;
+}
+Scene withoutTargets(Scene scene) {
+  scene.targets.clear();
+  return scene;
+}
+}  // namespace
+
+// The probe's scene without its targets, planned once.
 struct CloudProbe::State {
   Scene scene;
+  FramePlan plan;
   ReferenceTracer tracer;
-  State(Scene s) : scene(std::move(s)), tracer(scene, nullptr) {}
+  State(const Scene& s, const HeapDrawing& heaps)
+      : scene(withoutTargets(s)),
+        plan(scene, drawingHeaps(heaps)),
+        tracer(plan.view, plan.sea_probe ? &*plan.sea_probe : nullptr, nullptr) {}
 };
 
 CloudProbe::CloudProbe(const Scene& scene, const HeapDrawing& heaps)
-    : state_(
-          std::make_unique<State>(scene.fields.empty() ? scene : withFieldClouds(scene, heaps))) {
-  state_->scene.targets.clear();
-}
+    : state_(std::make_unique<State>(scene, heaps)) {}
 CloudProbe::~CloudProbe() = default;
 
 double CloudProbe::transmittance(glm::dvec3 direction, double distance) const {

@@ -972,12 +972,12 @@ struct Body {
   std::uint32_t cloud, part;
   Ellipsoid ellipsoid;
 };
-std::vector<Body> mergedBodies(const Scene& scene, const std::vector<std::vector<char>>& kept,
-                               std::size_t most) {
+std::vector<Body> mergedBodies(std::span<const EllipsoidCloud* const> clouds,
+                               const std::vector<std::vector<char>>& kept, std::size_t most) {
   for (bool per_cloud : {false, true}) {
     std::vector<Body> bodies;
-    for (std::size_t c = 0; c < scene.clouds.size(); ++c) {
-      const EllipsoidCloud& cloud = scene.clouds[c];
+    for (std::size_t c = 0; c < clouds.size(); ++c) {
+      const EllipsoidCloud& cloud = *clouds[c];
       const std::vector<char>& flags = kept[c];
       const std::size_t lost = std::size_t(std::count(flags.begin(), flags.end(), char(0)));
       if (lost < 2) continue;
@@ -1006,107 +1006,110 @@ std::vector<Body> mergedBodies(const Scene& scene, const std::vector<std::vector
   return {};
 }
 
-}  // namespace
+// Every lobe of the clouds ranked for the budget: its projected size (its largest radius over
+// its distance along the view; behind the camera, none) and its footprint.
+struct LobeSize {
+  double size, footprint;
+  std::uint32_t cloud, lobe;
+};
+bool larger(const LobeSize& a, const LobeSize& b) {
+  if (a.size != b.size) return a.size > b.size;
+  return a.cloud != b.cloud ? a.cloud < b.cloud : a.lobe < b.lobe;
+}
 
-std::optional<Scene> withinEllipsoidBudget(const Scene& scene, double budget, double overdraw) {
-  const std::size_t total = ellipsoidCount(scene);
-  const bool counted = budget > 0.0 && double(total) > budget;
-  if (!counted && !(overdraw > 0.0)) return std::nullopt;
-  // Every ellipsoid's projected size (its largest radius over its distance along the view;
-  // behind the camera, none) and footprint.
-  const ViewBasis basis = viewBasis(scene.camera);
-  struct Size {
-    double size, footprint;
-    std::uint32_t cloud, lobe;
-  };
-  std::vector<Size> sizes;
-  sizes.reserve(total);
-  double footprint = 0.0;
-  for (std::size_t c = 0; c < scene.clouds.size(); ++c) {
-    const std::vector<Ellipsoid>& lobes = scene.clouds[c].ellipsoids;
-    for (std::size_t i = 0; i < lobes.size(); ++i) {
-      const double f = ellipsoidFootprint(lobes[i], scene.camera, basis);
-      footprint += f;
-      sizes.push_back(
-          {projectedSize(lobes[i], scene.camera, basis), f, std::uint32_t(c), std::uint32_t(i)});
+// The lobes a budget keeps: the largest while at most `most` and, when `covered`, their
+// footprints within `room` (the largest always); sizes[0, keep) holds them.
+class LobeChoice {
+ public:
+  LobeChoice(std::vector<LobeSize> sizes, bool covered)
+      : sizes_(std::move(sizes)), keep_(sizes_.size()), covered_(covered) {}
+
+  void choose(std::size_t most, double room) {
+    if (most < keep_) {
+      std::nth_element(sizes_.begin(), sizes_.begin() + std::ptrdiff_t(most),
+                       sizes_.begin() + std::ptrdiff_t(keep_), larger);
+      keep_ = most;
     }
-  }
-  const bool covered = overdraw > 0.0 && footprint > overdraw;
-  if (!counted && !covered) return std::nullopt;
-  const auto larger = [](const Size& a, const Size& b) {
-    if (a.size != b.size) return a.size > b.size;
-    return a.cloud != b.cloud ? a.cloud < b.cloud : a.lobe < b.lobe;
-  };
-  // The largest while at most `most` and their footprints within `room` (the largest always);
-  // sizes[0, keep) holds them.
-  std::size_t keep = total;
-  bool sorted = false;
-  auto choose = [&](std::size_t most, double room) {
-    if (most < keep) {
-      std::nth_element(sizes.begin(), sizes.begin() + std::ptrdiff_t(most),
-                       sizes.begin() + std::ptrdiff_t(keep), larger);
-      keep = most;
-    }
-    if (!covered) return;
-    if (!sorted) std::sort(sizes.begin(), sizes.begin() + std::ptrdiff_t(keep), larger);
-    sorted = true;
+    if (!covered_) return;
+    if (!sorted_) std::sort(sizes_.begin(), sizes_.begin() + std::ptrdiff_t(keep_), larger);
+    sorted_ = true;
     double sum = 0.0;
     std::size_t fit = 0;
-    while (fit < keep && (fit == 0 || sum + sizes[fit].footprint <= room))
-      sum += sizes[fit++].footprint;
-    keep = fit;
-  };
-  auto keptFlags = [&] {
-    std::vector<std::vector<char>> kept(scene.clouds.size());
-    for (std::size_t c = 0; c < scene.clouds.size(); ++c)
-      kept[c].assign(scene.clouds[c].ellipsoids.size(), 0);
-    for (std::size_t k = 0; k < keep; ++k) kept[sizes[k].cloud][sizes[k].lobe] = 1;
-    // Lobes out of the view are dropped unmerged (mergedBodies merges flags of 0).
-    for (std::size_t k = keep; k < sizes.size(); ++k)
-      if (!(sizes[k].footprint > 0.0)) kept[sizes[k].cloud][sizes[k].lobe] = 2;
-    return kept;
-  };
-  // The dropped lobes' bodies count against both parts of the budget. They are made once, from
-  // the first choice, and kept largest first while they number at most a quarter of the count
-  // and cover at most kBodyShare of the footprint budget (a pile of clouds stacked in one place
-  // gives a body per cloud, each over the whole view); the lobes are then chosen again in the room
-  // the bodies leave, those dropped by this second choice going unmerged.
-  choose(counted ? std::size_t(budget) : total, overdraw);
-  std::vector<std::vector<char>> kept = keptFlags();
-  const std::size_t most_bodies =
-      counted ? std::max<std::size_t>(std::size_t(budget) / 4, 1) : total;
-  std::vector<Body> bodies = mergedBodies(scene, kept, most_bodies);
-  if (!bodies.empty()) {
-    std::vector<std::pair<Size, std::size_t>> ranked;  // bodies by projected size
-    for (std::size_t k = 0; k < bodies.size(); ++k) {
-      const Ellipsoid& e = bodies[k].ellipsoid;
-      ranked.push_back(
-          {{projectedSize(e, scene.camera, basis), ellipsoidFootprint(e, scene.camera, basis),
-            bodies[k].cloud, bodies[k].part},
-           k});
-    }
-    std::sort(ranked.begin(), ranked.end(),
-              [&](const auto& a, const auto& b) { return larger(a.first, b.first); });
-    std::vector<Body> chosen;
-    double body_footprint = 0.0;
-    for (const auto& [size, k] : ranked) {
-      if (chosen.size() >= most_bodies) break;
-      if (covered && !chosen.empty() && body_footprint + size.footprint > kBodyShare * overdraw)
-        break;
-      body_footprint += size.footprint;
-      chosen.push_back(bodies[k]);
-    }
-    bodies = std::move(chosen);
-    const std::size_t room =
-        counted ? std::size_t(budget) - std::min(bodies.size(), keep - 1) : total;
-    choose(room, overdraw - body_footprint);
-    kept = keptFlags();
+    while (fit < keep_ && (fit == 0 || sum + sizes_[fit].footprint <= room))
+      sum += sizes_[fit++].footprint;
+    keep_ = fit;
   }
-  // The kept lobes copied, not the world's (a world at its budget holds millions).
+  // Per cloud and lobe: 1 kept, 0 dropped, 2 dropped out of the view (left unmerged:
+  // mergedBodies merges flags of 0).
+  std::vector<std::vector<char>> keptFlags(std::span<const EllipsoidCloud* const> clouds) const {
+    std::vector<std::vector<char>> kept(clouds.size());
+    for (std::size_t c = 0; c < clouds.size(); ++c) kept[c].assign(clouds[c]->ellipsoids.size(), 0);
+    for (std::size_t k = 0; k < keep_; ++k) kept[sizes_[k].cloud][sizes_[k].lobe] = 1;
+    for (std::size_t k = keep_; k < sizes_.size(); ++k)
+      if (!(sizes_[k].footprint > 0.0)) kept[sizes_[k].cloud][sizes_[k].lobe] = 2;
+    return kept;
+  }
+  std::size_t kept() const { return keep_; }
+
+ private:
+  std::vector<LobeSize> sizes_;
+  std::size_t keep_;
+  bool sorted_ = false;
+  bool covered_;
+};
+
+std::vector<LobeSize> lobeSizes(std::span<const EllipsoidCloud* const> clouds, std::size_t total,
+                                const Camera& camera, const ViewBasis& basis, double& footprint) {
+  std::vector<LobeSize> sizes;
+  sizes.reserve(total);
+  footprint = 0.0;
+  for (std::size_t c = 0; c < clouds.size(); ++c) {
+    const std::vector<Ellipsoid>& lobes = clouds[c]->ellipsoids;
+    for (std::size_t i = 0; i < lobes.size(); ++i) {
+      const double f = ellipsoidFootprint(lobes[i], camera, basis);
+      footprint += f;
+      sizes.push_back(
+          {projectedSize(lobes[i], camera, basis), f, std::uint32_t(c), std::uint32_t(i)});
+    }
+  }
+  return sizes;
+}
+
+// Of the dropped lobes' bodies, the largest while they number at most `most` and, when
+// `covered`, cover at most kBodyShare of the footprint budget `overdraw` (the largest always);
+// `footprint` is what the chosen cover.
+std::vector<Body> largestBodies(const std::vector<Body>& bodies, const Camera& camera,
+                                const ViewBasis& basis, std::size_t most, bool covered,
+                                double overdraw, double& footprint) {
+  std::vector<std::pair<LobeSize, std::size_t>> ranked;  // bodies by projected size
+  for (std::size_t k = 0; k < bodies.size(); ++k) {
+    const Ellipsoid& e = bodies[k].ellipsoid;
+    ranked.push_back({{projectedSize(e, camera, basis), ellipsoidFootprint(e, camera, basis),
+                       bodies[k].cloud, bodies[k].part},
+                      k});
+  }
+  std::sort(ranked.begin(), ranked.end(),
+            [&](const auto& a, const auto& b) { return larger(a.first, b.first); });
+  std::vector<Body> chosen;
+  footprint = 0.0;
+  for (const auto& [size, k] : ranked) {
+    if (chosen.size() >= most) break;
+    if (covered && !chosen.empty() && footprint + size.footprint > kBodyShare * overdraw) break;
+    footprint += size.footprint;
+    chosen.push_back(bodies[k]);
+  }
+  return chosen;
+}
+
+// The kept lobes copied, not the world's (a world at its budget holds millions), with the bodies
+// added; clouds left empty are dropped.
+std::vector<EllipsoidCloud> keptClouds(std::span<const EllipsoidCloud* const> from_clouds,
+                                       const std::vector<std::vector<char>>& kept,
+                                       const std::vector<Body>& bodies) {
   std::vector<EllipsoidCloud> clouds;
-  clouds.reserve(scene.clouds.size());
-  for (std::size_t c = 0; c < scene.clouds.size(); ++c) {
-    const EllipsoidCloud& from = scene.clouds[c];
+  clouds.reserve(from_clouds.size());
+  for (std::size_t c = 0; c < from_clouds.size(); ++c) {
+    const EllipsoidCloud& from = *from_clouds[c];
     const bool parts = !from.parts.empty();
     std::vector<Ellipsoid> lobes;
     std::vector<std::uint32_t> lobe_parts;
@@ -1123,28 +1126,82 @@ std::optional<Scene> withinEllipsoidBudget(const Scene& scene, double budget, do
     if (thinned) clouds.back().texture.seed = clouds.back().texture.gardner.seed = 0;
   }
   for (const Body& b : bodies) {
-    const EllipsoidCloud& from = scene.clouds[b.cloud];
+    const EllipsoidCloud& from = *from_clouds[b.cloud];
     EllipsoidCloud& cloud = clouds[b.cloud];
     cloud.ellipsoids.push_back(b.ellipsoid);
     if (!from.parts.empty() && from.parts.size() == from.ellipsoids.size())
       cloud.parts.push_back(b.part);  // lit with the heap it stands in
   }
-  Scene out = withClouds(scene, std::move(clouds));
-  std::erase_if(out.clouds, [](const EllipsoidCloud& c) { return c.ellipsoids.empty(); });
+  std::erase_if(clouds, [](const EllipsoidCloud& c) { return c.ellipsoids.empty(); });
+  return clouds;
+}
+
+}  // namespace
+
+std::optional<std::vector<EllipsoidCloud>> cloudsWithinBudget(
+    std::span<const EllipsoidCloud* const> clouds, const Camera& camera, double budget,
+    double overdraw) {
+  std::size_t total = 0;
+  for (const EllipsoidCloud* cloud : clouds) total += cloud->ellipsoids.size();
+  const bool counted = budget > 0.0 && double(total) > budget;
+  if (!counted && !(overdraw > 0.0)) return std::nullopt;
+  const ViewBasis basis = viewBasis(camera);
+  double footprint = 0.0;
+  std::vector<LobeSize> sizes = lobeSizes(clouds, total, camera, basis, footprint);
+  const bool covered = overdraw > 0.0 && footprint > overdraw;
+  if (!counted && !covered) return std::nullopt;
+  // The dropped lobes' bodies count against both parts of the budget. They are made once, from
+  // the first choice, and kept largest first while they number at most a quarter of the count
+  // and cover at most kBodyShare of the footprint budget (a pile of clouds stacked in one place
+  // gives a body per cloud, each over the whole view); the lobes are then chosen again in the room
+  // the bodies leave, those dropped by this second choice going unmerged.
+  LobeChoice choice(std::move(sizes), covered);
+  choice.choose(counted ? std::size_t(budget) : total, overdraw);
+  std::vector<std::vector<char>> kept = choice.keptFlags(clouds);
+  const std::size_t most_bodies =
+      counted ? std::max<std::size_t>(std::size_t(budget) / 4, 1) : total;
+  std::vector<Body> bodies = mergedBodies(clouds, kept, most_bodies);
+  if (!bodies.empty()) {
+    double body_footprint = 0.0;
+    bodies = largestBodies(bodies, camera, basis, most_bodies, covered, overdraw, body_footprint);
+    const std::size_t room =
+        counted ? std::size_t(budget) - std::min(bodies.size(), choice.kept() - 1) : total;
+    choice.choose(room, overdraw - body_footprint);
+    kept = choice.keptFlags(clouds);
+  }
+  return keptClouds(clouds, kept, bodies);
+}
+
+std::optional<Scene> withinEllipsoidBudget(const Scene& scene, double budget, double overdraw) {
+  std::vector<const EllipsoidCloud*> clouds;
+  for (const EllipsoidCloud& cloud : scene.clouds) clouds.push_back(&cloud);
+  std::optional<std::vector<EllipsoidCloud>> kept =
+      cloudsWithinBudget(clouds, scene.camera, budget, overdraw);
+  if (!kept) return std::nullopt;
+  return withClouds(scene, std::move(*kept));
+}
+
+FieldContent fieldContent(const Scene& scene, const HeapDrawing& drawing) {
+  FieldContent out;
+  for (const CloudField& field : scene.fields) {
+    std::vector<EllipsoidCloud> heaps = fieldClouds(field, scene.camera, drawing);
+    out.heaps.insert(out.heaps.end(), std::make_move_iterator(heaps.begin()),
+                     std::make_move_iterator(heaps.end()));
+    const double range = heapRange(field, scene.camera, drawing.range_m);
+    if (field.coverage > 0.0 && planeSeenBeyond(scene.camera, field.base_m, range))
+      out.far_decks.push_back(farDeck(field, range, sunDirection(scene.sun)));
+  }
+  out.rain_shafts = rainShaftsInView(scene, drawing);
   return out;
 }
 
 Scene withFieldClouds(const Scene& scene, const HeapDrawing& drawing) {
+  FieldContent content = fieldContent(scene, drawing);
   Scene out = scene;
-  for (const CloudField& field : scene.fields) {
-    std::vector<EllipsoidCloud> heaps = fieldClouds(field, scene.camera, drawing);
-    out.clouds.insert(out.clouds.end(), std::make_move_iterator(heaps.begin()),
-                      std::make_move_iterator(heaps.end()));
-    const double range = heapRange(field, scene.camera, drawing.range_m);
-    if (field.coverage > 0.0 && planeSeenBeyond(scene.camera, field.base_m, range))
-      out.layers.push_back(farDeck(field, range, sunDirection(scene.sun)));
-  }
-  out.rain_shafts = rainShaftsInView(scene, drawing);
+  out.clouds.insert(out.clouds.end(), std::make_move_iterator(content.heaps.begin()),
+                    std::make_move_iterator(content.heaps.end()));
+  out.layers.insert(out.layers.end(), content.far_decks.begin(), content.far_decks.end());
+  out.rain_shafts = std::move(content.rain_shafts);
   out.fields.clear();
   return out;
 }

@@ -98,11 +98,19 @@ double veilOpacity(double eye_radius) {
 Veil inCloudVeil(const std::vector<EllipsoidCloud>& clouds,
                  const std::function<const SolidTexture&(std::size_t)>& texture, glm::dvec3 eye,
                  const Sun& sun) {
+  std::vector<const EllipsoidCloud*> listed;
+  for (const EllipsoidCloud& cloud : clouds) listed.push_back(&cloud);
+  return inCloudVeil(listed, texture, eye, sun);
+}
+
+Veil inCloudVeil(std::span<const EllipsoidCloud* const> clouds,
+                 const std::function<const SolidTexture&(std::size_t)>& texture, glm::dvec3 eye,
+                 const Sun& sun) {
   double transmittance = 1.0, weight = 0.0;
   glm::dvec3 weighted(0.0);
   const double lit_from_above = std::max(0.0, sunDirection(sun).z);
   for (std::size_t c = 0; c < clouds.size(); ++c) {
-    const EllipsoidCloud& cloud = clouds[c];
+    const EllipsoidCloud& cloud = *clouds[c];
     double cloud_transmittance = 1.0;
     for (const Ellipsoid& e : cloud.ellipsoids) {
       // Outside the ball of (1 + band) times the longest semi-axis the unit-sphere radius
@@ -114,7 +122,7 @@ Veil inCloudVeil(const std::vector<EllipsoidCloud>& clouds,
       cloud_transmittance *= 1.0 - veilOpacity(glm::length(o));
     }
     if (cloud_transmittance == 1.0) continue;
-    const double it = texture(c).value(eye - clouds[c].drift_m);
+    const double it = texture(c).value(eye - cloud.drift_m);
     const double intensity = gardnerIntensity(cloud.shading, lit_from_above, 0.0, it);
     const double opacity = 1.0 - cloud_transmittance;
     weighted += opacity * intensity * cloud.colour * sun.colour;

@@ -4,6 +4,7 @@
 // camera sees when it flies into one.
 #include <cstdint>
 #include <functional>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -105,6 +106,9 @@ struct Veil {
 // one of its ellipsoids (the caller keeps it built). Ellipsoids farther from the eye than
 // (1 + kInCloudBand) times their longest semi-axis are passed over without a transform, so a
 // world of many clouds costs a distance test per ellipsoid.
+Veil inCloudVeil(std::span<const EllipsoidCloud* const> clouds,
+                 const std::function<const SolidTexture&(std::size_t)>& texture, glm::dvec3 eye,
+                 const Sun& sun);
 Veil inCloudVeil(const std::vector<EllipsoidCloud>& clouds,
                  const std::function<const SolidTexture&(std::size_t)>& texture, glm::dvec3 eye,
                  const Sun& sun);
