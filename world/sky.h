@@ -5,6 +5,8 @@
 #include <optional>
 #include <span>
 
+#include "world/formulas/air.h"
+
 namespace nephele {
 
 struct Sky {
@@ -79,7 +81,7 @@ struct RainShaft {
   glm::dvec3 colour{0.45, 0.48, 0.52};
   bool operator==(const RainShaft&) const = default;
 };
-inline constexpr double kShaftGroundShare = 0.5;
+inline constexpr double kShaftGroundShare = formulas::kShaftGroundShare;
 
 // The shaft's optical depth along origin + s * direction, 0 <= s <= distance (+infinity allowed;
 // `direction` unit): exact, the density being a polynomial of degree 3 in s along the chord.

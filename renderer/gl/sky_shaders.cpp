@@ -1,5 +1,6 @@
 #include "renderer/gl/sky_shaders.h"
 
+#include "renderer/gl/shaders/formulas_glsl.h"
 #include "renderer/gl/shaders/sky_glsl.h"
 #include "renderer/gl/view_uniforms.h"
 #include "world/formations/cloud_shadow.h"
@@ -66,12 +67,12 @@ std::string slotStatement(int slot, LayerKind kind) {
          ", colour, transmittance); }\n";
 }
 
-// kCommon after the constants it takes from C++.
+// kCommon after the constants it takes from C++ and the formulas it shares with the CPU
+// reference (world/formulas/).
 std::string commonSource() {
   return "const int kPrecipitationSlabs = " + std::to_string(kPrecipitationSlabs) +
-         ";\nconst int kRainShafts = " + std::to_string(kMaxRainShafts) +
-         ";\nconst float kShaftGroundShare = " + std::to_string(kShaftGroundShare) + ";\n" +
-         kCommon;
+         ";\nconst int kRainShafts = " + std::to_string(kMaxRainShafts) + ";\n" +
+         glsl::formulas::kPrelude + glsl::formulas::kAir + kCommon;
 }
 
 }  // namespace

@@ -15,8 +15,8 @@ set(NEPHELE_GLSL_DIR ${CMAKE_CURRENT_LIST_DIR})
 set(NEPHELE_GLSL_INCLUDE_DIR ${PROJECT_BINARY_DIR}/generated)
 
 # nephele_embed_glsl(TARGET HEADER GROUP NAME FILE [NAME FILE ...]): the header HEADER, holding
-# each FILE (relative to renderer/gl/shaders) as constant NAME in nephele::glsl::GROUP,
-# compiled into TARGET.
+# each FILE (relative to renderer/gl/shaders, or an absolute path) as constant NAME in
+# nephele::glsl::GROUP, compiled into TARGET.
 function(nephele_embed_glsl target header group)
   set(output ${NEPHELE_GLSL_INCLUDE_DIR}/renderer/gl/shaders/${header})
   set(pieces "")
@@ -27,7 +27,11 @@ function(nephele_embed_glsl target header group)
     if(NOT file)
       message(FATAL_ERROR "nephele_embed_glsl(${header}): ${name} has no file")
     endif()
-    set(path ${NEPHELE_GLSL_DIR}/${file})
+    if(IS_ABSOLUTE ${file})
+      set(path ${file})
+    else()
+      set(path ${NEPHELE_GLSL_DIR}/${file})
+    endif()
     if(NOT EXISTS ${path})
       message(FATAL_ERROR "nephele_embed_glsl(${header}): ${path} does not exist")
     endif()
@@ -45,6 +49,13 @@ function(nephele_embed_glsl target header group)
   target_include_directories(${target} PRIVATE ${NEPHELE_GLSL_INCLUDE_DIR})
 endfunction()
 
+# The formulas the GL renderer shares with the CPU reference, written once in the common ground
+# of C++ and GLSL (world/formulas/prelude.h): the prelude first, then each family. sky_shaders.cpp
+# pastes them ahead of sky/common.glsl, so every stage that holds the view chunk holds them.
+set(NEPHELE_FORMULA_DIR ${PROJECT_SOURCE_DIR}/world/formulas)
+nephele_embed_glsl(nephele_renderer formulas_glsl.h formulas
+  kPrelude ${NEPHELE_FORMULA_DIR}/prelude.h  # real, FORMULA
+  kAir ${NEPHELE_FORMULA_DIR}/air.h)         # slabs, haze, shafts
 nephele_embed_glsl(nephele_renderer sky_glsl.h sky
   kCommon sky/common.glsl             # the view, output, air, background and targets
   kLayers sky/layers.glsl             # textured cloud layers

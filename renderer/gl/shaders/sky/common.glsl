@@ -33,7 +33,9 @@ vec3 viewRay() {
 
 #ifdef AIR
 // The air between the eye and a surface (MODEL.md section 5): ground fog, the in-layer veil
-// and distance haze; an absent one has zero extinction. world/sky.cpp's throughAir is the reference's twin.
+// and distance haze; an absent one has zero extinction. Each medium's optical depth is the
+// shared formula's (world/formulas/air.h, pasted ahead of this file), as in world/sky.cpp's
+// throughAir.
 uniform vec3 u_fog_slab;  // bottom, top, band of the ground fog, metres
 uniform float u_fog_sigma;
 uniform vec3 u_fog_colour;
@@ -55,88 +57,23 @@ uniform float u_haze_sigma;   // at Z = 0, per metre
 uniform float u_haze_height;  // scale height, metres
 uniform vec3 u_haze_colour;   // the sky's horizon
 
-// A slab's density (1 from bottom to top, linear to 0 over the band either side) and its
-// integral from below it to height z (world/sky.cpp, fogDensity and fogColumn).
-float slabDensity(vec3 slab, float z) {
-  if (z >= slab.x && z <= slab.y) return 1.0;
-  float out_by = z < slab.x ? slab.x - z : z - slab.y;
-  return slab.z > 0.0 ? max(0.0, 1.0 - out_by / slab.z) : 0.0;
-}
-float slabColumn(vec3 slab, float z) {
-  float b = slab.z, low = slab.x - b;
-  if (!(z > low)) return 0.0;
-  if (z <= slab.x) return (z - low) * (z - low) / (2.0 * b);
-  if (z <= slab.y) return 0.5 * b + (z - slab.x);
-  float u = min(z - slab.y, b);
-  return 0.5 * b + (slab.y - slab.x) + u - (b > 0.0 ? u * u / (2.0 * b) : 0.0);
-}
-
-// The density-weighted length through a slab of the unit ray from the camera up to `distance`
-// (world/sky.cpp's fogPathLength): level rays take the density half way.
-float slabPath(vec3 slab, vec3 d, float distance) {
-  float rise = distance * d.z;
-  if (abs(rise) < 1e-3) return slabDensity(slab, u_camera_z + 0.5 * rise) * distance;
-  return abs(slabColumn(slab, u_camera_z + rise) - slabColumn(slab, u_camera_z)) / abs(d.z);
-}
-
-// Shaft i's optical depth along the unit ray up to `distance` (world/sky.cpp's
-// shaftOpticalDepth): the chord inside its cylinder and between the ground and its top, and the
-// exact integral of its density, a cubic along the chord, about the chord's middle.
-float shaftDepth(int i, vec3 d, float distance) {
-  vec4 shaft = u_shaft[i];
-  vec2 o = -shaft.xy, dh = d.xy;
-  float r2 = shaft.z * shaft.z, a = dot(dh, dh), b = dot(o, dh);
-  float t0 = 0.0, t1 = distance;
-  if (a < 1e-8) {
-    if (dot(o, o) >= r2) return 0.0;
-  } else {
-    float cross_od = o.x * dh.y - o.y * dh.x, quarter_delta = a * r2 - cross_od * cross_od;
-    if (quarter_delta <= 0.0) return 0.0;
-    float root = sqrt(quarter_delta);
-    t0 = max(t0, (-b - root) / a);
-    t1 = min(t1, (-b + root) / a);
-  }
-  if (d.z == 0.0) {
-    if (u_camera_z < 0.0 || u_camera_z > shaft.w) return 0.0;
-  } else {
-    float at_ground = -u_camera_z / d.z, at_top = (shaft.w - u_camera_z) / d.z;
-    t0 = max(t0, min(at_ground, at_top));
-    t1 = min(t1, max(at_ground, at_top));
-  }
-  if (!(t1 > t0)) return 0.0;
-  float m = 0.5 * (t0 + t1), h = 0.5 * (t1 - t0);
-  vec2 q = o + m * dh;
-  float g0 = 1.0 - dot(q, q) / r2, g1 = -2.0 * dot(q, dh) / r2, g2 = -a / r2;
-  float fade = (1.0 - kShaftGroundShare) / shaft.w;
-  float l0 = kShaftGroundShare + fade * (u_camera_z + m * d.z), l1 = fade * d.z;
-  return u_shaft_sigma[i] * max(2.0 * h * g0 * l0 + (2.0 * h * h * h / 3.0) * (g2 * l0 + g1 * l1), 0.0);
-}
-
-// The haze's optical depth along the unit ray up to `distance`: sigma0 H (e^-a - e^-(a+x)) / dz,
-// a = z0 / H, x = s dz / H, or its series near x = 0 (hazeOpticalDepth).
-float hazeDepth(vec3 d, float distance) {
-  float s = min(distance, 1e9), h = u_haze_height;
-  float a = u_camera_z / h, x = s * d.z / h;
-  if (abs(x) < 1e-2) return u_haze_sigma * s * exp(-a) * (1.0 - x / 2.0 + x * x / 6.0);
-  return u_haze_sigma * h / d.z * (exp(-a) - exp(-max(a + x, -50.0)));
-}
-
 vec3 applyAir(vec3 colour, vec3 d, float distance) {
-  float tau_fog = u_fog_sigma > 0.0 ? min(u_fog_sigma * slabPath(u_fog_slab, d, distance), 1e3)
-                                    : 0.0;
+  float z = u_camera_z;
+  float tau_fog =
+      u_fog_sigma > 0.0 ? min(u_fog_sigma * slabPath(u_fog_slab, z, d.z, distance), 1e3) : 0.0;
   float tau_veil =
-      u_veil_sigma > 0.0 ? min(u_veil_sigma * slabPath(u_veil_slab, d, distance), 1e3) : 0.0;
-  float tau_haze = min(hazeDepth(d, distance), 1e3);
+      u_veil_sigma > 0.0 ? min(u_veil_sigma * slabPath(u_veil_slab, z, d.z, distance), 1e3) : 0.0;
+  float tau_haze = min(hazeDepth(u_haze_sigma, u_haze_height, z, d.z, distance), 1e3);
   float tau = tau_fog + tau_veil + tau_haze;
   vec3 weighted = tau_fog * u_fog_colour + tau_veil * u_veil_colour + tau_haze * u_haze_colour;
   for (int i = 0; i < kPrecipitationSlabs; ++i)
     if (u_precip_sigma[i] > 0.0) {
-      float tau_p = min(u_precip_sigma[i] * slabPath(u_precip_slab[i], d, distance), 1e3);
+      float tau_p = min(u_precip_sigma[i] * slabPath(u_precip_slab[i], z, d.z, distance), 1e3);
       tau += tau_p;
       weighted += tau_p * u_precip_colour[i];
     }
   for (int i = 0; i < u_shafts; ++i) {
-    float tau_s = min(shaftDepth(i, d, distance), 1e3);
+    float tau_s = min(shaftDepth(u_shaft[i], u_shaft_sigma[i], z, d, distance), 1e3);
     tau += tau_s;
     weighted += tau_s * u_shaft_colour[i];
   }
