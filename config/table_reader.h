@@ -284,8 +284,9 @@ class TableReader {
 // U+FB26-U+FEFE is whitespace: a gap in its generated table. It asks that of every character
 // it meets outside strings and comments (also while reading ahead through a malformed token,
 // quotes included), and inside a multi-line basic string of the first character after a
-// line-ending backslash. parseToml below keeps every such character from reaching those
-// questions, with the parser itself, not a second grammar, deciding what is inside a string:
+// line-ending backslash. parseToml below (its steps in toml_gap) keeps every such character
+// from reaching those questions, with the parser itself, not a second grammar, deciding what is
+// inside a string:
 //   1. Text that is all ASCII is parsed directly.
 //   2. Otherwise a copy with each character beyond ASCII replaced by '@' is parsed. '@' is
 //      valid TOML only inside strings and comments, so if the copy parses, every such
@@ -295,78 +296,108 @@ class TableReader {
 //   3. In the now valid document, a character of the gap straight after a line-ending
 //      backslash (and the whitespace it skips) is refused: write it as \uXXXX there.
 //   4. The original is parsed.
-// Throws SceneError ("FILE:LINE: what is wrong"); returns the parsed table.
-inline toml::table parseToml(std::string_view text, const std::string& file) {
-  auto fail = [&](int line, const std::string& what) {
-    throw SceneError{file + ":" + std::to_string(line) + ": " + what};
-  };
-  auto invalid = [&](const toml::parse_error& e) {
-    fail(int(e.source().begin.line), "not valid TOML: " + std::string(e.description()));
-  };
-  // Decodes one UTF-8 sequence at text[i]; 0 and length 1 for a malformed one, which is left
-  // for toml++ to report.
-  auto decode = [&](std::size_t i, std::size_t& length) -> char32_t {
-    const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(text[k]); };
-    const unsigned char b0 = byte(i);
-    length = b0 >= 0xF0 ? 4 : b0 >= 0xE0 ? 3 : b0 >= 0xC0 ? 2 : 1;
-    if (length == 1 || i + length > text.size()) return length = 1, 0;
-    char32_t c = b0 & (0x7F >> length);
-    for (std::size_t k = 1; k < length; ++k) {
-      if ((byte(i + k) & 0xC0) != 0x80) return length = 1, 0;
-      c = (c << 6) | (byte(i + k) & 0x3F);
-    }
-    return c;
-  };
-  auto inGap = [](char32_t c) {
-    return (c >= 0xA1 && c <= 0x499) || (c >= 0x2C5E && c <= 0x2FFF) ||
-           (c >= 0x3001 && c <= 0x3057) || (c >= 0xFB26 && c <= 0xFEFE);
-  };
-  auto hex = [](char32_t c) {
-    char buffer[16];
-    std::snprintf(buffer, sizeof buffer, "U+%04X", unsigned(c));
-    return std::string(buffer);
-  };
+namespace toml_gap {
 
-  std::string ascii;                                       // step 2's copy, one byte per character
+[[noreturn]] inline void failAt(const std::string& file, int line, const std::string& what) {
+  throw SceneError{file + ":" + std::to_string(line) + ": " + what};
+}
+
+[[noreturn]] inline void failInvalid(const std::string& file, const toml::parse_error& e) {
+  failAt(file, int(e.source().begin.line), "not valid TOML: " + std::string(e.description()));
+}
+
+// Decodes one UTF-8 sequence at text[i]; 0 and length 1 for a malformed one, which is left
+// for toml++ to report.
+inline char32_t decodeUtf8(std::string_view text, std::size_t i, std::size_t& length) {
+  const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(text[k]); };
+  const unsigned char b0 = byte(i);
+  length = b0 >= 0xF0 ? 4 : b0 >= 0xE0 ? 3 : b0 >= 0xC0 ? 2 : 1;
+  if (length == 1 || i + length > text.size()) return length = 1, 0;
+  char32_t c = b0 & (0x7F >> length);
+  for (std::size_t k = 1; k < length; ++k) {
+    if ((byte(i + k) & 0xC0) != 0x80) return length = 1, 0;
+    c = (c << 6) | (byte(i + k) & 0x3F);
+  }
+  return c;
+}
+
+// The characters toml++ 3.3's whitespace table lacks.
+inline bool inGap(char32_t c) {
+  return (c >= 0xA1 && c <= 0x499) || (c >= 0x2C5E && c <= 0x2FFF) ||
+         (c >= 0x3001 && c <= 0x3057) || (c >= 0xFB26 && c <= 0xFEFE);
+}
+
+inline std::string codePoint(char32_t c) {  // "U+00E9"
+  char buffer[16];
+  std::snprintf(buffer, sizeof buffer, "U+%04X", unsigned(c));
+  return std::string(buffer);
+}
+
+// Step 2's copy, one byte per character: each character beyond ASCII is '@'.
+struct AsciiCopy {
+  std::string ascii;
   std::vector<std::pair<std::size_t, char32_t>> replaced;  // (offset in ascii, character)
-  ascii.reserve(text.size());
+};
+
+inline AsciiCopy asciiCopyOf(std::string_view text) {
+  AsciiCopy copy;
+  copy.ascii.reserve(text.size());
   for (std::size_t i = 0; i < text.size();) {
     std::size_t length = 1;
-    const char32_t c = static_cast<unsigned char>(text[i]) < 0x80 ? 0 : decode(i, length);
+    const char32_t c = static_cast<unsigned char>(text[i]) < 0x80 ? 0 : decodeUtf8(text, i, length);
     if (c == 0) {
-      ascii += text[i];
+      copy.ascii += text[i];
     } else {
-      replaced.emplace_back(ascii.size(), c);
-      ascii += '@';
+      copy.replaced.emplace_back(copy.ascii.size(), c);
+      copy.ascii += '@';
     }
     i += length;
   }
-  if (replaced.empty()) {
-    try {
-      return toml::parse(text, file);
-    } catch (const toml::parse_error& e) {
-      invalid(e);
-    }
-  }
+  return copy;
+}
 
+// Step 2: the copy parses, else the original's error, naming the replaced character toml++
+// stopped at (by line and column, 1-based, one per byte in the copy) if it is one.
+inline void checkAsciiCopy(const AsciiCopy& copy, const std::string& file) {
   try {
-    (void)toml::parse(ascii, file);
+    (void)toml::parse(copy.ascii, file);
   } catch (const toml::parse_error& e) {
-    // toml++ names the character it stopped at by line and column (1-based, one per byte in
-    // the copy); if that is a replaced one, name it.
     std::size_t offset = 0;
-    for (std::size_t line = 1; line < e.source().begin.line && offset < ascii.size(); ++offset)
-      if (ascii[offset] == '\n') ++line;
+    for (std::size_t line = 1; line < e.source().begin.line && offset < copy.ascii.size(); ++offset)
+      if (copy.ascii[offset] == '\n') ++line;
     offset += e.source().begin.column - 1;
-    for (const auto& [at, c] : replaced)
+    for (const auto& [at, c] : copy.replaced)
       if (at == offset)
-        fail(int(e.source().begin.line),
-             "the character " + hex(c) +
-                 " is outside a string or comment (TOML allows only ASCII there)");
-    invalid(e);
+        failAt(file, int(e.source().begin.line),
+               "the character " + codePoint(c) +
+                   " is outside a string or comment (TOML allows only ASCII there)");
+    failInvalid(file, e);
   }
+}
 
-  // Step 3: a small scanner is enough now, the document being valid TOML.
+// Step 3, at the backslash ascii[i] of a multi-line basic string followed by whitespace: the
+// whitespace skipped (counting its lines), and a character of the gap after it refused.
+// Returns the index of the last character skipped.
+inline std::size_t skipLineEndingBackslash(const AsciiCopy& copy, std::size_t i, int& line,
+                                           const std::string& file) {
+  const std::string& ascii = copy.ascii;
+  std::size_t k = i + 1;
+  for (; k < ascii.size() && std::string_view(" \t\r\n").find(ascii[k]) != std::string_view::npos;
+       ++k)
+    if (ascii[k] == '\n') ++line;
+  for (const auto& [at, cp] : copy.replaced)
+    if (at == k && inGap(cp))
+      failAt(file, line,
+             "the character " + codePoint(cp) +
+                 " straight after a line-ending backslash cannot be read by this build's TOML "
+                 "parser (toml++ 3.3); write it as \\u" +
+                 codePoint(cp).substr(2) + " there");
+  return k - 1;
+}
+
+// Step 3: a small scanner is enough, the document being valid TOML.
+inline void checkLineEndingBackslashes(const AsciiCopy& copy, const std::string& file) {
+  const std::string& ascii = copy.ascii;
   int line = 1;
   enum class In { kCode, kComment, kBasic, kLiteral, kMultiBasic, kMultiLiteral } in = In::kCode;
   for (std::size_t i = 0; i < ascii.size(); ++i) {
@@ -401,18 +432,7 @@ inline toml::table parseToml(std::string_view text, const std::string& file) {
       case In::kMultiBasic:
         if (c == '\\' && i + 1 < ascii.size() &&
             std::string_view(" \t\r\n").find(ascii[i + 1]) != std::string_view::npos) {
-          std::size_t k = i + 1;
-          for (; k < ascii.size() &&
-                 std::string_view(" \t\r\n").find(ascii[k]) != std::string_view::npos;
-               ++k)
-            if (ascii[k] == '\n') ++line;
-          for (const auto& [at, cp] : replaced)
-            if (at == k && inGap(cp))
-              fail(line, "the character " + hex(cp) +
-                             " straight after a line-ending backslash cannot be read by this "
-                             "build's TOML parser (toml++ 3.3); write it as \\u" +
-                             hex(cp).substr(2) + " there");
-          i = k - 1;
+          i = skipLineEndingBackslash(copy, i, line, file);
         } else if (c == '\\') {
           ++i;
         } else if (rest.starts_with("\"\"\"")) {
@@ -429,12 +449,23 @@ inline toml::table parseToml(std::string_view text, const std::string& file) {
         break;
     }
   }
+}
+
+}  // namespace toml_gap
+
+// The table `text` holds, read past toml++ 3.3's gap (above). Throws SceneError
+// ("FILE:LINE: what is wrong").
+inline toml::table parseToml(std::string_view text, const std::string& file) {
+  const toml_gap::AsciiCopy copy = toml_gap::asciiCopyOf(text);
+  if (!copy.replaced.empty()) {
+    toml_gap::checkAsciiCopy(copy, file);
+    toml_gap::checkLineEndingBackslashes(copy, file);
+  }
   try {
     return toml::parse(text, file);
   } catch (const toml::parse_error& e) {
-    invalid(e);
+    toml_gap::failInvalid(file, e);
   }
-  return {};
 }
 
 // Reads a whole text file into `text`; on failure returns "cannot read WHAT 'path': reason".

@@ -91,6 +91,174 @@ struct Written {
   }
 };
 
+// A write's registers as commands, in the map's order: the view, the wind, the sun's angles,
+// the time scale, the weather layers, the fog, the haze and the sun's date. Each group the
+// write touches becomes its command; the first value out of range is the write's error.
+class HoldingWrite {
+ public:
+  HoldingWrite(const HoldingRegisters& registers, Written written)
+      : next_(registers), w_(written) {}
+
+  void viewSettings(const std::string& view);
+  void wind();
+  void sunAngles();
+  void timeScale();
+  void weatherLayer(int layer);
+  void fog();
+  void haze();
+  void sunDate();
+  std::variant<std::vector<Command>, RegisterError> result() && {
+    if (error_) return *error_;
+    return std::move(commands_);
+  }
+
+ private:
+  // The value of a touched float field, checked against its range.
+  double readFloat(const FloatField& f, int base = 0) {
+    const double v = getFloat(&next_[std::size_t(base + f.address)]);
+    if (!error_ && !(std::isfinite(v) && v >= f.lo && v <= f.hi))
+      error_ = RegisterError{kIllegalDataValue,
+                             std::string(f.name) + " (register " +
+                                 std::to_string(base + f.address) + "): " + formatNumber(v) +
+                                 " is out of range (allowed: " + formatNumber(f.lo) + " to " +
+                                 formatNumber(f.hi) + ")"};
+    return v;
+  }
+  void fail(std::optional<RegisterError> error) {
+    if (!error_) error_ = std::move(error);
+  }
+
+  const HoldingRegisters& next_;
+  const Written w_;
+  std::vector<Command> commands_;
+  std::optional<RegisterError> error_;
+};
+
+// The view's position (set whole when any coordinate is written), angles, field of view and
+// image size.
+void HoldingWrite::viewSettings(const std::string& view) {
+  command::SetView set_view{view, {}};
+  ViewPatch& p = set_view.patch;
+  glm::dvec3 position{0.0};
+  bool moved = false;
+  for (int i = 0; i < 3; ++i)
+    if (w_.touches(kViewFloats[i].address, 2)) {
+      position[i] = readFloat(kViewFloats[i]);
+      moved = true;
+    }
+  if (moved) {
+    for (int i = 0; i < 3; ++i)
+      if (!w_.touches(kViewFloats[i].address, 2))
+        position[i] = getFloat(&next_[std::size_t(kViewFloats[i].address)]);
+    p.position = position;
+  }
+  std::optional<double>* angles[] = {&p.heading, &p.pitch, &p.roll, &p.vfov};
+  for (int i = 3; i < 7; ++i)
+    if (w_.touches(kViewFloats[i].address, 2)) *angles[i - 3] = readFloat(kViewFloats[i]);
+  for (auto [a, out, name] :
+       {std::tuple{M::kWidth, &p.width, "width"}, std::tuple{M::kHeight, &p.height, "height"}})
+    if (w_.touches(a)) {
+      if (next_[std::size_t(a)] < 1 || next_[std::size_t(a)] > Limits::kMaxImageSide)
+        fail(RegisterError{kIllegalDataValue, std::string(name) + " (register " +
+                                                  std::to_string(a) +
+                                                  "): " + std::to_string(next_[std::size_t(a)]) +
+                                                  " is out of range (allowed: 1 to " +
+                                                  std::to_string(Limits::kMaxImageSide) + ")"});
+      *out = next_[std::size_t(a)];
+    }
+  if (w_.touches(0, M::kHeight + 1)) commands_.emplace_back(set_view);
+}
+
+void HoldingWrite::wind() {
+  if (!w_.touches(M::kWindEast, 4)) return;
+  const glm::dvec2 wind(readFloat(kOtherFloats[0]), readFloat(kOtherFloats[1]));
+  if (glm::length(wind) > Limits::kMaxWind)
+    fail(RegisterError{kIllegalDataValue, "wind: speed above 200 m/s"});
+  commands_.emplace_back(command::SetWind{wind});
+}
+
+void HoldingWrite::sunAngles() {
+  if (!w_.touches(M::kSunAzimuth, 4)) return;
+  command::SetSun sun;
+  if (w_.touches(M::kSunAzimuth, 2)) sun.azimuth = readFloat(kOtherFloats[2]);
+  if (w_.touches(M::kSunElevation, 2)) sun.elevation = readFloat(kOtherFloats[3]);
+  commands_.emplace_back(sun);
+}
+
+void HoldingWrite::timeScale() {
+  if (w_.touches(M::kTimeScale, 2))
+    commands_.emplace_back(command::SetTime{readFloat(kOtherFloats[4]), {}, {}, {}});
+}
+
+// Weather layer `layer` + 1, set whole when any of its registers is written.
+void HoldingWrite::weatherLayer(int layer) {
+  const int base = M::kLayerStart + layer * M::kLayerStride;
+  if (!w_.touches(base, M::kLayerStride)) return;
+  command::SetWeather set{layer + 1, {}, std::nullopt};
+  const std::uint16_t type = next_[std::size_t(base + M::kLayerType)];
+  const std::optional<CloudType> genus = cloudTypeFromCode(type);
+  if (!genus)
+    fail(RegisterError{kIllegalDataValue,
+                       "layer " + std::to_string(layer + 1) + " cloud type (register " +
+                           std::to_string(base) + "): " + std::to_string(type) +
+                           " is out of range (allowed: " + cloudTypeCodesAllowed() +
+                           ", CIGI cloud types)"});
+  set.weather.type = genus.value_or(CloudType::kNone);
+  set.weather.base_m = readFloat(kLayerFloats[0], base);
+  set.weather.thickness_m = readFloat(kLayerFloats[1], base);
+  set.weather.coverage = readFloat(kLayerFloats[2], base) / 100.0;
+  commands_.emplace_back(set);
+}
+
+// The fog, set whole: its top, visibility (0: none) and colour.
+void HoldingWrite::fog() {
+  if (!(w_.touches(M::kFogTop, 4) || w_.touches(M::kFogColour, 6))) return;
+  const double top = readFloat(kAtmosphereFloats[0]);
+  const double visibility = readFloat(kAtmosphereFloats[1]);
+  const glm::dvec3 colour(readFloat(kAtmosphereFloats[3]), readFloat(kAtmosphereFloats[4]),
+                          readFloat(kAtmosphereFloats[5]));
+  if (!error_) error_ = zeroOrWithin("fog", M::kFogVisibility, visibility, Limits::kFogVisibility);
+  if (visibility == 0.0)
+    commands_.emplace_back(command::SetFog{false, {}, {}, {}});
+  else
+    commands_.emplace_back(command::SetFog{true, top, visibility, colour});
+}
+
+// The haze, set whole: its visibility (0: none) and scale height.
+void HoldingWrite::haze() {
+  if (!w_.touches(M::kHazeVisibility, 4)) return;
+  const double visibility = readFloat(kOtherFloats[5]);
+  const double scale_height = readFloat(kOtherFloats[6]);
+  if (!error_)
+    error_ = zeroOrWithin("haze", M::kHazeVisibility, visibility, Limits::kHazeVisibility);
+  if (visibility == 0.0)
+    commands_.emplace_back(command::SetHaze{false, {}, {}});
+  else
+    commands_.emplace_back(command::SetHaze{true, visibility, scale_height});
+}
+
+// The sun placed by a UTC date and time of day at [site]; date 0 leaves it where the angles
+// put it. Written only when every value so far is in range (the seconds are checked).
+void HoldingWrite::sunDate() {
+  if (!w_.touches(M::kSunDate, 4)) return;
+  const std::uint32_t date = std::uint32_t(next_[M::kSunDate]) << 16 | next_[M::kSunDate + 1];
+  const double seconds = readFloat(kAtmosphereFloats[2]);
+  if (date == 0 || error_) return;
+  CivilTime t;
+  t.year = int(date / 10000);
+  t.month = int(date / 100 % 100);
+  t.day = int(date % 100);
+  const double s = std::floor(std::clamp(seconds, 0.0, 86399.999));
+  t.hour = int(s / 3600.0);
+  t.minute = int((s - t.hour * 3600.0) / 60.0);
+  t.second = std::clamp(seconds - t.hour * 3600.0 - t.minute * 60.0, 0.0, 59.999);
+  if (std::string e = civilTimeError(t); !e.empty())
+    fail(RegisterError{kIllegalDataValue, "sun date (registers " + std::to_string(M::kSunDate) +
+                                              "-" + std::to_string(M::kSunDate + 1) +
+                                              ", YYYYMMDD): " + e});
+  commands_.emplace_back(command::SetSun{std::nullopt, std::nullopt, t, std::nullopt});
+}
+
 }  // namespace
 
 void putFloat(std::uint16_t* registers, double value) {
@@ -173,128 +341,18 @@ std::variant<std::vector<Command>, RegisterError> decodeHoldingWrite(
                            "the write covers half of the float32 at registers " +
                                std::to_string(f) + "-" + std::to_string(f + 1) +
                                " (write both registers in one request)"};
-
   HoldingRegisters next = current;
   std::copy(values.begin(), values.end(), next.begin() + address);
-  std::optional<RegisterError> error;
-  // The value of a touched float field, checked against its range.
-  auto readFloat = [&](const FloatField& f, int base) -> double {
-    const double v = getFloat(&next[std::size_t(base + f.address)]);
-    if (!error && !(std::isfinite(v) && v >= f.lo && v <= f.hi))
-      error = RegisterError{kIllegalDataValue,
-                            std::string(f.name) + " (register " + std::to_string(base + f.address) +
-                                "): " + formatNumber(v) + " is out of range (allowed: " +
-                                formatNumber(f.lo) + " to " + formatNumber(f.hi) + ")"};
-    return v;
-  };
-
-  std::vector<Command> commands;
-  command::SetView set_view{view, {}};
-  ViewPatch& p = set_view.patch;
-  glm::dvec3 position{0.0};
-  bool moved = false;
-  for (int i = 0; i < 3; ++i)
-    if (w.touches(kViewFloats[i].address, 2)) {
-      position[i] = readFloat(kViewFloats[i], 0);
-      moved = true;
-    }
-  if (moved) {
-    for (int i = 0; i < 3; ++i)
-      if (!w.touches(kViewFloats[i].address, 2))
-        position[i] = getFloat(&next[std::size_t(kViewFloats[i].address)]);
-    p.position = position;
-  }
-  std::optional<double>* angles[] = {&p.heading, &p.pitch, &p.roll, &p.vfov};
-  for (int i = 3; i < 7; ++i)
-    if (w.touches(kViewFloats[i].address, 2)) *angles[i - 3] = readFloat(kViewFloats[i], 0);
-  for (auto [a, out, name] :
-       {std::tuple{M::kWidth, &p.width, "width"}, std::tuple{M::kHeight, &p.height, "height"}})
-    if (w.touches(a)) {
-      if (!error && (next[std::size_t(a)] < 1 || next[std::size_t(a)] > Limits::kMaxImageSide))
-        error =
-            RegisterError{kIllegalDataValue, std::string(name) + " (register " + std::to_string(a) +
-                                                 "): " + std::to_string(next[std::size_t(a)]) +
-                                                 " is out of range (allowed: 1 to " +
-                                                 std::to_string(Limits::kMaxImageSide) + ")"};
-      *out = next[std::size_t(a)];
-    }
-  if (w.touches(0, M::kHeight + 1)) commands.emplace_back(set_view);
-
-  if (w.touches(M::kWindEast, 4)) {
-    const glm::dvec2 wind(readFloat(kOtherFloats[0], 0), readFloat(kOtherFloats[1], 0));
-    if (!error && glm::length(wind) > Limits::kMaxWind)
-      error = RegisterError{kIllegalDataValue, "wind: speed above 200 m/s"};
-    commands.emplace_back(command::SetWind{wind});
-  }
-  if (w.touches(M::kSunAzimuth, 4)) {
-    command::SetSun sun;
-    if (w.touches(M::kSunAzimuth, 2)) sun.azimuth = readFloat(kOtherFloats[2], 0);
-    if (w.touches(M::kSunElevation, 2)) sun.elevation = readFloat(kOtherFloats[3], 0);
-    commands.emplace_back(sun);
-  }
-  if (w.touches(M::kTimeScale, 2))
-    commands.emplace_back(command::SetTime{readFloat(kOtherFloats[4], 0), {}, {}, {}});
-
-  for (int layer = 0; layer < ProtocolLimits::kWeatherLayers; ++layer) {
-    const int base = M::kLayerStart + layer * M::kLayerStride;
-    if (!w.touches(base, M::kLayerStride)) continue;
-    command::SetWeather set{layer + 1, {}, std::nullopt};
-    const std::uint16_t type = next[std::size_t(base + M::kLayerType)];
-    const std::optional<CloudType> genus = cloudTypeFromCode(type);
-    if (!error && !genus)
-      error = RegisterError{kIllegalDataValue,
-                            "layer " + std::to_string(layer + 1) + " cloud type (register " +
-                                std::to_string(base) + "): " + std::to_string(type) +
-                                " is out of range (allowed: " + cloudTypeCodesAllowed() +
-                                ", CIGI cloud types)"};
-    set.weather.type = genus.value_or(CloudType::kNone);
-    set.weather.base_m = readFloat(kLayerFloats[0], base);
-    set.weather.thickness_m = readFloat(kLayerFloats[1], base);
-    set.weather.coverage = readFloat(kLayerFloats[2], base) / 100.0;
-    commands.emplace_back(set);
-  }
-  if (w.touches(M::kFogTop, 4) || w.touches(M::kFogColour, 6)) {  // the fog, set whole
-    const double top = readFloat(kAtmosphereFloats[0], 0);
-    const double visibility = readFloat(kAtmosphereFloats[1], 0);
-    const glm::dvec3 colour(readFloat(kAtmosphereFloats[3], 0), readFloat(kAtmosphereFloats[4], 0),
-                            readFloat(kAtmosphereFloats[5], 0));
-    if (!error) error = zeroOrWithin("fog", M::kFogVisibility, visibility, Limits::kFogVisibility);
-    if (visibility == 0.0)
-      commands.emplace_back(command::SetFog{false, {}, {}, {}});
-    else
-      commands.emplace_back(command::SetFog{true, top, visibility, colour});
-  }
-  if (w.touches(M::kHazeVisibility, 4)) {  // the haze, set whole
-    const double visibility = readFloat(kOtherFloats[5], 0);
-    const double scale_height = readFloat(kOtherFloats[6], 0);
-    if (!error)
-      error = zeroOrWithin("haze", M::kHazeVisibility, visibility, Limits::kHazeVisibility);
-    if (visibility == 0.0)
-      commands.emplace_back(command::SetHaze{false, {}, {}});
-    else
-      commands.emplace_back(command::SetHaze{true, visibility, scale_height});
-  }
-  if (w.touches(M::kSunDate, 4)) {
-    const std::uint32_t date = std::uint32_t(next[M::kSunDate]) << 16 | next[M::kSunDate + 1];
-    const double seconds = readFloat(kAtmosphereFloats[2], 0);
-    if (date != 0 && !error) {  // 0 leaves the sun where the angles put it; seconds checked
-      CivilTime t;
-      t.year = int(date / 10000);
-      t.month = int(date / 100 % 100);
-      t.day = int(date % 100);
-      const double s = std::floor(std::clamp(seconds, 0.0, 86399.999));
-      t.hour = int(s / 3600.0);
-      t.minute = int((s - t.hour * 3600.0) / 60.0);
-      t.second = std::clamp(seconds - t.hour * 3600.0 - t.minute * 60.0, 0.0, 59.999);
-      if (std::string e = civilTimeError(t); !error && !e.empty())
-        error = RegisterError{kIllegalDataValue,
-                              "sun date (registers " + std::to_string(M::kSunDate) + "-" +
-                                  std::to_string(M::kSunDate + 1) + ", YYYYMMDD): " + e};
-      commands.emplace_back(command::SetSun{std::nullopt, std::nullopt, t, std::nullopt});
-    }
-  }
-  if (error) return *error;
-  return commands;
+  HoldingWrite write(next, w);
+  write.viewSettings(view);
+  write.wind();
+  write.sunAngles();
+  write.timeScale();
+  for (int layer = 0; layer < ProtocolLimits::kWeatherLayers; ++layer) write.weatherLayer(layer);
+  write.fog();
+  write.haze();
+  write.sunDate();
+  return std::move(write).result();
 }
 
 std::variant<CoilWrite, RegisterError> decodeCoilWrite(int address,

@@ -46,10 +46,8 @@ void readView(TableReader& t, const Camera& scene_camera, ViewConfig& view) {
   t.finish();
 }
 
-void readDaemon(const toml::table& root, const std::string& file, DaemonConfig& out) {
-  TableReader t(root, "", file);
-  t.allow({"scene", "world", "view", "socket", "modbus", "metrics", "snapshot", "output", "cigi",
-           "stream", "site", "entity_type"});
+// The scene file (relative to the config's directory), loaded.
+void readSceneKey(TableReader& t, const std::string& file, DaemonConfig& out) {
   if (!t.has("scene")) t.failHere("missing key scene (the scene file to load)");
   t.string("scene", out.scene_path);
   const std::filesystem::path scene(out.scene_path);
@@ -58,7 +56,10 @@ void readDaemon(const toml::table& root, const std::string& file, DaemonConfig& 
         (std::filesystem::path(file).parent_path() / scene).lexically_normal().string();
   if (std::string error = loadSceneFile(out.scene_path, out.scene); !error.empty())
     t.failAt("scene", error);
+}
 
+// [world], and the scene's clouds checked against its ellipsoid budget.
+void readWorld(TableReader& t, DaemonConfig& out) {
   if (auto w = t.table("world")) {
     w->allow({"mode", "tick_rate", "time_scale", "threads", "max_ellipsoids"});
     out.mode = TickMode(w->choice("mode", {"realtime", "lockstep"}, int(out.mode)));
@@ -73,6 +74,10 @@ void readDaemon(const toml::table& root, const std::string& file, DaemonConfig& 
     t.failAt("scene", "its clouds hold " + std::to_string(n) + " ellipsoids, more than the " +
                           "world's budget of " + std::to_string(out.max_ellipsoids) +
                           " ([world] max_ellipsoids)");
+}
+
+// [[view]]: at most kMaxViews, each named once; none: the scene's camera, named main.
+void readViews(TableReader& t, DaemonConfig& out) {
   std::vector<TableReader> views = t.tables("view");
   if (views.size() > std::size_t(DaemonLimits::kMaxViews))
     t.failAt("view", "more than " + std::to_string(DaemonLimits::kMaxViews) + " views");
@@ -83,7 +88,9 @@ void readDaemon(const toml::table& root, const std::string& file, DaemonConfig& 
       if (out.views[i].name == view.name) v.failAt("name", "\"" + view.name + "\" names two views");
   }
   if (out.views.empty()) out.views.push_back({"main", out.scene.scene.camera, {}, {}});
+}
 
+void readSocket(TableReader& t, DaemonConfig& out) {
   if (auto s = t.table("socket")) {
     s->allow({"enabled", "bind", "port", "token", "max_clients", "max_subscriptions", "max_queue",
               "max_image_pixels", "max_pending_mb", "request_timeout", "idle_timeout"});
@@ -102,6 +109,10 @@ void readDaemon(const toml::table& root, const std::string& file, DaemonConfig& 
     readTimeouts(*s, out.socket_timeouts);
     s->finish();
   }
+}
+
+// [modbus], and the view its registers drive (the first, unless it names one).
+void readModbus(TableReader& t, DaemonConfig& out) {
   if (auto m = t.table("modbus")) {
     m->allow({"enabled", "bind", "port", "allow", "view", "max_clients", "request_timeout",
               "idle_timeout"});
@@ -121,6 +132,10 @@ void readDaemon(const toml::table& root, const std::string& file, DaemonConfig& 
   else if (std::none_of(out.views.begin(), out.views.end(),
                         [&](const ViewConfig& v) { return v.name == out.modbus_view; }))
     t.failHere("modbus.view: \"" + out.modbus_view + "\" is not a view");
+}
+
+// [cigi]; the views a host's view ids index are every [[view]] unless it names them.
+void readCigi(TableReader& t, DaemonConfig& out) {
   if (auto c = t.table("cigi")) {
     c->allow({"enabled", "bind", "ig_port", "host_port", "views", "recentre_distance"});
     c->boolean("enabled", out.cigi.enabled);
@@ -145,6 +160,9 @@ void readDaemon(const toml::table& root, const std::string& file, DaemonConfig& 
   }
   if (out.cigi.views.empty())
     for (const ViewConfig& v : out.views) out.cigi.views.push_back(v.name);
+}
+
+void readSite(TableReader& t, DaemonConfig& out) {
   if (auto s = t.table("site")) {
     s->allow({"latitude", "longitude"});
     Site& site = out.site.emplace();
@@ -152,6 +170,10 @@ void readDaemon(const toml::table& root, const std::string& file, DaemonConfig& 
     s->number("longitude", site.longitude_deg, Limits::kLongitude);
     s->finish();
   }
+}
+
+// [[entity_type]]: the targets a CIGI entity type is drawn as, each id and name once.
+void readEntityTypes(TableReader& t, const std::string& file, DaemonConfig& out) {
   for (TableReader& e : t.tables("entity_type")) {
     EntityType& type = out.entity_types.emplace_back();
     if (!e.has("id")) e.failHere("missing key id (the CIGI entity type, 0 to 65535)");
@@ -165,6 +187,10 @@ void readDaemon(const toml::table& root, const std::string& file, DaemonConfig& 
                            "\" repeats an earlier id or name");
     e.finish();
   }
+}
+
+// [[stream]]: video of a [[view]], at most kMaxStreams.
+void readStreams(TableReader& t, DaemonConfig& out) {
   for (TableReader& r : t.tables("stream")) {
     r.allow({"view", "address", "bitrate", "rate", "keyframe_interval", "encoder", "stamp"});
     command::Stream& c = out.streams.emplace_back();
@@ -188,12 +214,9 @@ void readDaemon(const toml::table& root, const std::string& file, DaemonConfig& 
       r.failHere("more than " + std::to_string(ProtocolLimits::kMaxStreams) + " streams");
     r.finish();
   }
-  if (auto m = t.table("metrics")) {
-    m->allow({"enabled", "bind", "port"});
-    m->boolean("enabled", out.metrics_enabled);
-    readListen(*m, out.metrics);
-    m->finish();
-  }
+}
+
+void readSnapshot(TableReader& t, DaemonConfig& out) {
   if (auto s = t.table("snapshot")) {
     s->allow({"path", "interval", "restore", "directory"});
     s->string("path", out.snapshot_path);
@@ -202,6 +225,10 @@ void readDaemon(const toml::table& root, const std::string& file, DaemonConfig& 
     s->string("directory", out.snapshot_directory);
     s->finish();
   }
+}
+
+// [output]: where and how rendered files are written (raw frames are for the socket).
+void readOutput(TableReader& t, DaemonConfig& out) {
   if (auto o = t.table("output")) {
     o->allow({"directory", "format", "png_compression", "jpeg_quality"});
     o->string("directory", out.output_directory);
@@ -213,6 +240,29 @@ void readDaemon(const toml::table& root, const std::string& file, DaemonConfig& 
     o->integer("jpeg_quality", out.encode.jpeg_quality, 1, 100);
     o->finish();
   }
+}
+
+void readDaemon(const toml::table& root, const std::string& file, DaemonConfig& out) {
+  TableReader t(root, "", file);
+  t.allow({"scene", "world", "view", "socket", "modbus", "metrics", "snapshot", "output", "cigi",
+           "stream", "site", "entity_type"});
+  readSceneKey(t, file, out);
+  readWorld(t, out);
+  readViews(t, out);
+  readSocket(t, out);
+  readModbus(t, out);
+  readCigi(t, out);
+  readSite(t, out);
+  readEntityTypes(t, file, out);
+  readStreams(t, out);
+  if (auto m = t.table("metrics")) {
+    m->allow({"enabled", "bind", "port"});
+    m->boolean("enabled", out.metrics_enabled);
+    readListen(*m, out.metrics);
+    m->finish();
+  }
+  readSnapshot(t, out);
+  readOutput(t, out);
   t.finish();
 }
 
