@@ -231,6 +231,268 @@ std::string merge(const DatasetSpec& spec, const fs::path& dir) {
   return e;
 }
 
+// The description (read and parsed), this run's shard, and the --only indices checked: what
+// is wrong with the request, or empty.
+std::string readRequest(const DatasetCommandOptions& o, std::string& spec_text, DatasetSpec& spec,
+                        int& shard, int& shards) {
+  if (std::string e = config_detail::readTextFile(o.spec_path, "dataset description", spec_text);
+      !e.empty() || !(e = parseDatasetText(spec_text, o.spec_path, spec)).empty())
+    return e;
+  if (std::string e = shardOf(o, shard, shards); !e.empty()) return e;
+  for (int i : o.only)
+    if (i < 0 || i >= spec.samples)
+      return "--only: " + std::to_string(i) + " is not a sample index (allowed: 0 to " +
+             std::to_string(spec.samples - 1) + ")";
+  return "";
+}
+
+// Whether `dir` is new, or holds a dataset of the same description (its dataset.json's hash).
+bool holdsThisDescription(const fs::path& dir, const json& header) {
+  if (!fs::exists(dir / "dataset.json")) return true;
+  std::ifstream in(dir / "dataset.json");
+  json existing;
+  try {
+    in >> existing;
+  } catch (const json::exception&) {
+  }
+  return existing.value("description_hash", "") == header["description_hash"];
+}
+
+// The directories the description's files go to, and dataset.json. Shards start together on
+// shared storage: each writes the header under its own name and renames it into place (the
+// same bytes whoever wins).
+std::string prepareDirectory(const DatasetSpec& spec, const fs::path& dir, const json& header) {
+  std::error_code ec;
+  for (const char* sub : {"images", "masks", "glint", "labels", "exr", "records"}) {
+    if ((std::string(sub) == "masks" && !spec.write_masks) ||
+        (std::string(sub) == "glint" && !(spec.sea_probability > 0.0)) ||
+        (std::string(sub) == "exr" && !spec.write_depth && !spec.write_coverage &&
+         spec.band != Band::kLwir))
+      continue;
+    fs::create_directories(dir / sub, ec);
+    if (ec) return "cannot create '" + (dir / sub).string() + "': " + ec.message();
+  }
+  const fs::path own = dir / ("dataset.json." + std::to_string(::getpid()));
+  if (std::string e = writeText(own, header.dump(2) + "\n"); !e.empty()) return e;
+  fs::rename(own, dir / "dataset.json", ec);
+  if (ec) return "cannot write '" + (dir / "dataset.json").string() + "': " + ec.message();
+  return "";
+}
+
+// The samples this run renders: --only's, else the shard's not yet written (--resume). A run
+// killed while writing leaves files named *.partial, never a final name: these samples' are
+// removed (other shards' may be in progress).
+std::vector<int> samplesToRender(const DatasetCommandOptions& o, const DatasetSpec& spec,
+                                 const fs::path& dir, int shard, int shards) {
+  std::vector<int> todo;
+  if (!o.only.empty()) {
+    todo = o.only;
+  } else {
+    for (int i = shard; i < spec.samples; i += shards)
+      if (!o.resume || !fs::exists(dir / "records" / (sampleName(i) + ".json"))) todo.push_back(i);
+  }
+  std::error_code ec;
+  for (int i : todo)
+    for (const char* file :
+         {"images/%s.png", "masks/%s.png", "labels/%s.txt", "exr/%s.exr", "records/%s.json"}) {
+      char name[64];
+      std::snprintf(name, sizeof name, file, sampleName(i).c_str());
+      fs::remove(dir / (std::string(name) + ".partial"), ec);
+    }
+  return todo;
+}
+
+// The next kDrawAhead samples' scenes, drawn on other threads while one renders: a sample
+// whose heaps take longer to draw (60 to 106 ms, the first of a texture) than the one before
+// takes to render (20 to 50 ms, layers only) is then drawn before it is needed. The first
+// ones are drawn while the renderer starts.
+class SampleDrawer {
+ public:
+  static constexpr std::size_t kDrawAhead = 2;
+  SampleDrawer(const DatasetSpec& spec, const std::vector<int>& todo) : spec_(spec), todo_(todo) {
+    for (std::size_t n = 0; n < todo_.size() && n < kDrawAhead; ++n) ahead_.push_back(draw(n));
+  }
+  // The n-th sample to render (taken in order) and the seconds its drawing took.
+  std::pair<SampleScene, double> take(std::size_t n) {
+    auto drawn = ahead_.front().get();
+    ahead_.pop_front();
+    if (n + kDrawAhead < todo_.size()) ahead_.push_back(draw(n + kDrawAhead));
+    return drawn;
+  }
+
+ private:
+  std::future<std::pair<SampleScene, double>> draw(std::size_t n) {
+    return std::async(std::launch::async, [&spec = spec_, index = todo_[n]] {
+      const auto t0 = Clock::now();
+      SampleScene sample = drawSample(spec, index);
+      return std::pair{std::move(sample), std::chrono::duration<double>(Clock::now() - t0).count()};
+    });
+  }
+  const DatasetSpec& spec_;
+  const std::vector<int>& todo_;
+  std::deque<std::future<std::pair<SampleScene, double>>> ahead_;
+};
+
+// Labels and writes rendered samples on one worker thread while this one renders (it holds
+// the GL context); at most two rendered samples wait.
+class SampleWriter {
+ public:
+  SampleWriter(const DatasetSpec& spec, const fs::path& dir, const EncodeOptions& encode)
+      : spec_(spec), band_(spec.infrared), dir_(dir), encode_(encode), worker_([this] { run(); }) {}
+  ~SampleWriter() { finish(); }
+
+  // Hands a sample to the worker once fewer than two wait; false (and the sample dropped)
+  // once a write has failed.
+  bool push(Rendered r) {
+    std::unique_lock lock(mutex_);
+    changed_.wait(lock, [&] { return queue_.size() < 2 || !error_.empty(); });
+    if (!error_.empty()) return false;
+    queue_.push_back(std::move(r));
+    changed_.notify_all();
+    return true;
+  }
+  int written() {
+    std::unique_lock lock(mutex_);
+    return written_;
+  }
+  // Waits until every sample handed over is written: the first write's error, or empty.
+  std::string finish() {
+    {
+      std::unique_lock lock(mutex_);
+      done_ = true;
+      changed_.notify_all();
+    }
+    if (worker_.joinable()) worker_.join();
+    return error_;
+  }
+  double writeSeconds() const { return write_s_; }  // after finish
+
+ private:
+  void run() {
+    for (;;) {
+      std::unique_lock lock(mutex_);
+      changed_.wait(lock, [&] { return !queue_.empty() || done_; });
+      if (queue_.empty()) return;
+      Rendered r = std::move(queue_.front());
+      queue_.pop_front();
+      changed_.notify_all();
+      lock.unlock();
+      const auto start = Clock::now();
+      std::string e = writeSample(spec_, band_, dir_, r, encode_);
+      lock.lock();
+      write_s_ += std::chrono::duration<double>(Clock::now() - start).count();
+      if (!e.empty() && error_.empty()) error_ = e;
+      ++written_;
+      changed_.notify_all();
+    }
+  }
+
+  const DatasetSpec& spec_;
+  const BandTable band_;
+  const fs::path& dir_;
+  const EncodeOptions& encode_;
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::deque<Rendered> queue_;
+  bool done_ = false;
+  std::string error_;
+  int written_ = 0;
+  double write_s_ = 0.0;
+  std::jthread worker_;  // last: it starts once the members above are made
+};
+
+// The renderer the options ask for, sized for the description's samples; null with the error
+// logged, and `code` the exit code.
+std::unique_ptr<Renderer> datasetRenderer(const DatasetCommandOptions& o, const DatasetSpec& spec,
+                                          int& code) {
+  RendererOptions options;
+  options.kind = o.renderer == "reference" ? RendererKind::kReference : RendererKind::kGl;
+  options.gl_backend = backendFromName(o.gl_backend);
+  options.render.channel_divisor = o.channel_divisor;
+  options.render.heaps = options.reference.heaps = spec.heaps;
+  options.reference.label_divisor = o.channel_divisor;
+  std::string error;
+  std::unique_ptr<Renderer> renderer = createRenderer(options, error);
+  if (!renderer) {
+    spdlog::error("{}", error);
+    code = 1;
+    return nullptr;
+  }
+  if (std::string e = renderer->reserve(spec.width, spec.height, true, /*targets=*/true);
+      !e.empty()) {
+    spdlog::error("dataset.width/height: {}", e);
+    code = 2;
+    return nullptr;
+  }
+  spdlog::info("renderer: {}", renderer->description());
+  return renderer;
+}
+
+// The channels a sample is rendered with: its band's, the labels', and what the description
+// writes.
+FrameRequest sampleRequest(const DatasetSpec& spec) {
+  FrameRequest request;
+  request.channels = {spec.band == Band::kLwir ? Channel::kLwir : Channel::kColour,
+                      Channel::kObjectId, Channel::kVisibility};
+  if (spec.write_depth)
+    for (Channel c : {Channel::kDepth, Channel::kCloudDepth}) request.channels.add(c);
+  if (spec.write_coverage) request.channels.add(Channel::kCoverage);
+  if (spec.sea_probability > 0.0) request.channels.add(Channel::kGlint);
+  return request;
+}
+
+// Draws, renders and writes the samples `todo`, the three overlapping on their own threads,
+// with progress every 2 s: the exit code.
+int renderSamples(const DatasetCommandOptions& o, const DatasetSpec& spec, const fs::path& dir,
+                  const std::vector<int>& todo) {
+  SampleDrawer drawer(spec, todo);
+  int code = 0;
+  const std::unique_ptr<Renderer> renderer = datasetRenderer(o, spec, code);
+  if (!renderer) return code;
+  FrameRequest request = sampleRequest(spec);
+  SampleWriter writer(spec, dir, o.encode);
+  double draw_s = 0.0, render_s = 0.0;
+  const auto start = Clock::now();
+  auto last_report = start;
+  for (std::size_t n = 0; n < todo.size(); ++n) {
+    const auto t0 = Clock::now();
+    auto [sample, draw_seconds] = drawer.take(n);
+    Rendered r{todo[n], std::move(sample), {}};
+    const auto t1 = Clock::now();
+    request.infrared = r.sample.infrared;
+    r.frame = renderer->render(r.sample.scene, request);
+    const auto t2 = Clock::now();
+    spdlog::debug(
+        "sample {}: drawn in {:.1f} ms (waited {:.1f} ms), rendered in {:.1f} ms: {}", r.index,
+        1e3 * draw_seconds, std::chrono::duration<double, std::milli>(t1 - t0).count(),
+        std::chrono::duration<double, std::milli>(t2 - t1).count(), renderer->statsLine());
+    draw_s += draw_seconds;
+    render_s += std::chrono::duration<double>(t2 - t1).count();
+    if (!writer.push(std::move(r))) break;
+    const double elapsed = std::chrono::duration<double>(t2 - start).count();
+    if (std::chrono::duration<double>(t2 - last_report).count() >= 2.0) {
+      last_report = t2;
+      const int written = writer.written();
+      const double rate = written / elapsed;
+      spdlog::info("dataset: {}/{} samples, {:.1f} samples/s, {:.0f} s left", written, todo.size(),
+                   rate, rate > 0 ? (todo.size() - written) / rate : 0.0);
+    }
+  }
+  if (std::string e = writer.finish(); !e.empty()) {
+    spdlog::error("{}", e);
+    return 1;
+  }
+  const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+  auto perSample = [&](double seconds) { return todo.empty() ? 0.0 : 1e3 * seconds / todo.size(); };
+  spdlog::info(
+      "dataset: {} samples in {:.1f} s, {:.1f} samples/s (per sample: drawing {:.1f} ms, "
+      "rendering {:.1f} ms, labelling and writing {:.1f} ms; the three overlap on their own "
+      "threads)",
+      todo.size(), elapsed, todo.empty() ? 0.0 : todo.size() / elapsed, perSample(draw_s),
+      perSample(render_s), perSample(writer.writeSeconds()));
+  return 0;
+}
+
 }  // namespace
 
 void addDatasetCommand(CLI::App& app, DatasetCommandOptions& o) {
@@ -267,43 +529,24 @@ void addDatasetCommand(CLI::App& app, DatasetCommandOptions& o) {
 
 int runDatasetCommand(const DatasetCommandOptions& o) {
   // Everything that can be wrong with the request is found before any file is written.
-  // The text is read once: parsed here, and hashed below to tie the output to it.
+  // The text is read once: parsed here, and hashed to tie the output to it.
   std::string spec_text;
   DatasetSpec spec;
-  if (std::string e = config_detail::readTextFile(o.spec_path, "dataset description", spec_text);
-      !e.empty() || !(e = parseDatasetText(spec_text, o.spec_path, spec)).empty()) {
-    spdlog::error("{}", e);
-    return 2;
-  }
   int shard = 0, shards = 1;
-  if (std::string e = shardOf(o, shard, shards); !e.empty()) {
+  if (std::string e = readRequest(o, spec_text, spec, shard, shards); !e.empty()) {
     spdlog::error("{}", e);
     return 2;
   }
-  for (int i : o.only)
-    if (i < 0 || i >= spec.samples) {
-      spdlog::error("--only: {} is not a sample index (allowed: 0 to {})", i, spec.samples - 1);
-      return 2;
-    }
   const fs::path dir(o.output_dir);
   const json header = {{"description", o.spec_path},
                        {"description_hash", std::to_string(textHash(spec_text))},
                        {"samples", spec.samples},
                        {"width", spec.width},
                        {"height", spec.height}};
-  std::error_code ec;
-  if (fs::exists(dir / "dataset.json")) {
-    std::ifstream in(dir / "dataset.json");
-    json existing;
-    try {
-      in >> existing;
-    } catch (const json::exception&) {
-    }
-    if (existing.value("description_hash", "") != header["description_hash"]) {
-      spdlog::error("{}: holds a dataset from another description; use an empty directory",
-                    o.output_dir);
-      return 2;
-    }
+  if (!holdsThisDescription(dir, header)) {
+    spdlog::error("{}: holds a dataset from another description; use an empty directory",
+                  o.output_dir);
+    return 2;
   }
   if (o.merge_only) {
     if (std::string e = merge(spec, dir); !e.empty()) {
@@ -313,174 +556,18 @@ int runDatasetCommand(const DatasetCommandOptions& o) {
     spdlog::info("merged {} samples into {}/annotations.json", spec.samples, o.output_dir);
     return 0;
   }
-  for (const char* sub : {"images", "masks", "glint", "labels", "exr", "records"}) {
-    if ((std::string(sub) == "masks" && !spec.write_masks) ||
-        (std::string(sub) == "glint" && !(spec.sea_probability > 0.0)) ||
-        (std::string(sub) == "exr" && !spec.write_depth && !spec.write_coverage &&
-         spec.band != Band::kLwir))
-      continue;
-    fs::create_directories(dir / sub, ec);
-    if (ec) {
-      spdlog::error("cannot create '{}': {}", (dir / sub).string(), ec.message());
-      return 1;
-    }
-  }
-  // Shards start together on shared storage: each writes the header under its own name and
-  // renames it into place (the same bytes whoever wins).
-  const fs::path own = dir / ("dataset.json." + std::to_string(::getpid()));
-  if (std::string e = writeText(own, header.dump(2) + "\n"); !e.empty()) {
+  if (std::string e = prepareDirectory(spec, dir, header); !e.empty()) {
     spdlog::error("{}", e);
     return 1;
   }
-  fs::rename(own, dir / "dataset.json", ec);
-  if (ec) {
-    spdlog::error("cannot write '{}': {}", (dir / "dataset.json").string(), ec.message());
-    return 1;
-  }
-
-  std::vector<int> todo;
-  if (!o.only.empty()) {
-    todo = o.only;
-  } else {
-    for (int i = shard; i < spec.samples; i += shards)
-      if (!o.resume || !fs::exists(dir / "records" / (sampleName(i) + ".json"))) todo.push_back(i);
-  }
-  // A run killed while writing leaves files named *.partial, never a final name: this run's
-  // samples' are removed (other shards' may be in progress).
-  for (int i : todo)
-    for (const char* file :
-         {"images/%s.png", "masks/%s.png", "labels/%s.txt", "exr/%s.exr", "records/%s.json"}) {
-      char name[64];
-      std::snprintf(name, sizeof name, file, sampleName(i).c_str());
-      fs::remove(dir / (std::string(name) + ".partial"), ec);
-    }
+  const std::vector<int> todo = samplesToRender(o, spec, dir, shard, shards);
   const int skipped =
       o.only.empty() ? (spec.samples - shard + shards - 1) / shards - int(todo.size()) : 0;
   spdlog::info(
       "dataset: {} samples to render{}{}", todo.size(),
       shards > 1 ? " (shard " + std::to_string(shard) + "/" + std::to_string(shards) + ")" : "",
       skipped > 0 ? ", " + std::to_string(skipped) + " already written" : "");
-
-  // The next kDrawAhead samples' scenes are drawn on other threads while one renders: a
-  // sample whose heaps take longer to draw (60 to 106 ms, the first of a texture) than the one
-  // before takes to render (20 to 50 ms, layers only) is then drawn before it is needed. The
-  // first ones are drawn while the renderer starts.
-  constexpr std::size_t kDrawAhead = 2;
-  auto drawAsync = [&](std::size_t n) {
-    return std::async(std::launch::async, [&spec, index = todo[n]] {
-      const auto t0 = Clock::now();
-      SampleScene sample = drawSample(spec, index);
-      return std::pair{std::move(sample), std::chrono::duration<double>(Clock::now() - t0).count()};
-    });
-  };
-  std::deque<std::future<std::pair<SampleScene, double>>> ahead;
-  for (std::size_t n = 0; n < todo.size() && n < kDrawAhead; ++n) ahead.push_back(drawAsync(n));
-  RendererOptions options;
-  options.kind = o.renderer == "reference" ? RendererKind::kReference : RendererKind::kGl;
-  options.gl_backend = backendFromName(o.gl_backend);
-  options.render.channel_divisor = o.channel_divisor;
-  options.render.heaps = options.reference.heaps = spec.heaps;
-  options.reference.label_divisor = o.channel_divisor;
-  std::string error;
-  const std::unique_ptr<Renderer> renderer = createRenderer(options, error);
-  if (!renderer) {
-    spdlog::error("{}", error);
-    return 1;
-  }
-  if (std::string e = renderer->reserve(spec.width, spec.height, true, /*targets=*/true);
-      !e.empty()) {
-    spdlog::error("dataset.width/height: {}", e);
-    return 2;
-  }
-  spdlog::info("renderer: {}", renderer->description());
-
-  FrameRequest request;
-  request.channels = {spec.band == Band::kLwir ? Channel::kLwir : Channel::kColour,
-                      Channel::kObjectId, Channel::kVisibility};
-  if (spec.write_depth)
-    for (Channel c : {Channel::kDepth, Channel::kCloudDepth}) request.channels.add(c);
-  if (spec.write_coverage) request.channels.add(Channel::kCoverage);
-  if (spec.sea_probability > 0.0) request.channels.add(Channel::kGlint);
-
-  // Rendering (this thread, which holds the GL context) and encoding (one worker) overlap;
-  // at most two rendered samples wait.
-  const BandTable band(spec.infrared);
-  std::mutex mutex;
-  std::condition_variable changed;
-  std::deque<Rendered> queue;
-  bool done = false;
-  std::string write_error;
-  int written = 0;
-  double draw_s = 0.0, render_s = 0.0, write_s = 0.0;
-  std::jthread encoder([&] {
-    for (;;) {
-      std::unique_lock lock(mutex);
-      changed.wait(lock, [&] { return !queue.empty() || done; });
-      if (queue.empty()) return;
-      Rendered r = std::move(queue.front());
-      queue.pop_front();
-      changed.notify_all();
-      lock.unlock();
-      const auto start = Clock::now();
-      std::string e = writeSample(spec, band, dir, r, o.encode);
-      lock.lock();
-      write_s += std::chrono::duration<double>(Clock::now() - start).count();
-      if (!e.empty() && write_error.empty()) write_error = e;
-      ++written;
-      changed.notify_all();
-    }
-  });
-
-  const auto start = Clock::now();
-  auto last_report = start;
-  for (std::size_t n = 0; n < todo.size(); ++n) {
-    const auto t0 = Clock::now();
-    auto [sample, draw_seconds] = ahead.front().get();
-    ahead.pop_front();
-    if (n + kDrawAhead < todo.size()) ahead.push_back(drawAsync(n + kDrawAhead));
-    Rendered r{todo[n], std::move(sample), {}};
-    const auto t1 = Clock::now();
-    request.infrared = r.sample.infrared;
-    r.frame = renderer->render(r.sample.scene, request);
-    const auto t2 = Clock::now();
-    spdlog::debug(
-        "sample {}: drawn in {:.1f} ms (waited {:.1f} ms), rendered in {:.1f} ms: {}", r.index,
-        1e3 * draw_seconds, std::chrono::duration<double, std::milli>(t1 - t0).count(),
-        std::chrono::duration<double, std::milli>(t2 - t1).count(), renderer->statsLine());
-    draw_s += draw_seconds;
-    render_s += std::chrono::duration<double>(t2 - t1).count();
-    std::unique_lock lock(mutex);
-    changed.wait(lock, [&] { return queue.size() < 2 || !write_error.empty(); });
-    if (!write_error.empty()) break;
-    queue.push_back(std::move(r));
-    changed.notify_all();
-    const double elapsed = std::chrono::duration<double>(t2 - start).count();
-    if (std::chrono::duration<double>(t2 - last_report).count() >= 2.0) {
-      last_report = t2;
-      const double rate = written / elapsed;
-      spdlog::info("dataset: {}/{} samples, {:.1f} samples/s, {:.0f} s left", written, todo.size(),
-                   rate, rate > 0 ? (todo.size() - written) / rate : 0.0);
-    }
-  }
-  {
-    std::unique_lock lock(mutex);
-    done = true;
-    changed.notify_all();
-  }
-  encoder.join();
-  if (!write_error.empty()) {
-    spdlog::error("{}", write_error);
-    return 1;
-  }
-  const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
-  spdlog::info(
-      "dataset: {} samples in {:.1f} s, {:.1f} samples/s (per sample: drawing {:.1f} ms, "
-      "rendering {:.1f} ms, labelling and writing {:.1f} ms; the three overlap on their own "
-      "threads)",
-      todo.size(), elapsed, todo.empty() ? 0.0 : todo.size() / elapsed,
-      todo.empty() ? 0.0 : 1e3 * draw_s / todo.size(),
-      todo.empty() ? 0.0 : 1e3 * render_s / todo.size(),
-      todo.empty() ? 0.0 : 1e3 * write_s / todo.size());
+  if (const int code = renderSamples(o, spec, dir, todo); code != 0) return code;
   if (shards == 1 && o.only.empty()) {
     if (std::string e = merge(spec, dir); !e.empty()) {
       spdlog::error("{}", e);

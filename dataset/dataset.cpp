@@ -52,6 +52,218 @@ std::string spanError(const char* name, Span s) {
   return "";
 }
 
+// One sample's draws of a stream.
+Draws streamOf(std::uint64_t seed, Stream s) {
+  return Draws(hashCounters(seed, s));
+}
+
+// The sample's weather layers, genus by genus, and rain from the lowest of them: in shafts
+// under heaps, else from its base down (MODEL.md section 17), which the scene's weather holds.
+void drawSky(const DatasetSpec& spec, std::uint64_t seed, SampleScene& out) {
+  Draws sky = streamOf(seed, kSky);
+  const int layers = spec.genera.empty() ? 0 : sky.integer(spec.layers);
+  std::vector<WeatherLayer> weather(std::size_t(std::max(layers, 0)));
+  for (WeatherLayer& w : weather) {
+    w.type = spec.genera[std::min(spec.genera.size() - 1,
+                                  std::size_t(sky.unit() * double(spec.genera.size())))];
+    w.coverage = sky.in(spec.coverage);
+    w.base_m = sky.in(spec.base);
+    w.thickness_m = sky.in(spec.thickness);
+  }
+  Draws rain = streamOf(seed, kRain);
+  std::optional<std::size_t> raining;
+  if (rain.unit() < spec.rain_probability && layers > 0) {
+    raining = 0;
+    for (std::size_t k = 1; k < weather.size(); ++k)
+      if (weather[k].base_m < weather[*raining].base_m) raining = k;
+    weather[*raining].precipitation = {PrecipitationKind::kRain, rain.in(spec.rain_rate), 0.0};
+  }
+  Scene& scene = out.scene;
+  json& record = out.record;
+  record["layers"] = json::array();
+  for (int k = 0; k < layers; ++k) {
+    const WeatherLayer& w = weather[std::size_t(k)];
+    const std::uint64_t layer_seed = weatherSeed(seed, k + 1);
+    const WeatherClouds add = weatherClouds(w, "layer" + std::to_string(k + 1), layer_seed);
+    scene.layers.insert(scene.layers.end(), add.layers.begin(), add.layers.end());
+    scene.fields.insert(scene.fields.end(), add.fields.begin(), add.fields.end());
+    if (raining == std::size_t(k)) scene.weather[{k + 1, std::nullopt}] = w;
+    record["layers"].push_back({{"genus", std::string(cloudTypeName(w.type))},
+                                {"coverage", w.coverage},
+                                {"base_m", w.base_m},
+                                {"thickness_m", w.thickness_m},
+                                {"seed", std::to_string(layer_seed)}});
+  }
+  record["rain_mm_h"] = raining ? json(weather[*raining].precipitation.rate_mm_h) : json(nullptr);
+}
+
+void drawSea(const DatasetSpec& spec, std::uint64_t seed, SampleScene& out) {
+  Draws water = streamOf(seed, kSea);
+  if (!(water.unit() < spec.sea_probability)) {
+    out.record["sea"] = nullptr;
+    return;
+  }
+  Sea& sea = out.scene.sea.emplace();
+  const double speed = water.in(spec.sea_wind);
+  const double towards = glm::radians(water.in(spec.sea_wind_direction));
+  sea.wind = speed * glm::dvec2(std::sin(towards), std::cos(towards));
+  sea.clarity = water.in(spec.sea_clarity);
+  sea.whitecaps = spec.sea_whitecaps;
+  sea.seed = hashCounters(seed, kSea);
+  out.record["sea"] = {{"wind", json::array({sea.wind.x, sea.wind.y})},
+                       {"clarity", sea.clarity},
+                       {"whitecaps", sea.whitecaps},
+                       {"significant_height_m", SeaSurface(sea).significantHeight()}};
+}
+
+void drawSun(const DatasetSpec& spec, std::uint64_t seed, SampleScene& out) {
+  Draws sun = streamOf(seed, kSun);
+  Scene& scene = out.scene;
+  scene.sun.azimuth_deg = sun.in(spec.sun_azimuth);
+  scene.sun.elevation_deg = sun.in(spec.sun_elevation);
+  out.record["sun"] = {{"azimuth_deg", scene.sun.azimuth_deg},
+                       {"elevation_deg", scene.sun.elevation_deg}};
+}
+
+void drawFog(const DatasetSpec& spec, std::uint64_t seed, SampleScene& out) {
+  Draws fog = streamOf(seed, kFog);
+  if (!(fog.unit() < spec.fog_probability)) {
+    out.record["fog"] = nullptr;
+    return;
+  }
+  Fog& f = out.scene.fog.emplace();
+  f.top_m = fog.in(spec.fog_top);
+  f.visibility_m = fog.in(spec.fog_visibility);
+  out.record["fog"] = {{"top_m", f.top_m}, {"visibility_m", f.visibility_m}};
+}
+
+void drawCamera(const DatasetSpec& spec, std::uint64_t seed, SampleScene& out) {
+  Draws cam = streamOf(seed, kCamera);
+  Camera& camera = out.scene.camera;
+  camera.width = spec.width;
+  camera.height = spec.height;
+  camera.position = {0.0, 0.0, cam.in(spec.altitude)};
+  camera.orientation = {cam.in(spec.heading), cam.in(spec.pitch), cam.in(spec.roll)};
+  camera.vfov_deg = cam.in(spec.vfov);
+  out.record["camera"] = cameraJson(frameInfo(camera, 0.0));
+}
+
+// Places targets along rays of the sample's camera: a pixel and a distance per instance;
+// those meant to be behind cloud (or in the clear) try up to kPlacementAttempts placements
+// for one whose centre ray says so.
+class TargetPlacer {
+ public:
+  static constexpr int kPlacementAttempts = 64;
+  TargetPlacer(const DatasetSpec& spec, const Scene& scene, Draws& draw)
+      : spec_(spec),
+        scene_(scene),
+        camera_(scene.camera),
+        basis_(viewBasis(scene.camera)),
+        cloudy_(!scene.layers.empty() || !scene.fields.empty()),
+        draw_(draw) {}
+
+  struct Placement {
+    double transmittance = 1.0;  // along the ray to the target's centre
+    bool met = false;            // behind cloud or in the clear, as asked
+  };
+  Placement place(const TargetClass& cls, bool behind, Target& target) {
+    Placement placed;
+    for (int attempt = 0; attempt < kPlacementAttempts && !placed.met; ++attempt) {
+      const bool last = attempt + 1 == kPlacementAttempts;
+      const double px = draw_.in({0.1 * spec_.width, 0.9 * spec_.width});
+      const double py = draw_.in({0.1 * spec_.height, 0.9 * spec_.height});
+      const glm::dvec3 d = glm::normalize(rayDirection(basis_, camera_, px, py));
+      Span range = cls.distance;
+      if (cls.afloat) {
+        // Where the ray meets the plane of its centre, if that lies within its range.
+        const double at = (0.3 * cls.size.z - camera_.position.z) / d.z;
+        if (!(d.z < 0.0 && at >= range.lo && at <= range.hi) && !last) continue;
+        range = {at, at};
+      }
+      if (behind && cloudy_) {
+        if (transmittanceTo(d, range.hi) >= 0.9 && !last) continue;
+        range.lo = nearestBehindCloud(d, range);
+      }
+      const double distance = draw_.in(range);
+      const glm::dvec3 centre = camera_.position + distance * d;
+      if (centre.z < 0.0 && !last) continue;  // below the ground
+      target.centre = centre;
+      placed.transmittance = transmittanceTo(d, distance);
+      placed.met = behind ? placed.transmittance < 0.9 : placed.transmittance > 0.99;
+    }
+    return placed;
+  }
+
+ private:
+  double transmittanceTo(glm::dvec3 d, double distance) {
+    if (!cloudy_) return 1.0;
+    if (!probe_) probe_.emplace(scene_, spec_.heaps);
+    return probe_->transmittance(d, distance);
+  }
+  // Behind cloud: only as far as the cloud along this ray allows. Transmittance falls with
+  // distance; the nearest distance where it is below 0.9 is found by bisection, and the
+  // target drawn between it and the far end.
+  double nearestBehindCloud(glm::dvec3 d, Span range) {
+    if (transmittanceTo(d, range.lo) < 0.9) return range.lo;
+    double lo = range.lo, hi = range.hi;
+    for (int k = 0; k < 12; ++k) {
+      const double mid = 0.5 * (lo + hi);
+      (transmittanceTo(d, mid) < 0.9 ? hi : lo) = mid;
+    }
+    return hi;
+  }
+
+  const DatasetSpec& spec_;
+  const Scene& scene_;
+  const Camera& camera_;
+  const ViewBasis basis_;
+  const bool cloudy_;
+  Draws& draw_;
+  std::optional<CloudProbe> probe_;
+};
+
+// Every class's targets, with their temperatures from their own stream, so that both bands
+// place the same targets.
+void drawTargets(const DatasetSpec& spec, std::uint64_t seed, SampleScene& out) {
+  Draws draw = streamOf(seed, kTargets);
+  Draws heat = streamOf(seed, kInfrared);
+  out.infrared = spec.infrared;
+  TargetPlacer placer(spec, out.scene, draw);
+  json& record = out.record;
+  record["targets"] = json::array();
+  for (std::size_t c = 0; c < spec.targets.size(); ++c) {
+    const TargetClass& cls = spec.targets[c];
+    const int count = draw.integer(cls.count);
+    for (int i = 0; i < count; ++i) {
+      const bool behind = draw.unit() < spec.occluded_fraction;
+      Target target;
+      target.name = cls.name + std::to_string(i + 1);
+      target.shape = cls.shape;
+      target.mesh = cls.mesh;
+      target.size = cls.size;
+      target.colour = cls.colour;
+      target.orientation = {draw.in(cls.heading), draw.in(cls.pitch), draw.in(cls.roll)};
+      const TargetPlacer::Placement placed = placer.place(cls, behind, target);
+      const double temperature = heat.in(cls.temperature);
+      out.infrared.target_temperatures.push_back(temperature);
+      out.scene.targets.push_back(target);
+      out.target_class.push_back(int(c));
+      record["targets"].push_back({{"category", cls.name},
+                                   {"shape", shapeName(cls.shape)},
+                                   {"mesh", cls.mesh_path},
+                                   {"centre", vec3(target.centre)},
+                                   {"heading_deg", target.orientation.heading_deg},
+                                   {"pitch_deg", target.orientation.pitch_deg},
+                                   {"roll_deg", target.orientation.roll_deg},
+                                   {"size", vec3(target.size)},
+                                   {"placed", behind ? "behind cloud" : "clear"},
+                                   {"placement_met", placed.met},
+                                   {"centre_transmittance", placed.transmittance},
+                                   {"temperature_k", temperature}});
+    }
+  }
+}
+
 }  // namespace
 
 std::string datasetSpecError(const DatasetSpec& spec) {
@@ -91,173 +303,18 @@ std::string datasetSpecError(const DatasetSpec& spec) {
 
 SampleScene drawSample(const DatasetSpec& spec, int index) {
   const std::uint64_t seed = hashCounters(spec.seed, 0x53616d706c65ull, std::uint64_t(index));
-  auto stream = [&](Stream s) { return Draws(hashCounters(seed, s)); };
   SampleScene out;
-  Scene& scene = out.scene;
-  scene.seed = seed;
+  out.scene.seed = seed;
   json& record = out.record;
   record["index"] = index;
   record["seed"] = std::to_string(seed);
   record["band"] = spec.band == Band::kLwir ? "lwir" : "visible";
-
-  Draws sky = stream(kSky);
-  const int layers = spec.genera.empty() ? 0 : sky.integer(spec.layers);
-  std::vector<WeatherLayer> weather(std::size_t(std::max(layers, 0)));
-  for (WeatherLayer& w : weather) {
-    w.type = spec.genera[std::min(spec.genera.size() - 1,
-                                  std::size_t(sky.unit() * double(spec.genera.size())))];
-    w.coverage = sky.in(spec.coverage);
-    w.base_m = sky.in(spec.base);
-    w.thickness_m = sky.in(spec.thickness);
-  }
-  // Rain from the lowest layer: in shafts under heaps, else from its base down (MODEL.md
-  // section 17), which the scene's weather holds.
-  Draws rain = stream(kRain);
-  std::optional<std::size_t> raining;
-  if (rain.unit() < spec.rain_probability && layers > 0) {
-    raining = 0;
-    for (std::size_t k = 1; k < weather.size(); ++k)
-      if (weather[k].base_m < weather[*raining].base_m) raining = k;
-    weather[*raining].precipitation = {PrecipitationKind::kRain, rain.in(spec.rain_rate), 0.0};
-  }
-  record["layers"] = json::array();
-  for (int k = 0; k < layers; ++k) {
-    const WeatherLayer& w = weather[std::size_t(k)];
-    const std::uint64_t layer_seed = weatherSeed(seed, k + 1);
-    const WeatherClouds add = weatherClouds(w, "layer" + std::to_string(k + 1), layer_seed);
-    scene.layers.insert(scene.layers.end(), add.layers.begin(), add.layers.end());
-    scene.fields.insert(scene.fields.end(), add.fields.begin(), add.fields.end());
-    if (raining == std::size_t(k)) scene.weather[{k + 1, std::nullopt}] = w;
-    record["layers"].push_back({{"genus", std::string(cloudTypeName(w.type))},
-                                {"coverage", w.coverage},
-                                {"base_m", w.base_m},
-                                {"thickness_m", w.thickness_m},
-                                {"seed", std::to_string(layer_seed)}});
-  }
-  record["rain_mm_h"] = raining ? json(weather[*raining].precipitation.rate_mm_h) : json(nullptr);
-
-  Draws water = stream(kSea);
-  if (water.unit() < spec.sea_probability) {
-    Sea& sea = scene.sea.emplace();
-    const double speed = water.in(spec.sea_wind);
-    const double towards = glm::radians(water.in(spec.sea_wind_direction));
-    sea.wind = speed * glm::dvec2(std::sin(towards), std::cos(towards));
-    sea.clarity = water.in(spec.sea_clarity);
-    sea.whitecaps = spec.sea_whitecaps;
-    sea.seed = hashCounters(seed, kSea);
-    record["sea"] = {{"wind", json::array({sea.wind.x, sea.wind.y})},
-                     {"clarity", sea.clarity},
-                     {"whitecaps", sea.whitecaps},
-                     {"significant_height_m", SeaSurface(sea).significantHeight()}};
-  } else {
-    record["sea"] = nullptr;
-  }
-
-  Draws sun = stream(kSun);
-  scene.sun.azimuth_deg = sun.in(spec.sun_azimuth);
-  scene.sun.elevation_deg = sun.in(spec.sun_elevation);
-  record["sun"] = {{"azimuth_deg", scene.sun.azimuth_deg},
-                   {"elevation_deg", scene.sun.elevation_deg}};
-
-  Draws fog = stream(kFog);
-  if (fog.unit() < spec.fog_probability) {
-    Fog& f = scene.fog.emplace();
-    f.top_m = fog.in(spec.fog_top);
-    f.visibility_m = fog.in(spec.fog_visibility);
-    record["fog"] = {{"top_m", f.top_m}, {"visibility_m", f.visibility_m}};
-  } else {
-    record["fog"] = nullptr;
-  }
-
-  Draws cam = stream(kCamera);
-  Camera& camera = scene.camera;
-  camera.width = spec.width;
-  camera.height = spec.height;
-  camera.position = {0.0, 0.0, cam.in(spec.altitude)};
-  camera.orientation = {cam.in(spec.heading), cam.in(spec.pitch), cam.in(spec.roll)};
-  camera.vfov_deg = cam.in(spec.vfov);
-  record["camera"] = cameraJson(frameInfo(camera, 0.0));
-
-  // Targets: a pixel and a distance per instance; those meant to be behind cloud (or in the
-  // clear) try up to kPlacementAttempts placements for one whose centre ray says so.
-  constexpr int kPlacementAttempts = 64;
-  Draws draw = stream(kTargets);
-  Draws heat = stream(kInfrared);  // its own stream: both bands place the same targets
-  out.infrared = spec.infrared;
-  std::optional<CloudProbe> probe;
-  const ViewBasis basis = viewBasis(camera);
-  record["targets"] = json::array();
-  for (std::size_t c = 0; c < spec.targets.size(); ++c) {
-    const TargetClass& cls = spec.targets[c];
-    const int count = draw.integer(cls.count);
-    for (int i = 0; i < count; ++i) {
-      const bool behind = draw.unit() < spec.occluded_fraction;
-      Target target;
-      target.name = cls.name + std::to_string(i + 1);
-      target.shape = cls.shape;
-      target.mesh = cls.mesh;
-      target.size = cls.size;
-      target.colour = cls.colour;
-      target.orientation = {draw.in(cls.heading), draw.in(cls.pitch), draw.in(cls.roll)};
-      double transmittance = 1.0;
-      bool met = false;
-      const bool cloudy = !scene.layers.empty() || !scene.fields.empty();
-      auto transmittanceTo = [&](glm::dvec3 d, double distance) {
-        if (!cloudy) return 1.0;
-        if (!probe) probe.emplace(scene, spec.heaps);
-        return probe->transmittance(d, distance);
-      };
-      for (int attempt = 0; attempt < kPlacementAttempts && !met; ++attempt) {
-        const bool last = attempt + 1 == kPlacementAttempts;
-        const double px = draw.in({0.1 * spec.width, 0.9 * spec.width});
-        const double py = draw.in({0.1 * spec.height, 0.9 * spec.height});
-        const glm::dvec3 d = glm::normalize(rayDirection(basis, camera, px, py));
-        Span range = cls.distance;
-        if (cls.afloat) {
-          // Where the ray meets the plane of its centre, if that lies within its range.
-          const double at = (0.3 * cls.size.z - camera.position.z) / d.z;
-          if (!(d.z < 0.0 && at >= range.lo && at <= range.hi) && !last) continue;
-          range = {at, at};
-        }
-        if (behind && cloudy) {
-          // Behind cloud: only as far as the cloud along this ray allows. Transmittance falls
-          // with distance; the nearest distance where it is below 0.9 is found by bisection
-          // and the target drawn between it and the far end.
-          if (transmittanceTo(d, range.hi) >= 0.9 && !last) continue;
-          if (transmittanceTo(d, range.lo) >= 0.9) {
-            double lo = range.lo, hi = range.hi;
-            for (int k = 0; k < 12; ++k) {
-              const double mid = 0.5 * (lo + hi);
-              (transmittanceTo(d, mid) < 0.9 ? hi : lo) = mid;
-            }
-            range.lo = hi;
-          }
-        }
-        const double distance = draw.in(range);
-        const glm::dvec3 centre = camera.position + distance * d;
-        if (centre.z < 0.0 && !last) continue;  // below the ground
-        target.centre = centre;
-        transmittance = transmittanceTo(d, distance);
-        met = behind ? transmittance < 0.9 : transmittance > 0.99;
-      }
-      const double temperature = heat.in(cls.temperature);
-      out.infrared.target_temperatures.push_back(temperature);
-      scene.targets.push_back(target);
-      out.target_class.push_back(int(c));
-      record["targets"].push_back({{"category", cls.name},
-                                   {"shape", shapeName(cls.shape)},
-                                   {"mesh", cls.mesh_path},
-                                   {"centre", vec3(target.centre)},
-                                   {"heading_deg", target.orientation.heading_deg},
-                                   {"pitch_deg", target.orientation.pitch_deg},
-                                   {"roll_deg", target.orientation.roll_deg},
-                                   {"size", vec3(target.size)},
-                                   {"placed", behind ? "behind cloud" : "clear"},
-                                   {"placement_met", met},
-                                   {"centre_transmittance", transmittance},
-                                   {"temperature_k", temperature}});
-    }
-  }
+  drawSky(spec, seed, out);
+  drawSea(spec, seed, out);
+  drawSun(spec, seed, out);
+  drawFog(spec, seed, out);
+  drawCamera(spec, seed, out);
+  drawTargets(spec, seed, out);
   return out;
 }
 

@@ -118,55 +118,74 @@ Ellipsoid mound(const std::vector<Ellipsoid>& lobes) {
   return out;
 }
 
-// A cumulonimbus of tower radius about half r and height h on `base` (WMO International Cloud
-// Atlas, Cb incus): one continuous tower from a flat base to the tropopause, where it spreads
-// into an anvil several times its width, carried downwind by the shear, with an overshooting
-// dome over the updraft (MODEL.md section 10). The base is dark through the light model
-// (section 14).
-std::vector<Ellipsoid> cumulonimbusEllipsoids(const CloudField& f, glm::dvec3 base, double r,
-                                              double h, double squash, std::uint64_t seed,
-                                              bool detailed, std::size_t& anvil_from) {
-  const Shear shear = shearOf(f);
-  auto u = [&](std::uint64_t a, std::uint64_t b = 0) {
-    return unitFromBits(hashCounters(seed, 0x4362ull, a, b));
-  };
-  // The updraft's axis, leaning downwind with height.
-  auto axis = [&](double z) { return base + glm::dvec3(0.0, 0.0, z) + leanAt(shear, z); };
-  std::vector<Ellipsoid> out;
-  Ellipsoid bottom;  // flat, its bottom on the cloud base
-  bottom.radii = {0.4 * r, 0.4 * r * squash, 0.1 * h};
-  bottom.centre = base + glm::dvec3(0.0, 0.0, bottom.radii.z);
-  bottom.orientation.heading_deg = 360.0 * u(1);
-  out.push_back(bottom);
-  // The flat base at the condensation level: pancake lobes over the tower's foot, their middles
-  // a little above the base, so that the opaque core of each (its limb is translucent, Gardner
-  // eq. 11) ends level just above it, seen from the side and from below alike. The bottom
-  // ellipsoid above, seen from the side, ends in a translucent rounded limb 1 to 2 km up.
-  if (detailed) {
-    ClusterSpec floor;
-    floor.element.radii = {0.2 * r, 0.2 * r, 0.07 * h};
-    floor.centre = glm::dvec2(base);
-    floor.boundary_radii = {0.3 * r, 0.3 * r * squash};
-    floor.spacing = glm::dvec2(0.18 * r);
-    floor.altitude_m = base.z;
-    floor.size_variation = 0.15;
-    floor.position_variation = 0.2;
-    floor.heading_variation_deg = 90.0;
-    floor.seed = hashCounters(seed, kShape, 4);
-    for (Ellipsoid e : clusterEllipsoids(floor)) {
-      e.centre.z = base.z + 0.5 * e.radii.z;
-      out.push_back(e);
-    }
+// The parts of one cumulonimbus (cumulonimbusEllipsoids below), each drawn from its own
+// counters of the heap's seed.
+class Cumulonimbus {
+ public:
+  Cumulonimbus(const CloudField& f, glm::dvec3 base, double r, double h, double squash,
+               std::uint64_t seed)
+      : shear_(shearOf(f)), base_(base), r_(r), h_(h), squash_(squash), seed_(seed) {}
+
+  Ellipsoid bottom() const;
+  void addFloor(std::vector<Ellipsoid>& out) const;
+  std::vector<Ellipsoid> tower() const;
+  void addRings(std::vector<Ellipsoid>& tower, std::vector<Ellipsoid>& rings,
+                std::vector<Ellipsoid>& shoulder) const;
+  void addAnvil(std::vector<Ellipsoid>& out) const;
+
+ private:
+  double u(std::uint64_t a, std::uint64_t b = 0) const {
+    return unitFromBits(hashCounters(seed_, 0x4362ull, a, b));
   }
-  // The tower: a column of lobes each about 0.5 h tall, 0.13 h apart from the base up, so
-  // that no gap opens from the base to the anvil and no seam shows between them, with bulges
-  // half sunk into its faces that grow upward.
+  // The updraft's axis, leaning downwind with height.
+  glm::dvec3 axis(double z) const { return base_ + glm::dvec3(0.0, 0.0, z) + leanAt(shear_, z); }
+
+  const Shear shear_;
+  const glm::dvec3 base_;
+  const double r_, h_, squash_;
+  const std::uint64_t seed_;
+};
+
+// Flat, its bottom on the cloud base.
+Ellipsoid Cumulonimbus::bottom() const {
+  Ellipsoid bottom;
+  bottom.radii = {0.4 * r_, 0.4 * r_ * squash_, 0.1 * h_};
+  bottom.centre = base_ + glm::dvec3(0.0, 0.0, bottom.radii.z);
+  bottom.orientation.heading_deg = 360.0 * u(1);
+  return bottom;
+}
+
+// The flat base at the condensation level: pancake lobes over the tower's foot, their middles
+// a little above the base, so that the opaque core of each (its limb is translucent, Gardner
+// eq. 11) ends level just above it, seen from the side and from below alike. The bottom
+// ellipsoid, seen from the side, ends in a translucent rounded limb 1 to 2 km up.
+void Cumulonimbus::addFloor(std::vector<Ellipsoid>& out) const {
+  ClusterSpec floor;
+  floor.element.radii = {0.2 * r_, 0.2 * r_, 0.07 * h_};
+  floor.centre = glm::dvec2(base_);
+  floor.boundary_radii = {0.3 * r_, 0.3 * r_ * squash_};
+  floor.spacing = glm::dvec2(0.18 * r_);
+  floor.altitude_m = base_.z;
+  floor.size_variation = 0.15;
+  floor.position_variation = 0.2;
+  floor.heading_variation_deg = 90.0;
+  floor.seed = hashCounters(seed_, kShape, 4);
+  for (Ellipsoid e : clusterEllipsoids(floor)) {
+    e.centre.z = base_.z + 0.5 * e.radii.z;
+    out.push_back(e);
+  }
+}
+
+// The tower: a column of lobes each about 0.5 h tall, 0.13 h apart from the base up, so that
+// no gap opens from the base to the anvil and no seam shows between them, with bulges half
+// sunk into its faces that grow upward.
+std::vector<Ellipsoid> Cumulonimbus::tower() const {
   std::vector<Ellipsoid> tower;
   constexpr int kLevels = 5;
   for (int i = 0; i < kLevels; ++i) {
-    const double z = (0.26 + 0.13 * i) * h, rise = double(i) / (kLevels - 1);
+    const double z = (0.26 + 0.13 * i) * h_, rise = double(i) / (kLevels - 1);
     Ellipsoid core;
-    core.radii = glm::dvec3(0.42 * r, 0.42 * r * squash, 0.26 * h) * (0.95 + 0.1 * u(2, i));
+    core.radii = glm::dvec3(0.42 * r_, 0.42 * r_ * squash_, 0.26 * h_) * (0.95 + 0.1 * u(2, i));
     core.centre = axis(z);
     core.orientation.heading_deg = 360.0 * u(3, i);
     tower.push_back(core);
@@ -174,33 +193,37 @@ std::vector<Ellipsoid> cumulonimbusEllipsoids(const CloudField& f, glm::dvec3 ba
     for (int q = 0; q < 3; ++q) {
       const std::uint64_t k = 8 * std::uint64_t(i) + std::uint64_t(q);
       const double azimuth = turn + 2.0 * std::numbers::pi * (q + 0.5 * u(5, k)) / 3.0;
-      const double size = (0.22 + 0.08 * rise) * r * (0.85 + 0.3 * u(6, k));
+      const double size = (0.22 + 0.08 * rise) * r_ * (0.85 + 0.3 * u(6, k));
       Ellipsoid bulge;
-      bulge.radii = {size, size, 0.15 * h * (0.85 + 0.3 * u(7, k))};
+      bulge.radii = {size, size, 0.15 * h_ * (0.85 + 0.3 * u(7, k))};
       bulge.centre =
-          axis(z + 0.08 * h * (2.0 * u(8, k) - 1.0)) +
-          (0.26 + 0.06 * u(9, k)) * r * glm::dvec3(std::cos(azimuth), std::sin(azimuth), 0.0);
+          axis(z + 0.08 * h_ * (2.0 * u(8, k) - 1.0)) +
+          (0.26 + 0.06 * u(9, k)) * r_ * glm::dvec3(std::cos(azimuth), std::sin(azimuth), 0.0);
       bulge.orientation.heading_deg = 360.0 * u(10, k);
       tower.push_back(bulge);
     }
   }
-  // The incus: above 0.6 of its height the tower spreads out into the anvil, rings of
-  // lobes reaching further out (mostly downwind) at each level, their outer ends tilted up, so
-  // that the column widens into the anvil as one mass (an inverted cone under it) instead of a
-  // stem under a plate. The top ring joins the anvil and is kept at every distance, as the
-  // anvil is: from above it widens the anvil's edge, and merged into the far mound the heaps
-  // drew less cover than their measured footprint (0.444 against 0.463 over eight seeds).
-  // The upper rings are lit with the anvil they spread into (its part, MODEL.md section 14):
-  // in the tower's, they widened its envelope to the anvil's width, and the sunlit tower's face
-  // took its light through kilometres of it (0.149 of the sun's luminance, 0.41 without). The
-  // lowest, within the tower's width, stays with the tower: in the anvil's, its lobes showed
-  // as dark crescents between the sunlit tower's.
+  return tower;
+}
+
+// The incus: above 0.6 of its height the tower spreads out into the anvil, rings of lobes
+// reaching further out (mostly downwind) at each level, their outer ends tilted up, so that
+// the column widens into the anvil as one mass (an inverted cone under it) instead of a stem
+// under a plate. The top ring (`shoulder`) joins the anvil and is kept at every distance, as
+// the anvil is: from above it widens the anvil's edge, and merged into the far mound the heaps
+// drew less cover than their measured footprint (0.444 against 0.463 over eight seeds). The
+// upper rings are lit with the anvil they spread into (its part, MODEL.md section 14): in the
+// tower's, they widened its envelope to the anvil's width, and the sunlit tower's face took
+// its light through kilometres of it (0.149 of the sun's luminance, 0.41 without). The lowest,
+// within the tower's width, stays with the tower: in the anvil's, its lobes showed as dark
+// crescents between the sunlit tower's.
+void Cumulonimbus::addRings(std::vector<Ellipsoid>& tower, std::vector<Ellipsoid>& rings,
+                            std::vector<Ellipsoid>& shoulder) const {
   constexpr int kRings = 3, kAround = 7;
-  std::vector<Ellipsoid> rings, shoulder;
   const double turn = 2.0 * std::numbers::pi * u(11);
   for (int ring = 0; ring < kRings; ++ring) {
     const double step = double(ring) / (kRings - 1);
-    const double reach = (0.30 + 0.40 * step) * r, size = (0.30 + 0.08 * step) * r;
+    const double reach = (0.30 + 0.40 * step) * r_, size = (0.30 + 0.08 * step) * r_;
     for (int q = 0; q < kAround; ++q) {
       const std::uint64_t k = 8 * std::uint64_t(ring) + std::uint64_t(q);
       const double azimuth =
@@ -208,10 +231,10 @@ std::vector<Ellipsoid> cumulonimbusEllipsoids(const CloudField& f, glm::dvec3 ba
       const glm::dvec2 out_dir(std::cos(azimuth), std::sin(azimuth));
       // Further out downwind, where the upper wind carries the spreading top.
       const double stretch =
-          1.0 + 0.6 * shear.amount * std::max(glm::dot(out_dir, shear.direction), 0.0);
-      const double z = (0.63 + 0.08 * ring + 0.04 * (u(16, k) - 0.5)) * h;
+          1.0 + 0.6 * shear_.amount * std::max(glm::dot(out_dir, shear_.direction), 0.0);
+      const double z = (0.63 + 0.08 * ring + 0.04 * (u(16, k) - 0.5)) * h_;
       Ellipsoid lobe;
-      lobe.radii = {size, size, 0.11 * h * (0.85 + 0.3 * u(13, k))};
+      lobe.radii = {size, size, 0.11 * h_ * (0.85 + 0.3 * u(13, k))};
       lobe.centre =
           axis(z) + glm::dvec3(out_dir * (reach * stretch * (0.85 + 0.3 * u(14, k))), 0.0);
       // Body y (forward) along out_dir, pitched up by 10 to 25 degrees.
@@ -220,6 +243,69 @@ std::vector<Ellipsoid> cumulonimbusEllipsoids(const CloudField& f, glm::dvec3 ba
       (ring == 0 ? tower : ring + 1 < kRings ? rings : shoulder).push_back(lobe);
     }
   }
+}
+
+// The anvil: flat-topped at the tropopause (0.97 h), thickest where the tower feeds it (0.2 h)
+// and thinning downwind to 0.07 h in full shear (upwind, where it overhangs less, to 0.12 h),
+// longer along the shear and carried downwind; lobes hang from its flat top to a lumpy
+// underside, over a thin sheet that fills between them. The overshooting dome, over the
+// updraft, is sunk into it and lit with it.
+void Cumulonimbus::addAnvil(std::vector<Ellipsoid>& out) const {
+  const double along = (1.5 + 0.5 * shear_.amount) * r_, across = 1.2 * r_;
+  const glm::dvec3 crown = axis(0.97 * h_);  // the updraft's axis at the anvil's top
+  const double top = crown.z;
+  const glm::dvec2 middle =
+      glm::dvec2(axis(0.88 * h_)) + shear_.direction * (0.9 * shear_.amount * r_);
+  auto thickness = [&](glm::dvec2 at) {
+    const glm::dvec2 from_axis = at - glm::dvec2(crown);
+    const double t = std::min(glm::length(from_axis) / along, 1.0);
+    const bool downwind = glm::dot(from_axis, shear_.direction) > 0.0;
+    return h_ * (0.2 - (downwind ? 0.13 * shear_.amount + 0.05 * (1.0 - shear_.amount) : 0.08) * t);
+  };
+  const double heading = headingAlong(shear_.direction);
+  Ellipsoid dome;
+  dome.radii = {0.3 * r_, 0.3 * r_, 0.1 * h_};  // sunk into the anvil, its top at 1.05 h
+  dome.centre = axis(0.95 * h_);
+  out.push_back(dome);
+  Ellipsoid sheet;
+  sheet.radii = {along, across, 0.05 * h_};
+  sheet.centre = glm::dvec3(middle, top - sheet.radii.z);
+  sheet.orientation.heading_deg = heading;
+  out.push_back(sheet);
+  ClusterSpec cap;
+  const double cap_depth = 0.1 * h_;  // before each lobe takes the anvil's thickness below
+  cap.element.radii = {0.4 * r_, 0.4 * r_, cap_depth};
+  cap.centre = middle;
+  cap.boundary_radii = {along - 0.35 * r_, across - 0.35 * r_};
+  cap.boundary_heading_deg = heading;
+  cap.spacing = glm::dvec2(0.45 * r_);  // the anvil sets the outline: kept at every distance
+  cap.altitude_m = top;
+  cap.size_variation = 0.2;
+  cap.position_variation = 0.3;
+  cap.heading_variation_deg = 90.0;
+  cap.seed = hashCounters(seed_, kShape, 3);
+  for (Ellipsoid e : clusterEllipsoids(cap)) {
+    // Hanging from the flat top, as thick as the anvil is there, drooping a little downwind.
+    const double t = glm::dot(glm::dvec2(e.centre) - middle, shear_.direction) / along;
+    e.radii.z = 0.5 * thickness(glm::dvec2(e.centre)) * (e.radii.z / cap_depth);
+    e.centre.z = top - e.radii.z - 0.03 * h_ * std::max(t, 0.0) * t * shear_.amount;
+    out.push_back(e);
+  }
+}
+
+// A cumulonimbus of tower radius about half r and height h on `base` (WMO International Cloud
+// Atlas, Cb incus): one continuous tower from a flat base to the tropopause, where it spreads
+// into an anvil several times its width, carried downwind by the shear, with an overshooting
+// dome over the updraft (MODEL.md section 10). The base is dark through the light model
+// (section 14). Far away the tower and its lower rings merge into one mound.
+std::vector<Ellipsoid> cumulonimbusEllipsoids(const CloudField& f, glm::dvec3 base, double r,
+                                              double h, double squash, std::uint64_t seed,
+                                              bool detailed, std::size_t& anvil_from) {
+  const Cumulonimbus cb(f, base, r, h, squash, seed);
+  std::vector<Ellipsoid> out{cb.bottom()};
+  if (detailed) cb.addFloor(out);
+  std::vector<Ellipsoid> tower = cb.tower(), rings, shoulder;
+  cb.addRings(tower, rings, shoulder);
   if (!detailed) {
     tower.insert(tower.end(), rings.begin(), rings.end());
     tower = {mound(tower)};
@@ -229,50 +315,7 @@ std::vector<Ellipsoid> cumulonimbusEllipsoids(const CloudField& f, glm::dvec3 ba
   anvil_from = out.size();
   out.insert(out.end(), rings.begin(), rings.end());
   out.insert(out.end(), shoulder.begin(), shoulder.end());
-  // The anvil: flat-topped at the tropopause (0.97 h), thickest where the tower feeds it (0.2 h)
-  // and thinning downwind to 0.07 h in full shear (upwind, where it overhangs less, to 0.12 h),
-  // longer along the shear and carried downwind; lobes hang from its flat top to a lumpy
-  // underside, over a thin sheet that fills between them. The overshooting dome, over the
-  // updraft, is sunk into it and lit with it.
-  const double along = (1.5 + 0.5 * shear.amount) * r, across = 1.2 * r;
-  const glm::dvec3 crown = axis(0.97 * h);  // the updraft's axis at the anvil's top
-  const double top = crown.z;
-  const glm::dvec2 middle = glm::dvec2(axis(0.88 * h)) + shear.direction * (0.9 * shear.amount * r);
-  auto thickness = [&](glm::dvec2 at) {
-    const glm::dvec2 from_axis = at - glm::dvec2(crown);
-    const double t = std::min(glm::length(from_axis) / along, 1.0);
-    const bool downwind = glm::dot(from_axis, shear.direction) > 0.0;
-    return h * (0.2 - (downwind ? 0.13 * shear.amount + 0.05 * (1.0 - shear.amount) : 0.08) * t);
-  };
-  const double heading = headingAlong(shear.direction);
-  Ellipsoid dome;
-  dome.radii = {0.3 * r, 0.3 * r, 0.1 * h};  // sunk into the anvil, its top at 1.05 h
-  dome.centre = axis(0.95 * h);
-  out.push_back(dome);
-  Ellipsoid sheet;
-  sheet.radii = {along, across, 0.05 * h};
-  sheet.centre = glm::dvec3(middle, top - sheet.radii.z);
-  sheet.orientation.heading_deg = heading;
-  out.push_back(sheet);
-  ClusterSpec cap;
-  const double cap_depth = 0.1 * h;  // before each lobe takes the anvil's thickness below
-  cap.element.radii = {0.4 * r, 0.4 * r, cap_depth};
-  cap.centre = middle;
-  cap.boundary_radii = {along - 0.35 * r, across - 0.35 * r};
-  cap.boundary_heading_deg = heading;
-  cap.spacing = glm::dvec2(0.45 * r);  // the anvil sets the outline: kept at every distance
-  cap.altitude_m = top;
-  cap.size_variation = 0.2;
-  cap.position_variation = 0.3;
-  cap.heading_variation_deg = 90.0;
-  cap.seed = hashCounters(seed, kShape, 3);
-  for (Ellipsoid e : clusterEllipsoids(cap)) {
-    // Hanging from the flat top, as thick as the anvil is there, drooping a little downwind.
-    const double t = glm::dot(glm::dvec2(e.centre) - middle, shear.direction) / along;
-    e.radii.z = 0.5 * thickness(glm::dvec2(e.centre)) * (e.radii.z / cap_depth);
-    e.centre.z = top - e.radii.z - 0.03 * h * std::max(t, 0.0) * t * shear.amount;
-    out.push_back(e);
-  }
+  cb.addAnvil(out);
   return out;
 }
 
