@@ -450,6 +450,44 @@ void cumulusSky(const std::filesystem::path& dir, int repeats, double floor_ms) 
   row("socket tick to frames", cumulus.socket_frames, clear.socket_frames);
 }
 
+// The resident memory of process `pid`, MiB.
+double residentMiBOf(pid_t pid) {
+  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+  for (std::string line; std::getline(status, line);)
+    if (line.rfind("VmRSS:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;
+  return 0.0;
+}
+
+json renderRequest(int width, int height) {
+  return json{{"cmd", "render"},
+              {"view", "front"},
+              {"format", "raw"},
+              {"camera", {{"width", width}, {"height", height}}}};
+}
+
+// A render's time on `c`, and the longest hello `other` waited for meanwhile.
+std::pair<double, double> renderWhileAsking(Client& c, Client& other, int width, int height) {
+  std::vector<std::uint8_t> body;
+  std::atomic<bool> done{false};
+  double longest_hello = 0.0;
+  std::thread asker([&] {
+    std::vector<std::uint8_t> b;
+    while (!done) {
+      const auto t0 = Clock::now();
+      other.request({{"cmd", "hello"}}, b);
+      longest_hello = std::max(longest_hello, millisecondsBetween(t0, Clock::now()));
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  });
+  const auto t0 = Clock::now();
+  const json reply = c.request(renderRequest(width, height), body);
+  const double ms = millisecondsBetween(t0, Clock::now());
+  done = true;
+  asker.join();
+  if (!reply["ok"]) throw std::runtime_error(reply.dump());
+  return std::pair{ms, longest_hello};
+}
+
 // Issue 31, item 5: a lockstep daemon on cumulus.toml whose world grows by legal add_cloud
 // requests (cumulus clouds of 4,096 ellipsoids stacked 4.5 km in front of the camera) up to
 // the world budget set here; at each size a render at 64x48 and at 640x480 (as multiples of
@@ -467,38 +505,9 @@ void heavyWorlds(const std::filesystem::path& dir) {
   Daemon daemon(config);
   Client c(daemon.socket_port), other(daemon.socket_port);
   std::vector<std::uint8_t> body;
-  auto rssMiB = [&] {
-    std::ifstream status("/proc/" + std::to_string(daemon.pid) + "/status");
-    for (std::string line; std::getline(status, line);)
-      if (line.rfind("VmRSS:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;
-    return 0.0;
-  };
-  auto renderRequest = [](int width, int height) {
-    return json{{"cmd", "render"},
-                {"view", "front"},
-                {"format", "raw"},
-                {"camera", {{"width", width}, {"height", height}}}};
-  };
-  // A render's time, and the longest hello another client waited for meanwhile.
+  auto rssMiB = [&] { return residentMiBOf(daemon.pid); };
   auto timedRender = [&](int width, int height) {
-    std::atomic<bool> done{false};
-    double longest_hello = 0.0;
-    std::thread asker([&] {
-      std::vector<std::uint8_t> b;
-      while (!done) {
-        const auto t0 = Clock::now();
-        other.request({{"cmd", "hello"}}, b);
-        longest_hello = std::max(longest_hello, millisecondsBetween(t0, Clock::now()));
-        std::this_thread::sleep_for(std::chrono::milliseconds(20));
-      }
-    });
-    const auto t0 = Clock::now();
-    const json reply = c.request(renderRequest(width, height), body);
-    const double ms = millisecondsBetween(t0, Clock::now());
-    done = true;
-    asker.join();
-    if (!reply["ok"]) throw std::runtime_error(reply.dump());
-    return std::pair{ms, longest_hello};
+    return renderWhileAsking(c, other, width, height);
   };
   c.request({{"cmd", "remove_cloud"}, {"name", "cumulus"}}, body);
   timedRender(640, 480);  // warm: programs compiled

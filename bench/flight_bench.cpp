@@ -39,40 +39,39 @@ Means means(const FloatImage& image) {
   return m;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  CLI::App app("Nephele long-flight benchmark: two hours at 250 m/s through a macrocluster");
+struct FlightOptions {
   double hours = 2.0, speed = 250.0, interval = 60.0, start_x = 1.0e6;
   std::string size = "320x240";
   double heap_range = 0.0;
-  app.add_option("--heap-range", heap_range, "Heaps as ellipsoids this far, m (0 automatic)")
-      ->check(CLI::Range(0.0, 1.0e6))
-      ->capture_default_str();
-  app.add_option("--hours", hours, "Flight time, hours")
-      ->check(CLI::Range(0.01, 24.0))
-      ->capture_default_str();
-  app.add_option("--speed", speed, "Ground speed, m/s")
-      ->check(CLI::Range(1.0, 1000.0))
-      ->capture_default_str();
-  app.add_option("--interval", interval, "Simulated seconds between samples")
-      ->check(CLI::Range(1.0, 3600.0))
-      ->capture_default_str();
-  app.add_option("--start", start_x, "Start, metres east of the origin")
-      ->check(CLI::Range(-5.0e7, 5.0e7))
-      ->capture_default_str();
-  app.add_option("--size", size, "Image size WxH")->capture_default_str();
-  CLI11_PARSE(app, argc, argv);
+};
 
-  const auto platform = bench::openPlatform();
-  if (!platform) return 1;
-  GlRenderer renderer(*platform);
+// The weather system along the route, and the view flying through it.
+struct Flight {
+  Scene scene;
+  Camera camera;
+  glm::dvec2 wind{12.0, 4.0};
+  double start_x = 0.0, speed = 0.0;
 
-  // The weather system: one macrocluster along the route, an altocumulus layer everywhere.
-  const glm::dvec2 wind(12.0, 4.0);
+  // The world and the view `t` seconds into the flight.
+  Scene at(double t) const {
+    Scene s = scene;
+    s.time_s = t;
+    for (CloudField& f : s.fields) f.drift_m = wind * t;
+    s.camera = camera;
+    s.camera.position = {start_x + speed * t, 0.0, 3200.0};
+    return s;
+  }
+};
+
+// One macrocluster along the route, an altocumulus layer everywhere, drifting with the wind.
+Flight flightOf(const FlightOptions& o, const Camera& camera) {
+  Flight flight;
+  flight.camera = camera;
+  flight.start_x = o.start_x;
+  flight.speed = o.speed;
   WeatherLayer cumulus = typicalWeatherLayer(CloudType::kCumulus, 0.35);
-  cumulus.region.centre = {start_x + 0.5 * speed * hours * 3600.0, 0.0};
-  cumulus.region.half_size = {0.5 * speed * hours * 3600.0 + 200000.0, 150000.0};
+  cumulus.region.centre = {o.start_x + 0.5 * o.speed * o.hours * 3600.0, 0.0};
+  cumulus.region.half_size = {0.5 * o.speed * o.hours * 3600.0 + 200000.0, 150000.0};
   cumulus.region.heading_deg = 90.0;  // its long axis east
   std::swap(cumulus.region.half_size.x, cumulus.region.half_size.y);
   cumulus.region.edge_m = 20000.0;
@@ -80,41 +79,27 @@ int main(int argc, char** argv) {
   const WeatherClouds heaps = weatherClouds(cumulus, "cu", 5);
   const WeatherClouds cells =
       weatherClouds(typicalWeatherLayer(CloudType::kAltocumulus, 0.3), "ac", 6);
-  Scene scene;
+  Scene& scene = flight.scene;
   scene.sun.elevation_deg = 40.0;
   scene.sun.azimuth_deg = 200.0;
   scene.layers = cells.layers;
   scene.fields = heaps.fields;
-  for (CloudLayer& l : scene.layers) l.texture.drift_velocity = wind;
-  Camera camera;
-  if (!bench::parseSize(size, camera)) return 2;
-  camera.orientation = {90.0, -8.0, 0.0};  // east, a little down
-  camera.vfov_deg = 60.0;
-  RenderSettings settings;
-  settings.heaps.range_m = heap_range;
+  for (CloudLayer& l : scene.layers) l.texture.drift_velocity = flight.wind;
+  return flight;
+}
 
-  auto place = [&](double t) {
-    Scene s = scene;
-    s.time_s = t;
-    for (CloudField& f : s.fields) f.drift_m = wind * t;
-    s.camera = camera;
-    s.camera.position = {start_x + speed * t, 0.0, 3200.0};
-    return s;
-  };
-  const double floor =
-      medianMilliseconds(5, [&] { renderer.renderFloor(camera.width, camera.height); });
-  renderer.renderFloat(place(0.0), settings);  // shaders, textures, the heaps' footprints
-  const double start_mib = bench::residentMiB();
-  std::printf("flight: %.1f h at %.0f m/s from x = %.0f km, %s, floor %.2f ms\n", hours, speed,
-              start_x / 1000.0, size.c_str(), floor);
+// Every `interval` simulated seconds two frames 1/30 s apart: a row every tenth sample, and
+// the flight's summary.
+void flyAndPrint(GlRenderer& renderer, const Flight& flight, const RenderSettings& settings,
+                 const FlightOptions& o, double floor, double start_mib) {
   std::printf("%8s %10s %9s %8s %7s %10s %9s %9s %9s %9s\n", "time s", "x km", "first ms", "ms",
               "xfloor", "ellipsoids", "d cover", "d lum", "d pixel", "RSS MiB");
   double worst_cover = 0.0, worst_luminance = 0.0, worst_pixel = 0.0, total_ms = 0.0;
   double total_first_ms = 0.0, worst_at = 0.0;
   double peak_mib = start_mib;
   int samples = 0;
-  for (double t = 0.0; t <= hours * 3600.0; t += interval, ++samples) {
-    const Scene a = place(t), b = place(t + 1.0 / 30.0);
+  for (double t = 0.0; t <= o.hours * 3600.0; t += o.interval, ++samples) {
+    const Scene a = flight.at(t), b = flight.at(t + 1.0 / 30.0);
     auto begin = std::chrono::steady_clock::now();
     auto since = [&] {
       return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - begin)
@@ -151,20 +136,21 @@ int main(int argc, char** argv) {
       samples, total_ms / samples, total_ms / samples / floor, total_first_ms / samples,
       worst_cover, worst_at, worst_luminance, worst_pixel, start_mib, peak_mib,
       bench::residentMiB());
+}
 
-  // Precision: GL against the double-precision reference, near the origin and far from it.
-  Camera small = camera;
-  small.width = 160, small.height = 120;
-  camera = small;
+// Precision: GL against the double-precision reference, near the origin and far from it.
+void printPrecision(GlRenderer& renderer, Flight flight, const RenderSettings& settings,
+                    const FlightOptions& o) {
+  flight.camera.width = 160, flight.camera.height = 120;
   RenderSettings point = settings;
   point.texture_evaluation = TextureEvaluation::kProcedural;
   point.term_filter = TermFilter::kNone;
-  ReferenceSettings reference{1, 0, heap_range};
+  ReferenceSettings reference{1, 0, o.heap_range};
   std::printf("precision, 160x120 point-sampled (PSNR dB / largest difference):\n");
   std::printf("%10s %22s %22s %22s\n", "x km", "GL far vs GL origin", "GL far vs reference",
               "GL origin vs reference");
-  for (double t : {0.0, hours * 3600.0}) {
-    const Scene far = place(t);
+  for (double t : {0.0, o.hours * 3600.0}) {
+    const Scene far = flight.at(t);
     Scene near = far;
     const glm::dvec2 shift(-far.camera.position.x, 0.0);
     near.camera.position.x = 0.0;
@@ -179,5 +165,48 @@ int main(int argc, char** argv) {
                 far.camera.position.x / 1000.0, moved.psnr_db, moved.max_abs, e_far.psnr_db,
                 e_far.max_abs, e_near.psnr_db, e_near.max_abs);
   }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app("Nephele long-flight benchmark: two hours at 250 m/s through a macrocluster");
+  FlightOptions o;
+  app.add_option("--heap-range", o.heap_range, "Heaps as ellipsoids this far, m (0 automatic)")
+      ->check(CLI::Range(0.0, 1.0e6))
+      ->capture_default_str();
+  app.add_option("--hours", o.hours, "Flight time, hours")
+      ->check(CLI::Range(0.01, 24.0))
+      ->capture_default_str();
+  app.add_option("--speed", o.speed, "Ground speed, m/s")
+      ->check(CLI::Range(1.0, 1000.0))
+      ->capture_default_str();
+  app.add_option("--interval", o.interval, "Simulated seconds between samples")
+      ->check(CLI::Range(1.0, 3600.0))
+      ->capture_default_str();
+  app.add_option("--start", o.start_x, "Start, metres east of the origin")
+      ->check(CLI::Range(-5.0e7, 5.0e7))
+      ->capture_default_str();
+  app.add_option("--size", o.size, "Image size WxH")->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+
+  const auto platform = bench::openPlatform();
+  if (!platform) return 1;
+  GlRenderer renderer(*platform);
+  Camera camera;
+  if (!bench::parseSize(o.size, camera)) return 2;
+  camera.orientation = {90.0, -8.0, 0.0};  // east, a little down
+  camera.vfov_deg = 60.0;
+  const Flight flight = flightOf(o, camera);
+  RenderSettings settings;
+  settings.heaps.range_m = o.heap_range;
+  const double floor =
+      medianMilliseconds(5, [&] { renderer.renderFloor(camera.width, camera.height); });
+  renderer.renderFloat(flight.at(0.0), settings);  // shaders, textures, the heaps' footprints
+  const double start_mib = bench::residentMiB();
+  std::printf("flight: %.1f h at %.0f m/s from x = %.0f km, %s, floor %.2f ms\n", o.hours, o.speed,
+              o.start_x / 1000.0, o.size.c_str(), floor);
+  flyAndPrint(renderer, flight, settings, o, floor, start_mib);
+  printPrecision(renderer, flight, settings, o);
   return 0;
 }

@@ -21,7 +21,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -186,6 +188,24 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
+// The heap's view of printLightFigures side-lit at the benchmark's frame sizes: the outline's
+// detail the texture draws at 640x480 and 1280x1024 (issue 47 item 5).
+void printOutlinesAtFrameSizes(GlRenderer& renderer, const Scene& scene,
+                               const RenderSettings& render) {
+  for (const glm::ivec2 size : {glm::ivec2(640, 480), glm::ivec2(1280, 1024)}) {
+    Scene sized = scene;
+    sized.sun.azimuth_deg = 90.0, sized.sun.elevation_deg = 10.0;
+    sized.camera.width = size.x, sized.camera.height = size.y;
+    std::vector<int> silhouette;
+    for (const CloudRegion& region :
+         cloudRegions(renderer.renderFloat(sized, render), kMinCloudPixels))
+      if (region.pixels.size() > silhouette.size()) silhouette = region.pixels;
+    const OutlineFigures f = outlineFigures(silhouette, size.x, size.y);
+    std::printf("  outline at %dx%d: %zu px, dimension %.3f, %.2f within a pixel of its ellipse\n",
+                size.x, size.y, silhouette.size(), f.dimension, f.near_ellipse);
+  }
+}
+
 // Light figures of a heap (issue 27, MODEL.md section 14): the field's typical heap
 // (typicalHeap) alone, seen level from 8 km or three times its size, whichever is further. (b) With
 // the sun 90 degrees to the right at 10 degrees up, the median luminance of the right (sunlit) half
@@ -258,20 +278,7 @@ void printLightFigures(GlRenderer& renderer, const SceneFile& file, const std::s
       "  outline: heap seen level from %.1f km, %zu px: dimension %.3f (ellipse 1.0, cumulus "
       "1.3 to 1.4), %.2f of the outline within a pixel of its moment ellipse\n",
       distance / 1000.0, covered.size(), outline.dimension, outline.near_ellipse);
-  // The same view side-lit at the benchmark's frame sizes: the outline's detail the texture
-  // draws at 640x480 and 1280x1024 (issue 47 item 5).
-  for (const glm::ivec2 size : {glm::ivec2(640, 480), glm::ivec2(1280, 1024)}) {
-    Scene sized = scene;
-    sized.sun.azimuth_deg = 90.0, sized.sun.elevation_deg = 10.0;
-    sized.camera.width = size.x, sized.camera.height = size.y;
-    std::vector<int> silhouette;
-    for (const CloudRegion& region :
-         cloudRegions(renderer.renderFloat(sized, file.render), kMinCloudPixels))
-      if (region.pixels.size() > silhouette.size()) silhouette = region.pixels;
-    const OutlineFigures f = outlineFigures(silhouette, size.x, size.y);
-    std::printf("  outline at %dx%d: %zu px, dimension %.3f, %.2f within a pixel of its ellipse\n",
-                size.x, size.y, silhouette.size(), f.dimension, f.near_ellipse);
-  }
+  printOutlinesAtFrameSizes(renderer, scene, file.render);
   std::printf(
       "  light: heap of %zu ellipsoids, %.0f m wide; sun 90 deg to the side: sunlit half / "
       "shadowed half %.2f (%zu, %zu px); sun 12 deg behind: thin edge / body per unit opacity "
@@ -280,12 +287,109 @@ void printLightFigures(GlRenderer& renderer, const SceneFile& file, const std::s
       away.size(), median(edge) / std::max(median(body), 1e-9), edge.size(), body.size());
 }
 
+// Where a cumulonimbus's tower lies in its view across the shear (printCumulonimbusFigures):
+// its covered rows in the column through the base's middle, and its run at 0.45 of its height.
+struct TowerInView {
+  int top = -1, bottom = -1, mid_row = 0, lo = 0, hi = -1;
+};
+
+// The shape across the shear: coverage > 0.5 in the column `axis` (through the base's middle)
+// from the lowest to the highest covered row (a continuous tower has no uncovered row in it);
+// the tower's width at 0.45 of that height; the widest run of the top fifth (the anvil), its
+// width over the tower's and how far its middle lies downwind of the base. None: the column
+// is clear.
+std::optional<TowerInView> printCumulonimbusShape(const FloatImage& image, int axis,
+                                                  double metres_per_px, double speed) {
+  const int width = image.width, height = image.height;
+  auto covered = [&](int x, int y) { return image.pixel(x, y)[3] > 0.5f; };
+  TowerInView t;
+  for (int y = 0; y < height; ++y)
+    if (covered(axis, y)) t.bottom = y, t.top = t.top < 0 ? y : t.top;
+  if (t.top < 0) return std::nullopt;
+  int gaps = 0;
+  for (int y = t.top; y <= t.bottom; ++y) gaps += !covered(axis, y);
+  // The covered run through column x of row y, or through its widest part when x is clear.
+  auto run = [&](int y, int x) {
+    int lo = x, hi = x;
+    while (lo > 0 && covered(lo - 1, y)) --lo;
+    while (hi + 1 < width && covered(hi + 1, y)) ++hi;
+    return std::pair{lo, hi};
+  };
+  t.mid_row = t.bottom - int(0.45 * (t.bottom - t.top));
+  std::tie(t.lo, t.hi) = run(t.mid_row, axis);
+  int anvil_lo = 0, anvil_hi = -1;
+  for (int y = t.top; y <= t.top + (t.bottom - t.top) / 5; ++y)
+    for (int x = 0; x < width; ++x)
+      if (covered(x, y)) {
+        const auto [lo, hi] = run(y, x);
+        if (hi - lo > anvil_hi - anvil_lo) anvil_lo = lo, anvil_hi = hi;
+        x = hi;
+      }
+  const double tower = (t.hi - t.lo + 1) * metres_per_px;
+  const double anvil = (anvil_hi - anvil_lo + 1) * metres_per_px;
+  std::printf(
+      "  cumulonimbus alone across the shear (%.1f m/s): column through the base, %d of %d rows "
+      "uncovered; tower %.0f m wide at 0.45 of its height, anvil %.0f m wide (%.1f times), its "
+      "middle %.0f m downwind of the base\n",
+      speed, gaps, t.bottom - t.top + 1, tower, anvil, anvil / std::max(tower, 1.0),
+      (0.5 * (anvil_lo + anvil_hi) - axis) * metres_per_px);
+  return t;
+}
+
+// The cloud's own luminance (ownLuminance) in `view`, without the haze, over the opaque pixels
+// (x, y) for which `inside` holds: their median and how many.
+template <class Inside>
+std::pair<double, std::size_t> ownMedian(GlRenderer& renderer, Scene view, Inside inside,
+                                         const RenderSettings& settings) {
+  view.haze.reset();
+  const FloatImage frame = renderer.renderFloat(view, settings);
+  view.clouds.clear();
+  const FloatImage sky = renderer.renderFloat(view, settings);
+  std::vector<double> own;
+  for (int y = 0; y < view.camera.height; ++y)
+    for (int x = 0; x < view.camera.width; ++x)
+      if (inside(x, y) && frame.pixel(x, y)[3] > 0.95f)
+        own.push_back(ownLuminance(frame, sky, y * view.camera.width + x));
+  return std::pair{median(own), own.size()};
+}
+
+// The base against the sunlit tower (issue 47 item 5): the cloud's own luminance straight up
+// from the ground under the base's middle in a 20 degree view, and on the tower's face in the
+// view across the shear (`scene`, looking along `forward`) with the sun behind the camera (the
+// tower's rows from its foot to 0.45 of its height, within its width there); medians over
+// opaque pixels, without the haze (120 km of it would stand for the cloud's own light).
+void printCumulonimbusBase(GlRenderer& renderer, const SceneFile& file, const Scene& scene,
+                           glm::dvec3 base, glm::dvec3 forward, const TowerInView& tower) {
+  Scene lit = scene;
+  lit.sun.azimuth_deg = glm::degrees(std::atan2(-forward.x, -forward.y));
+  auto onFace = [&](int x, int y) {
+    return y >= tower.mid_row && y <= tower.bottom && x >= tower.lo && x <= tower.hi;
+  };
+  const auto [face, face_px] = ownMedian(renderer, lit, onFace, file.render);
+  // The same without the heaps' shadows (shadow_map_size 0): the tower's own light alone, where
+  // the anvil's upwind overhang does not shadow its face.
+  RenderSettings unshadowed = file.render;
+  unshadowed.shadow_map_size = 0;
+  const double own_face = ownMedian(renderer, lit, onFace, unshadowed).first;
+  Scene up = scene;
+  up.camera.position = base + glm::dvec3(0.0, 0.0, 2.0 - base.z);
+  up.camera.orientation = {0.0, 90.0, 0.0};
+  up.camera.vfov_deg = 20.0;
+  up.camera.width = up.camera.height = 64;
+  const auto [under, under_px] = ownMedian(
+      renderer, up, [](int, int) { return true; }, file.render);
+  std::printf(
+      "  cumulonimbus base from below %.3f (%zu px), sunlit tower %.3f (%zu px, sun behind the "
+      "camera): ratio %.2f (aim at most 0.3); without the heaps' shadows on the tower %.3f, "
+      "ratio %.2f\n",
+      under, under_px, face, face_px, under / std::max(face, 1e-9), own_face,
+      under / std::max(own_face, 1e-9));
+}
+
 // Cumulonimbus figures (issue 27 item 5d): the field's typical heap alone (with the shear the
 // world's wind gives it), seen level across the shear from 120 km, downwind to the right, with
-// the preset's sun. Coverage > 0.5 in the column through the base's middle from the lowest to
-// the highest covered row (a continuous tower has no uncovered row in it); the tower's width
-// at 0.45 of that height; the widest run of the top fifth (the anvil), its width over the
-// tower's and how far its middle lies downwind of the base.
+// the preset's sun: its shape (printCumulonimbusShape), then its base against its sunlit tower
+// (printCumulonimbusBase).
 void printCumulonimbusFigures(GlRenderer& renderer, const SceneFile& file, const std::string& name,
                               const std::string& images) {
   const Scene world = World(file.scene, file.dynamics).scene();
@@ -318,80 +422,9 @@ void printCumulonimbusFigures(GlRenderer& renderer, const SceneFile& file, const
   const double tan_half = std::tan(glm::radians(c.vfov_deg) / 2.0);
   const double metres_per_px = 2.0 * kDistance * tan_half / c.height;
   const int axis = int(c.width / 2 - aside / metres_per_px);  // the base's middle
-  auto covered = [&](int x, int y) { return image.pixel(x, y)[3] > 0.5f; };
-  int top = -1, bottom = -1;
-  for (int y = 0; y < c.height; ++y)
-    if (covered(axis, y)) bottom = y, top = top < 0 ? y : top;
-  if (top < 0) return;
-  int gaps = 0;
-  for (int y = top; y <= bottom; ++y) gaps += !covered(axis, y);
-  // The covered run through column x of row y, or through its widest part when x is clear.
-  auto run = [&](int y, int x) {
-    int lo = x, hi = x;
-    while (lo > 0 && covered(lo - 1, y)) --lo;
-    while (hi + 1 < c.width && covered(hi + 1, y)) ++hi;
-    return std::pair{lo, hi};
-  };
-  const int mid_row = bottom - int(0.45 * (bottom - top));
-  const auto [tower_lo, tower_hi] = run(mid_row, axis);
-  int anvil_lo = 0, anvil_hi = -1;
-  for (int y = top; y <= top + (bottom - top) / 5; ++y)
-    for (int x = 0; x < c.width; ++x)
-      if (covered(x, y)) {
-        const auto [lo, hi] = run(y, x);
-        if (hi - lo > anvil_hi - anvil_lo) anvil_lo = lo, anvil_hi = hi;
-        x = hi;
-      }
-  const double tower = (tower_hi - tower_lo + 1) * metres_per_px;
-  const double anvil = (anvil_hi - anvil_lo + 1) * metres_per_px;
-  std::printf(
-      "  cumulonimbus alone across the shear (%.1f m/s): column through the base, %d of %d rows "
-      "uncovered; tower %.0f m wide at 0.45 of its height, anvil %.0f m wide (%.1f times), its "
-      "middle %.0f m downwind of the base\n",
-      speed, gaps, bottom - top + 1, tower, anvil, anvil / std::max(tower, 1.0),
-      (0.5 * (anvil_lo + anvil_hi) - axis) * metres_per_px);
-
-  // The base against the sunlit tower (issue 47 item 5): the cloud's own luminance
-  // (ownLuminance) straight up from the ground under the base's middle in a 20 degree view, and
-  // on the tower's face in the view above with the sun behind the camera (the tower's rows from
-  // its foot to 0.45 of its height, within its width there); medians over opaque pixels, without
-  // the haze (120 km of it would stand for the cloud's own light).
-  auto ownMedian = [&](Scene view, auto inside, const RenderSettings& settings) {
-    view.haze.reset();
-    const FloatImage frame = renderer.renderFloat(view, settings);
-    view.clouds.clear();
-    const FloatImage sky = renderer.renderFloat(view, settings);
-    std::vector<double> own;
-    for (int y = 0; y < view.camera.height; ++y)
-      for (int x = 0; x < view.camera.width; ++x)
-        if (inside(x, y) && frame.pixel(x, y)[3] > 0.95f)
-          own.push_back(ownLuminance(frame, sky, y * view.camera.width + x));
-    return std::pair{median(own), own.size()};
-  };
-  Scene lit = scene;
-  lit.sun.azimuth_deg = glm::degrees(std::atan2(-forward.x, -forward.y));
-  auto onFace = [&](int x, int y) {
-    return y >= mid_row && y <= bottom && x >= tower_lo && x <= tower_hi;
-  };
-  const auto [face, face_px] = ownMedian(lit, onFace, file.render);
-  // The same without the heaps' shadows (shadow_map_size 0): the tower's own light alone, where
-  // the anvil's upwind overhang does not shadow its face.
-  RenderSettings unshadowed = file.render;
-  unshadowed.shadow_map_size = 0;
-  const double own_face = ownMedian(lit, onFace, unshadowed).first;
-  Scene up = scene;
-  up.camera.position = base + glm::dvec3(0.0, 0.0, 2.0 - base.z);
-  up.camera.orientation = {0.0, 90.0, 0.0};
-  up.camera.vfov_deg = 20.0;
-  up.camera.width = up.camera.height = 64;
-  const auto [under, under_px] = ownMedian(
-      up, [](int, int) { return true; }, file.render);
-  std::printf(
-      "  cumulonimbus base from below %.3f (%zu px), sunlit tower %.3f (%zu px, sun behind the "
-      "camera): ratio %.2f (aim at most 0.3); without the heaps' shadows on the tower %.3f, "
-      "ratio %.2f\n",
-      under, under_px, face, face_px, under / std::max(face, 1e-9), own_face,
-      under / std::max(own_face, 1e-9));
+  const std::optional<TowerInView> tower =
+      printCumulonimbusShape(image, axis, metres_per_px, speed);
+  if (tower) printCumulonimbusBase(renderer, file, scene, base, forward, *tower);
 }
 
 // Rain shafts (issue 47 item 5; MODEL.md section 17): the field's typical heap raining at 1, 4
@@ -589,83 +622,323 @@ std::size_t drawnEllipsoids(const Scene& scene) {
   return ellipsoidCount(withFieldClouds(scene));
 }
 
+// Every genus at its typical altitude (weather.h), seen from the ground: the fraction of the
+// sky dome covered for each cloud fraction asked.
+void printHemisphereFigures(GlPlatform& platform) {
+  GlRenderer renderer(platform);
+  std::printf(
+      "hemisphere fraction from the ground (cloud fraction asked -> fraction of the sky "
+      "dome with coverage > 0.5)\n%-14s",
+      "genus");
+  const double asked[] = {0.1, 0.3, 0.5, 0.7, 0.9};
+  for (double c : asked) std::printf(" %7.1f", c);
+  std::printf("\n");
+  for (int type = 1; type < kCloudTypeCount; ++type) {
+    std::printf("%-14s", std::string(cloudTypeName(CloudType(type))).c_str());
+    for (double c : asked) {
+      Scene scene;
+      const WeatherClouds add =
+          weatherClouds(typicalWeatherLayer(CloudType(type), c), "weather/1", 7);
+      scene.layers = add.layers;
+      scene.fields = add.fields;
+      std::printf(" %7.3f", hemisphereFraction(renderer, scene, RenderSettings{}));
+      std::fflush(stdout);
+    }
+    std::printf("\n");
+  }
+}
+
+struct GenusBenchOptions {
+  std::string presets_dir = NEPHELE_SOURCE_DIR "/config/scenes";
+  int repeats = 9;
+  std::vector<std::string> sizes{"640x480", "1280x1024"}, names;
+  std::string images;
+  double coverage = -1.0;
+  bool still_only = false;
+  int shading_rate = 0;
+  int refresh = 0;
+  double speed = 250.0;
+  bool hemisphere = false;
+};
+
+void addOptions(CLI::App& app, GenusBenchOptions& o) {
+  app.add_option("--repeats", o.repeats, "Frames per still median and per flight")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  app.add_option("--sizes", o.sizes, "Image sizes WxH")->delimiter(',');
+  app.add_option("--dir", o.presets_dir, "Directory of scene files")->capture_default_str();
+  app.add_option("--presets", o.names,
+                 "Only these presets (default: genus_* and cloudscape; harbour adds the "
+                 "automaton figures)")
+      ->delimiter(',');
+  app.add_option("--images", o.images,
+                 "Also write the heap views the light figures are measured on to this directory");
+  app.add_option("--coverage", o.coverage,
+                 "Draw every [[weather]] layer of the presets at this cover, percent (issue 28's "
+                 "30, 50, 70 and 100), instead of the preset's own")
+      ->check(CLI::Range(0.0, 100.0));
+  app.add_flag("--still", o.still_only,
+               "Only the still frames and their budgets: no flights, look or body figures");
+  app.add_option("--speed", o.speed,
+                 "Flights: the camera's speed east, m/s (0: a still view streamed)")
+      ->check(CLI::Range(0.0, 1000.0));
+  app.add_option("--heap-refresh", o.refresh,
+                 "Flights: walk one heap pixel in N anew a frame and reuse the last frame for "
+                 "the rest (1, 4 or 16) instead of the preset's own");
+  app.add_option("--heap-shading-rate", o.shading_rate,
+                 "Draw the heaps of every preset at this shading rate (1, 2 or 4) instead of its "
+                 "own");
+  app.add_flag("--hemisphere", o.hemisphere,
+               "Instead: the fraction of the sky dome covered, seen from the ground, for every "
+               "genus at coverage 0.1 to 0.9");
+}
+
+// A preset as the options draw it (its cover, heap shading rate and refresh replaced when
+// asked): 0, or the exit code with the error printed.
+int loadGenusPreset(const std::filesystem::path& path, const GenusBenchOptions& o,
+                    SceneFile& file) {
+  if (o.coverage < 0.0) {
+    if (!bench::loadPreset(path.string(), file)) return 1;
+  } else {  // the preset's text with every `coverage = ...` line replaced
+    std::ifstream in(path);
+    std::string text, line;
+    while (std::getline(in, line))
+      text += (line.starts_with("coverage =") ? "coverage = " + std::to_string(o.coverage) : line) +
+              "\n";
+    if (const std::string e = parseSceneText(text, path.string(), file); !e.empty()) {
+      std::fprintf(stderr, "%s\n", e.c_str());
+      return 1;
+    }
+  }
+  if (o.shading_rate > 0) {
+    file.render.heap_shading_rate = o.shading_rate;
+    if (const std::string e = validateRenderSettings(file.render); !e.empty()) {
+      std::fprintf(stderr, "--heap-shading-rate: %s\n", e.c_str());
+      return 2;
+    }
+  }
+  if (o.refresh > 0) {
+    file.render.heap_refresh = o.refresh;
+    if (const std::string e = validateRenderSettings(file.render); !e.empty()) {
+      std::fprintf(stderr, "--heap-refresh: %s\n", e.c_str());
+      return 2;
+    }
+  }
+  return 0;
+}
+
+// A still view's frame times: the floor, the clear sky, the frames that filled clipmaps, and
+// the view itself (medians), with the still and clear frames' budgets.
+struct StillFigures {
+  double floor = 0.0, clear_ms = 0.0, still = 0.0;
+  std::vector<double> fill;  // frames that filled clipmaps
+  FrameTimes still_budget, clear_budget;
+};
+
+StillFigures measureStill(GlRenderer& renderer, const Scene& scene, const RenderSettings& render,
+                          int repeats) {
+  StillFigures s;
+  const int width = scene.camera.width, height = scene.camera.height;
+  s.floor = medianMilliseconds(repeats, [&] { renderer.renderFloor(width, height); });
+  Scene clear = scene;
+  clear.layers.clear(), clear.clouds.clear(), clear.fields.clear(), clear.automata.clear();
+  s.clear_ms = medianMilliseconds(repeats, [&] { renderer.renderSrgb8(clear, render); });
+  for (int frame = 0; frame < 100; ++frame) {
+    const auto start = Clock::now();
+    renderer.renderSrgb8(scene, render);
+    const double ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+    if (renderer.lastFrameStats().layer_texels_baked == 0 && frame > 0) break;
+    if (frame > 0) s.fill.push_back(ms);
+  }
+  s.still = medianMilliseconds(repeats, [&] { renderer.renderSrgb8(scene, render); });
+  s.still_budget = renderer.lastFrameStats().times;
+  renderer.renderSrgb8(clear, render);
+  s.clear_budget = renderer.lastFrameStats().times;
+  return s;
+}
+
+// A flight east from the still view: its frame times (the first `repeats`, then `repeats` warm
+// ones after 60), its last frame against the exact one, and the first frame after a weather
+// change.
+struct FlightFigures {
+  std::vector<double> ms, warm;
+  double strip_texels = 0.0;  // clipmap texels evaluated per warm frame
+  FrameTimes budget;
+  std::string stats;
+  FloatImage reused, exact;
+  double change_ms = 0.0;
+};
+
+FlightFigures measureFlight(GlPlatform& platform, const Scene& scene, const RenderSettings& render,
+                            int repeats, double speed) {
+  FlightFigures f;
+  // The flight's renderer has drawn the still view once, as a running daemon has drawn
+  // frames before: its programs are compiled and its textures baked (one-off costs of
+  // hundreds of milliseconds), while the heaps along the flight are new to it.
+  GlRenderer flyer(platform);
+  flyer.renderSrgb8(scene, render);
+  // A flight is a continuous view, as a daemon's subscription is (heap_refresh).
+  flyer.setContinuousView("flight");
+  Scene moving = scene;
+  // Frame k of the flight: east at `speed` at 30 Hz, from 50 km east of the still view,
+  // where the heaps are new to the renderer; a still view streamed (speed 0) is the
+  // still view itself.
+  const double start_x = speed > 0.0 ? 50000.0 : 0.0;
+  auto flyTo = [&](int frame) {
+    moving.camera.position.x = scene.camera.position.x + speed / 30.0 * frame + start_x;
+  };
+  for (int frame = 0; frame < repeats; ++frame) {
+    flyTo(frame);
+    const auto start = Clock::now();
+    flyer.renderSrgb8(moving, render);
+    f.ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
+  }
+  for (int frame = repeats; frame < 60 + repeats; ++frame) {
+    flyTo(frame);
+    const auto start = Clock::now();
+    flyer.renderSrgb8(moving, render);
+    if (frame < 60) continue;
+    f.warm.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
+    f.strip_texels += flyer.lastFrameStats().layer_texels_baked / double(repeats);
+  }
+  f.budget = flyer.lastFrameStats().times;
+  f.stats = flyer.lastFrameStats().line();
+  // The next frame of the flight against the exact frame of its pose.
+  flyTo(60 + repeats);
+  f.reused = flyer.renderFloat(moving, render);
+  flyer.setContinuousView("");
+  f.exact = flyer.renderFloat(moving, render);
+  // The first frame after a weather change, as a subscription draws it: the world's
+  // edit makes a new continuous view, whose first frame is exact, with the heaps of the
+  // new cover generated. The cover is 5 points more (less above 90 %).
+  Scene changed = moving;
+  for (CloudField& field : changed.fields)
+    field.coverage = field.coverage > 0.9 ? field.coverage - 0.05 : field.coverage + 0.05;
+  flyer.setContinuousView("flight after the change");
+  const auto change_start = Clock::now();
+  flyer.renderSrgb8(changed, render);
+  f.change_ms = std::chrono::duration<double, std::milli>(Clock::now() - change_start).count();
+  flyer.setContinuousView("");
+  return f;
+}
+
+// One view's row of the table and its budget lines, flight figures included unless --still.
+void benchView(GlPlatform& platform, const std::filesystem::path& path, const SceneFile& file,
+               const View& view, const Scene& scene, const std::string& size,
+               const GenusBenchOptions& o) {
+  // A fresh renderer per case: heap tiles and bakes left by the previous case would
+  // make the first frames of this one look cheaper than a new view's are.
+  GlRenderer renderer(platform);
+  StillFigures s = measureStill(renderer, scene, file.render, o.repeats);
+  auto printBudgets = [&] {
+    std::printf("  budget, still: %s\n  budget, clear: %s\n",
+                bench::frameBudgetLine(s.still_budget).c_str(),
+                bench::frameBudgetLine(s.clear_budget).c_str());
+  };
+  if (o.still_only) {
+    std::printf("%-22s %-7s %-10s %8.2f %8.2f %9.2f %7.1f %7.1f\n", path.stem().c_str(), view.name,
+                size.c_str(), s.floor, s.clear_ms, s.still, s.still / s.floor,
+                s.still / s.clear_ms);
+    printBudgets();
+    std::fflush(stdout);
+    return;
+  }
+  FlightFigures f = measureFlight(platform, scene, file.render, o.repeats, o.speed);
+  const ImageError reuse_error = compareImages(f.reused, f.exact);
+  if (!o.images.empty()) {  // the flight's last frame and the exact one, to look at
+    std::filesystem::create_directories(o.images);
+    const std::string stem = o.images + "/" + path.stem().string() + "_" + view.name + "_";
+    for (const auto& [what, image] : {std::pair{"flight", &f.reused}, {"exact", &f.exact}})
+      if (const std::string error = writeImageFile(stem + what + ".png", *image); !error.empty())
+        std::fprintf(stderr, "%s\n", error.c_str());
+  }
+  const double clear_ms = s.clear_ms;
+  const double slowest = *std::max_element(f.ms.begin(), f.ms.end());
+  const double warm_slowest = *std::max_element(f.warm.begin(), f.warm.end());
+  std::sort(f.ms.begin(), f.ms.end());
+  std::sort(f.warm.begin(), f.warm.end());
+  const double flying = f.ms[f.ms.size() / 2], warm_flying = f.warm[f.warm.size() / 2];
+  std::printf(
+      "%-22s %-7s %-10s %8.2f %8.2f %9.2f %7.1f %7.1f %10.2f %7.1f %10.2f %7.1f %10.2f "
+      "%7.1f %10.2f %7.1f %10zu\n",
+      path.stem().c_str(), view.name, size.c_str(), s.floor, clear_ms, s.still, s.still / s.floor,
+      s.still / clear_ms, flying, flying / clear_ms, slowest, slowest / clear_ms, warm_flying,
+      warm_flying / clear_ms, warm_slowest, warm_slowest / clear_ms, drawnEllipsoids(scene));
+  printBudgets();
+  std::printf(
+      "  budget, warm flight: %s\n"
+      "  flight at heap_refresh %d: last frame against the exact one %.1f dB, largest "
+      "difference %.3f\n"
+      "  first frame after a weather change (%s): %.2f ms, %.1f x clear\n"
+      "  %s\n",
+      bench::frameBudgetLine(f.budget).c_str(), file.render.heap_refresh, reuse_error.psnr_db,
+      reuse_error.max_abs,
+      scene.fields.empty() ? "no field: the same sky" : "every field's cover 5 points on",
+      f.change_ms, f.change_ms / clear_ms, f.stats.c_str());
+  if (!s.fill.empty()) {
+    std::sort(s.fill.begin(), s.fill.end());
+    std::printf(
+        "  clipmaps filled over %zu frames after the first, median %.2f ms (%.1f x clear); "
+        "warm flight: %.0f texels a frame\n",
+        s.fill.size(), s.fill[s.fill.size() / 2], s.fill[s.fill.size() / 2] / clear_ms,
+        f.strip_texels);
+  }
+  std::fflush(stdout);
+}
+
+// One preset: every view at every size, then (unless --still) its look, light, cumulonimbus,
+// rain and shadow figures. 0, or the exit code.
+int benchPreset(GlPlatform& platform, const std::filesystem::path& path,
+                const GenusBenchOptions& o) {
+  SceneFile file;
+  if (const int code = loadGenusPreset(path, o, file); code != 0) return code;
+  for (const std::string& size : o.sizes) {
+    Camera sized;
+    if (!bench::parseSize(size, sized)) return 2;
+    // The world at the preset's time: automaton clouds are grown by the World.
+    const Scene at_time = World(file.scene, file.dynamics).scene();
+    for (const View& view : viewsOf(file)) {
+      Scene scene = at_time;
+      scene.camera = view.camera;
+      scene.camera.width = sized.width, scene.camera.height = sized.height;
+      benchView(platform, path, file, view, scene, size, o);
+    }
+    const auto [rss, peak] = residentMiB();
+    std::printf(
+        "  memory after %s at %s: resident %.0f MiB, peak %.0f MiB (the process, GL "
+        "included)\n",
+        path.stem().c_str(), size.c_str(), rss, peak);
+  }
+  if (o.still_only) return 0;
+  GlRenderer renderer(platform);
+  printBodyFigures(renderer, file);
+  printLightFigures(renderer, file, path.stem().string(), o.images);
+  printCumulonimbusFigures(renderer, file, path.stem().string(), o.images);
+  if (path.stem() == "genus_cumulonimbus") printRainFigures(renderer, file);
+  printShadowFigures(platform, file, path.stem().string(), o.repeats, o.images);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app("Nephele genus benchmark: frame times of the genus presets in floor multiples");
-  std::string presets_dir = NEPHELE_SOURCE_DIR "/config/scenes";
-  int repeats = 9;
-  std::vector<std::string> sizes{"640x480", "1280x1024"}, names;
-  app.add_option("--repeats", repeats, "Frames per still median and per flight")
-      ->check(CLI::Range(1, 1000))
-      ->capture_default_str();
-  app.add_option("--sizes", sizes, "Image sizes WxH")->delimiter(',');
-  app.add_option("--dir", presets_dir, "Directory of scene files")->capture_default_str();
-  app.add_option("--presets", names,
-                 "Only these presets (default: genus_* and cloudscape; harbour adds the "
-                 "automaton figures)")
-      ->delimiter(',');
-  std::string images;
-  app.add_option("--images", images,
-                 "Also write the heap views the light figures are measured on to this directory");
-  double coverage = -1.0;
-  app.add_option("--coverage", coverage,
-                 "Draw every [[weather]] layer of the presets at this cover, percent (issue 28's "
-                 "30, 50, 70 and 100), instead of the preset's own")
-      ->check(CLI::Range(0.0, 100.0));
-  bool still_only = false;
-  app.add_flag("--still", still_only,
-               "Only the still frames and their budgets: no flights, look or body figures");
-  int shading_rate = 0;
-  int refresh = 0;
-  double speed = 250.0;
-  app.add_option("--speed", speed,
-                 "Flights: the camera's speed east, m/s (0: a still view streamed)")
-      ->check(CLI::Range(0.0, 1000.0));
-  app.add_option("--heap-refresh", refresh,
-                 "Flights: walk one heap pixel in N anew a frame and reuse the last frame for "
-                 "the rest (1, 4 or 16) instead of the preset's own");
-  app.add_option("--heap-shading-rate", shading_rate,
-                 "Draw the heaps of every preset at this shading rate (1, 2 or 4) instead of its "
-                 "own");
-  bool hemisphere = false;
-  app.add_flag("--hemisphere", hemisphere,
-               "Instead: the fraction of the sky dome covered, seen from the ground, for every "
-               "genus at coverage 0.1 to 0.9");
+  GenusBenchOptions o;
+  addOptions(app, o);
   CLI11_PARSE(app, argc, argv);
 
   std::vector<std::filesystem::path> files;
-  for (const auto& path : bench::presetFiles(presets_dir)) {
+  for (const auto& path : bench::presetFiles(o.presets_dir)) {
     const std::string stem = path.stem().string();
-    const bool wanted = names.empty() ? stem.starts_with("genus_") || stem == "cloudscape"
-                                      : std::find(names.begin(), names.end(), stem) != names.end();
+    const bool wanted = o.names.empty()
+                            ? stem.starts_with("genus_") || stem == "cloudscape"
+                            : std::find(o.names.begin(), o.names.end(), stem) != o.names.end();
     if (wanted) files.push_back(path);
   }
   const auto platform = bench::openPlatform();
   if (!platform) return 1;
-  if (hemisphere) {
-    // Every genus at its typical altitude (weather.h), seen from the ground.
-    GlRenderer renderer(*platform);
-    std::printf(
-        "hemisphere fraction from the ground (cloud fraction asked -> fraction of the sky "
-        "dome with coverage > 0.5)\n%-14s",
-        "genus");
-    const double asked[] = {0.1, 0.3, 0.5, 0.7, 0.9};
-    for (double c : asked) std::printf(" %7.1f", c);
-    std::printf("\n");
-    for (int type = 1; type < kCloudTypeCount; ++type) {
-      std::printf("%-14s", std::string(cloudTypeName(CloudType(type))).c_str());
-      for (double c : asked) {
-        Scene scene;
-        const WeatherClouds add =
-            weatherClouds(typicalWeatherLayer(CloudType(type), c), "weather/1", 7);
-        scene.layers = add.layers;
-        scene.fields = add.fields;
-        std::printf(" %7.3f", hemisphereFraction(renderer, scene, RenderSettings{}));
-        std::fflush(stdout);
-      }
-      std::printf("\n");
-    }
+  if (o.hemisphere) {
+    printHemisphereFigures(*platform);
     return 0;
   }
   std::printf("GL: %s, %s; render + readback into an 8-bit target\n",
@@ -677,188 +950,10 @@ int main(int argc, char** argv) {
               "preset", "view", "size", "floor ms", "clear ms", "still ms", "xfloor", "xclear",
               "flying ms", "xclear", "slowest ms", "xclear", "warm ms", "xclear", "slowest ms",
               "xclear", "ellipsoids");
-
-  for (const auto& path : files) {
-    SceneFile file;
-    if (coverage < 0.0) {
-      if (!bench::loadPreset(path.string(), file)) return 1;
-    } else {  // the preset's text with every `coverage = ...` line replaced
-      std::ifstream in(path);
-      std::string text, line;
-      while (std::getline(in, line))
-        text += (line.starts_with("coverage =") ? "coverage = " + std::to_string(coverage) : line) +
-                "\n";
-      if (const std::string e = parseSceneText(text, path.string(), file); !e.empty()) {
-        std::fprintf(stderr, "%s\n", e.c_str());
-        return 1;
-      }
-    }
-    if (shading_rate > 0) {
-      file.render.heap_shading_rate = shading_rate;
-      if (const std::string e = validateRenderSettings(file.render); !e.empty()) {
-        std::fprintf(stderr, "--heap-shading-rate: %s\n", e.c_str());
-        return 2;
-      }
-    }
-    if (refresh > 0) {
-      file.render.heap_refresh = refresh;
-      if (const std::string e = validateRenderSettings(file.render); !e.empty()) {
-        std::fprintf(stderr, "--heap-refresh: %s\n", e.c_str());
-        return 2;
-      }
-    }
-    for (const std::string& size : sizes) {
-      Camera sized;
-      if (!bench::parseSize(size, sized)) return 2;
-      const int width = sized.width, height = sized.height;
-      // The world at the preset's time: automaton clouds are grown by the World.
-      const Scene at_time = World(file.scene, file.dynamics).scene();
-      for (const View& view : viewsOf(file)) {
-        Scene scene = at_time;
-        scene.camera = view.camera;
-        scene.camera.width = width, scene.camera.height = height;
-        // A fresh renderer per case: heap tiles and bakes left by the previous case would
-        // make the first frames of this one look cheaper than a new view's are.
-        GlRenderer renderer(*platform);
-        const double floor =
-            medianMilliseconds(repeats, [&] { renderer.renderFloor(width, height); });
-        Scene clear = scene;
-        clear.layers.clear(), clear.clouds.clear(), clear.fields.clear(), clear.automata.clear();
-        const double clear_ms =
-            medianMilliseconds(repeats, [&] { renderer.renderSrgb8(clear, file.render); });
-        std::vector<double> fill;  // frames that filled clipmaps
-        for (int frame = 0; frame < 100; ++frame) {
-          const auto start = Clock::now();
-          renderer.renderSrgb8(scene, file.render);
-          const double ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-          if (renderer.lastFrameStats().layer_texels_baked == 0 && frame > 0) break;
-          if (frame > 0) fill.push_back(ms);
-        }
-        const double still =
-            medianMilliseconds(repeats, [&] { renderer.renderSrgb8(scene, file.render); });
-        const FrameTimes still_budget = renderer.lastFrameStats().times;
-        renderer.renderSrgb8(clear, file.render);
-        const FrameTimes clear_budget = renderer.lastFrameStats().times;
-        auto printBudgets = [&] {
-          std::printf("  budget, still: %s\n  budget, clear: %s\n",
-                      bench::frameBudgetLine(still_budget).c_str(),
-                      bench::frameBudgetLine(clear_budget).c_str());
-        };
-        if (still_only) {
-          std::printf("%-22s %-7s %-10s %8.2f %8.2f %9.2f %7.1f %7.1f\n", path.stem().c_str(),
-                      view.name, size.c_str(), floor, clear_ms, still, still / floor,
-                      still / clear_ms);
-          printBudgets();
-          std::fflush(stdout);
-          continue;
-        }
-        // The flight's renderer has drawn the still view once, as a running daemon has drawn
-        // frames before: its programs are compiled and its textures baked (one-off costs of
-        // hundreds of milliseconds), while the heaps along the flight are new to it.
-        GlRenderer flyer(*platform);
-        flyer.renderSrgb8(scene, file.render);
-        // A flight is a continuous view, as a daemon's subscription is (heap_refresh).
-        flyer.setContinuousView("flight");
-        std::vector<double> ms;
-        Scene moving = scene;
-        // Frame k of the flight: east at `speed` at 30 Hz, from 50 km east of the still view,
-        // where the heaps are new to the renderer; a still view streamed (speed 0) is the
-        // still view itself.
-        const double start_x = speed > 0.0 ? 50000.0 : 0.0;
-        auto flyTo = [&](int frame) {
-          moving.camera.position.x = scene.camera.position.x + speed / 30.0 * frame + start_x;
-        };
-        for (int frame = 0; frame < repeats; ++frame) {
-          flyTo(frame);
-          const auto start = Clock::now();
-          flyer.renderSrgb8(moving, file.render);
-          ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
-        }
-        std::vector<double> warm;
-        double strip_texels = 0.0;  // clipmap texels evaluated per warm frame
-        for (int frame = repeats; frame < 60 + repeats; ++frame) {
-          flyTo(frame);
-          const auto start = Clock::now();
-          flyer.renderSrgb8(moving, file.render);
-          if (frame < 60) continue;
-          warm.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
-          strip_texels += flyer.lastFrameStats().layer_texels_baked / double(repeats);
-        }
-        const FrameTimes flight_budget = flyer.lastFrameStats().times;
-        const std::string flight_stats = flyer.lastFrameStats().line();
-        // The next frame of the flight against the exact frame of its pose.
-        flyTo(60 + repeats);
-        const FloatImage reused = flyer.renderFloat(moving, file.render);
-        flyer.setContinuousView("");
-        const FloatImage exact = flyer.renderFloat(moving, file.render);
-        const ImageError reuse_error = compareImages(reused, exact);
-        // The first frame after a weather change, as a subscription draws it: the world's
-        // edit makes a new continuous view, whose first frame is exact, with the heaps of the
-        // new cover generated. The cover is 5 points more (less above 90 %).
-        Scene changed = moving;
-        for (CloudField& f : changed.fields)
-          f.coverage = f.coverage > 0.9 ? f.coverage - 0.05 : f.coverage + 0.05;
-        flyer.setContinuousView("flight after the change");
-        const auto change_start = Clock::now();
-        flyer.renderSrgb8(changed, file.render);
-        const double change_ms =
-            std::chrono::duration<double, std::milli>(Clock::now() - change_start).count();
-        flyer.setContinuousView("");
-        if (!images.empty()) {  // the flight's last frame and the exact one, to look at
-          std::filesystem::create_directories(images);
-          const std::string stem = images + "/" + path.stem().string() + "_" + view.name + "_";
-          for (const auto& [what, image] : {std::pair{"flight", &reused}, {"exact", &exact}})
-            if (const std::string error = writeImageFile(stem + what + ".png", *image);
-                !error.empty())
-              std::fprintf(stderr, "%s\n", error.c_str());
-        }
-        const double slowest = *std::max_element(ms.begin(), ms.end());
-        const double warm_slowest = *std::max_element(warm.begin(), warm.end());
-        std::sort(ms.begin(), ms.end());
-        std::sort(warm.begin(), warm.end());
-        const double flying = ms[ms.size() / 2], warm_flying = warm[warm.size() / 2];
-        std::printf(
-            "%-22s %-7s %-10s %8.2f %8.2f %9.2f %7.1f %7.1f %10.2f %7.1f %10.2f %7.1f %10.2f "
-            "%7.1f %10.2f %7.1f %10zu\n",
-            path.stem().c_str(), view.name, size.c_str(), floor, clear_ms, still, still / floor,
-            still / clear_ms, flying, flying / clear_ms, slowest, slowest / clear_ms, warm_flying,
-            warm_flying / clear_ms, warm_slowest, warm_slowest / clear_ms, drawnEllipsoids(scene));
-        printBudgets();
-        std::printf(
-            "  budget, warm flight: %s\n"
-            "  flight at heap_refresh %d: last frame against the exact one %.1f dB, largest "
-            "difference %.3f\n"
-            "  first frame after a weather change (%s): %.2f ms, %.1f x clear\n"
-            "  %s\n",
-            bench::frameBudgetLine(flight_budget).c_str(), file.render.heap_refresh,
-            reuse_error.psnr_db, reuse_error.max_abs,
-            scene.fields.empty() ? "no field: the same sky" : "every field's cover 5 points on",
-            change_ms, change_ms / clear_ms, flight_stats.c_str());
-        if (!fill.empty()) {
-          std::sort(fill.begin(), fill.end());
-          std::printf(
-              "  clipmaps filled over %zu frames after the first, median %.2f ms (%.1f x clear); "
-              "warm flight: %.0f texels a frame\n",
-              fill.size(), fill[fill.size() / 2], fill[fill.size() / 2] / clear_ms, strip_texels);
-        }
-        std::fflush(stdout);
-      }
-      const auto [rss, peak] = residentMiB();
-      std::printf(
-          "  memory after %s at %s: resident %.0f MiB, peak %.0f MiB (the process, GL "
-          "included)\n",
-          path.stem().c_str(), size.c_str(), rss, peak);
-    }
-    if (still_only) continue;
-    GlRenderer renderer(*platform);
-    printBodyFigures(renderer, file);
-    printLightFigures(renderer, file, path.stem().string(), images);
-    printCumulonimbusFigures(renderer, file, path.stem().string(), images);
-    if (path.stem() == "genus_cumulonimbus") printRainFigures(renderer, file);
-    printShadowFigures(*platform, file, path.stem().string(), repeats, images);
-  }
-  if (!still_only &&
-      (names.empty() || std::find(names.begin(), names.end(), "harbour") != names.end())) {
+  for (const auto& path : files)
+    if (const int code = benchPreset(*platform, path, o); code != 0) return code;
+  if (!o.still_only &&
+      (o.names.empty() || std::find(o.names.begin(), o.names.end(), "harbour") != o.names.end())) {
     GlRenderer renderer(*platform);
     printAutomatonFigures(renderer);
   }

@@ -81,6 +81,49 @@ void horizon(GlPlatform& platform, const std::vector<std::string>& sizes, int re
               bench::residentMiB() - before);
 }
 
+// A square world `side_km` across of cumulus clouds of 25 ellipsoids, `spacing_m` apart.
+Scene gridWorld(double side_km, double spacing_m) {
+  Scene world;
+  world.sun.elevation_deg = 50.0;
+  const int per_side = int(side_km * 1000.0 / spacing_m);
+  for (int j = 0; j < per_side; ++j)
+    for (int i = 0; i < per_side; ++i) {
+      EllipsoidCloud cloud;
+      cloud.name = "c";
+      cloud.name += std::to_string(j * per_side + i);
+      cloud.texture.gardner.fx1 = cloud.texture.gardner.fy1 = 2.0e-3;
+      const glm::dvec3 base((i - 0.5 * (per_side - 1)) * spacing_m,
+                            (j - 0.5 * (per_side - 1)) * spacing_m, 1000.0);
+      cloud.ellipsoids = cumulusEllipsoids(25, base, 0.6 * spacing_m, std::uint64_t(j * 7919 + i));
+      world.clouds.push_back(std::move(cloud));
+    }
+  return world;
+}
+
+// The whole world's frame against that of the clouds its camera can see (the same test the
+// renderer culls with), both as multiples of the floor: one row of the table.
+void benchWorldView(GlPlatform& platform, const Scene& world, const std::string& size,
+                    int repeats) {
+  const Camera& camera = world.camera;
+  Scene seen = world;
+  const ViewBasis basis = viewBasis(camera);
+  std::erase_if(seen.clouds, [&](const EllipsoidCloud& c) {
+    const BoundingBox box = boundingBox(c);
+    return !boxMayBeInView(basis, camera.position, box.lo, box.hi);
+  });
+  GlRenderer renderer(platform);
+  const RenderSettings settings;
+  const double floor =
+      medianMilliseconds(repeats, [&] { renderer.renderFloor(camera.width, camera.height); });
+  const double whole = medianMilliseconds(repeats, [&] { renderer.renderSrgb8(world, settings); });
+  const FrameStats stats = renderer.lastFrameStats();
+  const double part = medianMilliseconds(repeats, [&] { renderer.renderSrgb8(seen, settings); });
+  std::printf("%-10s %9d %9.2f %9.1f %8.1f %9.1f %9.1f %7.2f %9d\n", size.c_str(),
+              stats.ellipsoids_drawn, floor, whole, whole / floor, part, part / floor, whole / part,
+              stats.ellipsoids_culled);
+  std::fflush(stdout);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -116,27 +159,13 @@ int main(int argc, char** argv) {
     return 0;
   }
   const double before_mib = bench::residentMiB();
-  Scene world;
-  world.sun.elevation_deg = 50.0;
-  const int per_side = int(side_km * 1000.0 / spacing_m);
-  for (int j = 0; j < per_side; ++j)
-    for (int i = 0; i < per_side; ++i) {
-      EllipsoidCloud cloud;
-      cloud.name = "c";
-      cloud.name += std::to_string(j * per_side + i);
-      cloud.texture.gardner.fx1 = cloud.texture.gardner.fy1 = 2.0e-3;
-      const glm::dvec3 base((i - 0.5 * (per_side - 1)) * spacing_m,
-                            (j - 0.5 * (per_side - 1)) * spacing_m, 1000.0);
-      cloud.ellipsoids = cumulusEllipsoids(25, base, 0.6 * spacing_m, std::uint64_t(j * 7919 + i));
-      world.clouds.push_back(std::move(cloud));
-    }
+  Scene world = gridWorld(side_km, spacing_m);
   const std::size_t total = ellipsoidCount(world);
   const double world_mib = bench::residentMiB() - before_mib;
   std::printf("world: %zu clouds, %zu ellipsoids over %.0f km x %.0f km; %.1f MiB resident\n",
               world.clouds.size(), total, side_km, side_km, world_mib);
   std::printf("%-10s %9s %9s %9s %8s %9s %9s %7s %9s\n", "size", "in view", "floor ms", "world ms",
               "xfloor", "view ms", "xfloor", "ratio", "culled");
-
   for (const std::string& size : sizes) {
     Camera camera;
     if (!bench::parseSize(size, camera)) return 2;
@@ -144,25 +173,7 @@ int main(int argc, char** argv) {
     camera.orientation = {0.0, -90.0, 0.0};
     camera.vfov_deg = 60.0;
     world.camera = camera;
-    // The world of the clouds this view can see (the same test the renderer culls with).
-    Scene seen = world;
-    const ViewBasis basis = viewBasis(camera);
-    std::erase_if(seen.clouds, [&](const EllipsoidCloud& c) {
-      const BoundingBox box = boundingBox(c);
-      return !boxMayBeInView(basis, camera.position, box.lo, box.hi);
-    });
-    GlRenderer renderer(*platform);
-    const RenderSettings settings;
-    const double floor =
-        medianMilliseconds(repeats, [&] { renderer.renderFloor(camera.width, camera.height); });
-    const double whole =
-        medianMilliseconds(repeats, [&] { renderer.renderSrgb8(world, settings); });
-    const FrameStats stats = renderer.lastFrameStats();
-    const double part = medianMilliseconds(repeats, [&] { renderer.renderSrgb8(seen, settings); });
-    std::printf("%-10s %9d %9.2f %9.1f %8.1f %9.1f %9.1f %7.2f %9d\n", size.c_str(),
-                stats.ellipsoids_drawn, floor, whole, whole / floor, part, part / floor,
-                whole / part, stats.ellipsoids_culled);
-    std::fflush(stdout);
+    benchWorldView(*platform, world, size, repeats);
   }
   if (horizon_part) horizon(*platform, sizes, repeats, ranges_km);
   return 0;

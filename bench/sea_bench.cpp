@@ -42,6 +42,84 @@ Scene withSea(Scene scene, double wind) {
   return scene;
 }
 
+// Every sea state's drawn surface against Pierson-Moskowitz, Monahan, and its repetition.
+void printSurfaceFigures(const RenderSettings& settings) {
+  std::printf("Surface (fully developed; heights from the drawn sines, 0.7 w_p up):\n");
+  std::printf("%-4s %-26s %6s %6s %8s %9s %14s %14s %11s %11s\n", "sea", "state", "wind", "Hs m",
+              "foam", "(Monahan)", "spectrum slope", "(Pierson-M.)", "repetition", "across");
+  for (const SeaState& state : kStates) {
+    const Sea sea = withSea(Scene{}, state.wind).sea.value();
+    const SeaSurface surface(sea, settings.sea_waves);
+    const SpectrumFit fit = measureSpectrum(surface, state.wind);
+    const glm::dvec2 along = glm::normalize(sea.wind);
+    std::printf("%-4d %-26s %6.1f %6.2f %8.4f %9.4f %14.2f %14.2f %11.3f %11.3f\n", state.code,
+                state.name, state.wind, surface.significantHeight(), meanFoam(surface),
+                surface.whitecapFraction(), fit.measured_slope, fit.expected_slope,
+                repetition(surface, along), repetition(surface, {-along.y, along.x}));
+  }
+}
+
+// The drawn surface's mean glint over the sun's reflection against Cox-Munk's.
+void printGlintFigures(const RenderSettings& settings) {
+  std::printf(
+      "\nGlint over the sun's reflection against Cox-Munk, the drawn surface's mean "
+      "(sun 37 deg up; tan beta in units of Cox-Munk's sigma):\n");
+  std::printf("%6s %10s %10s %10s\n", "wind", "0", "0.5", "0.9");
+  const glm::dvec3 sun = glm::normalize(glm::dvec3(0.0, 0.8, 0.6));
+  for (double wind : {2.0, 7.0, 15.0}) {
+    const SeaSurface surface(withSea(Scene{}, wind).sea.value(), settings.sea_waves);
+    const double sigma = std::sqrt(0.003 + 5.12e-3 * wind);
+    std::printf("%6.1f", wind);
+    for (double t : {0.0, 0.5, 0.9})
+      std::printf(" %10.3f", glintRatio(surface, wind, t * sigma, sun));
+    std::printf("\n");
+  }
+}
+
+// The GL frame's cost with each sea state, as a multiple of the flat ground's, with and
+// without the preset's clouds.
+void printFrameCosts(GlRenderer& renderer, const Scene& clouded, const Scene& clear,
+                     const RenderSettings& settings, int repeats) {
+  std::printf("%-4s %10s %10s %8s %12s %12s %8s\n", "sea", "ground ms", "sea ms", "x ground",
+              "clouds+grd", "clouds+sea", "x ground");
+  const double ground = bench::medianFrameMilliseconds(renderer, clear, settings, repeats, false);
+  const double ground_clouds =
+      bench::medianFrameMilliseconds(renderer, clouded, settings, repeats, false);
+  for (const SeaState& state : kStates) {
+    const double sea = bench::medianFrameMilliseconds(renderer, withSea(clear, state.wind),
+                                                      settings, repeats, false);
+    const double sea_clouds = bench::medianFrameMilliseconds(renderer, withSea(clouded, state.wind),
+                                                             settings, repeats, false);
+    std::printf("%-4d %10.2f %10.2f %8.2f %12.2f %12.2f %8.2f\n", state.code, ground, sea,
+                sea / ground, ground_clouds, sea_clouds, sea_clouds / ground_clouds);
+  }
+}
+
+// The picture board: every sea state from 300 m and 3 km, sun high and low, with and without
+// clouds, into `board`.
+void writeBoard(GlRenderer& renderer, const SceneFile& file, const Scene& clear,
+                const RenderSettings& settings, const std::string& board) {
+  std::filesystem::create_directories(board);
+  for (const SeaState& state : kStates)
+    for (double altitude : {300.0, 3000.0})
+      for (double elevation : {60.0, 12.0})
+        for (bool clouds : {false, true}) {
+          Scene scene = withSea(clouds ? file.scene : clear, state.wind);
+          scene.targets = file.scene.targets;
+          scene.camera = file.scene.camera;
+          scene.camera.width = 480;
+          scene.camera.height = 270;
+          scene.camera.position.z = altitude;
+          scene.camera.orientation.pitch_deg = altitude > 1000.0 ? -35.0 : -8.0;
+          scene.sun.elevation_deg = elevation;
+          char name[128];
+          std::snprintf(name, sizeof name, "%s/ss%d_%04.0fm_sun%02.0f_%s.png", board.c_str(),
+                        state.code, altitude, elevation, clouds ? "clouds" : "clear");
+          writeImageFile(name, renderer.renderFloat(scene, settings));
+          std::printf("wrote %s\n", name);
+        }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -60,33 +138,8 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(Limits::kSeaProbeScale.lo, Limits::kSeaProbeScale.hi));
   CLI11_PARSE(app, argc, argv);
 
-  std::printf("Surface (fully developed; heights from the drawn sines, 0.7 w_p up):\n");
-  std::printf("%-4s %-26s %6s %6s %8s %9s %14s %14s %11s %11s\n", "sea", "state", "wind", "Hs m",
-              "foam", "(Monahan)", "spectrum slope", "(Pierson-M.)", "repetition", "across");
-  for (const SeaState& state : kStates) {
-    const Sea sea = withSea(Scene{}, state.wind).sea.value();
-    const SeaSurface surface(sea, settings.sea_waves);
-    const SpectrumFit fit = measureSpectrum(surface, state.wind);
-    const glm::dvec2 along = glm::normalize(sea.wind);
-    std::printf("%-4d %-26s %6.1f %6.2f %8.4f %9.4f %14.2f %14.2f %11.3f %11.3f\n", state.code,
-                state.name, state.wind, surface.significantHeight(), meanFoam(surface),
-                surface.whitecapFraction(), fit.measured_slope, fit.expected_slope,
-                repetition(surface, along), repetition(surface, {-along.y, along.x}));
-  }
-  std::printf(
-      "\nGlint over the sun's reflection against Cox-Munk, the drawn surface's mean "
-      "(sun 37 deg up; tan beta in units of Cox-Munk's sigma):\n");
-  std::printf("%6s %10s %10s %10s\n", "wind", "0", "0.5", "0.9");
-  const glm::dvec3 sun = glm::normalize(glm::dvec3(0.0, 0.8, 0.6));
-  for (double wind : {2.0, 7.0, 15.0}) {
-    const SeaSurface surface(withSea(Scene{}, wind).sea.value(), settings.sea_waves);
-    const double sigma = std::sqrt(0.003 + 5.12e-3 * wind);
-    std::printf("%6.1f", wind);
-    for (double t : {0.0, 0.5, 0.9})
-      std::printf(" %10.3f", glintRatio(surface, wind, t * sigma, sun));
-    std::printf("\n");
-  }
-
+  printSurfaceFigures(settings);
+  printGlintFigures(settings);
   SceneFile file;
   if (std::string e = loadSceneFile(NEPHELE_SOURCE_DIR "/config/scenes/sea_search.toml", file);
       !e.empty()) {
@@ -112,39 +165,7 @@ int main(int argc, char** argv) {
       "\nGL frame at %dx%d from 300 m, 10 deg down, sun 30 deg up ahead (%s): ms and "
       "multiples of the flat ground's frame; floor %.2f ms\n",
       camera.width, camera.height, platform->renderer().c_str(), floor);
-  std::printf("%-4s %10s %10s %8s %12s %12s %8s\n", "sea", "ground ms", "sea ms", "x ground",
-              "clouds+grd", "clouds+sea", "x ground");
-  const double ground = bench::medianFrameMilliseconds(renderer, clear, settings, repeats, false);
-  const double ground_clouds =
-      bench::medianFrameMilliseconds(renderer, clouded, settings, repeats, false);
-  for (const SeaState& state : kStates) {
-    const double sea = bench::medianFrameMilliseconds(renderer, withSea(clear, state.wind),
-                                                      settings, repeats, false);
-    const double sea_clouds = bench::medianFrameMilliseconds(renderer, withSea(clouded, state.wind),
-                                                             settings, repeats, false);
-    std::printf("%-4d %10.2f %10.2f %8.2f %12.2f %12.2f %8.2f\n", state.code, ground, sea,
-                sea / ground, ground_clouds, sea_clouds, sea_clouds / ground_clouds);
-  }
-
-  if (board.empty()) return 0;
-  std::filesystem::create_directories(board);
-  for (const SeaState& state : kStates)
-    for (double altitude : {300.0, 3000.0})
-      for (double elevation : {60.0, 12.0})
-        for (bool clouds : {false, true}) {
-          Scene scene = withSea(clouds ? file.scene : clear, state.wind);
-          scene.targets = file.scene.targets;
-          scene.camera = file.scene.camera;
-          scene.camera.width = 480;
-          scene.camera.height = 270;
-          scene.camera.position.z = altitude;
-          scene.camera.orientation.pitch_deg = altitude > 1000.0 ? -35.0 : -8.0;
-          scene.sun.elevation_deg = elevation;
-          char name[128];
-          std::snprintf(name, sizeof name, "%s/ss%d_%04.0fm_sun%02.0f_%s.png", board.c_str(),
-                        state.code, altitude, elevation, clouds ? "clouds" : "clear");
-          writeImageFile(name, renderer.renderFloat(scene, settings));
-          std::printf("wrote %s\n", name);
-        }
+  printFrameCosts(renderer, clouded, clear, settings, repeats);
+  if (!board.empty()) writeBoard(renderer, file, clear, settings, board);
   return 0;
 }
