@@ -61,7 +61,8 @@ struct Point {
   double ms = 0.0;
   double floor_multiple = 0.0;
   ImageError error;
-  bool same_image = false;  // draws exactly what the defaults draw: its time is noise
+  bool same_image = false;   // draws exactly what the defaults draw: its time is noise
+  std::vector<float> image;  // its pixels, held while the sweep compares them with the defaults
   bool front = false;
   // Takes no part in the front: the defaults timed again, or another model (another sky).
   bool apart() const { return same_image || setting.changes_model; }
@@ -76,169 +77,116 @@ struct SceneResult {
   std::string default_status;
 };
 
-std::string withKnob(double value) {
-  std::ostringstream out;
-  out << value;
-  return out.str();
+// Gardner's lattice: a layer neither rotated nor jittered, whose texture is periodic and
+// baked (bake_texels_per_cycle); rotated or jittered ones are evaluated in a clipmap around
+// the camera (MODEL.md section 2).
+bool periodic(const CloudLayer& l) {
+  return l.texture.gardner.rotation_deg == 0.0 && l.texture.gardner.jitter_octaves == 0.0;
 }
 
-// The knobs that act on what a scene holds; a knob that cannot change its image is left out.
-std::vector<Setting> settingsFor(const SceneFile& file) {
-  std::vector<Setting> out{{}};
-  auto add = [&](std::string knob, std::string value, std::function<void(RenderSettings&)> edit) {
-    out.push_back({std::move(knob), std::move(value), std::move(edit), {}, false});
-  };
-  // Layers with Gardner's lattice bake a periodic table (bake_texels_per_cycle); rotated or
-  // jittered ones, which never repeat, a clipmap around the camera (MODEL.md section 2): both
-  // are "baked", against the sines per pixel.
-  const bool layers = !file.scene.layers.empty();
-  auto periodic = [](const CloudLayer& l) {
-    return l.texture.gardner.rotation_deg == 0.0 && l.texture.gardner.jitter_octaves == 0.0;
-  };
-  const bool baked_layers =
-      std::any_of(file.scene.layers.begin(), file.scene.layers.end(), periodic);
-  const bool clouds = !file.scene.clouds.empty() || !file.scene.fields.empty();
-  if (layers || clouds) {
-    add("texture", "baked",
-        [](RenderSettings& s) { s.texture_evaluation = TextureEvaluation::kBaked; });
-    add("texture", "procedural",
-        [](RenderSettings& s) { s.texture_evaluation = TextureEvaluation::kProcedural; });
+// Whether `file` holds what a knob of `scope` acts on.
+bool holds(const SceneFile& file, KnobScope scope) {
+  const Scene& s = file.scene;
+  const bool layers = !s.layers.empty(), fields = !s.fields.empty();
+  const bool clouds = !s.clouds.empty() || fields;
+  switch (scope) {
+    case KnobScope::kLayersOrClouds:
+      return layers || clouds;
+    case KnobScope::kLatticeLayers:
+      return std::any_of(s.layers.begin(), s.layers.end(), periodic);
+    case KnobScope::kLayers:
+      return layers;
+    case KnobScope::kClouds:
+      return clouds;
+    case KnobScope::kSingleClouds:
+      return clouds && !fields;
+    case KnobScope::kFields:
+      return fields;
+    case KnobScope::kShadowCasters:
+      return fields || std::any_of(s.clouds.begin(), s.clouds.end(), [](const EllipsoidCloud& c) {
+               return c.light_extinction > 0.0;
+             });
+    case KnobScope::kPlanes:
+      return layers || !s.weather.empty();
+    case KnobScope::kSea:
+      return s.sea.has_value();
+    case KnobScope::kAutomata:
+      return !file.dynamics.automata.empty();
   }
-  if (layers || clouds) {
-    add("term_filter", "cut", [](RenderSettings& s) { s.term_filter = TermFilter::kCut; });
-    add("term_filter", "none", [](RenderSettings& s) { s.term_filter = TermFilter::kNone; });
-  }
-  if (baked_layers)
-    for (int tpc : {2, 4, 16, 32})
-      add("bake_texels_per_cycle", std::to_string(tpc),
-          [tpc](RenderSettings& s) { s.bake_texels_per_cycle = tpc; });
-  if (layers) {
-    add("sky_passes", "multipass", [](RenderSettings& s) { s.sky_passes = SkyPasses::kMultipass; });
-  }
-  if (clouds) {
-    add("ellipsoid_order", "centre",
-        [](RenderSettings& s) { s.ellipsoid_order = EllipsoidOrder::kCentre; });
-    add("limb", "spotlight", [](RenderSettings& s) { s.limb = LimbEvaluation::kSpotlight; });
-    auto multipass = [](std::function<void(RenderSettings&)> more) {
-      return [more](RenderSettings& s) {
-        s.ellipsoid_passes = EllipsoidPasses::kMultipass;
-        more(s);
-      };
+  return false;
+}
+
+// A render knob's points (its row's sweep), on a scene that holds what it acts on.
+void addKnobPoints(const RenderKnob& knob, const SceneFile& file, std::vector<Setting>& out) {
+  if (!holds(file, knob.scope)) return;
+  const bool multipass = knob.how == KnobSweep::kMultipass;
+  for (double value : knob.sweep) {
+    Setting point;
+    point.knob = (multipass ? "ellipsoid_passes=multipass " : "") + std::string(knob.name);
+    point.value = knob.format(value);
+    point.edit = [&knob, value, multipass](RenderSettings& s) {
+      if (multipass) s.ellipsoid_passes = EllipsoidPasses::kMultipass;
+      knob.set(s, value);
     };
-    add("ellipsoid_passes", "multipass", multipass([](RenderSettings&) {}));
-    // Fixed tile sizes on fields of thousands of heaps cost seconds a frame (5 s at 200x150 for
-    // 256) and say nothing the scenes of single clouds do not: left out there.
-    if (file.scene.fields.empty())
-      for (int size : {64, 256})
-        add("ellipsoid_passes=multipass tile_resolution", std::to_string(size),
-            multipass([size](RenderSettings& s) { s.tile_resolution = size; }));
-    add("ellipsoid_passes=multipass tile_format", "rgba8",
-        multipass([](RenderSettings& s) { s.tile_format = TileFormat::kRgba8; }));
-    add("ellipsoid_passes=multipass tessellation", "10",
-        multipass([](RenderSettings& s) { s.tessellation = 10; }));
-    for (double px : {0.5, 2.0})
-      add("impostor_tolerance", withKnob(px),
-          [px](RenderSettings& s) { s.impostor_tolerance_px = px; });
+    point.changes_model = knob.how == KnobSweep::kModel;
+    point.stream = knob.how == KnobSweep::kStream;
+    out.push_back(std::move(point));
   }
-  // Heaps beyond the range drawn as a far deck (MODEL.md section 11), against the reference's
-  // heaps out to the automatic range; and every lobe of heaps whose radius spans `heap_detail`
-  // pixels, their outlines below (0: every lobe, as the reference draws them; 10000: outlines
-  // alone).
-  if (!file.scene.fields.empty()) {
-    for (double m : {5000.0, 15000.0})
-      add("heap_range", withKnob(m), [m](RenderSettings& s) { s.heaps.range_m = m; });
-    for (double px : {0.0, 16.0, 64.0, 10000.0})
-      add("heap_detail", withKnob(px), [px](RenderSettings& s) { s.heaps.detail_px = px; });
-  }
-  // Heaps at a reduced shading rate (issue 46): walked every 2 or 4 pixels, blended between.
-  if (!file.scene.clouds.empty() || !file.scene.fields.empty())
-    for (int rate : {2, 4})
-      add("heap_shading_rate", std::to_string(rate),
-          [rate](RenderSettings& s) { s.heap_shading_rate = rate; });
-  // A continuous view's reuse of its last frame (issue 46): one heap pixel in 4 or 16 walked
-  // anew a frame (the other points are single renders, exact whatever heap_refresh says).
-  if (!file.scene.clouds.empty() || !file.scene.fields.empty())
-    for (int refresh : {4, 16})
-      out.push_back({"heap_refresh",
-                     std::to_string(refresh),
-                     [refresh](RenderSettings& s) { s.heap_refresh = refresh; },
-                     {},
-                     false,
-                     true});
-  // The ground's cloud shadows (MODEL.md section 16): none, and maps coarser and finer than the
-  // default's 512 texels a side.
-  const bool shadows =
-      !file.scene.fields.empty() ||
-      std::any_of(file.scene.clouds.begin(), file.scene.clouds.end(),
-                  [](const EllipsoidCloud& c) { return c.light_extinction > 0.0; });
-  if (shadows)
-    for (int size : {0, 256, 2048})
-      add("shadow_map_size", std::to_string(size),
-          [size](RenderSettings& s) { s.shadow_map_size = size; });
-  // Sky planes' shadows (MODEL.md section 16, "sky planes"): left out.
-  if (!file.scene.layers.empty() || !file.scene.weather.empty())
-    add("plane_shadows", "false", [](RenderSettings& s) { s.plane_shadows = false; });
-  // The sea (MODEL.md section 18): fewer and more sines than the default 64, another sea (its
-  // error against a reference of the same sines: what they cost, beside the repetition that
-  // sea_bench prints), and the probe of what it mirrors at a quarter and the whole of the
-  // view's width (the default is half).
-  if (file.scene.sea) {
-    for (int waves : {16, 32, 128})
-      out.push_back({"sea_waves",
-                     std::to_string(waves),
-                     [waves](RenderSettings& s) { s.sea_waves = waves; },
-                     {},
-                     true});
-    for (double scale : {0.25, 1.0})
-      add("sea_probe_scale", withKnob(scale),
-          [scale](RenderSettings& s) { s.sea_probe_scale = scale; });
-  }
-  // The frame's work budget (issue 31): the presets hold a few thousand ellipsoids in view, so
-  // budgets below that show what thinning costs (the default, 65,536, changes none of them).
-  if (!file.scene.clouds.empty() || !file.scene.fields.empty())
-    for (double n : {1024.0, 4096.0})
-      add("ellipsoid_budget", withKnob(n), [n](RenderSettings& s) { s.ellipsoid_budget = n; });
-  // Its footprint part: the presets' views cover up to 132 views (the default, 256, changes
-  // none of them), so 16 and 64 show what thinning by footprint costs.
-  if (!file.scene.clouds.empty() || !file.scene.fields.empty())
-    for (double v : {16.0, 64.0})
-      add("ellipsoid_overdraw", withKnob(v), [v](RenderSettings& s) { s.ellipsoid_overdraw = v; });
-  if (!file.dynamics.automata.empty()) {
-    for (double step : {0.5, 2.0, 4.0})
-      add("volume_step", withKnob(step), [step](RenderSettings& s) { s.volume_step = step; });
+}
+
+// The knobs of the scene rather than of the renderer, each another model measured against
+// the reference of the edited scene: the automaton lattice, the layers' lattice breaking, a
+// distance haze.
+void addSceneKnobPoints(const SceneFile& file, std::vector<Setting>& out) {
+  auto model = [&](std::string knob, std::string value, std::function<void(SceneFile&)> edit,
+                   bool changes_model) {
+    out.push_back({std::move(knob), std::move(value), [](RenderSettings&) {}, std::move(edit),
+                   changes_model});
+  };
+  if (!file.dynamics.automata.empty())
     for (int samples : {1, 3})
-      out.push_back({"samples_per_cell", std::to_string(samples), [](RenderSettings&) {},
-                     [samples](SceneFile& f) {
-                       for (AutomatonCloudSpec& a : f.dynamics.automata)
-                         a.samples_per_cell = samples;
-                     }});
-  }
+      model(
+          "samples_per_cell", std::to_string(samples),
+          [samples](SceneFile& f) {
+            for (AutomatonCloudSpec& a : f.dynamics.automata) a.samples_per_cell = samples;
+          },
+          false);
   // Lattice breaking (MODEL.md section 2) on layers that have it: "off" is Gardner's periodic
   // texture, which the renderer can bake; rotated or jittered terms are evaluated per pixel.
   if (!std::all_of(file.scene.layers.begin(), file.scene.layers.end(), periodic)) {
-    auto model = [&](std::string knob, std::string value, double rotation, double jitter) {
-      out.push_back({std::move(knob), std::move(value), [](RenderSettings&) {},
-                     [rotation, jitter](SceneFile& f) {
-                       for (CloudLayer& l : f.scene.layers) {
-                         GardnerTextureParams& g = l.texture.gardner;
-                         if (rotation >= 0.0) g.rotation_deg = rotation;
-                         if (jitter >= 0.0) g.jitter_octaves = jitter;
-                       }
-                     },
-                     true});
+    auto layers = [&](std::string knob, std::string value, double rotation, double jitter) {
+      model(
+          std::move(knob), std::move(value),
+          [rotation, jitter](SceneFile& f) {
+            for (CloudLayer& l : f.scene.layers) {
+              GardnerTextureParams& g = l.texture.gardner;
+              if (rotation >= 0.0) g.rotation_deg = rotation;
+              if (jitter >= 0.0) g.jitter_octaves = jitter;
+            }
+          },
+          true);
     };
-    model("lattice_breaking", "off", 0.0, 0.0);
-    model("rotation", "15", 15.0, -1.0);
-    for (double octaves : {0.0, 1.0}) model("jitter", withKnob(octaves), -1.0, octaves);
+    layers("lattice_breaking", "off", 0.0, 0.0);
+    layers("rotation", "15", 15.0, -1.0);
+    for (double octaves : {0.0, 1.0}) layers("jitter", formatNumber(octaves), -1.0, octaves);
   }
-  // Distance haze (MODEL.md section 5) on scenes of heaps, where it shows: another model, whose
-  // time is the haze's cost and whose error is the renderer's against the hazy reference.
+  // Distance haze (MODEL.md section 5) on scenes of heaps, where it shows: its time is the
+  // haze's cost, its error the renderer's against the hazy reference.
   if (!file.scene.fields.empty() && !file.scene.haze)
-    out.push_back({"haze", "40000", [](RenderSettings&) {},
-                   [](SceneFile& f) {
-                     f.scene.haze = Haze{40000.0, 1200.0};
-                   },
-                   true});
+    model(
+        "haze", "40000",
+        [](SceneFile& f) {
+          f.scene.haze = Haze{40000.0, 1200.0};
+        },
+        true);
+}
+
+// The defaults, then every render knob's points (renderer/render_knobs.inc) and the scene's
+// knobs, each where it can change the scene's image.
+std::vector<Setting> settingsFor(const SceneFile& file) {
+  std::vector<Setting> out{{}};
+  for (const RenderKnob& knob : renderKnobs()) addKnobPoints(knob, file, out);
+  addSceneKnobPoints(file, out);
   return out;
 }
 
@@ -520,6 +468,195 @@ void writePlot(const std::filesystem::path& path, const std::vector<SceneResult>
   svg << "</svg>\n";
 }
 
+// The sweep's size, timed frames and reference supersampling.
+struct BenchRun {
+  int width = 640, height = 480;
+  int repeats = 7;
+  int samples = 4;
+};
+
+// --size, --repeats and --samples, with --quick's defaults; an error for a bad size.
+std::string readRun(const BenchCommandOptions& o, BenchRun& run) {
+  run.width = o.quick ? 200 : 640, run.height = o.quick ? 150 : 480;
+  if (!o.size.empty() && (std::sscanf(o.size.c_str(), "%dx%d", &run.width, &run.height) != 2 ||
+                          run.width < 1 || run.height < 1 || run.width > 4096 || run.height > 4096))
+    return "--size: '" + o.size + "' is not WxH with each side 1 to 4096";
+  run.repeats = o.repeats > 0 ? o.repeats : o.quick ? 3 : 7;
+  run.samples = o.samples > 0 ? o.samples : o.quick ? 2 : 4;
+  return "";
+}
+
+// The scenes --scenes names (all when it is empty); an error for an unknown name.
+std::string selectScenes(const std::vector<std::string>& names, std::vector<BenchScene>& scenes) {
+  for (const std::string& name : names)
+    if (std::none_of(scenes.begin(), scenes.end(),
+                     [&](const BenchScene& s) { return s.name == name; }))
+      return "--scenes: unknown scene '" + name + "' (allowed: " + sceneNames() + ")";
+  if (!names.empty())
+    std::erase_if(scenes, [&](const BenchScene& s) {
+      return std::find(names.begin(), names.end(), s.name) == names.end();
+    });
+  return "";
+}
+
+// What a scene's sweep shares: its renderer, run, reference and progress line.
+struct SweepContext {
+  GlRenderer& renderer;
+  const BenchRun& run;
+  const ReferenceSettings& reference_settings;
+  const FloatImage& reference;
+  const std::string& tag;
+  bool tty;
+};
+
+// Point k of the sweep drawn as a running daemon would hold it, and its error; its time is
+// left to timePoints.
+Point measurePoint(const SweepContext& c, std::size_t k, const Setting& setting, const Scene& scene,
+                   const RenderSettings& render) {
+  Point point;
+  point.setting = setting;
+  // A still view as a running daemon holds it: every clipmap filled (`auto` fills them over
+  // the frames after the first) before the image is measured and timed.
+  for (int warm = 0; warm < 64; ++warm) {
+    c.renderer.renderSrgb8(scene, render);
+    if (warm > 0 && c.renderer.lastFrameStats().layer_texels_baked == 0) break;
+  }
+  if (setting.stream) {
+    c.renderer.setContinuousView("sweep " + std::to_string(k));
+    Scene approach = scene;
+    for (int frame = 16; frame > 0; --frame) {
+      approach.camera.position.x = scene.camera.position.x - 250.0 / 30.0 * frame;
+      c.renderer.renderSrgb8(approach, render);
+    }
+  }
+  const FloatImage image = c.renderer.renderFloat(scene, render);
+  c.renderer.setContinuousView("");
+  if (setting.changes_model) {
+    if (c.tty)
+      std::fprintf(stderr, "\r%s: reference for %s", c.tag.c_str(), setting.name().c_str());
+    ReferenceSettings same = c.reference_settings;
+    same.sea_waves = render.sea_waves;  // the same sea as the GL draws
+    point.error = compareImages(image, renderReference(scene, same));
+  } else {
+    point.error = compareImages(image, c.reference);
+  }
+  point.image = image.rgba;
+  point.ms = std::numeric_limits<double>::infinity();
+  return point;
+}
+
+// Two timing rounds over every setting, each setting's time the lower of its two medians, so
+// that the machine's drift and the order of the settings do not decide the front.
+void timePoints(const SweepContext& c, const std::vector<Setting>& settings,
+                const std::vector<Scene>& scenes, const std::vector<RenderSettings>& renders,
+                SceneResult& result) {
+  for (int round = 1; round <= 2; ++round)
+    for (std::size_t k = 0; k < settings.size(); ++k) {
+      if (c.tty)
+        std::fprintf(stderr, "\r%s: timing round %d, %zu/%zu %-50s", c.tag.c_str(), round, k + 1,
+                     settings.size(), settings[k].name().c_str());
+      Point& point = result.points[k];
+      if (settings[k].stream) c.renderer.setContinuousView("sweep " + std::to_string(k));
+      point.ms = std::min(point.ms, medianMilliseconds(c.run.repeats, [&] {
+                            c.renderer.renderSrgb8(scenes[k], renders[k]);
+                          }));
+      c.renderer.setContinuousView("");
+      point.floor_multiple = point.ms / result.floor_ms;
+    }
+}
+
+// Every setting of one scene drawn, compared and timed.
+void sweepScene(const SweepContext& c, const BenchScene& bench_scene, const Scene& scene,
+                SceneResult& result) {
+  const std::vector<Setting> settings = settingsFor(bench_scene.file);
+  std::vector<Scene> edited(settings.size(), scene);
+  std::vector<RenderSettings> renders(settings.size(), bench_scene.file.render);
+  for (std::size_t k = 0; k < settings.size(); ++k) {
+    settings[k].edit(renders[k]);
+    if (settings[k].scene_edit) {
+      SceneFile file = bench_scene.file;
+      settings[k].scene_edit(file);
+      edited[k] = sceneAtTime(file);
+    }
+    Point& point =
+        result.points.emplace_back(measurePoint(c, k, settings[k], edited[k], renders[k]));
+    if (k > 0) {
+      point.same_image = point.image == result.points[0].image;
+      point.image.clear();
+    }
+  }
+  timePoints(c, settings, edited, renders, result);
+  result.points[0].image.clear();
+}
+
+// One scene: its reference, the platform floor, then its sweep; printed as it ends.
+SceneResult measureScene(GlRenderer& renderer, BenchScene& bench_scene, const BenchRun& run,
+                         const std::string& tag, Clock::time_point start) {
+  const bool tty = isatty(fileno(stderr));  // progress on one rewritten line, else a line each
+  bench_scene.file.scene.camera.width = run.width;
+  bench_scene.file.scene.camera.height = run.height;
+  const Scene scene = sceneAtTime(bench_scene.file);
+  SceneResult result;
+  result.name = bench_scene.name;
+  result.what = bench_scene.what;
+  // The scene's own reference settings at the sweep's supersampling, with every lobe of
+  // every heap in range, so that the heaps' level of detail is measured, not shared.
+  ReferenceSettings reference_settings = bench_scene.file.reference;
+  reference_settings.samples_per_axis = run.samples;
+  reference_settings.heaps.detail_px = 0.0;
+  const auto ref_start = Clock::now();
+  const FloatImage reference = renderReference(scene, reference_settings, [&](double fraction) {
+    if (tty) std::fprintf(stderr, "\r%s: reference %3.0f %%", tag.c_str(), 100.0 * fraction);
+  });
+  result.reference_s = secondsSince(ref_start);
+  std::fprintf(stderr, "%s%s: reference in %.2f s\n", tty ? "\r" : "", tag.c_str(),
+               result.reference_s);
+  result.floor_ms =
+      medianMilliseconds(run.repeats, [&] { renderer.renderFloor(run.width, run.height); });
+  sweepScene({renderer, run, reference_settings, reference, tag, tty}, bench_scene, scene, result);
+  std::fprintf(stderr, "%s%s: %zu settings, %.0f s since the start%40s\n", tty ? "\r" : "",
+               tag.c_str(), result.points.size(), secondsSince(start), "");
+  markFront(result.points);
+  result.default_status = defaultStatus(result.points);
+  printScene(result, run.width, run.height, run.samples);
+  return result;
+}
+
+// The label knob, on every scene with clouds (after the sweep: its tracing would disturb no
+// timing there).
+std::vector<LabelResult> measureLabels(GlRenderer& renderer,
+                                       const std::vector<BenchScene>& scenes) {
+  std::vector<LabelResult> labels;
+  const BandTable band{InfraredModel{}};
+  for (const BenchScene& bench_scene : scenes) {
+    const Scene scene = sceneAtTime(bench_scene.file);
+    if (scene.layers.empty() && scene.clouds.empty() && scene.fields.empty() &&
+        scene.automata.empty())
+      continue;
+    labels.push_back(measureLabelKnob(renderer, bench_scene, scene, band));
+    std::fprintf(stderr, "%s: label channels\n", bench_scene.name.c_str());
+    for (const LabelPoint& p : labels.back().points)
+      std::printf(
+          "  channel_divisor=%d: %.1f ms, %.2f %% cloud/clear flipped, cloud depth %.4f "
+          "relative, lwir %.3f K\n",
+          p.divisor, p.ms, 100.0 * p.cloud_depth.flipped, p.cloud_depth.mean_relative,
+          p.lwir_kelvin);
+  }
+  return labels;
+}
+
+// accuracy.csv, .md (with the label channels) and .svg in `dir`.
+void writeReports(const std::filesystem::path& dir, const std::vector<SceneResult>& results,
+                  const std::vector<LabelResult>& labels, const std::string& header) {
+  writeCsv(dir / "accuracy.csv", results);
+  writeMarkdown(dir / "accuracy.md", results, header);
+  {
+    std::ofstream out(dir / "accuracy.md", std::ios::app);
+    writeLabelMarkdown(out, labels);
+  }
+  writePlot(dir / "accuracy.svg", results);
+}
+
 }  // namespace
 
 void addBenchCommand(CLI::App& app, BenchCommandOptions& o) {
@@ -541,31 +678,20 @@ void addBenchCommand(CLI::App& app, BenchCommandOptions& o) {
 }
 
 int runBenchCommand(const BenchCommandOptions& o) {
-  int width = o.quick ? 200 : 640, height = o.quick ? 150 : 480;
-  if (!o.size.empty() && (std::sscanf(o.size.c_str(), "%dx%d", &width, &height) != 2 || width < 1 ||
-                          height < 1 || width > 4096 || height > 4096)) {
-    spdlog::error("--size: '{}' is not WxH with each side 1 to 4096", o.size);
+  BenchRun run;
+  std::vector<BenchScene> scenes;
+  if (std::string error = readRun(o, run); !error.empty()) {
+    spdlog::error("{}", error);
     return 2;
   }
-  const int repeats = o.repeats > 0 ? o.repeats : o.quick ? 3 : 7;
-  const int samples = o.samples > 0 ? o.samples : o.quick ? 2 : 4;
-
-  std::vector<BenchScene> scenes;
   if (std::string error = loadScenes(scenes); !error.empty()) {
     spdlog::error("{}", error);
     return 1;
   }
-  for (const std::string& name : o.scenes)
-    if (std::none_of(scenes.begin(), scenes.end(),
-                     [&](const BenchScene& s) { return s.name == name; })) {
-      spdlog::error("--scenes: unknown scene '{}' (allowed: {})", name, sceneNames());
-      return 2;
-    }
-  if (!o.scenes.empty())
-    std::erase_if(scenes, [&](const BenchScene& s) {
-      return std::find(o.scenes.begin(), o.scenes.end(), s.name) == o.scenes.end();
-    });
-
+  if (std::string error = selectScenes(o.scenes, scenes); !error.empty()) {
+    spdlog::error("{}", error);
+    return 2;
+  }
   std::string error;
   const auto platform = createGlPlatform(backendFromName(o.gl_backend), error);
   if (!platform) {
@@ -573,112 +699,22 @@ int runBenchCommand(const BenchCommandOptions& o) {
     return 1;
   }
   GlRenderer renderer(*platform);
-  const std::string header = "Measured by `nephele bench" + std::string(o.quick ? " --quick" : "") +
-                             "` at " + std::to_string(width) + "x" + std::to_string(height) +
-                             ", median of " + std::to_string(repeats) +
-                             " frames (render + readback into an 8-bit target), " +
-                             platform->renderer() + " (" + std::string(platform->backendName()) +
-                             "); error against the CPU reference at " + std::to_string(samples) +
-                             "x" + std::to_string(samples) + " samples per pixel.";
+  const std::string header =
+      "Measured by `nephele bench" + std::string(o.quick ? " --quick" : "") + "` at " +
+      std::to_string(run.width) + "x" + std::to_string(run.height) + ", median of " +
+      std::to_string(run.repeats) + " frames (render + readback into an 8-bit target), " +
+      platform->renderer() + " (" + std::string(platform->backendName()) +
+      "); error against the CPU reference at " + std::to_string(run.samples) + "x" +
+      std::to_string(run.samples) + " samples per pixel.";
   std::printf("%s\n", header.c_str());
 
   const auto start = Clock::now();
-  const bool tty = isatty(fileno(stderr));  // progress on one rewritten line, else a line each
   std::vector<SceneResult> results;
   for (std::size_t index = 0; index < scenes.size(); ++index) {
-    BenchScene& bench_scene = scenes[index];
-    bench_scene.file.scene.camera.width = width;
-    bench_scene.file.scene.camera.height = height;
     const std::string tag = "[" + std::to_string(index + 1) + "/" + std::to_string(scenes.size()) +
-                            "] " + bench_scene.name;
-    const Scene scene = sceneAtTime(bench_scene.file);
-    SceneResult result;
-    result.name = bench_scene.name;
-    result.what = bench_scene.what;
-
-    // The scene's own reference settings at the sweep's supersampling, with every lobe of
-    // every heap in range, so that the heaps' level of detail is measured, not shared.
-    ReferenceSettings reference_settings = bench_scene.file.reference;
-    reference_settings.samples_per_axis = samples;
-    reference_settings.heaps.detail_px = 0.0;
-    const auto ref_start = Clock::now();
-    const FloatImage reference = renderReference(scene, reference_settings, [&](double fraction) {
-      if (tty) std::fprintf(stderr, "\r%s: reference %3.0f %%", tag.c_str(), 100.0 * fraction);
-    });
-    result.reference_s = secondsSince(ref_start);
-    std::fprintf(stderr, "%s%s: reference in %.2f s\n", tty ? "\r" : "", tag.c_str(),
-                 result.reference_s);
-    result.floor_ms = medianMilliseconds(repeats, [&] { renderer.renderFloor(width, height); });
-
-    const std::vector<Setting> settings = settingsFor(bench_scene.file);
-    std::vector<Scene> edited(settings.size(), scene);
-    std::vector<RenderSettings> renders(settings.size(), bench_scene.file.render);
-    FloatImage defaults_image;
-    for (std::size_t k = 0; k < settings.size(); ++k) {
-      const Setting& setting = settings[k];
-      setting.edit(renders[k]);
-      if (setting.scene_edit) {
-        SceneFile file = bench_scene.file;
-        setting.scene_edit(file);
-        edited[k] = sceneAtTime(file);
-      }
-      Point point;
-      point.setting = setting;
-      // A still view as a running daemon holds it: every clipmap filled (`auto` fills them
-      // over the frames after the first) before the image is measured and timed.
-      for (int warm = 0; warm < 64; ++warm) {
-        renderer.renderSrgb8(edited[k], renders[k]);
-        if (warm > 0 && renderer.lastFrameStats().layer_texels_baked == 0) break;
-      }
-      if (setting.stream) {
-        renderer.setContinuousView("sweep " + std::to_string(k));
-        Scene approach = edited[k];
-        for (int frame = 16; frame > 0; --frame) {
-          approach.camera.position.x = edited[k].camera.position.x - 250.0 / 30.0 * frame;
-          renderer.renderSrgb8(approach, renders[k]);
-        }
-      }
-      const FloatImage image = renderer.renderFloat(edited[k], renders[k]);
-      renderer.setContinuousView("");
-      if (setting.changes_model) {
-        if (tty)
-          std::fprintf(stderr, "\r%s: reference for %s", tag.c_str(), setting.name().c_str());
-        ReferenceSettings same = reference_settings;
-        same.sea_waves = renders[k].sea_waves;  // the same sea as the GL draws
-        point.error = compareImages(image, renderReference(edited[k], same));
-      } else {
-        point.error = compareImages(image, reference);
-      }
-      if (k == 0)
-        defaults_image = image;
-      else
-        point.same_image = image.rgba == defaults_image.rgba;
-      point.ms = std::numeric_limits<double>::infinity();
-      result.points.push_back(point);
-    }
-    // Two timing rounds over every setting, each setting's time the lower of its two medians,
-    // so that the machine's drift and the order of the settings do not decide the front.
-    for (int round = 1; round <= 2; ++round)
-      for (std::size_t k = 0; k < settings.size(); ++k) {
-        if (tty)
-          std::fprintf(stderr, "\r%s: timing round %d, %zu/%zu %-50s", tag.c_str(), round, k + 1,
-                       settings.size(), settings[k].name().c_str());
-        Point& point = result.points[k];
-        if (settings[k].stream) renderer.setContinuousView("sweep " + std::to_string(k));
-        point.ms = std::min(point.ms, medianMilliseconds(repeats, [&] {
-                              renderer.renderSrgb8(edited[k], renders[k]);
-                            }));
-        renderer.setContinuousView("");
-        point.floor_multiple = point.ms / result.floor_ms;
-      }
-    std::fprintf(stderr, "%s%s: %zu settings, %.0f s since the start%40s\n", tty ? "\r" : "",
-                 tag.c_str(), settings.size(), secondsSince(start), "");
-    markFront(result.points);
-    result.default_status = defaultStatus(result.points);
-    printScene(result, width, height, samples);
-    results.push_back(std::move(result));
+                            "] " + scenes[index].name;
+    results.push_back(measureScene(renderer, scenes[index], run, tag, start));
   }
-
   const std::filesystem::path dir(o.output_dir);
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
@@ -686,32 +722,7 @@ int runBenchCommand(const BenchCommandOptions& o) {
     spdlog::error("{}: {}", o.output_dir, ec.message());
     return 1;
   }
-  // The label knob, on every scene with clouds (after the sweep: its tracing would disturb no
-  // timing there).
-  std::vector<LabelResult> labels;
-  const BandTable band{InfraredModel{}};
-  for (const BenchScene& bench_scene : scenes) {
-    const Scene scene = sceneAtTime(bench_scene.file);
-    if (scene.layers.empty() && scene.clouds.empty() && scene.fields.empty() &&
-        scene.automata.empty())
-      continue;
-    labels.push_back(measureLabelKnob(renderer, bench_scene, scene, band));
-    std::fprintf(stderr, "%s: label channels\n", bench_scene.name.c_str());
-    for (const LabelPoint& p : labels.back().points)
-      std::printf(
-          "  channel_divisor=%d: %.1f ms, %.2f %% cloud/clear flipped, cloud depth %.4f "
-          "relative, lwir %.3f K\n",
-          p.divisor, p.ms, 100.0 * p.cloud_depth.flipped, p.cloud_depth.mean_relative,
-          p.lwir_kelvin);
-  }
-
-  writeCsv(dir / "accuracy.csv", results);
-  writeMarkdown(dir / "accuracy.md", results, header);
-  {
-    std::ofstream out(dir / "accuracy.md", std::ios::app);
-    writeLabelMarkdown(out, labels);
-  }
-  writePlot(dir / "accuracy.svg", results);
+  writeReports(dir, results, measureLabels(renderer, scenes), header);
   std::printf("\nwrote %s, %s and %s in %.0f s\n", (dir / "accuracy.csv").c_str(),
               (dir / "accuracy.md").c_str(), (dir / "accuracy.svg").c_str(), secondsSince(start));
   return 0;

@@ -6,6 +6,7 @@
 
 #include "cli/bench_command.h"
 #include "cli/dataset_command.h"
+#include "cli/knobs_command.h"
 #include "cli/render_command.h"
 #include "server/serve_command.h"
 
@@ -27,6 +28,8 @@ int main(int argc, char** argv) {
   nephele::addBenchCommand(app, bench);
   nephele::DatasetCommandOptions dataset;
   nephele::addDatasetCommand(app, dataset);
+  nephele::KnobsCommandOptions knobs;
+  nephele::addKnobsCommand(app, knobs);
 
   try {
     app.parse(argc, argv);
@@ -40,5 +43,6 @@ int main(int argc, char** argv) {
   if (app.got_subcommand("serve")) return nephele::runServeCommand(serve);
   if (app.got_subcommand("bench")) return nephele::runBenchCommand(bench);
   if (app.got_subcommand("dataset")) return nephele::runDatasetCommand(dataset);
+  if (app.got_subcommand("knobs")) return nephele::runKnobsCommand(knobs);
   return 2;
 }

@@ -21,8 +21,8 @@ double millisecondsSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
-// Applies command-line overrides to the scene; returns an error for invalid values.
-std::string applyOverrides(const RenderCommandOptions& o, SceneFile& file) {
+// Applies the camera's, the sun's and the time's flags; returns an error for invalid values.
+std::string applyViewOverrides(const RenderCommandOptions& o, SceneFile& file) {
   Camera& camera = file.scene.camera;
   if (o.width) camera.width = *o.width;
   if (o.height) camera.height = *o.height;
@@ -37,43 +37,38 @@ std::string applyOverrides(const RenderCommandOptions& o, SceneFile& file) {
     if (outOfRange(out, "--sun azimuth", (*o.sun)[0],
                    {-Limits::kMaxHeading, Limits::kMaxHeading}) ||
         outOfRange(out, "--sun elevation", (*o.sun)[1], {-Limits::kMaxPitch, Limits::kMaxPitch}))
-      return "command line: " + out.str();
+      return out.str();
     file.scene.sun.azimuth_deg = (*o.sun)[0];
     file.scene.sun.elevation_deg = (*o.sun)[1];
   }
   if (o.time && !file.dynamics.automata.empty() && *o.time > Limits::kMaxAutomatonTime)
-    return "command line: --time " + std::to_string(*o.time) +
+    return "--time " + std::to_string(*o.time) +
            " is out of range with automaton clouds (allowed: 0 to 86400 s)";
   if (o.time)
     if (std::string e = automatonWorkError(file.dynamics.automata, *o.time); !e.empty())
-      return "command line: --time: " + e;
-  // The names were checked against the same lists when the flags were parsed.
-  if (o.texture)
-    file.render.texture_evaluation =
-        TextureEvaluation(nameIndex(kTextureEvaluationNames, *o.texture));
-  if (o.term_filter)
-    file.render.term_filter = TermFilter(nameIndex(kTermFilterNames, *o.term_filter));
-  if (o.sky_passes) file.render.sky_passes = SkyPasses(nameIndex(kSkyPassesNames, *o.sky_passes));
-  RenderSettings& r = file.render;
-  if (o.ellipsoid_passes)
-    r.ellipsoid_passes = EllipsoidPasses(nameIndex(kEllipsoidPassesNames, *o.ellipsoid_passes));
-  if (o.ellipsoid_order)
-    r.ellipsoid_order = EllipsoidOrder(nameIndex(kEllipsoidOrderNames, *o.ellipsoid_order));
-  if (o.limb) r.limb = LimbEvaluation(nameIndex(kLimbNames, *o.limb));
-  if (o.tile_format) r.tile_format = TileFormat(nameIndex(kTileFormatNames, *o.tile_format));
-  if (o.tile_resolution) r.tile_resolution = *o.tile_resolution;
-  if (o.tessellation) r.tessellation = *o.tessellation;
-  if (o.impostor_tolerance) r.impostor_tolerance_px = *o.impostor_tolerance;
-  if (o.volume_step) r.volume_step = *o.volume_step;
-  if (o.heap_range) r.heaps.range_m = *o.heap_range;
-  if (o.heap_detail) r.heaps.detail_px = *o.heap_detail;
-  if (o.ellipsoid_budget) r.ellipsoid_budget = *o.ellipsoid_budget;
-  if (o.ellipsoid_overdraw) r.ellipsoid_overdraw = *o.ellipsoid_overdraw;
-  if (o.heap_shading_rate) r.heap_shading_rate = *o.heap_shading_rate;
-  file.reference.heaps = r.heaps;  // both renderers draw the same heaps
+      return "--time: " + e;
+  return validateCamera(camera);
+}
+
+// Applies the render knobs' flags, each through its knob's one check.
+std::string applyKnobOverrides(const RenderCommandOptions& o, SceneFile& file) {
+  for (const auto& [name, text] : o.knobs) {
+    const RenderKnob& knob = *findRenderKnob(name);  // the flags were made from the table
+    double value = 0.0;
+    if (std::string e = parseKnobText(knob, text, value); !e.empty()) return e;
+    if (std::string e = knobError(knob, value); !e.empty()) return e;
+    knob.set(file.render, value);
+  }
+  file.reference.heaps = file.render.heaps;          // both renderers draw the same heaps
+  file.reference.sea_waves = file.render.sea_waves;  // and the same sea
   if (o.samples) file.reference.samples_per_axis = *o.samples;
-  std::string error = validateCamera(camera);
-  if (error.empty()) error = validateRenderSettings(r);
+  return "";
+}
+
+// Applies every command-line override to the scene; returns an error for invalid values.
+std::string applyOverrides(const RenderCommandOptions& o, SceneFile& file) {
+  std::string error = applyViewOverrides(o, file);
+  if (error.empty()) error = applyKnobOverrides(o, file);
   return error.empty() ? "" : "command line: " + error;
 }
 
@@ -120,6 +115,67 @@ GlBackend backendFromName(const std::string& name) {
   return GlBackend::kAuto;
 }
 
+namespace {
+
+void addViewFlags(CLI::App& cmd, RenderCommandOptions& o) {
+  cmd.add_option("--width", o.width, "Image width in pixels")
+      ->check(CLI::Range(1, Limits::kMaxImageSide));
+  cmd.add_option("--height", o.height, "Image height in pixels")
+      ->check(CLI::Range(1, Limits::kMaxImageSide));
+  cmd.add_option("--position", o.position, "Camera position X,Y,Z in metres")
+      ->expected(3)
+      ->delimiter(',');
+  cmd.add_option("--heading", o.heading, "Camera heading, degrees clockwise from north")
+      ->check(CLI::Range(-Limits::kMaxHeading, Limits::kMaxHeading));
+  cmd.add_option("--pitch", o.pitch, "Camera pitch, degrees, positive up")
+      ->check(CLI::Range(-Limits::kMaxPitch, Limits::kMaxPitch));
+  cmd.add_option("--roll", o.roll, "Camera roll, degrees, positive right wing down")
+      ->check(CLI::Range(-Limits::kMaxRoll, Limits::kMaxRoll));
+  cmd.add_option("--vfov", o.vfov, "Vertical field of view, degrees")
+      ->check(CLI::Range(Limits::kMinVfov, Limits::kMaxVfov));
+  cmd.add_option("--sun", o.sun,
+                 "Sun azimuth (degrees clockwise from north) and elevation (degrees), AZ,EL")
+      ->delimiter(',');
+  cmd.add_option("--time", o.time, "Simulation time in seconds (layers drift with it)")
+      ->check(CLI::Range(0.0, Limits::kMaxTime));
+}
+
+// One flag per render knob (renderer/render_knobs.inc): --kebab-case of its name, its doc as
+// help. Values are checked with the scene file's, by the knob's one check.
+void addKnobFlags(CLI::App& cmd, RenderCommandOptions& o) {
+  for (const RenderKnob& knob : renderKnobs()) {
+    CLI::Option* flag = cmd.add_option_function<std::string>(
+        knob.flag(),
+        [&o, name = std::string(knob.name)](const std::string& value) {
+          o.knobs.emplace_back(name, value);
+        },
+        knob.helpText());
+    if (knob.type == KnobType::kChoice)
+      flag->check(CLI::IsMember(knob.values.names));
+    else
+      flag->type_name(knob.type == KnobType::kInteger   ? "INT"
+                      : knob.type == KnobType::kBoolean ? "BOOL"
+                                                        : "FLOAT");
+  }
+  cmd.add_option("--samples", o.samples, "Reference supersampling per pixel axis")
+      ->check(CLI::Range(1, 16));
+}
+
+void addEncodeFlags(CLI::App& cmd, RenderCommandOptions& o) {
+  cmd.add_option("--png-compression", o.encode.png_compression, "PNG zlib level")
+      ->check(CLI::Range(0, 9))
+      ->capture_default_str();
+  cmd.add_option("--jpeg-quality", o.encode.jpeg_quality, "JPEG quality")
+      ->check(CLI::Range(1, 100))
+      ->capture_default_str();
+  cmd.add_option("--exr-compression", o.encode.exr_compression, "EXR compression")
+      ->check(CLI::IsMember({"none", "zip", "zips", "piz", "rle", "pxr24", "b44", "dwaa", "dwab"}))
+      ->capture_default_str();
+  cmd.add_flag("!--exr-float", o.encode.exr_half, "Write EXR as 32-bit float instead of half");
+}
+
+}  // namespace
+
 void addRenderCommand(CLI::App& app, RenderCommandOptions& o) {
   CLI::App* cmd = app.add_subcommand("render", "Render one image of a scene file");
   cmd->add_option("scene", o.scene_path, "Scene file (TOML)")->required()->check(CLI::ExistingFile);
@@ -135,82 +191,77 @@ void addRenderCommand(CLI::App& app, RenderCommandOptions& o) {
   cmd->add_option("--channels", o.channels,
                   "EXR output: channels to write, comma-separated, from " + channelNames() +
                       " (default colour,coverage)");
-  cmd->add_option("--width", o.width, "Image width in pixels")
-      ->check(CLI::Range(1, Limits::kMaxImageSide));
-  cmd->add_option("--height", o.height, "Image height in pixels")
-      ->check(CLI::Range(1, Limits::kMaxImageSide));
-  cmd->add_option("--position", o.position, "Camera position X,Y,Z in metres")
-      ->expected(3)
-      ->delimiter(',');
-  cmd->add_option("--heading", o.heading, "Camera heading, degrees clockwise from north")
-      ->check(CLI::Range(-Limits::kMaxHeading, Limits::kMaxHeading));
-  cmd->add_option("--pitch", o.pitch, "Camera pitch, degrees, positive up")
-      ->check(CLI::Range(-Limits::kMaxPitch, Limits::kMaxPitch));
-  cmd->add_option("--roll", o.roll, "Camera roll, degrees, positive right wing down")
-      ->check(CLI::Range(-Limits::kMaxRoll, Limits::kMaxRoll));
-  cmd->add_option("--vfov", o.vfov, "Vertical field of view, degrees")
-      ->check(CLI::Range(Limits::kMinVfov, Limits::kMaxVfov));
-  cmd->add_option("--sun", o.sun,
-                  "Sun azimuth (degrees clockwise from north) and elevation (degrees), AZ,EL")
-      ->delimiter(',');
-  cmd->add_option("--time", o.time, "Simulation time in seconds (layers drift with it)")
-      ->check(CLI::Range(0.0, Limits::kMaxTime));
   cmd->add_flag("--stats", o.stats,
                 "Print what the frame did: passes, ellipsoids drawn and culled, texture terms, "
                 "automaton steps and relights");
-  cmd->add_option("--texture", o.texture, "Gardner texture on the GPU: auto, baked or procedural")
-      ->check(CLI::IsMember(kTextureEvaluationNames));
-  cmd->add_option("--term-filter", o.term_filter,
-                  "Removal of texture terms above the pixel frequency: fade, cut or none")
-      ->check(CLI::IsMember(kTermFilterNames));
-  cmd->add_option("--sky-passes", o.sky_passes, "fused, or multipass (one pass per layer)")
-      ->check(CLI::IsMember(kSkyPassesNames));
-  cmd->add_option("--ellipsoid-passes", o.ellipsoid_passes,
-                  "Ellipsoids: fused (exact hit per fragment) or multipass (Elinas tiles)")
-      ->check(CLI::IsMember(kEllipsoidPassesNames));
-  cmd->add_option("--ellipsoid-order", o.ellipsoid_order,
-                  "Fused ellipsoids: per-pixel depth order, or centre (by ellipsoid centre)")
-      ->check(CLI::IsMember(kEllipsoidOrderNames));
-  cmd->add_option("--limb", o.limb, "Limb function g: exact, or spotlight (Elinas' texture)")
-      ->check(CLI::IsMember(kLimbNames));
-  cmd->add_option("--tile-resolution", o.tile_resolution,
-                  "Multipass tile size: 0 adaptive, or a power of two 8..1024");
-  cmd->add_option("--tile-format", o.tile_format, "Multipass tiles: float or rgba8")
-      ->check(CLI::IsMember(kTileFormatNames));
-  cmd->add_option("--tessellation", o.tessellation,
-                  "Multipass ellipsoid mesh: 0 adaptive, or N slices by N stacks (3..256)");
-  cmd->add_option("--impostor-tolerance", o.impostor_tolerance,
-                  "Reuse far-cloud impostors while they move less than this many pixels (0 off)");
-  cmd->add_option("--heap-range", o.heap_range,
-                  "Cloud fields: heaps as ellipsoids to this distance (m), a far deck beyond; "
-                  "0 is 40 km plus twice the height");
-  cmd->add_option("--heap-detail", o.heap_detail,
-                  "Cloud fields: every lobe of heaps whose radius spans this many pixels, their "
-                  "outline below (0..10000; default 32; 0 every lobe)");
-  cmd->add_option("--ellipsoid-budget", o.ellipsoid_budget,
-                  "Ellipsoids a frame draws at most, those of largest projected size "
-                  "(0..16777216; default 65536; 0 every ellipsoid)");
-  cmd->add_option("--ellipsoid-overdraw", o.ellipsoid_overdraw,
-                  "Views that the footprints of the ellipsoids a frame draws may cover, those of "
-                  "largest projected size first (0..65536; default 256; 0 no bound)");
-  cmd->add_option("--heap-shading-rate", o.heap_shading_rate,
-                  "Heaps: walk one pixel in N x N and blend those samples to full size (1, 2 "
-                  "or 4; default 1, every pixel)");
-  cmd->add_option("--volume-step", o.volume_step,
-                  "Automaton clouds: view march step in lattice spacings (0.25..8)");
-  cmd->add_option("--samples", o.samples, "Reference supersampling per pixel axis")
-      ->check(CLI::Range(1, 16));
-  cmd->add_option("--png-compression", o.encode.png_compression, "PNG zlib level")
-      ->check(CLI::Range(0, 9))
-      ->capture_default_str();
-  cmd->add_option("--jpeg-quality", o.encode.jpeg_quality, "JPEG quality")
-      ->check(CLI::Range(1, 100))
-      ->capture_default_str();
-  cmd->add_option("--exr-compression", o.encode.exr_compression, "EXR compression")
-      ->check(CLI::IsMember({"none", "zip", "zips", "piz", "rle", "pxr24", "b44", "dwaa", "dwab"}))
-      ->capture_default_str();
-  cmd->add_flag("!--exr-float", o.encode.exr_half, "Write EXR as 32-bit float instead of half");
+  addViewFlags(*cmd, o);
+  addKnobFlags(*cmd, o);
+  addEncodeFlags(*cmd, o);
 }
+
+namespace {
+
+// The scene file with the flags applied; an error for bad input.
+std::string loadScene(const RenderCommandOptions& o, SceneFile& file) {
+  if (std::string error = loadSceneFile(o.scene_path, file); !error.empty()) return error;
+  return applyOverrides(o, file);
+}
+
+// The channels --channels asks for; an error for an unknown one or an 8-bit format.
+std::string readChannels(const RenderCommandOptions& o, ImageFileFormat format,
+                         FrameRequest& request) {
+  if (o.channels.empty()) return "";
+  std::string error;
+  request.channels = parseChannelList(o.channels, error);
+  if (!error.empty()) return "--channels: " + error;
+  if (!isFloatFormat(format))
+    return "--channels: '" + o.output_path +
+           "' is an 8-bit format holding colour only; write an .exr";
+  return "";
+}
+
+void logScene(const std::string& path, const Scene& scene) {
+  std::size_t ellipsoids = 0;
+  for (const EllipsoidCloud& cloud : scene.clouds) ellipsoids += cloud.ellipsoids.size();
+  spdlog::info(
+      "scene {} at t = {} s: {}x{}, {} layer(s), {} cloud(s) of {} ellipsoid(s), {} automaton "
+      "cloud(s), {} target(s){}{}",
+      path, scene.time_s, scene.camera.width, scene.camera.height, scene.layers.size(),
+      scene.clouds.size(), ellipsoids, scene.automata.size(), scene.targets.size(),
+      scene.fog ? ", fog" : "", scene.haze ? ", haze" : "");
+}
+
+// Renders the world's scene and writes the image; the write's error, or empty. Progress
+// counts from `start`, before the world was simulated.
+std::string renderAndWrite(const RenderCommandOptions& o, Renderer& renderer, const World& world,
+                           const FrameRequest& request, ImageFileFormat format,
+                           Clock::time_point start) {
+  const Scene scene = world.scene();
+  logScene(o.scene_path, scene);
+  renderer.setProgress([&](double done) {
+    const double seconds = millisecondsSince(start) / 1000.0;
+    if (seconds >= 2.0)  // only long renders need a progress line
+      spdlog::info("render: {:.0f} % after {:.1f} s", 100.0 * done, seconds);
+  });
+  std::string error;
+  const auto render_start = Clock::now();
+  if (isFloatFormat(format)) {
+    const Frame frame = renderer.render(scene, request);
+    spdlog::info("render: {:.1f} ms", millisecondsSince(render_start));
+    error = writeFrameExr(o.output_path, frame, o.encode);
+  } else {
+    const Srgb8Image image = renderer.renderSrgb8(scene);
+    spdlog::info("render: {:.1f} ms", millisecondsSince(render_start));
+    error = writeImageFile(o.output_path, image, o.encode);
+  }
+  if (o.stats)
+    std::printf("stats: %s automaton_steps=%llu relights=%llu\n", renderer.statsLine().c_str(),
+                static_cast<unsigned long long>(world.automatonStepsRun()),
+                static_cast<unsigned long long>(world.relightsRun()));
+  return error;
+}
+
+}  // namespace
 
 int runRenderCommand(const RenderCommandOptions& o) {
   const auto format = imageFileFormatForPath(o.output_path);
@@ -220,27 +271,12 @@ int runRenderCommand(const RenderCommandOptions& o) {
     return 2;
   }
   SceneFile file;
-  if (std::string error = loadSceneFile(o.scene_path, file); !error.empty()) {
-    spdlog::error("{}", error);
-    return 2;
-  }
-  if (std::string error = applyOverrides(o, file); !error.empty()) {
-    spdlog::error("{}", error);
-    return 2;
-  }
   FrameRequest request;
-  if (!o.channels.empty()) {
-    std::string channel_error;
-    request.channels = parseChannelList(o.channels, channel_error);
-    if (!channel_error.empty()) {
-      spdlog::error("--channels: {}", channel_error);
-      return 2;
-    }
-    if (!isFloatFormat(*format)) {
-      spdlog::error("--channels: '{}' is an 8-bit format holding colour only; write an .exr",
-                    o.output_path);
-      return 2;
-    }
+  std::string error = loadScene(o, file);
+  if (error.empty()) error = readChannels(o, *format, request);
+  if (!error.empty()) {
+    spdlog::error("{}", error);
+    return 2;
   }
   // The renderer and its target first: a size the platform cannot allocate is refused before
   // the world is simulated or anything is drawn.
@@ -249,10 +285,9 @@ int runRenderCommand(const RenderCommandOptions& o) {
   options.gl_backend = backendFromName(o.gl_backend);
   options.render = file.render;
   options.reference = file.reference;
-  std::string renderer_error;
-  const std::unique_ptr<Renderer> renderer = createRenderer(options, renderer_error);
+  const std::unique_ptr<Renderer> renderer = createRenderer(options, error);
   if (!renderer) {
-    spdlog::error("{}", renderer_error);
+    spdlog::error("{}", error);
     return 1;
   }
   spdlog::info("renderer: {}", renderer->description());
@@ -266,36 +301,7 @@ int runRenderCommand(const RenderCommandOptions& o) {
   }
   const auto start = Clock::now();
   const World world = worldAtTime(file);
-  const Scene scene = world.scene();
-  std::size_t ellipsoids = 0;
-  for (const EllipsoidCloud& cloud : scene.clouds) ellipsoids += cloud.ellipsoids.size();
-  spdlog::info(
-      "scene {} at t = {} s: {}x{}, {} layer(s), {} cloud(s) of {} ellipsoid(s), {} automaton "
-      "cloud(s), {} target(s){}{}",
-      o.scene_path, scene.time_s, scene.camera.width, scene.camera.height, scene.layers.size(),
-      scene.clouds.size(), ellipsoids, scene.automata.size(), scene.targets.size(),
-      scene.fog ? ", fog" : "", scene.haze ? ", haze" : "");
-  renderer->setProgress([&](double done) {
-    const double seconds = millisecondsSince(start) / 1000.0;
-    if (seconds >= 2.0)  // only long renders need a progress line
-      spdlog::info("render: {:.0f} % after {:.1f} s", 100.0 * done, seconds);
-  });
-  std::string error;
-  const auto render_start = Clock::now();
-  if (isFloatFormat(*format)) {
-    const Frame frame = renderer->render(scene, request);
-    spdlog::info("render: {:.1f} ms", millisecondsSince(render_start));
-    error = writeFrameExr(o.output_path, frame, o.encode);
-  } else {
-    const Srgb8Image image = renderer->renderSrgb8(scene);
-    spdlog::info("render: {:.1f} ms", millisecondsSince(render_start));
-    error = writeImageFile(o.output_path, image, o.encode);
-  }
-  if (o.stats)
-    std::printf("stats: %s automaton_steps=%llu relights=%llu\n", renderer->statsLine().c_str(),
-                static_cast<unsigned long long>(world.automatonStepsRun()),
-                static_cast<unsigned long long>(world.relightsRun()));
-  if (!error.empty()) {
+  if (error = renderAndWrite(o, *renderer, world, request, *format, start); !error.empty()) {
     spdlog::error("{}", error);
     return 1;
   }

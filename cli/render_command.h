@@ -25,16 +25,9 @@ struct RenderCommandOptions {
   std::optional<std::vector<double>> position;
   std::optional<double> heading, pitch, roll, vfov, time;
   std::optional<std::array<double, 2>> sun;  // azimuth, elevation, degrees
-  std::optional<std::string> texture, term_filter, sky_passes;
-  std::optional<std::string> ellipsoid_passes, ellipsoid_order, limb, tile_format;
-  std::optional<int> tile_resolution, tessellation;
-  std::optional<double> impostor_tolerance;
-  std::optional<double> heap_range;
-  std::optional<double> heap_detail;
-  std::optional<double> ellipsoid_budget;
-  std::optional<double> ellipsoid_overdraw;
-  std::optional<int> heap_shading_rate;
-  std::optional<double> volume_step;
+  // Render knobs given as flags (one per row of renderer/render_knobs.inc): name, value as
+  // written, in the order given.
+  std::vector<std::pair<std::string, std::string>> knobs;
   std::optional<int> samples;
   bool stats = false;
   EncodeOptions encode;

@@ -134,67 +134,32 @@ void readSea(TableReader& t, std::optional<glm::dvec2> surface_wind, Sea& sea) {
   t.finish();
 }
 
+// One knob's key, typed by its row and checked by its one check (renderer/render_knobs.h).
+void readKnob(TableReader& t, const RenderKnob& knob, RenderSettings& settings) {
+  double value = knob.get(settings);
+  if (knob.type == KnobType::kChoice) {
+    value = t.choice(knob.name, knob.values.names, int(value));
+  } else if (knob.type == KnobType::kBoolean) {
+    bool on = value != 0.0;
+    t.boolean(knob.name, on);
+    value = on;
+  } else if (const auto number =
+                 t.numberToCheck(knob.name, knob.type == KnobType::kInteger, knob.allowed())) {
+    value = *number;
+  }
+  if (std::string error = knobError(knob, value); !error.empty())
+    t.failAt(knob.name, error.substr(knob.name.size() + 2));
+  knob.set(settings, value);
+}
+
 void readRender(TableReader& t, SceneFile& out) {
-  t.allow({"texture",
-           "term_filter",
-           "sky_passes",
-           "bake_texels_per_cycle",
-           "reference_samples",
-           "ellipsoid_passes",
-           "ellipsoid_order",
-           "limb",
-           "tile_resolution",
-           "tile_format",
-           "tessellation",
-           "impostor_tolerance",
-           "volume_step",
-           "heap_range",
-           "heap_detail",
-           "ellipsoid_budget",
-           "ellipsoid_overdraw",
-           "heap_shading_rate",
-           "heap_refresh",
-           "shadow_map_size",
-           "plane_shadows",
-           "sea_waves",
-           "sea_probe_scale"});
-  out.render.texture_evaluation = TextureEvaluation(
-      t.choice("texture", kTextureEvaluationNames, int(out.render.texture_evaluation)));
-  out.render.term_filter =
-      TermFilter(t.choice("term_filter", kTermFilterNames, int(out.render.term_filter)));
-  out.render.sky_passes =
-      SkyPasses(t.choice("sky_passes", kSkyPassesNames, int(out.render.sky_passes)));
-  t.integer("bake_texels_per_cycle", out.render.bake_texels_per_cycle, 2, 64);
+  std::vector<std::string> keys{"reference_samples"};
+  for (const RenderKnob& knob : renderKnobs()) keys.emplace_back(knob.name);
+  t.allow(keys);
+  for (const RenderKnob& knob : renderKnobs()) readKnob(t, knob, out.render);
   t.integer("reference_samples", out.reference.samples_per_axis, 1, 16);
-  RenderSettings& r = out.render;
-  r.ellipsoid_passes =
-      EllipsoidPasses(t.choice("ellipsoid_passes", kEllipsoidPassesNames, int(r.ellipsoid_passes)));
-  r.ellipsoid_order =
-      EllipsoidOrder(t.choice("ellipsoid_order", kEllipsoidOrderNames, int(r.ellipsoid_order)));
-  r.limb = LimbEvaluation(t.choice("limb", kLimbNames, int(r.limb)));
-  r.tile_format = TileFormat(t.choice("tile_format", kTileFormatNames, int(r.tile_format)));
-  t.integer("tile_resolution", r.tile_resolution, 0, 1024);
-  t.integer("tessellation", r.tessellation, 0, 256);
-  if (std::string error = validateRenderSettings(r); !error.empty())
-    t.failAt(error.substr(0, error.find(':')), error.substr(error.find(':') + 2));
-  t.number("impostor_tolerance", r.impostor_tolerance_px, 0.0, 100.0);
-  t.number("volume_step", r.volume_step, 0.25, 8.0);
-  t.number("heap_range", r.heaps.range_m, Limits::kHeapRange);
-  t.number("heap_detail", r.heaps.detail_px, Limits::kHeapDetail);
-  t.number("ellipsoid_budget", r.ellipsoid_budget, Limits::kEllipsoidBudget);
-  t.number("ellipsoid_overdraw", r.ellipsoid_overdraw, Limits::kEllipsoidOverdraw);
-  t.integer("heap_shading_rate", r.heap_shading_rate, int(Limits::kHeapShadingRate.lo),
-            int(Limits::kHeapShadingRate.hi));
-  t.integer("heap_refresh", r.heap_refresh, int(Limits::kHeapRefresh.lo),
-            int(Limits::kHeapRefresh.hi));
-  t.integer("shadow_map_size", r.shadow_map_size, 0, int(Limits::kShadowMapSize.hi));
-  t.boolean("plane_shadows", r.plane_shadows);
-  t.integer("sea_waves", r.sea_waves, int(Limits::kSeaWaves.lo), int(Limits::kSeaWaves.hi));
-  t.number("sea_probe_scale", r.sea_probe_scale, Limits::kSeaProbeScale);
-  if (std::string error = validateRenderSettings(r); !error.empty())
-    t.failAt(error.substr(0, error.find(':')), error.substr(error.find(':') + 2));
-  out.reference.heaps = r.heaps;          // both renderers draw the same heaps
-  out.reference.sea_waves = r.sea_waves;  // and the same sea
+  out.reference.heaps = out.render.heaps;          // both renderers draw the same heaps
+  out.reference.sea_waves = out.render.sea_waves;  // and the same sea
   t.finish();
 }
 
@@ -782,44 +747,6 @@ std::string loadSceneFile(const std::string& path, SceneFile& out) {
   if (std::string error = config_detail::readTextFile(path, "scene file", text); !error.empty())
     return error;
   return parseSceneText(text, path, out);
-}
-
-std::string validateRenderSettings(const RenderSettings& r) {
-  if (r.tile_resolution != 0 && (r.tile_resolution < 8 || r.tile_resolution > 1024 ||
-                                 (r.tile_resolution & (r.tile_resolution - 1)) != 0))
-    return "tile_resolution: " + std::to_string(r.tile_resolution) +
-           " is not allowed (allowed: 0 for adaptive, or a power of two from 8 to 1024)";
-  if (r.tessellation != 0 && (r.tessellation < 3 || r.tessellation > 256))
-    return "tessellation: " + std::to_string(r.tessellation) +
-           " is not allowed (allowed: 0 for adaptive, or 3 to 256)";
-  if (!(r.impostor_tolerance_px >= 0.0 && r.impostor_tolerance_px <= 100.0))
-    return "impostor_tolerance: " + formatNumber(r.impostor_tolerance_px) +
-           " is out of range (allowed: 0 to 100 pixels)";
-  if (std::ostringstream out; outOfRange(out, "heap_range", r.heaps.range_m, Limits::kHeapRange))
-    return out.str() + " metres; 0 is 40 km plus twice the height";
-  if (std::ostringstream out;
-      outOfRange(out, "heap_detail", r.heaps.detail_px, Limits::kHeapDetail))
-    return out.str() + " pixels of a heap's radius; 0 draws every lobe";
-  if (std::ostringstream out;
-      outOfRange(out, "ellipsoid_budget", r.ellipsoid_budget, Limits::kEllipsoidBudget))
-    return out.str() + " ellipsoids; 0 draws every one";
-  if (std::ostringstream out;
-      outOfRange(out, "ellipsoid_overdraw", r.ellipsoid_overdraw, Limits::kEllipsoidOverdraw))
-    return out.str() + " views of footprint; 0 is no bound";
-  if (r.heap_shading_rate != 1 && r.heap_shading_rate != 2 && r.heap_shading_rate != 4)
-    return "heap_shading_rate: " + std::to_string(r.heap_shading_rate) +
-           " is not allowed (allowed: 1, 2 or 4 pixels between samples)";
-  if (r.heap_refresh != 1 && r.heap_refresh != 4 && r.heap_refresh != 16)
-    return "heap_refresh: " + std::to_string(r.heap_refresh) +
-           " is not allowed (allowed: 1, 4 or 16, one pixel in that many walked anew a frame)";
-  if (r.shadow_map_size != 0 && !(r.shadow_map_size >= Limits::kShadowMapSize.lo &&
-                                  r.shadow_map_size <= Limits::kShadowMapSize.hi))
-    return "shadow_map_size: " + std::to_string(r.shadow_map_size) +
-           " is out of range (allowed: 0 for no cloud shadows, or 256 to 4096 texels a side)";
-  if (!(r.volume_step >= 0.25 && r.volume_step <= 8.0))
-    return "volume_step: " + formatNumber(r.volume_step) +
-           " is out of range (allowed: 0.25 to 8 lattice spacings)";
-  return "";
 }
 
 std::string validateCamera(const Camera& c) {

@@ -7,6 +7,7 @@
 
 #include <nlohmann/json_fwd.hpp>
 
+#include "renderer/render_knobs.h"
 #include "renderer/render_settings.h"
 #include "world/limits.h"
 #include "world/scene.h"
@@ -21,14 +22,8 @@ struct SceneFile {
   ReferenceSettings reference;
 };
 
-// Names of the render knobs in enum order, shared by scene files and the command line.
-inline const std::vector<std::string> kTextureEvaluationNames{"auto", "baked", "procedural"};
-inline const std::vector<std::string> kTermFilterNames{"fade", "cut", "none"};
-inline const std::vector<std::string> kSkyPassesNames{"fused", "multipass"};
-inline const std::vector<std::string> kEllipsoidPassesNames{"fused", "multipass"};
-inline const std::vector<std::string> kEllipsoidOrderNames{"centre", "per-pixel"};
-inline const std::vector<std::string> kLimbNames{"exact", "spotlight"};
-inline const std::vector<std::string> kTileFormatNames{"rgba8", "float"};
+// Names of an automaton cloud's phase functions in enum order. The render knobs' names are
+// in their table (renderer/render_knobs.inc).
 inline const std::vector<std::string> kPhaseFunctionNames{"rayleigh", "cornette-shanks"};
 
 // Position of `name` in `names`, or -1.
@@ -58,10 +53,6 @@ void readTarget(config_detail::TableReader& t, const std::string& path, Target& 
 // allowed.
 std::string parseTargetJson(const nlohmann::json& target, const std::vector<EntityType>& types,
                             Target& out);
-
-// Checks the render knobs whose allowed values are not a plain range: "key: what is wrong
-// (allowed: ...)", or empty when valid.
-std::string validateRenderSettings(const RenderSettings& settings);
 
 // Checks a camera after command-line overrides; empty string when valid.
 std::string validateCamera(const Camera& camera);

@@ -68,6 +68,25 @@ class TableReader {
     out = int(toInteger(*node, key, lo, hi));
   }
 
+  // A number (an integer where `integer`) for the caller's own check; absent: nothing.
+  // `allowed` completes the message of a value of another type.
+  std::optional<double> numberToCheck(std::string_view key, bool integer,
+                                      const std::string& allowed) {
+    const toml::node* node = take(key);
+    if (!node) return std::nullopt;
+    if (integer ? !node->is_integer() : !node->is_number())
+      fail(*node, key,
+           std::string(integer ? "must be an integer" : "must be a number") +
+               " (allowed: " + allowed + ")");
+    if (const auto* i = node->as_integer()) {
+      if (!heldExactly(i->get()))
+        fail(*node, key,
+             std::to_string(i->get()) + " cannot be held exactly (allowed: " + allowed + ")");
+      return double(i->get());
+    }
+    return node->as_floating_point()->get();
+  }
+
   void seed(std::string_view key, std::uint64_t& out) {
     const toml::node* node = take(key);
     if (!node) return;

@@ -165,6 +165,23 @@ TEST_F(RenderCommandTest, BadFlagsAreRejected) {
   EXPECT_TRUE(std::filesystem::is_empty(dir_));
 }
 
+// Every render knob has a flag (renderer/render_knobs.inc), checked as the scene file's key.
+TEST_F(RenderCommandTest, EveryRenderKnobHasAFlagCheckedAsInSceneFiles) {
+  const std::string preset = NEPHELE_SOURCE_DIR "/config/scenes/cumulus.toml";
+  CommandResult run = runNephele("render " + preset + " -o " + path("out.png") +
+                                 " --width 32 --height 24 --plane-shadows false"
+                                 " --shadow-map-size 256 --sea-probe-scale 0.25 --heap-refresh 16");
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  run = runNephele("render " + preset + " -o " + path("bad.png") + " --heap-refresh 3");
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_THAT(run.output,
+              HasSubstr("command line: heap_refresh: 3 is not allowed (allowed: 1, 4 or 16)"));
+  run = runNephele("render " + preset + " -o " + path("bad.png") + " --sea-waves many");
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_THAT(run.output, HasSubstr("sea_waves: 'many' is not an integer (allowed: 16 to 128)"));
+  EXPECT_FALSE(std::filesystem::exists(path("bad.png")));
+}
+
 TEST_F(RenderCommandTest, RendersACloudWithATargetFromItsMesh) {
   const CommandResult run =
       runNephele("render " NEPHELE_SOURCE_DIR "/config/scenes/cumulus_target.toml -o " +

@@ -324,7 +324,8 @@ TEST(SceneFile, BadTargetsAndKnobsAreRejected) {
   EXPECT_THAT(parseError("[render]\nellipsoid_order = \"random\"\n"),
               HasSubstr("(one of: centre, per-pixel)"));
   EXPECT_THAT(parseError("[render]\nheap_detail = -1\n"),
-              HasSubstr("render.heap_detail: -1 is out of range (allowed: 0 to 10000)"));
+              HasSubstr("render.heap_detail: -1 is out of range (allowed: 0 to 10000 pixels; 0 "
+                        "draws every lobe)"));
   EXPECT_THAT(parseError("[render]\nheap_refresh = 8\n"),
               HasSubstr("render.heap_refresh: 8 is not allowed (allowed: 1, 4 or 16"));
   EXPECT_THAT(parseError("[render]\nheap_refresh = 0\n"), HasSubstr("render.heap_refresh"));
@@ -497,7 +498,8 @@ TEST(SceneFile, BadWindDevelopmentAndAutomataAreRejected) {
                          "times = [0.0]\nt0 = [1.0]\n"),
               HasSubstr("t0: applies to texture source \"gardner\" only"));
   EXPECT_THAT(parseError("[render]\nvolume_step = 0.1\n"),
-              HasSubstr("render.volume_step: 0.1 is out of range (allowed: 0.25 to 8)"));
+              HasSubstr("render.volume_step: 0.1 is out of range (allowed: 0.25 to 8 lattice "
+                        "spacings)"));
   // A failed parse leaves the output as it was.
   SceneFile kept;
   kept.scene.seed = 12345;

@@ -105,23 +105,17 @@ struct Limits {
   static constexpr Range kRegionSize{1.0, 2.0e7};      // full extent along each axis
   static constexpr Range kRegionBand{0.0, 1.0e7};      // edge and front transition widths
   static constexpr Range kClusterVariation{0.0, 1.0};  // per-cluster spread of cover, height
-  static constexpr Range kHeapRange{0.0, 1.0e6};       // heaps as ellipsoids this far; 0 automatic
-  static constexpr Range kHeapDetail{0.0, 1.0e4};      // every lobe of heaps this many pixels wide
-  // The heaps' shading rate (`heap_shading_rate`: 1, 2 or 4 pixels between samples).
-  static constexpr Range kHeapShadingRate{1.0, 4.0};
-  // A continuous view's heaps: one pixel in `heap_refresh` (1, 4 or 16) walked anew a frame.
-  static constexpr Range kHeapRefresh{1.0, 16.0};
-  // The ground's shadow map, texels a side (`shadow_map_size`; 0: no cloud shadows).
-  static constexpr Range kShadowMapSize{256.0, 4096.0};
-  // The sea's sines (`sea_waves`) and its probe's width over the view's (`sea_probe_scale`).
+  // The heaps' drawing by distance (HeapDrawing, world/formations/cloud_field.h), which scene
+  // files' render knobs `heap_range` and `heap_detail` (renderer/render_knobs.inc) and
+  // dataset files both set: heaps as ellipsoids this far (0 automatic), and every lobe of
+  // heaps this many pixels wide.
+  static constexpr Range kHeapRange{0.0, 1.0e6};
+  static constexpr Range kHeapDetail{0.0, 1.0e4};
+  // The sea's sines (`sea_waves`) and its probe's width over the view's (`sea_probe_scale`),
+  // render knobs that bench/sea_bench sweeps too. The other render knobs' ranges are in their
+  // rows alone.
   static constexpr Range kSeaWaves{16.0, 128.0};
   static constexpr Range kSeaProbeScale{0.25, 2.0};
-  // Ellipsoids a GL frame draws, those of largest projected size (`ellipsoid_budget`; 0: no
-  // budget), at most what a world may hold.
-  static constexpr Range kEllipsoidBudget{0.0, double(kMaxWorldEllipsoids)};
-  // Views that the footprints of the ellipsoids a frame draws may cover (`ellipsoid_overdraw`;
-  // 0: no bound).
-  static constexpr Range kEllipsoidOverdraw{0.0, 65536.0};
 
   // Datasets (dataset/dataset.h).
   static constexpr int kMaxSamples = 100000000;
