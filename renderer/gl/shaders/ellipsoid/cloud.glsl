@@ -1,5 +1,3 @@
-
-const float kPi = 3.14159265358979;
 const float kHalfPi = 1.5707963267948966;
 uniform vec3 u_cloud_colour;  // cloud colour times sun colour
 uniform vec4 u_shading;       // Gardner eq. 8: ambient a, texture t, specular s, shininess e
@@ -167,10 +165,7 @@ vec3 surfaceColour(int i, vec3 n, vec3 r, vec3 p, float it, float tr, float dist
   float sun = light.x;
   float highlight = 0.0;
 #ifdef SPECULAR
-  if (n_dot_l > 0.0) {
-    vec3 reflected = 2.0 * n_dot_l * n - u_to_sun;
-    highlight = pow(max(dot(reflected, -normalize(r)), 0.0), u_shading.w);
-  }
+  if (n_dot_l > 0.0) highlight = phongHighlight(n, n_dot_l, u_to_sun, -normalize(r), u_shading.w);
 #endif
   float intensity = gardnerIntensity(u_shading, sun * diffuse, sun * highlight, it) +
                     u_shading.x * (light.y - 1.0);
@@ -193,7 +188,7 @@ vec4 ellipsoidSurface(int i, vec3 r, float s) {
   vec3 dpdx = s * (drx - r * (dot(n, drx) / n_dot_r));
   vec3 dpdy = s * (dry - r * (dot(n, dry) / n_dot_r));
   float it = solidValue(p, dpdx, dpdy);
-  float excess = it - u_thresholds.x - (u_thresholds.y - u_thresholds.x) * (1.0 - limbG(i, r));
+  float excess = limbExcess(it, u_thresholds.x, u_thresholds.y, limbG(i, r));
   float opacity = opacityFromExcess(excess);
   float alpha = opacity * record(i, 4).w;
   return vec4(surfaceColour(i, n, r, p, it, 1.0 - opacity, s * length(r)) * alpha, alpha);
