@@ -16,6 +16,7 @@
 #include "renderer/gl/gl_objects.h"
 #include "renderer/gl/shaders/formulas_glsl.h"
 #include "world/formulas/air.h"
+#include "world/formulas/ellipsoid.h"
 #include "world/formulas/sea.h"
 #include "world/formulas/shading.h"
 
@@ -67,15 +68,21 @@ struct Case {
 class Cases {
  public:
   // `formula` on `args` (rounded to float) in C++, and the GLSL call of `name` on them; the
-  // case's scale is max(|value|, floor).
-  template <typename... Args>
-  void add(const std::string& name, double (*formula)(Args...), double floor,
+  // case's scale is max(|value|, floor). A vector result gives a case for each component.
+  template <typename Result, typename... Args>
+  void add(const std::string& name, Result (*formula)(Args...), double floor,
            std::type_identity_t<Args>... args) {
-    const double cpu = formula(toFloat(args)...);
+    const Result cpu = formula(toFloat(args)...);
     std::string call = name + "(";
     bool first = true;
     ((call += (first ? "" : ", ") + glslArg(args), first = false), ...);
-    list_.push_back({call + ")", cpu, std::max(std::abs(cpu), floor)});
+    call += ")";
+    if constexpr (std::is_same_v<Result, double>) {
+      list_.push_back({call, cpu, std::max(std::abs(cpu), floor)});
+    } else {
+      for (int i = 0; i < Result::length(); ++i)
+        list_.push_back({call + "." + "xyzw"[i], cpu[i], std::max(std::abs(cpu[i]), floor)});
+    }
   }
   const std::vector<Case>& all() const { return list_; }
 
@@ -90,6 +97,7 @@ std::string fragmentSource(const std::vector<Case>& cases) {
   s += glsl::formulas::kAir;
   s += glsl::formulas::kShading;
   s += glsl::formulas::kSea;
+  s += glsl::formulas::kEllipsoid;
   s += "uniform float u_one;\nlayout(location = 0) out vec4 o_value;\nvoid main() {\n";
   s += "  float v = 0.0;\n  switch (int(gl_FragCoord.x)) {\n";
   for (std::size_t i = 0; i < cases.size(); ++i)
@@ -272,6 +280,37 @@ TEST_F(SharedFormulaTest, SeaOpticsAgree) {
                                              toFloat(n), toFloat(slope_var));
         cases.add("glintRadiance", &f::glintRadiance, peak, d, sun, n, slope_var);
       }
+  expectAgree(cases);
+}
+
+TEST_F(SharedFormulaTest, EllipsoidAgrees) {
+  Cases cases;
+  // The eye near, far (1e4 radii: the difference of squares would lose every digit in float)
+  // and level with the ellipsoid; rays through the middle, grazing, missing and turned away.
+  const glm::dvec3 eyes[] = {{0.0, -3.0, 0.5}, {2.0, -1.0e4, 300.0}, {-1.5, 0.2, 0.0}};
+  for (const glm::dvec3& o : eyes) {
+    const double c = glm::dot(o, o) - 1.0;
+    const glm::dvec3 to_centre = -o / glm::length(o);
+    const glm::dvec3 across = glm::normalize(glm::cross(to_centre, glm::dvec3(0.3, 0.2, 1.0)));
+    const double edge = 1.0 / glm::length(o);  // the tangent's offset per unit along
+    for (double offset : {0.0, 0.5 * edge, 0.99 * edge, 1.01 * edge, 3.0 * edge}) {
+      for (double length : {1.0, 250.0}) {
+        const glm::dvec3 w = length * (to_centre + offset * across);
+        const double delta = f::quarterDelta(toFloat(o), toFloat(w));
+        cases.add("quarterDelta", &f::quarterDelta, glm::dot(w, w), o, w);
+        if (delta > 1e-3 * glm::dot(w, w))
+          cases.add("unitSphereRoots", &f::unitSphereRoots, glm::length(o) / length, o, w, c,
+                    delta);
+      }
+    }
+  }
+  // The limb function of a sphere seen from 3 radii along -y: axis +y, P = (I - a a^T) / 8.
+  const glm::dvec3 axis(0.0, 1.0, 0.0);
+  const glm::dvec3 p0(1.0 / 8.0, 0.0, 0.0), p1(0.0, 0.0, 0.0), p2(0.0, 0.0, 1.0 / 8.0);
+  for (const glm::dvec3& d :
+       {glm::dvec3(0.0, 1.0, 0.0), glm::dvec3(0.1, 1.0, -0.2), glm::dvec3(0.35, 1.0, 0.0),
+        glm::dvec3(0.5, 1.0, 0.3), glm::dvec3(0.0, -1.0, 0.0), glm::dvec3(1.0, 0.0, 0.0)})
+    cases.add("limbFunction", &f::limbFunction, 1.0, d, axis, p0, p1, p2);
   expectAgree(cases);
 }
 

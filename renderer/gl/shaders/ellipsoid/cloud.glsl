@@ -18,16 +18,13 @@ vec3 gradientFromUnit(int i, vec3 u) {
 }
 
 // Nearest root s of |o + s W r| = 1, in units of r; negative when the ellipsoid is missed or
-// lies behind the eye. Delta / 4 = |w|^2 - |o x w|^2 keeps far ellipsoids exact.
+// lies behind the eye (world/formulas/ellipsoid.h).
 float hitEllipsoid(int i, vec3 r) {
   vec3 w = toUnit(i, r), o = record(i, 3).xyz;
-  float a = dot(w, w);
-  vec3 c = cross(o, w);
-  float quarter_delta = a - dot(c, c);
+  float quarter_delta = quarterDelta(o, w);
   if (quarter_delta <= 0.0) return -1.0;
-  float half_b = dot(o, w);
-  float q = -(half_b + (half_b >= 0.0 ? 1.0 : -1.0) * sqrt(quarter_delta));
-  return min(q / a, record(i, 3).w / q);
+  vec2 s = unitSphereRoots(o, w, record(i, 3).w, quarter_delta);
+  return min(s.x, s.y);
 }
 
 #ifdef SPOTLIGHT
@@ -36,17 +33,16 @@ layout(binding = 10) uniform sampler2D u_spotlight;  // 1 - rho^2 over [-1, 1]^2
 
 // The limb function g (MODEL.md section 4) for view direction d.
 float limbG(int i, vec3 d) {
+#ifdef SPOTLIGHT
+  // Elinas: a radial texture projected from the eye along the cone's axis.
   vec3 a = record(i, 4).xyz;
   float along = dot(d, a);
   if (along <= 0.0) return 0.0;
   vec3 q = d / along - a;
-#ifdef SPOTLIGHT
-  // Elinas: a radial texture projected from the eye along the cone's axis.
   vec2 st = vec2(dot(record(i, 8).xyz, q), dot(record(i, 9).xyz, q));
   return textureLod(u_spotlight, 0.5 + 0.5 * st, 0.0).r;
 #else
-  vec3 pq = vec3(dot(record(i, 5).xyz, q), dot(record(i, 6).xyz, q), dot(record(i, 7).xyz, q));
-  return clamp(1.0 - dot(q, pq), 0.0, 1.0);
+  return limbFunction(d, record(i, 4).xyz, record(i, 5).xyz, record(i, 6).xyz, record(i, 7).xyz);
 #endif
 }
 
