@@ -304,6 +304,12 @@ TEST_F(SharedFormulaTest, EllipsoidAgrees) {
       }
     }
   }
+  // Chords from inside, on and outside the unit sphere, along, across and away from it.
+  for (const glm::dvec3& o : {glm::dvec3(0.0), glm::dvec3(0.6, 0.0, 0.8),
+                              glm::dvec3(0.2, -0.3, 0.1), glm::dvec3(0.0, -2.5, 0.0)})
+    for (const glm::dvec3& w : {glm::dvec3(0.0, 1.0, 0.0), glm::dvec3(0.0, 0.0, 0.4),
+                                glm::dvec3(-0.6, 0.0, -0.8), glm::dvec3(1.0, 0.0, 0.0)})
+      cases.add("unitSphereChord", &f::unitSphereChord, 2.0 / glm::length(w), o, w);
   // The limb function of a sphere seen from 3 radii along -y: axis +y, P = (I - a a^T) / 8.
   const glm::dvec3 axis(0.0, 1.0, 0.0);
   const glm::dvec3 p0(1.0 / 8.0, 0.0, 0.0), p1(0.0, 0.0, 0.0), p2(0.0, 0.0, 1.0 / 8.0);

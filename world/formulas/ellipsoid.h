@@ -1,7 +1,8 @@
 // An ellipsoid seen from the eye (MODEL.md section 4), in the unit-sphere space of its body:
 // the eye at o, a view ray's direction at w (W times the world direction, any length), and
-// c = |o|^2 - 1. Shared by world/formations/ellipsoid.cpp (EllipsoidView) and the GL
-// renderer's renderer/gl/shaders/ellipsoid/cloud.glsl (see prelude.h).
+// c = |o|^2 - 1. Shared by world/formations/ellipsoid.cpp (EllipsoidView), heap_light.cpp
+// (envelopeChord) and the GL renderer's renderer/gl/shaders/ellipsoid/cloud.glsl (see
+// prelude.h).
 #ifdef __cplusplus
 #pragma once
 #include "world/formulas/prelude.h"
@@ -23,6 +24,17 @@ FORMULA vec2 unitSphereRoots(vec3 o, vec3 w, real c, real quarter_delta) {
   real half_b = dot(o, w);
   real q = -(half_b + (half_b >= 0.0 ? 1.0 : -1.0) * sqrt(quarter_delta));
   return vec2(q / dot(w, w), c / q);
+}
+
+// The length of the ray o + s w, s >= 0, inside the unit sphere, in units of w: a heap's
+// envelope seen from a point of its surface (envelopeChord, MODEL.md section 14), o and w
+// the point and the direction in the envelope's unit-sphere space. 0 where the ray misses.
+FORMULA real unitSphereChord(vec3 o, vec3 w) {
+  real a = dot(w, w), half_b = dot(o, w), c = dot(o, o) - 1.0;
+  real quarter_delta = half_b * half_b - a * c;
+  if (!(quarter_delta > 0.0) || !(a > 0.0)) return 0.0;
+  real root = sqrt(quarter_delta);
+  return max(0.0, (-half_b + root) / a - max((-half_b - root) / a, 0.0));
 }
 
 // Gardner's limb function g (MODEL.md section 4) along view direction d: 1 - q^T P q with

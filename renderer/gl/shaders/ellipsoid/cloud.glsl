@@ -120,12 +120,7 @@ float forwardScattered(float sun, float c) {
 // camera-relative (envelopeChord).
 float envelopeChord(int i, vec3 p, vec3 v) {
   vec3 inv = record(i, 18).xyz;
-  vec3 o = (p - record(i, 17).xyz) * inv, w = v * inv;
-  float a = dot(w, w), half_b = dot(o, w), c = dot(o, o) - 1.0;
-  float quarter_delta = half_b * half_b - a * c;
-  if (quarter_delta <= 0.0 || a <= 0.0) return 0.0;
-  float root = sqrt(quarter_delta);
-  return max(0.0, (-half_b + root) / a - max((-half_b - root) / a, 0.0));
+  return unitSphereChord((p - record(i, 17).xyz) * inv, v * inv);
 }
 
 // Two-stream transmittance of optical depth tau (diffuseTransmittance), asymmetry g.
