@@ -187,8 +187,8 @@ vec3 groundColour(vec3 d) {
 
 #ifdef SEA
 // The sea (MODEL.md section 18): its optics are world/formulas/sea.h's, as in world/sea.cpp;
-// the waves are summed as SeaSurface::sample sums them, with gardnerSin and the footprint's
-// weight in place of the reference's sin and waveResolved.
+// the waves' slopes are summed as SeaSurface::sample sums them, with gardnerSin in place of
+// sin and cos.
 // The surface's sines, longest first: wave vector (rad/m), amplitude, and the phase at the
 // camera's ground point now (mod 2 pi, in double on the CPU).
 uniform vec4 u_wave[kSeaWaves];
