@@ -6,6 +6,7 @@
 
 #include "world/counter_random.h"
 #include "world/formations/cloud_shadow.h"
+#include "world/formulas/sea.h"
 
 namespace nephele {
 namespace {
@@ -56,10 +57,6 @@ double spreadAngle(double u) {
     theta = std::clamp(theta, -0.5 * kPi, 0.5 * kPi);
   }
   return theta;
-}
-
-double logistic(double x) {
-  return 1.0 / (1.0 + std::exp(-x));
 }
 
 }  // namespace
@@ -192,12 +189,7 @@ SeaSample SeaSurface::sample(glm::dvec2 xy, double time_s, double footprint_m) c
 }
 
 double fresnelWater(double cos_incidence, double n) {
-  // Unpolarised, for a dielectric of index n from air (Born and Wolf).
-  const double c = std::clamp(cos_incidence, 0.0, 1.0);
-  const double g = std::sqrt(n * n - 1.0 + c * c);
-  const double a = (g - c) / (g + c);
-  const double b = (c * (g + c) - 1.0) / (c * (g - c) + 1.0);
-  return 0.5 * a * a * (1.0 + b * b);
+  return formulas::fresnelWater(cos_incidence, n);
 }
 
 glm::dvec3 waterBodyColour(double clarity) {
@@ -209,28 +201,12 @@ glm::dvec3 waterBodyColour(double clarity) {
 
 double foamShare(double whitecap_fraction, double foam_steepness, double steepness,
                  double var_total, double var_unresolved) {
-  if (!(whitecap_fraction > 0.0)) return 0.0;
-  if (whitecap_fraction >= 1.0) return 1.0;
-  const double resolved =
-      var_total > 0.0 ? std::clamp(1.0 - var_unresolved / var_total, 0.0, 1.0) : 0.0;
-  const double edge = std::sqrt(std::max(var_unresolved, 1e-4 * var_total + 1e-12));
-  const double crest = logistic(1.702 * (steepness - foam_steepness) / edge);
-  return (1.0 - resolved) * whitecap_fraction + resolved * crest;
+  return formulas::foamShare(whitecap_fraction, foam_steepness, steepness, var_total,
+                             var_unresolved);
 }
 
 double glintRadiance(glm::dvec3 d, glm::dvec3 sun, glm::dvec3 normal, double slope_var) {
-  const glm::dvec3 v = -d;
-  const double mu_v = glm::dot(v, normal), mu_s = glm::dot(sun, normal);
-  if (!(mu_v > 0.0) || !(mu_s > 0.0)) return 0.0;
-  const glm::dvec3 h = glm::normalize(v + sun);
-  const double mu_n = glm::dot(h, normal);
-  if (!(mu_n > 0.0)) return 0.0;
-  const double tan2 = (1.0 - mu_n * mu_n) / (mu_n * mu_n);
-  // L = E F p / (4 mu_v mu_n^4), p = exp(-tan^2 beta / s^2) / (pi s^2), E = pi (a unit
-  // diffuser facing the sun shows 1).
-  const double mu_n2 = mu_n * mu_n;
-  return fresnelWater(glm::dot(v, h)) * std::exp(-tan2 / slope_var) /
-         (4.0 * slope_var * std::max(mu_v, 1e-2) * mu_n2 * mu_n2);
+  return formulas::glintRadiance(d, sun, normal, slope_var);
 }
 
 SeaShading shadeSea(const SeaSurface& surface, const Sea& sea, const SeaSample& s, glm::dvec3 d,

@@ -2,8 +2,9 @@
 // The sea surface (docs/MODEL.md section 18): waves from an ocean spectrum for the wind, with
 // a host's wave trains laid over it, shaded by Fresnel reflection of the sky and clouds, the
 // sun's glint from Cox and Munk's facet slopes, Monahan's whitecaps and the water's own
-// colour. world/ only: no GL. Both renderers evaluate it through the functions below (the GL
-// through their GLSL copies in renderer/gl/shaders/sky/common.glsl).
+// colour. world/ only: no GL. Both renderers evaluate it through the functions below, whose
+// optics (Fresnel, foam, glint) are written once in world/formulas/sea.h for the reference and
+// the GL shaders alike.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>

@@ -72,7 +72,8 @@ std::string slotStatement(int slot, LayerKind kind) {
 std::string commonSource() {
   return "const int kPrecipitationSlabs = " + std::to_string(kPrecipitationSlabs) +
          ";\nconst int kRainShafts = " + std::to_string(kMaxRainShafts) + ";\n" +
-         glsl::formulas::kPrelude + glsl::formulas::kAir + kCommon;
+         glsl::formulas::kPrelude + glsl::formulas::kAir + glsl::formulas::kShading +
+         glsl::formulas::kSea + glsl::formulas::kEllipsoid + kCommon;
 }
 
 }  // namespace

@@ -5,6 +5,8 @@
 #include <sstream>
 #include <utility>
 
+#include "world/formulas/ellipsoid.h"
+
 namespace nephele {
 
 std::string ellipsoidError(const Ellipsoid& e) {
@@ -104,24 +106,19 @@ EllipsoidView::EllipsoidView(const Ellipsoid& ellipsoid, glm::dvec3 eye)
 
 std::optional<RaySpan> EllipsoidView::intersect(glm::dvec3 direction) const {
   const glm::dvec3 w = to_unit_ * direction;
-  const double a = glm::dot(w, w);
-  if (!(a > 0.0)) return std::nullopt;
-  // Delta / 4 = (o.w)^2 - |w|^2 (|o|^2 - 1) = |w|^2 - |o x w|^2, free of cancellation far away.
-  const glm::dvec3 cross = glm::cross(eye_unit_, w);
-  const double quarter_delta = a - glm::dot(cross, cross);
+  if (!(glm::dot(w, w) > 0.0)) return std::nullopt;
+  const double quarter_delta = formulas::quarterDelta(eye_unit_, w);
   if (!(quarter_delta > 0.0)) return std::nullopt;
-  const double half_b = glm::dot(eye_unit_, w);
-  const double q = -(half_b + std::copysign(std::sqrt(quarter_delta), half_b));
-  const double s1 = q / a, s2 = c_ / q;
-  return RaySpan{std::min(s1, s2), std::max(s1, s2)};
+  const glm::dvec2 s = formulas::unitSphereRoots(eye_unit_, w, c_, quarter_delta);
+  return RaySpan{std::min(s.x, s.y), std::max(s.x, s.y)};
 }
 
 double EllipsoidView::limb(glm::dvec3 direction) const {
   if (eyeInside()) return 0.0;
-  const double along = glm::dot(direction, axis_);
-  if (!(along > 0.0)) return 0.0;
-  const glm::dvec3 q = direction / along - axis_;
-  return std::clamp(1.0 - glm::dot(q, limb_form_ * q), 0.0, 1.0);
+  const glm::dmat3& p = limb_form_;  // its rows
+  return formulas::limbFunction(direction, axis_, glm::dvec3(p[0][0], p[1][0], p[2][0]),
+                                glm::dvec3(p[0][1], p[1][1], p[2][1]),
+                                glm::dvec3(p[0][2], p[1][2], p[2][2]));
 }
 
 glm::dvec3 EllipsoidView::normalAt(glm::dvec3 direction, double s) const {

@@ -9,6 +9,7 @@
 #include <glm/gtc/matrix_access.hpp>
 
 #include "world/automaton/cloud_density.h"
+#include "world/formulas/ellipsoid.h"
 
 namespace nephele {
 namespace {
@@ -117,13 +118,7 @@ std::vector<HeapEnvelope> heapEnvelopes(const EllipsoidCloud& cloud) {
 }
 
 double envelopeChord(const HeapEnvelope& envelope, glm::dvec3 p, glm::dvec3 dir) {
-  const glm::dvec3 o = (p - envelope.centre) / envelope.radii, d = dir / envelope.radii;
-  const double a = glm::dot(d, d), half_b = glm::dot(o, d), c = glm::dot(o, o) - 1.0;
-  const double quarter_delta = half_b * half_b - a * c;
-  if (!(quarter_delta > 0.0) || !(a > 0.0)) return 0.0;
-  const double root = std::sqrt(quarter_delta);
-  const double near = (-half_b - root) / a, far = (-half_b + root) / a;
-  return std::max(0.0, far - std::max(near, 0.0));
+  return formulas::unitSphereChord((p - envelope.centre) / envelope.radii, dir / envelope.radii);
 }
 
 HeapLight heapLightAt(const HeapEnvelope& envelope, glm::dvec3 p, glm::dvec3 normal,

@@ -55,7 +55,10 @@ endfunction()
 set(NEPHELE_FORMULA_DIR ${PROJECT_SOURCE_DIR}/world/formulas)
 nephele_embed_glsl(nephele_renderer formulas_glsl.h formulas
   kPrelude ${NEPHELE_FORMULA_DIR}/prelude.h  # real, FORMULA
-  kAir ${NEPHELE_FORMULA_DIR}/air.h)         # slabs, haze, shafts
+  kAir ${NEPHELE_FORMULA_DIR}/air.h          # slabs, haze, shafts
+  kShading ${NEPHELE_FORMULA_DIR}/shading.h  # Gardner eq. 8, 9, 11, far heaps' diffuse
+  kSea ${NEPHELE_FORMULA_DIR}/sea.h          # Fresnel, foam, glint
+  kEllipsoid ${NEPHELE_FORMULA_DIR}/ellipsoid.h)  # ray hit, limb function
 nephele_embed_glsl(nephele_renderer sky_glsl.h sky
   kCommon sky/common.glsl             # the view, output, air, background and targets
   kLayers sky/layers.glsl             # textured cloud layers

@@ -1,5 +1,3 @@
-
-const float kPi = 3.14159265358979;
 const float kHalfPi = 1.5707963267948966;
 uniform vec3 u_cloud_colour;  // cloud colour times sun colour
 uniform vec4 u_shading;       // Gardner eq. 8: ambient a, texture t, specular s, shininess e
@@ -20,16 +18,13 @@ vec3 gradientFromUnit(int i, vec3 u) {
 }
 
 // Nearest root s of |o + s W r| = 1, in units of r; negative when the ellipsoid is missed or
-// lies behind the eye. Delta / 4 = |w|^2 - |o x w|^2 keeps far ellipsoids exact.
+// lies behind the eye (world/formulas/ellipsoid.h).
 float hitEllipsoid(int i, vec3 r) {
   vec3 w = toUnit(i, r), o = record(i, 3).xyz;
-  float a = dot(w, w);
-  vec3 c = cross(o, w);
-  float quarter_delta = a - dot(c, c);
+  float quarter_delta = quarterDelta(o, w);
   if (quarter_delta <= 0.0) return -1.0;
-  float half_b = dot(o, w);
-  float q = -(half_b + (half_b >= 0.0 ? 1.0 : -1.0) * sqrt(quarter_delta));
-  return min(q / a, record(i, 3).w / q);
+  vec2 s = unitSphereRoots(o, w, record(i, 3).w, quarter_delta);
+  return min(s.x, s.y);
 }
 
 #ifdef SPOTLIGHT
@@ -38,17 +33,16 @@ layout(binding = 10) uniform sampler2D u_spotlight;  // 1 - rho^2 over [-1, 1]^2
 
 // The limb function g (MODEL.md section 4) for view direction d.
 float limbG(int i, vec3 d) {
+#ifdef SPOTLIGHT
+  // Elinas: a radial texture projected from the eye along the cone's axis.
   vec3 a = record(i, 4).xyz;
   float along = dot(d, a);
   if (along <= 0.0) return 0.0;
   vec3 q = d / along - a;
-#ifdef SPOTLIGHT
-  // Elinas: a radial texture projected from the eye along the cone's axis.
   vec2 st = vec2(dot(record(i, 8).xyz, q), dot(record(i, 9).xyz, q));
   return textureLod(u_spotlight, 0.5 + 0.5 * st, 0.0).r;
 #else
-  vec3 pq = vec3(dot(record(i, 5).xyz, q), dot(record(i, 6).xyz, q), dot(record(i, 7).xyz, q));
-  return clamp(1.0 - dot(q, pq), 0.0, 1.0);
+  return limbFunction(d, record(i, 4).xyz, record(i, 5).xyz, record(i, 6).xyz, record(i, 7).xyz);
 #endif
 }
 
@@ -126,12 +120,7 @@ float forwardScattered(float sun, float c) {
 // camera-relative (envelopeChord).
 float envelopeChord(int i, vec3 p, vec3 v) {
   vec3 inv = record(i, 18).xyz;
-  vec3 o = (p - record(i, 17).xyz) * inv, w = v * inv;
-  float a = dot(w, w), half_b = dot(o, w), c = dot(o, o) - 1.0;
-  float quarter_delta = half_b * half_b - a * c;
-  if (quarter_delta <= 0.0 || a <= 0.0) return 0.0;
-  float root = sqrt(quarter_delta);
-  return max(0.0, (-half_b + root) / a - max((-half_b - root) / a, 0.0));
+  return unitSphereChord((p - record(i, 17).xyz) * inv, v * inv);
 }
 
 // Two-stream transmittance of optical depth tau (diffuseTransmittance), asymmetry g.
@@ -167,10 +156,7 @@ vec3 surfaceColour(int i, vec3 n, vec3 r, vec3 p, float it, float tr, float dist
   float sun = light.x;
   float highlight = 0.0;
 #ifdef SPECULAR
-  if (n_dot_l > 0.0) {
-    vec3 reflected = 2.0 * n_dot_l * n - u_to_sun;
-    highlight = pow(max(dot(reflected, -normalize(r)), 0.0), u_shading.w);
-  }
+  if (n_dot_l > 0.0) highlight = phongHighlight(n, n_dot_l, u_to_sun, -normalize(r), u_shading.w);
 #endif
   float intensity = gardnerIntensity(u_shading, sun * diffuse, sun * highlight, it) +
                     u_shading.x * (light.y - 1.0);
@@ -193,7 +179,7 @@ vec4 ellipsoidSurface(int i, vec3 r, float s) {
   vec3 dpdx = s * (drx - r * (dot(n, drx) / n_dot_r));
   vec3 dpdy = s * (dry - r * (dot(n, dry) / n_dot_r));
   float it = solidValue(p, dpdx, dpdy);
-  float excess = it - u_thresholds.x - (u_thresholds.y - u_thresholds.x) * (1.0 - limbG(i, r));
+  float excess = limbExcess(it, u_thresholds.x, u_thresholds.y, limbG(i, r));
   float opacity = opacityFromExcess(excess);
   float alpha = opacity * record(i, 4).w;
   return vec4(surfaceColour(i, n, r, p, it, 1.0 - opacity, s * length(r)) * alpha, alpha);

@@ -108,18 +108,6 @@ float targetDistance() { return texelFetch(u_target_distance, ivec2(FRAG_XY), 0)
 vec3 targetColour() { return texelFetch(u_target_colour, ivec2(FRAG_XY), 0).rgb; }
 #endif
 
-// Gardner eq. 8 (MODEL.md section 3) from its terms; shading = (a, t, s, e).
-float gardnerIntensity(vec4 shading, float diffuse, float highlight, float it) {
-  float a = shading.x, t = shading.y, s = shading.z;
-  return (1.0 - a) * ((1.0 - t) * ((1.0 - s) * diffuse + s * highlight) + t * it) + a;
-}
-
-// Gardner eq. 9 and 11 (MODEL.md section 4): translucence TR for the texture's excess over
-// the threshold; D = 0 is a hard threshold.
-float translucence(float excess, float d) {
-  return d <= 0.0 ? (excess <= 0.0 ? 1.0 : 0.0) : clamp(1.0 - excess / d, 0.0, 1.0);
-}
-
 // Gardner terms a pixel resolves (MODEL.md section 2), fractional where one fades, for a
 // footprint in periods: term j (1-based) resolves while 2^j footprint <= 1/2
 // (GardnerTexture::termCountForFootprint on the CPU).
@@ -198,7 +186,9 @@ vec3 groundColour(vec3 d) {
 }
 
 #ifdef SEA
-// The sea (MODEL.md section 18); world/sea.cpp is the reference's twin, function by function.
+// The sea (MODEL.md section 18): its optics are world/formulas/sea.h's, as in world/sea.cpp;
+// the waves' slopes are summed as SeaSurface::sample sums them, with gardnerSin in place of
+// sin and cos.
 // The surface's sines, longest first: wave vector (rad/m), amplitude, and the phase at the
 // camera's ground point now (mod 2 pi, in double on the CPU).
 uniform vec4 u_wave[kSeaWaves];
@@ -220,35 +210,6 @@ uniform vec3 u_probe_up;
 uniform vec3 u_probe_forward;
 const float kSeaResolvedShare = 0.8;
 const float kFoamReflectance = 0.22;
-
-float fresnelWater(float cos_incidence) {
-  float c = clamp(cos_incidence, 0.0, 1.0), n = 1.34;
-  float g = sqrt(n * n - 1.0 + c * c);
-  float a = (g - c) / (g + c), b = (c * (g + c) - 1.0) / (c * (g - c) + 1.0);
-  return 0.5 * a * a * (1.0 + b * b);
-}
-
-float foamShare(float w, float foam_steepness, float steepness, float var_total,
-                float var_unresolved) {
-  if (!(w > 0.0)) return 0.0;
-  if (w >= 1.0) return 1.0;
-  float resolved = var_total > 0.0 ? clamp(1.0 - var_unresolved / var_total, 0.0, 1.0) : 0.0;
-  float edge = sqrt(max(var_unresolved, 1e-4 * var_total + 1e-12));
-  float crest = 1.0 / (1.0 + exp(-1.702 * (steepness - foam_steepness) / edge));
-  return (1.0 - resolved) * w + resolved * crest;
-}
-
-float glintRadiance(vec3 d, vec3 n, float slope_var) {
-  vec3 v = -d, sun = u_sea_sun;
-  float mu_v = dot(v, n), mu_s = dot(sun, n);
-  if (!(mu_v > 0.0) || !(mu_s > 0.0)) return 0.0;
-  vec3 h = normalize(v + sun);
-  float mu_n = dot(h, n);
-  if (!(mu_n > 0.0)) return 0.0;
-  float mu_n2 = mu_n * mu_n, tan2 = (1.0 - mu_n2) / mu_n2;
-  return fresnelWater(dot(v, h)) * exp(-tan2 / slope_var) /
-         (4.0 * slope_var * max(mu_v, 1e-2) * mu_n2 * mu_n2);
-}
 
 vec3 probeRadiance(vec3 r) {
   vec2 ndc = vec2(dot(r, u_probe_right), dot(r, u_probe_up)) / max(dot(r, u_probe_forward), 1e-6);
@@ -282,13 +243,13 @@ vec3 seaColour(vec3 d) {
   r = normalize(r);
   float foam = foamShare(u_sea.z, u_foam_steepness, dot(slope, slope), u_sea.y,
                          max(u_sea.y - resolved_slope, 0.0));
-  float fresnel = fresnelWater(cos_i);
+  float fresnel = fresnelWater(cos_i, 1.34);
   float sun = groundSunlight(d);
   float diffuse = max(u_sea_sun.z, 0.0) * (kGroundSkyShare + (1.0 - kGroundSkyShare) * sun);
   vec3 colour = diffuse * ((1.0 - foam) * (1.0 - fresnel) * u_sea_body +
                            foam * kFoamReflectance * u_sun_colour);
   if (u_sea_sun.z > 0.0 && sun > 0.0)
-    colour += (1.0 - foam) * sun * glintRadiance(d, n, slope_var) * u_sun_colour;
+    colour += (1.0 - foam) * sun * glintRadiance(d, u_sea_sun, n, slope_var) * u_sun_colour;
   return colour + (1.0 - foam) * fresnel * probeRadiance(r);
 }
 #endif

@@ -157,12 +157,6 @@ float regionRamp(float x, float width) {
   float u = clamp(x / max(width, 1.0e-3), 0.0, 1.0);
   return u * u * (3.0 - 2.0 * u);
 }
-// A far deck stands for rounded heaps: the mean of max(0, N.L) over a Lambertian sphere's
-// visible disc at phase angle alpha, 2/3 (sin alpha + (pi - alpha) cos alpha) / pi.
-float sphereDiffuse(float cos_alpha) {
-  float alpha = acos(clamp(cos_alpha, -1.0, 1.0));
-  return (2.0 / 3.0) * (sin(alpha) + (3.14159265 - alpha) * cos(alpha)) / 3.14159265;
-}
 float layerThreshold(int i, vec3 r, vec2 p) {
   float t1 = u_threshold[i];
   if (u_far[i].y > 0.0) {
@@ -202,10 +196,7 @@ void composite(int i, vec3 r, LayerHit hit, float t1, float it, inout vec3 colou
   float n_dot_l = dot(normal, u_to_sun);
   float highlight = 0.0;
 #ifdef SPECULAR
-  if (n_dot_l > 0.0) {
-    vec3 reflected = 2.0 * n_dot_l * normal - u_to_sun;
-    highlight = pow(max(dot(reflected, -normalize(r)), 0.0), u_shading[i].w);
-  }
+  if (n_dot_l > 0.0) highlight = phongHighlight(normal, n_dot_l, u_to_sun, -normalize(r), u_shading[i].w);
 #endif
   float diffuse = max(n_dot_l, 0.0);
 #ifdef REGIONS

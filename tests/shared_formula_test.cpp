@@ -1,0 +1,324 @@
+// The formulas the GL renderer and the CPU reference share (world/formulas/): each evaluated
+// on the same inputs in C++, in double, and in GLSL on the GPU, in float, one fragment per
+// case of a float target read back. The inputs are rounded to float first, so the two sides
+// differ only by float's arithmetic: each case allows a relative error of kRelative of its
+// scale (the magnitude of the terms it sums, where they may cancel), which float's 24 bits
+// and llvmpipe's exp and pow meet with room to spare (its acos needs more: sphereDiffuse).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "gl_test_fixture.h"
+#include "renderer/gl/gl_objects.h"
+#include "renderer/gl/shaders/formulas_glsl.h"
+#include "world/formulas/air.h"
+#include "world/formulas/ellipsoid.h"
+#include "world/formulas/sea.h"
+#include "world/formulas/shading.h"
+
+namespace nephele {
+namespace {
+
+namespace f = formulas;
+constexpr double kRelative = 2e-5;
+constexpr std::size_t kChunk = 64;
+
+// An input as the GPU takes it: rounded to float.
+double toFloat(double x) {
+  return double(float(x));
+}
+glm::dvec2 toFloat(glm::dvec2 v) {
+  return glm::dvec2(glm::vec2(v));
+}
+glm::dvec3 toFloat(glm::dvec3 v) {
+  return glm::dvec3(glm::vec3(v));
+}
+glm::dvec4 toFloat(glm::dvec4 v) {
+  return glm::dvec4(glm::vec4(v));
+}
+
+// The same input as a GLSL expression: its float written out in full and multiplied by a
+// uniform 1, so that the compiler cannot fold the formula at compile time, where Mesa would
+// evaluate it in C rather than as the GPU does.
+std::string glslNumber(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.9e", double(float(x)));
+  return text;
+}
+std::string glslArg(double x) {
+  return "(" + glslNumber(x) + " * u_one)";
+}
+template <int N>
+std::string glslArg(glm::vec<N, double> v) {
+  std::string s = "(vec" + std::to_string(N) + "(";
+  for (int i = 0; i < N; ++i) s += (i ? ", " : "") + glslNumber(v[i]);
+  return s + ") * u_one)";
+}
+
+struct Case {
+  std::string call;  // the GLSL expression
+  double cpu = 0.0;  // its value in C++
+  double scale = 0.0;
+};
+
+class Cases {
+ public:
+  // `formula` on `args` (rounded to float) in C++, and the GLSL call of `name` on them; the
+  // case's scale is max(|value|, floor). A vector result gives a case for each component.
+  template <typename Result, typename... Args>
+  void add(const std::string& name, Result (*formula)(Args...), double floor,
+           std::type_identity_t<Args>... args) {
+    const Result cpu = formula(toFloat(args)...);
+    std::string call = name + "(";
+    bool first = true;
+    ((call += (first ? "" : ", ") + glslArg(args), first = false), ...);
+    call += ")";
+    if constexpr (std::is_same_v<Result, double>) {
+      list_.push_back({call, cpu, std::max(std::abs(cpu), floor)});
+    } else {
+      for (int i = 0; i < Result::length(); ++i)
+        list_.push_back({call + "." + "xyzw"[i], cpu[i], std::max(std::abs(cpu[i]), floor)});
+    }
+  }
+  const std::vector<Case>& all() const { return list_; }
+
+ private:
+  std::vector<Case> list_;
+};
+
+// A fragment stage whose fragment x = i writes case i's value to red.
+std::string fragmentSource(const std::vector<Case>& cases) {
+  std::string s = "#version 450 core\n";
+  s += glsl::formulas::kPrelude;
+  s += glsl::formulas::kAir;
+  s += glsl::formulas::kShading;
+  s += glsl::formulas::kSea;
+  s += glsl::formulas::kEllipsoid;
+  s += "uniform float u_one;\nlayout(location = 0) out vec4 o_value;\nvoid main() {\n";
+  s += "  float v = 0.0;\n  switch (int(gl_FragCoord.x)) {\n";
+  for (std::size_t i = 0; i < cases.size(); ++i)
+    s += "    case " + std::to_string(i) + ": v = " + cases[i].call + "; break;\n";
+  return s + "  }\n  o_value = vec4(v, 0.0, 0.0, 1.0);\n}\n";
+}
+
+constexpr char kVertexSource[] = R"(#version 450 core
+void main() {
+  gl_Position = vec4(float((gl_VertexID & 1) * 4 - 1), float((gl_VertexID >> 1) * 4 - 1), 0.0, 1.0);
+}
+)";
+
+class SharedFormulaTest : public GlRenderTest {
+ protected:
+  // Each case's value on the GPU, kChunk cases a draw (one switch over a few hundred cases left
+  // those past about the 80th at 0 on llvmpipe).
+  static std::vector<float> evaluate(const std::vector<Case>& cases) {
+    std::vector<float> values;
+    for (std::size_t first = 0; first < cases.size(); first += kChunk) {
+      const std::vector<Case> chunk(cases.begin() + first,
+                                    cases.begin() + std::min(cases.size(), first + kChunk));
+      const std::vector<float> part = evaluateChunk(chunk);
+      if (part.size() != chunk.size()) return {};
+      values.insert(values.end(), part.begin(), part.end());
+    }
+    return values;
+  }
+
+  static std::vector<float> evaluateChunk(const std::vector<Case>& cases) {
+    const GlApi& gl = platform_->gl();
+    std::string error;
+    GlObject program = createProgram(gl, kVertexSource, fragmentSource(cases), error);
+    EXPECT_TRUE(program) << error;
+    if (!program) return {};
+    const int width = int(cases.size());
+    GlObject target = createRenderbuffer(gl), framebuffer = createFramebuffer(gl);
+    gl.NamedRenderbufferStorage(target.get(), GL_RGBA32F, width, 1);
+    gl.NamedFramebufferRenderbuffer(framebuffer.get(), GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER,
+                                    target.get());
+    EXPECT_TRUE(framebufferUsable(gl, framebuffer.get()));
+    GlObject vertex_array = createVertexArray(gl);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, framebuffer.get());
+    gl.BindVertexArray(vertex_array.get());
+    gl.UseProgram(program.get());
+    gl.ProgramUniform1f(program.get(), gl.GetUniformLocation(program.get(), "u_one"), 1.0f);
+    gl.Disable(GL_BLEND);
+    gl.Disable(GL_DEPTH_TEST);
+    gl.Disable(GL_SCISSOR_TEST);
+    gl.Viewport(0, 0, width, 1);
+    gl.DrawArrays(GL_TRIANGLES, 0, 3);
+    std::vector<float> rgba(4 * cases.size());
+    gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
+    gl.ReadPixels(0, 0, width, 1, GL_RGBA, GL_FLOAT, rgba.data());
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    std::vector<float> values(cases.size());
+    for (std::size_t i = 0; i < cases.size(); ++i) values[i] = rgba[4 * i];
+    return values;
+  }
+
+  // Both sides agree on every case, within kRelative of its scale; each that does not is
+  // listed with its call and both values.
+  static void expectAgree(const Cases& cases) {
+    const std::vector<float> gpu = evaluate(cases.all());
+    ASSERT_EQ(gpu.size(), cases.all().size());
+    int differing = 0;
+    for (std::size_t i = 0; i < gpu.size(); ++i) {
+      const Case& c = cases.all()[i];
+      const double tolerance = kRelative * c.scale;
+      if (std::abs(double(gpu[i]) - c.cpu) <= tolerance) continue;
+      ++differing;
+      ADD_FAILURE() << "case " << i << ", " << c.call << ": GLSL " << gpu[i] << ", C++ " << c.cpu
+                    << ", differ by " << std::abs(double(gpu[i]) - c.cpu) << " > " << tolerance;
+    }
+    EXPECT_EQ(differing, 0) << "of " << gpu.size() << " cases";
+  }
+};
+
+constexpr double kFar = 1e30;  // the shaders' endless distance (sky/common.glsl)
+
+TEST_F(SharedFormulaTest, SlabsAgree) {
+  Cases cases;
+  const glm::dvec3 slabs[] = {{0.0, 100.0, 0.0}, {800.0, 1400.0, 150.0}, {-50.0, 3.0, 40.0}};
+  const double heights[] = {-200.0, 0.0, 50.0, 99.9, 100.0, 760.0, 1420.0, 1e4, 1e9};
+  for (const glm::dvec3& slab : slabs) {
+    const double thickness = slab.y - slab.x + slab.z;
+    for (double z : heights) {
+      cases.add("slabDensity", &f::slabDensity, 1.0, slab, z);
+      cases.add("slabColumn", &f::slabColumn, thickness, slab, z);
+    }
+    // Level, nearly level, rising and falling rays, near and endless.
+    for (double z0 : {2.0, 900.0, 2000.0})
+      for (double dz : {0.0, 1e-9, 5e-7, 0.02, -0.02, 0.3, -0.7, 1.0})
+        for (double distance : {10.0, 5000.0, kFar}) {
+          // The columns' difference loses float's digits of the heights it subtracts.
+          const double floor =
+              std::abs(distance * dz) < 1e-3 ? distance : (std::abs(z0) + thickness) / std::abs(dz);
+          cases.add("slabPath", &f::slabPath, floor, slab, z0, dz, distance);
+        }
+  }
+  expectAgree(cases);
+}
+
+TEST_F(SharedFormulaTest, HazeAgrees) {
+  Cases cases;
+  const double sigma0 = 3.912 / 40000.0;
+  for (double z0 : {0.0, 2.0, 1500.0, 9000.0})
+    for (double dz : {0.0, 1e-6, -1e-6, 0.004, 0.05, -0.05, 0.5, -1.0, 1.0})
+      for (double distance : {1.0, 800.0, 60000.0, kFar}) {
+        // The series and the difference of exponentials meet at |x| = 1e-2, where float's
+        // difference has lost two digits; the scale is the depth of the level path.
+        const double level = sigma0 * std::min(distance, 1e9) * std::exp(-z0 / 1200.0);
+        cases.add("hazeDepth", &f::hazeDepth, std::max(level, 1e-12), sigma0, 1200.0, z0, dz,
+                  distance);
+      }
+  expectAgree(cases);
+}
+
+TEST_F(SharedFormulaTest, ShaftsAgree) {
+  Cases cases;
+  // Axis X, Y from the eye, radius, top; the eye inside, beside and far from the shaft.
+  const glm::dvec4 shafts[] = {
+      {0.0, 0.0, 800.0, 1500.0}, {3000.0, -200.0, 1200.0, 2000.0}, {4.0e4, 1.0e4, 2500.0, 1800.0}};
+  const glm::dvec3 directions[] = {glm::normalize(glm::dvec3(1.0, 0.0, 0.0)),
+                                   glm::normalize(glm::dvec3(1.0, -0.05, 0.1)),
+                                   glm::normalize(glm::dvec3(0.97, 0.25, -0.02)),
+                                   glm::normalize(glm::dvec3(0.0, 1e-5, 1.0)),
+                                   glm::dvec3(0.0, 0.0, -1.0),
+                                   glm::normalize(glm::dvec3(4.0, 1.0, 0.3))};
+  const double sigma = 3.912 / 2000.0;
+  for (const glm::dvec4& shaft : shafts)
+    for (double z0 : {2.0, 900.0, 2500.0})
+      for (const glm::dvec3& d : directions)
+        for (double distance : {500.0, 2e4, kFar})
+          cases.add("shaftDepth", &f::shaftDepth, sigma * 2.0 * shaft.z, shaft, sigma, z0, d,
+                    distance);
+  expectAgree(cases);
+}
+
+TEST_F(SharedFormulaTest, ShadingAgrees) {
+  Cases cases;
+  const glm::dvec4 terms[] = {{0.4, 0.5, 0.0, 8.0}, {0.25, 0.3, 0.6, 20.0}, {1.0, 0.0, 1.0, 1.0}};
+  for (const glm::dvec4& t : terms)
+    for (double diffuse : {0.0, 0.37, 1.0})
+      cases.add("gardnerIntensity", &f::gardnerIntensity, 1.0, t, diffuse, 0.8, 0.55);
+  const glm::dvec3 n = glm::normalize(glm::dvec3(0.2, -0.3, 1.0));
+  const glm::dvec3 sun = glm::normalize(glm::dvec3(0.5, 0.4, 0.6));
+  for (const glm::dvec3& view :
+       {glm::normalize(glm::dvec3(-0.4, -0.2, 0.9)), glm::dvec3(0.0, 0.0, 1.0),
+        glm::normalize(glm::dvec3(0.3, 0.1, -1.0))})
+    for (double e : {1.0, 8.0, 64.0})
+      cases.add("phongHighlight", &f::phongHighlight, 1.0, n, glm::dot(n, sun), sun, view, e);
+  // Excess below, at and above the threshold; a hard threshold (D = 0).
+  for (double excess : {-0.3, 0.0, 1e-7, 0.04, 0.2, 5.0})
+    for (double d : {0.0, 0.1, 0.5}) cases.add("translucence", &f::translucence, 1.0, excess, d);
+  for (double g : {0.0, 0.3, 1.0}) cases.add("limbExcess", &f::limbExcess, 1.0, 0.62, 0.35, 0.9, g);
+  // llvmpipe's acos is good to about 2e-4 radians, which moves the mean by up to 1e-4.
+  for (double c : {-1.5, -1.0, -0.6, 0.0, 0.3, 0.999, 1.0, 1.2})
+    cases.add("sphereDiffuse", &f::sphereDiffuse, 10.0, c);
+  expectAgree(cases);
+}
+
+TEST_F(SharedFormulaTest, SeaOpticsAgree) {
+  Cases cases;
+  for (double c : {-0.2, 0.0, 1e-4, 0.05, 0.5, 0.9, 1.0, 1.3})
+    for (double n : {1.34, 1.2}) cases.add("fresnelWater", &f::fresnelWater, 0.02, c, n);
+  // No whitecaps, all foam, and the blend of resolved and unresolved slopes (none resolved).
+  for (double w : {0.0, 0.004, 0.3, 1.0})
+    for (double var_unresolved : {0.0, 0.01, 0.03})
+      cases.add("foamShare", &f::foamShare, 1.0, w, 0.05, 0.06, 0.03, var_unresolved);
+  const glm::dvec3 sun = glm::normalize(glm::dvec3(0.3, 0.6, 0.5));
+  const glm::dvec3 normals[] = {glm::dvec3(0.0, 0.0, 1.0),
+                                glm::normalize(glm::dvec3(0.1, -0.2, 1.0))};
+  for (const glm::dvec3& n : normals)
+    for (const glm::dvec3& d :
+         {glm::normalize(glm::dvec3(-0.3, -0.6, -0.5)), glm::normalize(glm::dvec3(0.2, -0.9, -0.1)),
+          glm::normalize(glm::dvec3(0.0, 1.0, -0.001))})
+      for (double slope_var : {0.003, 0.03}) {
+        const double peak = f::glintRadiance(toFloat(glm::reflect(sun, n)), toFloat(sun),
+                                             toFloat(n), toFloat(slope_var));
+        cases.add("glintRadiance", &f::glintRadiance, peak, d, sun, n, slope_var);
+      }
+  expectAgree(cases);
+}
+
+TEST_F(SharedFormulaTest, EllipsoidAgrees) {
+  Cases cases;
+  // The eye near, far (1e4 radii: the difference of squares would lose every digit in float)
+  // and level with the ellipsoid; rays through the middle, grazing, missing and turned away.
+  const glm::dvec3 eyes[] = {{0.0, -3.0, 0.5}, {2.0, -1.0e4, 300.0}, {-1.5, 0.2, 0.0}};
+  for (const glm::dvec3& o : eyes) {
+    const double c = glm::dot(o, o) - 1.0;
+    const glm::dvec3 to_centre = -o / glm::length(o);
+    const glm::dvec3 across = glm::normalize(glm::cross(to_centre, glm::dvec3(0.3, 0.2, 1.0)));
+    const double edge = 1.0 / glm::length(o);  // the tangent's offset per unit along
+    for (double offset : {0.0, 0.5 * edge, 0.99 * edge, 1.01 * edge, 3.0 * edge}) {
+      for (double length : {1.0, 250.0}) {
+        const glm::dvec3 w = length * (to_centre + offset * across);
+        const double delta = f::quarterDelta(toFloat(o), toFloat(w));
+        cases.add("quarterDelta", &f::quarterDelta, glm::dot(w, w), o, w);
+        if (delta > 1e-3 * glm::dot(w, w))
+          cases.add("unitSphereRoots", &f::unitSphereRoots, glm::length(o) / length, o, w, c,
+                    delta);
+      }
+    }
+  }
+  // Chords from inside, on and outside the unit sphere, along, across and away from it.
+  for (const glm::dvec3& o : {glm::dvec3(0.0), glm::dvec3(0.6, 0.0, 0.8),
+                              glm::dvec3(0.2, -0.3, 0.1), glm::dvec3(0.0, -2.5, 0.0)})
+    for (const glm::dvec3& w : {glm::dvec3(0.0, 1.0, 0.0), glm::dvec3(0.0, 0.0, 0.4),
+                                glm::dvec3(-0.6, 0.0, -0.8), glm::dvec3(1.0, 0.0, 0.0)})
+      cases.add("unitSphereChord", &f::unitSphereChord, 2.0 / glm::length(w), o, w);
+  // The limb function of a sphere seen from 3 radii along -y: axis +y, P = (I - a a^T) / 8.
+  const glm::dvec3 axis(0.0, 1.0, 0.0);
+  const glm::dvec3 p0(1.0 / 8.0, 0.0, 0.0), p1(0.0, 0.0, 0.0), p2(0.0, 0.0, 1.0 / 8.0);
+  for (const glm::dvec3& d :
+       {glm::dvec3(0.0, 1.0, 0.0), glm::dvec3(0.1, 1.0, -0.2), glm::dvec3(0.35, 1.0, 0.0),
+        glm::dvec3(0.5, 1.0, 0.3), glm::dvec3(0.0, -1.0, 0.0), glm::dvec3(1.0, 0.0, 0.0)})
+    cases.add("limbFunction", &f::limbFunction, 1.0, d, axis, p0, p1, p2);
+  expectAgree(cases);
+}
+
+}  // namespace
+}  // namespace nephele

@@ -1,0 +1,50 @@
+// The sea's optics (MODEL.md section 18), shared by world/sea.cpp and the GL renderer's
+// renderer/gl/shaders/sky/common.glsl (see prelude.h).
+#ifdef __cplusplus
+#pragma once
+#include "world/formulas/prelude.h"
+
+namespace nephele::formulas {
+#endif
+
+// Unpolarised Fresnel reflectance of a dielectric of index n from air (Born and Wolf), for the
+// cosine of the incidence angle.
+FORMULA real fresnelWater(real cos_incidence, real n) {
+  real c = clamp(cos_incidence, 0.0, 1.0);
+  real g = sqrt(n * n - 1.0 + c * c);
+  real a = (g - c) / (g + c), b = (c * (g + c) - 1.0) / (c * (g - c) + 1.0);
+  return 0.5 * a * a * (1.0 + b * b);
+}
+
+// The share of a point covered by foam (SeaSurface, foamShare in world/sea.h): where the
+// surface is resolved, the logistic of its squared slope over `foam_steepness`, softened over
+// the unresolved slopes' variance; where it is not, the whitecap fraction w. The two blend by
+// the share of the drawn slope variance `var_total` resolved.
+FORMULA real foamShare(real w, real foam_steepness, real steepness, real var_total,
+                       real var_unresolved) {
+  if (!(w > 0.0)) return 0.0;
+  if (w >= 1.0) return 1.0;
+  real resolved = var_total > 0.0 ? clamp(1.0 - var_unresolved / var_total, 0.0, 1.0) : 0.0;
+  real edge = sqrt(max(var_unresolved, 1e-4 * var_total + 1e-12));
+  real crest = 1.0 / (1.0 + exp(-1.702 * (steepness - foam_steepness) / edge));
+  return (1.0 - resolved) * w + resolved * crest;
+}
+
+// Cox-Munk glint radiance for a unit irradiance per pi: F p / (4 mu_v mu_n^4) with p =
+// exp(-tan^2 beta / s^2) / (pi s^2), the facet normal that mirrors the unit view ray d to the
+// unit `sun` taken relative to the unit surface normal n, slope variance s^2 = slope_var.
+FORMULA real glintRadiance(vec3 d, vec3 sun, vec3 n, real slope_var) {
+  vec3 v = -d;
+  real mu_v = dot(v, n), mu_s = dot(sun, n);
+  if (!(mu_v > 0.0) || !(mu_s > 0.0)) return 0.0;
+  vec3 h = normalize(v + sun);
+  real mu_n = dot(h, n);
+  if (!(mu_n > 0.0)) return 0.0;
+  real mu_n2 = mu_n * mu_n, tan2 = (1.0 - mu_n2) / mu_n2;
+  return fresnelWater(dot(v, h), 1.34) * exp(-tan2 / slope_var) /
+         (4.0 * slope_var * max(mu_v, 1e-2) * mu_n2 * mu_n2);
+}
+
+#ifdef __cplusplus
+}  // namespace nephele::formulas
+#endif
