@@ -266,7 +266,7 @@ int runRenderCommand(const RenderCommandOptions& o) {
   }
   const auto start = Clock::now();
   const World world = worldAtTime(file);
-  const Scene scene = world.scene();
+  const Scene& scene = world.scene();
   std::size_t ellipsoids = 0;
   for (const EllipsoidCloud& cloud : scene.clouds) ellipsoids += cloud.ellipsoids.size();
   spdlog::info(
