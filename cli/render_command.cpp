@@ -236,7 +236,7 @@ void logScene(const std::string& path, const Scene& scene) {
 std::string renderAndWrite(const RenderCommandOptions& o, Renderer& renderer, const World& world,
                            const FrameRequest& request, ImageFileFormat format,
                            Clock::time_point start) {
-  const Scene scene = world.scene();
+  const Scene& scene = world.scene();
   logScene(o.scene_path, scene);
   renderer.setProgress([&](double done) {
     const double seconds = millisecondsSince(start) / 1000.0;

@@ -80,6 +80,7 @@ World::World(const Scene& scene, const WorldDynamics& dynamics, int threads, boo
   const glm::dvec3 to_sun = sunDirection(base_.sun);
   for (const AutomatonCloudSpec& spec : dynamics_.automata)
     automata_.emplace_back(spec, dynamics_.wind, to_sun, warm_up);
+  rebuildNow();
 }
 
 World::~World() = default;
@@ -114,14 +115,19 @@ std::string World::advanceInPieces(double dt_s, int pieces,
     const std::int64_t next = total_ns / n * i + (i == n ? total_ns % n : 0);
     advanceNs(next - done);
     done = next;
-    if (after_piece) after_piece(i, n);
+    if (after_piece) {
+      applyTime();  // the callback may look at the world
+      after_piece(i, n);
+    }
   }
+  if (!after_piece) applyTime();
   return {};
 }
 
 std::string World::advance(double dt_s) {
   if (std::string e = advanceError(dt_s); !e.empty()) return e;
   advanceNs(std::llround(dt_s / kTimeResolutionS));
+  applyTime();
   return {};
 }
 
@@ -136,9 +142,10 @@ void World::refreshAutomata() {
 }
 
 void World::setSun(const Sun& sun) {
-  base_.sun = sun;
+  base_.sun = now_.sun = sun;
   const glm::dvec3 to_sun = sunDirection(sun);
   for (AutomatonCloud& cloud : automata_) relights_run_ += cloud.setSun(to_sun);
+  refreshAutomatonViews();
 }
 
 void World::foldDrift(Scene& scene, const WorldDynamics& dynamics, double sign) const {
@@ -371,6 +378,7 @@ std::string World::setSite(const Site& site, bool* changed) {
   if (!error.empty()) return error;
   for (AutomatonCloudSpec& spec : dynamics_.automata) spec.position -= glm::dvec3(shift, 0.0);
   for (AutomatonCloud& cloud : automata_) cloud.moveBy(-shift);
+  refreshAutomatonViews();
   if (changed) *changed = true;
   return "";
 }
@@ -479,42 +487,62 @@ std::string World::edit(
   dynamics_.wind = dynamics.wind;
   dynamics_.layers = std::move(dynamics.layers);
   dynamics_.clouds = std::move(dynamics.clouds);
+  rebuildNow();
   ++edits_;
   return {};
 }
 
-Scene World::scene() const {
-  Scene s = base_;
+void World::rebuildNow() {
+  now_ = base_;
+  applyTime();
+}
+
+void World::applyTime() {
+  // Every member time changes is set from base_'s, as base + v t: the same arithmetic whenever it
+  // is applied, so that equal worlds hand out equal scenes.
   const double t = timeSeconds();
-  s.time_s = t;
+  now_.time_s = t;
   for (std::size_t i = 0; i < dynamics_.layers.size(); ++i) {
     const LayerDevelopment& d = dynamics_.layers[i];
-    CloudLayer& layer = s.layers[i];
-    layer.threshold = d.threshold.at(t, layer.threshold);
-    layer.transition = d.transition.at(t, layer.transition);
+    const CloudLayer& from = base_.layers[i];
+    CloudLayer& layer = now_.layers[i];
+    layer.threshold = d.threshold.at(t, from.threshold);
+    layer.transition = d.transition.at(t, from.transition);
     if (!d.t0.empty()) layer.texture.gardner.t0 = quantisedT0(d.t0.at(t, 0.0));
   }
   for (std::size_t i = 0; i < dynamics_.clouds.size(); ++i) {
     const CloudDevelopment& d = dynamics_.clouds[i];
-    EllipsoidCloud& cloud = s.clouds[i];
-    cloud.threshold_centre = d.threshold_centre.at(t, cloud.threshold_centre);
-    cloud.threshold_limb = d.threshold_limb.at(t, cloud.threshold_limb);
-    cloud.transition = d.transition.at(t, cloud.transition);
+    const EllipsoidCloud& from = base_.clouds[i];
+    EllipsoidCloud& cloud = now_.clouds[i];
+    cloud.threshold_centre = d.threshold_centre.at(t, from.threshold_centre);
+    cloud.threshold_limb = d.threshold_limb.at(t, from.threshold_limb);
+    cloud.transition = d.transition.at(t, from.transition);
   }
-  if (!dynamics_.wind.empty())
-    for (CloudField& field : s.fields) {
-      const glm::dvec2 carried = dynamics_.wind.at(fieldAltitude(field));
-      field.drift_m += carried * t;
-      field.shear = dynamics_.wind.at(field.base_m + field.thickness_m) - carried;
-    }
-  if (!dynamics_.wind.empty())
-    for (EllipsoidCloud& cloud : s.clouds) {
-      const glm::dvec3 drift(dynamics_.wind.at(cloudAltitude(cloud)) * t, 0.0);
-      for (Ellipsoid& e : cloud.ellipsoids) e.centre += drift;
-      cloud.drift_m += drift;
-    }
-  for (const AutomatonCloud& cloud : automata_) s.automata.push_back(cloud.view(time_ns_));
-  return s;
+  if (!dynamics_.wind.empty()) applyDrift(t);
+  refreshAutomatonViews();
+}
+
+void World::applyDrift(double t) {
+  for (std::size_t i = 0; i < base_.fields.size(); ++i) {
+    const CloudField& from = base_.fields[i];
+    CloudField& field = now_.fields[i];
+    const glm::dvec2 carried = dynamics_.wind.at(fieldAltitude(from));
+    field.drift_m = from.drift_m + carried * t;
+    field.shear = dynamics_.wind.at(from.base_m + from.thickness_m) - carried;
+  }
+  for (std::size_t i = 0; i < base_.clouds.size(); ++i) {
+    const EllipsoidCloud& from = base_.clouds[i];
+    EllipsoidCloud& cloud = now_.clouds[i];
+    const glm::dvec3 drift(dynamics_.wind.at(cloudAltitude(from)) * t, 0.0);
+    for (std::size_t k = 0; k < from.ellipsoids.size(); ++k)
+      cloud.ellipsoids[k].centre = from.ellipsoids[k].centre + drift;
+    cloud.drift_m = from.drift_m + drift;
+  }
+}
+
+void World::refreshAutomatonViews() {
+  now_.automata.clear();
+  for (const AutomatonCloud& cloud : automata_) now_.automata.push_back(cloud.view(time_ns_));
 }
 
 }  // namespace nephele

@@ -168,8 +168,10 @@ class World {
   std::string moveTarget(const std::string& name, const TargetPose& pose);
   std::string removeTarget(const std::string& name);
 
-  // The render's view of the world now.
-  Scene scene() const;
+  // The render's view of the world now: drift, development schedules and the automata's views
+  // applied, kept up to date by every change (advance, edit, setSun, restore) and valid until
+  // the next.
+  const Scene& scene() const { return now_; }
   const Scene& base() const { return base_; }
   const WorldDynamics& dynamics() const { return dynamics_; }
   const std::vector<AutomatonCloud>& automata() const { return automata_; }
@@ -194,8 +196,15 @@ class World {
   void advanceNs(std::int64_t dt_ns);  // checked by the caller
   // Moves the drift up to now into (sign +1) or out of (sign -1) the base scene.
   void foldDrift(Scene& scene, const WorldDynamics& dynamics, double sign) const;
+  // now_ from base_ (after base_ changed), or brought to the world's time in place: the
+  // development schedules, the wind's drift (applyDrift) and the automata's views.
+  void rebuildNow();
+  void applyTime();
+  void applyDrift(double t);
+  void refreshAutomatonViews();
 
-  Scene base_;
+  Scene base_;  // the world at time 0 (drift folded out)
+  Scene now_;   // the world at time_ns_, what scene() hands out
   WorldDynamics dynamics_;
   int threads_ = 1;
   std::int64_t time_ns_ = 0;

@@ -651,6 +651,50 @@ void EllipsoidRenderer::finishBand(const Scene& scene, const PassTarget& target)
   h.drift = heapDrift(scene);
 }
 
+void EllipsoidRenderer::renderImpostor(const ViewPlan& plan, std::size_t index, int size,
+                                       const RenderSettings& settings, const PassTarget& target,
+                                       Impostor& impostor) {
+  // The cloud alone from here, looking at its centre, into a square texture: the plan's clouds,
+  // borrowed, seen from that camera.
+  const Camera& camera = plan.camera();
+  const auto [centre, radius] = boundingSphere(plan.cloud(index));
+  const double distance = glm::length(centre - camera.position);
+  auto own = std::make_unique<Scene>(withClouds(*plan.scene, {}));
+  Camera& looking = own->camera;
+  const glm::dvec3 d = glm::normalize(centre - camera.position);
+  looking.position = camera.position;
+  looking.orientation = {glm::degrees(std::atan2(d.x, d.y)),
+                         glm::degrees(std::asin(std::clamp(d.z, -1.0, 1.0))), 0.0};
+  const double half_angle = std::asin(std::min(1.0, radius / distance)) * 1.02;
+  looking.vfov_deg = glm::degrees(2.0 * half_angle);
+  looking.width = looking.height = size;
+  ViewPlan view;
+  view.scene = own.get();
+  view.own = std::move(own);
+  view.clouds = plan.clouds;
+  if (impostor.size != size || !impostor.texture) {
+    createColourTarget(gl_, GL_RGBA16F, glm::ivec2(size), "impostor", impostor.texture,
+                       impostor.framebuffer);
+  }
+  const float clear[4] = {0, 0, 0, 0};
+  gl_.ClearNamedFramebufferfv(impostor.framebuffer.get(), GL_COLOR, 0, clear);
+  gl_.BindFramebuffer(GL_FRAMEBUFFER, impostor.framebuffer.get());
+  gl_.Viewport(0, 0, size, size);
+  const PassTarget impostor_target{impostor.framebuffer.get(), size, size};
+  drawDirect(view, {index}, settings, impostor_target, false, AltitudeBand{}, "");
+  gl_.BindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
+  gl_.Viewport(0, 0, target.width, target.height);
+  const ViewBasis basis = viewBasis(view.camera());
+  impostor.eye = camera.position;
+  impostor.centre = centre;
+  impostor.right = basis.right;
+  impostor.up = basis.up;
+  impostor.half_size = distance * std::tan(half_angle);
+  impostor.size = size;
+  ++impostor_renders_;
+  ++stats_->impostors_rendered;
+}
+
 bool EllipsoidRenderer::drawImpostor(const ViewPlan& plan, std::size_t index,
                                      const RenderSettings& settings, const PassTarget& target,
                                      bool targets_drawn, const AltitudeBand& band) {
@@ -679,43 +723,8 @@ bool EllipsoidRenderer::drawImpostor(const ViewPlan& plan, std::size_t index,
   const bool fresh = impostor.key == key && glm::distance(impostor.centre, centre) == 0.0 &&
                      impostor.size >= size && parallax_px <= settings.impostor_tolerance_px;
   if (!fresh) {
-    // Render the cloud alone from here, looking at its centre, into a square texture.
-    // The plan's clouds, borrowed, seen from that camera.
-    auto own = std::make_unique<Scene>(withClouds(scene, {}));
-    Camera& looking = own->camera;
-    const glm::dvec3 d = glm::normalize(centre - camera.position);
-    looking.position = camera.position;
-    looking.orientation = {glm::degrees(std::atan2(d.x, d.y)),
-                           glm::degrees(std::asin(std::clamp(d.z, -1.0, 1.0))), 0.0};
-    const double half_angle = std::asin(std::min(1.0, radius / distance)) * 1.02;
-    looking.vfov_deg = glm::degrees(2.0 * half_angle);
-    looking.width = looking.height = size;
-    ViewPlan view;
-    view.scene = own.get();
-    view.own = std::move(own);
-    view.clouds = plan.clouds;
-    if (impostor.size != size || !impostor.texture) {
-      createColourTarget(gl_, GL_RGBA16F, glm::ivec2(size), "impostor", impostor.texture,
-                         impostor.framebuffer);
-    }
-    const float clear[4] = {0, 0, 0, 0};
-    gl_.ClearNamedFramebufferfv(impostor.framebuffer.get(), GL_COLOR, 0, clear);
-    gl_.BindFramebuffer(GL_FRAMEBUFFER, impostor.framebuffer.get());
-    gl_.Viewport(0, 0, size, size);
-    const PassTarget impostor_target{impostor.framebuffer.get(), size, size};
-    drawDirect(view, {index}, settings, impostor_target, false, AltitudeBand{}, "");
-    gl_.BindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
-    gl_.Viewport(0, 0, target.width, target.height);
-    const ViewBasis basis = viewBasis(view.camera());
+    renderImpostor(plan, index, size, settings, target, impostor);
     impostor.key = key;
-    impostor.eye = camera.position;
-    impostor.centre = centre;
-    impostor.right = basis.right;
-    impostor.up = basis.up;
-    impostor.half_size = distance * std::tan(half_angle);
-    impostor.size = size;
-    ++impostor_renders_;
-    ++stats_->impostors_rendered;
   }
 
   EllipsoidPassLayout layout;
@@ -763,26 +772,12 @@ bool EllipsoidRenderer::drawWithHistory(const PassTarget& target, bool accumulat
   return done;
 }
 
-void EllipsoidRenderer::drawDirect(const ViewPlan& view, const std::vector<std::size_t>& indices,
-                                   const RenderSettings& settings, const PassTarget& target,
-                                   bool targets_drawn, const AltitudeBand& band,
-                                   const std::string& batch) {
-  const Scene& scene = *view.scene;
-  // The clouds look alike: the first one's texture and shading stand for all of them.
-  const EllipsoidCloud& cloud = view.cloud(indices.front());
-  // One of a continuous view's band of batches (an impostor's picture, `batch` empty, is not).
-  HeapHistory* history = batch.empty() ? nullptr : band_.history;
-  // Visible ellipsoids with the back-to-front key (the front-to-back key, the nearest a hit
-  // can be, is the record's order.z).
-  struct Visible {
-    double centre_distance;
-    EllipsoidRecord record;
-  };
-  const bool spotlight = settings.limb == LimbEvaluation::kSpotlight;
-  std::optional<StageClock> records_clock(std::in_place, stats_->times.cpu(CpuStage::kRecords));
+std::vector<EllipsoidRenderer::Visible> EllipsoidRenderer::visibleRecords(
+    const ViewPlan& view, const std::vector<std::size_t>& indices, bool spotlight, int& total) {
   // The records of members [from, to) in order; each ellipsoid's is its own, so a batch of many
   // is split over up to kRecordThreads threads by members and joined in order: the same
   // records whatever the split.
+  const Camera& camera = view.camera();
   const bool shadowed = sunlight_ && !sunlight_->empty();
   auto recordsOf = [&](std::size_t from, std::size_t to, bool watch) {
     std::vector<Visible> out;
@@ -795,11 +790,11 @@ void EllipsoidRenderer::drawDirect(const ViewPlan& view, const std::vector<std::
             (watch ? stopNow() : cancel_ && cancel_->load(std::memory_order_relaxed)))
           return out;
         Visible v;
-        if (!makeEllipsoidRecord(member.ellipsoids[i], scene.camera, spotlight, v.record,
+        if (!makeEllipsoidRecord(member.ellipsoids[i], camera, spotlight, v.record,
                                  v.centre_distance))
           continue;
         const HeapEnvelope& e = envelopes[i];
-        v.record.v[17] = glm::vec4(row(e.centre - scene.camera.position, e.extinction));
+        v.record.v[17] = glm::vec4(row(e.centre - camera.position, e.extinction));
         // The share of the sunlight the other clouds take, at the lobe's centre (MODEL.md
         // section 16, "heaps under clouds").
         const Ellipsoid& lobe = member.ellipsoids[i];
@@ -813,7 +808,7 @@ void EllipsoidRenderer::drawDirect(const ViewPlan& view, const std::vector<std::
     }
     return out;
   };
-  int total = 0;
+  total = 0;
   for (std::size_t index : indices) total += int(view.cloud(index).ellipsoids.size());
   const int threads =
       std::clamp(std::min(int(std::thread::hardware_concurrency()), total / kRecordsPerThread), 1,
@@ -827,13 +822,93 @@ void EllipsoidRenderer::drawDirect(const ViewPlan& view, const std::vector<std::
     const std::vector<Visible> more = part.get();
     visible.insert(visible.end(), more.begin(), more.end());
   }
+  return visible;
+}
+
+std::vector<EllipsoidRecord> EllipsoidRenderer::orderedRecords(std::vector<Visible>& visible,
+                                                               bool front_to_back) {
+  StageClock clock(stats_->times.cpu(CpuStage::kRecords));
+  if (front_to_back)  // nearest bound first: the per-pixel pass composites front to back
+    std::stable_sort(visible.begin(), visible.end(), [](const Visible& a, const Visible& b) {
+      return a.record.v[16].z < b.record.v[16].z;
+    });
+  else
+    std::stable_sort(visible.begin(), visible.end(), [](const Visible& a, const Visible& b) {
+      return a.centre_distance > b.centre_distance;
+    });
+  std::vector<EllipsoidRecord> out;
+  out.reserve(visible.size());
+  for (const Visible& v : visible) out.push_back(v.record);
+  return out;
+}
+
+void EllipsoidRenderer::drawDirect(const ViewPlan& view, const std::vector<std::size_t>& indices,
+                                   const RenderSettings& settings, const PassTarget& target,
+                                   bool targets_drawn, const AltitudeBand& band,
+                                   const std::string& batch) {
+  // The clouds look alike: the first one's texture and shading stand for all of them.
+  const EllipsoidCloud& cloud = view.cloud(indices.front());
+  // One of a continuous view's band of batches (an impostor's picture, `batch` empty, is not).
+  HeapHistory* history = batch.empty() ? nullptr : band_.history;
+  const bool spotlight = settings.limb == LimbEvaluation::kSpotlight;
+  int total = 0;
+  std::vector<Visible> visible;
+  {
+    StageClock clock(stats_->times.cpu(CpuStage::kRecords));
+    visible = visibleRecords(view, indices, spotlight, total);
+  }
   if (stopNow()) return;
-  records_clock.reset();
   stats_->ellipsoids_drawn += int(visible.size());
   stats_->ellipsoids_culled += total - int(visible.size());
   if (visible.empty()) return;
 
   CachedTexture& texture = cachedTexture(cloud.texture, settings);
+  const Batch b{*view.scene,
+                cloud,
+                texture,
+                settings,
+                target,
+                band,
+                batchLayout(*view.scene, cloud, texture, settings, spotlight, targets_drawn),
+                history,
+                targets_drawn};
+  // The per-pixel pass orders every hit of the batch: its records and bin lists must fit in
+  // buffer textures. Otherwise, and when asked, ellipsoids are blended back to front by
+  // their centres.
+  const std::size_t max_records = std::size_t(max_texels_) / kEllipsoidRecordVec4s;
+  const bool per_pixel = settings.ellipsoid_passes == EllipsoidPasses::kFused &&
+                         settings.ellipsoid_order == EllipsoidOrder::kPerPixel &&
+                         visible.size() <= max_records;
+  if (settings.ellipsoid_passes == EllipsoidPasses::kMultipass) {
+    std::vector<EllipsoidRecord> ordered = orderedRecords(visible, false);
+    drawTiles(b.scene, cloud, texture, b.base, settings, ordered, target, band);
+    return;
+  }
+  gl_.BindVertexArray(vertex_array_.get());
+  if (!per_pixel) {
+    if (history) band_.broken = true;
+    return drawByCentre(b, orderedRecords(visible, false));
+  }
+  const std::vector<EllipsoidRecord> ordered = orderedRecords(visible, true);
+  std::optional<BinLists> bins;
+  {
+    StageClock clock(stats_->times.cpu(CpuStage::kRecords));  // the bins, to the items' fill
+    bins = binLists(ordered, target, history != nullptr);
+  }
+  if (!bins) {
+    if (history) band_.broken = true;
+    return drawByCentre(b, orderedRecords(visible, false));
+  }
+  // Where no two ellipsoids share a bin, no pixel has two hits to order: the centre pass
+  // draws the same image, faster; but for a continuous view's, which go into its history.
+  if (bins->centre_suffices) return drawByCentre(b, ordered);
+  drawPerPixel(b, ordered, *bins);
+}
+
+EllipsoidPassLayout EllipsoidRenderer::batchLayout(const Scene& scene, const EllipsoidCloud& cloud,
+                                                   CachedTexture& texture,
+                                                   const RenderSettings& settings, bool spotlight,
+                                                   bool targets_drawn) {
   EllipsoidPassLayout base;
   // kAuto is the baked sums: with 16 texels per cycle of every term they come within 3 dB of
   // the sines against the reference however magnified (docs/ACCURACY.md, "Baked solid
@@ -852,125 +927,173 @@ void EllipsoidRenderer::drawDirect(const ViewPlan& view, const std::vector<std::
   if (base.spotlight) gl_.BindTextureUnit(kSpotlightTextureUnit, spotlightTexture());
   gl_.Enable(GL_BLEND);
   gl_.BlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  return base;
+}
 
-  // The per-pixel pass orders every hit of the batch: its records and bin lists must fit in
-  // buffer textures. Otherwise, and when asked, ellipsoids are blended back to front by
-  // their centres.
+void EllipsoidRenderer::drawByCentre(const Batch& b, const std::vector<EllipsoidRecord>& ordered) {
+  EllipsoidPassLayout layout = b.base;
+  layout.program = EllipsoidProgram::kFusedCentre;
+  const GLuint p = program(layout);
+  gl_.UseProgram(p);
+  setCloudUniforms(p, b.scene, b.cloud, b.texture, layout.texture, b.band);
+  gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_first"), 0);
+  // Instances blend in order, so drawing them in groups changes nothing but where a
+  // cancellation can land.
   const std::size_t max_records = std::size_t(max_texels_) / kEllipsoidRecordVec4s;
-  const bool per_pixel = settings.ellipsoid_passes == EllipsoidPasses::kFused &&
-                         settings.ellipsoid_order == EllipsoidOrder::kPerPixel &&
-                         visible.size() <= max_records;
-  auto records = [&](bool front_to_back) {
-    StageClock clock(stats_->times.cpu(CpuStage::kRecords));
-    if (front_to_back)  // nearest bound first: the per-pixel pass composites front to back
-      std::stable_sort(visible.begin(), visible.end(), [](const Visible& a, const Visible& b) {
-        return a.record.v[16].z < b.record.v[16].z;
-      });
-    else
-      std::stable_sort(visible.begin(), visible.end(), [](const Visible& a, const Visible& b) {
-        return a.centre_distance > b.centre_distance;
-      });
-    std::vector<EllipsoidRecord> out;
-    out.reserve(visible.size());
-    for (const Visible& v : visible) out.push_back(v.record);
-    return out;
-  };
-  if (settings.ellipsoid_passes == EllipsoidPasses::kMultipass) {
-    std::vector<EllipsoidRecord> ordered = records(false);
-    drawTiles(scene, cloud, texture, base, settings, ordered, target, band);
-    return;
-  }
-  gl_.BindVertexArray(vertex_array_.get());
-  auto drawByCentre = [&](const std::vector<EllipsoidRecord>& ordered) {
-    EllipsoidPassLayout layout = base;
-    layout.program = EllipsoidProgram::kFusedCentre;
-    const GLuint p = program(layout);
-    gl_.UseProgram(p);
-    setCloudUniforms(p, scene, cloud, texture, layout.texture, band);
-    gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_first"), 0);
-    // Instances blend in order, so drawing them in groups changes nothing but where a
-    // cancellation can land.
-    const bool cancellable = cancel_ && ordered.size() > kCancelInstances;
-    const std::size_t group = cancellable ? std::min(max_records, kCancelInstances) : max_records;
-    for (std::size_t first = 0; first < ordered.size(); first += group) {
-      if (cancellable && first > 0) {
-        paceQueued();
-        if (stopNow()) return;
-      }
-      const std::size_t count = std::min(group, ordered.size() - first);
-      bindFrameTexture(kRecordTextureUnit, GL_RGBA32F, ordered.data() + first,
-                       count * sizeof(EllipsoidRecord));
-      gl_.DrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(count));
-      for (std::size_t i = first; i < first + count; ++i) {  // a fragment per pixel of its rect
-        const glm::vec4 rect = ordered[i].v[10];
-        queued_work_ += std::int64_t(0.25 * (rect.z - rect.x) * (rect.w - rect.y) * target.width *
-                                     target.height) +
-                        1;
-      }
-      ++stats_->ellipsoid_passes;
+  const bool cancellable = cancel_ && ordered.size() > kCancelInstances;
+  const std::size_t group = cancellable ? std::min(max_records, kCancelInstances) : max_records;
+  for (std::size_t first = 0; first < ordered.size(); first += group) {
+    if (cancellable && first > 0) {
+      paceQueued();
+      if (stopNow()) return;
     }
-  };
-  if (!per_pixel) {
-    if (history) band_.broken = true;
-    return drawByCentre(records(false));
+    const std::size_t count = std::min(group, ordered.size() - first);
+    bindFrameTexture(kRecordTextureUnit, GL_RGBA32F, ordered.data() + first,
+                     count * sizeof(EllipsoidRecord));
+    gl_.DrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(count));
+    for (std::size_t i = first; i < first + count; ++i) {  // a fragment per pixel of its rect
+      const glm::vec4 rect = ordered[i].v[10];
+      queued_work_ += std::int64_t(0.25 * (rect.z - rect.x) * (rect.w - rect.y) * b.target.width *
+                                   b.target.height) +
+                      1;
+    }
+    ++stats_->ellipsoid_passes;
   }
+}
 
-  const std::vector<EllipsoidRecord> ordered = records(true);
-  records_clock.emplace(stats_->times.cpu(CpuStage::kRecords));  // the bins, to the items' fill
+std::optional<EllipsoidRenderer::BinLists> EllipsoidRenderer::binLists(
+    const std::vector<EllipsoidRecord>& ordered, const PassTarget& target, bool history) const {
   // Screen bins over the batch's rectangle, each listing the ellipsoids whose rectangles
   // overlap it, in the records' order (two passes: count, then fill).
   auto bin = [&](float ndc, int size) {
     return std::clamp(int((double(ndc) + 1.0) * 0.5 * size) / kPerPixelBinSize, 0,
                       (size - 1) / kPerPixelBinSize);
   };
-  glm::ivec4 area(std::numeric_limits<int>::max(), std::numeric_limits<int>::max(), -1, -1);
+  BinLists out;
+  glm::ivec4& area = out.area;
+  area = {std::numeric_limits<int>::max(), std::numeric_limits<int>::max(), -1, -1};
   std::vector<glm::ivec4> spans(ordered.size());
-  std::int64_t listed = 0;
   for (std::size_t i = 0; i < ordered.size(); ++i) {
     const glm::vec4 rect = ordered[i].v[10];
     spans[i] = {bin(rect.x, target.width), bin(rect.y, target.height), bin(rect.z, target.width),
                 bin(rect.w, target.height)};
     area = {std::min(area.x, spans[i].x), std::min(area.y, spans[i].y),
             std::max(area.z, spans[i].z), std::max(area.w, spans[i].w)};
-    listed += std::int64_t(spans[i].z - spans[i].x + 1) * (spans[i].w - spans[i].y + 1);
+    out.listed += std::int64_t(spans[i].z - spans[i].x + 1) * (spans[i].w - spans[i].y + 1);
   }
-  const int bins_x = area.z - area.x + 1, bins_y = area.w - area.y + 1;
+  out.bins_x = area.z - area.x + 1, out.bins_y = area.w - area.y + 1;
   // Bin lists beyond kMaxListed entries (64 MiB) fall back to the centre pass as well.
   const std::int64_t max_listed = std::min<std::int64_t>(max_texels_, kMaxListed);
-  if (listed > max_listed || std::int64_t(bins_x) * bins_y > max_listed) {
-    records_clock.reset();
-    if (history) band_.broken = true;
-    return drawByCentre(records(false));
-  }
+  if (out.listed > max_listed || std::int64_t(out.bins_x) * out.bins_y > max_listed)
+    return std::nullopt;
   // A bin is first item and count.
-  std::vector<glm::ivec2> bins(std::size_t(bins_x) * bins_y, glm::ivec2(0));
-  auto binAt = [&](int x, int y) -> glm::ivec2& {
-    return bins[std::size_t(y - area.y) * bins_x + (x - area.x)];
-  };
+  out.bins.assign(std::size_t(out.bins_x) * out.bins_y, glm::ivec2(0));
   for (const glm::ivec4& span : spans)
     for (int y = span.y; y <= span.w; ++y)
-      for (int x = span.x; x <= span.z; ++x) ++binAt(x, y).y;
+      for (int x = span.x; x <= span.z; ++x) ++out.at(x, y).y;
   int deepest = 0, first = 0;
-  for (glm::ivec2& b : bins) {
+  for (glm::ivec2& b : out.bins) {
     deepest = std::max(deepest, b.y);
     b.x = first;
     first += b.y;
     b.y = 0;
   }
-  // Where no two ellipsoids share a bin, no pixel has two hits to order: the centre pass
-  // draws the same image, faster; but for a continuous view's, which go into its history.
   if (deepest <= 1 && !history) {
-    records_clock.reset();
-    return drawByCentre(ordered);
+    out.centre_suffices = true;
+    return out;
   }
-  std::vector<GLint> items(static_cast<std::size_t>(first));
+  out.items.resize(static_cast<std::size_t>(first));
   for (std::size_t i = 0; i < spans.size(); ++i)
     for (int y = spans[i].y; y <= spans[i].w; ++y)
       for (int x = spans[i].x; x <= spans[i].z; ++x) {
-        glm::ivec2& b = binAt(x, y);
-        items[std::size_t(b.x + b.y++)] = GLint(i);
+        glm::ivec2& b = out.at(x, y);
+        out.items[std::size_t(b.x + b.y++)] = GLint(i);
       }
-  records_clock.reset();
+  return out;
+}
+
+GLuint EllipsoidRenderer::perPixelProgram(const Batch& b, const BinLists& bins,
+                                          EllipsoidProgram which, int rate, bool history_too) {
+  EllipsoidPassLayout layout = b.base;
+  layout.program = which;
+  layout.shading_rate = rate;
+  layout.history = history_too;
+  const GLuint p = program(layout);
+  setCloudUniforms(p, b.scene, b.cloud, b.texture, layout.texture, b.band);
+  gl_.ProgramUniform2i(p, gl_.GetUniformLocation(p, "u_bin_origin"), bins.area.x, bins.area.y);
+  gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_bins_x"), bins.bins_x);
+  gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_bin_size"), kPerPixelBinSize);
+  const double shown = std::max(b.target.seen, 1e-6);
+  gl_.ProgramUniform1f(p, gl_.GetUniformLocation(p, "u_opaque"),
+                       float(std::max(0.0, 1.0 - (1.0 - kOpaqueCoverage) / shown)));
+  return p;
+}
+
+void EllipsoidRenderer::drawBinRect(GLuint program, glm::ivec2 size, int step, glm::ivec4 rect,
+                                    int extra) {
+  auto ndc = [&](int bins, int axis, int more) {
+    return float(2.0 * std::min(double(bins * kPerPixelBinSize) / step + more, double(size[axis])) /
+                     size[axis] -
+                 1.0);
+  };
+  const float x0 = ndc(rect.x, 0, 0), y0 = ndc(rect.y, 1, 0), x1 = ndc(rect.z + 1, 0, extra),
+              y1 = ndc(rect.w + 1, 1, extra);
+  const glm::vec2 polygon[4] = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
+  gl_.UseProgram(program);
+  gl_.ProgramUniform2fv(program, gl_.GetUniformLocation(program, "u_polygon"), 4, &polygon[0].x);
+  gl_.DrawArrays(GL_TRIANGLE_FAN, 0, 4);
+}
+
+bool EllipsoidRenderer::drawArea(const BinLists& bins,
+                                 const std::function<void(glm::ivec4)>& draw) {
+  constexpr std::int64_t kBinPixels = std::int64_t(kPerPixelBinSize) * kPerPixelBinSize;
+  const glm::ivec4 area = bins.area;
+  if (!cancel_ || bins.listed * kBinPixels <= kCancelWork) {
+    draw(area);
+    queued_work_ += bins.listed * kBinPixels;
+    return true;
+  }
+  // Heavy: bands of whole bin rows of about kCancelWork hit tests (a row heavier than that
+  // alone in runs of its bins), each paced (paceQueued) before the flag is read.
+  auto finished = [&] {
+    paceQueued();
+    return stopNow();
+  };
+  int band_from = area.y;
+  std::int64_t band_work = 0;
+  for (int y = area.y; y <= area.w; ++y) {
+    std::int64_t row_work = 0;
+    for (int x = area.x; x <= area.z; ++x) row_work += bins.at(x, y).y * kBinPixels;
+    if (band_work > 0 && band_work + row_work > kCancelWork) {
+      draw({area.x, band_from, area.z, y - 1});
+      if (finished()) return false;
+      band_from = y, band_work = 0;
+    }
+    if (row_work <= kCancelWork) {
+      band_work += row_work;
+      continue;
+    }
+    int run_from = area.x;
+    std::int64_t run_work = 0;
+    for (int x = area.x; x <= area.z; ++x) {
+      const std::int64_t work = bins.at(x, y).y * kBinPixels;
+      if (run_work > 0 && run_work + work > kCancelWork) {
+        draw({run_from, y, x - 1, y});
+        if (finished()) return false;
+        run_from = x, run_work = 0;
+      }
+      run_work += work;
+    }
+    draw({run_from, y, area.z, y});
+    if (finished()) return false;
+    band_from = y + 1;
+  }
+  if (band_from <= area.w) draw({area.x, band_from, area.z, area.w});
+  return true;
+}
+
+void EllipsoidRenderer::drawPerPixel(const Batch& b, const std::vector<EllipsoidRecord>& ordered,
+                                     const BinLists& bins) {
   // Behind a thick veil the walk may err by what the veil hides (MODEL.md section 15, "behind
   // the veil"): it ends at a lower coverage, and where the error allowed is large enough it
   // runs first at one pixel in rate^2 into the samples texture, then over every pixel, which
@@ -978,134 +1101,57 @@ void EllipsoidRenderer::drawDirect(const ViewPlan& view, const std::vector<std::
   // Elsewhere it runs so at the heaps' own shading rate when one is asked (RenderSettings::
   // heap_shading_rate), and the samples are blended everywhere (MODEL.md section 15, "reduced
   // rate").
-  const double shown = std::max(target.seen, 1e-6);
-  const double tolerance = kVeiledTolerance / shown;
+  const double tolerance = kVeiledTolerance / std::max(b.target.seen, 1e-6);
   const bool veiled = tolerance >= kVeiledSamplingFrom;
-  const bool reduced = !veiled && settings.heap_shading_rate > 1;
+  const bool reduced = !veiled && b.settings.heap_shading_rate > 1;
   // A continuous view walks one pixel in heap_refresh each frame, at a sample offset that goes
   // round them all, and reuses its last frame for the others; the first frame after a cut is
   // the exact one (MODEL.md section 15, "reuse across frames"; beginBand). Behind a veil too:
   // there the reuse takes the place of the veiled sampling, with the veil's lower opacity cut.
-  const glm::ivec2 frame_size(target.width, target.height);
-  const bool reuse = history && band_.reuse;
-  const int rate = targets_drawn ? 1
-                   : reuse       ? band_.rate
-                   : history     ? 1
-                   : veiled      ? kVeiledShadingRate
-                   : reduced     ? settings.heap_shading_rate
-                                 : 1;
-  auto perPixelProgram = [&](EllipsoidProgram which, bool history_too = false) {
-    EllipsoidPassLayout layout = base;
-    layout.program = which;
-    layout.shading_rate = rate;
-    layout.history = history_too;
-    const GLuint p = program(layout);
-    setCloudUniforms(p, scene, cloud, texture, layout.texture, band);
-    gl_.ProgramUniform2i(p, gl_.GetUniformLocation(p, "u_bin_origin"), area.x, area.y);
-    gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_bins_x"), bins_x);
-    gl_.ProgramUniform1i(p, gl_.GetUniformLocation(p, "u_bin_size"), kPerPixelBinSize);
-    gl_.ProgramUniform1f(p, gl_.GetUniformLocation(p, "u_opaque"),
-                         float(std::max(0.0, 1.0 - (1.0 - kOpaqueCoverage) / shown)));
-    return p;
-  };
+  const bool reuse = b.history && band_.reuse;
+  const int rate = b.targets_drawn ? 1
+                   : reuse         ? band_.rate
+                   : b.history     ? 1
+                   : veiled        ? kVeiledShadingRate
+                   : reduced       ? b.settings.heap_shading_rate
+                                   : 1;
   bindFrameTexture(kRecordTextureUnit, GL_RGBA32F, ordered.data(),
                    ordered.size() * sizeof(EllipsoidRecord));
-  bindFrameTexture(kBinTextureUnit, GL_RG32I, bins.data(), bins.size() * sizeof(glm::ivec2));
-  bindFrameTexture(kBinItemTextureUnit, GL_R32I, items.data(), items.size() * sizeof(GLint));
-  // Draws bins [bx0, bx1] x [by0, by1] (absolute bin indices) with `program` into a viewport
-  // of `size` whose pixel i stands at frame pixel i * step: each pixel composites every hit of
-  // its bin, so disjoint rectangles give the image one quad gives. Samples are drawn to the
-  // end of the last bin, past the frame's edge, for the pixels next to it.
-  // `extra` more samples are drawn past the last bin (a continuous view's shifted samples).
-  auto drawRect = [&](GLuint program, glm::ivec2 size, int step, int bx0, int by0, int bx1, int by1,
-                      int extra = 0) {
-    auto ndc = [&](int bins, int axis, int more) {
-      return float(2.0 *
-                       std::min(double(bins * kPerPixelBinSize) / step + more, double(size[axis])) /
-                       size[axis] -
-                   1.0);
-    };
-    const float x0 = ndc(bx0, 0, 0), y0 = ndc(by0, 1, 0), x1 = ndc(bx1 + 1, 0, extra),
-                y1 = ndc(by1 + 1, 1, extra);
-    const glm::vec2 polygon[4] = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
-    gl_.UseProgram(program);
-    gl_.ProgramUniform2fv(program, gl_.GetUniformLocation(program, "u_polygon"), 4, &polygon[0].x);
-    gl_.DrawArrays(GL_TRIANGLE_FAN, 0, 4);
-  };
-  // Draws the batch's area with `draw(bx0, by0, bx1, by1)`; false once cancelled.
-  constexpr std::int64_t kBinPixels = std::int64_t(kPerPixelBinSize) * kPerPixelBinSize;
-  auto drawArea = [&](auto&& draw) {
-    if (!cancel_ || listed * kBinPixels <= kCancelWork) {
-      draw(area.x, area.y, area.z, area.w);
-      queued_work_ += listed * kBinPixels;
-      return true;
-    }
-    // Heavy: bands of whole bin rows of about kCancelWork hit tests (a row heavier than that
-    // alone in runs of its bins), each paced (paceQueued) before the flag is read.
-    auto finished = [&] {
-      paceQueued();
-      return stopNow();
-    };
-    int band_from = area.y;
-    std::int64_t band_work = 0;
-    for (int y = area.y; y <= area.w; ++y) {
-      std::int64_t row_work = 0;
-      for (int x = area.x; x <= area.z; ++x) row_work += binAt(x, y).y * kBinPixels;
-      if (band_work > 0 && band_work + row_work > kCancelWork) {
-        draw(area.x, band_from, area.z, y - 1);
-        if (finished()) return false;
-        band_from = y, band_work = 0;
-      }
-      if (row_work <= kCancelWork) {
-        band_work += row_work;
-        continue;
-      }
-      int run_from = area.x;
-      std::int64_t run_work = 0;
-      for (int x = area.x; x <= area.z; ++x) {
-        const std::int64_t work = binAt(x, y).y * kBinPixels;
-        if (run_work > 0 && run_work + work > kCancelWork) {
-          draw(run_from, y, x - 1, y);
-          if (finished()) return false;
-          run_from = x, run_work = 0;
-        }
-        run_work += work;
-      }
-      draw(run_from, y, area.z, y);
-      if (finished()) return false;
-      band_from = y + 1;
-    }
-    if (band_from <= area.w) draw(area.x, band_from, area.z, area.w);
-    return true;
-  };
+  bindFrameTexture(kBinTextureUnit, GL_RG32I, bins.bins.data(),
+                   bins.bins.size() * sizeof(glm::ivec2));
+  bindFrameTexture(kBinItemTextureUnit, GL_R32I, bins.items.data(),
+                   bins.items.size() * sizeof(GLint));
   ++stats_->ellipsoid_passes;
-  const GLfloat nothing[4] = {0.0f, 0.0f, 0.0f, 0.0f};
-  if (rate == 1) {
-    const GLuint p = perPixelProgram(EllipsoidProgram::kFusedPerPixel, history != nullptr);
-    auto draw = [&] {
-      return drawArea([&](int bx0, int by0, int bx1, int by1) {
-        drawRect(p, frame_size, 1, bx0, by0, bx1, by1);
-      });
-    };
-    if (!history)
-      draw();
-    else if (!drawWithHistory(target, true, draw))
-      band_.cancelled = true;
-    return;
-  }
+  if (rate != 1) return drawSampled(b, bins, rate, reduced, tolerance);
+  const GLuint p = perPixelProgram(b, bins, EllipsoidProgram::kFusedPerPixel, 1, b.history);
+  const glm::ivec2 frame_size(b.target.width, b.target.height);
+  auto draw = [&] {
+    return drawArea(bins, [&](glm::ivec4 rect) { drawBinRect(p, frame_size, 1, rect); });
+  };
+  if (!b.history)
+    draw();
+  else if (!drawWithHistory(b.target, true, draw))
+    band_.cancelled = true;
+}
+
+void EllipsoidRenderer::drawSampled(const Batch& b, const BinLists& bins, int rate, bool reduced,
+                                    double tolerance) {
   // Sample c stands at pixel c * rate; one more than the frame needs on each axis, so that
   // every pixel has samples on both sides. Those outside the area stay 0: nothing of the batch
   // is there. A continuous view's grid is its band's (beginBand), which every batch of the band
   // samples over the others.
+  const bool reuse = b.history && band_.reuse;
+  const glm::ivec2 frame_size(b.target.width, b.target.height);
   const glm::ivec2 origin = reuse ? band_.origin : glm::ivec2(0);
   const glm::ivec2 size = reuse ? band_.size : (frame_size - 1) / rate + 2;
   if (!reuse) {  // only the colours are read: the distances are a continuous view's
     prepareSamples(size);
+    const GLfloat nothing[4] = {0.0f, 0.0f, 0.0f, 0.0f};
     gl_.ClearNamedFramebufferfv(samples_framebuffer_.get(), GL_COLOR, 0, nothing);
   }
-  const GLuint s = perPixelProgram(EllipsoidProgram::kFusedSamples);
+  const GLuint s = perPixelProgram(b, bins, EllipsoidProgram::kFusedSamples, rate);
   gl_.ProgramUniform2i(s, gl_.GetUniformLocation(s, "u_sample_origin"), origin.x, origin.y);
-  gl_.ProgramUniform1i(s, gl_.GetUniformLocation(s, "u_bins_y"), bins_y);
+  gl_.ProgramUniform1i(s, gl_.GetUniformLocation(s, "u_bins_y"), bins.bins_y);
   gl_.BindFramebuffer(GL_FRAMEBUFFER, samples_framebuffer_.get());
   gl_.Viewport(0, 0, size.x, size.y);
   if (reuse) {
@@ -1116,54 +1162,36 @@ void EllipsoidRenderer::drawDirect(const ViewPlan& view, const std::vector<std::
   } else {
     gl_.Disable(GL_BLEND);
   }
-  const bool done = drawArea([&](int bx0, int by0, int bx1, int by1) {
-    drawRect(s, size, rate, bx0, by0, bx1, by1, reuse ? 2 : 0);
-  });
+  const bool done =
+      drawArea(bins, [&](glm::ivec4 rect) { drawBinRect(s, size, rate, rect, reuse ? 2 : 0); });
   gl_.BlendEquationi(1, GL_FUNC_ADD);
   gl_.Enable(GL_BLEND);
-  gl_.BindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
-  gl_.Viewport(0, 0, target.width, target.height);
+  gl_.BindFramebuffer(GL_FRAMEBUFFER, b.target.framebuffer);
+  gl_.Viewport(0, 0, b.target.width, b.target.height);
   if (reuse) {
     if (!done) band_.cancelled = true;
+    const glm::ivec4 area = bins.area;
     for (int y = area.y; y <= area.w; ++y)
       for (int x = area.x; x <= area.z; ++x)
-        if (binAt(x, y).y > 0) band_.bins[std::size_t(y) * band_.bins_x + x] = 1;
+        if (bins.at(x, y).y > 0) band_.bins[std::size_t(y) * band_.bins_x + x] = 1;
     ++stats_->sampled_passes;
     return;
   }
   if (!done) return;
   timer_->settle();  // the samples are read next
+  resolveSamples(b, bins, rate, size, reduced, tolerance);
+}
+
+void EllipsoidRenderer::resolveSamples(const Batch& b, const BinLists& bins, int rate,
+                                       glm::ivec2 size, bool reduced, double tolerance) {
+  const glm::ivec4 area = bins.area;
   const glm::ivec2 from = glm::ivec2(area.x, area.y) * kPerPixelBinSize / rate;
   const glm::ivec2 end = (glm::ivec2(area.z, area.w) + 1) * kPerPixelBinSize / rate;  // samples
-  // The blended runs in one draw; the walked ones, when the frame can be cancelled, in groups
-  // of about kCancelWork hit tests.
-  auto drawRuns = [&](EllipsoidProgram which, const std::vector<glm::ivec4>& runs) {
-    const GLuint q = perPixelProgram(which);
-    const bool chunked = cancel_ && which == EllipsoidProgram::kFusedRest;
-    std::size_t first = 0;
-    std::int64_t work = 0;
-    for (std::size_t i = 0; i < runs.size(); ++i) {
-      const glm::ivec4 r = runs[i];
-      for (int bx = r.x / kPerPixelBinSize; chunked && bx * kPerPixelBinSize < r.z; ++bx)
-        work += std::int64_t(binAt(bx, r.y / kPerPixelBinSize).y) * rate *
-                (std::min(r.z, (bx + 1) * kPerPixelBinSize) - std::max(r.x, bx * kPerPixelBinSize));
-      const bool last = i + 1 == runs.size();
-      if (!last && work <= kCancelWork) continue;
-      bindFrameTexture(kRectTextureUnit, GL_RGBA32I, runs.data() + first,
-                       (i + 1 - first) * sizeof(glm::ivec4));
-      gl_.UseProgram(q);
-      gl_.DrawArrays(GL_TRIANGLES, 0, GLsizei(6 * (i + 1 - first)));
-      if (last) break;
-      paceQueued();
-      if (stopNow()) return;
-      first = i + 1, work = 0;
-    }
-  };
   gl_.BindTextureUnit(kSamplesTextureUnit, samples_.get());
   if (reduced) {
     // The samples are brought to full size by their bilinear blend over the whole area, with
     // no readback (MODEL.md section 15, "reduced rate").
-    drawRuns(EllipsoidProgram::kFusedBlend, {glm::ivec4(from * rate, end * rate)});
+    drawRuns(b, bins, EllipsoidProgram::kFusedBlend, rate, {glm::ivec4(from * rate, end * rate)});
     ++stats_->sampled_passes;
     return;
   }
@@ -1193,9 +1221,35 @@ void EllipsoidRenderer::drawDirect(const ViewPlan& view, const std::vector<std::
       (blend ? blended : walked).push_back(glm::ivec4(x, y, to, y + 1) * rate);
       x = to;
     }
-  if (!blended.empty()) drawRuns(EllipsoidProgram::kFusedBlend, blended);
-  if (!walked.empty()) drawRuns(EllipsoidProgram::kFusedRest, walked);
+  if (!blended.empty()) drawRuns(b, bins, EllipsoidProgram::kFusedBlend, rate, blended);
+  if (!walked.empty()) drawRuns(b, bins, EllipsoidProgram::kFusedRest, rate, walked);
   ++stats_->sampled_passes;
+}
+
+void EllipsoidRenderer::drawRuns(const Batch& b, const BinLists& bins, EllipsoidProgram which,
+                                 int rate, const std::vector<glm::ivec4>& runs) {
+  // The blended runs in one draw; the walked ones, when the frame can be cancelled, in groups
+  // of about kCancelWork hit tests.
+  const GLuint q = perPixelProgram(b, bins, which, rate);
+  const bool chunked = cancel_ && which == EllipsoidProgram::kFusedRest;
+  std::size_t first = 0;
+  std::int64_t work = 0;
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    const glm::ivec4 r = runs[i];
+    for (int bx = r.x / kPerPixelBinSize; chunked && bx * kPerPixelBinSize < r.z; ++bx)
+      work += std::int64_t(bins.at(bx, r.y / kPerPixelBinSize).y) * rate *
+              (std::min(r.z, (bx + 1) * kPerPixelBinSize) - std::max(r.x, bx * kPerPixelBinSize));
+    const bool last = i + 1 == runs.size();
+    if (!last && work <= kCancelWork) continue;
+    bindFrameTexture(kRectTextureUnit, GL_RGBA32I, runs.data() + first,
+                     (i + 1 - first) * sizeof(glm::ivec4));
+    gl_.UseProgram(q);
+    gl_.DrawArrays(GL_TRIANGLES, 0, GLsizei(6 * (i + 1 - first)));
+    if (last) break;
+    paceQueued();
+    if (stopNow()) return;
+    first = i + 1, work = 0;
+  }
 }
 
 void EllipsoidRenderer::prepareSamples(glm::ivec2 size) {

@@ -165,6 +165,9 @@ class EllipsoidRenderer {
   // False when the cloud is too near for an impostor; then the caller draws it directly.
   bool drawImpostor(const ViewPlan& view, std::size_t index, const RenderSettings& settings,
                     const PassTarget& target, bool targets_drawn, const AltitudeBand& band);
+  // Draws the cloud alone into its impostor's texture, from the eye towards its centre.
+  void renderImpostor(const ViewPlan& plan, std::size_t index, int size,
+                      const RenderSettings& settings, const PassTarget& target, Impostor& impostor);
   GLuint program(const EllipsoidPassLayout& layout);
   CachedTexture& cachedTexture(const SolidTextureSpec& spec, const RenderSettings& settings);
   // Binds the texture's tables (the baked Gardner sums, or a Perlin table), baking them first
@@ -233,6 +236,72 @@ class EllipsoidRenderer {
   static constexpr float kNoSampleDistance = 3.4e38f;
   void finishBand(const Scene& scene, const PassTarget& target);
   BandReuse band_;
+
+  // The parts of drawDirect. Visible ellipsoids with the back-to-front key (the front-to-back
+  // key, the nearest a hit can be, is the record's order.z).
+  struct Visible {
+    double centre_distance;
+    EllipsoidRecord record;
+  };
+  // What the passes of one batch share.
+  struct Batch {
+    const Scene& scene;
+    const EllipsoidCloud& cloud;  // the first of the batch, whose look stands for all
+    CachedTexture& texture;
+    const RenderSettings& settings;
+    const PassTarget& target;
+    const AltitudeBand& band;
+    EllipsoidPassLayout base;
+    HeapHistory* history;  // one of a continuous view's band of batches, or null
+    bool targets_drawn;
+  };
+  // The per-pixel pass's screen bins over a batch's area (absolute bin indices in x, y, z, w
+  // = first x, first y, last x, last y), each its first item and count, and the items: records
+  // in the order drawn.
+  struct BinLists {
+    glm::ivec4 area{0};
+    int bins_x = 0, bins_y = 0;
+    std::int64_t listed = 0;  // entries over all bins
+    std::vector<glm::ivec2> bins;
+    std::vector<GLint> items;
+    // No two ellipsoids share a bin (and no history is kept): the centre pass draws the same.
+    bool centre_suffices = false;
+    glm::ivec2& at(int x, int y) { return bins[std::size_t(y - area.y) * bins_x + (x - area.x)]; }
+    const glm::ivec2& at(int x, int y) const {
+      return bins[std::size_t(y - area.y) * bins_x + (x - area.x)];
+    }
+  };
+  // The batch's records, made on up to kRecordThreads threads; `total` its ellipsoids.
+  std::vector<Visible> visibleRecords(const ViewPlan& view, const std::vector<std::size_t>& indices,
+                                      bool spotlight, int& total);
+  std::vector<EllipsoidRecord> orderedRecords(std::vector<Visible>& visible, bool front_to_back);
+  EllipsoidPassLayout batchLayout(const Scene& scene, const EllipsoidCloud& cloud,
+                                  CachedTexture& texture, const RenderSettings& settings,
+                                  bool spotlight, bool targets_drawn);
+  // Ellipsoids blended in the records' order, by their centres.
+  void drawByCentre(const Batch& b, const std::vector<EllipsoidRecord>& ordered);
+  // None when the lists would not fit in buffer textures.
+  std::optional<BinLists> binLists(const std::vector<EllipsoidRecord>& ordered,
+                                   const PassTarget& target, bool history) const;
+  // The per-pixel pass: every hit of the batch composited front to back, at every pixel or
+  // first at a sample rate (drawSampled, resolveSamples).
+  void drawPerPixel(const Batch& b, const std::vector<EllipsoidRecord>& ordered,
+                    const BinLists& bins);
+  GLuint perPixelProgram(const Batch& b, const BinLists& bins, EllipsoidProgram which, int rate,
+                         bool history_too = false);
+  // Draws bins `rect` with `program` into a viewport of `size` whose pixel i stands at frame
+  // pixel i * step: each pixel composites every hit of its bin, so disjoint rectangles give the
+  // image one quad gives. Samples are drawn to the end of the last bin, past the frame's edge,
+  // for the pixels next to it; `extra` more past the last bin (a continuous view's shifted
+  // samples).
+  void drawBinRect(GLuint program, glm::ivec2 size, int step, glm::ivec4 rect, int extra = 0);
+  // Draws the batch's area with `draw(rect)`; false once cancelled.
+  bool drawArea(const BinLists& bins, const std::function<void(glm::ivec4)>& draw);
+  void drawSampled(const Batch& b, const BinLists& bins, int rate, bool reduced, double tolerance);
+  void resolveSamples(const Batch& b, const BinLists& bins, int rate, glm::ivec2 size, bool reduced,
+                      double tolerance);
+  void drawRuns(const Batch& b, const BinLists& bins, EllipsoidProgram which, int rate,
+                const std::vector<glm::ivec4>& runs);
 
   const GlApi& gl_;
   GlObject vertex_array_;  // empty: attribute-less draws

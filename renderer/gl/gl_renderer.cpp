@@ -189,6 +189,44 @@ bool softwareGl(const std::string& renderer) {
 
 }  // namespace
 
+// Lines across a camera's screen, as a x + b y + c >= 0 over [-1, 1]^2.
+class ScreenLines {
+ public:
+  explicit ScreenLines(const Camera& camera) : camera_(camera), basis_(viewBasis(camera)) {}
+
+  // How far the line a x + b y + c = 0 moves over `pixels` pixels, in c.
+  double pixelsOf(double a, double b, double pixels) const {
+    return pixels * (std::abs(a) * 2.0 / camera_.width + std::abs(b) * 2.0 / camera_.height);
+  }
+  // The screen region whose rays climb (sign = 1) or descend (sign = -1), widened by
+  // `margin_pixels`: ray.z is linear across the image, so the horizon is a straight line.
+  std::vector<glm::vec2> sideOfHorizon(double sign, double margin_pixels) const {
+    const ViewBasis& basis = basis_;
+    const double a = sign * basis.right.z * basis.tan_half_vfov * basis.aspect;
+    const double b = sign * basis.up.z * basis.tan_half_vfov;
+    return clipScreenToHalfPlane(a, b, sign * basis.forward.z + pixelsOf(a, b, margin_pixels));
+  }
+  // A far deck is clear within its hole (CloudLayer::hole_radius_m of horizontal distance from
+  // the camera), so a ray steeper than |h| / radius never shows it. With r = forward +
+  // x right' + y up' (right' and up' scaled to the screen's half extents), |r.xy| <= |r| <=
+  // r_max over the screen, so every ray that can reach the deck beyond its hole satisfies
+  // sign r.z <= r_max |h| / radius: a half-plane of the screen along the horizon. This is the
+  // strip of `layer` on side `sign`, as the line (a, b, c); none for a layer without a hole.
+  std::optional<glm::dvec3> strip(const CloudLayer& l, double sign) const {
+    if (l.hole_radius_m <= 0.0) return std::nullopt;
+    const ViewBasis& basis = basis_;
+    const double r_max = std::sqrt(1.0 + basis.tan_half_vfov * basis.tan_half_vfov *
+                                             (1.0 + basis.aspect * basis.aspect));
+    const double reach = r_max * std::abs(l.altitude_m - camera_.position.z) / l.hole_radius_m;
+    return glm::dvec3(-sign * basis.right.z * basis.tan_half_vfov * basis.aspect,
+                      -sign * basis.up.z * basis.tan_half_vfov, reach - sign * basis.forward.z);
+  }
+
+ private:
+  const Camera& camera_;
+  ViewBasis basis_;
+};
+
 GlRenderer::GlRenderer(const GlPlatform& platform)
     : gl_(platform.gl()),
       vertex_array_(createVertexArray(gl_)),
@@ -542,7 +580,6 @@ void GlRenderer::drawSkyPass(const Scene& scene, const RenderSettings& settings,
 void GlRenderer::drawSkyGroup(const Scene& scene, const RenderSettings& settings,
                               const std::vector<LayerSlot>& above,
                               const std::vector<LayerSlot>& below, bool background, bool targets) {
-  const Camera& camera = scene.camera;
   SkyPassLayout base;
   base.air = sceneHasAir(scene);
   base.term_filter = settings.term_filter;
@@ -555,20 +592,6 @@ void GlRenderer::drawSkyGroup(const Scene& scene, const RenderSettings& settings
   }
   const bool fused = settings.sky_passes == SkyPasses::kFused &&
                      int(std::max(above.size(), below.size())) <= kMaxLayerSlots;
-
-  // The screen region whose rays climb (sign = 1) or descend (sign = -1), widened by
-  // `margin_pixels`: ray.z is linear across the image, so the horizon is a straight line.
-  const ViewBasis basis = viewBasis(camera);
-  // How far the line a x + b y + c = 0 moves over `pixels` pixels, in c.
-  auto pixelsOf = [&](double a, double b, double pixels) {
-    return pixels * (std::abs(a) * 2.0 / camera.width + std::abs(b) * 2.0 / camera.height);
-  };
-  auto sideOfHorizon = [&](double sign, double margin_pixels) {
-    const double a = sign * basis.right.z * basis.tan_half_vfov * basis.aspect;
-    const double b = sign * basis.up.z * basis.tan_half_vfov;
-    return clipScreenToHalfPlane(a, b, sign * basis.forward.z + pixelsOf(a, b, margin_pixels));
-  };
-
   // Every pass writes premultiplied colour and coverage; a pass with the background
   // overwrites, the others blend "over".
   gl_.BlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
@@ -576,58 +599,8 @@ void GlRenderer::drawSkyGroup(const Scene& scene, const RenderSettings& settings
     gl_.Disable(GL_BLEND);
   else
     gl_.Enable(GL_BLEND);
-  // A far deck is clear within its hole (CloudLayer::hole_radius_m of horizontal distance from
-  // the camera), so a ray steeper than |h| / radius never shows it. With r = forward +
-  // x right' + y up' (right' and up' scaled to the screen's half extents), |r.xy| <= |r| <=
-  // r_max over the screen, so every ray that can reach the deck beyond its hole satisfies
-  // sign r.z <= r_max |h| / radius: a half-plane of the screen along the horizon. This is the
-  // strip of slot `slot`, as the line a x + b y + c >= 0; none for a layer without a hole.
-  const double r_max = std::sqrt(1.0 + basis.tan_half_vfov * basis.tan_half_vfov *
-                                           (1.0 + basis.aspect * basis.aspect));
-  auto strip = [&](const LayerSlot& slot, double sign) -> std::optional<glm::dvec3> {
-    const CloudLayer& l = *slot.layer;
-    if (l.hole_radius_m <= 0.0) return std::nullopt;
-    const double reach = r_max * std::abs(l.altitude_m - camera.position.z) / l.hole_radius_m;
-    return glm::dvec3(-sign * basis.right.z * basis.tan_half_vfov * basis.aspect,
-                      -sign * basis.up.z * basis.tan_half_vfov, reach - sign * basis.forward.z);
-  };
-  if (fused) {
-    // One pass per side of the horizon, each with the background and that side's layers:
-    // pixels below the horizon never run the code of layers above the camera. Where that
-    // side has far decks, it is cut again along the widest of their strips: beyond it the
-    // pass leaves them out. The polygons share their edges exactly, so every pixel is drawn
-    // once.
-    for (const auto* side : {&above, &below}) {
-      if (!background && side->empty()) continue;
-      const double sign = side == &above ? 1.0 : -1.0;
-      const std::vector<glm::vec2> polygon = sideOfHorizon(sign, 0.0);
-      if (polygon.empty()) continue;
-      std::optional<glm::dvec3> widest;
-      std::vector<LayerSlot> open;  // the slots drawn beyond the widest strip
-      for (const LayerSlot& slot : *side) {
-        const std::optional<glm::dvec3> line = strip(slot, sign);
-        if (!line)
-          open.push_back(slot);
-        else if (!widest || line->z > widest->z)
-          widest = line;
-      }
-      auto draw = [&](const std::vector<LayerSlot>& slots, const std::vector<glm::vec2>& area) {
-        if (area.empty() || (!background && slots.empty())) return;
-        SkyPassLayout layout = base;
-        layout.background = background;
-        for (const LayerSlot& slot : slots)
-          (side == &above ? layout.above : layout.below).push_back(slot.kind);
-        drawSkyPass(scene, settings, layout, slots, area);
-      };
-      if (!widest) {
-        draw(*side, polygon);
-        continue;
-      }
-      draw(*side, clipPolygon(polygon, widest->x, widest->y, widest->z));
-      draw(open, clipPolygon(polygon, -widest->x, -widest->y, -widest->z));
-    }
-    return;
-  }
+  const ScreenLines lines(scene.camera);
+  if (fused) return drawFusedSky(scene, settings, base, lines, above, below, background);
   if (background) {
     // One triangle covering the screen: no diagonal edge for the rasteriser to split tiles on.
     drawSkyPass(scene, settings, base, {}, {{-1, -1}, {3, -1}, {-1, 3}});
@@ -638,15 +611,56 @@ void GlRenderer::drawSkyGroup(const Scene& scene, const RenderSettings& settings
       // Only where rays meet the plane (and reach beyond a far deck's hole), plus two pixels
       // the shader leaves untouched.
       const double sign = side == &above ? 1.0 : -1.0;
-      std::vector<glm::vec2> polygon = sideOfHorizon(sign, 2.0);
-      if (const std::optional<glm::dvec3> line = strip(slot, sign))
-        polygon = clipPolygon(polygon, line->x, line->y, line->z + pixelsOf(line->x, line->y, 2.0));
+      std::vector<glm::vec2> polygon = lines.sideOfHorizon(sign, 2.0);
+      if (const std::optional<glm::dvec3> line = lines.strip(*slot.layer, sign))
+        polygon =
+            clipPolygon(polygon, line->x, line->y, line->z + lines.pixelsOf(line->x, line->y, 2.0));
       if (polygon.empty()) continue;
       SkyPassLayout layout = base;
       layout.background = false;
       (side == &above ? layout.above : layout.below).push_back(slot.kind);
       drawSkyPass(scene, settings, layout, {slot}, polygon);
     }
+}
+
+void GlRenderer::drawFusedSky(const Scene& scene, const RenderSettings& settings,
+                              const SkyPassLayout& base, const ScreenLines& lines,
+                              const std::vector<LayerSlot>& above,
+                              const std::vector<LayerSlot>& below, bool background) {
+  // One pass per side of the horizon, each with the background and that side's layers:
+  // pixels below the horizon never run the code of layers above the camera. Where that
+  // side has far decks, it is cut again along the widest of their strips: beyond it the
+  // pass leaves them out. The polygons share their edges exactly, so every pixel is drawn
+  // once.
+  for (const auto* side : {&above, &below}) {
+    if (!background && side->empty()) continue;
+    const double sign = side == &above ? 1.0 : -1.0;
+    const std::vector<glm::vec2> polygon = lines.sideOfHorizon(sign, 0.0);
+    if (polygon.empty()) continue;
+    std::optional<glm::dvec3> widest;
+    std::vector<LayerSlot> open;  // the slots drawn beyond the widest strip
+    for (const LayerSlot& slot : *side) {
+      const std::optional<glm::dvec3> line = lines.strip(*slot.layer, sign);
+      if (!line)
+        open.push_back(slot);
+      else if (!widest || line->z > widest->z)
+        widest = line;
+    }
+    auto draw = [&](const std::vector<LayerSlot>& slots, const std::vector<glm::vec2>& area) {
+      if (area.empty() || (!background && slots.empty())) return;
+      SkyPassLayout layout = base;
+      layout.background = background;
+      for (const LayerSlot& slot : slots)
+        (side == &above ? layout.above : layout.below).push_back(slot.kind);
+      drawSkyPass(scene, settings, layout, slots, area);
+    };
+    if (!widest) {
+      draw(*side, polygon);
+      continue;
+    }
+    draw(*side, clipPolygon(polygon, widest->x, widest->y, widest->z));
+    draw(open, clipPolygon(polygon, -widest->x, -widest->y, -widest->z));
+  }
 }
 
 void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,

@@ -25,6 +25,7 @@
 namespace nephele {
 
 class LayerTexture;
+class ScreenLines;
 
 class GlRenderer {
  public:
@@ -134,6 +135,10 @@ class GlRenderer {
   void drawSkyGroup(const Scene& scene, const RenderSettings& settings,
                     const std::vector<LayerSlot>& above, const std::vector<LayerSlot>& below,
                     bool background, bool targets);
+  // The fused sky passes: one per side of the horizon, cut along far decks' holes.
+  void drawFusedSky(const Scene& scene, const RenderSettings& settings, const SkyPassLayout& base,
+                    const ScreenLines& lines, const std::vector<LayerSlot>& above,
+                    const std::vector<LayerSlot>& below, bool background);
   void drawSkyPass(const Scene& scene, const RenderSettings& settings, const SkyPassLayout& layout,
                    const std::vector<LayerSlot>& slots, const std::vector<glm::vec2>& polygon);
   // Slot `slot` of the program's arrays, its table on texture unit `unit`.

@@ -399,6 +399,75 @@ class ReferenceTracer {
 
 }  // namespace
 
+namespace {
+
+// What one frame of the reference asks of each pixel.
+struct PixelWork {
+  const ReferenceTracer& tracer;
+  const Camera& camera;
+  ViewBasis basis;
+  int samples;  // per axis
+  int divisor;  // labels: one in divisor x divisor pixels
+  bool colour, labels;
+  const InfraredModel* infrared;
+};
+
+// Pixel (x, y)'s supersampled colour and coverage.
+void traceColour(const PixelWork& w, int x, int y, std::vector<Surface>& hits, Frame& frame) {
+  const int n = w.samples;
+  glm::dvec4 sum(0.0);
+  for (int sy = 0; sy < n; ++sy)
+    for (int sx = 0; sx < n; ++sx) {
+      const glm::dvec3 d =
+          glm::normalize(rayDirection(w.basis, w.camera, x + (sx + 0.5) / n, y + (sy + 0.5) / n));
+      sum += w.tracer.trace(d, hits);
+    }
+  const glm::dvec4 mean = sum / double(n * n);
+  const std::size_t i = std::size_t(y) * w.camera.width + x;
+  for (int c = 0; c < 4; ++c) frame.colour.rgba[i * 4 + c] = float(mean[c]);
+}
+
+// Labels come from the pixel's centre ray, as a rasteriser samples them, or from the centre ray
+// of a divisor x divisor block, copied to the block.
+void traceLabels(const PixelWork& w, int x, int y, std::vector<Surface>& hits, Frame& frame) {
+  const int divisor = w.divisor;
+  RayLabels ray;
+  w.tracer.trace(
+      glm::normalize(rayDirection(w.basis, w.camera, x + 0.5 * divisor, y + 0.5 * divisor)), hits,
+      &ray, kInfinity, w.infrared);
+  for (int by = y; by < std::min(y + divisor, w.camera.height); ++by)
+    for (int bx = x; bx < std::min(x + divisor, w.camera.width); ++bx) {
+      const std::size_t i = std::size_t(by) * w.camera.width + bx;
+      if (!frame.depth.empty()) frame.depth[i] = float(ray.depth);
+      if (!frame.cloud_depth.empty()) frame.cloud_depth[i] = float(ray.cloud_depth);
+      if (!frame.object_id.empty()) frame.object_id[i] = float(ray.object_id);
+      if (!frame.lwir.empty()) frame.lwir[i] = float(ray.lwir);
+      if (!frame.glint.empty()) frame.glint[i] = float(ray.glint);
+    }
+}
+
+// The rows taken from `next_row` until none is left; `progress` (when `report`) told about
+// every tenth.
+void traceRows(const PixelWork& w, std::atomic<int>& next_row, Frame& frame, bool report,
+               const std::function<void(double)>& progress) {
+  std::vector<Surface> hits;
+  int reported_tenths = 0;
+  const int height = w.camera.height;
+  for (int y; (y = next_row.fetch_add(1)) < height;) {
+    if (!w.colour && y % w.divisor != 0) continue;
+    if (report && progress && y * 10 / height > reported_tenths) {
+      reported_tenths = y * 10 / height;
+      progress(double(y) / height);
+    }
+    for (int x = 0; x < w.camera.width; ++x) {
+      if (w.colour) traceColour(w, x, y, hits, frame);
+      if (w.labels && x % w.divisor == 0 && y % w.divisor == 0) traceLabels(w, x, y, hits, frame);
+    }
+  }
+}
+
+}  // namespace
+
 Frame renderReferenceFrame(const Scene& scene, const ReferenceSettings& settings,
                            const FrameRequest& request,
                            const std::function<void(double)>& progress) {
@@ -424,58 +493,21 @@ Frame renderReferenceFrame(const Scene& scene, const ReferenceSettings& settings
   const FramePlan plan(scene, plan_request);
   const ReferenceTracer tracer(plan.view, plan.sea_probe ? &*plan.sea_probe : nullptr,
                                &*plan.heap_shadows, settings.sea_waves);
-  const ViewBasis basis = viewBasis(camera);
-  const int n = std::max(1, settings.samples_per_axis);
-  const int divisor = std::max(1, settings.label_divisor);
-
+  const PixelWork work{tracer,
+                       camera,
+                       viewBasis(camera),
+                       std::max(1, settings.samples_per_axis),
+                       std::max(1, settings.label_divisor),
+                       colour,
+                       labels,
+                       infrared};
   std::atomic<int> next_row{0};
-  auto work = [&](bool report) {
-    std::vector<Surface> hits;
-    int reported_tenths = 0;
-    for (int y; (y = next_row.fetch_add(1)) < camera.height;) {
-      if (!colour && y % divisor != 0) continue;
-      if (report && progress && y * 10 / camera.height > reported_tenths) {
-        reported_tenths = y * 10 / camera.height;
-        progress(double(y) / camera.height);
-      }
-      for (int x = 0; x < camera.width; ++x) {
-        const std::size_t i = std::size_t(y) * camera.width + x;
-        if (colour) {
-          glm::dvec4 sum(0.0);
-          for (int sy = 0; sy < n; ++sy)
-            for (int sx = 0; sx < n; ++sx) {
-              const glm::dvec3 d = glm::normalize(
-                  rayDirection(basis, camera, x + (sx + 0.5) / n, y + (sy + 0.5) / n));
-              sum += tracer.trace(d, hits);
-            }
-          const glm::dvec4 mean = sum / double(n * n);
-          for (int c = 0; c < 4; ++c) frame.colour.rgba[i * 4 + c] = float(mean[c]);
-        }
-        if (labels && x % divisor == 0 && y % divisor == 0) {
-          // Labels come from the pixel's centre ray, as a rasteriser samples them, or from
-          // the centre ray of a divisor x divisor block, copied to the block.
-          RayLabels ray;
-          tracer.trace(
-              glm::normalize(rayDirection(basis, camera, x + 0.5 * divisor, y + 0.5 * divisor)),
-              hits, &ray, kInfinity, infrared);
-          for (int by = y; by < std::min(y + divisor, camera.height); ++by)
-            for (int bx = x; bx < std::min(x + divisor, camera.width); ++bx) {
-              const std::size_t i = std::size_t(by) * camera.width + bx;
-              if (!frame.depth.empty()) frame.depth[i] = float(ray.depth);
-              if (!frame.cloud_depth.empty()) frame.cloud_depth[i] = float(ray.cloud_depth);
-              if (!frame.object_id.empty()) frame.object_id[i] = float(ray.object_id);
-              if (!frame.lwir.empty()) frame.lwir[i] = float(ray.lwir);
-              if (!frame.glint.empty()) frame.glint[i] = float(ray.glint);
-            }
-        }
-      }
-    }
-  };
   const int threads = settings.threads > 0 ? settings.threads
                                            : std::max(1, int(std::thread::hardware_concurrency()));
   std::vector<std::jthread> pool;
-  for (int i = 1; i < threads; ++i) pool.emplace_back(work, false);
-  work(true);
+  for (int i = 1; i < threads; ++i)
+    pool.emplace_back([&] { traceRows(work, next_row, frame, false, progress); });
+  traceRows(work, next_row, frame, true, progress);
   pool.clear();  // join before the frame is handed out
   if (asked.has(Channel::kVisibility)) {
     frame.visibilityFromCoverage();
