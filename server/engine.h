@@ -188,8 +188,9 @@ class Engine {
   void advance(double dt_s);  // one tick
   // Renders a view (float for EXR, else 8-bit) and records its time.
   // `continuous`: a frame of a subscription's stream, which may reuse the view's last frame.
-  void renderFrame(const ViewConfig& view, const ImageRequest& image, struct ViewFrame& frame,
+  void renderFrame(const ViewConfig& view, const ImageRequest& image, struct RenderedView& out,
                    bool continuous = false);
+  void noteRender(double ms);  // a view's render time, for stats and metrics
   void realtimeTicks();
   enum class Delivery {
     kDue,        // realtime: subscriptions whose period has come round
