@@ -55,9 +55,9 @@ inline SharedReply chainReplies(std::vector<SharedReply> replies) {
 
 // Receives a request's reply, once, on a daemon thread (not the caller's).
 using ReplySink = std::function<void(SharedReply)>;
-// Receives subscribed frames; returns false once the client is gone, which ends its
-// subscriptions.
-using FrameSink = std::function<bool(SharedReply)>;
+// Receives what is pushed to a client unasked (its subscriptions' images); returns false
+// once the client is gone, which ends its subscriptions.
+using PushSink = std::function<bool(SharedReply)>;
 // Receives the outcome of a Modbus write or render trigger.
 using DoneSink = std::function<void(std::optional<ProtocolError>)>;
 
@@ -98,7 +98,7 @@ class Engine {
   bool stopping() const;
 
   // Queues work; each returns false (and queues nothing) when the queue is full.
-  bool submit(Request request, std::int64_t client, FrameSink frames, ReplySink done);
+  bool submit(Request request, std::int64_t client, PushSink push, ReplySink done);
   // A Modbus write: every command is checked before any is applied; with `render` (the
   // render coil) the Modbus view is then rendered into the output directory and pushed to
   // the view's subscribers. `done` hears the outcome once the commands are applied and the
@@ -148,7 +148,8 @@ class Engine {
   using Clock = std::chrono::steady_clock;
   struct Job;
   struct Subscription;
-  struct State;  // everything the world thread owns
+  struct State;     // everything the world thread owns
+  struct Handlers;  // a request's handler by command (dispatch.cpp)
   class Encoder;
 
   bool enqueue(Job job);

@@ -152,7 +152,7 @@ struct Engine::Job {
   enum class Kind { kRequest, kBatch } kind = Kind::kRequest;
   Request request;
   std::int64_t client = 0;
-  FrameSink frames;
+  PushSink push;
   ReplySink reply;
   std::vector<Command> batch;
   bool render = false;  // a batch with the render coil
@@ -168,7 +168,7 @@ struct Engine::Subscription {
   Clock::duration period{};
   Clock::time_point next_due;
   std::uint64_t last_tick = UINT64_MAX;  // the tick of the last frame sent
-  FrameSink sink;
+  PushSink sink;
   std::shared_ptr<std::atomic<bool>> gone;  // set when the sink reports its client gone
   // A streamed view (stream): its frames go to the encoder in place of `sink`; its address.
   std::shared_ptr<VideoStream> video;
