@@ -211,13 +211,10 @@ std::optional<Outcome> Engine::renderRequest(const command::Render& c, Job& job)
   return std::nullopt;
 }
 
-void Engine::deliverFrames(Delivery which, const std::string& view_name) {
+std::map<std::string, std::vector<Engine::Subscription*>> Engine::dueByView(
+    Delivery which, const std::string& view_name) {
   State& s = *state_;
-  if (std::erase_if(s.subscriptions, [](const Subscription& sub) { return sub.gone->load(); }))
-    countSubscriptions();
   const auto now = Clock::now();
-  // Group the subscriptions that are due by view and by image request: one render per view
-  // (and per kind of pixel), one encoding per request.
   std::map<std::string, std::vector<Subscription*>> by_view;
   for (Subscription& sub : s.subscriptions) {
     const bool due = which == Delivery::kDue         ? now >= sub.next_due
@@ -236,7 +233,16 @@ void Engine::deliverFrames(Delivery which, const std::string& view_name) {
     }
     by_view[sub.view].push_back(&sub);
   }
-  for (auto& [name, subs] : by_view) {
+  return by_view;
+}
+
+void Engine::deliverFrames(Delivery which, const std::string& view_name) {
+  State& s = *state_;
+  if (std::erase_if(s.subscriptions, [](const Subscription& sub) { return sub.gone->load(); }))
+    countSubscriptions();
+  // The subscriptions that are due, grouped by view and by image request: one render per view
+  // (and per kind of pixel), one encoding per request.
+  for (auto& [name, subs] : dueByView(which, view_name)) {
     const ViewConfig* view = s.view(name);
     if (!view) continue;
     std::shared_ptr<RenderedView> frames[2];  // 8-bit and linear
@@ -262,36 +268,41 @@ void Engine::deliverFrames(Delivery which, const std::string& view_name) {
         frame = std::make_shared<RenderedView>();
         renderFrame(*view, image, *frame, /*continuous=*/true);
       }
-      std::vector<Subscription> sinks;  // copies: the encoder may run after a change
-      for (Subscription* sub : members) {
-        if (sub->video)  // to its own encoder thread, which drops what it cannot take
-          sub->video->push(std::shared_ptr<const Srgb8Image>(frame, &frame->frame.srgb), s.ticks);
-        else
-          sinks.push_back(*sub);
-      }
-      if (sinks.empty()) continue;
-      auto send = [frame, image = image, sinks, options = config_.encode,
-                   encode_ms = &last_encode_ms_]() {
-        const auto t0 = Clock::now();
-        auto encoded = encodeView(*frame, image, options);
-        encode_ms->store(msSince(t0));
-        if (auto* e = std::get_if<std::string>(&encoded)) {
-          spdlog::error("event=encode_failed error=\"{}\"", *e);
-          return;
-        }
-        auto bytes = std::make_shared<const std::vector<std::uint8_t>>(
-            std::move(std::get<std::vector<std::uint8_t>>(encoded)));
-        const json meta = imageMeta(*frame, image);
-        for (const Subscription& sub : sinks)
-          if (!sub.sink(makeReply(frameEventHeader(sub.id, meta, bytes->size()), bytes)))
-            sub.gone->store(true);
-      };
-      if (image.format == ImageFormat::kRaw && !image.floatPlanes())
-        send();
-      else if (!encoder_->post(send))
-        frames_dropped += sinks.size();
+      sendToSubscribers(frame, image, members);
     }
   }
+}
+
+void Engine::sendToSubscribers(const std::shared_ptr<const RenderedView>& frame,
+                               const ImageRequest& image,
+                               const std::vector<Subscription*>& members) {
+  std::vector<Subscription> sinks;  // copies: the encoder may run after a change
+  for (Subscription* sub : members) {
+    if (sub->video)  // to its own encoder thread, which drops what it cannot take
+      sub->video->push(std::shared_ptr<const Srgb8Image>(frame, &frame->frame.srgb), state_->ticks);
+    else
+      sinks.push_back(*sub);
+  }
+  if (sinks.empty()) return;
+  auto send = [frame, image, sinks, options = config_.encode, encode_ms = &last_encode_ms_]() {
+    const auto t0 = Clock::now();
+    auto encoded = encodeView(*frame, image, options);
+    encode_ms->store(msSince(t0));
+    if (auto* e = std::get_if<std::string>(&encoded)) {
+      spdlog::error("event=encode_failed error=\"{}\"", *e);
+      return;
+    }
+    auto bytes = std::make_shared<const std::vector<std::uint8_t>>(
+        std::move(std::get<std::vector<std::uint8_t>>(encoded)));
+    const json meta = imageMeta(*frame, image);
+    for (const Subscription& sub : sinks)
+      if (!sub.sink(makeReply(frameEventHeader(sub.id, meta, bytes->size()), bytes)))
+        sub.gone->store(true);
+  };
+  if (image.format == ImageFormat::kRaw && !image.floatPlanes())
+    send();
+  else if (!encoder_->post(send))
+    frames_dropped += sinks.size();
 }
 
 Outcome Engine::startStream(const command::Stream& c) {
@@ -404,9 +415,9 @@ void Engine::renderTrigger() {
     std::filesystem::create_directories(path.parent_path(), ec);
     // writeImage picks the format from the extension and renames into place.
     const std::string e = writeImage(path.string(), frame->frame, channels, options);
-    if (!e.empty()) {
-      spdlog::error("event=render_trigger_failed error=\"{}\"", e);
+    if (!e.empty()) {  // counted before it is logged: whoever reads the log sees it in stats
       noteError(ErrorCode::kFailed);
+      spdlog::error("event=render_trigger_failed error=\"{}\"", e);
     } else {
       spdlog::info("event=render_trigger path={}", path.string());
     }

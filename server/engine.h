@@ -199,6 +199,13 @@ class Engine {
     kView,       // the render coil: the subscribers of one view
   };
   void deliverFrames(Delivery which, const std::string& view);
+  // The subscriptions `which` makes due now, by view (their next due time moved on).
+  std::map<std::string, std::vector<Subscription*>> dueByView(Delivery which,
+                                                              const std::string& view);
+  // One rendered view to the subscribers of one image request: streams to their encoders,
+  // sockets through the image encoder (raw 8-bit at once).
+  void sendToSubscribers(const std::shared_ptr<const struct RenderedView>& frame,
+                         const ImageRequest& image, const std::vector<Subscription*>& members);
   void renderTrigger();
   bool saveSnapshot(const std::string& path, const char* why);
   void countSubscriptions();  // refreshes subscribers_ from the world thread's list
