@@ -123,7 +123,7 @@ std::string writeSample(const DatasetSpec& spec, const BandTable& band, const fs
     }
     e = writeImageFile(image, grey, encode);
   } else {
-    e = writeImageFile(image, r.frame.colour, encode);
+    e = writeImage(image, r.frame, Channels{{Channel::kColour}, Channels::Pixels::kSrgb8}, encode);
   }
   if (e.empty() && spec.write_masks)
     e = writeMaskPng((dir / "masks" / (name + ".png")).string(), w, h, instanceMask(r.frame),

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "config/scene_file.h"
+#include "renderer/encode.h"
 #include "renderer/renderer.h"
 #include "world/check.h"
 #include "world/world.h"
@@ -243,17 +244,18 @@ std::string renderAndWrite(const RenderCommandOptions& o, Renderer& renderer, co
     if (seconds >= 2.0)  // only long renders need a progress line
       spdlog::info("render: {:.0f} % after {:.1f} s", 100.0 * done, seconds);
   });
-  std::string error;
+  // EXR: every channel asked, as float planes; else 8-bit colour.
   const auto render_start = Clock::now();
-  if (isFloatFormat(format)) {
-    const Frame frame = renderer.render(scene, request);
-    spdlog::info("render: {:.1f} ms", millisecondsSince(render_start));
-    error = writeFrameExr(o.output_path, frame, o.encode);
-  } else {
-    const Srgb8Image image = renderer.renderSrgb8(scene);
-    spdlog::info("render: {:.1f} ms", millisecondsSince(render_start));
-    error = writeImageFile(o.output_path, image, o.encode);
-  }
+  Frame frame;
+  if (isFloatFormat(format))
+    frame = renderer.render(scene, request);
+  else
+    frame.srgb = renderer.renderSrgb8(scene);
+  spdlog::info("render: {:.1f} ms", millisecondsSince(render_start));
+  const Channels channels = isFloatFormat(format)
+                                ? Channels::planesOf(frame.channels)
+                                : Channels{{Channel::kColour}, Channels::Pixels::kSrgb8};
+  const std::string error = writeImage(o.output_path, frame, channels, o.encode);
   if (o.stats)
     std::printf("stats: %s automaton_steps=%llu relights=%llu\n", renderer.statsLine().c_str(),
                 static_cast<unsigned long long>(world.automatonStepsRun()),

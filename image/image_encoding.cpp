@@ -176,15 +176,10 @@ std::string writeImageFile(const std::string& path, const FloatImage& image,
   const auto format = imageFileFormatForPath(path);
   if (!format) return unknownExtension(path);
   if (!isFloatFormat(*format)) return writeImageFile(path, toSrgb8(image), options);
-  oiio::ImageSpec spec(image.width, image.height, 4,
-                       options.exr_half ? oiio::TypeDesc::HALF : oiio::TypeDesc::FLOAT);
-  spec.channelnames = {"R", "G", "B", "A"};
-  spec.alpha_channel = 3;
-  spec.attribute("compression", options.exr_compression);
-  spec.attribute("oiio:ColorSpace", "Linear");
-  const std::ptrdiff_t row = std::ptrdiff_t(image.width) * 4 * sizeof(float);
-  return writeWithOiio(path, *format, spec, oiio::TypeDesc::FLOAT, image.rgba.data(),
-                       4 * sizeof(float), row);
+  const float* rgba = image.rgba.data();
+  return writeExrPlanes(
+      path, image.width, image.height,
+      {{"R", rgba, 4}, {"G", rgba + 1, 4}, {"B", rgba + 2, 4}, {"A", rgba + 3, 4}}, {}, options);
 }
 
 std::string encodeImage(ImageFileFormat format, const Srgb8Image& image, bool colour, bool coverage,
@@ -213,21 +208,6 @@ std::string encodeImage(ImageFileFormat format, const Srgb8Image& image, bool co
                                                              : ".tif";
   return encodeWithOiio(extension, spec, oiio::TypeDesc::UINT8, first, 4,
                         image.bottom_up ? -row : row, out);
-}
-
-std::string encodeImage(const FloatImage& image, bool colour, bool coverage,
-                        const EncodeOptions& options, std::vector<std::uint8_t>& out) {
-  if (!colour && !coverage) return "no channels selected";
-  const int channels = (colour ? 3 : 0) + (coverage ? 1 : 0);
-  oiio::ImageSpec spec(image.width, image.height, channels,
-                       options.exr_half ? oiio::TypeDesc::HALF : oiio::TypeDesc::FLOAT);
-  spec.channelnames = channelNamesFor(colour, coverage);
-  spec.alpha_channel = coverage ? channels - 1 : -1;
-  spec.attribute("compression", options.exr_compression);
-  spec.attribute("oiio:ColorSpace", "Linear");
-  const std::ptrdiff_t pixel = 4 * sizeof(float);
-  return encodeWithOiio(".exr", spec, oiio::TypeDesc::FLOAT, image.rgba.data() + (colour ? 0 : 3),
-                        pixel, pixel * image.width, out);
 }
 
 std::vector<std::uint8_t> packRaw(const Srgb8Image& image, bool colour, bool coverage) {

@@ -12,7 +12,8 @@
 
 namespace nephele {
 
-enum class ImageFileFormat { kPng, kJpeg, kTiff, kExr };
+// kRaw: pixels alone, no container (the socket protocol's raw images); never a file's.
+enum class ImageFileFormat { kRaw, kPng, kJpeg, kTiff, kExr };
 
 // The format for a path's extension (case-insensitive), or nothing for an unknown one.
 std::optional<ImageFileFormat> imageFileFormatForPath(std::string_view path);
@@ -65,12 +66,11 @@ std::string encodeExrPlanes(int width, int height, const std::vector<ExrPlane>& 
                             const std::vector<ImageAttribute>& attributes,
                             const EncodeOptions& options, std::vector<std::uint8_t>& out);
 
-// In-memory images for the socket protocol. `colour` selects RGB and `coverage` the alpha;
-// each returns an empty string on success, else what went wrong. PNG takes any selection,
-// JPEG colour only; EXR is linear float (half unless options say otherwise).
+// An 8-bit image in memory (renderer/encode.h's encode for every format and channel).
+// `colour` selects RGB and `coverage` the alpha; returns an empty string on success, else what
+// went wrong. PNG and TIFF take any selection, JPEG colour only; EXR is float
+// (encodeExrPlanes).
 std::string encodeImage(ImageFileFormat format, const Srgb8Image& image, bool colour, bool coverage,
-                        const EncodeOptions& options, std::vector<std::uint8_t>& out);
-std::string encodeImage(const FloatImage& image, bool colour, bool coverage,
                         const EncodeOptions& options, std::vector<std::uint8_t>& out);
 // Raw 8-bit pixels, rows top-down, the selected channels packed per pixel.
 std::vector<std::uint8_t> packRaw(const Srgb8Image& image, bool colour, bool coverage);

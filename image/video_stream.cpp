@@ -83,20 +83,12 @@ struct VideoStream::Codec {
   }
 };
 
-std::variant<std::unique_ptr<VideoStream>, std::string> VideoStream::open(
-    const VideoStreamSettings& settings, int width, int height) {
-  if (std::string e = videoStreamSettingsError(settings); !e.empty()) return e;
-  const std::string& address = settings.address;
-  const std::string scheme = address.substr(0, address.find("://"));
-  if (width < 16 || height < 16) return "the view is smaller than 16 x 16 pixels";
-  std::unique_ptr<VideoStream> out(new VideoStream);
-  // H.264 wants even sizes for 4:2:0; an odd view loses its last row or column.
-  out->width_ = width & ~1;
-  out->height_ = height & ~1;
-  out->stamp_ = settings.stamp;
-  out->codec_ = std::make_unique<Codec>();
-  Codec& c = *out->codec_;
+namespace {
 
+// Opens the first of the settings' encoders that this FFmpeg has and accepts (auto: NVENC,
+// then x264), set for low latency: no B-frames, constant bit rate. Empty on success.
+std::string openEncoder(const VideoStreamSettings& settings, int width, int height,
+                        AVCodecContext*& context, std::string& opened) {
   std::vector<std::string> names;
   if (settings.encoder == "auto")
     names = {"h264_nvenc", "libx264"};
@@ -110,8 +102,8 @@ std::variant<std::unique_ptr<VideoStream>, std::string> VideoStream::open(
       continue;
     }
     AVCodecContext* ctx = avcodec_alloc_context3(codec);
-    ctx->width = out->width_;
-    ctx->height = out->height_;
+    ctx->width = width;
+    ctx->height = height;
     ctx->pix_fmt = AV_PIX_FMT_YUV420P;
     ctx->time_base = av_d2q(1.0 / settings.rate_hz, 1000000);
     ctx->framerate = av_d2q(settings.rate_hz, 1000000);
@@ -136,11 +128,33 @@ std::variant<std::unique_ptr<VideoStream>, std::string> VideoStream::open(
       avcodec_free_context(&ctx);
       continue;
     }
-    c.context = ctx;
-    out->encoder_name_ = name;
-    break;
+    context = ctx;
+    opened = name;
+    return "";
   }
-  if (!c.context) return "encoder: none opened (" + why.substr(0, why.size() - 2) + ")";
+  return "encoder: none opened (" + why.substr(0, why.size() - 2) + ")";
+}
+
+}  // namespace
+
+std::variant<std::unique_ptr<VideoStream>, std::string> VideoStream::open(
+    const VideoStreamSettings& settings, int width, int height) {
+  if (std::string e = videoStreamSettingsError(settings); !e.empty()) return e;
+  const std::string& address = settings.address;
+  const std::string scheme = address.substr(0, address.find("://"));
+  if (width < 16 || height < 16) return "the view is smaller than 16 x 16 pixels";
+  std::unique_ptr<VideoStream> out(new VideoStream);
+  // H.264 wants even sizes for 4:2:0; an odd view loses its last row or column.
+  out->width_ = width & ~1;
+  out->height_ = height & ~1;
+  out->stamp_ = settings.stamp;
+  out->codec_ = std::make_unique<Codec>();
+  Codec& c = *out->codec_;
+
+  if (std::string e =
+          openEncoder(settings, out->width_, out->height_, c.context, out->encoder_name_);
+      !e.empty())
+    return e;
 
   const char* muxer = scheme == "rtp" ? "rtp" : "mpegts";
   if (const int r = avformat_alloc_output_context2(&c.format, nullptr, muxer, address.c_str());

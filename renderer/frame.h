@@ -1,6 +1,7 @@
 #pragma once
 // A rendered frame: named channels, each computed only when asked for, and the camera and
 // clock it was rendered from (docs/DATASETS.md, "Channels").
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <optional>
@@ -82,6 +83,35 @@ class ChannelSet {
   unsigned bits_ = 0;
 };
 
+// The pixels a view asks for: which channels, in what order, and how each is stored. The
+// socket protocol's render and subscribe requests, the view's default, the render command's
+// file and the dataset's files each name one.
+struct Channels {
+  enum class Pixels {
+    kSrgb8,   // colour as sRGB R, G, B then coverage as A, 8 bits each, whatever the order
+    kLinear,  // the same as linear floats (EXR: half unless EncodeOptions say otherwise)
+    kPlanes,  // one float plane per channel in `order` (colour as R, G, B), with the frame's
+              // pose and clock where the format holds them (EXR attributes)
+  };
+  std::vector<Channel> order;
+  Pixels pixels = Pixels::kSrgb8;
+
+  bool has(Channel c) const { return std::find(order.begin(), order.end(), c) != order.end(); }
+  ChannelSet set() const {
+    ChannelSet out;
+    for (Channel c : order) out.add(c);
+    return out;
+  }
+  bool operator==(const Channels&) const = default;
+  // Every channel of `set`, in the order of kChannels, as float planes.
+  static Channels planesOf(const ChannelSet& set) {
+    Channels out{{}, Pixels::kPlanes};
+    for (const ChannelInfo& info : kChannels)
+      if (set.has(info.channel)) out.order.push_back(info.channel);
+    return out;
+  }
+};
+
 // Whether a frame needs the GL renderer's target layers besides its colour target (what
 // Renderer::reserve is asked for): the scene has targets, or depth or object ids are asked.
 inline bool needsTargetLayers(bool scene_has_targets, const ChannelSet& channels) {
@@ -124,6 +154,9 @@ struct Frame {
   FrameInfo info;
   ChannelSet channels;
   FloatImage colour;  // RGB and coverage as alpha: present for colour or coverage
+  // Colour and coverage as the GL back end reads its 8-bit target (Renderer::renderSrgb8),
+  // in place of `colour`: encoded as they are, never from floats.
+  Srgb8Image srgb;
   std::vector<float> depth, cloud_depth, object_id, visibility, lwir, glint;
 
   int width() const { return info.width; }
@@ -143,6 +176,7 @@ struct Frame {
     out.info.height = h;
     out.channels = channels;
     if (!colour.rgba.empty()) out.colour = cropImage(colour, x0, y0, w, h);
+    if (!srgb.rgba.empty()) out.srgb = cropImage(srgb, x0, y0, w, h);
     for (const ChannelInfo& c : kChannels)
       if (const std::vector<float>* plane = ownPlane(c.channel); plane && !plane->empty())
         *out.ownPlane(c.channel) = cropPlane(*plane, info.width, info.height, 1, x0, y0, w, h);

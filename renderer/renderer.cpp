@@ -1,7 +1,6 @@
 #include "renderer/renderer.h"
 
 #include <algorithm>
-#include <ctime>
 #include <limits>
 
 #include "renderer/gl/gl_renderer.h"
@@ -78,60 +77,6 @@ void dimVisibilityByPrecipitation(Frame& frame, const Scene& scene, const HeapDr
       frame.visibility[std::size_t(y) * camera.width + x] *=
           float(precipitationTransmittance(media.slabs, media.shafts, eye, d, opaque));
     }
-}
-
-std::vector<ImageAttribute> frameAttributes(const FrameInfo& info) {
-  // DateTime is the simulation clock counted from the Unix epoch, not the wall clock: a frame
-  // rendered twice is the same file.
-  const std::time_t seconds = std::time_t(std::clamp(info.time_s, 0.0, 1e11));
-  std::tm utc{};
-  gmtime_r(&seconds, &utc);
-  char date[32];
-  std::strftime(date, sizeof date, "%Y:%m:%d %H:%M:%S", &utc);
-  return {
-      {"DateTime", 0.0, date},
-      {"nephele:position_x", info.position.x, ""},
-      {"nephele:position_y", info.position.y, ""},
-      {"nephele:position_z", info.position.z, ""},
-      {"nephele:heading_deg", info.orientation.heading_deg, ""},
-      {"nephele:pitch_deg", info.orientation.pitch_deg, ""},
-      {"nephele:roll_deg", info.orientation.roll_deg, ""},
-      {"nephele:vfov_deg", info.vfov_deg, ""},
-      {"nephele:focal_px", info.focal_px, ""},
-      {"nephele:cx", info.cx, ""},
-      {"nephele:cy", info.cy, ""},
-      {"nephele:time_s", info.time_s, ""},
-      {"nephele:tick", 0.0, std::to_string(info.tick)},
-  };
-}
-
-std::vector<ExrPlane> exrPlanesOf(const Frame& frame, const std::vector<Channel>& order) {
-  std::vector<ExrPlane> planes;
-  const float* rgba = frame.colour.rgba.data();
-  for (Channel c : order) {
-    if (c == Channel::kColour)
-      for (int k = 0; k < 3; ++k) planes.push_back({std::string(1, "RGB"[k]), rgba + k, 4});
-    else if (c == Channel::kCoverage)
-      planes.push_back({"A", rgba + 3, 4});
-    else
-      planes.push_back({channelName(c), frame.ownPlane(c)->data(), 1});
-  }
-  return planes;
-}
-
-std::string writeFrameExr(const std::string& path, const Frame& frame,
-                          const EncodeOptions& options) {
-  std::vector<Channel> order;
-  for (const ChannelInfo& info : kChannels)
-    if (frame.channels.has(info.channel)) order.push_back(info.channel);
-  return writeExrPlanes(path, frame.width(), frame.height(), exrPlanesOf(frame, order),
-                        frameAttributes(frame.info), options);
-}
-
-std::string encodeFrameExr(const Frame& frame, const std::vector<Channel>& order,
-                           const EncodeOptions& options, std::vector<std::uint8_t>& out) {
-  return encodeExrPlanes(frame.width(), frame.height(), exrPlanesOf(frame, order),
-                         frameAttributes(frame.info), options, out);
 }
 
 }  // namespace nephele

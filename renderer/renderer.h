@@ -6,7 +6,7 @@
 #include <memory>
 #include <string>
 
-#include "image/image_encoding.h"
+#include "renderer/encode.h"
 #include "renderer/frame.h"
 #include "renderer/gl/gl_platform.h"
 #include "renderer/render_settings.h"
@@ -51,17 +51,5 @@ std::unique_ptr<Renderer> createRenderer(const RendererOptions& options, std::st
 // behind rain is less visible; the shafts under heaps are those of `heaps`' range, as drawn.
 // Nothing without precipitation or without the channel.
 void dimVisibilityByPrecipitation(Frame& frame, const Scene& scene, const HeapDrawing& heaps);
-
-// The frame's pose, intrinsics and clock as image attributes (docs/DATASETS.md).
-std::vector<ImageAttribute> frameAttributes(const FrameInfo& info);
-// Every channel the frame holds as named EXR layers: R, G, B (colour), A (coverage), depth,
-// cloud_depth, object_id, visibility; with frameAttributes.
-std::string writeFrameExr(const std::string& path, const Frame& frame,
-                          const EncodeOptions& options = {});
-// The EXR layers of the channels in `order` (colour as R, G, B, coverage as A).
-std::vector<ExrPlane> exrPlanesOf(const Frame& frame, const std::vector<Channel>& order);
-// The same in memory, the channels in `order`.
-std::string encodeFrameExr(const Frame& frame, const std::vector<Channel>& order,
-                           const EncodeOptions& options, std::vector<std::uint8_t>& out);
 
 }  // namespace nephele

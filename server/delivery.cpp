@@ -14,56 +14,37 @@ using namespace engine_detail;
 
 namespace engine_detail {
 
-// Encodes `frame` as `image` asks; on failure returns the error.
-std::variant<std::vector<std::uint8_t>, std::string> encodeFrame(const ViewFrame& frame,
-                                                                 const ImageRequest& image,
-                                                                 const EncodeOptions& options) {
-  std::vector<std::uint8_t> bytes;
-  std::string error;
-  if (image.floatPlanes()) {
-    const Frame& f = frame.planes;
-    if (image.format == ImageFormat::kExr) {
-      error = encodeFrameExr(f, image.order, options, bytes);
-      if (!error.empty()) return error;
-      return bytes;
-    }
-    // Raw: float32 planes, host byte order (little-endian on x86-64 and ARM), in the order asked.
-    const std::size_t pixels = std::size_t(f.width()) * f.height();
-    std::vector<float> planes;
-    planes.reserve(pixels * (image.order.size() + 2));
-    for (Channel c : image.order) {
-      if (c == Channel::kColour) {
-        for (int k = 0; k < 3; ++k)
-          for (std::size_t i = 0; i < pixels; ++i) planes.push_back(f.colour.rgba[i * 4 + k]);
-      } else {
-        const std::vector<float> plane = f.plane(c);
-        planes.insert(planes.end(), plane.begin(), plane.end());
-      }
-    }
-    const auto* raw = reinterpret_cast<const std::uint8_t*>(planes.data());
-    return std::vector<std::uint8_t>(raw, raw + planes.size() * sizeof(float));
-  }
-  switch (image.format) {
-    case ImageFormat::kRaw:
-      return packRaw(frame.srgb, image.colour, image.coverage);
-    case ImageFormat::kPng:
-      error = encodeImage(ImageFileFormat::kPng, frame.srgb, image.colour, image.coverage, options,
-                          bytes);
-      break;
-    case ImageFormat::kJpeg:
-      error = encodeImage(ImageFileFormat::kJpeg, frame.srgb, image.colour, image.coverage, options,
-                          bytes);
-      break;
-    case ImageFormat::kExr:
-      error = encodeImage(frame.linear, image.colour, image.coverage, options, bytes);
-      break;
-  }
-  if (!error.empty()) return error;
-  return bytes;
+Channels channelsOf(const ImageRequest& image) {
+  if (image.floatPlanes()) return {image.order, Channels::Pixels::kPlanes};
+  Channels out;
+  if (image.colour) out.order.push_back(Channel::kColour);
+  if (image.coverage) out.order.push_back(Channel::kCoverage);
+  out.pixels =
+      image.format == ImageFormat::kExr ? Channels::Pixels::kLinear : Channels::Pixels::kSrgb8;
+  return out;
 }
 
-json imageMeta(const ViewFrame& frame, const ImageRequest& image) {
-  json meta = frame.meta;
+ImageFileFormat fileFormatOf(ImageFormat format) {
+  switch (format) {
+    case ImageFormat::kRaw:
+      return ImageFileFormat::kRaw;
+    case ImageFormat::kPng:
+      return ImageFileFormat::kPng;
+    case ImageFormat::kJpeg:
+      return ImageFileFormat::kJpeg;
+    case ImageFormat::kExr:
+      return ImageFileFormat::kExr;
+  }
+  return ImageFileFormat::kRaw;
+}
+
+Encoded encodeView(const RenderedView& view, const ImageRequest& image,
+                   const EncodeOptions& options) {
+  return encode(view.frame, fileFormatOf(image.format), channelsOf(image), options);
+}
+
+json imageMeta(const RenderedView& view, const ImageRequest& image) {
+  json meta = view.meta;
   meta["format"] = imageFormatName(image.format);
   meta["channels"] = channelNames(image);
   meta["rows"] = "top-down";
@@ -75,7 +56,7 @@ json imageMeta(const ViewFrame& frame, const ImageRequest& image) {
 
 }  // namespace engine_detail
 
-void Engine::renderFrame(const ViewConfig& view, const ImageRequest& image, ViewFrame& frame,
+void Engine::renderFrame(const ViewConfig& view, const ImageRequest& image, RenderedView& out,
                          bool continuous) {
   State& s = *state_;
   // A subscription's frames are one stream: its heaps reuse the last frame until the world is
@@ -92,15 +73,17 @@ void Engine::renderFrame(const ViewConfig& view, const ImageRequest& image, View
     scene.camera = off_axis->render;
   }
   const auto t0 = Clock::now();
-  if (image.floatPlanes()) {
+  Frame& frame = out.frame;
+  const Channels channels = channelsOf(image);
+  if (channels.pixels == Channels::Pixels::kPlanes) {
     FrameRequest request;
     request.channels = image.planes;
     if (image.colour) request.channels.add(Channel::kColour);
     if (image.coverage) request.channels.add(Channel::kCoverage);
     request.tick = std::uint64_t(s.ticks);
-    frame.planes = s.renderer->renderFrame(scene, config_.scene.render, request);
-  } else if (image.format == ImageFormat::kExr) {
-    frame.linear = s.renderer->renderFloat(scene, config_.scene.render);
+    frame = s.renderer->renderFrame(scene, config_.scene.render, request);
+  } else if (channels.pixels == Channels::Pixels::kLinear) {
+    frame.colour = s.renderer->renderFloat(scene, config_.scene.render);
   } else {
     frame.srgb = s.renderer->renderSrgb8(scene, config_.scene.render);
   }
@@ -109,29 +92,29 @@ void Engine::renderFrame(const ViewConfig& view, const ImageRequest& image, View
   FrameInfo info = frameInfo(view.camera, s.world->timeSeconds(), std::uint64_t(s.ticks));
   if (off_axis) {
     const OffAxisView& o = *off_axis;
-    if (image.floatPlanes())
-      frame.planes = frame.planes.cropped(o.x0, o.y0, o.width, o.height);
-    else if (image.format == ImageFormat::kExr)
-      frame.linear = cropImage(frame.linear, o.x0, o.y0, o.width, o.height);
-    else
-      frame.srgb = cropImage(frame.srgb, o.x0, o.y0, o.width, o.height);
+    frame = frame.cropped(o.x0, o.y0, o.width, o.height);
     info.width = o.width;
     info.height = o.height;
     info.focal_px = o.focal_px;
     info.cx = o.cx;
     info.cy = o.cy;
-    if (image.floatPlanes()) frame.planes.info = info;
   }
-  s.last_render_ms = msSince(t0);
-  s.render_ms.push_back(s.last_render_ms);
-  s.render_seconds.add(s.last_render_ms * 1e-3);
+  if (channels.pixels == Channels::Pixels::kPlanes && off_axis) frame.info = info;
+  noteRender(msSince(t0));
+  out.meta = {{"view", view.name},         {"width", info.width},
+              {"height", info.height},     {"time", s.world->timeSeconds()},
+              {"tick", s.ticks},           {"frame", s.frames},
+              {"camera", cameraJson(info)}};
+  if (view.frustum) out.meta["camera"]["frustum"] = frustumJson(*view.frustum);
+}
+
+void Engine::noteRender(double ms) {
+  State& s = *state_;
+  s.last_render_ms = ms;
+  s.render_ms.push_back(ms);
+  s.render_seconds.add(ms * 1e-3);
   if (s.render_ms.size() > kRenderHistory) s.render_ms.pop_front();
   ++s.frames;
-  frame.meta = {{"view", view.name},         {"width", info.width},
-                {"height", info.height},     {"time", s.world->timeSeconds()},
-                {"tick", s.ticks},           {"frame", s.frames},
-                {"camera", cameraJson(info)}};
-  if (view.frustum) frame.meta["camera"]["frustum"] = frustumJson(*view.frustum);
 }
 
 namespace {
@@ -187,13 +170,13 @@ std::optional<Outcome> Engine::renderRequest(const command::Render& c, Job& job)
     if (auto error = platformLimit(v, c.image.value_or(v.image))) return *error;
   // Every view is rendered before anything else runs on this thread: one tick, one world.
   struct Part {
-    std::shared_ptr<ViewFrame> frame;
+    std::shared_ptr<RenderedView> frame;
     ImageRequest image;
   };
   std::vector<Part> parts;
   bool all_raw = true;
   for (const ViewConfig& v : views) {
-    Part part{std::make_shared<ViewFrame>(), c.image.value_or(v.image)};
+    Part part{std::make_shared<RenderedView>(), c.image.value_or(v.image)};
     renderFrame(v, part.image, *part.frame);
     all_raw = all_raw && part.image.format == ImageFormat::kRaw && !part.image.floatPlanes();
     parts.push_back(std::move(part));
@@ -203,7 +186,7 @@ std::optional<Outcome> Engine::renderRequest(const command::Render& c, Job& job)
     std::vector<SharedReply> replies;
     for (std::size_t i = 0; i < parts.size(); ++i) {
       const auto t0 = Clock::now();
-      auto encoded = encodeFrame(*parts[i].frame, parts[i].image, options);
+      auto encoded = encodeView(*parts[i].frame, parts[i].image, options);
       encode_ms->store(msSince(t0));
       if (auto* e = std::get_if<std::string>(&encoded)) {
         reply(makeReply(errorReply(id, {ErrorCode::kFailed, *e})));
@@ -228,13 +211,10 @@ std::optional<Outcome> Engine::renderRequest(const command::Render& c, Job& job)
   return std::nullopt;
 }
 
-void Engine::deliverFrames(Delivery which, const std::string& view_name) {
+std::map<std::string, std::vector<Engine::Subscription*>> Engine::dueByView(
+    Delivery which, const std::string& view_name) {
   State& s = *state_;
-  if (std::erase_if(s.subscriptions, [](const Subscription& sub) { return sub.gone->load(); }))
-    countSubscriptions();
   const auto now = Clock::now();
-  // Group the subscriptions that are due by view and by image request: one render per view
-  // (and per kind of pixel), one encoding per request.
   std::map<std::string, std::vector<Subscription*>> by_view;
   for (Subscription& sub : s.subscriptions) {
     const bool due = which == Delivery::kDue         ? now >= sub.next_due
@@ -253,10 +233,19 @@ void Engine::deliverFrames(Delivery which, const std::string& view_name) {
     }
     by_view[sub.view].push_back(&sub);
   }
-  for (auto& [name, subs] : by_view) {
+  return by_view;
+}
+
+void Engine::deliverFrames(Delivery which, const std::string& view_name) {
+  State& s = *state_;
+  if (std::erase_if(s.subscriptions, [](const Subscription& sub) { return sub.gone->load(); }))
+    countSubscriptions();
+  // The subscriptions that are due, grouped by view and by image request: one render per view
+  // (and per kind of pixel), one encoding per request.
+  for (auto& [name, subs] : dueByView(which, view_name)) {
     const ViewConfig* view = s.view(name);
     if (!view) continue;
-    std::shared_ptr<ViewFrame> frames[2];  // 8-bit and linear
+    std::shared_ptr<RenderedView> frames[2];  // 8-bit and linear
     std::vector<std::pair<ImageRequest, std::vector<Subscription*>>> groups;
     for (Subscription* sub : subs) {
       auto it = std::find_if(groups.begin(), groups.end(),
@@ -268,47 +257,52 @@ void Engine::deliverFrames(Delivery which, const std::string& view_name) {
     }
     for (auto& [image, members] : groups) {
       const bool linear = image.format == ImageFormat::kExr;
-      std::shared_ptr<ViewFrame> planes;  // ground-truth channels: rendered for this group
-      std::shared_ptr<ViewFrame>& frame = image.floatPlanes() ? planes : frames[linear ? 1 : 0];
+      std::shared_ptr<RenderedView> planes;  // ground-truth channels: rendered for this group
+      std::shared_ptr<RenderedView>& frame = image.floatPlanes() ? planes : frames[linear ? 1 : 0];
       if (!frame) {
         if (auto error = platformLimit(*view, image)) {
           spdlog::error("event=frame_skipped view={} error=\"{}\"", view->name, error->message);
           frames_dropped += members.size();
           continue;
         }
-        frame = std::make_shared<ViewFrame>();
+        frame = std::make_shared<RenderedView>();
         renderFrame(*view, image, *frame, /*continuous=*/true);
       }
-      std::vector<Subscription> sinks;  // copies: the encoder may run after a change
-      for (Subscription* sub : members) {
-        if (sub->video)  // to its own encoder thread, which drops what it cannot take
-          sub->video->push(std::shared_ptr<const Srgb8Image>(frame, &frame->srgb), s.ticks);
-        else
-          sinks.push_back(*sub);
-      }
-      if (sinks.empty()) continue;
-      auto send = [frame, image = image, sinks, options = config_.encode,
-                   encode_ms = &last_encode_ms_]() {
-        const auto t0 = Clock::now();
-        auto encoded = encodeFrame(*frame, image, options);
-        encode_ms->store(msSince(t0));
-        if (auto* e = std::get_if<std::string>(&encoded)) {
-          spdlog::error("event=encode_failed error=\"{}\"", *e);
-          return;
-        }
-        auto bytes = std::make_shared<const std::vector<std::uint8_t>>(
-            std::move(std::get<std::vector<std::uint8_t>>(encoded)));
-        const json meta = imageMeta(*frame, image);
-        for (const Subscription& sub : sinks)
-          if (!sub.sink(makeReply(frameEventHeader(sub.id, meta, bytes->size()), bytes)))
-            sub.gone->store(true);
-      };
-      if (image.format == ImageFormat::kRaw && !image.floatPlanes())
-        send();
-      else if (!encoder_->post(send))
-        frames_dropped += sinks.size();
+      sendToSubscribers(frame, image, members);
     }
   }
+}
+
+void Engine::sendToSubscribers(const std::shared_ptr<const RenderedView>& frame,
+                               const ImageRequest& image,
+                               const std::vector<Subscription*>& members) {
+  std::vector<Subscription> sinks;  // copies: the encoder may run after a change
+  for (Subscription* sub : members) {
+    if (sub->video)  // to its own encoder thread, which drops what it cannot take
+      sub->video->push(std::shared_ptr<const Srgb8Image>(frame, &frame->frame.srgb), state_->ticks);
+    else
+      sinks.push_back(*sub);
+  }
+  if (sinks.empty()) return;
+  auto send = [frame, image, sinks, options = config_.encode, encode_ms = &last_encode_ms_]() {
+    const auto t0 = Clock::now();
+    auto encoded = encodeView(*frame, image, options);
+    encode_ms->store(msSince(t0));
+    if (auto* e = std::get_if<std::string>(&encoded)) {
+      spdlog::error("event=encode_failed error=\"{}\"", *e);
+      return;
+    }
+    auto bytes = std::make_shared<const std::vector<std::uint8_t>>(
+        std::move(std::get<std::vector<std::uint8_t>>(encoded)));
+    const json meta = imageMeta(*frame, image);
+    for (const Subscription& sub : sinks)
+      if (!sub.sink(makeReply(frameEventHeader(sub.id, meta, bytes->size()), bytes)))
+        sub.gone->store(true);
+  };
+  if (image.format == ImageFormat::kRaw && !image.floatPlanes())
+    send();
+  else if (!encoder_->post(send))
+    frames_dropped += sinks.size();
 }
 
 Outcome Engine::startStream(const command::Stream& c) {
@@ -392,7 +386,7 @@ void Engine::renderTrigger() {
   State& s = *state_;
   const ViewConfig& view = *s.view(config_.modbus_view);
   const bool linear = config_.output_format == ImageFormat::kExr;
-  auto frame = std::make_shared<ViewFrame>();
+  auto frame = std::make_shared<RenderedView>();
   ImageRequest image;
   image.format = config_.output_format;
   if (auto error = platformLimit(view, image)) {
@@ -412,15 +406,18 @@ void Engine::renderTrigger() {
     path = directory / (stem + "." + std::to_string(n) + extension);
   // The caller checked that the encoder has room, and only this thread feeds it; the
   // subscribers' frames come after.
-  encoder_->post([this, frame, linear, path, options = config_.encode]() {
+  // 8-bit files are for viewing: colour only; EXR holds coverage as its alpha.
+  const Channels channels =
+      linear ? Channels{{Channel::kColour, Channel::kCoverage}, Channels::Pixels::kLinear}
+             : Channels{{Channel::kColour}, Channels::Pixels::kSrgb8};
+  encoder_->post([this, frame, channels, path, options = config_.encode]() {
     std::error_code ec;
     std::filesystem::create_directories(path.parent_path(), ec);
-    // writeImageFile picks the format from the extension and renames into place.
-    const std::string e = linear ? writeImageFile(path.string(), frame->linear, options)
-                                 : writeImageFile(path.string(), frame->srgb, options);
-    if (!e.empty()) {
-      spdlog::error("event=render_trigger_failed error=\"{}\"", e);
+    // writeImage picks the format from the extension and renames into place.
+    const std::string e = writeImage(path.string(), frame->frame, channels, options);
+    if (!e.empty()) {  // counted before it is logged: whoever reads the log sees it in stats
       noteError(ErrorCode::kFailed);
+      spdlog::error("event=render_trigger_failed error=\"{}\"", e);
     } else {
       spdlog::info("event=render_trigger path={}", path.string());
     }

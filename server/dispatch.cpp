@@ -11,6 +11,7 @@
 namespace nephele {
 
 using namespace engine_detail;
+using namespace command;
 
 namespace {
 
@@ -61,239 +62,236 @@ std::optional<ProtocolError> Engine::check(const Command& command) const {
   return std::nullopt;
 }
 
-std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
-  State& s = *state_;
+// One handler per command of protocol/commands.inc, on the world thread: a command added to
+// the protocol without one here does not compile (Engine::apply visits them).
+struct Engine::Handlers {
+  Engine& engine;
+  Job& job;
+  State& s = *engine.state_;
   World& world = *s.world;
-  using namespace command;
-  auto notFoundView = [&](const std::string& name) -> Outcome {
-    return unknownView(s.views, name);
-  };
-  const ProtocolError noSnapshotDirectory{
-      ErrorCode::kFailed, "name: no snapshot directory is configured ([snapshot] directory)"};
-  auto snapshotPath = [&](const std::string& name) {
-    return (std::filesystem::path(config_.snapshotDirectory()) / (name + ".snap")).string();
-  };
-  // One handler per command: a command added to the protocol without one here does not
-  // compile.
-  const Overloaded handlers{
+  const DaemonConfig& config_ = engine.config_;
 
-      [&](const Hello& c) -> std::optional<Outcome> {
-        (void)c;  // the token is checked by the transport
-        return helloJson();
-      },
-      [&](const GetView& c) -> std::optional<Outcome> {
-        if (c.view.empty()) {
-          json all = json::array();
-          for (const ViewConfig& v : s.views) all.push_back(viewJson(v));
-          return json{{"views", all}};
-        }
-        const ViewConfig* v = s.view(c.view);
-        if (!v) return notFoundView(c.view);
-        return viewJson(*v);
-      },
-      [&](const SetView& c) -> std::optional<Outcome> {
-        ViewConfig* v = s.view(c.view);
-        if (!v) return notFoundView(c.view);
-        applyViewPatch(*v, c.patch);
-        return viewJson(*v);
-      },
-      [&](const SetWeather& c) -> std::optional<Outcome> {
-        if (auto error = setWeather(c.layer, c.weather, c.region)) return *error;
-        json reply{{"layer", c.layer},
-                   {"type", cloudTypeName(c.weather.type)},
-                   {"layers", world.base().layers.size()},
-                   {"clouds", world.base().clouds.size()},
-                   {"fields", world.base().fields.size()}};
-        if (c.region) reply["region"] = *c.region;
-        return reply;
-      },
-      [&](const SetWind& c) -> std::optional<Outcome> {
-        std::string error = world.setWind({{{0.0, c.velocity}}});
-        if (!error.empty()) return ProtocolError{ErrorCode::kFailed, error};
-        return json{{"velocity", {c.velocity.x, c.velocity.y}}};
-      },
-      [&](const SetSun& c) -> std::optional<Outcome> { return setSun(c); },
-      [&](const SetFog& c) -> std::optional<Outcome> { return setFog(c); },
-      [&](const SetHaze& c) -> std::optional<Outcome> { return setHaze(c); },
-      [&](const SetSea& c) -> std::optional<Outcome> { return setSea(c); },
-      [&](const SetSite& c) -> std::optional<Outcome> { return setSite(c); },
-      [&](const SetTime& c) -> std::optional<Outcome> {
-        if (c.time_scale) s.time_scale = *c.time_scale;
-        if (c.paused) s.paused = *c.paused;
-        if (c.mode) setMode(*c.mode);
-        if (c.advance) advance(*c.advance);
-        return json{{"time", world.timeSeconds()},
-                    {"time_scale", s.time_scale},
-                    {"paused", s.paused},
-                    {"mode", modeName(s.mode)},
-                    {"ticks", s.ticks}};
-      },
-      [&](const AddCloud& c) -> std::optional<Outcome> {
-        const auto name = c.cloud.find("name");
-        if (name == c.cloud.end() || !name->is_string())
-          return badField(
-              "cloud.name: is missing (a unique name, to change or remove the cloud by)");
-        if (std::string e = nameError(name->get<std::string>()); !e.empty())
-          return badField("cloud.name: " + e);
-        EllipsoidCloud cloud;
-        const std::string cloud_name = name->get<std::string>();
-        if (std::string e = parseCloudJson(
-                c.cloud, hashCounters(config_.scene.scene.seed, nameHash(cloud_name)), cloud);
-            !e.empty())
-          return badField(e);
-        std::size_t ellipsoids = cloud.ellipsoids.size();
-        // The world budget (docs/RELIABILITY.md): refused with `limit`, nothing added.
-        if (world.base().clouds.size() >= kMaxClouds)
-          return ProtocolError{ErrorCode::kLimit, "cloud: the world holds " +
-                                                      std::to_string(kMaxClouds) +
-                                                      " clouds already (the most it may)"};
-        if (const std::size_t held = ellipsoidCount(world.base());
-            held + ellipsoids > std::size_t(config_.max_ellipsoids))
-          return ProtocolError{ErrorCode::kLimit,
-                               "cloud: its " + std::to_string(ellipsoids) +
-                                   " ellipsoids would make the world's " + std::to_string(held) +
-                                   " more than its budget of " +
-                                   std::to_string(config_.max_ellipsoids) +
-                                   " ([world] max_ellipsoids in the daemon config; about " +
-                                   std::to_string(Limits::kBytesPerEllipsoid) + " bytes each)"};
-        if (std::string error = world.addCloud(cloud); !error.empty()) return badField(error);
-        return json{{"name", cloud.name}, {"ellipsoids", ellipsoids}};
-      },
-      [&](const ChangeCloud& c) -> std::optional<Outcome> {
-        std::string error = world.changeCloud(
-            c.name, {c.move, c.threshold, c.limb_threshold, c.transition, c.colour});
-        if (!error.empty()) return ProtocolError{ErrorCode::kNotFound, error};
-        return json{{"name", c.name}};
-      },
-      [&](const RemoveCloud& c) -> std::optional<Outcome> {
-        std::string error = world.removeCloud(c.name);
-        if (!error.empty()) return ProtocolError{ErrorCode::kNotFound, error};
-        return json{{"name", c.name}};
-      },
-      [&](const AddTarget& c) -> std::optional<Outcome> {
-        Target target;
-        if (c.entity) {  // a CIGI entity: its type's prototype at its pose
-          const auto type =
-              std::find_if(config_.entity_types.begin(), config_.entity_types.end(),
-                           [&](const EntityType& t) { return t.name == c.entity->type; });
-          if (type == config_.entity_types.end())
-            return badField("target.type: \"" + c.entity->type +
-                            "\" is not an entity type of the daemon config");
-          target = type->prototype;
-          target.name = c.entity->name;
-          target.centre = c.entity->centre;
-          target.orientation = c.entity->orientation;
-        } else if (std::string e = parseTargetJson(c.target, config_.entity_types, target);
-                   !e.empty()) {
-          return badField(e);
-        }
-        // A CIGI entity the world already holds (after a restart) is replaced.
-        std::string error =
-            world.addTarget(target, c.replace, std::size_t(ProtocolLimits::kMaxTargets));
-        if (!error.empty()) return badField(error);
-        return targetJson(target, world.base().targets.size());
-      },
-      [&](const MoveTarget& c) -> std::optional<Outcome> {
-        if (std::string error = world.moveTarget(c.name, {c.centre, c.heading, c.pitch, c.roll});
-            !error.empty())
-          return ProtocolError{ErrorCode::kNotFound, error};
-        const std::vector<Target>& targets = world.base().targets;
-        const auto moved = std::find_if(targets.begin(), targets.end(),
-                                        [&](const Target& t) { return t.name == c.name; });
-        return targetJson(*moved, std::size_t(moved - targets.begin()) + 1);
-      },
-      [&](const RemoveTarget& c) -> std::optional<Outcome> {
-        std::string error = world.removeTarget(c.name);
-        if (!error.empty()) return ProtocolError{ErrorCode::kNotFound, error};
-        return json{{"name", c.name}};
-      },
-      [&](const ListTargets&) -> std::optional<Outcome> {
-        json all = json::array();
-        const std::vector<Target>& targets = world.base().targets;
-        for (std::size_t i = 0; i < targets.size(); ++i)
-          all.push_back(targetJson(targets[i], i + 1));
-        return json{{"targets", all}};
-      },
-      [&](const Tick& c) -> std::optional<Outcome> {
-        advance(c.dt);
-        return json{{"time", world.timeSeconds()}, {"ticks", s.ticks}};
-      },
-      [&](const Render& c) -> std::optional<Outcome> { return renderRequest(c, job); },
-      [&](const Subscribe& c) -> std::optional<Outcome> {
-        const ViewConfig* v = s.view(c.view);
-        if (!v) return notFoundView(c.view);
-        if (int(s.subscriptions.size()) >= config_.max_subscriptions)
-          return ProtocolError{ErrorCode::kLimit,
-                               "subscribe: the daemon serves " +
-                                   std::to_string(config_.max_subscriptions) +
-                                   " subscriptions already (the configured limit)"};
-        if (auto error = platformLimit(*v, c.image.value_or(v->image))) return *error;
-        Subscription sub;
-        sub.id = s.next_subscription++;
-        sub.client = job.client;
-        sub.view = c.view;
-        sub.image = c.image.value_or(v->image);
-        sub.period = secondsToDuration(1.0 / c.rate_hz);
-        sub.next_due = Clock::now();
-        sub.sink = job.frames;
-        sub.gone = std::make_shared<std::atomic<bool>>(false);
-        s.subscriptions.push_back(sub);
-        countSubscriptions();
-        return json{{"subscription", sub.id},
-                    {"view", sub.view},
-                    {"rate", c.rate_hz},
-                    {"format", imageFormatName(sub.image.format)},
-                    {"channels", channelNames(sub.image)}};
-      },
-      [&](const Unsubscribe& c) -> std::optional<Outcome> {
-        const std::size_t before = s.subscriptions.size();
-        std::erase_if(s.subscriptions, [&](const Subscription& sub) {
-          return sub.id == c.subscription && sub.client == job.client;
-        });
-        countSubscriptions();
-        if (s.subscriptions.size() == before)
-          return ProtocolError{ErrorCode::kNotFound,
-                               "subscription: " + std::to_string(c.subscription) +
-                                   " is not one of this connection's subscriptions"};
-        return json{{"subscription", c.subscription}};
-      },
-      [&](const Stream& c) -> std::optional<Outcome> { return startStream(c); },
-      [&](const Unstream& c) -> std::optional<Outcome> { return stopStream(c); },
-      [&](const Snapshot& c) -> std::optional<Outcome> {
-        if (config_.snapshotDirectory().empty()) return noSnapshotDirectory;
-        std::error_code ec;
-        std::filesystem::create_directories(config_.snapshotDirectory(), ec);
-        if (std::string e = writeSnapshot(snapshotPath(c.name)); !e.empty())
-          return ProtocolError{ErrorCode::kFailed, e};
-        return json{
-            {"name", c.name}, {"time", world.timeSeconds()}, {"hash", hexHash(world.hash())}};
-      },
-      [&](const Restore& c) -> std::optional<Outcome> {
-        if (config_.snapshotDirectory().empty()) return noSnapshotDirectory;
-        const std::string path = snapshotPath(c.name);
-        if (!std::filesystem::exists(path))
-          return ProtocolError{ErrorCode::kNotFound, "name: no snapshot \"" + c.name + "\""};
-        if (std::string e = restoreSnapshot(path); !e.empty())
-          return ProtocolError{
-              e.starts_with(World::kOverBudget) ? ErrorCode::kLimit : ErrorCode::kFailed, e};
-        return json{{"name", c.name},
-                    {"time", world.timeSeconds()},
-                    {"hash", hexHash(world.hash())},
-                    {"ticks", s.ticks},
-                    {"frames", s.frames}};
-      },
-      [&](const Stats&) -> std::optional<Outcome> {
-        publish();
-        return stats();
-      },
-      [&](const Hash&) -> std::optional<Outcome> {
-        return json{{"hash", hexHash(world.hash())},
-                    {"time", world.timeSeconds()},
-                    {"time_ns", world.timeNs()},
-                    {"ticks", s.ticks}};
-      },
-  };
-  return std::visit(handlers, command);
+  ProtocolError noSnapshotDirectory() const {
+    return {ErrorCode::kFailed, "name: no snapshot directory is configured ([snapshot] directory)"};
+  }
+  std::string snapshotPath(const std::string& name) const {
+    return (std::filesystem::path(config_.snapshotDirectory()) / (name + ".snap")).string();
+  }
+
+  std::optional<Outcome> operator()(const Hello& c) const {
+    (void)c;  // the token is checked by the transport
+    return engine.helloJson();
+  }
+  std::optional<Outcome> operator()(const GetView& c) const {
+    if (c.view.empty()) {
+      json all = json::array();
+      for (const ViewConfig& v : s.views) all.push_back(viewJson(v));
+      return json{{"views", all}};
+    }
+    const ViewConfig* v = s.view(c.view);
+    if (!v) return unknownView(s.views, c.view);
+    return viewJson(*v);
+  }
+  std::optional<Outcome> operator()(const SetView& c) const {
+    ViewConfig* v = s.view(c.view);
+    if (!v) return unknownView(s.views, c.view);
+    applyViewPatch(*v, c.patch);
+    return viewJson(*v);
+  }
+  std::optional<Outcome> operator()(const SetWeather& c) const {
+    if (auto error = engine.setWeather(c.layer, c.weather, c.region)) return *error;
+    json reply{{"layer", c.layer},
+               {"type", cloudTypeName(c.weather.type)},
+               {"layers", world.base().layers.size()},
+               {"clouds", world.base().clouds.size()},
+               {"fields", world.base().fields.size()}};
+    if (c.region) reply["region"] = *c.region;
+    return reply;
+  }
+  std::optional<Outcome> operator()(const SetWind& c) const {
+    std::string error = world.setWind({{{0.0, c.velocity}}});
+    if (!error.empty()) return ProtocolError{ErrorCode::kFailed, error};
+    return json{{"velocity", {c.velocity.x, c.velocity.y}}};
+  }
+  std::optional<Outcome> operator()(const SetSun& c) const { return engine.setSun(c); }
+  std::optional<Outcome> operator()(const SetFog& c) const { return engine.setFog(c); }
+  std::optional<Outcome> operator()(const SetHaze& c) const { return engine.setHaze(c); }
+  std::optional<Outcome> operator()(const SetSea& c) const { return engine.setSea(c); }
+  std::optional<Outcome> operator()(const SetSite& c) const { return engine.setSite(c); }
+  std::optional<Outcome> operator()(const SetTime& c) const {
+    if (c.time_scale) s.time_scale = *c.time_scale;
+    if (c.paused) s.paused = *c.paused;
+    if (c.mode) engine.setMode(*c.mode);
+    if (c.advance) engine.advance(*c.advance);
+    return json{{"time", world.timeSeconds()},
+                {"time_scale", s.time_scale},
+                {"paused", s.paused},
+                {"mode", modeName(s.mode)},
+                {"ticks", s.ticks}};
+  }
+  std::optional<Outcome> operator()(const AddCloud& c) const {
+    const auto name = c.cloud.find("name");
+    if (name == c.cloud.end() || !name->is_string())
+      return badField("cloud.name: is missing (a unique name, to change or remove the cloud by)");
+    if (std::string e = nameError(name->get<std::string>()); !e.empty())
+      return badField("cloud.name: " + e);
+    EllipsoidCloud cloud;
+    const std::string cloud_name = name->get<std::string>();
+    if (std::string e = parseCloudJson(
+            c.cloud, hashCounters(config_.scene.scene.seed, nameHash(cloud_name)), cloud);
+        !e.empty())
+      return badField(e);
+    std::size_t ellipsoids = cloud.ellipsoids.size();
+    // The world budget (docs/RELIABILITY.md): refused with `limit`, nothing added.
+    if (world.base().clouds.size() >= kMaxClouds)
+      return ProtocolError{ErrorCode::kLimit, "cloud: the world holds " +
+                                                  std::to_string(kMaxClouds) +
+                                                  " clouds already (the most it may)"};
+    if (const std::size_t held = ellipsoidCount(world.base());
+        held + ellipsoids > std::size_t(config_.max_ellipsoids))
+      return ProtocolError{ErrorCode::kLimit,
+                           "cloud: its " + std::to_string(ellipsoids) +
+                               " ellipsoids would make the world's " + std::to_string(held) +
+                               " more than its budget of " +
+                               std::to_string(config_.max_ellipsoids) +
+                               " ([world] max_ellipsoids in the daemon config; about " +
+                               std::to_string(Limits::kBytesPerEllipsoid) + " bytes each)"};
+    if (std::string error = world.addCloud(cloud); !error.empty()) return badField(error);
+    return json{{"name", cloud.name}, {"ellipsoids", ellipsoids}};
+  }
+  std::optional<Outcome> operator()(const ChangeCloud& c) const {
+    std::string error =
+        world.changeCloud(c.name, {c.move, c.threshold, c.limb_threshold, c.transition, c.colour});
+    if (!error.empty()) return ProtocolError{ErrorCode::kNotFound, error};
+    return json{{"name", c.name}};
+  }
+  std::optional<Outcome> operator()(const RemoveCloud& c) const {
+    std::string error = world.removeCloud(c.name);
+    if (!error.empty()) return ProtocolError{ErrorCode::kNotFound, error};
+    return json{{"name", c.name}};
+  }
+  std::optional<Outcome> operator()(const AddTarget& c) const {
+    Target target;
+    if (c.entity) {  // a CIGI entity: its type's prototype at its pose
+      const auto type = std::find_if(config_.entity_types.begin(), config_.entity_types.end(),
+                                     [&](const EntityType& t) { return t.name == c.entity->type; });
+      if (type == config_.entity_types.end())
+        return badField("target.type: \"" + c.entity->type +
+                        "\" is not an entity type of the daemon config");
+      target = type->prototype;
+      target.name = c.entity->name;
+      target.centre = c.entity->centre;
+      target.orientation = c.entity->orientation;
+    } else if (std::string e = parseTargetJson(c.target, config_.entity_types, target);
+               !e.empty()) {
+      return badField(e);
+    }
+    // A CIGI entity the world already holds (after a restart) is replaced.
+    std::string error =
+        world.addTarget(target, c.replace, std::size_t(ProtocolLimits::kMaxTargets));
+    if (!error.empty()) return badField(error);
+    return targetJson(target, world.base().targets.size());
+  }
+  std::optional<Outcome> operator()(const MoveTarget& c) const {
+    if (std::string error = world.moveTarget(c.name, {c.centre, c.heading, c.pitch, c.roll});
+        !error.empty())
+      return ProtocolError{ErrorCode::kNotFound, error};
+    const std::vector<Target>& targets = world.base().targets;
+    const auto moved = std::find_if(targets.begin(), targets.end(),
+                                    [&](const Target& t) { return t.name == c.name; });
+    return targetJson(*moved, std::size_t(moved - targets.begin()) + 1);
+  }
+  std::optional<Outcome> operator()(const RemoveTarget& c) const {
+    std::string error = world.removeTarget(c.name);
+    if (!error.empty()) return ProtocolError{ErrorCode::kNotFound, error};
+    return json{{"name", c.name}};
+  }
+  std::optional<Outcome> operator()(const ListTargets&) const {
+    json all = json::array();
+    const std::vector<Target>& targets = world.base().targets;
+    for (std::size_t i = 0; i < targets.size(); ++i) all.push_back(targetJson(targets[i], i + 1));
+    return json{{"targets", all}};
+  }
+  std::optional<Outcome> operator()(const Tick& c) const {
+    engine.advance(c.dt);
+    return json{{"time", world.timeSeconds()}, {"ticks", s.ticks}};
+  }
+  std::optional<Outcome> operator()(const Render& c) const { return engine.renderRequest(c, job); }
+  std::optional<Outcome> operator()(const Subscribe& c) const {
+    const ViewConfig* v = s.view(c.view);
+    if (!v) return unknownView(s.views, c.view);
+    if (int(s.subscriptions.size()) >= config_.max_subscriptions)
+      return ProtocolError{ErrorCode::kLimit, "subscribe: the daemon serves " +
+                                                  std::to_string(config_.max_subscriptions) +
+                                                  " subscriptions already (the configured limit)"};
+    if (auto error = engine.platformLimit(*v, c.image.value_or(v->image))) return *error;
+    Subscription sub;
+    sub.id = s.next_subscription++;
+    sub.client = job.client;
+    sub.view = c.view;
+    sub.image = c.image.value_or(v->image);
+    sub.period = secondsToDuration(1.0 / c.rate_hz);
+    sub.next_due = Clock::now();
+    sub.sink = job.push;
+    sub.gone = std::make_shared<std::atomic<bool>>(false);
+    s.subscriptions.push_back(sub);
+    engine.countSubscriptions();
+    return json{{"subscription", sub.id},
+                {"view", sub.view},
+                {"rate", c.rate_hz},
+                {"format", imageFormatName(sub.image.format)},
+                {"channels", channelNames(sub.image)}};
+  }
+  std::optional<Outcome> operator()(const Unsubscribe& c) const {
+    const std::size_t before = s.subscriptions.size();
+    std::erase_if(s.subscriptions, [&](const Subscription& sub) {
+      return sub.id == c.subscription && sub.client == job.client;
+    });
+    engine.countSubscriptions();
+    if (s.subscriptions.size() == before)
+      return ProtocolError{ErrorCode::kNotFound,
+                           "subscription: " + std::to_string(c.subscription) +
+                               " is not one of this connection's subscriptions"};
+    return json{{"subscription", c.subscription}};
+  }
+  std::optional<Outcome> operator()(const Stream& c) const { return engine.startStream(c); }
+  std::optional<Outcome> operator()(const Unstream& c) const { return engine.stopStream(c); }
+  std::optional<Outcome> operator()(const Snapshot& c) const {
+    if (config_.snapshotDirectory().empty()) return noSnapshotDirectory();
+    std::error_code ec;
+    std::filesystem::create_directories(config_.snapshotDirectory(), ec);
+    if (std::string e = engine.writeSnapshot(snapshotPath(c.name)); !e.empty())
+      return ProtocolError{ErrorCode::kFailed, e};
+    return json{{"name", c.name}, {"time", world.timeSeconds()}, {"hash", hexHash(world.hash())}};
+  }
+  std::optional<Outcome> operator()(const Restore& c) const {
+    if (config_.snapshotDirectory().empty()) return noSnapshotDirectory();
+    const std::string path = snapshotPath(c.name);
+    if (!std::filesystem::exists(path))
+      return ProtocolError{ErrorCode::kNotFound, "name: no snapshot \"" + c.name + "\""};
+    if (std::string e = engine.restoreSnapshot(path); !e.empty())
+      return ProtocolError{
+          e.starts_with(World::kOverBudget) ? ErrorCode::kLimit : ErrorCode::kFailed, e};
+    return json{{"name", c.name},
+                {"time", world.timeSeconds()},
+                {"hash", hexHash(world.hash())},
+                {"ticks", s.ticks},
+                {"frames", s.frames}};
+  }
+  std::optional<Outcome> operator()(const Stats&) const {
+    engine.publish();
+    return engine.stats();
+  }
+  std::optional<Outcome> operator()(const Hash&) const {
+    return json{{"hash", hexHash(world.hash())},
+                {"time", world.timeSeconds()},
+                {"time_ns", world.timeNs()},
+                {"ticks", s.ticks}};
+  }
+};
+
+std::optional<Outcome> Engine::apply(const Command& command, Job& job) {
+  return std::visit(Handlers{*this, job}, command);
 }
 
 }  // namespace nephele

@@ -100,11 +100,11 @@ bool Engine::enqueue(Job job) {
   return true;
 }
 
-bool Engine::submit(Request request, std::int64_t client, FrameSink frames, ReplySink done) {
+bool Engine::submit(Request request, std::int64_t client, PushSink push, ReplySink done) {
   Job job;
   job.request = std::move(request);
   job.client = client;
-  job.frames = std::move(frames);
+  job.push = std::move(push);
   job.reply = std::move(done);
   return enqueue(std::move(job));
 }

@@ -55,9 +55,9 @@ inline SharedReply chainReplies(std::vector<SharedReply> replies) {
 
 // Receives a request's reply, once, on a daemon thread (not the caller's).
 using ReplySink = std::function<void(SharedReply)>;
-// Receives subscribed frames; returns false once the client is gone, which ends its
-// subscriptions.
-using FrameSink = std::function<bool(SharedReply)>;
+// Receives what is pushed to a client unasked (its subscriptions' images); returns false
+// once the client is gone, which ends its subscriptions.
+using PushSink = std::function<bool(SharedReply)>;
 // Receives the outcome of a Modbus write or render trigger.
 using DoneSink = std::function<void(std::optional<ProtocolError>)>;
 
@@ -98,7 +98,7 @@ class Engine {
   bool stopping() const;
 
   // Queues work; each returns false (and queues nothing) when the queue is full.
-  bool submit(Request request, std::int64_t client, FrameSink frames, ReplySink done);
+  bool submit(Request request, std::int64_t client, PushSink push, ReplySink done);
   // A Modbus write: every command is checked before any is applied; with `render` (the
   // render coil) the Modbus view is then rendered into the output directory and pushed to
   // the view's subscribers. `done` hears the outcome once the commands are applied and the
@@ -148,7 +148,8 @@ class Engine {
   using Clock = std::chrono::steady_clock;
   struct Job;
   struct Subscription;
-  struct State;  // everything the world thread owns
+  struct State;     // everything the world thread owns
+  struct Handlers;  // a request's handler by command (dispatch.cpp)
   class Encoder;
 
   bool enqueue(Job job);
@@ -188,8 +189,9 @@ class Engine {
   void advance(double dt_s);  // one tick
   // Renders a view (float for EXR, else 8-bit) and records its time.
   // `continuous`: a frame of a subscription's stream, which may reuse the view's last frame.
-  void renderFrame(const ViewConfig& view, const ImageRequest& image, struct ViewFrame& frame,
+  void renderFrame(const ViewConfig& view, const ImageRequest& image, struct RenderedView& out,
                    bool continuous = false);
+  void noteRender(double ms);  // a view's render time, for stats and metrics
   void realtimeTicks();
   enum class Delivery {
     kDue,        // realtime: subscriptions whose period has come round
@@ -197,6 +199,13 @@ class Engine {
     kView,       // the render coil: the subscribers of one view
   };
   void deliverFrames(Delivery which, const std::string& view);
+  // The subscriptions `which` makes due now, by view (their next due time moved on).
+  std::map<std::string, std::vector<Subscription*>> dueByView(Delivery which,
+                                                              const std::string& view);
+  // One rendered view to the subscribers of one image request: streams to their encoders,
+  // sockets through the image encoder (raw 8-bit at once).
+  void sendToSubscribers(const std::shared_ptr<const struct RenderedView>& frame,
+                         const ImageRequest& image, const std::vector<Subscription*>& members);
   void renderTrigger();
   bool saveSnapshot(const std::string& path, const char* why);
   void countSubscriptions();  // refreshes subscribers_ from the world thread's list

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "image/image_encoding.h"
+#include "renderer/encode.h"
 #include "renderer/frame.h"
 #include "renderer/frame_timing.h"
 #include "renderer/gl/gl_platform.h"
@@ -151,7 +152,7 @@ struct Engine::Job {
   enum class Kind { kRequest, kBatch } kind = Kind::kRequest;
   Request request;
   std::int64_t client = 0;
-  FrameSink frames;
+  PushSink push;
   ReplySink reply;
   std::vector<Command> batch;
   bool render = false;  // a batch with the render coil
@@ -167,7 +168,7 @@ struct Engine::Subscription {
   Clock::duration period{};
   Clock::time_point next_due;
   std::uint64_t last_tick = UINT64_MAX;  // the tick of the last frame sent
-  FrameSink sink;
+  PushSink sink;
   std::shared_ptr<std::atomic<bool>> gone;  // set when the sink reports its client gone
   // A streamed view (stream): its frames go to the encoder in place of `sink`; its address.
   std::shared_ptr<VideoStream> video;
@@ -262,11 +263,10 @@ struct Engine::State {
   }
 };
 
-// A rendered view, before encoding.
-struct ViewFrame {
-  Srgb8Image srgb;
-  FloatImage linear;  // for EXR
-  Frame planes;       // with ground-truth channels (ImageRequest::floatPlanes)
+// A view as rendered, before encoding: its frame (8-bit, linear or float planes, as its
+// ImageRequest asked) and the fields of its image header.
+struct RenderedView {
+  Frame frame;
   nlohmann::json meta;
 };
 
@@ -282,12 +282,16 @@ json seaJson(const std::optional<Sea>& sea);
 // Where the world's database lies on the Earth (set_site's reply, stats' "site").
 json siteJson(const World& world);
 
-// Encodes `frame` as `image` asks (delivery.cpp); on failure returns the error.
-std::variant<std::vector<std::uint8_t>, std::string> encodeFrame(const ViewFrame& frame,
-                                                                 const ImageRequest& image,
-                                                                 const EncodeOptions& options);
+// The pixels an image request asks for: float planes with ground-truth channels, else colour
+// and coverage, linear for EXR and 8-bit sRGB otherwise (PROTOCOL.md, "Images").
+Channels channelsOf(const ImageRequest& image);
+// The container of a protocol image format.
+ImageFileFormat fileFormatOf(ImageFormat format);
+// Encodes a rendered view as `image` asks (delivery.cpp); on failure returns the error.
+Encoded encodeView(const RenderedView& view, const ImageRequest& image,
+                   const EncodeOptions& options);
 // An image header's fields: the frame's view, pose, time and tick, and how it is encoded.
-json imageMeta(const ViewFrame& frame, const ImageRequest& image);
+json imageMeta(const RenderedView& view, const ImageRequest& image);
 }  // namespace engine_detail
 
 }  // namespace nephele

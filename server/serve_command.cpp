@@ -33,21 +33,23 @@ void addServeCommand(CLI::App& app, ServeCommandOptions& o) {
                   "Snapshot file: restored at start if present, saved periodically and at exit");
 }
 
-int runServeCommand(const ServeCommandOptions& o) {
-  // SIGTERM and SIGINT are taken by sigwait below; block them before any thread starts so
-  // that every thread inherits the mask.
+namespace {
+
+// SIGTERM and SIGINT, blocked before any thread starts so that every thread inherits the mask;
+// runServeCommand takes them with sigwait.
+sigset_t blockStopSignals() {
   sigset_t signals;
   sigemptyset(&signals);
   sigaddset(&signals, SIGTERM);
   sigaddset(&signals, SIGINT);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
   signal(SIGPIPE, SIG_IGN);  // a vanished client is a write error, not a dead daemon
+  return signals;
+}
 
-  DaemonConfig config;
-  if (std::string error = loadDaemonConfig(o.config_path, config); !error.empty()) {
-    spdlog::error("{}", error);
-    return 2;
-  }
+// The daemon config file, with the command line's ports and snapshot over it.
+std::string loadServeConfig(const ServeCommandOptions& o, DaemonConfig& config) {
+  if (std::string error = loadDaemonConfig(o.config_path, config); !error.empty()) return error;
   if (o.socket_port) config.socket.port = *o.socket_port;
   if (o.modbus_port) config.modbus.port = *o.modbus_port;
   if (o.metrics_port) {
@@ -55,6 +57,33 @@ int runServeCommand(const ServeCommandOptions& o) {
     config.metrics_enabled = true;
   }
   if (o.snapshot_path) config.snapshot_path = *o.snapshot_path;
+  return "";
+}
+
+// With systemd's WatchdogSec, a thread that beats every half period while the world thread
+// keeps going round its loop, until `stopping`; without it, no thread.
+std::thread startWatchdog(const Engine& engine, const std::atomic<bool>& stopping) {
+  std::uint64_t watchdog_us = 0;
+  if (sd_watchdog_enabled(0, &watchdog_us) <= 0) return {};
+  return std::thread([&engine, &stopping, watchdog_us] {
+    const auto period = std::chrono::microseconds(watchdog_us / 2);
+    while (!stopping) {
+      if (engine.heartbeatAge() < double(watchdog_us) * 1e-6) sd_notify(0, "WATCHDOG=1");
+      std::this_thread::sleep_for(
+          std::min<std::chrono::microseconds>(period, std::chrono::milliseconds(200)));
+    }
+  });
+}
+
+}  // namespace
+
+int runServeCommand(const ServeCommandOptions& o) {
+  const sigset_t signals = blockStopSignals();
+  DaemonConfig config;
+  if (std::string error = loadServeConfig(o, config); !error.empty()) {
+    spdlog::error("{}", error);
+    return 2;
+  }
 
   Engine engine(config);
   if (std::string error = engine.start(); !error.empty()) {
@@ -91,18 +120,8 @@ int runServeCommand(const ServeCommandOptions& o) {
   sd_notifyf(0, "READY=1\nSTATUS=serving socket %d modbus %d cigi %d",
              config.socket_enabled ? socket.port() : -1, config.modbus_enabled ? modbus.port() : -1,
              config.cigi.enabled ? cigi.port() : -1);
-  std::uint64_t watchdog_us = 0;
   std::atomic<bool> stopping{false};
-  std::thread watchdog;
-  if (sd_watchdog_enabled(0, &watchdog_us) > 0)
-    watchdog = std::thread([&] {
-      const auto period = std::chrono::microseconds(watchdog_us / 2);
-      while (!stopping) {
-        if (engine.heartbeatAge() < double(watchdog_us) * 1e-6) sd_notify(0, "WATCHDOG=1");
-        std::this_thread::sleep_for(
-            std::min<std::chrono::microseconds>(period, std::chrono::milliseconds(200)));
-      }
-    });
+  std::thread watchdog = startWatchdog(engine, stopping);
   spdlog::info("event=listening socket={}:{} modbus={}:{} metrics={}", config.socket.bind,
                socket.port(), config.modbus.bind, modbus.port(),
                config.metrics_enabled ? std::to_string(metrics.port()) : "off");
