@@ -1384,8 +1384,16 @@ void EllipsoidRenderer::renderAtlasBatch(const Scene& scene, const EllipsoidClou
   gl_.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   gl_.BlendEquationSeparate(GL_FUNC_ADD, GL_FUNC_ADD);
   gl_.Disable(GL_CULL_FACE);
+  compositeAtlasTiles(scene, cloud, texture, base, records, tiles, target, band);
+}
 
-  // Composite every tile as a screen rectangle, back to front (records are in that order).
+void EllipsoidRenderer::compositeAtlasTiles(const Scene& scene, const EllipsoidCloud& cloud,
+                                            const CachedTexture& texture,
+                                            const EllipsoidPassLayout& base,
+                                            const std::vector<EllipsoidRecord>& records,
+                                            const std::vector<Tile>& tiles,
+                                            const PassTarget& target, const AltitudeBand& band) {
+  // Every tile as a screen rectangle, back to front (records are in that order).
   gl_.BindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
   gl_.Viewport(0, 0, target.width, target.height);
   gl_.Enable(GL_BLEND);

@@ -190,6 +190,12 @@ class EllipsoidRenderer {
                         const RenderSettings& settings, std::vector<EllipsoidRecord>& records,
                         std::vector<Tile>& tiles, const PassTarget& target,
                         const AltitudeBand& band);
+  // The atlas's tiles composited over `target`.
+  void compositeAtlasTiles(const Scene& scene, const EllipsoidCloud& cloud,
+                           const CachedTexture& texture, const EllipsoidPassLayout& base,
+                           const std::vector<EllipsoidRecord>& records,
+                           const std::vector<Tile>& tiles, const PassTarget& target,
+                           const AltitudeBand& band);
   void prepareAtlas(TileFormat format);
   // The per-pixel pass's samples texture (RGBA16F) and their distances (R32F), and their
   // framebuffer, at `size`.

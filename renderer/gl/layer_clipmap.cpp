@@ -121,6 +121,27 @@ void LayerClipmaps::bake(Clipmap& c, const GardnerTexture& g, int ring, glm::ive
   texels_baked_ += std::int64_t(rect.z - rect.x) * (rect.w - rect.y);
 }
 
+void LayerClipmaps::bindForBaking(Clipmap& c, int size) {
+  if (!program_) {
+    std::string error;
+    program_ = createProgram(gl_, polygonVertexSource(), clipmapBakeSource(), error);
+    NEPHELE_CHECK(program_, "clipmap bake program: " << error);
+    framebuffer_ = createFramebuffer(gl_);
+  }
+  if (!c.texture) {
+    c.texture = createTexture(gl_, GL_TEXTURE_2D_ARRAY);
+    gl_.TextureStorage3D(c.texture.get(), 1, GL_R16, size, size, c.rings);
+    gl_.TextureParameteri(c.texture.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    gl_.TextureParameteri(c.texture.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    gl_.TextureParameteri(c.texture.get(), GL_TEXTURE_WRAP_S, GL_REPEAT);
+    gl_.TextureParameteri(c.texture.get(), GL_TEXTURE_WRAP_T, GL_REPEAT);
+  }
+  gl_.BindFramebuffer(GL_FRAMEBUFFER, framebuffer_.get());
+  gl_.Viewport(0, 0, size, size);
+  gl_.Disable(GL_BLEND);
+  gl_.UseProgram(program_.get());
+}
+
 const ClipmapView& LayerClipmaps::prepare(const std::string& key, const GardnerTexture& g,
                                           glm::dvec2 eye, int size, std::int64_t budget, bool wait,
                                           FrameStats& stats) {
@@ -134,24 +155,7 @@ const ClipmapView& LayerClipmaps::prepare(const std::string& key, const GardnerT
   bool bound = false;
   auto bind = [&] {
     if (bound) return;
-    if (!program_) {
-      std::string error;
-      program_ = createProgram(gl_, polygonVertexSource(), clipmapBakeSource(), error);
-      NEPHELE_CHECK(program_, "clipmap bake program: " << error);
-      framebuffer_ = createFramebuffer(gl_);
-    }
-    if (!c.texture) {
-      c.texture = createTexture(gl_, GL_TEXTURE_2D_ARRAY);
-      gl_.TextureStorage3D(c.texture.get(), 1, GL_R16, size, size, c.rings);
-      gl_.TextureParameteri(c.texture.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-      gl_.TextureParameteri(c.texture.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-      gl_.TextureParameteri(c.texture.get(), GL_TEXTURE_WRAP_S, GL_REPEAT);
-      gl_.TextureParameteri(c.texture.get(), GL_TEXTURE_WRAP_T, GL_REPEAT);
-    }
-    gl_.BindFramebuffer(GL_FRAMEBUFFER, framebuffer_.get());
-    gl_.Viewport(0, 0, size, size);
-    gl_.Disable(GL_BLEND);
-    gl_.UseProgram(program_.get());
+    bindForBaking(c, size);
     bound = true;
   };
   for (int ring = 0; ring < c.rings; ++ring) {

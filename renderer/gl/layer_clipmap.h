@@ -83,6 +83,8 @@ class LayerClipmaps {
   Clipmap& choose(const std::string& key, const GardnerTexture& g, glm::dvec2 eye, int size);
   // Evaluates storage rectangle [x0, x1) x [y0, y1) of ring `ring`.
   void bake(Clipmap& c, const GardnerTexture& g, int ring, glm::ivec4 rect);
+  // Makes the bake program and c's texture when missing, and binds them for bake.
+  void bindForBaking(Clipmap& c, int size);
 
   const GlApi& gl_;
   GlObject program_;

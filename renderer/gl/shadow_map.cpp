@@ -26,6 +26,22 @@ void hashBytes(std::uint64_t& h, const void* data, std::size_t bytes) {
   for (std::size_t i = 0; i < bytes; ++i) h = (h ^ p[i]) * 0x100000001b3ull;
 }
 
+// The casters as the shader reads them, four rows each: the centre from the map's centre (the
+// anchor plus `centre`), its height and reach; the rows of its W, its extinction and table.
+std::vector<glm::vec4> casterRecords(const CloudShadows& shadows, glm::dvec2 anchor,
+                                     glm::dvec2 centre) {
+  std::vector<glm::vec4> records;
+  records.reserve(shadows.casters().size() * 4);
+  for (const ShadowCaster& c : shadows.casters()) {
+    const glm::dmat3 w = glm::transpose(c.to_unit);  // columns of the transpose: rows of W
+    records.emplace_back(glm::dvec2(c.centre) - anchor - centre, c.centre.z, c.reach);
+    records.emplace_back(w[0], 0.0);
+    records.emplace_back(w[1], c.extinction);
+    records.emplace_back(w[2], double(c.table));
+  }
+  return records;
+}
+
 }  // namespace
 
 ShadowMap::ShadowMap(const GlApi& gl) : gl_(gl) {}
@@ -52,15 +68,7 @@ void ShadowMap::prepare(const CloudShadows& shadows, glm::dvec3 camera, int size
   const glm::dvec2 centre = 0.5 * (lo + hi);  // from the anchor
   const double half = 0.5 * std::max(hi.x - lo.x, hi.y - lo.y);
 
-  std::vector<glm::vec4> records;
-  records.reserve(shadows.casters().size() * 4);
-  for (const ShadowCaster& c : shadows.casters()) {
-    const glm::dmat3 w = glm::transpose(c.to_unit);  // columns of the transpose: rows of W
-    records.emplace_back(glm::dvec2(c.centre) - anchor - centre, c.centre.z, c.reach);
-    records.emplace_back(w[0], 0.0);
-    records.emplace_back(w[1], c.extinction);
-    records.emplace_back(w[2], double(c.table));
-  }
+  const std::vector<glm::vec4> records = casterRecords(shadows, anchor, centre);
   std::vector<float> tables;
   for (const ShadowTable& t : shadows.tables()) tables.insert(tables.end(), t.begin(), t.end());
   const glm::vec3 to_sun(shadows.toSun());
@@ -74,7 +82,13 @@ void ShadowMap::prepare(const CloudShadows& shadows, glm::dvec3 camera, int size
   half_ = half;
   floor_ = shadows.floor();
   if (key == key_ && texture_) return;
+  draw(shadows, records, tables, to_sun, size, half, stats, timer);
+  key_ = key;
+}
 
+void ShadowMap::draw(const CloudShadows& shadows, const std::vector<glm::vec4>& records,
+                     const std::vector<float>& tables, glm::vec3 to_sun, int size, double half,
+                     FrameStats& stats, GpuPassTimer& timer) {
   StageClock clock(stats.times.cpu(CpuStage::kUploads));
   if (!program_) {
     std::string error;
@@ -123,7 +137,6 @@ void ShadowMap::prepare(const CloudShadows& shadows, glm::dvec3 camera, int size
   gl_.BlendFuncSeparate(GL_ZERO, GL_SRC_COLOR, GL_ZERO, GL_SRC_ALPHA);
   gl_.DrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(shadows.casters().size()));
   gl_.Disable(GL_BLEND);
-  key_ = key;
   ++draws_;
   ++stats.shadow_maps;
 }

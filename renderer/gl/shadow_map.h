@@ -35,6 +35,11 @@ class ShadowMap {
   int draws() const { return draws_; }  // maps drawn since construction
 
  private:
+  // Uploads the casters' records and tables and draws the map.
+  void draw(const CloudShadows& shadows, const std::vector<glm::vec4>& records,
+            const std::vector<float>& tables, glm::vec3 to_sun, int size, double half,
+            FrameStats& stats, GpuPassTimer& timer);
+
   const GlApi& gl_;
   GlObject program_, vertex_array_, framebuffer_, texture_, tables_, records_buffer_, records_;
   int size_ = 0;

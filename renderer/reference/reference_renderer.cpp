@@ -155,22 +155,7 @@ class ReferenceTracer {
     }
     colour = withAir(colour, direction, nearest_opaque);
 
-    surfaces.clear();
-    for (std::size_t i = 0; i < scene_.layers.size(); ++i) {
-      const double s = (scene_.layers[i].altitude_m - eye.z) / direction.z;
-      if (s > 0.0 && s <= nearest_opaque && std::isfinite(s))
-        surfaces.push_back(layerSurface(scene_.layers[i], textures_[i], direction, s));
-    }
-    for (const EllipsoidEntry& entry : ellipsoids_) {
-      const auto span = entry.view.intersect(direction);
-      if (span && span->near > 0.0 && span->near <= nearest_opaque)
-        surfaces.push_back(ellipsoidSurface(entry, direction, span->near));
-    }
-    for (const AutomatonCloudView& cloud : scene_.automata)
-      if (const auto surface = volumeSurface(cloud, direction, nearest_opaque))
-        surfaces.push_back(*surface);
-    std::sort(surfaces.begin(), surfaces.end(),
-              [](const Surface& a, const Surface& b) { return a.distance > b.distance; });
+    surfacesAlong(direction, nearest_opaque, surfaces);
 
     double translucence_product = 1.0;
     for (const Surface& surface : surfaces) {                                    // back to front
@@ -206,6 +191,29 @@ class ReferenceTracer {
   }
 
  private:
+  // The surfaces the ray meets before `nearest_opaque`, back to front: layers, ellipsoids and
+  // automaton clouds.
+  void surfacesAlong(glm::dvec3 direction, double nearest_opaque,
+                     std::vector<Surface>& surfaces) const {
+    const glm::dvec3 eye = scene_.camera.position;
+    surfaces.clear();
+    for (std::size_t i = 0; i < scene_.layers.size(); ++i) {
+      const double s = (scene_.layers[i].altitude_m - eye.z) / direction.z;
+      if (s > 0.0 && s <= nearest_opaque && std::isfinite(s))
+        surfaces.push_back(layerSurface(scene_.layers[i], textures_[i], direction, s));
+    }
+    for (const EllipsoidEntry& entry : ellipsoids_) {
+      const auto span = entry.view.intersect(direction);
+      if (span && span->near > 0.0 && span->near <= nearest_opaque)
+        surfaces.push_back(ellipsoidSurface(entry, direction, span->near));
+    }
+    for (const AutomatonCloudView& cloud : scene_.automata)
+      if (const auto surface = volumeSurface(cloud, direction, nearest_opaque))
+        surfaces.push_back(*surface);
+    std::sort(surfaces.begin(), surfaces.end(),
+              [](const Surface& a, const Surface& b) { return a.distance > b.distance; });
+  }
+
   // MODEL.md section 12: the opaque surface or clear sky behind, then every cloud surface back
   // to front as a grey body at the air temperature of its altitude, emissivity its opacity.
   double infraredRadiance(const InfraredModel& model, glm::dvec3 direction,
