@@ -50,8 +50,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (selector % 4 == 3) {
     // A stream of Modbus TCP frames, framed the way the server frames them.
     while (size >= ModbusAdu::kHeaderBytes) {
-      auto header = decodeMbapHeader(std::span<const std::uint8_t, ModbusAdu::kHeaderBytes>(
-          data, ModbusAdu::kHeaderBytes));
+      auto header = decodeMbapHeader(
+          std::span<const std::uint8_t, ModbusAdu::kHeaderBytes>(data, ModbusAdu::kHeaderBytes));
       if (std::holds_alternative<std::string>(header)) return 0;  // the server closes
       const MbapHeader& h = std::get<MbapHeader>(header);
       if (size < ModbusAdu::kHeaderBytes + h.pduBytes()) return 0;
