@@ -803,6 +803,10 @@ json channelNames(const ImageRequest& image) {
   return out;
 }
 
+json frustumJson(const Frustum& f) {
+  return {{"left", f.left}, {"right", f.right}, {"bottom", f.bottom}, {"top", f.top}};
+}
+
 json cameraJson(const FrameInfo& info) {
   return {{"position", {info.position.x, info.position.y, info.position.z}},
           {"heading_deg", info.orientation.heading_deg},

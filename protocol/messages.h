@@ -319,5 +319,7 @@ nlohmann::json channelNames(const ImageRequest& image);
 // The camera a frame was seen from, as frame headers and dataset records carry it: position,
 // attitude, vertical field of view, focal length in pixels and principal point.
 nlohmann::json cameraJson(const FrameInfo& info);
+// An off-axis view's frustum, in degrees from the view's axis, as set_view takes it.
+nlohmann::json frustumJson(const Frustum& f);
 
 }  // namespace nephele

@@ -1,6 +1,6 @@
 #include <spdlog/spdlog.h>
 
-#include "server/engine_state.h"
+#include "server/engine_detail.h"
 #include "world/formations/weather.h"
 
 // Weather and atmosphere at run time: weather layers onto formations (MODEL.md section 10),
@@ -13,11 +13,10 @@ using namespace engine_detail;
 
 std::optional<ProtocolError> Engine::setWeather(int layer, const WeatherLayer& weather,
                                                 std::optional<int> region) {
-  State& s = *state_;
   const WeatherKey key{
       layer, region ? std::optional<std::uint16_t>(std::uint16_t(*region)) : std::nullopt};
   bool changed = false;
-  if (std::string error = s.world->setWeather(key, weather, &changed); !error.empty())
+  if (std::string error = world_->setWeather(key, weather, &changed); !error.empty())
     return ProtocolError{ErrorCode::kFailed, error};
   if (changed)
     spdlog::info("event=weather layer={} region={} type={} base={} thickness={} coverage={:.2f}",
@@ -27,32 +26,30 @@ std::optional<ProtocolError> Engine::setWeather(int layer, const WeatherLayer& w
 }
 
 Outcome Engine::setSun(const command::SetSun& c) {
-  State& s = *state_;
-  Sun sun = s.world->base().sun;
+  Sun sun = world_->base().sun;
   if (c.utc) {
     // At the place given, else at the database's origin; the azimuth from true north there
     // turned to the database's north (MODEL.md section 13).
-    const std::optional<Site>& site = s.world->base().site;
+    const std::optional<Site>& site = world_->base().site;
     const glm::dvec2 place = c.place.value_or(
         site ? glm::dvec2(site->latitude_deg, site->longitude_deg) : glm::dvec2(0.0));
     const SolarPosition p = solarPosition(*c.utc, place.x, place.y);
     sun.azimuth_deg = p.azimuth_deg;
     if (site) sun.azimuth_deg += LocalFrame(*site).northBearing({place.x, place.y, 0.0});
     sun.elevation_deg = p.elevation_deg;
-    s.sun_utc = c.utc;
+    sun_utc_ = c.utc;
   }
-  if (c.azimuth || c.elevation) s.sun_utc.reset();
+  if (c.azimuth || c.elevation) sun_utc_.reset();
   if (c.azimuth) sun.azimuth_deg = *c.azimuth;
   if (c.elevation) sun.elevation_deg = *c.elevation;
-  s.world->setSun(sun);
+  world_->setSun(sun);
   json out{{"azimuth", sun.azimuth_deg}, {"elevation", sun.elevation_deg}};
-  if (s.sun_utc) out["utc"] = formatUtc(*s.sun_utc);
+  if (sun_utc_) out["utc"] = formatUtc(*sun_utc_);
   return out;
 }
 
 Outcome Engine::setFog(const command::SetFog& c) {
-  State& s = *state_;
-  std::optional<Fog> fog = s.world->base().fog;
+  std::optional<Fog> fog = world_->base().fog;
   const bool read_back = !c.enabled && !c.top && !c.visibility && !c.colour;
   if (read_back) {
     // no field: the fog as it is
@@ -64,7 +61,7 @@ Outcome Engine::setFog(const command::SetFog& c) {
     if (c.visibility) fog->visibility_m = *c.visibility;
     if (c.colour) fog->colour = *c.colour;
   }
-  if (std::string error = s.world->setFog(fog); !error.empty())
+  if (std::string error = world_->setFog(fog); !error.empty())
     return ProtocolError{ErrorCode::kFailed, error};
   if (!fog) return json{{"enabled", false}};
   return json{{"enabled", true},
@@ -74,8 +71,7 @@ Outcome Engine::setFog(const command::SetFog& c) {
 }
 
 Outcome Engine::setHaze(const command::SetHaze& c) {
-  State& s = *state_;
-  std::optional<Haze> haze = s.world->base().haze;
+  std::optional<Haze> haze = world_->base().haze;
   const bool read_back = !c.enabled && !c.visibility && !c.scale_height;
   if (read_back) {
     // no field: the haze as it is
@@ -86,7 +82,7 @@ Outcome Engine::setHaze(const command::SetHaze& c) {
     if (c.visibility) haze->visibility_m = *c.visibility;
     if (c.scale_height) haze->scale_height_m = *c.scale_height;
   }
-  if (std::string error = s.world->setHaze(haze); !error.empty())
+  if (std::string error = world_->setHaze(haze); !error.empty())
     return ProtocolError{ErrorCode::kFailed, error};
   if (!haze) return json{{"enabled", false}};
   return json{{"enabled", true},
@@ -162,12 +158,11 @@ json engine_detail::seaJson(const std::optional<Sea>& sea) {
 }
 
 Outcome Engine::setSea(const command::SetSea& c) {
-  State& s = *state_;
-  auto sea = seaAfter(s.world->base().sea, c, surfaceWind(*s.world));
+  auto sea = seaAfter(world_->base().sea, c, surfaceWind(*world_));
   if (const auto* error = std::get_if<ProtocolError>(&sea)) return *error;
   const std::optional<Sea>& after = std::get<std::optional<Sea>>(sea);
   bool changed = false;
-  if (std::string error = s.world->setSea(after, &changed); !error.empty()) return badField(error);
+  if (std::string error = world_->setSea(after, &changed); !error.empty()) return badField(error);
   if (changed)
     spdlog::info("event=sea enabled={} trains={}", after.has_value(),
                  after ? after->trains.size() : 0);
@@ -186,8 +181,7 @@ nlohmann::json engine_detail::siteJson(const World& world) {
 }
 
 Outcome Engine::setSite(const command::SetSite& c) {
-  State& s = *state_;
-  World& world = *s.world;
+  World& world = *world_;
   if (c.latitude) {
     const std::optional<Site> before = world.base().site;
     Site site{*c.latitude, *c.longitude, 0.0};
@@ -198,23 +192,12 @@ Outcome Engine::setSite(const command::SetSite& c) {
     if (std::string error = world.setSite(site, &changed); !error.empty()) return badField(error);
     // The views move with the world, so that each sees what it saw (a host places its own).
     const glm::dvec3 shift(world.base().content_origin - origin, 0.0);
-    for (ViewConfig& v : s.views) v.camera.position -= shift;
+    views_.shiftAll(shift);
     if (changed)
       spdlog::info("event=site latitude={:.6f} longitude={:.6f} grid={:.4f} moved={:.1f}",
                    site.latitude_deg, site.longitude_deg, site.grid_deg, glm::length(shift));
   }
   return siteJson(world);
-}
-
-void Engine::setMode(TickMode mode) {
-  State& s = *state_;
-  if (mode == s.mode) return;
-  s.mode = mode;
-  lockstep_ = mode == TickMode::kLockstep;
-  // Realtime ticks and subscription periods start from now, not from when they last ran.
-  s.next_tick = Clock::now();
-  for (Subscription& sub : s.subscriptions) sub.next_due = Clock::now();
-  spdlog::info("event=mode mode={}", modeName(mode));
 }
 
 }  // namespace nephele

@@ -77,7 +77,7 @@ void CigiServer::receive() {
 // never a datagram's).
 void CigiServer::refuse(const std::string& reason, const std::string& message,
                         const udp::endpoint& from) {
-  engine_.countCigi("refused_" + reason);
+  engine_.telemetry().countCigi("refused_" + reason);
   if (listenerLog().admit("cigi_refused/" + reason))
     spdlog::warn("event=cigi_refused reason={} from={}:{} error=\"{}\"", reason,
                  from.address().to_string(), from.port(), message);
@@ -104,7 +104,7 @@ void CigiServer::next() {
   }
   cigi::MappedMessage& frame = std::get<cigi::MappedMessage>(mapped);
   for (const std::string& what : frame.ignored) {
-    engine_.countCigi("ignored");
+    engine_.telemetry().countCigi("ignored");
     spdlog::debug("event=cigi_ignored what=\"{}\"", what);
   }
   for (const std::string& what : frame.refused) refuse("bad_value", what, d.from);
@@ -113,7 +113,7 @@ void CigiServer::next() {
         "event=cigi_site latitude={:.6f} longitude={:.6f} what=\"no [site] configured: the "
         "database origin is the host's first position\"",
         frame.site_adopted->latitude_deg, frame.site_adopted->longitude_deg);
-  if (frame.recentred) engine_.countCigi("recentred");
+  if (frame.recentred) engine_.telemetry().countCigi("recentred");
   const std::uint8_t status =
       frame.refused.empty() ? cigi::IgStatus::kApplied : cigi::IgStatus::kPacketsRefused;
   // Synchronous (lockstep) mode: the world advances by the host's frame time, and the tick
@@ -133,7 +133,7 @@ void CigiServer::next() {
         answer(control, order, from, cigi::IgStatus::kWorldRefused);
       } else {
         session_.commit();
-        engine_.countCigi("messages");
+        engine_.telemetry().countCigi("messages");
         answer(control, order, from, status);
       }
       next();

@@ -2,7 +2,7 @@
 #include <filesystem>
 
 #include "config/scene_file.h"
-#include "server/engine_state.h"
+#include "server/engine_detail.h"
 #include "world/counter_random.h"
 #include "world/limits.h"
 
@@ -37,17 +37,16 @@ json targetJson(const Target& t, std::size_t object_id) {
 }  // namespace
 
 std::optional<ProtocolError> Engine::check(const Command& command) const {
-  const State& s = *state_;
   if (const auto* c = std::get_if<command::SetView>(&command)) {
-    const ViewConfig* view = s.view(c->view);
-    if (!view) return unknownView(s.views, c->view);
+    const ViewConfig* view = views_.find(c->view);
+    if (!view) return views_.unknown(c->view);
     ViewConfig changed = *view;
     applyViewPatch(changed, c->patch);
-    if (auto error = pixelLimit(changed)) return error;
+    if (auto error = renders_->pixelLimit(changed)) return error;
     if (auto error = platformLimit(changed, changed.image)) return error;
   }
   if (const auto* c = std::get_if<command::Tick>(&command)) {
-    if (s.mode == TickMode::kRealtime)
+    if (!clock_.lockstep())
       return ProtocolError{ErrorCode::kFailed,
                            "tick: the daemon runs in realtime mode, where it ticks itself (switch "
                            "with set_time mode \"lockstep\", or use set_time advance)"};
@@ -56,7 +55,7 @@ std::optional<ProtocolError> Engine::check(const Command& command) const {
   if (const auto* c = std::get_if<command::SetTime>(&command); c && c->advance)
     return checkAdvance(*c->advance);
   if (const auto* c = std::get_if<command::SetSea>(&command))  // the trains it would hold
-    if (auto sea = seaAfter(s.world->base().sea, *c, surfaceWind(*s.world));
+    if (auto sea = seaAfter(world_->base().sea, *c, surfaceWind(*world_));
         std::holds_alternative<ProtocolError>(sea))
       return std::get<ProtocolError>(sea);
   return std::nullopt;
@@ -67,8 +66,9 @@ std::optional<ProtocolError> Engine::check(const Command& command) const {
 struct Engine::Handlers {
   Engine& engine;
   Job& job;
-  State& s = *engine.state_;
-  World& world = *s.world;
+  World& world = *engine.world_;
+  Views& views = engine.views_;
+  WorldClock& clock = engine.clock_;
   const DaemonConfig& config_ = engine.config_;
 
   ProtocolError noSnapshotDirectory() const {
@@ -85,16 +85,16 @@ struct Engine::Handlers {
   std::optional<Outcome> operator()(const GetView& c) const {
     if (c.view.empty()) {
       json all = json::array();
-      for (const ViewConfig& v : s.views) all.push_back(viewJson(v));
+      for (const ViewConfig& v : views.all()) all.push_back(viewJson(v));
       return json{{"views", all}};
     }
-    const ViewConfig* v = s.view(c.view);
-    if (!v) return unknownView(s.views, c.view);
+    const ViewConfig* v = views.find(c.view);
+    if (!v) return views.unknown(c.view);
     return viewJson(*v);
   }
   std::optional<Outcome> operator()(const SetView& c) const {
-    ViewConfig* v = s.view(c.view);
-    if (!v) return unknownView(s.views, c.view);
+    ViewConfig* v = views.find(c.view);
+    if (!v) return views.unknown(c.view);
     applyViewPatch(*v, c.patch);
     return viewJson(*v);
   }
@@ -119,15 +119,15 @@ struct Engine::Handlers {
   std::optional<Outcome> operator()(const SetSea& c) const { return engine.setSea(c); }
   std::optional<Outcome> operator()(const SetSite& c) const { return engine.setSite(c); }
   std::optional<Outcome> operator()(const SetTime& c) const {
-    if (c.time_scale) s.time_scale = *c.time_scale;
-    if (c.paused) s.paused = *c.paused;
+    if (c.time_scale) clock.setTimeScale(*c.time_scale);
+    if (c.paused) clock.setPaused(*c.paused);
     if (c.mode) engine.setMode(*c.mode);
     if (c.advance) engine.advance(*c.advance);
     return json{{"time", world.timeSeconds()},
-                {"time_scale", s.time_scale},
-                {"paused", s.paused},
-                {"mode", modeName(s.mode)},
-                {"ticks", s.ticks}};
+                {"time_scale", clock.timeScale()},
+                {"paused", clock.paused()},
+                {"mode", modeName(clock.mode())},
+                {"ticks", clock.ticks()}};
   }
   std::optional<Outcome> operator()(const AddCloud& c) const {
     const auto name = c.cloud.find("name");
@@ -214,19 +214,18 @@ struct Engine::Handlers {
   }
   std::optional<Outcome> operator()(const Tick& c) const {
     engine.advance(c.dt);
-    return json{{"time", world.timeSeconds()}, {"ticks", s.ticks}};
+    return json{{"time", world.timeSeconds()}, {"ticks", clock.ticks()}};
   }
   std::optional<Outcome> operator()(const Render& c) const { return engine.renderRequest(c, job); }
   std::optional<Outcome> operator()(const Subscribe& c) const {
-    const ViewConfig* v = s.view(c.view);
-    if (!v) return unknownView(s.views, c.view);
-    if (int(s.subscriptions.size()) >= config_.max_subscriptions)
+    const ViewConfig* v = views.find(c.view);
+    if (!v) return views.unknown(c.view);
+    if (int(views.subscriptions().size()) >= config_.max_subscriptions)
       return ProtocolError{ErrorCode::kLimit, "subscribe: the daemon serves " +
                                                   std::to_string(config_.max_subscriptions) +
                                                   " subscriptions already (the configured limit)"};
     if (auto error = engine.platformLimit(*v, c.image.value_or(v->image))) return *error;
     Subscription sub;
-    sub.id = s.next_subscription++;
     sub.client = job.client;
     sub.view = c.view;
     sub.image = c.image.value_or(v->image);
@@ -234,8 +233,7 @@ struct Engine::Handlers {
     sub.next_due = Clock::now();
     sub.sink = job.push;
     sub.gone = std::make_shared<std::atomic<bool>>(false);
-    s.subscriptions.push_back(sub);
-    engine.countSubscriptions();
+    sub.id = views.subscribe(sub);
     return json{{"subscription", sub.id},
                 {"view", sub.view},
                 {"rate", c.rate_hz},
@@ -243,12 +241,7 @@ struct Engine::Handlers {
                 {"channels", channelNames(sub.image)}};
   }
   std::optional<Outcome> operator()(const Unsubscribe& c) const {
-    const std::size_t before = s.subscriptions.size();
-    std::erase_if(s.subscriptions, [&](const Subscription& sub) {
-      return sub.id == c.subscription && sub.client == job.client;
-    });
-    engine.countSubscriptions();
-    if (s.subscriptions.size() == before)
+    if (!views.unsubscribe(c.subscription, job.client))
       return ProtocolError{ErrorCode::kNotFound,
                            "subscription: " + std::to_string(c.subscription) +
                                " is not one of this connection's subscriptions"};
@@ -275,8 +268,8 @@ struct Engine::Handlers {
     return json{{"name", c.name},
                 {"time", world.timeSeconds()},
                 {"hash", hexHash(world.hash())},
-                {"ticks", s.ticks},
-                {"frames", s.frames}};
+                {"ticks", clock.ticks()},
+                {"frames", engine.telemetry_.frames()}};
   }
   std::optional<Outcome> operator()(const Stats&) const {
     engine.publish();
@@ -286,7 +279,7 @@ struct Engine::Handlers {
     return json{{"hash", hexHash(world.hash())},
                 {"time", world.timeSeconds()},
                 {"time_ns", world.timeNs()},
-                {"ticks", s.ticks}};
+                {"ticks", clock.ticks()}};
   }
 };
 

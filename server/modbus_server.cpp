@@ -174,7 +174,7 @@ void ModbusServer::acceptLoop() {
         std::find(allow.begin(), allow.end(), address) == allow.end()) {
       if (listenerLog().admit("modbus_refused/not_allowed"))
         spdlog::warn("event=modbus_refused peer={} reason=not_allowed", address);
-      engine_.noteError(ErrorCode::kUnauthorized);
+      engine_.telemetry().noteError(ErrorCode::kUnauthorized);
       ::close(fd);
       continue;
     }
@@ -188,7 +188,7 @@ void ModbusServer::acceptLoop() {
     if (activeClients() >= config.modbus_max_clients) {
       if (listenerLog().admit("modbus_refused/max_clients"))
         spdlog::warn("event=modbus_refused peer={} reason=max_clients", address);
-      engine_.noteError(ErrorCode::kLimit);
+      engine_.telemetry().noteError(ErrorCode::kLimit);
       ::close(fd);
       continue;
     }
@@ -204,7 +204,7 @@ void ModbusServer::acceptLoop() {
 }
 
 void ModbusServer::serveClient(int fd, const std::string& peer, ClientState& state) {
-  ++engine_.modbus_clients;
+  ++engine_.telemetry().modbus_clients;
   if (listenerLog().admit("modbus_connected")) spdlog::info("event=modbus_connected peer={}", peer);
   const Timeouts& timeouts = engine_.config().modbus_timeouts;
   setSendTimeout(fd, timeouts.request_s);
@@ -247,7 +247,7 @@ void ModbusServer::serveClient(int fd, const std::string& peer, ClientState& sta
         // The stream cannot be framed past this header: close rather than guess.
         if (listenerLog().admit("modbus_bad_frame"))
           spdlog::warn("event=modbus_bad_frame peer={} error=\"{}\"", peer, *e);
-        engine_.noteError(ErrorCode::kBadField);
+        engine_.telemetry().noteError(ErrorCode::kBadField);
         why = "bad_frame";
         break;
       }
@@ -269,7 +269,7 @@ void ModbusServer::serveClient(int fd, const std::string& peer, ClientState& sta
     }
   }
   state.closeSocket();
-  --engine_.modbus_clients;
+  --engine_.telemetry().modbus_clients;
   if (listenerLog().admit(std::string("modbus_closed/") + why))
     spdlog::info("event=modbus_closed peer={} reason={}", peer, why);
 }
@@ -279,7 +279,8 @@ std::vector<std::uint8_t> ModbusServer::refuse(const MbapHeader& header,
   if (listenerLog().admit("modbus_exception"))
     spdlog::warn("event=modbus_exception function=0x{:02x} code={} message=\"{}\"",
                  exception.function, exception.code, exception.message);
-  engine_.noteError(exception.code == kServerDeviceBusy ? ErrorCode::kBusy : ErrorCode::kBadField);
+  engine_.telemetry().noteError(exception.code == kServerDeviceBusy ? ErrorCode::kBusy
+                                                                    : ErrorCode::kBadField);
   return encodeModbusException(header, exception);
 }
 
@@ -323,7 +324,7 @@ std::vector<std::uint8_t> ModbusServer::answer(const ModbusRequest& request) {
       if (!fits(ModbusMap::kCoilCount)) return outOfMap(ModbusMap::kCoilCount, "coils");
       std::array<std::uint8_t, ModbusMap::kCoilCount> coils{};
       coils[ModbusMap::kRenderCoil] = engine_.renderTriggerPending();
-      coils[ModbusMap::kPauseCoil] = engine_.status().status == RunState::kPaused;
+      coils[ModbusMap::kPauseCoil] = engine_.telemetry().status().status == RunState::kPaused;
       return encodeReadBits(request, std::span(coils).subspan(std::size_t(request.address),
                                                               std::size_t(request.count)));
     }
@@ -333,19 +334,19 @@ std::vector<std::uint8_t> ModbusServer::answer(const ModbusRequest& request) {
     case ModbusFunction::kReadHoldingRegisters: {
       if (!fits(ModbusMap::kHoldingCount))
         return outOfMap(ModbusMap::kHoldingCount, "holding registers");
-      const HoldingRegisters holding = encodeHolding(engine_.readings());
+      const HoldingRegisters holding = encodeHolding(engine_.telemetry().readings());
       return encodeReadRegisters(request, std::span(holding).subspan(std::size_t(request.address),
                                                                      std::size_t(request.count)));
     }
     case ModbusFunction::kReadInputRegisters: {
       if (!fits(ModbusMap::kInputCount)) return outOfMap(ModbusMap::kInputCount, "input registers");
-      const InputRegisters input = encodeInput(engine_.status());
+      const InputRegisters input = encodeInput(engine_.telemetry().status());
       return encodeReadRegisters(request, std::span(input).subspan(std::size_t(request.address),
                                                                    std::size_t(request.count)));
     }
     case ModbusFunction::kWriteSingleRegister:
     case ModbusFunction::kWriteMultipleRegisters: {
-      const HoldingRegisters current = encodeHolding(engine_.readings());
+      const HoldingRegisters current = encodeHolding(engine_.telemetry().readings());
       auto decoded = decodeHoldingWrite(current, request.address, request.registers,
                                         engine_.config().modbus_view);
       if (auto* e = std::get_if<RegisterError>(&decoded))

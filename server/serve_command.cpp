@@ -68,7 +68,8 @@ std::thread startWatchdog(const Engine& engine, const std::atomic<bool>& stoppin
   return std::thread([&engine, &stopping, watchdog_us] {
     const auto period = std::chrono::microseconds(watchdog_us / 2);
     while (!stopping) {
-      if (engine.heartbeatAge() < double(watchdog_us) * 1e-6) sd_notify(0, "WATCHDOG=1");
+      if (engine.telemetry().heartbeatAge() < double(watchdog_us) * 1e-6)
+        sd_notify(0, "WATCHDOG=1");
       std::this_thread::sleep_for(
           std::min<std::chrono::microseconds>(period, std::chrono::milliseconds(200)));
     }

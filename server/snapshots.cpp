@@ -3,7 +3,7 @@
 #include <filesystem>
 
 #include "config/table_reader.h"
-#include "server/engine_state.h"
+#include "server/engine_detail.h"
 #include "world/file_output.h"
 #include "world/limits.h"
 
@@ -38,23 +38,18 @@ json viewRequest(const ViewConfig& v) {
 }  // namespace
 
 json Engine::daemonState() const {
-  const State& s = *state_;
   json requests = json::array();
-  for (const ViewConfig& v : s.views) requests.push_back(viewRequest(v));
-  json out{{"format", "nephele-daemon-state"},
-           {"version", kDaemonStateVersion},
-           {"ticks", s.ticks},
-           {"frames", s.frames},
-           {"mode", modeName(s.mode)},
-           {"time_scale", s.time_scale},
-           {"paused", s.paused},
-           {"requests", requests}};
-  if (s.sun_utc) out["sun_utc"] = formatUtc(*s.sun_utc);
+  for (const ViewConfig& v : views_.all()) requests.push_back(viewRequest(v));
+  json out{{"format", "nephele-daemon-state"}, {"version", kDaemonStateVersion},
+           {"ticks", clock_.ticks()},          {"frames", telemetry_.frames()},
+           {"mode", modeName(clock_.mode())},  {"time_scale", clock_.timeScale()},
+           {"paused", clock_.paused()},        {"requests", requests}};
+  if (sun_utc_) out["sun_utc"] = formatUtc(*sun_utc_);
   return out;
 }
 
 std::string Engine::writeSnapshot(const std::string& path) {
-  if (std::string e = state_->world->saveSnapshot(path); !e.empty()) return e;
+  if (std::string e = world_->saveSnapshot(path); !e.empty()) return e;
   const std::string text = daemonState().dump(1) + "\n";
   return writeFileAtomically(
       daemonStatePath(path),
@@ -62,7 +57,6 @@ std::string Engine::writeSnapshot(const std::string& path) {
 }
 
 std::string Engine::restoreSnapshot(const std::string& path) {
-  State& s = *state_;
   // The daemon's part is read and checked first, so that a bad file changes nothing.
   const std::string side = daemonStatePath(path);
   std::optional<json> state;
@@ -115,19 +109,19 @@ std::string Engine::restoreSnapshot(const std::string& path) {
     }
     state = std::move(j);
   }
-  if (std::string e = s.world->restoreSnapshot(path, std::size_t(config_.max_ellipsoids));
+  if (std::string e = world_->restoreSnapshot(path, std::size_t(config_.max_ellipsoids));
       !e.empty())
     return e;
   if (!state) return "";  // a snapshot from before daemon state was saved: the world alone
-  s.ticks = (*state)["ticks"].get<std::uint64_t>();
-  s.frames = (*state)["frames"].get<std::uint64_t>();
-  s.time_scale = (*state)["time_scale"].get<double>();
-  s.paused = (*state)["paused"].get<bool>();
+  clock_.restoreTicks((*state)["ticks"].get<std::uint64_t>());
+  telemetry_.restoreFrames((*state)["frames"].get<std::uint64_t>());
+  clock_.setTimeScale((*state)["time_scale"].get<double>());
+  clock_.setPaused((*state)["paused"].get<bool>());
   setMode((*state)["mode"] == "lockstep" ? TickMode::kLockstep : TickMode::kRealtime);
-  s.sun_utc = sun_utc;
+  sun_utc_ = sun_utc;
   for (const Command& c : requests) {
     if (const auto* v = std::get_if<command::SetView>(&c)) {
-      ViewConfig* view = s.view(v->view);
+      ViewConfig* view = views_.find(v->view);
       if (!view) {  // the config no longer has it
         spdlog::warn("event=restore_view_skipped view={}", v->view);
         continue;
@@ -144,12 +138,11 @@ bool Engine::saveSnapshot(const std::string& path, const char* why) {
   std::filesystem::create_directories(std::filesystem::path(path).parent_path(), ec);
   if (std::string e = writeSnapshot(path); !e.empty()) {
     spdlog::error("event=snapshot_failed reason={} error=\"{}\"", why, e);
-    noteError(ErrorCode::kFailed);
+    telemetry_.noteError(ErrorCode::kFailed);
     return false;
   }
   spdlog::info("event=snapshot reason={} path={} time={:.3f} hash={} ticks={} ms={:.1f}", why, path,
-               state_->world->timeSeconds(), hexHash(state_->world->hash()), state_->ticks,
-               msSince(t0));
+               world_->timeSeconds(), hexHash(world_->hash()), clock_.ticks(), msSince(t0));
   return true;
 }
 

@@ -67,7 +67,7 @@ class Connection : public std::enable_shared_from_this<Connection> {
   }
 
   void start() {
-    ++engine_.socket_clients;
+    ++engine_.telemetry().socket_clients;
     if (listenerLog().admit("client_connected"))
       spdlog::info("event=client_connected id={} peer={}", id_, peer_);
     resume();
@@ -85,7 +85,7 @@ class Connection : public std::enable_shared_from_this<Connection> {
     socket_.shutdown(tcp::socket::shutdown_both, ec);
     socket_.close(ec);
     if (drain_timer_) drain_timer_->cancel();
-    --engine_.socket_clients;
+    --engine_.telemetry().socket_clients;
     engine_.clientGone(id_);
     if (listenerLog().admit(std::string("client_closed/") + why))
       spdlog::info("event=client_closed id={} peer={} reason={}", id_, peer_, why);
@@ -122,7 +122,7 @@ class Connection : public std::enable_shared_from_this<Connection> {
     if (closed_) return;
     if (r->body && pending_bytes_ > 0 &&
         pending_bytes_ + r->size() > engine_.config().max_pending_bytes) {
-      engine_.noteError(ErrorCode::kBusy);
+      engine_.telemetry().noteError(ErrorCode::kBusy);
       r = makeReply(errorReply(
           id, {ErrorCode::kBusy, "this connection has " + std::to_string(pending_bytes_ >> 20) +
                                      " MiB of output unread (allowed: " +
@@ -137,7 +137,7 @@ class Connection : public std::enable_shared_from_this<Connection> {
   void offerFrame(SharedReply frame) {
     if (closed_) return;
     if (pending_bytes_ + frame->size() > engine_.config().max_pending_bytes) {
-      ++engine_.frames_dropped;
+      ++engine_.telemetry().frames_dropped;
       return;
     }
     send(std::move(frame));
@@ -313,7 +313,7 @@ class Connection : public std::enable_shared_from_this<Connection> {
   }
 
   void sendError(const nlohmann::json& id, const ProtocolError& error) {
-    engine_.noteError(error.code);
+    engine_.telemetry().noteError(error.code);
     send(makeReply(errorReply(id, error)));
   }
 
@@ -515,7 +515,7 @@ void SocketServer::accept() {
     if (int(connections_.size()) >= max_clients) {
       if (listenerLog().admit("client_refused/max_clients"))
         spdlog::warn("event=client_refused reason=max_clients");
-      engine_.noteError(ErrorCode::kLimit);
+      engine_.telemetry().noteError(ErrorCode::kLimit);
       if (refusing_->load() < kMaxRefusing) {
         refuseOverLimit(std::move(socket), max_clients, refusing_);
       } else {
@@ -608,7 +608,7 @@ void MetricsServer::accept() {
             // kStuckSeconds (a render or advance that long is a fault for an IG).
             const bool metrics = first_line.rfind("GET /metrics ", 0) == 0;
             const bool health = first_line.rfind("GET /healthz ", 0) == 0;
-            const bool healthy = engine_.heartbeatAge() < Engine::kStuckSeconds;
+            const bool healthy = engine_.telemetry().heartbeatAge() < Telemetry::kStuckSeconds;
             const std::string body = metrics  ? engine_.prometheusText()
                                      : health ? (healthy ? "ok\n" : "world thread stuck\n")
                                               : "not found\n";

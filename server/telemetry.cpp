@@ -1,123 +1,101 @@
+#include "server/telemetry.h"
+
 #include <sstream>
+#include <vector>
 
-#include "server/engine_state.h"
+#include "renderer/frame_timing.h"
 
-// Telemetry: the stats reply, the Modbus readings and the Prometheus text.
 namespace nephele {
 
-using namespace engine_detail;
+using nlohmann::json;
 
-void Engine::publish() {
-  State& s = *state_;
-  const auto now = Clock::now();
-  if (s.tick_history.empty() || now - s.tick_history.back().first >= std::chrono::seconds(1)) {
-    s.tick_history.push_back({now, s.ticks});
-    if (s.tick_history.size() > 6) s.tick_history.pop_front();
-  }
-  double ticks_per_second = 0.0;
-  if (s.tick_history.size() >= 2) {
-    const auto& [t0, n0] = s.tick_history.front();
-    const double seconds = std::chrono::duration<double>(now - t0).count();
-    if (seconds > 0.0) ticks_per_second = double(s.ticks - n0) / seconds;
-  }
-  const std::vector<double> history(s.render_ms.begin(), s.render_ms.end());
-  const World& world = *s.world;
-  json stats = {
-      {"time", world.timeSeconds()},
-      {"ticks", s.ticks},
-      {"ticks_per_second", ticks_per_second},
-      {"mode", modeName(s.mode)},
-      {"paused", s.paused},
-      {"time_scale", s.time_scale},
-      {"frames", s.frames},
-      {"render_ms",
-       {{"last", s.last_render_ms},
-        {"p50", percentile(history, 0.5)},
-        {"p99", percentile(history, 0.99)},
-        {"samples", history.size()}}},
-      // The counters other threads keep (clients, queue and encoder depth, frames dropped,
-      // errors, CIGI) are added by stats() when it is read.
-      {"queue", {{"limit", config_.max_queue}, {"encoder_limit", kEncoderQueue}}},
-      {"subscriptions", s.subscriptions.size()},
-      {"requests", s.requests},
-      {"automaton_steps", world.automatonStepsRun()},
-      {"relights", world.relightsRun()},
-      {"site", siteJson(world)},
-      {"streams", streamsJson()},
-      {"last_frame", frameStatsJson(s.renderer->lastFrameStats())},
-  };
-  stats["histograms"] = {{"render_seconds", s.render_seconds.toJson()},
-                         {"request_seconds", s.request_seconds.toJson()}};
-  {
-    std::lock_guard lock(published_mutex_);
-    published_stats_ = std::move(stats);
-  }
-  publishReadings();
+void Histogram::add(double seconds) {
+  std::size_t i = 0;
+  while (i < kBounds.size() && seconds > kBounds[i]) ++i;
+  ++counts[i];
+  sum += seconds;
+  ++count;
 }
 
-void Engine::publishReadings() {
-  const State& s = *state_;
-  const World& world = *s.world;
-  HostReadings settings;
-  const ViewConfig& view = *s.view(config_.modbus_view);
-  settings.position = view.camera.position;
-  settings.heading = view.camera.orientation.heading_deg;
-  settings.pitch = view.camera.orientation.pitch_deg;
-  settings.roll = view.camera.orientation.roll_deg;
-  settings.vfov = view.camera.vfov_deg;
-  settings.width = view.camera.width;
-  settings.height = view.camera.height;
-  const WindProfile& wind = world.dynamics().wind;
-  settings.wind = wind.empty() ? glm::dvec2(0.0) : wind.samples.front().velocity;
-  settings.sun_azimuth = world.base().sun.azimuth_deg;
-  settings.sun_elevation = world.base().sun.elevation_deg;
-  settings.time_scale = s.time_scale;
-  for (int layer = 1; layer <= ProtocolLimits::kWeatherLayers; ++layer)  // the world's, as set
-    if (auto w = world.base().weather.find({layer, std::nullopt}); w != world.base().weather.end())
-      settings.layers[std::size_t(layer - 1)] = w->second;
-  if (const std::optional<Fog>& fog = world.base().fog) {
-    settings.fog_top = fog->top_m;
-    settings.fog_visibility = fog->visibility_m;
-    settings.fog_colour = fog->colour;
-  }
-  if (const std::optional<Haze>& haze = world.base().haze) {
-    settings.haze_visibility = haze->visibility_m;
-    settings.haze_scale_height = haze->scale_height_m;
-  }
-  settings.sun_utc = s.sun_utc;
-  HostStatus status;
-  status.status = s.mode == TickMode::kLockstep ? RunState::kLockstep
-                  : s.paused                    ? RunState::kPaused
-                                                : RunState::kRunning;
-  status.frames = std::uint32_t(s.frames);
-  status.render_ms = s.last_render_ms;
-  status.ticks = s.ticks;
-  status.time_s = world.timeSeconds();
-  json hello = helloJson();
-  std::lock_guard lock(published_mutex_);
-  published_settings_ = settings;
-  published_status_ = status;
-  published_hello_ = std::move(hello);
+json Histogram::toJson() const {
+  return {{"counts", counts}, {"sum", sum}, {"count", count}};
 }
 
-json Engine::helloJson() const {
-  const State& s = *state_;
-  json views = json::array();
-  for (const ViewConfig& v : s.views) views.push_back(v.name);
-  return json{{"server", "nephele"},          {"version", NEPHELE_VERSION},
-              {"protocol", kProtocolVersion}, {"views", views},
-              {"mode", modeName(s.mode)},     {"tick_rate", config_.tick_rate_hz}};
+void Telemetry::noteError(ErrorCode code) {
+  ++errors_;
+  last_error_ = 1 + int(code);
 }
 
-void Engine::setInHand(std::string what, std::int64_t client) {
+void Telemetry::countCigi(const std::string& what) {
+  std::lock_guard lock(cigi_mutex_);
+  ++cigi_counts_[what];
+}
+
+double Telemetry::heartbeatAge() const {
+  const std::int64_t beat = heartbeat_ns_.load();
+  if (beat == 0) return 0.0;  // not started yet
+  return std::chrono::duration<double>(Clock::now().time_since_epoch() - Clock::duration(beat))
+      .count();
+}
+
+void Telemetry::noteRender(double ms) {
+  last_render_ms_ = ms;
+  render_ms_.push_back(ms);
+  render_seconds_.add(ms * 1e-3);
+  if (render_ms_.size() > kRenderHistory) render_ms_.pop_front();
+  ++frames_;
+}
+
+void Telemetry::noteRequestDone(Clock::time_point queued) {
+  request_seconds_.add(std::chrono::duration<double>(Clock::now() - queued).count());
+}
+
+void Telemetry::addRecords(json& stats) const {
+  const std::vector<double> history(render_ms_.begin(), render_ms_.end());
+  stats["frames"] = frames_;
+  stats["render_ms"] = {{"last", last_render_ms_},
+                        {"p50", percentile(history, 0.5)},
+                        {"p99", percentile(history, 0.99)},
+                        {"samples", history.size()}};
+  stats["requests"] = requests_;
+  stats["histograms"] = {{"render_seconds", render_seconds_.toJson()},
+                         {"request_seconds", request_seconds_.toJson()}};
+}
+
+void Telemetry::setInHand(std::string what, std::int64_t client) {
   std::lock_guard lock(published_mutex_);
   in_hand_ = {std::move(what), client, Clock::now()};
 }
 
-std::optional<json> Engine::answerAtOnce(const Command& command) {
+void Telemetry::publishStats(json stats) {
+  std::lock_guard lock(published_mutex_);
+  published_stats_ = std::move(stats);
+}
+
+void Telemetry::publishReadings(const HostReadings& readings, const HostStatus& status,
+                                json hello) {
+  std::lock_guard lock(published_mutex_);
+  published_readings_ = readings;
+  published_status_ = status;
+  published_hello_ = std::move(hello);
+}
+
+HostReadings Telemetry::readings() const {
+  std::lock_guard lock(published_mutex_);
+  return published_readings_;
+}
+
+HostStatus Telemetry::status() const {
+  std::lock_guard lock(published_mutex_);
+  HostStatus status = published_status_;
+  status.last_error = std::uint16_t(last_error_.load());
+  return status;
+}
+
+std::optional<json> Telemetry::answerAtOnce(const Command& command, const Live& live) {
   if (std::holds_alternative<command::Stats>(command)) {
     ++answered_at_once_;  // counted among the requests, as the world thread counts its own
-    json out = stats();
+    json out = stats(live);
     if (!out.is_null()) return out;
     --answered_at_once_;
   }
@@ -131,37 +109,14 @@ std::optional<json> Engine::answerAtOnce(const Command& command) {
   return std::nullopt;
 }
 
-HostReadings Engine::readings() const {
-  std::lock_guard lock(published_mutex_);
-  return published_settings_;
-}
-
-HostStatus Engine::status() const {
-  std::lock_guard lock(published_mutex_);
-  HostStatus status = published_status_;
-  status.last_error = std::uint16_t(last_error_.load());
-  return status;
-}
-
-void Engine::countCigi(const std::string& what) {
-  std::lock_guard lock(cigi_mutex_);
-  ++cigi_counts_[what];
-}
-
-json Engine::stats() const {
-  // The world thread's figures as of its last request (publish), with what other threads
-  // count read now (each lock alone, none held while another is taken).
-  std::size_t depth = 0;
-  {
-    std::lock_guard lock(queue_mutex_);
-    depth = queue_.size();
-  }
+json Telemetry::stats(const Live& live) const {
+  // The world thread's figures as of its last publish, with what other threads count read now
+  // (each lock alone, none held while another is taken).
   json cigi;
   {
     std::lock_guard lock(cigi_mutex_);
     cigi = cigi_counts_;
   }
-  const std::size_t encoding = encoder_ ? encoder_->depth() : 0;
   json out;
   InHand in_hand;
   {
@@ -174,8 +129,8 @@ json Engine::stats() const {
   out["errors"] = errors_.load();
   out["frames_dropped"] = frames_dropped.load();
   out["clients"] = {{"socket", socket_clients.load()}, {"modbus", modbus_clients.load()}};
-  out["queue"]["depth"] = depth;
-  out["queue"]["encoder"] = encoding;
+  out["queue"]["depth"] = live.queue_depth;
+  out["queue"]["encoder"] = live.encoder_depth;
   out["cigi"] = std::move(cigi);
   out["heartbeat_age"] = heartbeatAge();
   out["last_frame"]["ms"]["encode"] = last_encode_ms_.load();
@@ -190,8 +145,29 @@ json Engine::stats() const {
   return out;
 }
 
-std::string Engine::prometheusText() const {
-  const json st = stats();
+namespace {
+
+void writeHistogram(std::ostringstream& out, const json& st, const char* name, const char* help) {
+  const json& h = st["histograms"][name];
+  out << "# HELP nephele_" << name << ' ' << help << "\n# TYPE nephele_" << name << " histogram\n";
+  std::uint64_t cumulative = 0;
+  for (std::size_t i = 0; i <= Histogram::kBounds.size(); ++i) {
+    cumulative += h["counts"][i].get<std::uint64_t>();
+    out << "nephele_" << name << "_bucket{le=\"";
+    if (i < Histogram::kBounds.size())
+      out << Histogram::kBounds[i];
+    else
+      out << "+Inf";
+    out << "\"} " << cumulative << '\n';
+  }
+  out << "nephele_" << name << "_sum " << h["sum"].get<double>() << "\nnephele_" << name
+      << "_count " << h["count"].get<std::uint64_t>() << '\n';
+}
+
+}  // namespace
+
+std::string Telemetry::prometheusText(const Live& live) const {
+  const json st = stats(live);
   std::ostringstream out;
   auto metric = [&](const char* name, const char* type, const char* help, double value) {
     out << "# HELP nephele_" << name << ' ' << help << "\n# TYPE nephele_" << name << ' ' << type
@@ -214,27 +190,10 @@ std::string Engine::prometheusText() const {
          "Since the world thread last ran its loop or made progress in a render.",
          st["heartbeat_age"].get<double>());
   // Latencies as histograms, in seconds (Prometheus base units).
-  auto histogram = [&](const char* name, const char* help) {
-    const json& h = st["histograms"][name];
-    out << "# HELP nephele_" << name << ' ' << help << "\n# TYPE nephele_" << name
-        << " histogram\n";
-    std::uint64_t cumulative = 0;
-    for (std::size_t i = 0; i <= Histogram::kBounds.size(); ++i) {
-      cumulative += h["counts"][i].get<std::uint64_t>();
-      out << "nephele_" << name << "_bucket{le=\"";
-      if (i < Histogram::kBounds.size())
-        out << Histogram::kBounds[i];
-      else
-        out << "+Inf";
-      out << "\"} " << cumulative << '\n';
-    }
-    out << "nephele_" << name << "_sum " << h["sum"].get<double>() << "\nnephele_" << name
-        << "_count " << h["count"].get<std::uint64_t>() << '\n';
-  };
-  histogram("render_seconds", "Time to render one view.");
-  histogram("request_seconds",
-            "Time from a request's queueing to its reply (images: to the "
-            "render, before encoding).");
+  writeHistogram(out, st, "render_seconds", "Time to render one view.");
+  writeHistogram(out, st, "request_seconds",
+                 "Time from a request's queueing to its reply (images: to the "
+                 "render, before encoding).");
   // The last frame's budget (FrameTimes): CPU stages, GPU passes, wait, readback, encoding.
   out << "# HELP nephele_last_frame_seconds Where the last rendered frame's time went: CPU "
          "stages (cpu_*), GPU passes by timer query (gpu_*), submit, wait, readback, encode.\n"

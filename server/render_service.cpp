@@ -1,0 +1,247 @@
+#include "server/render_service.h"
+
+#include <condition_variable>
+#include <deque>
+#include <mutex>
+#include <thread>
+
+#include "renderer/gl/gl_platform.h"
+#include "renderer/gl/gl_renderer.h"
+#include "server/telemetry.h"
+#include "world/limits.h"
+#include "world/world.h"
+
+namespace nephele {
+
+using nlohmann::json;
+
+Channels channelsOf(const ImageRequest& image) {
+  if (image.floatPlanes()) return {image.order, Channels::Pixels::kPlanes};
+  Channels out;
+  if (image.colour) out.order.push_back(Channel::kColour);
+  if (image.coverage) out.order.push_back(Channel::kCoverage);
+  out.pixels =
+      image.format == ImageFormat::kExr ? Channels::Pixels::kLinear : Channels::Pixels::kSrgb8;
+  return out;
+}
+
+ImageFileFormat fileFormatOf(ImageFormat format) {
+  switch (format) {
+    case ImageFormat::kRaw:
+      return ImageFileFormat::kRaw;
+    case ImageFormat::kPng:
+      return ImageFileFormat::kPng;
+    case ImageFormat::kJpeg:
+      return ImageFileFormat::kJpeg;
+    case ImageFormat::kExr:
+      return ImageFileFormat::kExr;
+  }
+  return ImageFileFormat::kRaw;
+}
+
+Encoded encodeView(const RenderedView& view, const ImageRequest& image,
+                   const EncodeOptions& options) {
+  return encode(view.frame, fileFormatOf(image.format), channelsOf(image), options);
+}
+
+json imageMeta(const RenderedView& view, const ImageRequest& image) {
+  json meta = view.meta;
+  meta["format"] = imageFormatName(image.format);
+  meta["channels"] = channelNames(image);
+  meta["rows"] = "top-down";
+  meta["encoding"] = image.format == ImageFormat::kExr ? "linear"
+                     : image.floatPlanes()             ? "float32-planes"
+                                                       : "srgb";
+  return meta;
+}
+
+// A thread that encodes images off the world thread, from a bounded queue.
+class RenderService::Encoder {
+ public:
+  Encoder() : thread_([this] { run(); }) {}
+  ~Encoder() { finish(); }
+  // Sends what it holds, then stops its thread; posts after this are refused. The Encoder
+  // itself stays, so a stats request on the socket thread may still ask its depth.
+  void finish() {
+    {
+      std::lock_guard lock(mutex_);
+      stop_ = true;
+    }
+    cv_.notify_all();
+    if (thread_.joinable()) thread_.join();
+  }
+  bool post(std::function<void()> job) {
+    {
+      std::lock_guard lock(mutex_);
+      if (stop_ || jobs_.size() >= kEncoderQueue) return false;
+      jobs_.push_back(std::move(job));
+    }
+    cv_.notify_one();
+    return true;
+  }
+  std::size_t depth() const {
+    std::lock_guard lock(mutex_);
+    return jobs_.size();
+  }
+
+ private:
+  void run() {
+    for (;;) {
+      std::function<void()> job;
+      {
+        std::unique_lock lock(mutex_);
+        cv_.wait(lock, [&] { return stop_ || !jobs_.empty(); });
+        if (jobs_.empty()) return;  // stopping, and every queued image is out
+        job = std::move(jobs_.front());
+        jobs_.pop_front();
+      }
+      job();
+    }
+  }
+  mutable std::mutex mutex_;
+  std::condition_variable cv_;
+  std::deque<std::function<void()>> jobs_;
+  bool stop_ = false;
+  std::thread thread_;
+};
+
+RenderService::RenderService(const DaemonConfig& config, Telemetry& telemetry)
+    : config_(config), telemetry_(telemetry) {}
+
+RenderService::~RenderService() = default;
+
+void RenderService::startEncoder() {
+  encoder_ = std::make_unique<Encoder>();
+}
+
+void RenderService::finishEncoder() {
+  if (encoder_) encoder_->finish();  // kept for stats' depth
+}
+
+std::string RenderService::open() {
+  std::string error;
+  platform_ = createGlPlatform(GlBackend::kAuto, error);
+  if (!platform_) return "no OpenGL context: " + error;
+  renderer_ = std::make_unique<GlRenderer>(*platform_);
+  // A long render beats the heart at each point where it can be cancelled, so /healthz and the
+  // systemd watchdog tell a render that makes progress from a stuck world thread.
+  renderer_->setCancel(&cancel_, [this] { telemetry_.beat(); });
+  return "";
+}
+
+void RenderService::close() {
+  renderer_.reset();
+  platform_.reset();
+}
+
+std::string RenderService::glName() const {
+  return platform_->renderer();
+}
+
+std::string RenderService::backendName() const {
+  return std::string(platform_->backendName());
+}
+
+namespace {
+
+// The camera a view is rendered with: an off-axis view renders the centred view that holds it.
+Camera renderedCamera(const ViewConfig& view) {
+  return view.frustum ? offAxisView(view.camera, *view.frustum).render : view.camera;
+}
+
+}  // namespace
+
+std::optional<ProtocolError> RenderService::pixelLimit(const ViewConfig& view) const {
+  const Camera camera = renderedCamera(view);
+  if (camera.width > Limits::kMaxImageSide || camera.height > Limits::kMaxImageSide)
+    return ProtocolError{ErrorCode::kLimit, "frustum: the view it is cut from would be " +
+                                                std::to_string(camera.width) + "x" +
+                                                std::to_string(camera.height) +
+                                                " pixels (allowed: at most " +
+                                                std::to_string(Limits::kMaxImageSide) + " a side)"};
+  const std::int64_t w = camera.width, h = camera.height;
+  if (w * h <= config_.max_image_pixels) return std::nullopt;
+  return ProtocolError{ErrorCode::kLimit, "width x height: " + std::to_string(w) + "x" +
+                                              std::to_string(h) + " is above the limit of " +
+                                              std::to_string(config_.max_image_pixels) + " pixels"};
+}
+
+std::optional<ProtocolError> RenderService::platformLimit(const ViewConfig& view,
+                                                          const ImageRequest& image,
+                                                          bool world_has_targets) const {
+  const Camera camera = renderedCamera(view);
+  const bool linear = image.format == ImageFormat::kExr || image.floatPlanes();
+  const bool targets = needsTargetLayers(world_has_targets, image.planes);
+  const std::string error = renderer_->reserveTarget(camera.width, camera.height, linear, targets);
+  if (error.empty()) return std::nullopt;
+  return ProtocolError{ErrorCode::kLimit, "view " + view.name + ": " + error};
+}
+
+void RenderService::render(const World& world, const ViewConfig& view, const ImageRequest& image,
+                           std::uint64_t tick, bool continuous, RenderedView& out) {
+  renderer_->setContinuousView(continuous ? view.name + "#" + std::to_string(world.edits())
+                                          : std::string());
+  Scene scene = world.scene();
+  scene.camera = view.camera;
+  // An off-axis view is cut from a centred render of the same focal length (exact: a pinhole
+  // image moves its principal point when cropped).
+  std::optional<OffAxisView> off_axis;
+  if (view.frustum) {
+    off_axis = offAxisView(view.camera, *view.frustum);
+    scene.camera = off_axis->render;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  Frame& frame = out.frame;
+  const Channels channels = channelsOf(image);
+  const RenderSettings& settings = config_.scene.render;
+  if (channels.pixels == Channels::Pixels::kPlanes) {
+    FrameRequest request;
+    request.channels = image.planes;
+    if (image.colour) request.channels.add(Channel::kColour);
+    if (image.coverage) request.channels.add(Channel::kCoverage);
+    request.tick = tick;
+    frame = renderer_->renderFrame(scene, settings, request);
+  } else if (channels.pixels == Channels::Pixels::kLinear) {
+    frame.colour = renderer_->renderFloat(scene, settings);
+  } else {
+    frame.srgb = renderer_->renderSrgb8(scene, settings);
+  }
+  // Stopping: the frame is incomplete and nothing is sent or counted (docs/RELIABILITY.md).
+  if (renderer_->lastFrameCancelled()) throw RenderCancelled{};
+  FrameInfo info = frameInfo(view.camera, world.timeSeconds(), tick);
+  if (off_axis) {
+    const OffAxisView& o = *off_axis;
+    frame = frame.cropped(o.x0, o.y0, o.width, o.height);
+    info.width = o.width;
+    info.height = o.height;
+    info.focal_px = o.focal_px;
+    info.cx = o.cx;
+    info.cy = o.cy;
+  }
+  if (channels.pixels == Channels::Pixels::kPlanes && off_axis) frame.info = info;
+  telemetry_.noteRender(
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  out.meta = {{"view", view.name},           {"width", info.width}, {"height", info.height},
+              {"time", world.timeSeconds()}, {"tick", tick},        {"frame", telemetry_.frames()},
+              {"camera", cameraJson(info)}};
+  if (view.frustum) out.meta["camera"]["frustum"] = frustumJson(*view.frustum);
+}
+
+json RenderService::lastFrameJson() const {
+  const FrameStats& f = renderer_->lastFrameStats();
+  json out = json::object();
+  for (const auto& [name, value] : f.fields()) out[name] = value;
+  json& ms = out["ms"] = json::object();  // where its time went (FrameTimes)
+  for (const auto& [name, value] : f.times.fields()) ms[name] = value;
+  return out;
+}
+
+bool RenderService::post(std::function<void()> job) {
+  return encoder_->post(std::move(job));
+}
+
+std::size_t RenderService::encoderDepth() const {
+  return encoder_ ? encoder_->depth() : 0;
+}
+
+}  // namespace nephele
