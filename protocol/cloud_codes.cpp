@@ -30,4 +30,12 @@ std::string cloudTypeCodesAllowed() {
   return "0 to " + std::to_string(kByCode.size() - 1);
 }
 
+std::string cloudTypeCodesListed() {
+  std::string out;
+  for (std::size_t code = 0; code < kByCode.size(); ++code)
+    out +=
+        (code ? ", " : "") + std::to_string(code) + " " + std::string(cloudTypeName(kByCode[code]));
+  return out;
+}
+
 }  // namespace nephele

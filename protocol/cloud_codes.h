@@ -20,5 +20,7 @@ std::optional<CloudType> cloudTypeFromCode(int code);
 int cloudTypeCode(CloudType type);
 // The codes a host may send, for error messages: "0 to 10".
 std::string cloudTypeCodesAllowed();
+// Every code with its genus, for error messages: "0 none, 1 altocumulus, ..., 10 stratus".
+std::string cloudTypeCodesListed();
 
 }  // namespace nephele

@@ -330,10 +330,8 @@ SetWeather readSetWeather(FieldReader& r) {
            "layers)");
   c.layer = int(*r.integer("layer", 1, ProtocolLimits::kWeatherKeys));
   if (!r.has("type"))
-    r.fail("type",
-           "is missing (allowed: 0 to 10, CIGI cloud types: 0 none, 1 altocumulus, 2 "
-           "altostratus, 3 cirrocumulus, 4 cirrostratus, 5 cirrus, 6 cumulonimbus, 7 "
-           "cumulus, 8 nimbostratus, 9 stratocumulus, 10 stratus)");
+    r.fail("type", "is missing (allowed: " + cloudTypeCodesAllowed() +
+                       ", CIGI cloud types: " + cloudTypeCodesListed() + ")");
   const bool named = r.has("precipitation");
   c.weather = readWeather(r);
   if (c.layer > ProtocolLimits::kWeatherLayers) {

@@ -118,6 +118,11 @@ TEST(CloudCodes, AreCigisAndEveryGenusHasOne) {
   EXPECT_FALSE(cloudTypeFromCode(kCloudTypeCodes).has_value());
   EXPECT_THAT(rejected(R"({"cmd":"set_weather","layer":1,"type":11})").error.message,
               HasSubstr("type"));
+  // A layer without a type names every code with its genus, from the one code table.
+  EXPECT_THAT(rejected(R"({"cmd":"set_weather","layer":1})").error.message,
+              HasSubstr("allowed: 0 to 10, CIGI cloud types: 0 none, 1 altocumulus, 2 "
+                        "altostratus, 3 cirrocumulus, 4 cirrostratus, 5 cirrus, 6 cumulonimbus, "
+                        "7 cumulus, 8 nimbostratus, 9 stratocumulus, 10 stratus)"));
 }
 
 // Precipitation (MODEL.md section 17): on a cloud layer, and CIGI's precipitation layers 4 to 9,
