@@ -542,6 +542,38 @@ WeatherLayer readWeather(TableReader& t, bool macro = false) {
   return w;
 }
 
+// The [[wind]] samples, by altitude; true when there are any.
+bool readWinds(TableReader& t, WindProfile& wind) {
+  std::vector<TableReader> tables = t.tables("wind");
+  for (TableReader& w : tables) readWind(w, wind.samples.emplace_back());
+  std::sort(wind.samples.begin(), wind.samples.end(),
+            [](const WindSample& a, const WindSample& b) { return a.altitude_m < b.altitude_m; });
+  for (std::size_t i = 1; i < wind.samples.size(); ++i)
+    if (wind.samples[i].altitude_m == wind.samples[i - 1].altitude_m)
+      t.failAt("wind",
+               "two [[wind]] samples at altitude " + formatNumber(wind.samples[i].altitude_m));
+  return !tables.empty();
+}
+
+// The [[automaton]] clouds, and the work the scene's start time asks of them.
+void readAutomata(TableReader& t, const Scene& scene, std::vector<AutomatonCloudSpec>& out) {
+  std::vector<TableReader> automata = t.tables("automaton");
+  if (automata.size() > std::size_t(Limits::kMaxAutomata))
+    t.failAt("automaton",
+             "more than " + std::to_string(Limits::kMaxAutomata) + " automaton clouds");
+  for (std::size_t i = 0; i < automata.size(); ++i) {
+    AutomatonCloudSpec& a = out.emplace_back();
+    readAutomaton(automata[i], hashCounters(scene.seed, 0x4175746f6dull, i), a);
+    if (a.name.empty()) a.name = "automaton" + std::to_string(i);
+  }
+  if (!automata.empty() && scene.time_s > Limits::kMaxAutomatonTime)
+    t.failAt("time", formatNumber(scene.time_s) + " is out of range with automaton clouds " +
+                         "(allowed: 0 to " + formatNumber(Limits::kMaxAutomatonTime) +
+                         " s; every automaton step is simulated)");
+  if (std::string e = automatonWorkError(out, scene.time_s); !e.empty())
+    t.failAt(t.has("time") ? "time" : "automaton", e);
+}
+
 void readScene(const toml::table& root, const std::string& file, SceneFile& out) {
   TableReader t(root, "", file);
   t.allow({"seed", "time", "image", "camera", "sun", "sky", "fog", "haze", "sea", "render", "wind",
@@ -557,14 +589,7 @@ void readScene(const toml::table& root, const std::string& file, SceneFile& out)
   if (auto haze = t.table("haze")) readHaze(*haze, scene.haze.emplace());
   if (auto render = t.table("render")) readRender(*render, out);
   WorldDynamics& dynamics = out.dynamics;
-  std::vector<TableReader> wind = t.tables("wind");
-  for (TableReader& w : wind) readWind(w, dynamics.wind.samples.emplace_back());
-  std::sort(dynamics.wind.samples.begin(), dynamics.wind.samples.end(),
-            [](const WindSample& a, const WindSample& b) { return a.altitude_m < b.altitude_m; });
-  for (std::size_t i = 1; i < dynamics.wind.samples.size(); ++i)
-    if (dynamics.wind.samples[i].altitude_m == dynamics.wind.samples[i - 1].altitude_m)
-      t.failAt("wind", "two [[wind]] samples at altitude " +
-                           formatNumber(dynamics.wind.samples[i].altitude_m));
+  const bool wind = readWinds(t, dynamics.wind);
   if (auto sea = t.table("sea"))
     readSea(*sea, dynamics.wind.empty() ? std::nullopt : std::optional(dynamics.wind.at(0.0)),
             scene.sea.emplace());
@@ -572,7 +597,7 @@ void readScene(const toml::table& root, const std::string& file, SceneFile& out)
   for (std::size_t i = 0; i < layers.size(); ++i) {
     CloudLayer& layer = scene.layers.emplace_back();
     layer.texture.seed = hashCounters(scene.seed, 0x4c61796572ull, i);  // unless given
-    if (!wind.empty())
+    if (wind)
       layers[i].forbid("drift",
                        "conflicts with [[wind]]: layers drift with the wind at their "
                        "altitude (remove one of them)");
@@ -600,21 +625,7 @@ void readScene(const toml::table& root, const std::string& file, SceneFile& out)
               dynamics.clouds.emplace_back());
     if (cloud.name.empty()) cloud.name = "cloud" + std::to_string(i);
   }
-  std::vector<TableReader> automata = t.tables("automaton");
-  if (automata.size() > std::size_t(Limits::kMaxAutomata))
-    t.failAt("automaton",
-             "more than " + std::to_string(Limits::kMaxAutomata) + " automaton clouds");
-  for (std::size_t i = 0; i < automata.size(); ++i) {
-    AutomatonCloudSpec& a = dynamics.automata.emplace_back();
-    readAutomaton(automata[i], hashCounters(scene.seed, 0x4175746f6dull, i), a);
-    if (a.name.empty()) a.name = "automaton" + std::to_string(i);
-  }
-  if (!automata.empty() && scene.time_s > Limits::kMaxAutomatonTime)
-    t.failAt("time", formatNumber(scene.time_s) + " is out of range with automaton clouds " +
-                         "(allowed: 0 to " + formatNumber(Limits::kMaxAutomatonTime) +
-                         " s; every automaton step is simulated)");
-  if (std::string e = automatonWorkError(dynamics.automata, scene.time_s); !e.empty())
-    t.failAt(t.has("time") ? "time" : "automaton", e);
+  readAutomata(t, scene, dynamics.automata);
   std::vector<TableReader> targets = t.tables("target");
   for (std::size_t i = 0; i < targets.size(); ++i) {
     Target& target = scene.targets.emplace_back();
