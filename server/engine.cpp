@@ -246,7 +246,9 @@ void Engine::executeBatch(Job& job) {
       publishReadings();
       return refuse(std::get<ProtocolError>(*outcome));
     }
-  publishReadings();  // so that a register read right after the reply sees the change
+  // So that a register read, or stats answered at once, right after the reply sees the change
+  // (a CIGI frame that re-centred the world: its site).
+  publish();
   job.done(std::nullopt);
   if (job.render) {
     renderTrigger();  // the render coil reads 1 until the file is written
