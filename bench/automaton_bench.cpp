@@ -14,7 +14,6 @@
 #include "bench/bench_common.h"
 #include "config/scene_file.h"
 #include "image/image_metrics.h"
-#include "renderer/gl/gl_renderer.h"
 #include "renderer/reference/reference_renderer.h"
 #include "world/world.h"
 
@@ -75,13 +74,13 @@ void lightUpdates(int repeats) {
 // error against the CPU reference at a quarter of the size, for the march-step knob and the
 // lattice resolution.
 void renderTable(const std::string& presets, const std::string& size, int repeats) {
-  const auto platform = bench::openPlatform();
-  if (!platform) return;
-  GlRenderer renderer(*platform);
+  const std::unique_ptr<Renderer> gl = bench::openRenderer();
+  if (!gl) return;
+  Renderer& renderer = *gl;
   std::printf(
       "\nframes (%s, %s; error: sRGB RGB against the reference at a quarter size, 1 sample "
       "per pixel)\n",
-      size.c_str(), platform->renderer().c_str());
+      size.c_str(), renderer.platform().device.c_str());
   std::printf("%-16s %-22s %9s %8s %9s %9s\n", "preset", "knob", "ms/frame", "fps", "PSNR dB",
               "max err");
   struct Case {

@@ -11,7 +11,7 @@
 
 #include "config/scene_file.h"
 #include "renderer/frame_timing.h"
-#include "renderer/gl/gl_renderer.h"
+#include "renderer/renderer.h"
 
 namespace nephele::bench {
 
@@ -33,17 +33,17 @@ inline double linearLuminance(double r, double g, double b) {
   return 0.2126 * r + 0.7152 * g + 0.0722 * b;
 }
 
-// The default GL platform, or null after printing why there is none.
-inline std::unique_ptr<GlPlatform> openPlatform() {
+// The GL renderer on the default platform, or null after printing why there is none.
+inline std::unique_ptr<Renderer> openRenderer() {
   std::string error;
-  auto platform = createGlPlatform(GlBackend::kAuto, error);
-  if (!platform) std::fprintf(stderr, "%s\n", error.c_str());
-  return platform;
+  auto renderer = createRenderer({}, error);
+  if (!renderer) std::fprintf(stderr, "%s\n", error.c_str());
+  return renderer;
 }
 
 // Median milliseconds of `repeats` frames after one warm-up (shader compile, texture bake).
-// Each frame includes glReadPixels, so it has finished when timed.
-inline double medianFrameMilliseconds(GlRenderer& renderer, const Scene& scene,
+// Each frame includes its readback, so it has finished when timed.
+inline double medianFrameMilliseconds(Renderer& renderer, const Scene& scene,
                                       const RenderSettings& settings, int repeats,
                                       bool float_target) {
   return medianMilliseconds(repeats, [&] {

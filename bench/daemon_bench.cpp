@@ -31,8 +31,7 @@
 
 #include "protocol/cigi.h"
 #include "renderer/frame_timing.h"
-#include "renderer/gl/gl_platform.h"
-#include "renderer/gl/gl_renderer.h"
+#include "renderer/renderer.h"
 
 #include <algorithm>
 #include <atomic>
@@ -260,10 +259,9 @@ std::string writeHostConfig(const std::filesystem::path& dir, int host_port,
 
 double floorMs(int width, int height) {
   std::string error;
-  auto platform = nephele::createGlPlatform(nephele::GlBackend::kAuto, error);
-  if (!platform) throw std::runtime_error("no GL for the floor: " + error);
-  nephele::GlRenderer gl(*platform);
-  return nephele::medianMilliseconds(9, [&] { gl.renderFloor(width, height); });
+  const std::unique_ptr<nephele::Renderer> gl = nephele::createRenderer({}, error);
+  if (!gl) throw std::runtime_error("no GL for the floor: " + error);
+  return nephele::medianMilliseconds(9, [&] { gl->renderFloor(width, height); });
 }
 
 struct HostFrameFigures {

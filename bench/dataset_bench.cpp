@@ -16,7 +16,6 @@
 #include "dataset/dataset_file.h"
 #include "image/image_encoding.h"
 #include "image/image_metrics.h"
-#include "renderer/gl/gl_renderer.h"
 #include "world/infrared.h"
 
 using namespace nephele;
@@ -37,7 +36,7 @@ struct StageTimes {
 };
 
 // Sample i of `spec` through every stage, each timed alone.
-void timeSample(GlRenderer& gl, const DatasetSpec& spec, const RenderSettings& settings,
+void timeSample(Renderer& gl, const DatasetSpec& spec, const RenderSettings& settings,
                 const FrameRequest& request, int i, int samples, bool per_sample,
                 StageTimes& times) {
   auto t = Clock::now();
@@ -48,7 +47,7 @@ void timeSample(GlRenderer& gl, const DatasetSpec& spec, const RenderSettings& s
   const Scene with_heaps = withFieldClouds(sample.scene, spec.heaps);
   times.heaps += msSince(t);
   t = Clock::now();
-  const Frame frame = gl.renderFrame(with_heaps, settings, request);
+  const Frame frame = gl.render(with_heaps, settings, request);
   const double render_ms = msSince(t);
   times.render += render_ms;
   times.budget.accumulate(gl.lastFrameStats().times, 1.0 / samples);
@@ -79,7 +78,7 @@ void timeSample(GlRenderer& gl, const DatasetSpec& spec, const RenderSettings& s
 
 // One description's samples per second, serial and pipelined, and its time per stage: 0, or
 // the exit code.
-int benchDescription(GlRenderer& gl, const std::string& path, int samples, bool per_sample) {
+int benchDescription(Renderer& gl, const std::string& path, int samples, bool per_sample) {
   DatasetSpec spec;
   if (std::string e = loadDatasetFile(path, spec); !e.empty()) {
     std::fprintf(stderr, "%s\n", e.c_str());
@@ -89,7 +88,7 @@ int benchDescription(GlRenderer& gl, const std::string& path, int samples, bool 
   RenderSettings settings;
   settings.heaps = spec.heaps;
   const FrameRequest request{{Channel::kColour, Channel::kObjectId, Channel::kVisibility}};
-  gl.renderFrame(drawSample(spec, 0).scene, settings, request);  // warm-up: shaders, tables
+  gl.render(drawSample(spec, 0).scene, settings, request);  // warm-up: shaders, tables
   StageTimes s;
   for (int i = 0; i < samples; ++i)
     timeSample(gl, spec, settings, request, i, samples, per_sample, s);
@@ -117,7 +116,7 @@ int benchDescription(GlRenderer& gl, const std::string& path, int samples, bool 
 // The label knob: cloud depth traced once per N x N pixels, against every pixel traced, on
 // the first samples of a description (error: pixels whose cloud depth changes between finite
 // and infinite, and the mean relative change where both are finite).
-void printDivisorFigures(GlRenderer& gl, const std::string& path, int samples) {
+void printDivisorFigures(Renderer& gl, const std::string& path, int samples) {
   DatasetSpec spec;
   loadDatasetFile(path, spec);
   std::printf("cloud_depth channel_divisor (%s, %d samples):\n", path.c_str(),
@@ -132,7 +131,7 @@ void printDivisorFigures(GlRenderer& gl, const std::string& path, int samples) {
     for (int i = 0; i < n; ++i) {
       const Scene scene = drawSample(spec, i).scene;
       const auto t = Clock::now();
-      const Frame frame = gl.renderFrame(scene, settings, {ChannelSet{Channel::kCloudDepth}});
+      const Frame frame = gl.render(scene, settings, {ChannelSet{Channel::kCloudDepth}});
       ms += msSince(t);
       if (divisor == 1) exact.push_back(frame.cloud_depth);
       const PlaneError e = comparePlanes(frame.cloud_depth, exact[std::size_t(i)]);
@@ -180,9 +179,9 @@ int main(int argc, char** argv) {
   app.add_flag("--per-sample", per_sample, "Print each sample's camera and render time");
   CLI11_PARSE(app, argc, argv);
 
-  const auto platform = openPlatform();
-  if (!platform) return 1;
-  GlRenderer gl(*platform);
+  const std::unique_ptr<Renderer> renderer = openRenderer();
+  if (!renderer) return 1;
+  Renderer& gl = *renderer;
   for (const std::string& path : specs)
     if (const int code = benchDescription(gl, path, samples, per_sample); code != 0) return code;
   printDivisorFigures(gl, specs.front(), samples);

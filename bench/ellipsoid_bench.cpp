@@ -15,7 +15,6 @@
 #include "bench/bench_common.h"
 #include "config/scene_file.h"
 #include "image/image_metrics.h"
-#include "renderer/gl/gl_renderer.h"
 #include "renderer/reference/reference_renderer.h"
 
 namespace {
@@ -87,11 +86,12 @@ int main(int argc, char** argv) {
   app.add_flag("--no-knobs", skip_knobs, "Print only the scaling table");
   CLI11_PARSE(app, argc, argv);
 
-  const auto platform = bench::openPlatform();
-  if (!platform) return 1;
-  std::printf("GL: %s, %s; timed: render + readback, 8-bit sRGB target\n",
-              std::string(platform->backendName()).c_str(), platform->renderer().c_str());
-  GlRenderer renderer(*platform);
+  const std::unique_ptr<Renderer> gl = bench::openRenderer();
+  if (!gl) return 1;
+  Renderer& renderer = *gl;
+  const RendererPlatform platform = renderer.platform();
+  std::printf("GL: %s, %s; timed: render + readback, 8-bit sRGB target\n", platform.backend.c_str(),
+              platform.device.c_str());
 
   SceneFile cumulus;
   if (!bench::loadPreset(presets + "/cumulus.toml", cumulus)) return 1;

@@ -18,7 +18,6 @@
 
 #include "bench/bench_common.h"
 #include "image/image_metrics.h"
-#include "renderer/gl/gl_renderer.h"
 #include "renderer/reference/reference_renderer.h"
 #include "world/formations/weather.h"
 
@@ -90,7 +89,7 @@ Flight flightOf(const FlightOptions& o, const Camera& camera) {
 
 // Every `interval` simulated seconds two frames 1/30 s apart: a row every tenth sample, and
 // the flight's summary.
-void flyAndPrint(GlRenderer& renderer, const Flight& flight, const RenderSettings& settings,
+void flyAndPrint(Renderer& renderer, const Flight& flight, const RenderSettings& settings,
                  const FlightOptions& o, double floor, double start_mib) {
   std::printf("%8s %10s %9s %8s %7s %10s %9s %9s %9s %9s\n", "time s", "x km", "first ms", "ms",
               "xfloor", "ellipsoids", "d cover", "d lum", "d pixel", "RSS MiB");
@@ -139,7 +138,7 @@ void flyAndPrint(GlRenderer& renderer, const Flight& flight, const RenderSetting
 }
 
 // Precision: GL against the double-precision reference, near the origin and far from it.
-void printPrecision(GlRenderer& renderer, Flight flight, const RenderSettings& settings,
+void printPrecision(Renderer& renderer, Flight flight, const RenderSettings& settings,
                     const FlightOptions& o) {
   flight.camera.width = 160, flight.camera.height = 120;
   RenderSettings point = settings;
@@ -190,9 +189,9 @@ int main(int argc, char** argv) {
   app.add_option("--size", o.size, "Image size WxH")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
-  const auto platform = bench::openPlatform();
-  if (!platform) return 1;
-  GlRenderer renderer(*platform);
+  const std::unique_ptr<Renderer> gl = bench::openRenderer();
+  if (!gl) return 1;
+  Renderer& renderer = *gl;
   Camera camera;
   if (!bench::parseSize(o.size, camera)) return 2;
   camera.orientation = {90.0, -8.0, 0.0};  // east, a little down

@@ -35,7 +35,6 @@
 #include "image/image.h"
 #include "image/image_encoding.h"
 #include "image/image_metrics.h"
-#include "renderer/gl/gl_renderer.h"
 #include "renderer/reference/reference_renderer.h"
 #include "world/formations/cloud_field.h"
 #include "world/formations/weather.h"
@@ -116,7 +115,7 @@ BodyFigure bodyFigure(const FloatImage& image, const std::vector<int>& region) {
 // straight down from far above (near-orthographic) and straight up from the ground under its
 // middle; per heap the fraction of its inner half that is opaque (coverage > 0.95), and the
 // luminance of its underside against that of its sunlit top.
-void printBodyFigures(GlRenderer& renderer, const SceneFile& file) {
+void printBodyFigures(Renderer& renderer, const SceneFile& file) {
   if (file.scene.fields.empty()) return;
   const CloudField& field = file.scene.fields.front();
   const double tile = fieldTileSize(field);
@@ -190,7 +189,7 @@ double median(std::vector<double> v) {
 
 // The heap's view of printLightFigures side-lit at the benchmark's frame sizes: the outline's
 // detail the texture draws at 640x480 and 1280x1024 (issue 47 item 5).
-void printOutlinesAtFrameSizes(GlRenderer& renderer, const Scene& scene,
+void printOutlinesAtFrameSizes(Renderer& renderer, const Scene& scene,
                                const RenderSettings& render) {
   for (const glm::ivec2 size : {glm::ivec2(640, 480), glm::ivec2(1280, 1024)}) {
     Scene sized = scene;
@@ -215,7 +214,7 @@ void printOutlinesAtFrameSizes(GlRenderer& renderer, const Scene& scene,
 // body's (coverage > 0.95): a silver lining is > 1. (a) On the side-lit view's silhouette, its
 // outline's dimension and the fraction of it within a pixel of its moment ellipse
 // (outlineFigures, image/cloud_statistics.h).
-void printLightFigures(GlRenderer& renderer, const SceneFile& file, const std::string& name,
+void printLightFigures(Renderer& renderer, const SceneFile& file, const std::string& name,
                        const std::string& images) {
   if (file.scene.fields.empty()) return;
   const CloudField& field = file.scene.fields.front();
@@ -339,7 +338,7 @@ std::optional<TowerInView> printCumulonimbusShape(const FloatImage& image, int a
 // The cloud's own luminance (ownLuminance) in `view`, without the haze, over the opaque pixels
 // (x, y) for which `inside` holds: their median and how many.
 template <class Inside>
-std::pair<double, std::size_t> ownMedian(GlRenderer& renderer, Scene view, Inside inside,
+std::pair<double, std::size_t> ownMedian(Renderer& renderer, Scene view, Inside inside,
                                          const RenderSettings& settings) {
   view.haze.reset();
   const FloatImage frame = renderer.renderFloat(view, settings);
@@ -358,7 +357,7 @@ std::pair<double, std::size_t> ownMedian(GlRenderer& renderer, Scene view, Insid
 // view across the shear (`scene`, looking along `forward`) with the sun behind the camera (the
 // tower's rows from its foot to 0.45 of its height, within its width there); medians over
 // opaque pixels, without the haze (120 km of it would stand for the cloud's own light).
-void printCumulonimbusBase(GlRenderer& renderer, const SceneFile& file, const Scene& scene,
+void printCumulonimbusBase(Renderer& renderer, const SceneFile& file, const Scene& scene,
                            glm::dvec3 base, glm::dvec3 forward, const TowerInView& tower) {
   Scene lit = scene;
   lit.sun.azimuth_deg = glm::degrees(std::atan2(-forward.x, -forward.y));
@@ -390,7 +389,7 @@ void printCumulonimbusBase(GlRenderer& renderer, const SceneFile& file, const Sc
 // world's wind gives it), seen level across the shear from 120 km, downwind to the right, with
 // the preset's sun: its shape (printCumulonimbusShape), then its base against its sunlit tower
 // (printCumulonimbusBase).
-void printCumulonimbusFigures(GlRenderer& renderer, const SceneFile& file, const std::string& name,
+void printCumulonimbusFigures(Renderer& renderer, const SceneFile& file, const std::string& name,
                               const std::string& images) {
   const Scene world = World(file.scene, file.dynamics).scene();
   if (world.fields.empty() || world.fields.front().type != CloudType::kCumulonimbus) return;
@@ -433,7 +432,7 @@ void printCumulonimbusFigures(GlRenderer& renderer, const SceneFile& file, const
 // (the GL's), against exp(-tau) on the ray through the boat's middle with tau the shaft's exact
 // optical depth; and the equivalent path tau / sigma against the Koschmieder range 3.912 /
 // sigma of the rate, the visibility the same rain would leave filling the air.
-void printRainFigures(GlRenderer& renderer, const SceneFile& file) {
+void printRainFigures(Renderer& renderer, const SceneFile& file) {
   const Scene world = World(file.scene, file.dynamics).scene();
   if (world.fields.empty()) return;
   CloudField field = world.fields.front();
@@ -461,7 +460,7 @@ void printRainFigures(GlRenderer& renderer, const SceneFile& file) {
     c.vfov_deg = 2.0;
     FrameRequest request;
     request.channels = {Channel::kVisibility, Channel::kObjectId};
-    const Frame frame = renderer.renderFrame(scene, file.render, request);
+    const Frame frame = renderer.render(scene, file.render, request);
     double sum = 0.0;
     int pixels = 0;
     for (std::size_t i = 0; i < frame.visibility.size(); ++i)
@@ -486,7 +485,7 @@ void printRainFigures(GlRenderer& renderer, const SceneFile& file) {
 // 320x240 with one sample a pixel) and what the shadows cost at 640x480: the frame whose map
 // is drawn anew (every frame of a world that ticks, or whose sun moves), the frame that reuses
 // it (the other views of one eye at one tick), against the frame without shadows.
-void printShadowFigures(const GlPlatform& platform, const SceneFile& file, const std::string& name,
+void printShadowFigures(const Renderer& base, const SceneFile& file, const std::string& name,
                         int repeats, const std::string& images) {
   if (file.scene.fields.empty()) return;
   const CloudField& field = file.scene.fields.front();
@@ -495,7 +494,8 @@ void printShadowFigures(const GlPlatform& platform, const SceneFile& file, const
   c.position = {0.0, 0.0, fieldTop(field) + 4000.0};
   c.orientation = {file.scene.camera.orientation.heading_deg, -60.0, 0.0};
   c.width = 320, c.height = 240;
-  GlRenderer renderer(platform);
+  const std::unique_ptr<Renderer> fresh = base.another();
+  Renderer& renderer = *fresh;
   RenderSettings none = file.render;
   none.shadow_map_size = 0;
   RenderSettings exact = file.render;
@@ -536,8 +536,7 @@ void printShadowFigures(const GlPlatform& platform, const SceneFile& file, const
       reused, reused / without);
 }
 
-double hemisphereFraction(GlRenderer& renderer, const Scene& weather,
-                          const RenderSettings& render) {
+double hemisphereFraction(Renderer& renderer, const Scene& weather, const RenderSettings& render) {
   constexpr int kFace = 128;
   double cloudy = 0.0, total = 0.0;
   for (int place = 0; place < 4; ++place) {
@@ -567,7 +566,7 @@ double hemisphereFraction(GlRenderer& renderer, const Scene& weather,
 // Automaton clouds' underside against their sunlit top (MODEL.md section 6, sky light): each
 // automaton of the harbour preset seen straight up from the ground under its middle and
 // straight down from 2 km above it; mean luminance over the inner half of its outline.
-void printAutomatonFigures(GlRenderer& renderer) {
+void printAutomatonFigures(Renderer& renderer) {
   SceneFile file;
   if (!bench::loadPreset(NEPHELE_SOURCE_DIR "/config/scenes/harbour.toml", file)) return;
   file.scene.fog.reset();  // the sea fog lies below the clouds; it would grey the view down
@@ -624,8 +623,7 @@ std::size_t drawnEllipsoids(const Scene& scene) {
 
 // Every genus at its typical altitude (weather.h), seen from the ground: the fraction of the
 // sky dome covered for each cloud fraction asked.
-void printHemisphereFigures(GlPlatform& platform) {
-  GlRenderer renderer(platform);
+void printHemisphereFigures(Renderer& renderer) {
   std::printf(
       "hemisphere fraction from the ground (cloud fraction asked -> fraction of the sky "
       "dome with coverage > 0.5)\n%-14s",
@@ -735,7 +733,7 @@ struct StillFigures {
   FrameTimes still_budget, clear_budget;
 };
 
-StillFigures measureStill(GlRenderer& renderer, const Scene& scene, const RenderSettings& render,
+StillFigures measureStill(Renderer& renderer, const Scene& scene, const RenderSettings& render,
                           int repeats) {
   StillFigures s;
   const int width = scene.camera.width, height = scene.camera.height;
@@ -769,13 +767,14 @@ struct FlightFigures {
   double change_ms = 0.0;
 };
 
-FlightFigures measureFlight(GlPlatform& platform, const Scene& scene, const RenderSettings& render,
+FlightFigures measureFlight(const Renderer& base, const Scene& scene, const RenderSettings& render,
                             int repeats, double speed) {
   FlightFigures f;
   // The flight's renderer has drawn the still view once, as a running daemon has drawn
   // frames before: its programs are compiled and its textures baked (one-off costs of
   // hundreds of milliseconds), while the heaps along the flight are new to it.
-  GlRenderer flyer(platform);
+  const std::unique_ptr<Renderer> fresh = base.another();
+  Renderer& flyer = *fresh;
   flyer.renderSrgb8(scene, render);
   // A flight is a continuous view, as a daemon's subscription is (heap_refresh).
   flyer.setContinuousView("flight");
@@ -823,12 +822,13 @@ FlightFigures measureFlight(GlPlatform& platform, const Scene& scene, const Rend
 }
 
 // One view's row of the table and its budget lines, flight figures included unless --still.
-void benchView(GlPlatform& platform, const std::filesystem::path& path, const SceneFile& file,
+void benchView(const Renderer& base, const std::filesystem::path& path, const SceneFile& file,
                const View& view, const Scene& scene, const std::string& size,
                const GenusBenchOptions& o) {
   // A fresh renderer per case: heap tiles and bakes left by the previous case would
   // make the first frames of this one look cheaper than a new view's are.
-  GlRenderer renderer(platform);
+  const std::unique_ptr<Renderer> fresh = base.another();
+  Renderer& renderer = *fresh;
   StillFigures s = measureStill(renderer, scene, file.render, o.repeats);
   auto printBudgets = [&] {
     std::printf("  budget, still: %s\n  budget, clear: %s\n",
@@ -843,7 +843,7 @@ void benchView(GlPlatform& platform, const std::filesystem::path& path, const Sc
     std::fflush(stdout);
     return;
   }
-  FlightFigures f = measureFlight(platform, scene, file.render, o.repeats, o.speed);
+  FlightFigures f = measureFlight(base, scene, file.render, o.repeats, o.speed);
   const ImageError reuse_error = compareImages(f.reused, f.exact);
   if (!o.images.empty()) {  // the flight's last frame and the exact one, to look at
     std::filesystem::create_directories(o.images);
@@ -888,7 +888,7 @@ void benchView(GlPlatform& platform, const std::filesystem::path& path, const Sc
 
 // One preset: every view at every size, then (unless --still) its look, light, cumulonimbus,
 // rain and shadow figures. 0, or the exit code.
-int benchPreset(GlPlatform& platform, const std::filesystem::path& path,
+int benchPreset(const Renderer& base, const std::filesystem::path& path,
                 const GenusBenchOptions& o) {
   SceneFile file;
   if (const int code = loadGenusPreset(path, o, file); code != 0) return code;
@@ -901,7 +901,7 @@ int benchPreset(GlPlatform& platform, const std::filesystem::path& path,
       Scene scene = at_time;
       scene.camera = view.camera;
       scene.camera.width = sized.width, scene.camera.height = sized.height;
-      benchView(platform, path, file, view, scene, size, o);
+      benchView(base, path, file, view, scene, size, o);
     }
     const auto [rss, peak] = residentMiB();
     std::printf(
@@ -910,12 +910,13 @@ int benchPreset(GlPlatform& platform, const std::filesystem::path& path,
         path.stem().c_str(), size.c_str(), rss, peak);
   }
   if (o.still_only) return 0;
-  GlRenderer renderer(platform);
+  const std::unique_ptr<Renderer> fresh = base.another();
+  Renderer& renderer = *fresh;
   printBodyFigures(renderer, file);
   printLightFigures(renderer, file, path.stem().string(), o.images);
   printCumulonimbusFigures(renderer, file, path.stem().string(), o.images);
   if (path.stem() == "genus_cumulonimbus") printRainFigures(renderer, file);
-  printShadowFigures(platform, file, path.stem().string(), o.repeats, o.images);
+  printShadowFigures(base, file, path.stem().string(), o.repeats, o.images);
   return 0;
 }
 
@@ -935,14 +936,17 @@ int main(int argc, char** argv) {
                             : std::find(o.names.begin(), o.names.end(), stem) != o.names.end();
     if (wanted) files.push_back(path);
   }
-  const auto platform = bench::openPlatform();
-  if (!platform) return 1;
+  // Every case draws on a renderer of its own, made from this one (Renderer::another);
+  // the hemisphere and automaton figures, drawn alone, on this one.
+  const std::unique_ptr<Renderer> gl = bench::openRenderer();
+  if (!gl) return 1;
   if (o.hemisphere) {
-    printHemisphereFigures(*platform);
+    printHemisphereFigures(*gl);
     return 0;
   }
-  std::printf("GL: %s, %s; render + readback into an 8-bit target\n",
-              std::string(platform->backendName()).c_str(), platform->renderer().c_str());
+  const RendererPlatform platform = gl->platform();
+  std::printf("GL: %s, %s; render + readback into an 8-bit target\n", platform.backend.c_str(),
+              platform.device.c_str());
   std::printf(
       "still and flying are also given as multiples of the clear frame: the same view "
       "with no cloud, timed in the same run\n");
@@ -951,11 +955,10 @@ int main(int argc, char** argv) {
               "flying ms", "xclear", "slowest ms", "xclear", "warm ms", "xclear", "slowest ms",
               "xclear", "ellipsoids");
   for (const auto& path : files)
-    if (const int code = benchPreset(*platform, path, o); code != 0) return code;
+    if (const int code = benchPreset(*gl, path, o); code != 0) return code;
   if (!o.still_only &&
       (o.names.empty() || std::find(o.names.begin(), o.names.end(), "harbour") != o.names.end())) {
-    GlRenderer renderer(*platform);
-    printAutomatonFigures(renderer);
+    printAutomatonFigures(*gl);
   }
   return 0;
 }

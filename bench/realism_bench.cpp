@@ -17,7 +17,6 @@
 #include "bench/bench_common.h"
 #include "image/cloud_statistics.h"
 #include "image/image.h"
-#include "renderer/gl/gl_renderer.h"
 #include "world/formations/weather.h"
 
 using namespace nephele;
@@ -34,7 +33,7 @@ struct Figures {
   double ms = 0.0;        // render time of the view
 };
 
-Figures measure(GlRenderer& renderer, CloudType type, double coverage, double span_m, int pixels,
+Figures measure(Renderer& renderer, CloudType type, double coverage, double span_m, int pixels,
                 double shortest_m, const ClusterVariation& clusters) {
   Scene scene;
   WeatherLayer w = typicalWeatherLayer(type, coverage);
@@ -110,9 +109,9 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "--genera: none of the names is a genus (allowed: altocumulus, ...)\n");
     return 2;
   }
-  const auto platform = bench::openPlatform();
-  if (!platform) return 1;
-  GlRenderer renderer(*platform);
+  const std::unique_ptr<Renderer> gl = bench::openRenderer();
+  if (!gl) return 1;
+  Renderer& renderer = *gl;
   std::printf(
       "Straight down over %.0f km, %d x %d (%.0f m per pixel); clouds of %d pixels or more; "
       "spectrum between %.0f m and %.1f km.\nObserved: D about 1.35 (aim 1.25 to 1.45), "

@@ -15,7 +15,6 @@
 #include "bench/bench_common.h"
 #include "config/scene_file.h"
 #include "image/image_metrics.h"
-#include "renderer/gl/gl_renderer.h"
 #include "renderer/reference/reference_renderer.h"
 
 namespace {
@@ -65,16 +64,15 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
-  const auto platform = bench::openPlatform();
-  if (!platform) return 1;
-  std::printf("GL: %s, %s\n", std::string(platform->backendName()).c_str(),
-              platform->renderer().c_str());
+  const std::unique_ptr<Renderer> renderer = bench::openRenderer();
+  if (!renderer) return 1;
+  const RendererPlatform platform = renderer->platform();
+  std::printf("GL: %s, %s\n", platform.backend.c_str(), platform.device.c_str());
   std::printf("timed: %s target, render + readback\n", target.c_str());
   std::printf("error: sRGB RGB against the CPU reference (%dx%d samples, every term)\n\n", samples,
               samples);
   std::printf("%-12s %-10s %-22s %9s %9s %9s\n", "preset", "size", "knob", "ms/frame", "PSNR dB",
               "max err");
-  GlRenderer renderer(*platform);
 
   const std::vector<std::filesystem::path> files = bench::presetFiles(presets);
 
@@ -89,9 +87,10 @@ int main(int argc, char** argv) {
       const double ref_ms =
           std::chrono::duration<double, std::milli>(Clock::now() - ref_start).count();
       for (const Knob& knob : knobs()) {
-        const double ms = bench::medianFrameMilliseconds(renderer, scene, knob.settings, repeats,
+        const double ms = bench::medianFrameMilliseconds(*renderer, scene, knob.settings, repeats,
                                                          target == "float");
-        const ImageError err = compareImages(renderer.renderFloat(scene, knob.settings), reference);
+        const ImageError err =
+            compareImages(renderer->renderFloat(scene, knob.settings), reference);
         std::printf("%-12s %-10s %-22s %9.2f %9.2f %9.4f%s\n", path.stem().c_str(), size.c_str(),
                     knob.name, ms, err.psnr_db, err.max_abs,
                     err.non_finite ? "  NON-FINITE PIXELS" : "");

@@ -16,7 +16,6 @@
 
 #include "bench/bench_common.h"
 #include "image/image_metrics.h"
-#include "renderer/gl/gl_renderer.h"
 #include "renderer/reference/reference_renderer.h"
 #include "world/formations/ellipsoid_cloud.h"
 #include "world/formations/weather.h"
@@ -27,7 +26,7 @@ using namespace nephele;
 namespace {
 
 // The horizon part: see the file comment.
-void horizon(GlPlatform& platform, const std::vector<std::string>& sizes, int repeats,
+void horizon(const Renderer& gl, const std::vector<std::string>& sizes, int repeats,
              const std::vector<double>& ranges_km) {
   WeatherLayer w = typicalWeatherLayer(CloudType::kCumulus, 0.4);
   w.region.half_size = {150000.0, 150000.0};
@@ -56,7 +55,8 @@ void horizon(GlPlatform& platform, const std::vector<std::string>& sizes, int re
               heapRange(scene.fields[0], small) / 1000.0);
   std::printf("%-10s %9s %9s %9s %8s %10s %8s %10s %10s\n", "size", "range km", "floor ms",
               "frame ms", "xfloor", "ellipsoids", "PSNR dB", "row cover", "row lum");
-  GlRenderer renderer(platform);
+  const std::unique_ptr<Renderer> fresh = gl.another();
+  Renderer& renderer = *fresh;
   for (double km : ranges_km) {
     RenderSettings settings;
     settings.heaps.range_m = km * 1000.0;
@@ -102,8 +102,7 @@ Scene gridWorld(double side_km, double spacing_m) {
 
 // The whole world's frame against that of the clouds its camera can see (the same test the
 // renderer culls with), both as multiples of the floor: one row of the table.
-void benchWorldView(GlPlatform& platform, const Scene& world, const std::string& size,
-                    int repeats) {
+void benchWorldView(const Renderer& gl, const Scene& world, const std::string& size, int repeats) {
   const Camera& camera = world.camera;
   Scene seen = world;
   const ViewBasis basis = viewBasis(camera);
@@ -111,7 +110,8 @@ void benchWorldView(GlPlatform& platform, const Scene& world, const std::string&
     const BoundingBox box = boundingBox(c);
     return !boxMayBeInView(basis, camera.position, box.lo, box.hi);
   });
-  GlRenderer renderer(platform);
+  const std::unique_ptr<Renderer> fresh = gl.another();
+  Renderer& renderer = *fresh;
   const RenderSettings settings;
   const double floor =
       medianMilliseconds(repeats, [&] { renderer.renderFloor(camera.width, camera.height); });
@@ -152,10 +152,10 @@ int main(int argc, char** argv) {
   app.add_flag("!--no-horizon", horizon_part, "Skip the horizon part");
   CLI11_PARSE(app, argc, argv);
 
-  const auto platform = bench::openPlatform();
-  if (!platform) return 1;
+  const std::unique_ptr<Renderer> gl = bench::openRenderer();
+  if (!gl) return 1;
   if (!world_part) {
-    if (horizon_part) horizon(*platform, sizes, repeats, ranges_km);
+    if (horizon_part) horizon(*gl, sizes, repeats, ranges_km);
     return 0;
   }
   const double before_mib = bench::residentMiB();
@@ -173,8 +173,8 @@ int main(int argc, char** argv) {
     camera.orientation = {0.0, -90.0, 0.0};
     camera.vfov_deg = 60.0;
     world.camera = camera;
-    benchWorldView(*platform, world, size, repeats);
+    benchWorldView(*gl, world, size, repeats);
   }
-  if (horizon_part) horizon(*platform, sizes, repeats, ranges_km);
+  if (horizon_part) horizon(*gl, sizes, repeats, ranges_km);
   return 0;
 }

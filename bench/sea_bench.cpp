@@ -78,7 +78,7 @@ void printGlintFigures(const RenderSettings& settings) {
 
 // The GL frame's cost with each sea state, as a multiple of the flat ground's, with and
 // without the preset's clouds.
-void printFrameCosts(GlRenderer& renderer, const Scene& clouded, const Scene& clear,
+void printFrameCosts(Renderer& renderer, const Scene& clouded, const Scene& clear,
                      const RenderSettings& settings, int repeats) {
   std::printf("%-4s %10s %10s %8s %12s %12s %8s\n", "sea", "ground ms", "sea ms", "x ground",
               "clouds+grd", "clouds+sea", "x ground");
@@ -97,7 +97,7 @@ void printFrameCosts(GlRenderer& renderer, const Scene& clouded, const Scene& cl
 
 // The picture board: every sea state from 300 m and 3 km, sun high and low, with and without
 // clouds, into `board`.
-void writeBoard(GlRenderer& renderer, const SceneFile& file, const Scene& clear,
+void writeBoard(Renderer& renderer, const SceneFile& file, const Scene& clear,
                 const RenderSettings& settings, const std::string& board) {
   std::filesystem::create_directories(board);
   for (const SeaState& state : kStates)
@@ -148,9 +148,9 @@ int main(int argc, char** argv) {
   }
   Camera camera = file.scene.camera;
   if (!bench::parseSize(size, camera)) return 2;
-  auto platform = bench::openPlatform();
-  if (!platform) return 1;
-  GlRenderer renderer(*platform);
+  const std::unique_ptr<Renderer> gl = bench::openRenderer();
+  if (!gl) return 1;
+  Renderer& renderer = *gl;
   Scene clouded = file.scene;
   clouded.targets.clear();
   clouded.sea.reset();
@@ -164,7 +164,7 @@ int main(int argc, char** argv) {
   std::printf(
       "\nGL frame at %dx%d from 300 m, 10 deg down, sun 30 deg up ahead (%s): ms and "
       "multiples of the flat ground's frame; floor %.2f ms\n",
-      camera.width, camera.height, platform->renderer().c_str(), floor);
+      camera.width, camera.height, renderer.platform().device.c_str(), floor);
   printFrameCosts(renderer, clouded, clear, settings, repeats);
   if (!board.empty()) writeBoard(renderer, file, clear, settings, board);
   return 0;

@@ -29,7 +29,7 @@ extern "C" {
 #include "config/scene_file.h"
 #include "image/video_stream.h"
 #include "renderer/frame_timing.h"
-#include "renderer/gl/gl_renderer.h"
+#include "renderer/renderer.h"
 
 using namespace nephele;
 using Clock = std::chrono::steady_clock;
@@ -63,7 +63,7 @@ double psnr(const std::vector<std::uint8_t>& decoded, const Srgb8Image& frame) {
 using Frames = std::vector<std::shared_ptr<const Srgb8Image>>;
 
 // The frames of a camera sweeping 30 degrees, and what each cost to render.
-Frames renderSweep(GlRenderer& renderer, Scene scene, const RenderSettings& render, int distinct,
+Frames renderSweep(Renderer& renderer, Scene scene, const RenderSettings& render, int distinct,
                    std::vector<double>& render_ms) {
   Frames frames;
   renderer.renderSrgb8(scene, render);  // warm-up: shaders, textures
@@ -214,9 +214,9 @@ int main(int argc, char** argv) {
   }
   Scene scene = file.scene;
   if (!bench::parseSize(o.size, scene.camera)) return 2;
-  auto platform = bench::openPlatform();
-  if (!platform) return 1;
-  GlRenderer renderer(*platform);
+  const std::unique_ptr<Renderer> gl = bench::openRenderer();
+  if (!gl) return 1;
+  Renderer& renderer = *gl;
   const int w = scene.camera.width, h = scene.camera.height;
   // The frames, and what one costs to render (the median of the sweep's).
   std::vector<double> render_ms;
@@ -261,7 +261,7 @@ int main(int argc, char** argv) {
     latency.push_back(millisecondsBetween(ready[tick], d.at));
     quality.push_back(d.psnr);
   }
-  printStreamFigures(o, settings, w, h, platform->renderer(), count, counts, latency, quality,
+  printStreamFigures(o, settings, w, h, renderer.platform().device, count, counts, latency, quality,
                      render, floor);
   return latency.empty() ? 1 : 0;
 }

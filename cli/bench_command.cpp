@@ -18,8 +18,8 @@
 #include "config/scene_file.h"
 #include "image/image_metrics.h"
 #include "renderer/frame_timing.h"
-#include "renderer/gl/gl_renderer.h"
 #include "renderer/reference/reference_renderer.h"
+#include "renderer/renderer.h"
 #include "world/formations/ellipsoid_cloud.h"
 #include "world/infrared.h"
 
@@ -43,7 +43,7 @@ struct Setting {
   // The knob changes the model itself (not how closely it is drawn): its error is measured
   // against the reference image of the edited scene.
   bool changes_model = false;
-  // Drawn as a continuous view (GlRenderer::setContinuousView): its image is the frame after
+  // Drawn as a continuous view (Renderer::setContinuousView): its image is the frame after
   // flying into the view at 250 m/s for 16 frames at 30 Hz, its time that of the view streamed.
   bool stream = false;
 
@@ -363,8 +363,8 @@ struct LabelResult {
   std::vector<LabelPoint> points;
 };
 
-LabelResult measureLabelKnob(GlRenderer& renderer, const BenchScene& bench_scene,
-                             const Scene& scene, const BandTable& band) {
+LabelResult measureLabelKnob(Renderer& renderer, const BenchScene& bench_scene, const Scene& scene,
+                             const BandTable& band) {
   LabelResult result{bench_scene.name, {}};
   const FrameRequest request(ChannelSet{Channel::kCloudDepth, Channel::kLwir});
   Frame exact;
@@ -373,7 +373,7 @@ LabelResult measureLabelKnob(GlRenderer& renderer, const BenchScene& bench_scene
     RenderSettings settings = bench_scene.file.render;
     settings.channel_divisor = divisor;
     const auto start = Clock::now();
-    Frame frame = renderer.renderFrame(scene, settings, request);
+    Frame frame = renderer.render(scene, settings, request);
     LabelPoint point;
     point.divisor = divisor;
     point.ms = secondsSince(start) * 1e3;
@@ -501,7 +501,7 @@ std::string selectScenes(const std::vector<std::string>& names, std::vector<Benc
 
 // What a scene's sweep shares: its renderer, run, reference and progress line.
 struct SweepContext {
-  GlRenderer& renderer;
+  Renderer& renderer;
   const BenchRun& run;
   const ReferenceSettings& reference_settings;
   const FloatImage& reference;
@@ -590,7 +590,7 @@ void sweepScene(const SweepContext& c, const BenchScene& bench_scene, const Scen
 }
 
 // One scene: its reference, the platform floor, then its sweep; printed as it ends.
-SceneResult measureScene(GlRenderer& renderer, BenchScene& bench_scene, const BenchRun& run,
+SceneResult measureScene(Renderer& renderer, BenchScene& bench_scene, const BenchRun& run,
                          const std::string& tag, Clock::time_point start) {
   const bool tty = isatty(fileno(stderr));  // progress on one rewritten line, else a line each
   bench_scene.file.scene.camera.width = run.width;
@@ -624,8 +624,7 @@ SceneResult measureScene(GlRenderer& renderer, BenchScene& bench_scene, const Be
 
 // The label knob, on every scene with clouds (after the sweep: its tracing would disturb no
 // timing there).
-std::vector<LabelResult> measureLabels(GlRenderer& renderer,
-                                       const std::vector<BenchScene>& scenes) {
+std::vector<LabelResult> measureLabels(Renderer& renderer, const std::vector<BenchScene>& scenes) {
   std::vector<LabelResult> labels;
   const BandTable band{InfraredModel{}};
   for (const BenchScene& bench_scene : scenes) {
@@ -693,19 +692,21 @@ int runBenchCommand(const BenchCommandOptions& o) {
     return 2;
   }
   std::string error;
-  const auto platform = createGlPlatform(backendFromName(o.gl_backend), error);
-  if (!platform) {
+  RendererOptions options;
+  options.gl_backend = backendFromName(o.gl_backend);
+  const std::unique_ptr<Renderer> gl = createRenderer(options, error);
+  if (!gl) {
     spdlog::error("{}", error);
     return 1;
   }
-  GlRenderer renderer(*platform);
+  Renderer& renderer = *gl;
+  const RendererPlatform platform = renderer.platform();
   const std::string header =
       "Measured by `nephele bench" + std::string(o.quick ? " --quick" : "") + "` at " +
       std::to_string(run.width) + "x" + std::to_string(run.height) + ", median of " +
       std::to_string(run.repeats) + " frames (render + readback into an 8-bit target), " +
-      platform->renderer() + " (" + std::string(platform->backendName()) +
-      "); error against the CPU reference at " + std::to_string(run.samples) + "x" +
-      std::to_string(run.samples) + " samples per pixel.";
+      platform.device + " (" + platform.backend + "); error against the CPU reference at " +
+      std::to_string(run.samples) + "x" + std::to_string(run.samples) + " samples per pixel.";
   std::printf("%s\n", header.c_str());
 
   const auto start = Clock::now();

@@ -5,10 +5,12 @@
 // every channel.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <memory>
+#include <utility>
 
 #include "renderer/renderer.h"
 #include "world/shading.h"
@@ -291,6 +293,87 @@ TEST(ChannelsCompare, GlMatchesReferenceOnEveryChannel) {
     // cloud limbs and thresholds in half floats differ by a few hundredths there.
     std::printf("%-12s %4d of %zu pixels differ\n", info.name, differing, pg.size());
     EXPECT_LE(differing, int(pg.size() / 50)) << info.name;
+  }
+}
+
+// The reference through the interface: a flag raised while it draws stops it between rows. One
+// thread, and `alive` (called before each row's check) raising the flag before row 10: rows 0
+// to 9 are drawn, the rest left empty, and the frame says it was cancelled; with the flag
+// lowered the next frame is whole.
+TEST(RendererInterface, ReferenceStopsBetweenRowsWhenCancelled) {
+  RendererOptions options;
+  options.kind = RendererKind::kReference;
+  options.reference.samples_per_axis = 1;
+  options.reference.threads = 1;
+  std::string error;
+  const auto reference = createRenderer(options, error);
+  ASSERT_NE(reference, nullptr) << error;
+  std::atomic<bool> cancel{false};
+  int rows_checked = 0;
+  reference->setCancel(&cancel, [&] { cancel = ++rows_checked > 10; });
+  const Scene scene = ChannelsTestScenes::level(32, 24);
+  const FloatImage stopped = reference->renderFloat(scene, {});
+  EXPECT_TRUE(reference->lastFrameCancelled());
+  EXPECT_EQ(rows_checked, 11);
+  auto rowDrawn = [](const FloatImage& image, int y) {
+    for (int x = 0; x < image.width; ++x)
+      if (image.pixel(x, y)[2] > 0.0f) return true;  // the sky is blue everywhere
+    return false;
+  };
+  for (int y = 0; y < scene.camera.height; ++y) EXPECT_EQ(rowDrawn(stopped, y), y < 10) << y;
+
+  reference->setCancel(nullptr);
+  const FloatImage whole = reference->renderFloat(scene, {});
+  EXPECT_FALSE(reference->lastFrameCancelled());
+  for (int y = 0; y < scene.camera.height; ++y) EXPECT_TRUE(rowDrawn(whole, y)) << y;
+}
+
+// The reference takes what both back ends draw alike from each call's settings: depth at
+// channel_divisor 4 is one centre ray per 4 x 4 block, while the renderer's own settings
+// (divisor 1) trace every pixel, whose ground depth changes from row to row.
+TEST(RendererInterface, ReferenceDrawsEachCallsSettings) {
+  RendererOptions options;
+  options.kind = RendererKind::kReference;
+  options.reference.samples_per_axis = 1;
+  std::string error;
+  const auto reference = createRenderer(options, error);
+  ASSERT_NE(reference, nullptr) << error;
+  const Scene scene = ChannelsTestScenes::level(32, 24);
+  const FrameRequest depth(ChannelSet{Channel::kDepth});
+  RenderSettings blocks;
+  blocks.channel_divisor = 4;
+  const Frame coarse = reference->render(scene, blocks, depth);
+  const Frame fine = reference->render(scene, depth);
+  const int w = scene.camera.width;
+  int ground = 0, fine_steps = 0;
+  for (int y = 16; y < scene.camera.height; ++y)  // below the horizon: the ground
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = std::size_t(y) * w + x;
+      ASSERT_TRUE(std::isfinite(fine.depth[i])) << x << "," << y;
+      ++ground;
+      EXPECT_EQ(coarse.depth[i], coarse.depth[std::size_t(y - y % 4) * w + (x - x % 4)]);
+      fine_steps += fine.depth[i] != fine.depth[i - w];
+    }
+  EXPECT_EQ(fine_steps, ground);
+}
+
+// Both back ends draw the platform floor at the size asked, and a renderer made by
+// another() (GL: on the same context) too.
+TEST(RendererInterface, FloorHasTheSizeAsked) {
+  for (RendererKind kind : {RendererKind::kGl, RendererKind::kReference}) {
+    RendererOptions options;
+    options.kind = kind;
+    std::string error;
+    const auto renderer = createRenderer(options, error);
+    ASSERT_NE(renderer, nullptr) << error;
+    const std::unique_ptr<Renderer> other = renderer->another();
+    for (Renderer* r : {renderer.get(), other.get()})
+      for (auto [width, height] : {std::pair{37, 23}, std::pair{8, 61}}) {
+        const Srgb8Image floor = r->renderFloor(width, height);
+        EXPECT_EQ(floor.width, width) << r->description();
+        EXPECT_EQ(floor.height, height) << r->description();
+        EXPECT_EQ(floor.rgba.size(), std::size_t(width) * height * 4) << r->description();
+      }
   }
 }
 

@@ -1,5 +1,5 @@
 // Leave out what a scene does not need: a frame pays only for the kinds of cloud it holds
-// and for the texture terms its pixels can resolve (renderer/gl/frame_stats.h).
+// and for the texture terms its pixels can resolve (renderer/frame_stats.h).
 #include <gtest/gtest.h>
 
 #include <chrono>

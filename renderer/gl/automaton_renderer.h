@@ -7,7 +7,7 @@
 #include <memory>
 #include <string>
 
-#include "renderer/gl/frame_stats.h"
+#include "renderer/frame_stats.h"
 #include "renderer/gl/gl_objects.h"
 #include "renderer/gl/view_uniforms.h"
 #include "renderer/render_settings.h"

@@ -11,7 +11,7 @@
 #include "renderer/frame_plan.h"
 #include "renderer/gl/automaton_renderer.h"
 #include "renderer/gl/ellipsoid_renderer.h"
-#include "renderer/gl/frame_stats.h"
+#include "renderer/frame_stats.h"
 #include "renderer/gl/gl_objects.h"
 #include "renderer/gl/gl_platform.h"
 #include "renderer/gl/gpu_pass_timer.h"

@@ -9,7 +9,7 @@
 #include <chrono>
 #include <vector>
 
-#include "renderer/gl/frame_stats.h"
+#include "renderer/frame_stats.h"
 #include "renderer/gl/gl_objects.h"
 
 namespace nephele {

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "renderer/gl/frame_stats.h"
+#include "renderer/frame_stats.h"
 #include "renderer/gl/sky_shaders.h"
 #include "world/check.h"
 #include "world/textures/gardner_texture.h"

@@ -10,7 +10,7 @@
 
 #include <glm/glm.hpp>
 
-#include "renderer/gl/frame_stats.h"
+#include "renderer/frame_stats.h"
 #include "renderer/gl/gl_objects.h"
 #include "renderer/gl/gpu_pass_timer.h"
 #include "world/formations/cloud_shadow.h"

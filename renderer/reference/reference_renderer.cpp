@@ -454,16 +454,34 @@ void traceLabels(const PixelWork& w, int x, int y, std::vector<Surface>& hits, F
     }
 }
 
-// The rows taken from `next_row` until none is left; `progress` (when `report`) told about
-// every tenth.
-void traceRows(const PixelWork& w, std::atomic<int>& next_row, Frame& frame, bool report,
+// How the threads of one frame share its rows: the next row to take, and whether a raised
+// cancel flag stopped one of them.
+struct RowQueue {
+  std::atomic<int> next{0};
+  std::atomic<bool> stopped{false};
+  const ReferenceCancel& cancel;
+};
+
+// False, once the queue is marked stopped, when the frame's cancel flag is raised.
+bool keepGoing(RowQueue& rows, bool calling_thread) {
+  if (!rows.cancel.flag) return true;
+  if (calling_thread && rows.cancel.alive) rows.cancel.alive();
+  if (!rows.cancel.flag->load(std::memory_order_relaxed)) return true;
+  rows.stopped.store(true, std::memory_order_relaxed);
+  return false;
+}
+
+// The rows taken from `rows` until none is left or the frame is cancelled; `progress` (on the
+// calling thread) told about every tenth.
+void traceRows(const PixelWork& w, RowQueue& rows, Frame& frame, bool calling_thread,
                const std::function<void(double)>& progress) {
   std::vector<Surface> hits;
   int reported_tenths = 0;
   const int height = w.camera.height;
-  for (int y; (y = next_row.fetch_add(1)) < height;) {
+  for (int y; (y = rows.next.fetch_add(1)) < height;) {
     if (!w.colour && y % w.divisor != 0) continue;
-    if (report && progress && y * 10 / height > reported_tenths) {
+    if (!keepGoing(rows, calling_thread)) return;
+    if (calling_thread && progress && y * 10 / height > reported_tenths) {
       reported_tenths = y * 10 / height;
       progress(double(y) / height);
     }
@@ -477,8 +495,8 @@ void traceRows(const PixelWork& w, std::atomic<int>& next_row, Frame& frame, boo
 }  // namespace
 
 Frame renderReferenceFrame(const Scene& scene, const ReferenceSettings& settings,
-                           const FrameRequest& request,
-                           const std::function<void(double)>& progress) {
+                           const FrameRequest& request, const std::function<void(double)>& progress,
+                           const ReferenceCancel& cancel, bool* cancelled) {
   const Camera& camera = scene.camera;
   const std::size_t pixels = std::size_t(camera.width) * camera.height;
   const ChannelSet& asked = request.channels;
@@ -509,15 +527,17 @@ Frame renderReferenceFrame(const Scene& scene, const ReferenceSettings& settings
                        colour,
                        labels,
                        infrared};
-  std::atomic<int> next_row{0};
+  RowQueue rows{.cancel = cancel};
   const int threads = settings.threads > 0 ? settings.threads
                                            : std::max(1, int(std::thread::hardware_concurrency()));
   std::vector<std::jthread> pool;
   for (int i = 1; i < threads; ++i)
-    pool.emplace_back([&] { traceRows(work, next_row, frame, false, progress); });
-  traceRows(work, next_row, frame, true, progress);
+    pool.emplace_back([&] { traceRows(work, rows, frame, false, progress); });
+  traceRows(work, rows, frame, true, progress);
   pool.clear();  // join before the frame is handed out
-  if (asked.has(Channel::kVisibility)) {
+  const bool stopped = rows.stopped.load();
+  if (cancelled) *cancelled = stopped;
+  if (asked.has(Channel::kVisibility) && !stopped) {
     frame.visibilityFromCoverage();
     dimVisibilityByPrecipitation(frame, scene, settings.heaps);
   }

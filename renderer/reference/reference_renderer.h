@@ -2,6 +2,7 @@
 // The CPU reference renderer (MODEL.md section 7): double precision, exact ray-plane hits, every
 // texture term, exact ray-ellipsoid hits and limb function, per-pixel depth order,
 // supersampled. Slow and simple enough to trust.
+#include <atomic>
 #include <functional>
 #include <memory>
 
@@ -17,12 +18,21 @@ namespace nephele {
 FloatImage renderReference(const Scene& scene, const ReferenceSettings& settings = {},
                            const std::function<void(double)>& progress = {});
 
+// Stops a frame early: every thread reads `flag` before each row it takes, and `alive` is
+// called on the calling thread wherever it reads it (Renderer::setCancel).
+struct ReferenceCancel {
+  const std::atomic<bool>* flag = nullptr;
+  std::function<void()> alive;
+};
+
 // Every channel of renderer/frame.h that `request` asks for. Colour and coverage (and
 // visibility, 1 - coverage) are supersampled; depth, cloud depth and object id come from each
-// pixel's centre ray, where a rasteriser samples them.
+// pixel's centre ray, where a rasteriser samples them. `cancelled`, when given, is set to
+// whether `cancel` stopped the frame before its last row (its channels then incomplete).
 Frame renderReferenceFrame(const Scene& scene, const ReferenceSettings& settings,
                            const FrameRequest& request,
-                           const std::function<void(double)>& progress = {});
+                           const std::function<void(double)>& progress = {},
+                           const ReferenceCancel& cancel = {}, bool* cancelled = nullptr);
 
 // Cloud transmittance along rays from the scene's camera up to a distance, as the reference
 // composites it: how the dataset generator places targets behind cloud or in the clear. The

@@ -1,6 +1,7 @@
 #pragma once
-// What one GL frame did, so that a user can see that a scene pays only for what it shows
-// (`nephele render --stats`, the daemon's `stats`).
+// What one frame did, so that a user can see that a scene pays only for what it shows
+// (`nephele render --stats`, the daemon's `stats`). The GL back end fills it; the CPU
+// reference leaves it at zero (Renderer::lastFrameStats).
 #include <array>
 #include <chrono>
 #include <cstddef>

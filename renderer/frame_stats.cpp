@@ -1,4 +1,4 @@
-#include "renderer/gl/frame_stats.h"
+#include "renderer/frame_stats.h"
 
 #include <numeric>
 #include <sstream>
