@@ -5,8 +5,7 @@
 #include <mutex>
 #include <thread>
 
-#include "renderer/gl/gl_platform.h"
-#include "renderer/gl/gl_renderer.h"
+#include "renderer/renderer.h"
 #include "server/telemetry.h"
 #include "world/limits.h"
 #include "world/world.h"
@@ -120,9 +119,8 @@ void RenderService::finishEncoder() {
 
 std::string RenderService::open() {
   std::string error;
-  platform_ = createGlPlatform(GlBackend::kAuto, error);
-  if (!platform_) return "no OpenGL context: " + error;
-  renderer_ = std::make_unique<GlRenderer>(*platform_);
+  renderer_ = createRenderer(RendererOptions{}, error);  // GL, EGL or OSMesa as found
+  if (!renderer_) return "no OpenGL context: " + error;
   // A long render beats the heart at each point where it can be cancelled, so /healthz and the
   // systemd watchdog tell a render that makes progress from a stuck world thread.
   renderer_->setCancel(&cancel_, [this] { telemetry_.beat(); });
@@ -131,15 +129,14 @@ std::string RenderService::open() {
 
 void RenderService::close() {
   renderer_.reset();
-  platform_.reset();
 }
 
 std::string RenderService::glName() const {
-  return platform_->renderer();
+  return renderer_->platform().device;
 }
 
 std::string RenderService::backendName() const {
-  return std::string(platform_->backendName());
+  return renderer_->platform().backend;
 }
 
 namespace {
@@ -172,7 +169,7 @@ std::optional<ProtocolError> RenderService::platformLimit(const ViewConfig& view
   const Camera camera = renderedCamera(view);
   const bool linear = image.format == ImageFormat::kExr || image.floatPlanes();
   const bool targets = needsTargetLayers(world_has_targets, image.planes);
-  const std::string error = renderer_->reserveTarget(camera.width, camera.height, linear, targets);
+  const std::string error = renderer_->reserve(camera.width, camera.height, linear, targets);
   if (error.empty()) return std::nullopt;
   return ProtocolError{ErrorCode::kLimit, "view " + view.name + ": " + error};
 }
@@ -200,7 +197,7 @@ void RenderService::render(const World& world, const ViewConfig& view, const Ima
     if (image.colour) request.channels.add(Channel::kColour);
     if (image.coverage) request.channels.add(Channel::kCoverage);
     request.tick = tick;
-    frame = renderer_->renderFrame(scene, settings, request);
+    frame = renderer_->render(scene, settings, request);
   } else if (channels.pixels == Channels::Pixels::kLinear) {
     frame.colour = renderer_->renderFloat(scene, settings);
   } else {

@@ -1,6 +1,6 @@
 #pragma once
-// The daemon's renderer: the GL context and the renderer on the world thread, the checks a view
-// must pass before any work (the configured pixel limit, the platform's largest target), a
+// The daemon's renderer: the GL back end of the Renderer interface on the world thread, the checks
+// a view must pass before any work (the configured pixel limit, the platform's largest target), a
 // view rendered at the world's time, and the encoder thread that turns frames into bytes off the
 // world thread (PROTOCOL.md, "Images").
 #include <atomic>
@@ -18,8 +18,7 @@
 
 namespace nephele {
 
-class GlPlatform;
-class GlRenderer;
+class Renderer;
 class Telemetry;
 class World;
 
@@ -78,7 +77,7 @@ class RenderService {
   // reuse the view's last frame until the world is edited (RenderSettings::heap_refresh).
   void render(const World& world, const ViewConfig& view, const ImageRequest& image,
               std::uint64_t tick, bool continuous, RenderedView& out);
-  // The last frame's passes and times (renderer/gl/frame_stats.h) for stats.
+  // The last frame's passes and times (renderer/frame_stats.h) for stats.
   nlohmann::json lastFrameJson() const;
 
   // The encoder thread: false when it holds kEncoderQueue images, or has finished.
@@ -91,8 +90,7 @@ class RenderService {
 
   const DaemonConfig& config_;
   Telemetry& telemetry_;
-  std::unique_ptr<GlPlatform> platform_;
-  std::unique_ptr<GlRenderer> renderer_;
+  std::unique_ptr<Renderer> renderer_;
   std::unique_ptr<Encoder> encoder_;
   std::atomic<bool> cancel_{false};
 };
