@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -284,11 +285,7 @@ TEST(World, AWindChangeKeepsCloudsAndLayersWhereTheyAre) {
   ASSERT_EQ(world.advance(100.0), "");
   const Scene before = world.scene();
   const LayerTexture layer_before(before.layers[0].texture);
-  ASSERT_EQ(world.edit([](Scene&, WorldDynamics& d) {
-    d.wind.samples = {{0.0, {-20.0, 5.0}}};
-    return std::string();
-  }),
-            "");
+  ASSERT_EQ(world.setWind({{{0.0, {-20.0, 5.0}}}}), "");
   const Scene now = world.scene();
   const LayerTexture layer_now(now.layers[0].texture);
   const glm::dvec3 c0 = before.clouds[0].ellipsoids[0].centre;
@@ -303,37 +300,272 @@ TEST(World, AWindChangeKeepsCloudsAndLayersWhereTheyAre) {
   EXPECT_NEAR(moved.y, 50.0, 1e-6);
 }
 
-TEST(World, AFailedEditChangesNothing) {
+// Every member of two scenes that the world's time or its edits set, compared bit for bit.
+void expectSameScene(const Scene& a, const Scene& b) {
+  EXPECT_EQ(a.time_s, b.time_s);
+  EXPECT_EQ(a.camera.position, b.camera.position);
+  EXPECT_EQ(a.sun.elevation_deg, b.sun.elevation_deg);
+  EXPECT_EQ(a.fog, b.fog);
+  EXPECT_EQ(a.haze, b.haze);
+  EXPECT_EQ(a.sea, b.sea);
+  EXPECT_EQ(a.site, b.site);
+  EXPECT_EQ(a.content_origin, b.content_origin);
+  EXPECT_EQ(a.weather, b.weather);
+  ASSERT_EQ(a.layers.size(), b.layers.size());
+  for (std::size_t i = 0; i < a.layers.size(); ++i) {
+    const CloudLayer &x = a.layers[i], &y = b.layers[i];
+    EXPECT_EQ(x.name, y.name);
+    EXPECT_EQ(x.threshold, y.threshold);
+    EXPECT_EQ(x.transition, y.transition);
+    EXPECT_EQ(x.texture.drift_offset_m, y.texture.drift_offset_m);
+    EXPECT_EQ(x.texture.drift_velocity, y.texture.drift_velocity);
+    EXPECT_EQ(x.texture.gardner.t0, y.texture.gardner.t0);
+    EXPECT_EQ(x.region, y.region);
+  }
+  ASSERT_EQ(a.clouds.size(), b.clouds.size());
+  for (std::size_t i = 0; i < a.clouds.size(); ++i) {
+    const EllipsoidCloud &x = a.clouds[i], &y = b.clouds[i];
+    EXPECT_EQ(x.name, y.name);
+    EXPECT_EQ(x.drift_m, y.drift_m);
+    EXPECT_EQ(x.threshold_centre, y.threshold_centre);
+    EXPECT_EQ(x.threshold_limb, y.threshold_limb);
+    EXPECT_EQ(x.transition, y.transition);
+    EXPECT_EQ(x.colour, y.colour);
+    ASSERT_EQ(x.ellipsoids.size(), y.ellipsoids.size());
+    for (std::size_t k = 0; k < x.ellipsoids.size(); ++k)
+      EXPECT_EQ(x.ellipsoids[k].centre, y.ellipsoids[k].centre);
+  }
+  ASSERT_EQ(a.fields.size(), b.fields.size());
+  for (std::size_t i = 0; i < a.fields.size(); ++i) {
+    EXPECT_EQ(a.fields[i].name, b.fields[i].name);
+    EXPECT_EQ(a.fields[i].drift_m, b.fields[i].drift_m);
+    EXPECT_EQ(a.fields[i].shear, b.fields[i].shear);
+    EXPECT_EQ(a.fields[i].region, b.fields[i].region);
+  }
+  ASSERT_EQ(a.targets.size(), b.targets.size());
+  for (std::size_t i = 0; i < a.targets.size(); ++i) {
+    EXPECT_EQ(a.targets[i].name, b.targets[i].name);
+    EXPECT_EQ(a.targets[i].centre, b.targets[i].centre);
+    EXPECT_EQ(a.targets[i].orientation.heading_deg, b.targets[i].orientation.heading_deg);
+  }
+  ASSERT_EQ(a.automata.size(), b.automata.size());
+  for (std::size_t i = 0; i < a.automata.size(); ++i) {
+    EXPECT_EQ(a.automata[i].corner, b.automata[i].corner);
+    EXPECT_EQ(a.automata[i].blend, b.automata[i].blend);
+    EXPECT_EQ(a.automata[i].to->lattice.density, b.automata[i].to->lattice.density);
+  }
+}
+
+// A typed edit refused for what it was given changes nothing: not the hash, not the edits
+// counted, not one bit of what a render sees.
+TEST(World, RefusedEditsChangeNothing) {
   World world = makeWorld();
-  const std::uint64_t hash = world.hash();
-  EXPECT_EQ(world.edit([](Scene& now, WorldDynamics&) {
-    now.clouds.clear();
-    return std::string("refused");
-  }),
-            "refused");
-  EXPECT_THAT(world.edit([](Scene& now, WorldDynamics&) {
-    now.layers.push_back({});  // without a development entry: the schedules no longer fit
-    return std::string();
-  }),
-              ::testing::HasSubstr("layer schedules"));
-  EXPECT_THAT(world.edit([](Scene&, WorldDynamics& d) {
-    d.automata.clear();
-    return std::string();
-  }),
-              ::testing::HasSubstr("automaton"));
+  ASSERT_EQ(world.advance(12.5), "");
+  Target boat;
+  boat.name = "boat";
+  ASSERT_EQ(world.addTarget(boat, false, 1), "");
+  const std::uint64_t hash = world.hash(), edits = world.edits();
+  const Scene before = world.scene();
+  WeatherLayer stratus = typicalWeatherLayer(CloudType::kStratus, 0.6);
+  stratus.coverage = 1.5;
+  EXPECT_THAT(world.setWeather({2, std::nullopt}, stratus), ::testing::HasSubstr("coverage"));
+  stratus.coverage = 0.6;
+  stratus.wind = glm::dvec2(190.0, 190.0);  // each part in range, the speed not
+  EXPECT_THAT(world.setWeather({2, std::nullopt}, stratus),
+              ::testing::HasSubstr("speed of at most 200 m/s"));
+  EXPECT_THAT(world.setWind({{{0.0, {1.0, 0.0}}, {0.0, {2.0, 0.0}}}}),
+              ::testing::HasSubstr("altitudes must increase"));
+  EXPECT_THAT(world.setWind({{{0.0, {300.0, 0.0}}}}), ::testing::HasSubstr("speed"));
+  Sea sea;
+  sea.clarity = 2.0;
+  EXPECT_THAT(world.setSea(sea), ::testing::HasSubstr("clarity"));
+  EXPECT_THAT(world.setSite({95.0, 0.0, 0.0}), ::testing::HasSubstr("latitude"));
+  EXPECT_THAT(world.addCloud(world.base().clouds[0]), ::testing::HasSubstr("is taken"));
+  EXPECT_THAT(world.changeCloud("none", {}), ::testing::HasSubstr("no cloud is called"));
+  EXPECT_THAT(world.removeCloud("none"), ::testing::HasSubstr("no cloud is called"));
+  EXPECT_THAT(world.addTarget(boat, false, 2), ::testing::HasSubstr("is taken"));
+  boat.name = "raft";
+  EXPECT_THAT(world.addTarget(boat, false, 1), ::testing::HasSubstr("holds 1 targets"));
+  EXPECT_THAT(world.moveTarget("raft", {}), ::testing::HasSubstr("no target is called"));
+  EXPECT_THAT(world.removeTarget("raft"), ::testing::HasSubstr("no target is called"));
   EXPECT_EQ(world.hash(), hash);
+  EXPECT_EQ(world.edits(), edits);
+  expectSameScene(world.scene(), before);
   // An edit that succeeds survives a snapshot round trip.
-  ASSERT_EQ(world.edit([](Scene& now, WorldDynamics& d) {
-    now.clouds.push_back(now.clouds[0]);
-    now.clouds.back().name = "copy";
-    d.clouds.emplace_back();
-    return std::string();
-  }),
-            "");
+  EllipsoidCloud copy_of_first = world.base().clouds[0];
+  copy_of_first.name = "copy";
+  ASSERT_EQ(world.addCloud(copy_of_first), "");
   World copy = makeWorld();
   ASSERT_EQ(copy.restore(world.snapshot()), "");
   EXPECT_EQ(copy.hash(), world.hash());
   EXPECT_EQ(copy.scene().clouds.size(), 2u);
+}
+
+// Moves the drift of `t` seconds into (t > 0) or out of (t < 0) a base scene, as edits have
+// always done it.
+void foldDrift(Scene& scene, const WindProfile& wind, double t) {
+  for (CloudLayer& layer : scene.layers)
+    layer.texture.drift_offset_m += layer.texture.drift_velocity * t;
+  if (wind.empty()) return;
+  for (CloudField& field : scene.fields) field.drift_m += wind.at(fieldAltitude(field)) * t;
+  for (EllipsoidCloud& cloud : scene.clouds) {
+    const glm::dvec3 drift(wind.at(cloudAltitude(cloud)) * t, 0.0);
+    for (Ellipsoid& e : cloud.ellipsoids) e.centre += drift;
+    cloud.drift_m += drift;
+  }
+}
+
+// `world` changed as edits changed it before they were typed: the whole world copied with the
+// drift so far folded in, changed, the drift folded out with the new wind, and a world built
+// anew from that at the same time. A world without automata, whose states a new world would
+// have to simulate again.
+World copyEdited(const World& world,
+                 const std::function<void(Scene& now, WorldDynamics& dynamics)>& change) {
+  Scene now = world.base();
+  WorldDynamics dynamics = world.dynamics();
+  const double t = world.timeSeconds();
+  foldDrift(now, dynamics.wind, t);
+  change(now, dynamics);
+  if (!dynamics.wind.empty())
+    for (CloudLayer& layer : now.layers)
+      layer.texture.drift_velocity = dynamics.wind.at(layer.altitude_m);
+  const auto& old = world.dynamics().wind.samples;
+  const bool wind_changed =
+      !std::equal(old.begin(), old.end(), dynamics.wind.samples.begin(),
+                  dynamics.wind.samples.end(), [](const WindSample& a, const WindSample& b) {
+                    return a.altitude_m == b.altitude_m && a.velocity == b.velocity;
+                  });
+  if (now.sea && !dynamics.wind.empty() && wind_changed) now.sea->wind = dynamics.wind.at(0.0);
+  foldDrift(now, dynamics.wind, -t);
+  World edited(now, dynamics);
+  EXPECT_EQ(edited.advance(t), "");
+  EXPECT_EQ(edited.timeNs(), world.timeNs());
+  return edited;
+}
+
+// Typed edits change base_ and the state now in place; the world they leave is bit for bit the
+// one a whole copy of the world, changed and built anew, would be.
+TEST(World, TypedEditsEqualTheCopyEditBitForBit) {
+  auto [scene, dynamics] = smallWorld();
+  dynamics.automata.clear();
+  scene.clouds[0].name = "first";
+  World world(scene, dynamics);
+  int checks = 0;
+  const auto check = [&](const std::string& error, const World& expected) {
+    SCOPED_TRACE(::testing::Message() << "edit " << ++checks);
+    ASSERT_EQ(error, "");
+    EXPECT_EQ(world.hash(), expected.hash());
+    expectSameScene(world.scene(), expected.scene());
+  };
+  ASSERT_EQ(world.advance(37.3), "");
+  Fog fog;
+  fog.top_m = 80.0;
+  World expected = copyEdited(world, [&](Scene& now, WorldDynamics&) { now.fog = fog; });
+  check(world.setFog(fog), expected);
+  ASSERT_EQ(world.advance(0.7), "");
+  Target boat;
+  boat.name = "boat";
+  boat.centre = {1.0, 2.0, 3.0};
+  expected = copyEdited(world, [&](Scene& now, WorldDynamics&) { now.targets.push_back(boat); });
+  check(world.addTarget(boat, false, 4), expected);
+  expected = copyEdited(world, [&](Scene& now, WorldDynamics&) {
+    now.targets[0].centre = {5.0, 6.0, 7.0};
+    now.targets[0].orientation.heading_deg = 45.0;
+  });
+  check(world.moveTarget("boat", {glm::dvec3(5.0, 6.0, 7.0), 45.0, {}, {}}), expected);
+  ASSERT_EQ(world.advance(2.5), "");
+  EllipsoidCloud extra = world.base().clouds[0];
+  extra.name = "extra";
+  expected = copyEdited(world, [&](Scene& now, WorldDynamics& d) {
+    now.clouds.push_back(extra);
+    d.clouds.emplace_back();
+  });
+  check(world.addCloud(extra), expected);
+  const glm::dvec3 move(10.0, -3.0, 400.0);  // up into another wind
+  expected = copyEdited(world, [&](Scene& now, WorldDynamics&) {
+    for (Ellipsoid& e : now.clouds[1].ellipsoids) e.centre += move;
+    now.clouds[1].drift_m += move;
+    now.clouds[1].threshold_centre = 0.2;
+  });
+  check(world.changeCloud("extra", {move, 0.2, {}, {}, {}}), expected);
+  ASSERT_EQ(world.advance(4.0), "");
+  WeatherLayer cumulus = typicalWeatherLayer(CloudType::kCumulus, 0.3);
+  cumulus.wind = glm::dvec2(3.0, 4.0);
+  const WeatherKey key{1, std::nullopt};
+  expected = copyEdited(world, [&](Scene& now, WorldDynamics& d) {
+    EXPECT_EQ(placeWeather(now, d, key, cumulus), "");
+  });
+  check(world.setWeather(key, cumulus), expected);
+  Sea sea;
+  expected = copyEdited(world, [&](Scene& now, WorldDynamics&) {
+    now.sea = sea;
+    now.sea->origin_m = -now.content_origin;  // setSea lays a new sea's waves out so
+  });
+  check(world.setSea(sea), expected);
+  ASSERT_EQ(world.advance(9.0), "");
+  const WindProfile calm{{{0.0, {-20.0, 5.0}}, {2000.0, {4.0, 1.0}}}};
+  expected = copyEdited(world, [&](Scene&, WorldDynamics& d) { d.wind = calm; });
+  check(world.setWind(calm), expected);
+  ASSERT_EQ(world.advance(2.0), "");
+  expected = copyEdited(world, [&](Scene&, WorldDynamics& d) { d.wind = {}; });
+  check(world.setWind({}), expected);  // no wind: what drifted stays where it is
+  ASSERT_EQ(world.advance(2.0), "");
+  expected = copyEdited(world, [&](Scene&, WorldDynamics& d) { d.wind = calm; });
+  check(world.setWind(calm), expected);
+  ASSERT_EQ(world.advance(1.0), "");
+  expected = copyEdited(
+      world, [&](Scene& now, WorldDynamics& d) { EXPECT_EQ(placeWeather(now, d, key, {}), ""); });
+  check(world.setWeather(key, {}), expected);
+  expected = copyEdited(world, [&](Scene& now, WorldDynamics& d) {
+    now.clouds.erase(now.clouds.begin());
+    d.clouds.erase(d.clouds.begin());
+  });
+  check(world.removeCloud("first"), expected);
+  expected = copyEdited(world, [&](Scene& now, WorldDynamics&) { now.targets.clear(); });
+  check(world.removeTarget("boat"), expected);
+  ASSERT_EQ(world.advance(5.0), "");
+  World restored = makeWorld();
+  ASSERT_EQ(restored.restore(world.snapshot()), "");
+  check("", restored);
+}
+
+// The state now is brought up to date when read: advancing many times and reading once hands
+// out the same scene, bit for bit, as reading after every advance, edits between or not, and
+// as a world restored from a snapshot (which builds it anew).
+TEST(World, ManyAdvancesThenOneReadEqualReadingEachTime) {
+  World once = makeWorld(), each = makeWorld();
+  Target boat;
+  boat.name = "boat";
+  for (World* w : {&once, &each}) ASSERT_EQ(w->addTarget(boat, false, 1), "");
+  const WeatherLayer cumulus = typicalWeatherLayer(CloudType::kCumulus, 0.3);
+  const auto step = [&](int i) {
+    for (World* w : {&once, &each}) {
+      std::string error = w->advance(0.1 + 0.01 * (i % 7));
+      if (i % 10 == 3) error += w->moveTarget("boat", {glm::dvec3(i, 0.0, 0.0), {}, {}, {}});
+      if (i == 25) error += w->setWeather({1, std::nullopt}, cumulus);
+      if (i == 31) error += w->setFog(Fog{});
+      if (i == 37) error += w->setSite({45.0, 7.0, 0.0});
+      ASSERT_EQ(error, "");
+    }
+    static_cast<void>(each.scene());
+  };
+  for (int i = 0; i < 60; ++i) step(i);
+  EXPECT_EQ(once.hash(), each.hash());
+  {
+    SCOPED_TRACE("read once against read each time");
+    expectSameScene(once.scene(), each.scene());
+  }
+  World restored = makeWorld();
+  ASSERT_EQ(restored.restore(once.snapshot()), "");
+  expectSameScene(restored.scene(), once.scene());
+  // The sun's light reaches the automata's views on the next read, too.
+  Sun sun = once.base().sun;
+  sun.elevation_deg = 15.0;
+  for (World* w : {&once, &each}) w->setSun(sun);
+  EXPECT_EQ(once.scene().automata[0].to->lattice.sunlight,
+            each.scene().automata[0].to->lattice.sunlight);
+  EXPECT_NE(once.scene().automata[0].to->lattice.sunlight,
+            restored.scene().automata[0].to->lattice.sunlight);
 }
 
 TEST(World, HashesDifferWhenTheWorldDiffers) {

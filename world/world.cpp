@@ -27,6 +27,20 @@ double quantisedT0(double t0) {
   return std::round(t0 * 256.0) / 256.0;
 }
 
+// What is wrong with a wind profile (a sample's altitude or speed, altitudes out of order), or
+// empty.
+std::string windProfileError(const WindProfile& wind) {
+  std::ostringstream out;
+  for (std::size_t i = 0; i < wind.samples.size() && out.tellp() == 0; ++i) {
+    const WindSample& w = wind.samples[i];
+    if (!std::isfinite(w.altitude_m) || !(glm::length(w.velocity) <= 200.0))
+      out << "wind: sample " << i << " needs a finite altitude and a speed of at most 200 m/s";
+    else if (i > 0 && !(w.altitude_m > wind.samples[i - 1].altitude_m))
+      out << "wind: altitudes must increase strictly";
+  }
+  return out.str();
+}
+
 }  // namespace
 
 std::string worldDynamicsError(const Scene& scene, const WorldDynamics& d) {
@@ -37,13 +51,7 @@ std::string worldDynamicsError(const Scene& scene, const WorldDynamics& d) {
   if (!d.clouds.empty() && d.clouds.size() != scene.clouds.size())
     out << "development: " << d.clouds.size() << " cloud schedules for " << scene.clouds.size()
         << " clouds";
-  for (std::size_t i = 0; i < d.wind.samples.size() && out.tellp() == 0; ++i) {
-    const WindSample& w = d.wind.samples[i];
-    if (!std::isfinite(w.altitude_m) || !(glm::length(w.velocity) <= 200.0))
-      out << "wind: sample " << i << " needs a finite altitude and a speed of at most 200 m/s";
-    else if (i > 0 && !(w.altitude_m > d.wind.samples[i - 1].altitude_m))
-      out << "wind: altitudes must increase strictly";
-  }
+  if (out.tellp() == 0) out << windProfileError(d.wind);
   auto check = [&](const char* what, const Schedule& s, double lo, double hi) {
     if (out.tellp() != 0) return;
     if (std::string e = scheduleError(s, lo, hi); !e.empty()) out << what << ": " << e;
@@ -115,19 +123,14 @@ std::string World::advanceInPieces(double dt_s, int pieces,
     const std::int64_t next = total_ns / n * i + (i == n ? total_ns % n : 0);
     advanceNs(next - done);
     done = next;
-    if (after_piece) {
-      applyTime();  // the callback may look at the world
-      after_piece(i, n);
-    }
+    if (after_piece) after_piece(i, n);
   }
-  if (!after_piece) applyTime();
   return {};
 }
 
 std::string World::advance(double dt_s) {
   if (std::string e = advanceError(dt_s); !e.empty()) return e;
   advanceNs(std::llround(dt_s / kTimeResolutionS));
-  applyTime();
   return {};
 }
 
@@ -135,6 +138,7 @@ void World::advanceNs(std::int64_t dt_ns) {
   if (dt_ns == 0) return;
   time_ns_ += dt_ns;
   refreshAutomata();
+  now_stale_ = true;
 }
 
 void World::refreshAutomata() {
@@ -145,18 +149,18 @@ void World::setSun(const Sun& sun) {
   base_.sun = now_.sun = sun;
   const glm::dvec3 to_sun = sunDirection(sun);
   for (AutomatonCloud& cloud : automata_) relights_run_ += cloud.setSun(to_sun);
-  refreshAutomatonViews();
+  now_stale_ = true;  // the automata's views
 }
 
-void World::foldDrift(Scene& scene, const WorldDynamics& dynamics, double sign) const {
+void World::foldDrift(double sign) {
   const double t = timeSeconds();
-  for (CloudLayer& layer : scene.layers)
+  for (CloudLayer& layer : base_.layers)
     layer.texture.drift_offset_m += sign * layer.texture.drift_velocity * t;
-  if (dynamics.wind.empty()) return;
-  for (CloudField& field : scene.fields)
-    field.drift_m += sign * dynamics.wind.at(fieldAltitude(field)) * t;
-  for (EllipsoidCloud& cloud : scene.clouds) {
-    const glm::dvec3 drift(sign * dynamics.wind.at(cloudAltitude(cloud)) * t, 0.0);
+  if (dynamics_.wind.empty()) return;
+  for (CloudField& field : base_.fields)
+    field.drift_m += sign * dynamics_.wind.at(fieldAltitude(field)) * t;
+  for (EllipsoidCloud& cloud : base_.clouds) {
+    const glm::dvec3 drift(sign * dynamics_.wind.at(cloudAltitude(cloud)) * t, 0.0);
     for (Ellipsoid& e : cloud.ellipsoids) e.centre += drift;
     cloud.drift_m += drift;
   }
@@ -248,42 +252,54 @@ std::string placeWeather(Scene& scene, WorldDynamics& dynamics, const WeatherKey
 }
 
 std::string World::setWeather(const WeatherKey& key, const WeatherLayer& weather, bool* changed) {
+  if (changed) *changed = false;
   const auto held = base_.weather.find(key);
   const bool same = !weatherHeld(weather) ? held == base_.weather.end()
                                           : held != base_.weather.end() && held->second == weather;
-  if (changed) *changed = false;
   if (same) return "";
-  std::string error = edit([&](Scene& now, WorldDynamics& dynamics) {
-    return placeWeather(now, dynamics, key, weather);
-  });
-  if (changed) *changed = error.empty();
-  return error;
+  // Checked first, so that placeWeather cannot fail: the layer, then the wind it sets.
+  bool wind_changes = false;
+  if (weatherHeld(weather)) {
+    if (std::string e = weatherLayerError(weather); !e.empty()) return e;
+    if (weather.wind) {
+      WindProfile wind = dynamics_.wind;
+      setWindSample(wind, weather.base_m + 0.5 * weather.thickness_m, *weather.wind);
+      if (std::string e = windProfileError(wind); !e.empty()) return e;
+      wind_changes = !sameWind(wind, dynamics_.wind);
+    }
+  }
+  editBase(
+      [&](Scene& base, WorldDynamics& dynamics) { placeWeather(base, dynamics, key, weather); },
+      wind_changes);
+  // The layers and fields are a few plain values each; the clouds are untouched.
+  now_.layers = base_.layers;
+  now_.fields = base_.fields;
+  now_.weather = base_.weather;
+  now_.sea = base_.sea;
+  finishEdit();
+  if (changed) *changed = true;
+  return "";
 }
 
-namespace {
-
-// Sets one optional part of the scene (fog, haze): nothing when it is already so.
+// Sets one optional part of the scene (fog, haze, the sea): nothing when it is already so.
 template <class T>
-std::string setPart(World& world, std::optional<T> Scene::*part, const std::optional<T>& value,
-                    bool* changed) {
+std::string World::setPart(std::optional<T> Scene::*part, const std::optional<T>& value,
+                           bool* changed) {
   if (changed) *changed = false;
-  if (world.base().*part == value) return "";
-  std::string error = world.edit([&](Scene& now, WorldDynamics&) {
-    now.*part = value;
-    return std::string();
-  });
-  if (changed) *changed = error.empty();
-  return error;
+  if (base_.*part == value) return "";
+  editBase([&](Scene& base, WorldDynamics&) { base.*part = value; });
+  now_.*part = value;
+  finishEdit();
+  if (changed) *changed = true;
+  return "";
 }
-
-}  // namespace
 
 std::string World::setFog(const std::optional<Fog>& fog, bool* changed) {
-  return setPart(*this, &Scene::fog, fog, changed);
+  return setPart(&Scene::fog, fog, changed);
 }
 
 std::string World::setHaze(const std::optional<Haze>& haze, bool* changed) {
-  return setPart(*this, &Scene::haze, haze, changed);
+  return setPart(&Scene::haze, haze, changed);
 }
 
 std::string seaError(const Sea& sea) {
@@ -325,15 +341,15 @@ std::string World::setSea(const std::optional<Sea>& sea, bool* changed) {
   if (sea && !base_.sea) {  // a new sea's waves are laid out from where the content was
     std::optional<Sea> laid_out = sea;
     laid_out->origin_m = -base_.content_origin;
-    return setPart(*this, &Scene::sea, laid_out, changed);
+    return setPart(&Scene::sea, laid_out, changed);
   }
-  return setPart(*this, &Scene::sea, sea, changed);
+  return setPart(&Scene::sea, sea, changed);
 }
 
 namespace {
 
 // Moves everything `scene` holds by -shift: the database's origin to `shift` (setSite).
-// The automata move apart (World::setSite): edit() keeps their specs.
+// The automata move apart (World::setSite).
 void moveContent(Scene& scene, glm::dvec2 shift) {
   const glm::dvec3 by(shift, 0.0);
   scene.camera.position -= by;
@@ -370,134 +386,177 @@ std::string World::setSite(const Site& site, bool* changed) {
   const glm::dvec2 shift = base_.site
                                ? recentred(*base_.site, site.latitude_deg, site.longitude_deg).shift
                                : glm::dvec2(0.0);
-  std::string error = edit([&](Scene& now, WorldDynamics&) {
-    now.site = site;
-    moveContent(now, shift);
-    return std::string();
+  editBase([&](Scene& base, WorldDynamics&) {
+    base.site = site;
+    moveContent(base, shift);
   });
-  if (!error.empty()) return error;
+  now_.site = site;
+  moveContent(now_, shift);
   for (AutomatonCloudSpec& spec : dynamics_.automata) spec.position -= glm::dvec3(shift, 0.0);
   for (AutomatonCloud& cloud : automata_) cloud.moveBy(-shift);
-  refreshAutomatonViews();
+  finishEdit();
   if (changed) *changed = true;
   return "";
 }
 
 std::string World::setWind(const WindProfile& wind) {
-  return edit([&](Scene&, WorldDynamics& d) {
-    d.wind = wind;
-    return std::string();
-  });
+  if (std::string e = windProfileError(wind); !e.empty()) return e;
+  editBase([&](Scene&, WorldDynamics& dynamics) { dynamics.wind = wind; },
+           !sameWind(wind, dynamics_.wind));
+  now_.sea = base_.sea;
+  // Without a wind time moves no field or cloud and shears no field: now_ holds base_'s, into
+  // which the drift so far was folded.
+  if (dynamics_.wind.empty()) {
+    for (std::size_t i = 0; i < base_.fields.size(); ++i) {
+      now_.fields[i].drift_m = base_.fields[i].drift_m;
+      now_.fields[i].shear = base_.fields[i].shear;
+    }
+    for (std::size_t i = 0; i < base_.clouds.size(); ++i) {
+      const EllipsoidCloud& from = base_.clouds[i];
+      EllipsoidCloud& cloud = now_.clouds[i];
+      for (std::size_t k = 0; k < from.ellipsoids.size(); ++k)
+        cloud.ellipsoids[k].centre = from.ellipsoids[k].centre;
+      cloud.drift_m = from.drift_m;
+    }
+  }
+  finishEdit();
+  return "";
 }
 
+namespace {
+
+void applyCloudChange(EllipsoidCloud& cloud, const CloudChange& c) {
+  if (c.move) {
+    for (Ellipsoid& e : cloud.ellipsoids) e.centre += *c.move;
+    cloud.drift_m += *c.move;  // the texture moves with the cloud
+  }
+  if (c.threshold) cloud.threshold_centre = *c.threshold;
+  if (c.limb_threshold) cloud.threshold_limb = *c.limb_threshold;
+  if (c.transition) cloud.transition = *c.transition;
+  if (c.colour) cloud.colour = *c.colour;
+}
+
+void applyPose(Target& t, const TargetPose& pose) {
+  if (pose.centre) t.centre = *pose.centre;
+  if (pose.heading) t.orientation.heading_deg = *pose.heading;
+  if (pose.pitch) t.orientation.pitch_deg = *pose.pitch;
+  if (pose.roll) t.orientation.roll_deg = *pose.roll;
+}
+
+// The index of the item called `name` in `items`, or none.
+template <class T>
+std::optional<std::size_t> indexOf(const std::vector<T>& items, const std::string& name) {
+  const auto at =
+      std::find_if(items.begin(), items.end(), [&](const T& x) { return x.name == name; });
+  if (at == items.end()) return std::nullopt;
+  return std::size_t(at - items.begin());
+}
+
+}  // namespace
+
 std::string World::addCloud(const EllipsoidCloud& cloud) {
-  return edit([&](Scene& now, WorldDynamics& d) -> std::string {
-    for (const EllipsoidCloud& other : now.clouds)
-      if (other.name == cloud.name) return "cloud.name: \"" + cloud.name + "\" is taken";
-    now.clouds.push_back(cloud);
-    if (!d.clouds.empty()) d.clouds.emplace_back();  // none, or one per cloud
-    return "";
+  if (indexOf(base_.clouds, cloud.name)) return "cloud.name: \"" + cloud.name + "\" is taken";
+  editBase([&](Scene& base, WorldDynamics& dynamics) {
+    base.clouds.push_back(cloud);
+    if (!dynamics.clouds.empty()) dynamics.clouds.emplace_back();  // none, or one per cloud
   });
+  now_.clouds.push_back(cloud);
+  finishEdit();
+  return "";
 }
 
 std::string World::changeCloud(const std::string& name, const CloudChange& c) {
-  return edit([&](Scene& now, WorldDynamics&) -> std::string {
-    for (EllipsoidCloud& cloud : now.clouds) {
-      if (cloud.name != name) continue;
-      if (c.move) {
-        for (Ellipsoid& e : cloud.ellipsoids) e.centre += *c.move;
-        cloud.drift_m += *c.move;  // the texture moves with the cloud
-      }
-      if (c.threshold) cloud.threshold_centre = *c.threshold;
-      if (c.limb_threshold) cloud.threshold_limb = *c.limb_threshold;
-      if (c.transition) cloud.transition = *c.transition;
-      if (c.colour) cloud.colour = *c.colour;
-      return "";
-    }
-    return "name: no cloud is called \"" + name + "\"";
-  });
+  const std::optional<std::size_t> i = indexOf(base_.clouds, name);
+  if (!i) return "name: no cloud is called \"" + name + "\"";
+  editBase([&](Scene& base, WorldDynamics&) { applyCloudChange(base.clouds[*i], c); });
+  applyCloudChange(now_.clouds[*i], c);
+  finishEdit();
+  return "";
 }
 
 std::string World::removeCloud(const std::string& name) {
-  return edit([&](Scene& now, WorldDynamics& d) -> std::string {
-    const std::size_t before = now.clouds.size();
-    eraseWithDevelopment(now.clouds, d.clouds,
-                         [&](const EllipsoidCloud& cloud) { return cloud.name == name; });
-    return now.clouds.size() == before ? "name: no cloud is called \"" + name + "\"" : "";
+  if (!indexOf(base_.clouds, name)) return "name: no cloud is called \"" + name + "\"";
+  const auto called = [&](const EllipsoidCloud& cloud) { return cloud.name == name; };
+  editBase([&](Scene& base, WorldDynamics& dynamics) {
+    eraseWithDevelopment(base.clouds, dynamics.clouds, called);
   });
+  std::erase_if(now_.clouds, called);
+  finishEdit();
+  return "";
 }
 
 std::string World::addTarget(const Target& target, bool replace, std::size_t max_targets) {
-  return edit([&](Scene& now, WorldDynamics&) -> std::string {
-    for (Target& other : now.targets)
-      if (other.name == target.name) {
-        if (!replace) return "target.name: \"" + target.name + "\" is taken";
-        other = target;
-        return "";
-      }
-    if (now.targets.size() >= max_targets)
-      return "target: the world holds " + std::to_string(max_targets) + " targets already";
-    now.targets.push_back(target);
-    return "";
+  const std::optional<std::size_t> i = indexOf(base_.targets, target.name);
+  if (i && !replace) return "target.name: \"" + target.name + "\" is taken";
+  if (!i && base_.targets.size() >= max_targets)
+    return "target: the world holds " + std::to_string(max_targets) + " targets already";
+  editBase([&](Scene& base, WorldDynamics&) {
+    if (i)
+      base.targets[*i] = target;
+    else
+      base.targets.push_back(target);
   });
+  if (i)
+    now_.targets[*i] = target;
+  else
+    now_.targets.push_back(target);
+  finishEdit();
+  return "";
 }
 
 std::string World::moveTarget(const std::string& name, const TargetPose& pose) {
-  return edit([&](Scene& now, WorldDynamics&) -> std::string {
-    for (Target& t : now.targets) {
-      if (t.name != name) continue;
-      if (pose.centre) t.centre = *pose.centre;
-      if (pose.heading) t.orientation.heading_deg = *pose.heading;
-      if (pose.pitch) t.orientation.pitch_deg = *pose.pitch;
-      if (pose.roll) t.orientation.roll_deg = *pose.roll;
-      return "";
-    }
-    return "name: no target is called \"" + name + "\"";
-  });
+  const std::optional<std::size_t> i = indexOf(base_.targets, name);
+  if (!i) return "name: no target is called \"" + name + "\"";
+  editBase([&](Scene& base, WorldDynamics&) { applyPose(base.targets[*i], pose); });
+  applyPose(now_.targets[*i], pose);
+  finishEdit();
+  return "";
 }
 
 std::string World::removeTarget(const std::string& name) {
-  return edit([&](Scene& now, WorldDynamics&) -> std::string {
-    const std::size_t before = now.targets.size();
-    std::erase_if(now.targets, [&](const Target& t) { return t.name == name; });
-    return now.targets.size() == before ? "name: no target is called \"" + name + "\"" : "";
-  });
+  if (!indexOf(base_.targets, name)) return "name: no target is called \"" + name + "\"";
+  const auto called = [&](const Target& t) { return t.name == name; };
+  editBase([&](Scene& base, WorldDynamics&) { std::erase_if(base.targets, called); });
+  std::erase_if(now_.targets, called);
+  finishEdit();
+  return "";
 }
 
-std::string World::edit(
-    const std::function<std::string(Scene& now, WorldDynamics& dynamics)>& change) {
-  Scene now = base_;
-  WorldDynamics dynamics = dynamics_;
-  foldDrift(now, dynamics, +1.0);
-  if (std::string error = change(now, dynamics); !error.empty()) return error;
-  if (dynamics.automata.size() != dynamics_.automata.size())
-    return "automaton clouds come from the scene file and cannot be added or removed";
-  if (std::string error = worldDynamicsError(now, dynamics); !error.empty()) return error;
-  if (!dynamics.wind.empty())
-    for (CloudLayer& layer : now.layers)
-      layer.texture.drift_velocity = dynamics.wind.at(layer.altitude_m);
+void World::editBase(const std::function<void(Scene& base, WorldDynamics& dynamics)>& change,
+                     bool wind_changes) {
+  // The arithmetic of every edit since the world began (base_ and the drift are bit-exact
+  // parts of its hash): the change sees positions as they are now.
+  foldDrift(+1.0);
+  change(base_, dynamics_);
+  if (!dynamics_.wind.empty())
+    for (CloudLayer& layer : base_.layers)
+      layer.texture.drift_velocity = dynamics_.wind.at(layer.altitude_m);
   // The sea's wind is the surface wind (its waves are the wind's): it follows the wind's changes.
-  if (now.sea && !dynamics.wind.empty() && !sameWind(dynamics.wind, dynamics_.wind))
-    now.sea->wind = dynamics.wind.at(0.0);
-  foldDrift(now, dynamics, -1.0);
-  now.time_s = 0.0;
-  now.sun = base_.sun;  // the sun changes through setSun, which relights
-  now.automata.clear();
-  base_ = std::move(now);
-  dynamics_.wind = dynamics.wind;
-  dynamics_.layers = std::move(dynamics.layers);
-  dynamics_.clouds = std::move(dynamics.clouds);
-  rebuildNow();
+  if (base_.sea && !dynamics_.wind.empty() && wind_changes)
+    base_.sea->wind = dynamics_.wind.at(0.0);
+  foldDrift(-1.0);
+}
+
+void World::finishEdit() {
+  for (std::size_t i = 0; i < base_.layers.size(); ++i) {
+    now_.layers[i].texture.drift_offset_m = base_.layers[i].texture.drift_offset_m;
+    now_.layers[i].texture.drift_velocity = base_.layers[i].texture.drift_velocity;
+  }
+  now_stale_ = true;
   ++edits_;
-  return {};
+}
+
+const Scene& World::scene() const {
+  if (now_stale_) applyTime();
+  return now_;
 }
 
 void World::rebuildNow() {
   now_ = base_;
-  applyTime();
+  now_stale_ = true;
 }
 
-void World::applyTime() {
+void World::applyTime() const {
   // Every member time changes is set from base_'s, as base + v t: the same arithmetic whenever it
   // is applied, so that equal worlds hand out equal scenes.
   const double t = timeSeconds();
@@ -520,9 +579,10 @@ void World::applyTime() {
   }
   if (!dynamics_.wind.empty()) applyDrift(t);
   refreshAutomatonViews();
+  now_stale_ = false;
 }
 
-void World::applyDrift(double t) {
+void World::applyDrift(double t) const {
   for (std::size_t i = 0; i < base_.fields.size(); ++i) {
     const CloudField& from = base_.fields[i];
     CloudField& field = now_.fields[i];
@@ -540,7 +600,7 @@ void World::applyDrift(double t) {
   }
 }
 
-void World::refreshAutomatonViews() {
+void World::refreshAutomatonViews() const {
   now_.automata.clear();
   for (const AutomatonCloud& cloud : automata_) now_.automata.push_back(cloud.view(time_ns_));
 }

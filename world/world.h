@@ -122,22 +122,20 @@ class World {
   // Sunlight sweeps recomputed after the sun moved, summed over automaton clouds.
   std::uint64_t relightsRun() const { return relights_run_; }
 
-  // Edits applied through edit() since construction: what the world holds changed (a view
-  // that reuses earlier frames starts anew after one).
+  // Edits made since construction: what the world holds changed (a view that reuses earlier
+  // frames starts anew after one).
   std::uint64_t edits() const { return edits_; }
 
   // Relights automaton clouds only if the sun's direction changed.
   void setSun(const Sun& sun);
 
-  // Changes layers, ellipsoid clouds, wind and their development while time, the sun and
-  // automaton clouds carry on. `change` edits the world as it stands now (positions include
-  // the drift so far) and returns an error to cancel. A layer or cloud whose wind changes
-  // stays where it is and drifts on with the new wind. On any error nothing changes.
-  std::string edit(const std::function<std::string(Scene& now, WorldDynamics& dynamics)>& change);
-
-  // Typed edits, through edit(): each returns an error and then changes nothing. `changed`
-  // (if given) says whether the world differs afterwards: a host repeating what it sent last
-  // changes nothing and costs a comparison.
+  // Typed edits: each checks first and returns an error that changes nothing, or changes the
+  // world in place, copying no scene. Layers, ellipsoid clouds, wind and their development
+  // change while time, the sun and automaton clouds carry on; an edit sees the world as it
+  // stands now (positions include the drift so far), and a layer or cloud whose wind changes
+  // stays where it is and drifts on with the new wind. `changed` (if given) says whether the
+  // world differs afterwards: a host repeating what it sent last changes nothing and costs a
+  // comparison.
   std::string setWeather(const WeatherKey& key, const WeatherLayer& weather,
                          bool* changed = nullptr);
   std::string setFog(const std::optional<Fog>& fog, bool* changed = nullptr);
@@ -154,7 +152,7 @@ class World {
   // range is refused.
   std::string setSite(const Site& site, bool* changed = nullptr);
   // The wind by altitude (layers, clouds and fields drift on from where they are; the sea
-  // takes the wind at altitude 0).
+  // takes the wind at altitude 0). A profile worldDynamicsError refuses is refused.
   std::string setWind(const WindProfile& wind);
   // Ellipsoid clouds and targets by name (names are unique within each kind); a cloud keeps
   // its development schedules beside it and loses them with it. Errors name the key.
@@ -169,9 +167,11 @@ class World {
   std::string removeTarget(const std::string& name);
 
   // The render's view of the world now: drift, development schedules and the automata's views
-  // applied, kept up to date by every change (advance, edit, setSun, restore) and valid until
-  // the next.
-  const Scene& scene() const { return now_; }
+  // applied. Brought up to date on the first read after a change (advance, an edit, setSun,
+  // restore), once however many advances came before it, and valid until the next change.
+  // Reading it may write the world's state now: like every other member, call it from one
+  // thread at a time.
+  const Scene& scene() const;
   const Scene& base() const { return base_; }
   const WorldDynamics& dynamics() const { return dynamics_; }
   const std::vector<AutomatonCloud>& automata() const { return automata_; }
@@ -194,17 +194,30 @@ class World {
   World(const Scene& scene, const WorldDynamics& dynamics, int threads, bool warm_up);
   void refreshAutomata();
   void advanceNs(std::int64_t dt_ns);  // checked by the caller
-  // Moves the drift up to now into (sign +1) or out of (sign -1) the base scene.
-  void foldDrift(Scene& scene, const WorldDynamics& dynamics, double sign) const;
-  // now_ from base_ (after base_ changed), or brought to the world's time in place: the
+  // Moves the drift up to now into (sign +1) or out of (sign -1) base_.
+  void foldDrift(double sign);
+  // Changes base_ and dynamics_ by `change`, already checked, as the world stands now: the drift
+  // folded in, the change, the layers' drift velocities from the wind (and the sea's wind from
+  // the surface wind when `wind_changes`), the drift folded out again.
+  void editBase(const std::function<void(Scene& base, WorldDynamics& dynamics)>& change,
+                bool wind_changes = false);
+  // After editBase and the same change to now_'s parts that time does not set: now_'s layers
+  // take base_'s drift, time is applied on the next read, and the edit is counted.
+  void finishEdit();
+  template <class T>
+  std::string setPart(std::optional<T> Scene::*part, const std::optional<T>& value, bool* changed);
+  // now_ from base_ (after base_ was made), or brought to the world's time in place: the
   // development schedules, the wind's drift (applyDrift) and the automata's views.
   void rebuildNow();
-  void applyTime();
-  void applyDrift(double t);
-  void refreshAutomatonViews();
+  void applyTime() const;
+  void applyDrift(double t) const;
+  void refreshAutomatonViews() const;
 
   Scene base_;  // the world at time 0 (drift folded out)
-  Scene now_;   // the world at time_ns_, what scene() hands out
+  // The world at time_ns_, what scene() hands out: its parts time does not set always equal
+  // base_'s, the parts time sets (applyTime) are brought up to date when read after a change.
+  mutable Scene now_;
+  mutable bool now_stale_ = true;
   WorldDynamics dynamics_;
   int threads_ = 1;
   std::int64_t time_ns_ = 0;

@@ -438,7 +438,6 @@ std::string World::restore(std::span<const std::uint8_t> bytes, std::size_t max_
       return "snapshot: automaton " + cloud.spec().name + ": state does not match the time";
   }
   if (r.remaining() != 0) return "snapshot: " + std::to_string(r.remaining()) + " bytes left over";
-  restored.applyTime();
   *this = std::move(restored);
   return {};
 }
