@@ -85,9 +85,9 @@ glm::dvec3 throughAir(glm::dvec3 colour, const std::optional<Fog>& fog,
                       const std::optional<Fog>& veil, const std::optional<Haze>& haze,
                       glm::dvec3 horizon, glm::dvec3 origin, glm::dvec3 direction, double distance,
                       std::span<const Fog> precipitation, std::span<const RainShaft> shafts) {
-  // Each depth is capped where its transmittance is already 0 in double, so the weights of the
-  // colours stay finite.
-  constexpr double kOpaque = 1.0e3;
+  // Each depth capped (kOpaqueDepth), weighted by its colour and mixed as the GL's applyAir
+  // does (formulas::airOver).
+  constexpr double kOpaque = formulas::kOpaqueDepth;
   auto depth = [&](const std::optional<Fog>& f) {
     return f ? std::min(fogExtinction(*f) * fogPathLength(*f, origin, direction, distance), kOpaque)
              : 0.0;
@@ -108,10 +108,7 @@ glm::dvec3 throughAir(glm::dvec3 colour, const std::optional<Fog>& fog,
     tau += tau_s;
     weighted += tau_s * s.colour;
   }
-  if (!(tau > 0.0)) return colour;
-  const glm::dvec3 air = weighted / tau;
-  const double t = std::exp(-tau);
-  return t * colour + (1.0 - t) * air;
+  return formulas::airOver(colour, weighted, tau);
 }
 
 }  // namespace nephele
