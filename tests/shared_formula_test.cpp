@@ -17,6 +17,7 @@
 #include "renderer/gl/shaders/formulas_glsl.h"
 #include "world/formulas/air.h"
 #include "world/formulas/ellipsoid.h"
+#include "world/formulas/far_deck.h"
 #include "world/formulas/heap.h"
 #include "world/formulas/sea.h"
 #include "world/formulas/shading.h"
@@ -100,6 +101,7 @@ std::string fragmentSource(const std::vector<Case>& cases) {
   s += glsl::formulas::kSea;
   s += glsl::formulas::kEllipsoid;
   s += glsl::formulas::kHeap;
+  s += glsl::formulas::kFarDeck;
   s += "uniform float u_one;\nlayout(location = 0) out vec4 o_value;\nvoid main() {\n";
   s += "  float v = 0.0;\n  switch (int(gl_FragCoord.x)) {\n";
   for (std::size_t i = 0; i < cases.size(); ++i)
@@ -323,6 +325,20 @@ TEST_F(SharedFormulaTest, SeaOpticsAgree) {
                                              toFloat(n), toFloat(slope_var));
         cases.add("glintRadiance", &f::glintRadiance, peak, d, sun, n, slope_var);
       }
+  expectAgree(cases);
+}
+
+TEST_F(SharedFormulaTest, FarDeckCoverAgrees) {
+  Cases cases;
+  // Rays straight up and down, steep, low and grazing (cot e up to 1e9, where the power's base
+  // is raised to a huge exponent), level (the floor of |r.z|) and long; no cover, some, all.
+  const glm::dvec3 rays[] = {{0.0, 0.0, 1.0},   {0.3, -0.2, -1.0}, {1.0, 0.5, 0.1},
+                             {-0.7, 0.7, 0.01}, {1.0, 0.0, 1e-5},  {0.0, 1.0, 0.0},
+                             {4e4, -3e4, 250.0}};
+  for (const glm::dvec3& r : rays)
+    for (double coverage : {0.0, 0.3, 0.92, 1.0, 1.4})
+      for (double side_ratio : {0.0, 0.8, 2.5})
+        cases.add("farApparentCover", &f::farApparentCover, 1.0, coverage, side_ratio, r);
   expectAgree(cases);
 }
 
