@@ -253,6 +253,11 @@ TEST_F(SharedFormulaTest, AirMixingAgrees) {
     for (double tau_haze : {1e-9, 2.0, f::kOpaqueDepth})
       cases.add("airOver", &f::airOver, 1.0, glm::dvec3(0.0, 1.0, 0.5),
                 tau_fog * fog + tau_haze * air, tau_fog + tau_haze);
+  // A medium added to none and to others: thin, capped and endless (+infinity in C++, where
+  // fogPathLength takes an endless path; 1e30 stands for it on the GPU, which caps it the same).
+  for (const glm::dvec4& sum : {glm::dvec4(0.0), glm::dvec4(0.4, 0.45, 0.5, 0.8)})
+    for (double tau : {0.0, 1e-7, 0.6, 999.0, 1e3, 1e30})
+      cases.add("withMedium", &f::withMedium, 1e3, sum, tau, fog);
   expectAgree(cases);
 }
 

@@ -95,6 +95,14 @@ FORMULA real shaftDepth(vec4 shaft, real sigma, real z0, vec3 d, real distance) 
   return sigma * max(2.0 * h * g0 * l0 + (2.0 * h * h * h / 3.0) * (g2 * l0 + g1 * l1), 0.0);
 }
 
+// The media along a path as airOver takes them, `air` = (the sum of each medium's depth times
+// its colour, the sum of the depths), with one more medium of optical depth tau (capped at
+// kOpaqueDepth) and colour c.
+FORMULA vec4 withMedium(vec4 air, real tau, vec3 c) {
+  real capped = min(tau, kOpaqueDepth);
+  return vec4(vec3(air.x, air.y, air.z) + capped * c, air.w + capped);
+}
+
 // A surface of `colour` seen through media of total optical depth tau (MODEL.md section 5),
 // `weighted` the sum of each medium's depth times its colour: the media taken as one of their
 // depth-weighted mean colour, colour T + (1 - T) weighted / tau with T = exp(-tau). `colour`

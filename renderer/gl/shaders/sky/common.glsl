@@ -61,28 +61,20 @@ uniform vec3 u_haze_colour;   // the sky's horizon
 
 vec3 applyAir(vec3 colour, vec3 d, float distance) {
   float z = u_camera_z;
-  float tau_fog = u_fog_sigma > 0.0
-                      ? min(u_fog_sigma * slabPath(u_fog_slab, z, d.z, distance), kOpaqueDepth)
-                      : 0.0;
-  float tau_veil = u_veil_sigma > 0.0
-                       ? min(u_veil_sigma * slabPath(u_veil_slab, z, d.z, distance), kOpaqueDepth)
-                       : 0.0;
-  float tau_haze = min(hazeDepth(u_haze_sigma, u_haze_height, z, d.z, distance), kOpaqueDepth);
-  float tau = tau_fog + tau_veil + tau_haze;
-  vec3 weighted = tau_fog * u_fog_colour + tau_veil * u_veil_colour + tau_haze * u_haze_colour;
+  float tau_fog = u_fog_sigma > 0.0 ? u_fog_sigma * slabPath(u_fog_slab, z, d.z, distance) : 0.0;
+  float tau_veil =
+      u_veil_sigma > 0.0 ? u_veil_sigma * slabPath(u_veil_slab, z, d.z, distance) : 0.0;
+  vec4 air = withMedium(vec4(0.0), tau_fog, u_fog_colour);
+  air = withMedium(air, tau_veil, u_veil_colour);
+  air = withMedium(air, hazeDepth(u_haze_sigma, u_haze_height, z, d.z, distance), u_haze_colour);
   for (int i = 0; i < kPrecipitationSlabs; ++i)
-    if (u_precip_sigma[i] > 0.0) {
-      float tau_p =
-          min(u_precip_sigma[i] * slabPath(u_precip_slab[i], z, d.z, distance), kOpaqueDepth);
-      tau += tau_p;
-      weighted += tau_p * u_precip_colour[i];
-    }
-  for (int i = 0; i < u_shafts; ++i) {
-    float tau_s = min(shaftDepth(u_shaft[i], u_shaft_sigma[i], z, d, distance), kOpaqueDepth);
-    tau += tau_s;
-    weighted += tau_s * u_shaft_colour[i];
-  }
-  return airOver(colour, weighted, tau);
+    if (u_precip_sigma[i] > 0.0)
+      air = withMedium(air, u_precip_sigma[i] * slabPath(u_precip_slab[i], z, d.z, distance),
+                       u_precip_colour[i]);
+  for (int i = 0; i < u_shafts; ++i)
+    air = withMedium(air, shaftDepth(u_shaft[i], u_shaft_sigma[i], z, d, distance),
+                     u_shaft_colour[i]);
+  return airOver(colour, air.xyz, air.w);
 }
 
 // The air at the end of an endless path through it (the ground at the horizon): each medium
