@@ -17,6 +17,8 @@
 #include "renderer/gl/shaders/formulas_glsl.h"
 #include "world/formulas/air.h"
 #include "world/formulas/ellipsoid.h"
+#include "world/formulas/far_deck.h"
+#include "world/formulas/heap.h"
 #include "world/formulas/sea.h"
 #include "world/formulas/shading.h"
 
@@ -98,6 +100,8 @@ std::string fragmentSource(const std::vector<Case>& cases) {
   s += glsl::formulas::kShading;
   s += glsl::formulas::kSea;
   s += glsl::formulas::kEllipsoid;
+  s += glsl::formulas::kHeap;
+  s += glsl::formulas::kFarDeck;
   s += "uniform float u_one;\nlayout(location = 0) out vec4 o_value;\nvoid main() {\n";
   s += "  float v = 0.0;\n  switch (int(gl_FragCoord.x)) {\n";
   for (std::size_t i = 0; i < cases.size(); ++i)
@@ -237,6 +241,52 @@ TEST_F(SharedFormulaTest, ShaftsAgree) {
   expectAgree(cases);
 }
 
+TEST_F(SharedFormulaTest, AirMixingAgrees) {
+  Cases cases;
+  // No air, a trace of it (weighted / tau of two tiny numbers), thin, thick and capped air.
+  const glm::dvec3 colour(0.9, 0.35, 0.02), air(0.55, 0.6, 0.7);
+  for (double tau : {0.0, 1e-20, 1e-6, 0.02, 0.7, 6.0, 80.0, f::kOpaqueDepth})
+    cases.add("airOver", &f::airOver, 1.0, colour, tau * air, tau);
+  // Two media of different colours, the weights summed as applyAir sums them.
+  const glm::dvec3 fog(0.8, 0.8, 0.82);
+  for (double tau_fog : {0.0, 0.3, f::kOpaqueDepth})
+    for (double tau_haze : {1e-9, 2.0, f::kOpaqueDepth})
+      cases.add("airOver", &f::airOver, 1.0, glm::dvec3(0.0, 1.0, 0.5),
+                tau_fog * fog + tau_haze * air, tau_fog + tau_haze);
+  // A medium added to none and to others: thin, capped and endless (+infinity in C++, where
+  // fogPathLength takes an endless path; 1e30 stands for it on the GPU, which caps it the same).
+  for (const glm::dvec4& sum : {glm::dvec4(0.0), glm::dvec4(0.4, 0.45, 0.5, 0.8)})
+    for (double tau : {0.0, 1e-7, 0.6, 999.0, 1e3, 1e30})
+      cases.add("withMedium", &f::withMedium, 1e3, sum, tau, fog);
+  expectAgree(cases);
+}
+
+TEST_F(SharedFormulaTest, HeapLightAgrees) {
+  Cases cases;
+  // Clear, thin, thick and endless heaps; no forward scattering, the droplets' and nearly all.
+  for (double tau : {0.0, 1e-7, 0.4, 25.0, 1e4, 1e30})
+    for (double g : {0.0, 0.85, 0.999})
+      cases.add("diffuseTransmittance", &f::diffuseTransmittance, 1.0, tau, g);
+  // Faces turned to the light (no depth), grazing and turned away, past +-1 as rounding leaves
+  // a dot product; chords of none, a heap's and a huge one.
+  for (double chord : {0.0, 1500.0, 1e7})
+    for (double n_dot_v : {-1.2, -1.0, -0.3, 0.0, 1e-6, 0.5, 1.0, 1.0000001})
+      cases.add("heapDepth", &f::heapDepth, std::max(0.02 * chord, 1e-30), 0.02, chord, n_dot_v);
+  for (double sun : {0.0, 1e-6, 0.8, 30.0, 1e3})
+    for (double sky : {0.0, 4.0, 1e5}) cases.add("heapLight", &f::heapLight, 1.0, sun, sky, 0.85);
+  // Normals bent towards gradients near, across and against them; gradients of a few metres'
+  // envelope and of tiny and huge ones.
+  const glm::dvec3 n = glm::normalize(glm::dvec3(0.3, -0.8, 0.5));
+  for (const glm::dvec3& g : {glm::dvec3(0.2, -0.7, 0.6), glm::dvec3(1.0, 0.0, 0.0),
+                              glm::dvec3(-0.3, 0.8, -0.45), glm::dvec3(0.0, 0.0, 1.0)})
+    for (double size : {1e-12, 3e-3, 1.0, 1e6})
+      for (double bend : {0.0, 0.6, 1.0})
+        cases.add("bentNormal", &f::bentNormal, 1.0, n, size * g, bend);
+  for (double n_dot_l : {-1.0, -0.6, -0.59, -0.2, 0.0, 0.45, 1.0})
+    for (double wrap : {0.0, 0.6}) cases.add("skinDiffuse", &f::skinDiffuse, 1.0, n_dot_l, wrap);
+  expectAgree(cases);
+}
+
 TEST_F(SharedFormulaTest, ShadingAgrees) {
   Cases cases;
   const glm::dvec4 terms[] = {{0.4, 0.5, 0.0, 8.0}, {0.25, 0.3, 0.6, 20.0}, {1.0, 0.0, 1.0, 1.0}};
@@ -279,6 +329,43 @@ TEST_F(SharedFormulaTest, SeaOpticsAgree) {
         const double peak = f::glintRadiance(toFloat(glm::reflect(sun, n)), toFloat(sun),
                                              toFloat(n), toFloat(slope_var));
         cases.add("glintRadiance", &f::glintRadiance, peak, d, sun, n, slope_var);
+      }
+  expectAgree(cases);
+}
+
+TEST_F(SharedFormulaTest, FarDeckCoverAgrees) {
+  Cases cases;
+  // Rays straight up and down, steep, low and grazing (cot e up to 1e9, where the power's base
+  // is raised to a huge exponent), level (the floor of |r.z|) and long; no cover, some, all.
+  const glm::dvec3 rays[] = {{0.0, 0.0, 1.0},   {0.3, -0.2, -1.0}, {1.0, 0.5, 0.1},
+                             {-0.7, 0.7, 0.01}, {1.0, 0.0, 1e-5},  {0.0, 1.0, 0.0},
+                             {4e4, -3e4, 250.0}};
+  for (const glm::dvec3& r : rays)
+    for (double coverage : {0.0, 0.3, 0.92, 1.0, 1.4})
+      for (double side_ratio : {0.0, 0.8, 2.5})
+        cases.add("farApparentCover", &f::farApparentCover, 1.0, coverage, side_ratio, r);
+  expectAgree(cases);
+}
+
+TEST_F(SharedFormulaTest, WavesAgree) {
+  Cases cases;
+  // Footprints from none to a kilometre's, wavelengths from the shortest drawn to the longest:
+  // resolved, fading and lost.
+  for (double footprint : {1e-6, 0.05, 3.0, 20.0, 1e3})
+    for (double wavelength : {0.5, 83.0, 600.0})
+      cases.add("waveResolved", &f::waveResolved, 1.0, wavelength, footprint);
+  for (double w : {0.0, 0.3, 1.0})
+    for (double amplitude : {1e-3, 1.2, 17.0})
+      cases.add("waveHeightVariance", &f::waveHeightVariance, 0.5 * amplitude * amplitude, w,
+                amplitude);
+  // The shortest and the longest sines, at a crest, a slope and a trough of their phase and of
+  // their modulation's, the modulation's wave vector across theirs.
+  for (const glm::dvec2& k : {glm::dvec2(8.9, -8.9), glm::dvec2(0.02, 0.071)})
+    for (double sin_phase : {-1.0, 0.0, 0.7})
+      for (double cos_wobble : {-1.0, 0.3, 1.0}) {
+        const glm::dvec2 q = 0.05 * glm::dvec2(-k.y, k.x);
+        const double scale = 1.2 * (glm::length(k) + 2.5 * glm::length(q));
+        cases.add("waveSlope", &f::waveSlope, scale, 1.0, 1.2, sin_phase, k, 2.5, cos_wobble, q);
       }
   expectAgree(cases);
 }

@@ -63,7 +63,7 @@ double spreadAngle(double u) {
 
 double waveResolved(double wavelength_m, double footprint_m) {
   if (!(footprint_m > 0.0)) return 1.0;
-  return std::clamp(wavelength_m / (4.0 * footprint_m) - 1.0, 0.0, 1.0);
+  return formulas::waveResolved(wavelength_m, footprint_m);
 }
 
 SeaSurface::SeaSurface(const Sea& sea, int count) {
@@ -175,9 +175,9 @@ SeaSample SeaSurface::sample(glm::dvec2 xy, double time_s, double footprint_m) c
     const double phase =
         glm::dot(c.k, xy) - c.omega * time_s + c.phase + kWaveModulation * std::sin(wobble);
     s.height += w * c.amplitude * std::cos(phase);
-    s.slope -=
-        (w * c.amplitude * std::sin(phase)) * (c.k + kWaveModulation * std::cos(wobble) * c.q);
-    const double height_var = 0.5 * w * w * c.amplitude * c.amplitude;
+    s.slope -= formulas::waveSlope(w, c.amplitude, std::sin(phase), c.k, kWaveModulation,
+                                   std::cos(wobble), c.q);
+    const double height_var = formulas::waveHeightVariance(w, c.amplitude);
     resolved_height_var += height_var;
     resolved_slope_var += height_var * k * k;
   }

@@ -85,33 +85,22 @@ glm::dvec3 throughAir(glm::dvec3 colour, const std::optional<Fog>& fog,
                       const std::optional<Fog>& veil, const std::optional<Haze>& haze,
                       glm::dvec3 horizon, glm::dvec3 origin, glm::dvec3 direction, double distance,
                       std::span<const Fog> precipitation, std::span<const RainShaft> shafts) {
-  // Each depth is capped where its transmittance is already 0 in double, so the weights of the
-  // colours stay finite.
-  constexpr double kOpaque = 1.0e3;
-  auto depth = [&](const std::optional<Fog>& f) {
-    return f ? std::min(fogExtinction(*f) * fogPathLength(*f, origin, direction, distance), kOpaque)
-             : 0.0;
+  // The media summed and mixed by the formulas the GL's applyAir takes (world/formulas/air.h).
+  // Only the inputs differ: here absent media are optionals (there, sigma 0) and an endless path
+  // is +infinity, which fogPathLength's guards take (there, kFar = 1e30).
+  auto fogDepth = [&](const Fog& f) {
+    return fogExtinction(f) * fogPathLength(f, origin, direction, distance);
   };
-  const double tau_fog = depth(fog), tau_veil = depth(veil);
-  const double tau_haze =
-      haze ? std::min(hazeOpticalDepth(*haze, origin, direction, distance), kOpaque) : 0.0;
-  double tau = tau_fog + tau_veil + tau_haze;
-  glm::dvec3 weighted = tau_fog * (fog ? fog->colour : glm::dvec3(0.0)) +
-                        tau_veil * (veil ? veil->colour : glm::dvec3(0.0)) + tau_haze * horizon;
-  for (const Fog& p : precipitation) {
-    const double tau_p = depth(p);
-    tau += tau_p;
-    weighted += tau_p * p.colour;
-  }
-  for (const RainShaft& s : shafts) {
-    const double tau_s = std::min(shaftOpticalDepth(s, origin, direction, distance), kOpaque);
-    tau += tau_s;
-    weighted += tau_s * s.colour;
-  }
-  if (!(tau > 0.0)) return colour;
-  const glm::dvec3 air = weighted / tau;
-  const double t = std::exp(-tau);
-  return t * colour + (1.0 - t) * air;
+  glm::dvec4 air = formulas::withMedium(glm::dvec4(0.0), fog ? fogDepth(*fog) : 0.0,
+                                        fog ? fog->colour : glm::dvec3(0.0));
+  air = formulas::withMedium(air, veil ? fogDepth(*veil) : 0.0,
+                             veil ? veil->colour : glm::dvec3(0.0));
+  air = formulas::withMedium(air, haze ? hazeOpticalDepth(*haze, origin, direction, distance) : 0.0,
+                             horizon);
+  for (const Fog& p : precipitation) air = formulas::withMedium(air, fogDepth(p), p.colour);
+  for (const RainShaft& s : shafts)
+    air = formulas::withMedium(air, shaftOpticalDepth(s, origin, direction, distance), s.colour);
+  return formulas::airOver(colour, glm::dvec3(air), air.w);
 }
 
 }  // namespace nephele

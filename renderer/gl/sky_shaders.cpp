@@ -73,7 +73,8 @@ std::string commonSource() {
   return "const int kPrecipitationSlabs = " + std::to_string(kPrecipitationSlabs) +
          ";\nconst int kRainShafts = " + std::to_string(kMaxRainShafts) + ";\n" +
          glsl::formulas::kPrelude + glsl::formulas::kAir + glsl::formulas::kShading +
-         glsl::formulas::kSea + glsl::formulas::kEllipsoid + kCommon;
+         glsl::formulas::kSea + glsl::formulas::kEllipsoid + glsl::formulas::kHeap +
+         glsl::formulas::kFarDeck + kCommon;
 }
 
 }  // namespace

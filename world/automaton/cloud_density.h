@@ -9,6 +9,7 @@
 #include <glm/glm.hpp>
 
 #include "world/automaton/cellular_automaton.h"
+#include "world/formulas/heap.h"
 
 namespace nephele {
 
@@ -22,7 +23,7 @@ inline constexpr double kDiffuseAsymmetry = 0.85;
 // (two-stream: 1 / (1 + 3/4 (1 - g) tau); MODEL.md section 6, sky light). 1 at tau = 0,
 // falling as 1 / tau, never to 0.
 inline double diffuseTransmittance(double tau) {
-  return 1.0 / (1.0 + 0.75 * (1.0 - kDiffuseAsymmetry) * tau);
+  return formulas::diffuseTransmittance(tau, kDiffuseAsymmetry);
 }
 
 // The sunlight at a point in all, scattered or not, per unit of the sun's (MODEL.md section 6,

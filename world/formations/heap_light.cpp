@@ -10,6 +10,7 @@
 
 #include "world/automaton/cloud_density.h"
 #include "world/formulas/ellipsoid.h"
+#include "world/formulas/heap.h"
 
 namespace nephele {
 namespace {
@@ -125,16 +126,15 @@ HeapLight heapLightAt(const HeapEnvelope& envelope, glm::dvec3 p, glm::dvec3 nor
                       glm::dvec3 to_sun) {
   if (!(envelope.extinction > 0.0)) return {};
   // MODEL.md section 14: light inside a cloud is scattered on, not removed, so it falls as the
-  // two-stream transmittance of the depth, not exp(-depth). A face turned towards the light
-  // looks out of the heap, not through it: the depth counts by (1 - n.v) / 2.
-  const double k = envelope.extinction;
-  auto depth = [&](glm::dvec3 v) {
-    return k * envelopeChord(envelope, p, v) * 0.5 *
-           (1.0 - std::clamp(glm::dot(normal, v), -1.0, 1.0));
-  };
-  const double sun = depth(to_sun);
-  return {diffuseTransmittance(sun), 0.5 + 0.5 * diffuseTransmittance(depth({0.0, 0.0, 1.0})),
-          std::exp(-sun)};
+  // two-stream transmittance of the depth, not exp(-depth); the GL's cloud.glsl takes the same
+  // formulas (world/formulas/heap.h).
+  const glm::dvec3 up(0.0, 0.0, 1.0);
+  const double sun = formulas::heapDepth(envelope.extinction, envelopeChord(envelope, p, to_sun),
+                                         glm::dot(normal, to_sun));
+  const double sky = formulas::heapDepth(envelope.extinction, envelopeChord(envelope, p, up),
+                                         glm::dot(normal, up));
+  const glm::dvec3 light = formulas::heapLight(sun, sky, kDiffuseAsymmetry);
+  return {light.x, light.y, light.z};
 }
 
 glm::dvec3 heapLitNormal(const HeapEnvelope& envelope, glm::dvec3 p, glm::dvec3 normal) {
@@ -144,11 +144,11 @@ glm::dvec3 heapLitNormal(const HeapEnvelope& envelope, glm::dvec3 p, glm::dvec3 
   const double length = glm::length(gradient);
   if (!(length > 0.0) || !std::isfinite(length)) return normal;
   // Both unit, and 1 - b != b: the blend is at least |1 - 2b| long, never zero.
-  return glm::normalize((1.0 - kHeapNormalBend) * normal + kHeapNormalBend * (gradient / length));
+  return formulas::bentNormal(normal, gradient, kHeapNormalBend);
 }
 
 double skinDiffuse(double n_dot_l) {
-  return std::max(0.0, (n_dot_l + kSkinWrap) / (1.0 + kSkinWrap));
+  return formulas::skinDiffuse(n_dot_l, kSkinWrap);
 }
 
 MeanHeapLight meanHeapLight(const EllipsoidCloud& cloud, glm::dvec3 to_sun) {

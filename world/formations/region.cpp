@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "world/counter_random.h"
+#include "world/formulas/far_deck.h"
 #include "world/limits.h"
 
 namespace nephele {
@@ -55,8 +56,7 @@ std::string regionError(const Region& r) {
 }
 
 double farApparentCover(const FarCover& far, glm::dvec3 ray) {
-  const double cot = glm::length(glm::dvec2(ray)) / std::max(std::abs(ray.z), 1e-9);
-  return 1.0 - std::pow(1.0 - std::min(far.coverage, 1.0), 1.0 + far.side_ratio * cot);
+  return formulas::farApparentCover(far.coverage, far.side_ratio, ray);
 }
 
 double farThreshold(const FarCover& far, glm::dvec3 ray) {

@@ -70,7 +70,8 @@ struct FarCover {
   double side_ratio = 0.0;
   double threshold[kSteps + 1]{};
 };
-// Apparent cover along view ray `ray` (any length, ray.z != 0).
+// Apparent cover along view ray `ray` (any length; |ray.z| counts as at least 1e-9 |ray|),
+// the GL's formula too (world/formulas/far_deck.h).
 double farApparentCover(const FarCover& far, glm::dvec3 ray);
 // T1 for that cover.
 double farThreshold(const FarCover& far, glm::dvec3 ray);

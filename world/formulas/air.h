@@ -10,6 +10,10 @@
 namespace nephele::formulas {
 #endif
 
+// Each medium's optical depth is capped here, where its transmittance exp(-tau) is already 0
+// in float and in double, so that the weights of the colours in airOver stay finite.
+CONSTANT real kOpaqueDepth = 1e3;
+
 // The share of a shaft's density left at the ground (RainShaft): its density falls linearly
 // from 1 under the heap's base to this at Z = 0.
 CONSTANT real kShaftGroundShare = 0.5;
@@ -89,6 +93,23 @@ FORMULA real shaftDepth(vec4 shaft, real sigma, real z0, vec3 d, real distance) 
   real fade = (1.0 - kShaftGroundShare) / shaft.w;
   real l0 = kShaftGroundShare + fade * (z0 + m * d.z), l1 = fade * d.z;
   return sigma * max(2.0 * h * g0 * l0 + (2.0 * h * h * h / 3.0) * (g2 * l0 + g1 * l1), 0.0);
+}
+
+// The media along a path as airOver takes them, `air` = (the sum of each medium's depth times
+// its colour, the sum of the depths), with one more medium of optical depth tau (capped at
+// kOpaqueDepth) and colour c.
+FORMULA vec4 withMedium(vec4 air, real tau, vec3 c) {
+  real capped = min(tau, kOpaqueDepth);
+  return vec4(vec3(air.x, air.y, air.z) + capped * c, air.w + capped);
+}
+
+// A surface of `colour` seen through media of total optical depth tau (MODEL.md section 5),
+// `weighted` the sum of each medium's depth times its colour: the media taken as one of their
+// depth-weighted mean colour, colour T + (1 - T) weighted / tau with T = exp(-tau). `colour`
+// itself where there is no air (tau 0).
+FORMULA vec3 airOver(vec3 colour, vec3 weighted, real tau) {
+  if (!(tau > 0.0)) return colour;
+  return mix(weighted / tau, colour, exp(-tau));
 }
 
 #ifdef __cplusplus

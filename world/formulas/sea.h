@@ -45,6 +45,27 @@ FORMULA real glintRadiance(vec3 d, vec3 sun, vec3 n, real slope_var) {
          (4.0 * slope_var * max(mu_v, 1e-2) * mu_n2 * mu_n2);
 }
 
+// A sine's weight for a pixel's footprint f (MODEL.md section 18, filtering): 1 while its
+// wavelength L is at least 8 footprints, 0 at 4 or fewer, linear between: clamp(L / (4 f) - 1).
+FORMULA real waveResolved(real wavelength, real footprint) {
+  return clamp(wavelength / (4.0 * footprint) - 1.0, 0.0, 1.0);
+}
+
+// The variance of a sine's height, amplitude a at weight w: w^2 a^2 / 2 (times |k|^2, its
+// slope's).
+FORMULA real waveHeightVariance(real w, real amplitude) {
+  return 0.5 * w * w * amplitude * amplitude;
+}
+
+// The slope of the sine a cos(phase), phase = k . x + m sin(q . x + psi) + ..., at weight w:
+// -w a sin(phase) (k + m cos(q . x + psi) q), this returning its negative. The sines are the
+// caller's: the reference takes sin and cos (the model, MODEL.md section 18), the GPU its
+// polynomial gardnerSin, within 4e-6 of them (docs/ACCURACY.md, "Per-pixel sines").
+FORMULA vec2 waveSlope(real w, real amplitude, real sin_phase, vec2 k, real m, real cos_wobble,
+                       vec2 q) {
+  return (w * amplitude * sin_phase) * (k + m * cos_wobble * q);
+}
+
 #ifdef __cplusplus
 }  // namespace nephele::formulas
 #endif

@@ -58,7 +58,9 @@ nephele_embed_glsl(nephele_renderer formulas_glsl.h formulas
   kAir ${NEPHELE_FORMULA_DIR}/air.h          # slabs, haze, shafts
   kShading ${NEPHELE_FORMULA_DIR}/shading.h  # Gardner eq. 8, 9, 11, far heaps' diffuse
   kSea ${NEPHELE_FORMULA_DIR}/sea.h          # Fresnel, foam, glint
-  kEllipsoid ${NEPHELE_FORMULA_DIR}/ellipsoid.h)  # ray hit, limb function
+  kEllipsoid ${NEPHELE_FORMULA_DIR}/ellipsoid.h  # ray hit, limb function
+  kHeap ${NEPHELE_FORMULA_DIR}/heap.h            # heap light, two-stream transmittance
+  kFarDeck ${NEPHELE_FORMULA_DIR}/far_deck.h)    # a far deck's apparent cover
 nephele_embed_glsl(nephele_renderer sky_glsl.h sky
   kCommon sky/common.glsl             # the view, output, air, background and targets
   kLayers sky/layers.glsl             # textured cloud layers

@@ -123,11 +123,8 @@ float envelopeChord(int i, vec3 p, vec3 v) {
   return unitSphereChord((p - record(i, 17).xyz) * inv, v * inv);
 }
 
-// Two-stream transmittance of optical depth tau (diffuseTransmittance), asymmetry g.
-float diffuseTransmittance(float tau) { return 1.0 / (1.0 + 0.75 * (1.0 - u_scatter.y) * tau); }
-
 // Gardner eq. 8 with the light reaching surface point p of ellipsoid i through its heap
-// (heapLightAt), plus the light scattered forward through the surface's translucence tr
+// (heapLightAt, from world/formulas/heap.h), plus the light scattered forward through the surface's translucence tr
 // (MODEL.md section 14), times cloud and sun colour, fogged; n faces the viewer (and is lit
 // as heapLitNormal bends it), r points at the surface from the eye, p camera-relative,
 // `distance` in metres.
@@ -139,20 +136,18 @@ vec3 surfaceColour(int i, vec3 n, vec3 r, vec3 p, float it, float tr, float dist
     // heapLitNormal: n bent towards the envelope's outward normal, (p - c) / radii^2.
     vec3 inv = record(i, 18).xyz;
     vec3 gradient = (p - record(i, 17).xyz) * inv * inv;
-    if (dot(gradient, gradient) > 0.0) n = normalize(mix(n, normalize(gradient), u_scatter.w));
-    float toward_sun = 0.5 * (1.0 - clamp(dot(n, u_to_sun), -1.0, 1.0));
-    float toward_sky = 0.5 * (1.0 - clamp(n.z, -1.0, 1.0));
-    float sun_depth = extinction * toward_sun * envelopeChord(i, p, u_to_sun);
-    light = vec2(diffuseTransmittance(sun_depth),
-                 0.5 + 0.5 * diffuseTransmittance(extinction * toward_sky *
-                                                  envelopeChord(i, p, vec3(0.0, 0.0, 1.0))));
-    direct = exp(-sun_depth);
+    if (dot(gradient, gradient) > 0.0) n = bentNormal(n, gradient, u_scatter.w);
+    float sun_depth = heapDepth(extinction, envelopeChord(i, p, u_to_sun), dot(n, u_to_sun));
+    float sky_depth = heapDepth(extinction, envelopeChord(i, p, vec3(0.0, 0.0, 1.0)), n.z);
+    vec3 heap = heapLight(sun_depth, sky_depth, u_scatter.y);
+    light = heap.xy;
+    direct = heap.z;
   }
   float outside = 1.0 - record(i, 18).w;
   light.x *= outside;
   direct *= outside;
   float n_dot_l = dot(n, u_to_sun);
-  float diffuse = max((n_dot_l + u_scatter.z) / (1.0 + u_scatter.z), 0.0);
+  float diffuse = skinDiffuse(n_dot_l, u_scatter.z);
   float sun = light.x;
   float highlight = 0.0;
 #ifdef SPECULAR

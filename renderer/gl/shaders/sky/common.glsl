@@ -33,9 +33,11 @@ vec3 viewRay() {
 
 #ifdef AIR
 // The air between the eye and a surface (MODEL.md section 5): ground fog, the in-layer veil
-// and distance haze; an absent one has zero extinction. Each medium's optical depth is the
-// shared formula's (world/formulas/air.h, pasted ahead of this file), as in world/sky.cpp's
-// throughAir.
+// and distance haze; an absent one has zero extinction. Each medium's optical depth and their
+// mixing are the shared formulas' (world/formulas/air.h, pasted ahead of this file), as in
+// world/sky.cpp's throughAir; what stays here is which media there are (uniforms, sigma 0 for
+// none, where throughAir takes optionals and spans) and the endless path, kFar here and
+// +infinity there (fogPathLength's guards).
 uniform vec3 u_fog_slab;  // bottom, top, band of the ground fog, metres
 uniform float u_fog_sigma;
 uniform vec3 u_fog_colour;
@@ -59,26 +61,20 @@ uniform vec3 u_haze_colour;   // the sky's horizon
 
 vec3 applyAir(vec3 colour, vec3 d, float distance) {
   float z = u_camera_z;
-  float tau_fog =
-      u_fog_sigma > 0.0 ? min(u_fog_sigma * slabPath(u_fog_slab, z, d.z, distance), 1e3) : 0.0;
+  float tau_fog = u_fog_sigma > 0.0 ? u_fog_sigma * slabPath(u_fog_slab, z, d.z, distance) : 0.0;
   float tau_veil =
-      u_veil_sigma > 0.0 ? min(u_veil_sigma * slabPath(u_veil_slab, z, d.z, distance), 1e3) : 0.0;
-  float tau_haze = min(hazeDepth(u_haze_sigma, u_haze_height, z, d.z, distance), 1e3);
-  float tau = tau_fog + tau_veil + tau_haze;
-  vec3 weighted = tau_fog * u_fog_colour + tau_veil * u_veil_colour + tau_haze * u_haze_colour;
+      u_veil_sigma > 0.0 ? u_veil_sigma * slabPath(u_veil_slab, z, d.z, distance) : 0.0;
+  vec4 air = withMedium(vec4(0.0), tau_fog, u_fog_colour);
+  air = withMedium(air, tau_veil, u_veil_colour);
+  air = withMedium(air, hazeDepth(u_haze_sigma, u_haze_height, z, d.z, distance), u_haze_colour);
   for (int i = 0; i < kPrecipitationSlabs; ++i)
-    if (u_precip_sigma[i] > 0.0) {
-      float tau_p = min(u_precip_sigma[i] * slabPath(u_precip_slab[i], z, d.z, distance), 1e3);
-      tau += tau_p;
-      weighted += tau_p * u_precip_colour[i];
-    }
-  for (int i = 0; i < u_shafts; ++i) {
-    float tau_s = min(shaftDepth(u_shaft[i], u_shaft_sigma[i], z, d, distance), 1e3);
-    tau += tau_s;
-    weighted += tau_s * u_shaft_colour[i];
-  }
-  if (!(tau > 0.0)) return colour;
-  return mix(weighted / tau, colour, exp(-tau));
+    if (u_precip_sigma[i] > 0.0)
+      air = withMedium(air, u_precip_sigma[i] * slabPath(u_precip_slab[i], z, d.z, distance),
+                       u_precip_colour[i]);
+  for (int i = 0; i < u_shafts; ++i)
+    air = withMedium(air, shaftDepth(u_shaft[i], u_shaft_sigma[i], z, d, distance),
+                     u_shaft_colour[i]);
+  return airOver(colour, air.xyz, air.w);
 }
 
 // The air at the end of an endless path through it (the ground at the horizon): each medium
@@ -186,9 +182,10 @@ vec3 groundColour(vec3 d) {
 }
 
 #ifdef SEA
-// The sea (MODEL.md section 18): its optics are world/formulas/sea.h's, as in world/sea.cpp;
-// the waves' slopes are summed as SeaSurface::sample sums them, with gardnerSin in place of
-// sin and cos.
+// The sea (MODEL.md section 18): its optics, each sine's weight, slope and variance are
+// world/formulas/sea.h's, as in world/sea.cpp; the sum over the sines is SeaSurface::sample's
+// with gardnerSin in place of sin and cos (docs/ACCURACY.md, "Per-pixel sines"), the phases
+// camera-relative (MODEL.md section 2's precision rule).
 // The surface's sines, longest first: wave vector (rad/m), amplitude, and the phase at the
 // camera's ground point now (mod 2 pi, in double on the CPU).
 uniform vec4 u_wave[kSeaWaves];
@@ -226,14 +223,14 @@ vec3 seaColour(vec3 d) {
   for (int i = 0; i < u_waves; ++i) {
     vec4 w = u_wave[i];
     float k = length(w.xy);
-    float weight = clamp(6.283185307179586 / k / (4.0 * footprint) - 1.0, 0.0, 1.0);
+    float weight = waveResolved(6.283185307179586 / k, footprint);
     if (weight <= 0.0) break;
     vec3 m = u_wave_wobble[i];
     float wobble = dot(m.xy, p) + m.z;
     float phase = dot(w.xy, p) + w.w + kWaveModulation * gardnerSin(wobble);
-    slope -= (weight * w.z * gardnerSin(phase)) *
-             (w.xy + kWaveModulation * gardnerSin(wobble + 1.5707963267948966) * m.xy);
-    resolved_slope += 0.5 * weight * weight * w.z * w.z * k * k;
+    slope -= waveSlope(weight, w.z, gardnerSin(phase), w.xy, kWaveModulation,
+                       gardnerSin(wobble + 1.5707963267948966), m.xy);
+    resolved_slope += waveHeightVariance(weight, w.z) * k * k;
   }
   float slope_var = max(u_sea.x - resolved_slope, (1.0 - kSeaResolvedShare) * u_sea.x);
   vec3 n = normalize(vec3(-slope, 1.0));

@@ -160,8 +160,7 @@ float regionRamp(float x, float width) {
 float layerThreshold(int i, vec3 r, vec2 p) {
   float t1 = u_threshold[i];
   if (u_far[i].y > 0.0) {
-    float cot_e = length(r.xy) / max(abs(r.z), 1e-9 * length(r));
-    float cover = 1.0 - pow(1.0 - min(u_far[i].x, 1.0), 1.0 + u_far[i].y * cot_e);
+    float cover = farApparentCover(u_far[i].x, u_far[i].y, r);  // world/formulas/far_deck.h
     float x = clamp(cover, 0.0, 1.0) * 16.0;
     int k = min(int(x), 15);
     t1 = mix(u_far_threshold[17 * i + k], u_far_threshold[17 * i + k + 1], x - float(k));
