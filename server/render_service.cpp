@@ -178,15 +178,11 @@ void RenderService::render(const World& world, const ViewConfig& view, const Ima
                            std::uint64_t tick, bool continuous, RenderedView& out) {
   renderer_->setContinuousView(continuous ? view.name + "#" + std::to_string(world.edits())
                                           : std::string());
-  Scene scene = world.scene();
-  scene.camera = view.camera;
   // An off-axis view is cut from a centred render of the same focal length (exact: a pinhole
   // image moves its principal point when cropped).
   std::optional<OffAxisView> off_axis;
-  if (view.frustum) {
-    off_axis = offAxisView(view.camera, *view.frustum);
-    scene.camera = off_axis->render;
-  }
+  if (view.frustum) off_axis = offAxisView(view.camera, *view.frustum);
+  const Scene& scene = world.seenFrom(off_axis ? off_axis->render : view.camera);
   const auto t0 = std::chrono::steady_clock::now();
   Frame& frame = out.frame;
   const Channels channels = channelsOf(image);

@@ -568,6 +568,28 @@ TEST(World, ManyAdvancesThenOneReadEqualReadingEachTime) {
             restored.scene().automata[0].to->lattice.sunlight);
 }
 
+// A view of the world from a camera (the daemon's views) is the state now with only its camera
+// set: no copy, no change to the hash, and what time sets is as scene() has it.
+TEST(World, SeenFromSetsTheCameraAloneAndKeepsTheHash) {
+  World world = makeWorld(), plain = makeWorld();
+  for (World* w : {&world, &plain}) ASSERT_EQ(w->advance(12.5), "");
+  const std::uint64_t hash = world.hash();
+  Camera camera = world.base().camera;
+  camera.position += glm::dvec3(1234.0, -50.0, 300.0);
+  camera.orientation.heading_deg = 77.0;
+  camera.width = 321;
+  const Scene& seen = world.seenFrom(camera);
+  EXPECT_EQ(&seen, &world.scene());  // the world's own state, not a copy
+  EXPECT_EQ(seen.camera.position, camera.position);
+  EXPECT_EQ(seen.camera.orientation.heading_deg, 77.0);
+  EXPECT_EQ(seen.camera.width, 321);
+  EXPECT_EQ(world.hash(), hash);
+  EXPECT_EQ(world.hash(), plain.hash());
+  Scene expected = plain.scene();
+  expected.camera = camera;
+  expectSameScene(seen, expected);
+}
+
 TEST(World, HashesDifferWhenTheWorldDiffers) {
   World a = makeWorld(), b = makeWorld();
   EXPECT_EQ(a.hash(), b.hash());

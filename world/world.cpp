@@ -551,6 +551,12 @@ const Scene& World::scene() const {
   return now_;
 }
 
+const Scene& World::seenFrom(const Camera& camera) const {
+  scene();
+  now_.camera = camera;
+  return now_;
+}
+
 void World::rebuildNow() {
   now_ = base_;
   now_stale_ = true;

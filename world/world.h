@@ -172,6 +172,10 @@ class World {
   // Reading it may write the world's state now: like every other member, call it from one
   // thread at a time.
   const Scene& scene() const;
+  // scene() seen from `camera`, without a copy: the state now with its camera set. A view's
+  // camera is not the world's state (snapshots and hash() read base_), so this changes no hash;
+  // scene() keeps the camera until the next seenFrom or change.
+  const Scene& seenFrom(const Camera& camera) const;
   const Scene& base() const { return base_; }
   const WorldDynamics& dynamics() const { return dynamics_; }
   const std::vector<AutomatonCloud>& automata() const { return automata_; }
