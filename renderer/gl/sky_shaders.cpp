@@ -117,7 +117,10 @@ std::string polygonVertexSource() {
   return kPolygonVertex;
 }
 
-std::string skyFragmentSource(const SkyPassLayout& layout) {
+namespace {
+
+// The pass's defines and constants: what the layout draws, and its slots.
+std::string skyDefines(const SkyPassLayout& layout) {
   std::string s = "#version 450 core\n";
   if (layout.air) s += "#define AIR\n";
   if (layout.background) s += "#define BACKGROUND\n";
@@ -145,7 +148,13 @@ std::string skyFragmentSource(const SkyPassLayout& layout) {
   s += "const int kComponents = " + std::to_string(GardnerTextureParams::kComponents) + ";\n";
   const int slots = layout.slots() + int(layout.casters.size());
   s += "const int kSlots = " + std::to_string(std::max(slots, 1)) + ";\n";
-  s += commonSource();
+  return s;
+}
+
+// The layer code, a sampler per sampled slot and the casters' sunlight, when there are slots.
+std::string skySlots(const SkyPassLayout& layout) {
+  std::string s;
+  const int slots = layout.slots() + int(layout.casters.size());
   if (slots > 0) s += kLayers;
   // One sampler uniform per sampled slot: llvmpipe samples a sampler-array element far more
   // slowly.
@@ -166,6 +175,12 @@ std::string skyFragmentSource(const SkyPassLayout& layout) {
     s += "float planesSunlight(LayerHit hit, float height) { return " + product + "; }\n";
   }
 
+  return s;
+}
+
+// main(): the slots nearest first on the side the ray looks to, then the background.
+std::string skyMain(const SkyPassLayout& layout) {
+  std::string s;
   s += "const float kClear = 1.0 / 1024.0;\n";
   s += "void main() {\n  vec3 r = viewRay();\n";
   if (layout.targets) {
@@ -200,6 +215,12 @@ std::string skyFragmentSource(const SkyPassLayout& layout) {
   }
   s += "  o_colour = vec4(colour, 1.0 - transmittance);\n}\n";
   return s;
+}
+
+}  // namespace
+
+std::string skyFragmentSource(const SkyPassLayout& layout) {
+  return skyDefines(layout) + commonSource() + skySlots(layout) + skyMain(layout);
 }
 
 }  // namespace nephele
