@@ -17,9 +17,9 @@
 #include "bench/bench_common.h"
 #include "image/image_metrics.h"
 #include "renderer/reference/reference_renderer.h"
+#include "world/camera.h"
 #include "world/formations/ellipsoid_cloud.h"
 #include "world/formations/weather.h"
-#include "world/frames.h"
 
 using namespace nephele;
 

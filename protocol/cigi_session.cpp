@@ -6,8 +6,8 @@
 #include <sstream>
 
 #include "protocol/cloud_codes.h"
+#include "world/camera.h"
 #include "world/formations/cloud_field.h"
-#include "world/frames.h"
 #include "world/limits.h"
 #include "world/sea.h"
 #include "world/solar.h"

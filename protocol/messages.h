@@ -14,8 +14,8 @@
 #include "renderer/frame.h"
 
 #include "image/video_stream.h"
+#include "world/camera.h"
 #include "world/formations/weather.h"
-#include "world/frames.h"
 #include "world/solar.h"
 
 namespace nephele {

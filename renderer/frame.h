@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "image/image.h"
-#include "world/frames.h"
+#include "world/camera.h"
 #include "world/infrared.h"
 
 namespace nephele {

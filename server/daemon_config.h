@@ -20,7 +20,7 @@ struct ViewConfig {
   std::string name;
   Camera camera;  // pose, field of view and size
   // An off-axis view (CIGI View Definition, set_view "frustum"): camera.vfov_deg is then its
-  // vertical extent and camera.width follows from it (world/frames.h offAxisView).
+  // vertical extent and camera.width follows from it (world/camera.h offAxisView).
   std::optional<Frustum> frustum;
   ImageRequest image;
 };

@@ -10,10 +10,10 @@
 #include <glm/glm.hpp>
 
 #include "world/automaton/automaton_cloud.h"
+#include "world/camera.h"
 #include "world/formations/cloud_field.h"
 #include "world/formations/ellipsoid_cloud.h"
 #include "world/formations/region.h"
-#include "world/frames.h"
 #include "world/geodesy.h"
 #include "world/sea.h"
 #include "world/shading.h"

@@ -11,7 +11,7 @@
 
 #include <glm/glm.hpp>
 
-#include "world/frames.h"
+#include "world/camera.h"
 #include "world/sky.h"
 
 namespace nephele {

@@ -3,7 +3,7 @@
 #include <optional>
 
 #include "renderer/gl/gl_api.h"
-#include "world/frames.h"
+#include "world/camera.h"
 #include "world/scene.h"
 
 namespace nephele {

@@ -12,10 +12,10 @@
 #include "renderer/frame_plan.h"
 #include "renderer/renderer.h"
 #include "world/automaton/cloud_density.h"
+#include "world/camera.h"
 #include "world/formations/cloud_shadow.h"
 #include "world/formations/ellipsoid.h"
 #include "world/formations/heap_light.h"
-#include "world/frames.h"
 #include "world/sea.h"
 #include "world/textures/layer_texture.h"
 

@@ -12,13 +12,13 @@
 #include <sstream>
 #include <tuple>
 
+#include "world/camera.h"
 #include "world/counter_random.h"
 #include "world/formations/cloud_shadow.h"
 #include "world/formations/cluster.h"
 #include "world/formations/genus.h"
 #include "world/formations/heap_light.h"
 #include "world/formations/weather.h"
-#include "world/frames.h"
 #include "world/limits.h"
 #include "world/scene.h"
 #include "world/sky.h"

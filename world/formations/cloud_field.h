@@ -12,9 +12,9 @@
 
 #include <glm/glm.hpp>
 
+#include "world/camera.h"
 #include "world/formations/ellipsoid_cloud.h"
 #include "world/formations/region.h"
-#include "world/frames.h"
 #include "world/precipitation.h"
 
 namespace nephele {

@@ -8,7 +8,7 @@
 
 #include <glm/glm.hpp>
 
-#include "world/frames.h"
+#include "world/camera.h"
 
 namespace nephele {
 

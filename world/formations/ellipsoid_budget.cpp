@@ -6,9 +6,9 @@
 #include <span>
 #include <vector>
 
+#include "world/camera.h"
 #include "world/formations/cloud_field.h"
 #include "world/formations/heap_light.h"
-#include "world/frames.h"
 
 // The frame's work budget (MODEL.md section 15): the ellipsoids a frame draws at most, those of
 // largest projected size, with the heaps beyond it merged into bodies or left out.

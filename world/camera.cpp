@@ -1,4 +1,4 @@
-#include "world/frames.h"
+#include "world/camera.h"
 
 #include "world/limits.h"
 

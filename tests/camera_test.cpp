@@ -1,4 +1,4 @@
-#include "world/frames.h"
+#include "world/camera.h"
 
 #include <gtest/gtest.h>
 
@@ -11,28 +11,28 @@ void expectNear(glm::dvec3 actual, glm::dvec3 expected) {
   for (int i = 0; i < 3; ++i) EXPECT_NEAR(actual[i], expected[i], 1e-12) << "component " << i;
 }
 
-TEST(Frames, IdentityLooksNorthWithZUp) {
+TEST(Camera, IdentityLooksNorthWithZUp) {
   const glm::dmat3 r = bodyToWorld({});
   expectNear(r[0], {1, 0, 0});
   expectNear(r[1], {0, 1, 0});
   expectNear(r[2], {0, 0, 1});
 }
 
-TEST(Frames, HeadingNinetyLooksEast) {
+TEST(Camera, HeadingNinetyLooksEast) {
   expectNear(bodyToWorld({90, 0, 0})[1], {1, 0, 0});
 }
 
-TEST(Frames, PitchNinetyLooksUp) {
+TEST(Camera, PitchNinetyLooksUp) {
   expectNear(bodyToWorld({0, 90, 0})[1], {0, 0, 1});
 }
 
-TEST(Frames, RollNinetyTurnsImageUpToEast) {
+TEST(Camera, RollNinetyTurnsImageUpToEast) {
   const glm::dmat3 r = bodyToWorld({0, 0, 90});
   expectNear(r[2], {1, 0, 0});
   expectNear(r[0], {0, 0, -1});  // right wing down
 }
 
-TEST(Frames, RotationIsOrthonormal) {
+TEST(Camera, RotationIsOrthonormal) {
   const glm::dmat3 r = bodyToWorld({37, -21, 123});
   const glm::dmat3 identity = glm::transpose(r) * r;
   for (int c = 0; c < 3; ++c)
@@ -40,7 +40,7 @@ TEST(Frames, RotationIsOrthonormal) {
   EXPECT_NEAR(glm::determinant(r), 1.0, 1e-12);
 }
 
-TEST(Frames, PixelRaysFollowSpecImagePlane) {
+TEST(Camera, PixelRaysFollowSpecImagePlane) {
   Camera camera;
   camera.width = 200;
   camera.height = 100;
@@ -64,7 +64,7 @@ namespace {
 
 // orientationOf inverts bodyToWorld, including rolled, inverted and vertical attitudes (the
 // CIGI views compose an entity's attitude with the view's offset through it).
-TEST(Frames, OrientationOfInvertsBodyToWorld) {
+TEST(Camera, OrientationOfInvertsBodyToWorld) {
   for (double h : {0.0, 37.0, 181.0, 359.0})
     for (double p : {-89.0, -30.0, 0.0, 45.0, 89.9})
       for (double r : {-179.0, -20.0, 0.0, 60.0, 180.0}) {
@@ -91,7 +91,7 @@ namespace {
 // An off-axis view cut from a centred render: the crop's edges, seen through the render
 // camera's own rays, are the frustum's sides to within half a pixel, and its principal point
 // is where the optical axis lands.
-TEST(Frames, OffAxisViewCropsToTheFrustum) {
+TEST(Camera, OffAxisViewCropsToTheFrustum) {
   const Frustum cases[] = {
       {-30, 30, -20, 20}, {-20, 40, -10, 25}, {-45, -5, 3, 30}, {-5, 5, -80, 80}};
   for (const Frustum& f : cases) {
