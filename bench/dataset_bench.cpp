@@ -16,6 +16,7 @@
 #include "dataset/dataset_file.h"
 #include "image/image_encoding.h"
 #include "image/image_metrics.h"
+#include "renderer/encode.h"
 #include "world/infrared.h"
 
 using namespace nephele;
@@ -47,7 +48,7 @@ void timeSample(Renderer& gl, const DatasetSpec& spec, const RenderSettings& set
   const Scene with_heaps = withFieldClouds(sample.scene, spec.heaps);
   times.heaps += msSince(t);
   t = Clock::now();
-  const Frame frame = gl.render(with_heaps, settings, request);
+  Frame frame = gl.render(with_heaps, settings, request);
   const double render_ms = msSince(t);
   times.render += render_ms;
   times.budget.accumulate(gl.lastFrameStats().times, 1.0 / samples);
@@ -60,7 +61,7 @@ void timeSample(Renderer& gl, const DatasetSpec& spec, const RenderSettings& set
   const std::vector<TargetLabel> labels = labelTargets(frame, sample.target_class);
   const std::string json = sampleLabelsJson(labels, spec.width, spec.height).dump() +
                            yoloText(labels, spec.width, spec.height);
-  const std::vector<std::uint16_t> ids = instanceMask(frame);
+  frame.derived.push_back({"instance_mask", instanceMask(frame)});
   times.label += msSince(t);
   t = Clock::now();
   const Srgb8Image bytes = toSrgb8(frame.colour);
@@ -70,7 +71,8 @@ void timeSample(Renderer& gl, const DatasetSpec& spec, const RenderSettings& set
   encodeImage(ImageFileFormat::kPng, bytes, true, false, EncodeOptions{1}, encoded);
   times.png += msSince(t);
   t = Clock::now();
-  encodeMaskPng(spec.width, spec.height, ids, EncodeOptions{1}, encoded);
+  encode(frame, ImageFileFormat::kPng, {{}, Channels::Pixels::kGrey16, {"instance_mask"}},
+         EncodeOptions{1});
   times.mask += msSince(t);
   times.targets += int(labels.size());
   for (const TargetLabel& l : labels) times.visible += l.visible_px > 0;

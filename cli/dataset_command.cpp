@@ -91,61 +91,80 @@ struct Rendered {
   Frame frame;
 };
 
+// The planes a sample's files show besides its channels (Frame::derived): brightness
+// temperature in the infrared band, the instance mask and, at sea, the glint mask.
+void deriveSamplePlanes(const DatasetSpec& spec, const BandTable& band, Frame& frame) {
+  if (spec.band == Band::kLwir) {
+    std::vector<float> kelvin(frame.lwir.size());
+    for (std::size_t i = 0; i < kelvin.size(); ++i)
+      kelvin[i] = float(band.temperature(frame.lwir[i]));
+    frame.derived.push_back({"brightness_temperature", std::move(kelvin)});
+  }
+  if (spec.write_masks) frame.derived.push_back({"instance_mask", instanceMask(frame)});
+  if (!frame.glint.empty())
+    frame.derived.push_back({"glint_mask", glintMask(frame, spec.glint_threshold)});
+}
+
+// The image: colour, or brightness temperature shown linearly from display_k.lo (black) to
+// .hi (white).
+Channels sampleImage(const DatasetSpec& spec) {
+  if (spec.band != Band::kLwir) return {{Channel::kColour}, Channels::Pixels::kSrgb8};
+  Channels grey{{}, Channels::Pixels::kGrey8, {"brightness_temperature"}};
+  grey.grey_lo = spec.display_k.lo;
+  grey.grey_hi = spec.display_k.hi;
+  return grey;
+}
+
+// The EXR's layers: radiance and brightness temperature in the infrared band, depths and ids,
+// coverage and visibility as the description asks, and glint at sea; none (no EXR) unless
+// the band or the description asks for one.
+Channels sampleExr(const DatasetSpec& spec, const Frame& frame) {
+  Channels exr{{}, Channels::Pixels::kPlanes};
+  if (!(spec.write_depth || spec.write_coverage || spec.band == Band::kLwir)) return exr;
+  if (spec.band == Band::kLwir) exr.order.push_back(Channel::kLwir);
+  if (spec.write_depth)
+    exr.order.insert(exr.order.end(), {Channel::kDepth, Channel::kCloudDepth, Channel::kObjectId});
+  if (spec.write_coverage)
+    exr.order.insert(exr.order.end(), {Channel::kCoverage, Channel::kVisibility});
+  if (!frame.glint.empty()) exr.order.push_back(Channel::kGlint);
+  if (spec.band == Band::kLwir) exr.derived.push_back("brightness_temperature");
+  return exr;
+}
+
 // Labels, masks, images and the record of one sample; the record last, so that a sample
-// whose record exists is complete (--resume).
+// whose record exists is complete (--resume). The frame gains the sample's derived planes.
 std::string writeSample(const DatasetSpec& spec, const BandTable& band, const fs::path& dir,
-                        const Rendered& r, const EncodeOptions& encode) {
+                        Rendered& r, const EncodeOptions& encode) {
   const std::string name = sampleName(r.index);
   const int w = r.frame.width(), h = r.frame.height();
   const std::vector<TargetLabel> labels =
       labelTargets(r.frame, r.sample.target_class, spec.glint_threshold);
+  deriveSamplePlanes(spec, band, r.frame);
   json record = r.sample.record;
-  if (!r.frame.glint.empty()) {
-    const std::vector<std::uint16_t> glint = glintMask(r.frame, spec.glint_threshold);
+  if (const DerivedPlane* glint = r.frame.derivedPlane("glint_mask")) {
     record["glint_fraction"] =
-        double(std::count(glint.begin(), glint.end(), 65535)) / double(glint.size());
+        double(std::count(glint->values.begin(), glint->values.end(), 65535.0f)) /
+        double(glint->values.size());
     record["glint_file"] = "glint/" + name + ".png";
   }
   record["file_name"] = "images/" + name + ".png";
   record["labels"] = sampleLabelsJson(labels, w, h);
-  const std::string image = (dir / "images" / (name + ".png")).string();
-  std::string e;
-  std::vector<float> kelvin;
-  if (spec.band == Band::kLwir) {
-    // Brightness temperature, shown linearly from display_k.lo (black) to .hi (white).
-    kelvin.resize(r.frame.lwir.size());
-    Srgb8Image grey{w, h, false, std::vector<std::uint8_t>(kelvin.size() * 4, 255)};
-    for (std::size_t i = 0; i < kelvin.size(); ++i) {
-      kelvin[i] = float(band.temperature(r.frame.lwir[i]));
-      const std::uint8_t v =
-          toByte((kelvin[i] - spec.display_k.lo) / (spec.display_k.hi - spec.display_k.lo));
-      grey.rgba[i * 4] = grey.rgba[i * 4 + 1] = grey.rgba[i * 4 + 2] = v;
-    }
-    e = writeImageFile(image, grey, encode);
-  } else {
-    e = writeImage(image, r.frame, Channels{{Channel::kColour}, Channels::Pixels::kSrgb8}, encode);
-  }
+  const auto mask = [](const char* plane) {
+    return Channels{{}, Channels::Pixels::kGrey16, {plane}};
+  };
+  std::string e =
+      writeImage((dir / "images" / (name + ".png")).string(), r.frame, sampleImage(spec), encode);
   if (e.empty() && spec.write_masks)
-    e = writeMaskPng((dir / "masks" / (name + ".png")).string(), w, h, instanceMask(r.frame),
-                     encode);
-  if (e.empty() && !r.frame.glint.empty())
-    e = writeMaskPng((dir / "glint" / (name + ".png")).string(), w, h,
-                     glintMask(r.frame, spec.glint_threshold), encode);
+    e = writeImage((dir / "masks" / (name + ".png")).string(), r.frame, mask("instance_mask"),
+                   encode);
+  if (e.empty() && r.frame.derivedPlane("glint_mask"))
+    e = writeImage((dir / "glint" / (name + ".png")).string(), r.frame, mask("glint_mask"), encode);
   if (e.empty()) e = writeText(dir / "labels" / (name + ".txt"), yoloText(labels, w, h));
-  if (e.empty() && (spec.write_depth || spec.write_coverage || spec.band == Band::kLwir)) {
-    std::vector<Channel> order;
-    if (spec.band == Band::kLwir) order.push_back(Channel::kLwir);
-    if (spec.write_depth)
-      order.insert(order.end(), {Channel::kDepth, Channel::kCloudDepth, Channel::kObjectId});
-    if (spec.write_coverage) order.insert(order.end(), {Channel::kCoverage, Channel::kVisibility});
-    if (!r.frame.glint.empty()) order.push_back(Channel::kGlint);
-    std::vector<ExrPlane> planes = exrPlanesOf(r.frame, order);
-    if (spec.band == Band::kLwir)
-      planes.insert(planes.begin() + 1, {"brightness_temperature", kelvin.data(), 1});
-    EncodeOptions exr = encode;
-    exr.exr_compression = "zip";
-    e = writeExrPlanes((dir / "exr" / (name + ".exr")).string(), w, h, planes,
-                       frameAttributes(r.frame.info), exr);
+  if (const Channels exr = sampleExr(spec, r.frame);
+      e.empty() && !(exr.order.empty() && exr.derived.empty())) {
+    EncodeOptions zip = encode;
+    zip.exr_compression = "zip";
+    e = writeImage((dir / "exr" / (name + ".exr")).string(), r.frame, exr, zip);
   }
   if (e.empty()) e = writeText(dir / "records" / (name + ".json"), record.dump() + "\n");
   return e;

@@ -318,10 +318,10 @@ SampleScene drawSample(const DatasetSpec& spec, int index) {
   return out;
 }
 
-std::vector<std::uint16_t> glintMask(const Frame& frame, double threshold) {
-  std::vector<std::uint16_t> mask(frame.glint.size(), 0);
+std::vector<float> glintMask(const Frame& frame, double threshold) {
+  std::vector<float> mask(frame.glint.size(), 0.0f);
   for (std::size_t i = 0; i < mask.size(); ++i)
-    if (frame.glint[i] >= threshold) mask[i] = 65535;
+    if (frame.glint[i] >= threshold) mask[i] = 65535.0f;
   return mask;
 }
 
@@ -391,11 +391,11 @@ std::vector<TargetLabel> labelTargets(const Frame& frame, const std::vector<int>
   return labels;
 }
 
-std::vector<std::uint16_t> instanceMask(const Frame& frame) {
-  std::vector<std::uint16_t> mask(frame.object_id.size(), 0);
+std::vector<float> instanceMask(const Frame& frame) {
+  std::vector<float> mask(frame.object_id.size(), 0.0f);
   for (std::size_t i = 0; i < mask.size(); ++i)
     if (frame.object_id[i] > 0.0f && frame.visibility[i] >= 0.5f)
-      mask[i] = std::uint16_t(frame.object_id[i]);
+      mask[i] = float(std::uint16_t(frame.object_id[i]));
   return mask;
 }
 

@@ -118,12 +118,14 @@ struct TargetLabel {
 std::vector<TargetLabel> labelTargets(const Frame& frame, const std::vector<int>& target_class,
                                       double glint_threshold = 0.25);
 
+// Masks as float planes, which hold every integer to 65535 exactly: derived planes that encode
+// writes as 16-bit grey (Channels::Pixels::kGrey16).
 // The sun's glint on the sea (a false alarm's first cause): 65535 where the frame's glint
 // luminance is at least `threshold`, 0 elsewhere; empty without a glint channel.
-std::vector<std::uint16_t> glintMask(const Frame& frame, double threshold);
+std::vector<float> glintMask(const Frame& frame, double threshold);
 
 // The visible-part mask of every target: 1 + target index where visible, 0 elsewhere.
-std::vector<std::uint16_t> instanceMask(const Frame& frame);
+std::vector<float> instanceMask(const Frame& frame);
 
 // One sample's COCO image entry and annotations (ids filled in when merged), YOLO lines.
 nlohmann::json sampleLabelsJson(const std::vector<TargetLabel>& labels, int width, int height);

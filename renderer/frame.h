@@ -90,11 +90,22 @@ struct Channels {
   enum class Pixels {
     kSrgb8,   // colour as sRGB R, G, B then coverage as A, 8 bits each, whatever the order
     kLinear,  // the same as linear floats (EXR: half unless EncodeOptions say otherwise)
-    kPlanes,  // one float plane per channel in `order` (colour as R, G, B), with the frame's
-              // pose and clock where the format holds them (EXR attributes)
+    kPlanes,  // one float plane per channel in `order` (colour as R, G, B), then the `derived`
+              // planes, with the frame's pose and clock where the format holds them (EXR
+              // attributes)
+    kGrey8,   // the one plane of `order` and `derived` as grey, grey_lo black to grey_hi white
+              // linearly, in 8-bit R = G = B (the layout of every 8-bit colour image)
+    kGrey16,  // the one plane, integers 0..65535 (ids, masks), as 16-bit grey (PNG)
   };
+  Channels() = default;
+  Channels(std::vector<Channel> channels, Pixels as = Pixels::kSrgb8,
+           std::vector<std::string> derived_planes = {})
+      : order(std::move(channels)), pixels(as), derived(std::move(derived_planes)) {}
+
   std::vector<Channel> order;
   Pixels pixels = Pixels::kSrgb8;
+  std::vector<std::string> derived;     // names of the frame's derived planes (Frame::derived)
+  double grey_lo = 0.0, grey_hi = 1.0;  // kGrey8's display range, in the plane's units
 
   bool has(Channel c) const { return std::find(order.begin(), order.end(), c) != order.end(); }
   ChannelSet set() const {
@@ -148,6 +159,13 @@ inline FrameInfo frameInfo(const Camera& camera, double time_s, std::uint64_t ti
   return info;
 }
 
+// A float plane its user derives from a frame's channels (the dataset's brightness
+// temperature and masks), named as an EXR layer: encode takes it as it takes a channel's.
+struct DerivedPlane {
+  std::string name;
+  std::vector<float> values;  // one per pixel, rows top-down
+};
+
 // One frame. Rows run top to bottom; planes hold one float per pixel and are empty unless
 // their channel was asked for.
 struct Frame {
@@ -158,6 +176,7 @@ struct Frame {
   // in place of `colour`: encoded as they are, never from floats.
   Srgb8Image srgb;
   std::vector<float> depth, cloud_depth, object_id, visibility, lwir, glint;
+  std::vector<DerivedPlane> derived;
 
   int width() const { return info.width; }
   // visibility = 1 - coverage, from colour's alpha (both back ends composite it there).
@@ -180,6 +199,9 @@ struct Frame {
     for (const ChannelInfo& c : kChannels)
       if (const std::vector<float>* plane = ownPlane(c.channel); plane && !plane->empty())
         *out.ownPlane(c.channel) = cropPlane(*plane, info.width, info.height, 1, x0, y0, w, h);
+    for (const DerivedPlane& d : derived)
+      out.derived.push_back(
+          {d.name, cropPlane(d.values, info.width, info.height, 1, x0, y0, w, h)});
     return out;
   }
   // The frame's own one-float-per-pixel plane of a channel; null for colour and coverage,
@@ -206,6 +228,12 @@ struct Frame {
   }
   std::vector<float>* ownPlane(Channel c) {
     return const_cast<std::vector<float>*>(std::as_const(*this).ownPlane(c));
+  }
+  // The derived plane of that name; null without one.
+  const DerivedPlane* derivedPlane(std::string_view name) const {
+    for (const DerivedPlane& d : derived)
+      if (d.name == name) return &d;
+    return nullptr;
   }
   // The single-float plane of a channel (coverage is copied out of colour's alpha); colour,
   // three floats per pixel, has none: read `colour`.

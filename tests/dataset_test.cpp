@@ -188,7 +188,7 @@ TEST(Dataset, LabelsOfAHandMadeFrame) {
       EXPECT_EQ(decoded[x * 4 + y], (x == 1 || x == 2) && (y == 1 || y == 2)) << x << "," << y;
   EXPECT_EQ(labels[1].silhouette_px, 0);
   EXPECT_EQ(yoloText(labels, 5, 4), "0 0.400000 0.500000 0.400000 0.500000\n");
-  const std::vector<std::uint16_t> mask = instanceMask(frame);
+  const std::vector<float> mask = instanceMask(frame);
   EXPECT_EQ(mask[1 * 5 + 1], 1);
   EXPECT_EQ(mask[1 * 5 + 3], 0);
 }
@@ -225,8 +225,8 @@ clarity = [0.2, 0.4]
   frame.object_id = {kSeaObjectId, 1, 1, kSeaObjectId, kSeaObjectId, 1, 1, kSeaObjectId};
   frame.visibility.assign(8, 1.0f);
   frame.glint = {0.0f, 0.3f, 0.1f, 2.0f, 0.0f, 0.0f, 0.25f, 0.0f};
-  const std::vector<std::uint16_t> mask = glintMask(frame, 0.25);
-  EXPECT_EQ(mask, (std::vector<std::uint16_t>{0, 65535, 0, 65535, 0, 0, 65535, 0}));
+  const std::vector<float> mask = glintMask(frame, 0.25);
+  EXPECT_EQ(mask, (std::vector<float>{0, 65535, 0, 65535, 0, 0, 65535, 0}));
   const std::vector<TargetLabel> labels = labelTargets(frame, {0}, 0.25);
   EXPECT_EQ(labels[0].glint_px, 2);  // columns 1-2 of both rows
   frame.glint.clear();
