@@ -75,7 +75,9 @@ class VideoStream {
   // Whether push would drop: a caller can skip rendering a frame no one would see.
   bool full() const;
   // Hands a frame (any size: it is scaled to the stream's) to the encoder thread; false, and
-  // counted, when the queue is full.
+  // counted, when the queue is full. A rendered frame's pixels are those encode's 8-bit
+  // formats take (srgb8Pixels, renderer/encode.h); turning them into YUV 4:2:0 at the
+  // stream's size is the encoder's own input stage.
   bool push(std::shared_ptr<const Srgb8Image> image, std::uint64_t tick);
   // A frame refused before it was rendered (full()), counted with the dropped.
   void countDropped() { ++dropped_; }

@@ -2,7 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <OpenImageIO/imageio.h>
+
+#include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 
 namespace nephele {
 namespace {
@@ -82,6 +87,119 @@ TEST(Encode, ExrOfPlanesCarriesThePoseAndLinearExrDoesNot) {
   EXPECT_TRUE(holds(planes, "depth"));
   EXPECT_FALSE(holds(linear, "nephele:focal_px"));
   EXPECT_FALSE(holds(linear, "depth"));
+}
+
+// The pixels of encoded bytes as OpenImageIO decodes them, `channels` per pixel as T; the
+// channel names of the file in `names`.
+template <typename T>
+std::vector<T> decoded(const Encoded& encoded, const char* extension, int channels,
+                       std::vector<std::string>* names = nullptr) {
+  const auto* bytes = std::get_if<std::vector<std::uint8_t>>(&encoded);
+  if (!bytes) {
+    ADD_FAILURE() << std::get<std::string>(encoded);
+    return {};
+  }
+  const std::string path = testing::TempDir() + "encode_test" + extension;
+  std::ofstream(path, std::ios::binary)
+      .write(reinterpret_cast<const char*>(bytes->data()), std::streamsize(bytes->size()));
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) {
+    ADD_FAILURE() << OIIO::geterror();
+    return {};
+  }
+  const OIIO::ImageSpec& spec = in->spec();
+  if (names) *names = spec.channelnames;
+  EXPECT_EQ(spec.nchannels, channels);
+  std::vector<T> out(std::size_t(spec.width) * spec.height * channels);
+  const auto type = std::is_same_v<T, float>           ? OIIO::TypeDesc::FLOAT
+                    : std::is_same_v<T, std::uint16_t> ? OIIO::TypeDesc::UINT16
+                                                       : OIIO::TypeDesc::UINT8;
+  EXPECT_TRUE(in->read_image(0, 0, 0, channels, type, out.data()));
+  std::filesystem::remove(path);
+  return out;
+}
+
+// A 3x2 frame with an lwir channel and a derived plane of brightness temperatures.
+Frame greyFrame() {
+  Frame f;
+  f.info.width = 3;
+  f.info.height = 2;
+  f.channels = {Channel::kLwir};
+  f.lwir = {1.0f, 2.0f, 3.0f, 4.0f, 5.0f, 6.0f};
+  f.derived.push_back({"kelvin", {210.0f, 220.0f, 245.3f, 270.0f, 319.9f, 340.0f}});
+  f.derived.push_back({"mask", {0.0f, 1.0f, 2.4f, 65535.0f, 70000.0f, -3.0f}});
+  return f;
+}
+
+TEST(Encode, Grey8PngShowsThePlaneFromLowToHighInEveryColourByte) {
+  const Frame f = greyFrame();
+  Channels grey{{}, Channels::Pixels::kGrey8, {"kelvin"}};
+  grey.grey_lo = 220.0;
+  grey.grey_hi = 320.0;
+  const std::vector<std::uint8_t> rgb =
+      decoded<std::uint8_t>(encode(f, ImageFileFormat::kPng, grey), ".png", 3);
+  ASSERT_EQ(rgb.size(), 18u);
+  const std::vector<float>& kelvin = f.derived[0].values;
+  for (std::size_t i = 0; i < kelvin.size(); ++i) {
+    const double unit = std::min(1.0, std::max(0.0, (kelvin[i] - 220.0) / 100.0));
+    const auto expected = std::uint8_t(std::floor(unit * 255.0 + 0.5));
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(rgb[i * 3 + k], expected) << i << " " << k;
+  }
+  // A channel's plane is grey too; two planes are not.
+  const Channels lwir{{Channel::kLwir}, Channels::Pixels::kGrey8};
+  const std::vector<std::uint8_t> raw =
+      std::get<std::vector<std::uint8_t>>(encode(f, ImageFileFormat::kRaw, lwir));
+  EXPECT_EQ(raw[0], 255);  // 1 W m^-2 sr^-1 against the range 0..1
+  EXPECT_TRUE(std::holds_alternative<std::string>(
+      encode(f, ImageFileFormat::kPng, {{Channel::kLwir}, Channels::Pixels::kGrey8, {"kelvin"}})));
+}
+
+TEST(Encode, Grey16PngHoldsThePlanesIntegers) {
+  const Frame f = greyFrame();
+  const Channels mask{{}, Channels::Pixels::kGrey16, {"mask"}};
+  EXPECT_EQ(decoded<std::uint16_t>(encode(f, ImageFileFormat::kPng, mask), ".png", 1),
+            (std::vector<std::uint16_t>{0, 1, 2, 65535, 65535, 0}));
+  EXPECT_TRUE(std::holds_alternative<std::string>(encode(f, ImageFileFormat::kTiff, mask)));
+  EXPECT_TRUE(std::holds_alternative<std::string>(
+      encode(f, ImageFileFormat::kPng, {{}, Channels::Pixels::kGrey16, {"absent"}})));
+}
+
+TEST(Encode, DerivedPlanesFollowTheChannelsAsFloatPlanes) {
+  const Frame f = greyFrame();
+  const Channels planes{{Channel::kLwir}, Channels::Pixels::kPlanes, {"kelvin"}};
+  std::vector<float> expected = f.lwir;
+  expected.insert(expected.end(), f.derived[0].values.begin(), f.derived[0].values.end());
+  EXPECT_EQ(asFloats(std::get<std::vector<std::uint8_t>>(encode(f, ImageFileFormat::kRaw, planes))),
+            expected);
+  std::vector<std::string> names;
+  const std::vector<float> exr =
+      decoded<float>(encode(f, ImageFileFormat::kExr, planes), ".exr", 2, &names);
+  ASSERT_EQ(exr.size(), 12u);
+  for (int c = 0; c < 2; ++c) {
+    const std::vector<float>& plane = names[c] == "lwir" ? f.lwir : f.derived[0].values;
+    EXPECT_TRUE(names[c] == "lwir" || names[c] == "kelvin") << names[c];
+    for (std::size_t i = 0; i < 6; ++i) EXPECT_EQ(exr[i * 2 + c], plane[i]) << names[c] << i;
+  }
+  EXPECT_NE(names[0], names[1]);
+}
+
+TEST(Encode, CroppingAFrameCropsItsDerivedPlanes) {
+  const Frame crop = greyFrame().cropped(1, 1, 2, 1);
+  ASSERT_EQ(crop.derived.size(), 2u);
+  EXPECT_EQ(crop.derivedPlane("kelvin")->values, (std::vector<float>{319.9f, 340.0f}));
+}
+
+// A video stream takes the same 8-bit pixels as encode: the frame's own, shared, or its
+// colour sRGB-encoded.
+TEST(Encode, Srgb8PixelsAreTheFramesOwnOrItsColourEncoded) {
+  auto own = std::make_shared<Frame>(smallFrame());
+  own->srgb = {2, 1, true, {1, 2, 3, 4, 5, 6, 7, 8}};
+  EXPECT_EQ(srgb8Pixels(std::shared_ptr<const Frame>(own)).get(), &own->srgb);
+  const auto converted = srgb8Pixels(std::make_shared<const Frame>(smallFrame()));
+  const std::vector<float>& linear = smallFrame().colour.rgba;
+  ASSERT_EQ(converted->rgba.size(), linear.size());
+  for (std::size_t i = 0; i < linear.size(); ++i)
+    EXPECT_EQ(converted->rgba[i], toByte(i % 4 == 3 ? linear[i] : srgbEncode(linear[i]))) << i;
 }
 
 }  // namespace
