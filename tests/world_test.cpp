@@ -415,6 +415,24 @@ void foldDrift(Scene& scene, const WindProfile& wind, double t) {
   }
 }
 
+// Moves everything `scene` holds by -shift, as set_site's re-centring has always moved it.
+void moveContent(Scene& scene, glm::dvec2 shift) {
+  const glm::dvec3 by(shift, 0.0);
+  scene.camera.position -= by;
+  for (CloudLayer& layer : scene.layers) layer.texture.drift_offset_m -= shift;
+  for (CloudField& field : scene.fields) field.drift_m -= shift;
+  for (EllipsoidCloud& cloud : scene.clouds) {
+    for (Ellipsoid& e : cloud.ellipsoids) e.centre -= by;
+    cloud.drift_m -= by;
+  }
+  for (Target& target : scene.targets) target.centre -= by;
+  for (RainShaft& shaft : scene.rain_shafts) shaft.centre -= shift;
+  for (auto& [key, weather] : scene.weather)
+    if (!weather.region.everywhere()) weather.region.centre -= shift;
+  if (scene.sea) scene.sea->origin_m -= shift;
+  scene.content_origin += shift;
+}
+
 // `world` changed as edits changed it before they were typed: the whole world copied with the
 // drift so far folded in, changed, the drift folded out with the new wind, and a world built
 // anew from that at the same time. A world without automata, whose states a new world would
@@ -502,6 +520,28 @@ TEST(World, TypedEditsEqualTheCopyEditBitForBit) {
     now.sea->origin_m = -now.content_origin;  // setSea lays a new sea's waves out so
   });
   check(world.setSea(sea), expected);
+  Haze haze;
+  haze.visibility_m = 9000.0;
+  expected = copyEdited(world, [&](Scene& now, WorldDynamics&) { now.haze = haze; });
+  check(world.setHaze(haze), expected);
+  ASSERT_EQ(world.advance(1.5), "");
+  // The first site places the world; the next re-centres it, moving all it holds.
+  const Site alps{45.0, 7.0, 0.0}, east{45.0, 7.5, 0.0};
+  expected = copyEdited(world, [&](Scene& now, WorldDynamics&) { now.site = alps; });
+  check(world.setSite(alps), expected);
+  ASSERT_EQ(world.advance(3.0), "");
+  const glm::dvec2 shift = recentred(alps, east.latitude_deg, east.longitude_deg).shift;
+  ASSERT_GT(glm::length(shift), 30000.0);
+  expected = copyEdited(world, [&](Scene& now, WorldDynamics&) {
+    now.site = east;
+    moveContent(now, shift);
+  });
+  check(world.setSite(east), expected);
+  ASSERT_EQ(world.advance(0.5), "");
+  expected = copyEdited(world, [&](Scene& now, WorldDynamics&) {
+    now.clouds[1].colour = {1, 0, 0};
+  });
+  check(world.changeCloud("extra", {{}, {}, {}, {}, glm::dvec3(1.0, 0.0, 0.0)}), expected);
   ASSERT_EQ(world.advance(9.0), "");
   const WindProfile calm{{{0.0, {-20.0, 5.0}}, {2000.0, {4.0, 1.0}}}};
   expected = copyEdited(world, [&](Scene&, WorldDynamics& d) { d.wind = calm; });
