@@ -490,16 +490,14 @@ std::string World::addTarget(const Target& target, bool replace, std::size_t max
   if (i && !replace) return "target.name: \"" + target.name + "\" is taken";
   if (!i && base_.targets.size() >= max_targets)
     return "target: the world holds " + std::to_string(max_targets) + " targets already";
-  editBase([&](Scene& base, WorldDynamics&) {
+  const auto place = [&](std::vector<Target>& targets) {
     if (i)
-      base.targets[*i] = target;
+      targets[*i] = target;
     else
-      base.targets.push_back(target);
-  });
-  if (i)
-    now_.targets[*i] = target;
-  else
-    now_.targets.push_back(target);
+      targets.push_back(target);
+  };
+  editBase([&](Scene& base, WorldDynamics&) { place(base.targets); });
+  place(now_.targets);
   finishEdit();
   return "";
 }

@@ -11,8 +11,8 @@
 #include <glm/glm.hpp>
 
 #include "renderer/frame_plan.h"
-#include "renderer/gl/ellipsoid_shaders.h"
 #include "renderer/frame_stats.h"
+#include "renderer/gl/ellipsoid_shaders.h"
 #include "renderer/gl/gl_objects.h"
 #include "renderer/gl/gpu_pass_timer.h"
 #include "renderer/gl/view_uniforms.h"
