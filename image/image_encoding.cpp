@@ -243,13 +243,6 @@ std::string encodeMaskPng(int width, int height, const std::vector<std::uint16_t
                         std::ptrdiff_t(width) * sizeof(std::uint16_t), out);
 }
 
-std::string writeMaskPng(const std::string& path, int width, int height,
-                         const std::vector<std::uint16_t>& values, const EncodeOptions& options) {
-  return writeWithOiio(path, ImageFileFormat::kPng, maskSpec(width, height, options),
-                       oiio::TypeDesc::UINT16, values.data(), sizeof(std::uint16_t),
-                       std::ptrdiff_t(width) * sizeof(std::uint16_t));
-}
-
 namespace {
 
 // The spec and interleaved pixels of named planes (writeExrPlanes, encodeExrPlanes).

@@ -36,13 +36,9 @@ std::string writeImageFile(const std::string& path, const FloatImage& image,
 std::string writeImageFile(const std::string& path, const Srgb8Image& image,
                            const EncodeOptions& options = {});
 
-// One 16-bit grey PNG (instance masks: the value is an id), rows top-down; in memory or as a
-// file.
+// One 16-bit grey PNG in memory (instance masks: the value is an id), rows top-down.
 std::string encodeMaskPng(int width, int height, const std::vector<std::uint16_t>& values,
                           const EncodeOptions& options, std::vector<std::uint8_t>& out);
-std::string writeMaskPng(const std::string& path, int width, int height,
-                         const std::vector<std::uint16_t>& values,
-                         const EncodeOptions& options = {});
 
 // Named float planes as one EXR: `stride` floats between a plane's pixels, rows top-down.
 // Colour-like planes (R, G, B, A) follow options.exr_half; every other plane is 32-bit float,

@@ -4,6 +4,7 @@
 #include <map>
 
 #include "image/video_stream.h"
+#include "renderer/encode.h"
 #include "server/engine_detail.h"
 
 // Frames: rendering a view, encoding off the world thread, render replies, subscriptions and
@@ -121,7 +122,7 @@ void Engine::sendToSubscribers(const std::shared_ptr<const RenderedView>& frame,
   std::vector<Subscription> sinks;  // copies: the encoder may run after a change
   for (Subscription* sub : members) {
     if (sub->video)  // to its own encoder thread, which drops what it cannot take
-      sub->video->push(std::shared_ptr<const Srgb8Image>(frame, &frame->frame.srgb),
+      sub->video->push(srgb8Pixels(std::shared_ptr<const Frame>(frame, &frame->frame)),
                        clock_.ticks());
     else
       sinks.push_back(*sub);
