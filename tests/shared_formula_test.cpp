@@ -14,13 +14,17 @@
 
 #include "gl_test_fixture.h"
 #include "renderer/gl/gl_objects.h"
-#include "renderer/gl/shaders/formulas_glsl.h"
+#include "renderer/gl/sky_shaders.h"
 #include "world/formulas/air.h"
 #include "world/formulas/ellipsoid.h"
 #include "world/formulas/far_deck.h"
 #include "world/formulas/heap.h"
+#include "world/formulas/region.h"
 #include "world/formulas/sea.h"
 #include "world/formulas/shading.h"
+#include "world/formulas/shadow.h"
+#include "world/formulas/texture.h"
+#include "world/formulas/volume.h"
 
 namespace nephele {
 namespace {
@@ -29,7 +33,10 @@ namespace f = formulas;
 constexpr double kRelative = 2e-5;
 constexpr std::size_t kChunk = 64;
 
-// An input as the GPU takes it: rounded to float.
+// An input as the GPU takes it: rounded to float (an integer as it is).
+int toFloat(int x) {
+  return x;
+}
 double toFloat(double x) {
   return double(float(x));
 }
@@ -53,6 +60,9 @@ std::string glslNumber(double x) {
 }
 std::string glslArg(double x) {
   return "(" + glslNumber(x) + " * u_one)";
+}
+std::string glslArg(int x) {
+  return "(" + std::to_string(x) + " * int(u_one))";
 }
 template <int N>
 std::string glslArg(glm::vec<N, double> v) {
@@ -95,13 +105,7 @@ class Cases {
 // A fragment stage whose fragment x = i writes case i's value to red.
 std::string fragmentSource(const std::vector<Case>& cases) {
   std::string s = "#version 450 core\n";
-  s += glsl::formulas::kPrelude;
-  s += glsl::formulas::kAir;
-  s += glsl::formulas::kShading;
-  s += glsl::formulas::kSea;
-  s += glsl::formulas::kEllipsoid;
-  s += glsl::formulas::kHeap;
-  s += glsl::formulas::kFarDeck;
+  s += formulaSource();  // as every stage of the GL renderer holds them
   s += "uniform float u_one;\nlayout(location = 0) out vec4 o_value;\nvoid main() {\n";
   s += "  float v = 0.0;\n  switch (int(gl_FragCoord.x)) {\n";
   for (std::size_t i = 0; i < cases.size(); ++i)
@@ -284,6 +288,12 @@ TEST_F(SharedFormulaTest, HeapLightAgrees) {
         cases.add("bentNormal", &f::bentNormal, 1.0, n, size * g, bend);
   for (double n_dot_l : {-1.0, -0.6, -0.59, -0.2, 0.0, 0.45, 1.0})
     for (double wrap : {0.0, 0.6}) cases.add("skinDiffuse", &f::skinDiffuse, 1.0, n_dot_l, wrap);
+  // Eq. 8 through a heap: in full light, its sun hidden, its sky hidden (K = 1/2), with and
+  // without a highlight.
+  for (const glm::dvec2& light : {glm::dvec2(1.0), glm::dvec2(0.0, 1.0), glm::dvec2(0.3, 0.5)})
+    for (double highlight : {0.0, 0.7})
+      cases.add("heapLitIntensity", &f::heapLitIntensity, 1.0, glm::dvec4(0.4, 0.5, 0.2, 8.0),
+                light.x, light.y, 0.8, highlight, 0.55);
   expectAgree(cases);
 }
 
@@ -330,6 +340,99 @@ TEST_F(SharedFormulaTest, SeaOpticsAgree) {
                                              toFloat(n), toFloat(slope_var));
         cases.add("glintRadiance", &f::glintRadiance, peak, d, sun, n, slope_var);
       }
+  // Facets level, tilted and steep enough to send a ray back down (the mirror held 0.01 above
+  // level); rays steep, low and grazing.
+  for (const glm::dvec2& slope : {glm::dvec2(0.0), glm::dvec2(0.1, -0.2), glm::dvec2(1e-7, 0.0),
+                                  glm::dvec2(-3.0, 1.5), glm::dvec2(0.0, 40.0)}) {
+    cases.add("seaNormal", &f::seaNormal, 1.0, slope);
+    const glm::dvec3 n = f::seaNormal(slope);
+    for (const glm::dvec3& d :
+         {glm::dvec3(0.0, 0.0, -1.0), glm::normalize(glm::dvec3(0.3, 0.9, -0.2)),
+          glm::normalize(glm::dvec3(0.0, 1.0, -1e-4)),
+          glm::normalize(glm::dvec3(-0.5, -0.5, -0.7))}) {
+      cases.add("seaIncidence", &f::seaIncidence, 1.0, d, n);
+      cases.add("mirroredRay", &f::mirroredRay, 1.0, d, n, f::seaIncidence(toFloat(d), toFloat(n)));
+    }
+  }
+  // The sines resolving none, some, the share's limit and more than all of the variance.
+  for (double resolved : {0.0, 0.004, 0.02, 0.03, 0.5})
+    cases.add("unresolvedSlopeVariance", &f::unresolvedSlopeVariance, 0.03, 0.03, resolved);
+  expectAgree(cases);
+}
+
+TEST_F(SharedFormulaTest, ShadowsAgree) {
+  Cases cases;
+  for (double sunlight : {0.0, 1e-6, 0.45, 1.0})
+    cases.add("groundLight", &f::groundLight, 1.0, sunlight);
+  // Sun rays through a lobe's centre, off it, along its outline and missing it, from below it,
+  // inside it and far below it; directions of unit and of other lengths (W is not a rotation).
+  for (const glm::dvec3& o : {glm::dvec3(0.0, 0.0, -3.0), glm::dvec3(0.4, -0.2, 0.1),
+                              glm::dvec3(1.0, 0.0, -2.0), glm::dvec3(2.5, 0.0, -40.0)})
+    for (const glm::dvec3& w :
+         {glm::dvec3(0.0, 0.0, 1.0), glm::dvec3(0.1, 0.05, 0.4), glm::dvec3(-0.8, 0.3, 2.5)})
+      cases.add("sunRayLimb", &f::sunRayLimb, glm::dot(o, o) + 1.0, o, w);
+  // Clear, thin, thick and endless chords; surfaces of no, some and full opacity.
+  for (double opacity : {0.0, 0.3, 1.0})
+    for (double depth : {0.0, 1e-6, 2.0, 1e4, 1e30})
+      cases.add("lobeSunlight", &f::lobeSunlight, 1.0, opacity, depth, f::kDiffuseAsymmetry);
+  // Targets in sun and shade, facing the sun, grazing and turned away.
+  for (double sunlight : {0.0, 0.4, 1.0})
+    for (double n_dot_l : {-0.5, 0.0, 0.3, 1.0})
+      cases.add("targetLight", &f::targetLight, 1.0, sunlight, n_dot_l);
+  expectAgree(cases);
+}
+
+TEST_F(SharedFormulaTest, VolumeAgrees) {
+  Cases cases;
+  // Back, side and forward scattering; no asymmetry, the default u = 0.8 and a strong one, and
+  // g = 1, where the forward peak meets the base's floor. (Nearer g = 1 float's base loses its
+  // digits to cancellation, which the tolerance would not cover.)
+  for (double c : {-1.0, -0.4, 0.0, 0.5, 0.9, 1.0}) {
+    cases.add("rayleighPhase", &f::rayleighPhase, 1.0, c);
+    for (double g : {0.0, 0.3, 0.7485870751, 0.85, 1.0})
+      cases.add("cornetteShanksPhase", &f::cornetteShanksPhase, 1.0, c, g);
+  }
+  // Lit, shaded (the difference below 0, held at 0) and sky-lit points.
+  for (const glm::dvec3& sun :
+       {glm::dvec3(0.9, 1.7, 0.0), glm::dvec3(0.4, 0.3, 0.6), glm::dvec3(0.0, 0.0, 1.0)})
+    for (double phase : {0.0, 0.75, 40.0})
+      cases.add("scatteredLight", &f::scatteredLight, phase + 3.0, phase, sun.x, sun.y, 0.35,
+                sun.z);
+  // Through the skin: backlit, side-lit and looking into the sun, with no beam left and all.
+  for (double c : {-1.0, 0.2, 0.95})
+    for (double sun : {0.0, 0.6})
+      cases.add("forwardScattered", &f::forwardScattered, 1.0, sun, c, f::kDiffuseAsymmetry);
+  // Steps of clear air, of thin and thick cloud, and of density rising, falling and huge.
+  for (const glm::dvec2& rho : {glm::dvec2(0.0), glm::dvec2(0.1, 0.4), glm::dvec2(1.0, 0.0),
+                                glm::dvec2(3.0, 5.0), glm::dvec2(1e6, 1e6)})
+    for (double ds : {0.0, 25.0, 400.0})
+      cases.add("segmentTransmittance", &f::segmentTransmittance, 1.0, rho.x, rho.y, ds, 16.33e-3);
+  expectAgree(cases);
+}
+
+TEST_F(SharedFormulaTest, RegionsAndTermsAgree) {
+  Cases cases;
+  // Bands before, across and past their width; none (a step at kRegionMinBand).
+  for (double x : {-5.0, 0.0, 1e-4, 200.0, 999.0, 4000.0})
+    for (double width : {0.0, 1000.0}) cases.add("bandRamp", &f::bandRamp, 1.0, x, width);
+  for (double heading : {0.0, 0.7, 3.0}) {
+    const glm::dvec2 d(1234.5, -876.0);
+    cases.add("regionAxes", &f::regionAxes, glm::length(d), d, std::cos(heading),
+              std::sin(heading));
+  }
+  // Inside, on the edge band and outside a rectangle; each side of a front and none.
+  for (const glm::dvec2& q : {glm::dvec2(0.0), glm::dvec2(4900.0, 100.0),
+                              glm::dvec2(-300.0, 7950.0), glm::dvec2(6000.0, 0.0)})
+    for (double side : {-1.0, 0.0, 1.0})
+      cases.add("regionWeightAt", &f::regionWeightAt, 1.0, q, glm::dvec2(5000.0, 8000.0), 500.0,
+                side, 2000.0);
+  for (double t1 : {0.2, 0.99, 1.0, 1.5})
+    for (double w : {0.0, 0.5, 1.0}) cases.add("regionThreshold", &f::regionThreshold, 1.0, t1, w);
+  // Footprints from none to far past the lowest term, each removal of terms; the fade's
+  // octave and the cut's steps.
+  for (double footprint : {0.0, 1e-6, 0.01, 0.06, 0.1, 0.3, 2.0, 1e30})
+    for (int removal : {f::kTermFade, f::kTermCut, f::kTermAll})
+      cases.add("resolvedTerms", &f::resolvedTerms, 8.0, footprint, 8.0, removal);
   expectAgree(cases);
 }
 
@@ -344,6 +447,10 @@ TEST_F(SharedFormulaTest, FarDeckCoverAgrees) {
     for (double coverage : {0.0, 0.3, 0.92, 1.0, 1.4})
       for (double side_ratio : {0.0, 0.8, 2.5})
         cases.add("farApparentCover", &f::farApparentCover, 1.0, coverage, side_ratio, r);
+  // The table's cell for covers outside [0, 1], at its first, a middle and its last step, and
+  // between steps.
+  for (double cover : {-0.2, 0.0, 0.0625, 0.3, 0.5, 0.96875, 0.999, 1.0, 1.3})
+    cases.add("farTableCell", &f::farTableCell, 1.0, cover);
   expectAgree(cases);
 }
 

@@ -6,7 +6,6 @@
 
 #include "world/counter_random.h"
 #include "world/formations/cloud_shadow.h"
-#include "world/formulas/sea.h"
 
 namespace nephele {
 namespace {
@@ -17,7 +16,6 @@ constexpr double kPi = std::numbers::pi;
 constexpr double kShortestWave = 0.5;
 // The drawn waves take at most this share of Cox-Munk's slope variance; the rest stays
 // unresolved at every distance, so no pixel is a perfect mirror.
-constexpr double kResolvedSlopeShare = 0.8;
 
 // The omnidirectional frequency spectrum S(omega), m^2 s (MODEL.md section 18): JONSWAP for a
 // fetch-limited sea, Pierson-Moskowitz when the fetch is long enough to be fully developed.
@@ -85,7 +83,7 @@ SeaSurface::SeaSurface(const Sea& sea, int count) {
     for (int i = 0; i < count; ++i) order[std::size_t(i)] = i;
     for (int i = count - 1; i > 0; --i)
       std::swap(order[std::size_t(i)], order[hashCounters(sea.seed, 1, i) % std::uint64_t(i + 1)]);
-    double budget = kResolvedSlopeShare * slope_var_;
+    double budget = formulas::kResolvedSlopeShare * slope_var_;
     for (int i = 0; i < count; ++i) {
       const double jitter = unitFromBits(hashCounters(sea.seed, 2, i));
       const double w = lo * std::exp((i + jitter) * step);
@@ -183,8 +181,7 @@ SeaSample SeaSurface::sample(glm::dvec2 xy, double time_s, double footprint_m) c
   }
   s.unresolved_height_var = std::max(height_var_ - resolved_height_var, 0.0);
   s.resolved_slope_var = resolved_slope_var;
-  s.unresolved_slope_var =
-      std::max(slope_var_ - resolved_slope_var, (1.0 - kResolvedSlopeShare) * slope_var_);
+  s.unresolved_slope_var = formulas::unresolvedSlopeVariance(slope_var_, resolved_slope_var);
   return s;
 }
 
@@ -212,12 +209,9 @@ double glintRadiance(glm::dvec3 d, glm::dvec3 sun, glm::dvec3 normal, double slo
 SeaShading shadeSea(const SeaSurface& surface, const Sea& sea, const SeaSample& s, glm::dvec3 d,
                     glm::dvec3 sun, glm::dvec3 sun_colour, double sunlight) {
   SeaShading out;
-  const glm::dvec3 n = glm::normalize(glm::dvec3(-s.slope.x, -s.slope.y, 1.0));
-  const double cos_i = std::clamp(-glm::dot(d, n), 0.0, 1.0);
-  glm::dvec3 r = d + 2.0 * cos_i * n;
-  // A facet that sends the ray back down would show the sea again: the sky at the horizon.
-  r.z = std::max(r.z, 0.01);
-  out.reflect_dir = glm::normalize(r);
+  const glm::dvec3 n = formulas::seaNormal(s.slope);
+  const double cos_i = formulas::seaIncidence(d, n);
+  out.reflect_dir = formulas::mirroredRay(d, n, cos_i);
   out.foam =
       foamShare(surface.whitecapFraction(), surface.foamSteepness(), glm::dot(s.slope, s.slope),
                 surface.drawnSlopeVariance(), surface.drawnSlopeVariance() - s.resolved_slope_var);

@@ -15,6 +15,8 @@
 
 #include <glm/glm.hpp>
 
+#include "world/formulas/sea.h"
+
 namespace nephele {
 
 // One wave train a host sets (CIGI 3.3 Wave Control): a long-crested sine on top of the
@@ -125,8 +127,8 @@ double fresnelWater(double cos_incidence, double n = 1.34);
 // The water's diffuse reflectance below the surface for its clarity (linear RGB).
 glm::dvec3 waterBodyColour(double clarity);
 
-// The effective reflectance of whitecap foam (Koepke 1984).
-inline constexpr double kFoamReflectance = 0.22;
+// The effective reflectance of whitecap foam (Koepke 1984): world/formulas/sea.h.
+using formulas::kFoamReflectance;
 
 // The share of a point covered by foam (MODEL.md section 18): where the surface is resolved,
 // where it is steepest, its squared slope above `foam_steepness` (what a fraction W of the

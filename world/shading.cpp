@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "world/formulas/heap.h"
 #include "world/formulas/shading.h"
 
 namespace nephele {
@@ -16,6 +17,11 @@ glm::dvec4 termsOf(const ShadingParams& shading) {
 double gardnerIntensity(const ShadingParams& shading, double diffuse, double highlight,
                         double texture_value) {
   return formulas::gardnerIntensity(termsOf(shading), diffuse, highlight, texture_value);
+}
+
+double heapLitIntensity(const ShadingParams& shading, double sun, double sky, double diffuse,
+                        double highlight, double texture_value) {
+  return formulas::heapLitIntensity(termsOf(shading), sun, sky, diffuse, highlight, texture_value);
 }
 
 DiffuseHighlight diffuseHighlight(const ShadingParams& shading, glm::dvec3 normal,

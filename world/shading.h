@@ -15,6 +15,11 @@ struct ShadingParams {
 double gardnerIntensity(const ShadingParams& shading, double diffuse, double highlight,
                         double texture_value);
 
+// Gardner eq. 8 lit through a heap (MODEL.md section 14; world/formulas/heap.h): the sun's
+// terms times its share `sun`, the ambient term times the sky's share `sky`.
+double heapLitIntensity(const ShadingParams& shading, double sun, double sky, double diffuse,
+                        double highlight, double texture_value);
+
 // Id = max(0, N.L) and Is = max(0, R.V)^e at a surface (0 where N.L <= 0 or s = 0), N turned
 // towards the viewer unless `turn` is false (a lighting normal, such as heapLitNormal's, that
 // may face away); n_dot_l is N.L itself, negative on the side turned from the sun.

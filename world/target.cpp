@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "world/formations/ellipsoid.h"
+#include "world/formulas/shadow.h"
 
 namespace nephele {
 namespace {
@@ -53,8 +54,7 @@ std::optional<double> intersectTriangle(glm::dvec3 o, glm::dvec3 d, glm::dvec3 a
 glm::dvec3 targetRadiance(const Target& target, glm::dvec3 normal, glm::dvec3 to_sun,
                           glm::dvec3 to_viewer, const Sun& sun, double sunlight) {
   if (glm::dot(normal, to_viewer) < 0.0) normal = -normal;
-  const double diffuse = sunlight * std::max(0.0, glm::dot(normal, to_sun));
-  return target.colour * sun.colour * (kTargetAmbient + (1.0 - kTargetAmbient) * diffuse);
+  return target.colour * sun.colour * formulas::targetLight(sunlight, glm::dot(normal, to_sun));
 }
 
 std::vector<glm::dvec3> scaledMeshVertices(const Target& target) {

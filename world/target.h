@@ -45,8 +45,7 @@ struct EntityType {
 
 // Targets are Lambertian with a fixed ambient share: colour * sun * (a + (1 - a) S max(0, N.L)),
 // N turned towards the viewer, S the share of the sunlight the clouds above let through
-// (MODEL.md section 16).
-inline constexpr double kTargetAmbient = 0.3;
+// (MODEL.md section 16; world/formulas/shadow.h targetLight).
 glm::dvec3 targetRadiance(const Target& target, glm::dvec3 normal, glm::dvec3 to_sun,
                           glm::dvec3 to_viewer, const Sun& sun, double sunlight = 1.0);
 

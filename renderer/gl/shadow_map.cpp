@@ -6,6 +6,7 @@
 
 #include "renderer/gl/gl_platform.h"
 #include "renderer/gl/shaders/shadow_map_glsl.h"
+#include "renderer/gl/sky_shaders.h"
 #include "world/automaton/cloud_density.h"
 #include "world/check.h"
 
@@ -86,17 +87,18 @@ void ShadowMap::prepare(const CloudShadows& shadows, glm::dvec3 camera, int size
   key_ = key;
 }
 
+std::string ShadowMap::fragmentSource() {
+  return "#version 450 core\nconst int kTableSize = " + std::to_string(kShadowTableSize) + ";\n" +
+         formulaSource() + kFragment;
+}
+
 void ShadowMap::draw(const CloudShadows& shadows, const std::vector<glm::vec4>& records,
                      const std::vector<float>& tables, glm::vec3 to_sun, int size, double half,
                      FrameStats& stats, GpuPassTimer& timer) {
   StageClock clock(stats.times.cpu(CpuStage::kUploads));
   if (!program_) {
     std::string error;
-    const std::string fragment =
-        "#version 450 core\nconst int kTableSize = " + std::to_string(kShadowTableSize) +
-        ";\nconst float kDiffuse = " + std::to_string(0.75 * (1.0 - kDiffuseAsymmetry)) + ";\n" +
-        kFragment;
-    program_ = createProgram(gl_, kVertex, fragment, error);
+    program_ = createProgram(gl_, kVertex, fragmentSource(), error);
     NEPHELE_CHECK(program_, "shadow map program: " << error);
     vertex_array_ = createVertexArray(gl_);
     framebuffer_ = createFramebuffer(gl_);

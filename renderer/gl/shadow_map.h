@@ -6,6 +6,7 @@
 // needs no order. The map is drawn again only when its casters, their tables or the sun change:
 // the views of one eye at one tick share it.
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -33,6 +34,8 @@ class ShadowMap {
   // and u_shadow_floor (the casters' lowest point above the camera, CloudShadows::floor).
   void bind(GLuint program, GLuint unit, glm::dvec3 camera) const;
   int draws() const { return draws_; }  // maps drawn since construction
+  // The map's fragment stage: its table size, the shared formulas and sunlight.glsl.
+  static std::string fragmentSource();
 
  private:
   // Uploads the casters' records and tables and draws the map.

@@ -71,10 +71,8 @@ std::string slotStatement(int slot, LayerKind kind) {
 // reference (world/formulas/).
 std::string commonSource() {
   return "const int kPrecipitationSlabs = " + std::to_string(kPrecipitationSlabs) +
-         ";\nconst int kRainShafts = " + std::to_string(kMaxRainShafts) + ";\n" +
-         glsl::formulas::kPrelude + glsl::formulas::kAir + glsl::formulas::kShading +
-         glsl::formulas::kSea + glsl::formulas::kEllipsoid + glsl::formulas::kHeap +
-         glsl::formulas::kFarDeck + kCommon;
+         ";\nconst int kRainShafts = " + std::to_string(kMaxRainShafts) + ";\n" + formulaSource() +
+         kCommon;
 }
 
 }  // namespace
@@ -95,6 +93,12 @@ std::string SkyPassLayout::key() const {
   k += '/';
   for (LayerKind kind : casters) k += char('a' + int(kind));
   return k;
+}
+
+std::string formulaSource() {
+  using namespace glsl::formulas;
+  return std::string(kPrelude) + kAir + kShading + kSea + kEllipsoid + kHeap + kFarDeck + kRegion +
+         kTexture + kShadow + kVolume;
 }
 
 std::string viewShaderSource() {
@@ -132,8 +136,6 @@ std::string skyDefines(const SkyPassLayout& layout) {
   if (layout.sea)
     s += "#define SEA\nconst int kSeaWaves = " + std::to_string(kMaxSeaWaves) +
          ";\nconst float kWaveModulation = " + std::to_string(kWaveModulation) + ";\n";
-  if (layout.shadows || !layout.casters.empty() || layout.sea)
-    s += "const float kGroundSkyShare = " + std::to_string(kGroundSkyShare) + ";\n";
   if (layout.term_filter == TermFilter::kCut) s += "#define FILTER_CUT\n";
   if (layout.term_filter == TermFilter::kNone) s += "#define FILTER_NONE\n";
   bool procedural = false, clipmap = false;

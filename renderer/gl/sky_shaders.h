@@ -45,6 +45,9 @@ struct SkyPassLayout {
 
 // The view chunk every screen-space pass shares: the view ray, fog, the background and the
 // targets' colour and distance, each behind its #define.
+// The formulas the GL shares with the CPU reference (world/formulas/, prelude first), as GLSL:
+// every stage that calls one holds them all (the compiler drops what a stage does not call).
+std::string formulaSource();
 std::string viewShaderSource();
 std::string polygonVertexSource();
 std::string skyFragmentSource(const SkyPassLayout& layout);

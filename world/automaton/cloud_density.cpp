@@ -228,16 +228,6 @@ void sweepSkylight(DensityLattice& lattice, double extinction_per_m) {
     }
 }
 
-double rayleighPhase(double cos_theta) {
-  return 0.75 * (1.0 + cos_theta * cos_theta);
-}
-
-double cornetteShanksPhase(double cos_theta, double g) {
-  const double g2 = g * g;
-  const double denominator = std::pow(std::max(1.0 + g2 - 2.0 * g * cos_theta, 1e-12), 1.5);
-  return 1.5 * (1.0 - g2) / (2.0 + g2) * (1.0 + cos_theta * cos_theta) / denominator;
-}
-
 double cornetteShanksAsymmetry(double u) {
   const double u2 = u * u;
   const double x = 5.0 / 9.0 * u + 125.0 / 729.0 * u2 * u +

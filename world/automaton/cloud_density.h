@@ -10,6 +10,7 @@
 
 #include "world/automaton/cellular_automaton.h"
 #include "world/formulas/heap.h"
+#include "world/formulas/volume.h"
 
 namespace nephele {
 
@@ -17,7 +18,7 @@ inline constexpr double kCloudExtinctionPerMetre =
     16.33e-3;                                        // Ex for density 1 (MODEL.md section 6)
 inline constexpr double kMetaballRadiusCells = 2.0;  // R = 2 l (MODEL.md section 6 default)
 // Asymmetry of cloud droplets' scattering for diffuse light (MODEL.md section 6, sky light).
-inline constexpr double kDiffuseAsymmetry = 0.85;
+using formulas::kDiffuseAsymmetry;
 
 // The share of diffuse light a non-absorbing cloud layer of optical depth tau lets through
 // (two-stream: 1 / (1 + 3/4 (1 - g) tau); MODEL.md section 6, sky light). 1 at tau = 0,
@@ -39,15 +40,9 @@ inline double diffuseSunlight(double tau_sun, double tau_away) {
 }
 
 // The light a point scatters towards the viewer, per unit of the sun's (MODEL.md section 6,
-// multiple scattering): the unscattered sunlight `sun_direct` = exp(-tau_sun) through the phase
-// function, the rest of the sunlight there, `sun_diffuse` (diffuseSunlight) less sun_direct,
-// scattered evenly, and the sky light `ambient` x `sky`. The difference is clamped at 0: exact
-// values never go below it (diffuseSunlight >= 1 / (1 + k tau_sun) >= exp(-tau_sun) for
-// k <= 1), interpolated ones might.
-inline double scatteredLight(double phase, double sun_direct, double sun_diffuse, double ambient,
-                             double sky) {
-  return phase * sun_direct + std::max(sun_diffuse - sun_direct, 0.0) + ambient * sky;
-}
+// multiple scattering): world/formulas/volume.h. Exact values never go below its clamp
+// (diffuseSunlight >= 1 / (1 + k tau_sun) >= exp(-tau_sun) for k <= 1), interpolated ones might.
+using formulas::scatteredLight;
 
 // The metaball field f(r) = -4/9 a^6 + 17/9 a^4 - 22/9 a^2 + 1, a = r / R; 0 beyond R.
 double metaballField(double r, double radius);
@@ -100,19 +95,19 @@ void sweepSunlight(DensityLattice& lattice, glm::dvec3 to_sun,
 // sky light). A vertical column needs no interpolation: exact at every sample.
 void sweepSkylight(DensityLattice& lattice, double extinction_per_m = kCloudExtinctionPerMetre);
 
-// Transmittance of a segment whose density runs linearly from rho_a to rho_b: exact, and
-// stays in [0, 1] however thick the segment.
+// Transmittance of a segment whose density runs linearly from rho_a to rho_b
+// (world/formulas/volume.h), at the cloud's extinction unless given.
 inline double segmentTransmittance(double rho_a, double rho_b, double length,
                                    double extinction_per_m = kCloudExtinctionPerMetre) {
-  return std::exp(-extinction_per_m * 0.5 * (rho_a + rho_b) * length);
+  return formulas::segmentTransmittance(rho_a, rho_b, length, extinction_per_m);
 }
 
 enum class PhaseFunction { kRayleigh, kCornetteShanks };
 
 // Both integrate to 4 pi over the sphere (mean 1). cos_theta is the cosine of the scattering
 // angle between the sunlight's direction of travel and the scattered ray's.
-double rayleighPhase(double cos_theta);                  // 3/4 (1 + cos^2)
-double cornetteShanksPhase(double cos_theta, double g);  // Shen eq. 11
-double cornetteShanksAsymmetry(double u);                // Shen eq. 12-13, g(u)
+using formulas::cornetteShanksPhase;       // Shen eq. 11
+using formulas::rayleighPhase;             // 3/4 (1 + cos^2)
+double cornetteShanksAsymmetry(double u);  // Shen eq. 12-13, g(u)
 
 }  // namespace nephele

@@ -11,6 +11,7 @@
 #include "world/automaton/cloud_density.h"
 #include "world/counter_random.h"
 #include "world/formations/cloud_field.h"
+#include "world/formulas/ellipsoid.h"
 #include "world/scene.h"
 #include "world/shading.h"
 #include "world/textures/solid_texture.h"
@@ -79,17 +80,11 @@ double meanOpacity(const ShadowTable& table, double g) {
 
 double casterSunlight(const ShadowCaster& caster, const ShadowTable& table, glm::dvec3 p,
                       glm::dvec3 to_sun) {
-  // |o + s w| = 1 in the unit sphere: a s^2 + 2 b s + c = 0.
   const glm::dvec3 o = caster.to_unit * (p - caster.centre), w = caster.to_unit * to_sun;
-  const double a = glm::dot(w, w), b = glm::dot(o, w), c = glm::dot(o, o) - 1.0;
-  const double quarter = b * b - a * c;  // a (1 - |o_perp|^2)
-  if (!(quarter > 0.0)) return 1.0;
-  const double root = std::sqrt(quarter);
-  const double far = (-b + root) / a;
-  if (!(far > 0.0)) return 1.0;  // the lobe lies below p
-  const double chord = far - std::max(0.0, (-b - root) / a);
-  const double g = quarter / a;
-  return 1.0 - meanOpacity(table, g) * (1.0 - diffuseTransmittance(caster.extinction * chord));
+  const double chord = formulas::unitSphereChord(o, w);  // 0 where the ray misses
+  if (!(chord > 0.0)) return 1.0;
+  return formulas::lobeSunlight(meanOpacity(table, formulas::sunRayLimb(o, w)),
+                                caster.extinction * chord, kDiffuseAsymmetry);
 }
 
 std::vector<std::size_t> castingPlanes(const Scene& scene) {

@@ -14,6 +14,7 @@
 #include "world/formations/cloud_field.h"
 #include "world/formations/ellipsoid_cloud.h"
 #include "world/formations/heap_light.h"
+#include "world/formulas/shadow.h"
 #include "world/textures/layer_texture.h"
 
 namespace nephele {
@@ -34,13 +35,10 @@ ShadowTable meanOpacityTable(const EllipsoidCloud& cloud);
 // The table read linearly at g in [0, 1].
 double meanOpacity(const ShadowTable& table, double g);
 
-// The share of the ground's light that comes from the sky rather than straight from the sun
-// under a clear sky: a ground point in full shadow keeps this much (MODEL.md section 16).
-inline constexpr double kGroundSkyShare = 0.3;
-// The ground's brightness relative to the unshadowed ground, for sunlight share S in [0, 1].
-inline double groundLight(double sunlight) {
-  return kGroundSkyShare + (1.0 - kGroundSkyShare) * sunlight;
-}
+// The ground's brightness relative to the unshadowed ground for a share of the sunlight, and
+// the share a point in full shadow keeps (MODEL.md section 16): world/formulas/shadow.h.
+using formulas::groundLight;
+using formulas::kGroundSkyShare;
 
 // Below this elevation of the sun no cloud casts a shadow: the ground is lit by the sky alone,
 // and a shadow would reach 60 times a cloud's height.

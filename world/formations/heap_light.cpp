@@ -178,7 +178,7 @@ MeanHeapLight meanHeapLight(const EllipsoidCloud& cloud, glm::dvec3 to_sun) {
 }
 
 double forwardScattered(double sun, double cos_theta) {
-  return sun * cornetteShanksPhase(cos_theta, kDiffuseAsymmetry) / (4.0 * std::numbers::pi);
+  return formulas::forwardScattered(sun, cos_theta, kDiffuseAsymmetry);
 }
 
 double heapIntensity(const EllipsoidCloud& cloud, const HeapLight& light, double texture_value,
@@ -191,9 +191,8 @@ double heapIntensity(const EllipsoidCloud& cloud, const HeapLight& light, double
   if (!(cloud.light_extinction > 0.0))
     return gardnerIntensity(shading, light.sun * d.diffuse, light.sun * d.highlight, texture_value);
   // Gardner eq. 8 with the sun's terms times S and the ambient term times K.
-  const double eq8 = gardnerIntensity(shading, light.sun * skinDiffuse(d.n_dot_l),
-                                      light.sun * d.highlight, texture_value) +
-                     shading.ambient * (light.sky - 1.0);
+  const double eq8 = heapLitIntensity(shading, light.sun, light.sky, skinDiffuse(d.n_dot_l),
+                                      d.highlight, texture_value);
   return eq8 + forwardScattered(light.direct, glm::dot(direction, to_sun)) * translucence;
 }
 

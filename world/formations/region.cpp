@@ -7,25 +7,21 @@
 
 #include "world/counter_random.h"
 #include "world/formulas/far_deck.h"
+#include "world/formulas/region.h"
 #include "world/limits.h"
 
 namespace nephele {
 
 glm::dvec2 regionLocal(const Region& r, glm::dvec2 xy) {
   const double h = r.heading_deg * std::numbers::pi / 180.0;
-  const glm::dvec2 d = xy - r.centre;
   // y along the heading (clockwise from north), x a quarter turn further clockwise.
-  return {d.x * std::cos(h) - d.y * std::sin(h), d.x * std::sin(h) + d.y * std::cos(h)};
+  return formulas::regionAxes(xy - r.centre, std::cos(h), std::sin(h));
 }
 
 double regionWeight(const Region& r, glm::dvec2 xy) {
   if (r.everywhere()) return 1.0;
-  const glm::dvec2 p = regionLocal(r, xy);
-  double w = bandRamp(r.half_size.x - std::abs(p.x), r.edge_m) *
-             bandRamp(r.half_size.y - std::abs(p.y), r.edge_m);
-  // The front: weight 1/2 on the line, rising to 1 half a band into the region's side.
-  if (r.side != 0) w *= bandRamp(r.side * p.x + 0.5 * r.transition_m, r.transition_m);
-  return w;
+  return formulas::regionWeightAt(regionLocal(r, xy), r.half_size, r.edge_m, double(r.side),
+                                  r.transition_m);
 }
 
 bool regionExcludesDisc(const Region& r, glm::dvec2 xy, double radius) {
@@ -60,9 +56,9 @@ double farApparentCover(const FarCover& far, glm::dvec3 ray) {
 }
 
 double farThreshold(const FarCover& far, glm::dvec3 ray) {
-  const double x = std::clamp(farApparentCover(far, ray), 0.0, 1.0) * FarCover::kSteps;
-  const int k = std::min(int(x), FarCover::kSteps - 1);
-  return far.threshold[k] + (x - k) * (far.threshold[k + 1] - far.threshold[k]);
+  const glm::dvec2 cell = formulas::farTableCell(farApparentCover(far, ray));
+  const int k = int(cell.x);
+  return glm::mix(far.threshold[k], far.threshold[k + 1], cell.y);
 }
 
 double clusterFactor(const ClusterVariation& v, std::uint64_t seed, std::uint64_t purpose,

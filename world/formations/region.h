@@ -10,6 +10,9 @@
 
 #include <glm/glm.hpp>
 
+#include "world/formulas/far_deck.h"
+#include "world/formulas/region.h"
+
 namespace nephele {
 
 struct Region {
@@ -27,7 +30,7 @@ struct Region {
 };
 
 // Bands narrower than this count as this wide (a step, without dividing by zero).
-inline constexpr double kRegionMinBand = 1.0e-3;
+using formulas::kRegionMinBand;
 
 // The region's coordinates of world point `xy`: x across the front line (positive to the
 // right of the heading), y along it.
@@ -42,18 +45,12 @@ double regionWeight(const Region& region, glm::dvec2 xy);
 bool regionExcludesDisc(const Region& region, glm::dvec2 xy, double radius);
 
 // Smoothstep of x / width clamped to [0, 1] (width at least kRegionMinBand): every band of a
-// region, and a far deck's hole, ramps this way.
-inline double bandRamp(double x, double width) {
-  const double u = std::min(std::max(x / std::max(width, kRegionMinBand), 0.0), 1.0);
-  return u * u * (3.0 - 2.0 * u);
-}
+// region, and a far deck's hole, ramps this way (world/formulas/region.h).
+using formulas::bandRamp;
 
-// A sky plane's T1 where the region's weight is w (MODEL.md section 11): raised towards 1,
-// above every value of T, as w falls to 0, so cover thins out and breaks up into the
-// texture's highest peaks before it ends, as a layer's edge does.
-inline double regionThreshold(double t1, double weight) {
-  return t1 >= 1.0 ? t1 : t1 + (1.0 - weight) * (1.0 - t1);
-}
+// A sky plane's T1 where the region's weight is w, raised towards 1 as w falls (MODEL.md
+// section 11; world/formulas/region.h).
+using formulas::regionThreshold;
 
 // Empty when usable, else what is wrong and what is allowed (ranges in world/limits.h).
 std::string regionError(const Region& region);
@@ -65,7 +62,7 @@ std::string regionError(const Region& region);
 // seen from the side over a path cot e times as long). T1 for a cover c is interpolated in a
 // table of T1 at c = 0, 1/16, ..., 1 calibrated on the deck's texture. side_ratio 0: none.
 struct FarCover {
-  static constexpr int kSteps = 16;
+  static constexpr int kSteps = formulas::kFarCoverSteps;
   double coverage = 0.0;
   double side_ratio = 0.0;
   double threshold[kSteps + 1]{};

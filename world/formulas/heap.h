@@ -6,9 +6,13 @@
 #ifdef __cplusplus
 #pragma once
 #include "world/formulas/prelude.h"
+#include "world/formulas/shading.h"
 
 namespace nephele::formulas {
 #endif
+
+// The asymmetry of cloud droplets' scattering for diffuse light (MODEL.md section 6, sky light).
+CONSTANT real kDiffuseAsymmetry = 0.85;
 
 // The share of diffuse light a non-absorbing cloud of optical depth tau lets through, two-stream
 // with asymmetry g: 1 / (1 + 3/4 (1 - g) tau) (MODEL.md section 6, sky light). 1 at tau = 0,
@@ -44,6 +48,15 @@ FORMULA vec3 bentNormal(vec3 n, vec3 gradient, real bend) {
 // max(0, N.L) at w = 0 (skinDiffuse).
 FORMULA real skinDiffuse(real n_dot_l, real wrap) {
   return max((n_dot_l + wrap) / (1.0 + wrap), 0.0);
+}
+
+// Gardner eq. 8 lit through a heap (MODEL.md section 14): the sun's terms (`diffuse`,
+// `highlight`) times the sun's share S, the ambient term a times the sky's K, with shading =
+// (a, t, s, e): gardnerIntensity + a (K - 1). The sunbeam scattered forward through the skin is
+// the caller's to add.
+FORMULA real heapLitIntensity(vec4 shading, real sun, real sky, real diffuse, real highlight,
+                              real it) {
+  return gardnerIntensity(shading, sun * diffuse, sun * highlight, it) + shading.x * (sky - 1.0);
 }
 
 #ifdef __cplusplus

@@ -19,8 +19,9 @@
 
 namespace nephele::formulas {
 // GLSL's built-ins, declared here so that no function of an enclosing namespace hides them.
-using glm::abs, glm::acos, glm::clamp, glm::cos, glm::cross, glm::dot, glm::exp, glm::length,
-    glm::max, glm::min, glm::mix, glm::normalize, glm::pow, glm::sin, glm::sqrt;
+using glm::abs, glm::acos, glm::clamp, glm::cos, glm::cross, glm::dot, glm::exp, glm::floor,
+    glm::length, glm::log2, glm::max, glm::min, glm::mix, glm::normalize, glm::pow, glm::sin,
+    glm::sqrt;
 using real = double;
 using vec2 = glm::dvec2;
 using vec3 = glm::dvec3;

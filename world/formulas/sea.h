@@ -7,6 +7,38 @@
 namespace nephele::formulas {
 #endif
 
+// The effective reflectance of whitecap foam (Koepke 1984).
+CONSTANT real kFoamReflectance = 0.22;
+// The share of the sea's slope variance the drawn sines may take (SeaSurface); at least the
+// rest is left to the glint's slope variance.
+CONSTANT real kResolvedSlopeShare = 0.8;
+
+// The slope variance the glint spreads over, for the sea's total and the share the drawn sines
+// resolve at the pixel: what they leave, but at least 1 - kResolvedSlopeShare of the total.
+FORMULA real unresolvedSlopeVariance(real total, real resolved) {
+  return max(total - resolved, (1.0 - kResolvedSlopeShare) * total);
+}
+
+// The unit facet normal of a surface whose height has gradient `slope`.
+FORMULA vec3 seaNormal(vec2 slope) {
+  return normalize(vec3(-slope.x, -slope.y, 1.0));
+}
+
+// The cosine of the incidence of unit view ray d on the facet of unit normal n, 0 for a facet
+// turned away.
+FORMULA real seaIncidence(vec3 d, vec3 n) {
+  return clamp(-dot(d, n), 0.0, 1.0);
+}
+
+// Where the sea mirrors unit view ray d: d reflected about the facet normal n (cos_i from
+// seaIncidence). A facet that sends the ray back down would show the sea again, so the ray
+// leaves at least 0.01 above level, and sees the sky at the horizon.
+FORMULA vec3 mirroredRay(vec3 d, vec3 n, real cos_i) {
+  vec3 r = d + 2.0 * cos_i * n;
+  r.z = max(r.z, 0.01);
+  return normalize(r);
+}
+
 // Unpolarised Fresnel reflectance of a dielectric of index n from air (Born and Wolf), for the
 // cosine of the incidence angle.
 FORMULA real fresnelWater(real cos_incidence, real n) {

@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include "world/counter_random.h"
+#include "world/formulas/texture.h"
 
 namespace nephele {
 double wrapPeriodic(double x, double period) {
@@ -118,10 +119,10 @@ double GardnerTexture::termCountForFootprint(double footprint_periods, TermFilte
   if (filter == TermFilter::kNone) return n;
   if (!(footprint_periods > 0.0)) return n;           // zero footprint: every term resolves
   if (!std::isfinite(footprint_periods)) return 0.0;  // infinite footprint: nothing resolves
-  // Term i (1-based) has 2^i cycles per period; it resolves while 2^i * footprint <= 1/2.
-  const double highest_resolved = std::log2(0.5 / footprint_periods);
-  if (filter == TermFilter::kCut) return std::clamp(std::floor(highest_resolved), 0.0, double(n));
-  return std::clamp(highest_resolved - 1.0, 0.0, double(n));
+  static_assert(int(TermFilter::kFade) == formulas::kTermFade &&
+                int(TermFilter::kCut) == formulas::kTermCut &&
+                int(TermFilter::kNone) == formulas::kTermAll);
+  return formulas::resolvedTerms(footprint_periods, double(n), int(filter));
 }
 
 }  // namespace nephele

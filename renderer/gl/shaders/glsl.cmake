@@ -51,7 +51,8 @@ endfunction()
 
 # The formulas the GL renderer shares with the CPU reference, written once in the common ground
 # of C++ and GLSL (world/formulas/prelude.h): the prelude first, then each family. sky_shaders.cpp
-# pastes them ahead of sky/common.glsl, so every stage that holds the view chunk holds them.
+# (formulaSource) pastes them ahead of sky/common.glsl, so every stage that holds the view chunk
+# holds them, and ahead of the shadow map's fragment stage.
 set(NEPHELE_FORMULA_DIR ${PROJECT_SOURCE_DIR}/world/formulas)
 nephele_embed_glsl(nephele_renderer formulas_glsl.h formulas
   kPrelude ${NEPHELE_FORMULA_DIR}/prelude.h  # real, FORMULA
@@ -60,7 +61,11 @@ nephele_embed_glsl(nephele_renderer formulas_glsl.h formulas
   kSea ${NEPHELE_FORMULA_DIR}/sea.h          # Fresnel, foam, glint
   kEllipsoid ${NEPHELE_FORMULA_DIR}/ellipsoid.h  # ray hit, limb function
   kHeap ${NEPHELE_FORMULA_DIR}/heap.h            # heap light, two-stream transmittance
-  kFarDeck ${NEPHELE_FORMULA_DIR}/far_deck.h)    # a far deck's apparent cover
+  kFarDeck ${NEPHELE_FORMULA_DIR}/far_deck.h     # a far deck's apparent cover
+  kRegion ${NEPHELE_FORMULA_DIR}/region.h        # a region's bands and threshold
+  kTexture ${NEPHELE_FORMULA_DIR}/texture.h      # the terms a footprint resolves
+  kShadow ${NEPHELE_FORMULA_DIR}/shadow.h        # a lobe's shadow, the ground's light
+  kVolume ${NEPHELE_FORMULA_DIR}/volume.h)       # phase functions, single scattering
 nephele_embed_glsl(nephele_renderer sky_glsl.h sky
   kCommon sky/common.glsl             # the view, output, air, background and targets
   kLayers sky/layers.glsl             # textured cloud layers

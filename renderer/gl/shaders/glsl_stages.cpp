@@ -7,10 +7,10 @@
 //   glsl_stages VALIDATOR DIRECTORY
 //
 // The sky, clipmap and ellipsoid stages come from the renderer's own source functions
-// (sky_shaders.h, ellipsoid_shaders.h). The automaton, shadow-map, target and floor programs
-// are assembled inside their renderers' classes; here their few prefix lines are written out
-// again, next to the pieces those classes join (automaton_renderer.cpp, shadow_map.cpp,
-// target_renderer.cpp, gl_renderer.cpp).
+// (sky_shaders.h, ellipsoid_shaders.h) and the shadow map's from ShadowMap::fragmentSource. The
+// automaton, target and floor programs are assembled inside their renderers' classes; here
+// their few prefix lines are written out again, next to the pieces those classes join
+// (automaton_renderer.cpp, target_renderer.cpp, gl_renderer.cpp).
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -24,9 +24,8 @@
 #include "renderer/gl/shaders/floor_glsl.h"
 #include "renderer/gl/shaders/shadow_map_glsl.h"
 #include "renderer/gl/shaders/target_glsl.h"
+#include "renderer/gl/shadow_map.h"
 #include "renderer/gl/sky_shaders.h"
-#include "world/automaton/cloud_density.h"
-#include "world/formations/cloud_shadow.h"
 
 namespace nephele {
 namespace {
@@ -142,10 +141,7 @@ void addOthers(Stages& stages) {
   }
   // ShadowMap::prepare.
   stages.add("shadow_map", true, glsl::shadow_map::kVertex);
-  stages.add("shadow_map", false,
-             "#version 450 core\nconst int kTableSize = " + std::to_string(kShadowTableSize) +
-                 ";\nconst float kDiffuse = " + std::to_string(0.75 * (1.0 - kDiffuseAsymmetry)) +
-                 ";\n" + glsl::shadow_map::kFragment);
+  stages.add("shadow_map", false, ShadowMap::fragmentSource());
   // TargetRenderer::program.
   stages.add("target", true, glsl::target::kVertex);
   stages.add("target", false,

@@ -23,19 +23,18 @@ vec4 densityAndLight(vec3 p) {
   return vec4(mix(v.xy, v.zw, u_blend), mix(sky.xz, sky.yw, u_blend));
 }
 
-// Light scattered towards the viewer per unit of the sun's: cloud_density.h scatteredLight.
-float scatteredLight(float phase, vec4 s) {
-  return phase * s.y + max(s.w - s.y, 0.0) + u_ambient * s.z;
-}
-
+// The phase function the cloud asks for (world/formulas/volume.h).
 float phase(float c) {
 #ifdef CORNETTE_SHANKS
-  float g2 = u_phase_g * u_phase_g;  // Shen eq. 11
-  return 1.5 * (1.0 - g2) / (2.0 + g2) * (1.0 + c * c) /
-         pow(max(1.0 + g2 - 2.0 * u_phase_g * c, 1e-6), 1.5);
+  return cornetteShanksPhase(c, u_phase_g);
 #else
-  return 0.75 * (1.0 + c * c);
+  return rayleighPhase(c);
 #endif
+}
+
+// Light scattered towards the viewer per unit of the sun's at sample s (densityAndLight).
+float scatteredAt(float phase, vec4 s) {
+  return scatteredLight(phase, s.y, s.w, u_ambient, s.z);
 }
 
 void main() {
@@ -60,8 +59,8 @@ void main() {
     vec4 b = densityAndLight((enter + float(i) * ds) * d);
     // Exact attenuation over the step for density linear along it (MODEL.md section 6), with the source
     // held at the mean of the step's ends, as the reference does.
-    float segment = exp(-u_extinction * 0.5 * (a.x + b.x) * ds);
-    float source = 0.5 * (scatteredLight(scattering, a) + scatteredLight(scattering, b));
+    float segment = segmentTransmittance(a.x, b.x, ds, u_extinction);
+    float source = 0.5 * (scatteredAt(scattering, a) + scatteredAt(scattering, b));
     radiance += transmittance * (1.0 - segment) * source * u_light;
     transmittance *= segment;
     a = b;

@@ -72,7 +72,8 @@ void addSolidTerm(int j, vec3 p, inout float sx, inout float sy) {
 
 float solidValue(vec3 p, vec3 dpdx, vec3 dpdy) {
   float count = resolvedTerms(
-      max(length(dpdx), length(dpdy)) * max(u_inv_period.x, u_inv_period.y), u_terms);
+      max(length(dpdx), length(dpdy)) * max(u_inv_period.x, u_inv_period.y), u_terms,
+      kTermFilter);
   int whole = int(count);
   float sx = u_t0, sy = u_t0;
   for (int j = 0; j < whole; ++j) addSolidTerm(j, p, sx, sy);
@@ -108,13 +109,6 @@ float solidValue(vec3 p, vec3 dpdx, vec3 dpdy) {
                      dpdy * u_inv_period).r;
 }
 #endif
-
-// L.sun P(cos theta) / (4 pi), P Cornette-Shanks (Shen eq. 11) with asymmetry g.
-float forwardScattered(float sun, float c) {
-  float g = u_scatter.y, g2 = g * g;
-  return sun * 1.5 * (1.0 - g2) / (2.0 + g2) * (1.0 + c * c) /
-         pow(max(1.0 + g2 - 2.0 * g * c, 1e-6), 1.5) / (4.0 * kPi);
-}
 
 // Length of the ray p + s v (v unit, s >= 0) inside the envelope of ellipsoid i's heap, p
 // camera-relative (envelopeChord).
@@ -153,10 +147,9 @@ vec3 surfaceColour(int i, vec3 n, vec3 r, vec3 p, float it, float tr, float dist
 #ifdef SPECULAR
   if (n_dot_l > 0.0) highlight = phongHighlight(n, n_dot_l, u_to_sun, -normalize(r), u_shading.w);
 #endif
-  float intensity = gardnerIntensity(u_shading, sun * diffuse, sun * highlight, it) +
-                    u_shading.x * (light.y - 1.0);
+  float intensity = heapLitIntensity(u_shading, sun, light.y, diffuse, highlight, it);
   vec3 d = normalize(r);
-  intensity += u_scatter.x * forwardScattered(direct, dot(d, u_to_sun)) * tr;
+  intensity += u_scatter.x * forwardScattered(direct, dot(d, u_to_sun), u_scatter.y) * tr;
   return applyAir(intensity * u_cloud_colour, d, distance);
 }
 

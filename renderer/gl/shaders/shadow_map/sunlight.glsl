@@ -1,4 +1,7 @@
 
+// One caster's share of the sunlight at each ground texel its footprint covers
+// (world/formations/cloud_shadow.cpp casterSunlight, with world/formulas/shadow.h); the
+// map's blending multiplies the casters' shares.
 layout(binding = 13) uniform samplerBuffer u_casters;
 layout(binding = 12) uniform sampler2D u_tables;  // kTableSize x tables: C(g)
 uniform vec3 u_to_sun;
@@ -14,18 +17,14 @@ void main() {
   vec3 rel = vec3(ground, 0.0) - c.xyz;
   vec3 o = vec3(dot(w0.xyz, rel), dot(w1.xyz, rel), dot(w2.xyz, rel));
   vec3 w = vec3(dot(w0.xyz, u_to_sun), dot(w1.xyz, u_to_sun), dot(w2.xyz, u_to_sun));
-  float a = dot(w, w), b = dot(o, w), quarter = b * b - a * (dot(o, o) - 1.0);
+  float chord = unitSphereChord(o, w);
   float light = 1.0;
-  if (quarter > 0.0) {
-    float root = sqrt(quarter), far = (-b + root) / a;
-    if (far > 0.0) {
-      float chord = far - max(0.0, (-b - root) / a);
-      float x = clamp(quarter / a, 0.0, 1.0) * float(kTableSize - 1);
-      int i = min(int(x), kTableSize - 2), row = int(w2.w);
-      float opacity = mix(texelFetch(u_tables, ivec2(i, row), 0).r,
-                          texelFetch(u_tables, ivec2(i + 1, row), 0).r, x - float(i));
-      light = 1.0 - opacity * (1.0 - 1.0 / (1.0 + kDiffuse * w1.w * chord));
-    }
+  if (chord > 0.0) {
+    float x = clamp(sunRayLimb(o, w), 0.0, 1.0) * float(kTableSize - 1);
+    int i = min(int(x), kTableSize - 2), row = int(w2.w);
+    float opacity = mix(texelFetch(u_tables, ivec2(i, row), 0).r,
+                        texelFetch(u_tables, ivec2(i + 1, row), 0).r, x - float(i));
+    light = lobeSunlight(opacity, w1.w * chord, kDiffuseAsymmetry);
   }
   o_light = vec4(light);
 }

@@ -104,21 +104,15 @@ float targetDistance() { return texelFetch(u_target_distance, ivec2(FRAG_XY), 0)
 vec3 targetColour() { return texelFetch(u_target_colour, ivec2(FRAG_XY), 0).rgb; }
 #endif
 
-// Gardner terms a pixel resolves (MODEL.md section 2), fractional where one fades, for a
-// footprint in periods: term j (1-based) resolves while 2^j footprint <= 1/2
-// (GardnerTexture::termCountForFootprint on the CPU).
-float resolvedTerms(float footprint, float terms) {
+// The stage's removal of terms above the pixel's frequency, for resolvedTerms
+// (world/formulas/texture.h).
 #if defined(FILTER_NONE)
-  return terms;
+const int kTermFilter = kTermAll;
+#elif defined(FILTER_CUT)
+const int kTermFilter = kTermCut;
 #else
-  float highest = log2(0.5 / max(footprint, 1e-30));
-#if defined(FILTER_CUT)
-  return clamp(floor(highest), 0.0, terms);
-#else
-  return clamp(highest - 1.0, 0.0, terms);  // fade over the octave below
+const int kTermFilter = kTermFade;
 #endif
-#endif
-}
 
 // Distance in metres along r (any length) to the first opaque surface: the ground plane
 // (MODEL.md section 5) or a target; kFar where the ray reaches the sky.
@@ -175,7 +169,7 @@ float groundSunlight(vec3 d) {
 }
 vec3 groundColour(vec3 d) {
 #if defined(SHADOWS) || defined(PLANE_SHADOWS)
-  return u_ground * (kGroundSkyShare + (1.0 - kGroundSkyShare) * groundSunlight(d));
+  return u_ground * groundLight(groundSunlight(d));
 #else
   return u_ground;
 #endif
@@ -205,8 +199,6 @@ layout(binding = 6) uniform sampler2D u_sea_probe;
 uniform vec3 u_probe_right;
 uniform vec3 u_probe_up;
 uniform vec3 u_probe_forward;
-const float kSeaResolvedShare = 0.8;
-const float kFoamReflectance = 0.22;
 
 vec3 probeRadiance(vec3 r) {
   vec2 ndc = vec2(dot(r, u_probe_right), dot(r, u_probe_up)) / max(dot(r, u_probe_forward), 1e-6);
@@ -232,17 +224,15 @@ vec3 seaColour(vec3 d) {
                        gardnerSin(wobble + 1.5707963267948966), m.xy);
     resolved_slope += waveHeightVariance(weight, w.z) * k * k;
   }
-  float slope_var = max(u_sea.x - resolved_slope, (1.0 - kSeaResolvedShare) * u_sea.x);
-  vec3 n = normalize(vec3(-slope, 1.0));
-  float cos_i = clamp(-dot(d, n), 0.0, 1.0);
-  vec3 r = d + 2.0 * cos_i * n;
-  r.z = max(r.z, 0.01);
-  r = normalize(r);
+  float slope_var = unresolvedSlopeVariance(u_sea.x, resolved_slope);
+  vec3 n = seaNormal(slope);
+  float cos_i = seaIncidence(d, n);
+  vec3 r = mirroredRay(d, n, cos_i);
   float foam = foamShare(u_sea.z, u_foam_steepness, dot(slope, slope), u_sea.y,
                          max(u_sea.y - resolved_slope, 0.0));
   float fresnel = fresnelWater(cos_i, 1.34);
   float sun = groundSunlight(d);
-  float diffuse = max(u_sea_sun.z, 0.0) * (kGroundSkyShare + (1.0 - kGroundSkyShare) * sun);
+  float diffuse = max(u_sea_sun.z, 0.0) * groundLight(sun);
   vec3 colour = diffuse * ((1.0 - foam) * (1.0 - fresnel) * u_sea_body +
                            foam * kFoamReflectance * u_sun_colour);
   if (u_sea_sun.z > 0.0 && sun > 0.0)

@@ -13,7 +13,7 @@ uniform vec4 u_region_size[kSlots];  // half sizes (m, 1e30 unbounded), edge, fr
 uniform float u_region_side[kSlots]; // front side -1 or 1, 0 for none
 uniform vec2 u_hole[kSlots];         // a far deck's hole around the camera and its band, m
 uniform vec2 u_far[kSlots];          // a far deck's coverage and side ratio (0 none)
-uniform float u_far_threshold[kSlots * 17];  // its T1 at cover 0, 1/16, ..., 1
+uniform float u_far_threshold[kSlots * (kFarCoverSteps + 1)];  // its T1 at cover 0, 1/16, ..., 1
 #endif
 uniform vec3 u_to_sun;
 
@@ -46,7 +46,8 @@ vec2 layerCoordinate(int i, LayerHit hit) { return u_origin[i] + hit.p * u_inv_p
 // Number of Gardner terms a pixel of slot i resolves.
 float termCount(int i, LayerHit hit) {
   return resolvedTerms(
-      max(length(hit.dpdx * u_inv_period[i]), length(hit.dpdy * u_inv_period[i])), u_terms[i]);
+      max(length(hit.dpdx * u_inv_period[i]), length(hit.dpdy * u_inv_period[i])), u_terms[i],
+      kTermFilter);
 }
 
 // Baked Gardner: level l holds the truncation to n - l terms in red and to n - l - 1 in
@@ -153,25 +154,19 @@ float clipmapValue(sampler2DArray rings, int i, LayerHit hit) {
 // T1 of slot i at `p` (metres from the camera): raised towards 1 as the weight of the layer's
 // region falls (world/formations/region.h, MODEL.md section 11).
 #ifdef REGIONS
-float regionRamp(float x, float width) {
-  float u = clamp(x / max(width, 1.0e-3), 0.0, 1.0);
-  return u * u * (3.0 - 2.0 * u);
-}
 float layerThreshold(int i, vec3 r, vec2 p) {
   float t1 = u_threshold[i];
   if (u_far[i].y > 0.0) {
     float cover = farApparentCover(u_far[i].x, u_far[i].y, r);  // world/formulas/far_deck.h
-    float x = clamp(cover, 0.0, 1.0) * 16.0;
-    int k = min(int(x), 15);
-    t1 = mix(u_far_threshold[17 * i + k], u_far_threshold[17 * i + k + 1], x - float(k));
+    vec2 cell = farTableCell(cover);
+    int k = (kFarCoverSteps + 1) * i + int(cell.x);
+    t1 = mix(u_far_threshold[k], u_far_threshold[k + 1], cell.y);
   }
-  vec2 d = p - u_region[i].xy;
-  vec2 q = vec2(d.x * u_region[i].z - d.y * u_region[i].w, d.x * u_region[i].w + d.y * u_region[i].z);
-  vec4 size = u_region_size[i];
-  float w = regionRamp(size.x - abs(q.x), size.z) * regionRamp(size.y - abs(q.y), size.z);
-  if (u_region_side[i] != 0.0) w *= regionRamp(u_region_side[i] * q.x + 0.5 * size.w, size.w);
-  if (u_hole[i].x > 0.0) w *= regionRamp(length(p) - u_hole[i].x, u_hole[i].y);
-  return t1 >= 1.0 ? t1 : t1 + (1.0 - w) * (1.0 - t1);
+  vec2 q = regionAxes(p - u_region[i].xy, u_region[i].z, u_region[i].w);
+  vec4 size = u_region_size[i];  // half sizes, edge band, transition band
+  float w = regionWeightAt(q, size.xy, size.z, u_region_side[i], size.w);
+  if (u_hole[i].x > 0.0) w *= bandRamp(length(p) - u_hole[i].x, u_hole[i].y);
+  return regionThreshold(t1, w);
 }
 #else
 float layerThreshold(int i, vec3 r, vec2 p) { return u_threshold[i]; }
@@ -213,7 +208,7 @@ void composite(int i, vec3 r, LayerHit hit, float t1, float it, inout vec3 colou
   if (u_height[i] <= u_shadow_floor)
     sun *= mapSunlight(hit.p - ((u_height[i] + u_camera_z) / u_to_sun.z) * u_to_sun.xy);
 #endif
-  surface *= kGroundSkyShare + (1.0 - kGroundSkyShare) * sun;
+  surface *= groundLight(sun);
 #endif
 #ifdef AIR
   surface = applyAir(surface, normalize(r), hit.distance);

@@ -9,13 +9,11 @@ uniform int u_smooth;           // 1: analytic ellipsoid normals, 0: facet norma
 uniform mat3 u_normal_matrix;   // R S^-1
 in vec3 v_position;
 in vec3 v_body;
-const float kAmbient = 0.3;     // kTargetAmbient
 void main() {
   vec3 n = u_smooth != 0 ? u_normal_matrix * v_body : cross(dFdx(v_position), dFdy(v_position));
   n = normalize(n);
   if (dot(n, v_position) > 0.0) n = -n;
-  vec3 colour =
-      u_albedo * (kAmbient + (1.0 - kAmbient) * u_sunlight * max(dot(n, u_to_sun), 0.0));
+  vec3 colour = u_albedo * targetLight(u_sunlight, dot(n, u_to_sun));
   float distance = length(v_position);
   o_colour = vec4(applyAir(colour, v_position / distance, distance), 1.0);
   o_distance = distance;
