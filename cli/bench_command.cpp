@@ -46,6 +46,9 @@ struct Setting {
   // Drawn as a continuous view (Renderer::setContinuousView): its image is the frame after
   // flying into the view at 250 m/s for 16 frames at 30 Hz, its time that of the view streamed.
   bool stream = false;
+  // Drawn by the CPU reference at this grid (reference_samples), not by the GL: its error
+  // against the sweep's reference and its time on the CPU, once. 0 for a GL point.
+  int reference_samples = 0;
 
   std::string name() const { return knob.empty() ? "defaults" : knob + "=" + value; }
 };
@@ -64,8 +67,11 @@ struct Point {
   bool same_image = false;   // draws exactly what the defaults draw: its time is noise
   std::vector<float> image;  // its pixels, held while the sweep compares them with the defaults
   bool front = false;
-  // Takes no part in the front: the defaults timed again, or another model (another sky).
-  bool apart() const { return same_image || setting.changes_model; }
+  // Takes no part in the front: the defaults timed again, another model (another sky), or the
+  // reference itself.
+  bool apart() const {
+    return same_image || setting.changes_model || setting.reference_samples > 0;
+  }
 };
 
 struct SceneResult {
@@ -112,6 +118,8 @@ bool holds(const SceneFile& file, KnobScope scope) {
       return s.sea.has_value();
     case KnobScope::kAutomata:
       return !file.dynamics.automata.empty();
+    case KnobScope::kAnything:
+      return true;
   }
   return false;
 }
@@ -130,6 +138,7 @@ void addKnobPoints(const RenderKnob& knob, const SceneFile& file, std::vector<Se
     };
     point.changes_model = knob.how == KnobSweep::kModel;
     point.stream = knob.how == KnobSweep::kStream;
+    if (knob.how == KnobSweep::kReference) point.reference_samples = int(value);
     out.push_back(std::move(point));
   }
 }
@@ -509,10 +518,26 @@ struct SweepContext {
   bool tty;
 };
 
+// A point of the reference's own grid: drawn and timed once on the CPU, its error against the
+// sweep's reference.
+Point measureReferencePoint(const SweepContext& c, const Setting& setting, const Scene& scene) {
+  Point point;
+  point.setting = setting;
+  if (c.tty) std::fprintf(stderr, "\r%s: %s", c.tag.c_str(), setting.name().c_str());
+  ReferenceSettings coarse = c.reference_settings;
+  coarse.samples_per_axis = setting.reference_samples;
+  const auto start = Clock::now();
+  const FloatImage image = renderReference(scene, coarse);
+  point.ms = 1e3 * secondsSince(start);
+  point.error = compareImages(image, c.reference);
+  return point;
+}
+
 // Point k of the sweep drawn as a running daemon would hold it, and its error; its time is
 // left to timePoints.
 Point measurePoint(const SweepContext& c, std::size_t k, const Setting& setting, const Scene& scene,
                    const RenderSettings& render) {
+  if (setting.reference_samples > 0) return measureReferencePoint(c, setting, scene);
   Point point;
   point.setting = setting;
   // A still view as a running daemon holds it: every clipmap filled (`auto` fills them over
@@ -556,6 +581,10 @@ void timePoints(const SweepContext& c, const std::vector<Setting>& settings,
         std::fprintf(stderr, "\r%s: timing round %d, %zu/%zu %-50s", c.tag.c_str(), round, k + 1,
                      settings.size(), settings[k].name().c_str());
       Point& point = result.points[k];
+      if (settings[k].reference_samples > 0) {  // timed once as it was drawn
+        point.floor_multiple = point.ms / result.floor_ms;
+        continue;
+      }
       if (settings[k].stream) c.renderer.setContinuousView("sweep " + std::to_string(k));
       point.ms = std::min(point.ms, medianMilliseconds(c.run.repeats, [&] {
                             c.renderer.renderSrgb8(scenes[k], renders[k]);
@@ -568,7 +597,9 @@ void timePoints(const SweepContext& c, const std::vector<Setting>& settings,
 // Every setting of one scene drawn, compared and timed.
 void sweepScene(const SweepContext& c, const BenchScene& bench_scene, const Scene& scene,
                 SceneResult& result) {
-  const std::vector<Setting> settings = settingsFor(bench_scene.file);
+  std::vector<Setting> settings = settingsFor(bench_scene.file);
+  // The reference's own grid only below the sweep's: at it, it is the sweep's reference.
+  std::erase_if(settings, [&](const Setting& p) { return p.reference_samples >= c.run.samples; });
   std::vector<Scene> edited(settings.size(), scene);
   std::vector<RenderSettings> renders(settings.size(), bench_scene.file.render);
   for (std::size_t k = 0; k < settings.size(); ++k) {

@@ -428,8 +428,7 @@ std::unique_ptr<Renderer> datasetRenderer(const DatasetCommandOptions& o, const 
   options.kind = o.renderer == "reference" ? RendererKind::kReference : RendererKind::kGl;
   options.gl_backend = backendFromName(o.gl_backend);
   options.render.channel_divisor = o.channel_divisor;
-  options.render.heaps = options.reference.heaps = spec.heaps;
-  options.reference.label_divisor = o.channel_divisor;
+  options.render.heaps = spec.heaps;
   std::string error;
   std::unique_ptr<Renderer> renderer = createRenderer(options, error);
   if (!renderer) {

@@ -60,9 +60,7 @@ std::string applyKnobOverrides(const RenderCommandOptions& o, SceneFile& file) {
     if (std::string e = knobError(knob, value); !e.empty()) return e;
     knob.set(file.render, value);
   }
-  file.reference.heaps = file.render.heaps;          // both renderers draw the same heaps
-  file.reference.sea_waves = file.render.sea_waves;  // and the same sea
-  if (o.samples) file.reference.samples_per_axis = *o.samples;
+  file.reference = referenceSettingsOf(file.render);
   return "";
 }
 
@@ -158,8 +156,12 @@ void addKnobFlags(CLI::App& cmd, RenderCommandOptions& o) {
                       : knob.type == KnobType::kBoolean ? "BOOL"
                                                         : "FLOAT");
   }
-  cmd.add_option("--samples", o.samples, "Reference supersampling per pixel axis")
-      ->check(CLI::Range(1, 16));
+  // --samples: the short name of --reference-samples, as `nephele bench` names its reference's.
+  cmd.add_option_function<std::string>(
+         "--samples",
+         [&o](const std::string& value) { o.knobs.emplace_back("reference_samples", value); },
+         "The same as --reference-samples")
+      ->type_name("INT");
 }
 
 void addEncodeFlags(CLI::App& cmd, RenderCommandOptions& o) {
@@ -286,7 +288,6 @@ int runRenderCommand(const RenderCommandOptions& o) {
   options.kind = o.renderer == "reference" ? RendererKind::kReference : RendererKind::kGl;
   options.gl_backend = backendFromName(o.gl_backend);
   options.render = file.render;
-  options.reference = file.reference;
   const std::unique_ptr<Renderer> renderer = createRenderer(options, error);
   if (!renderer) {
     spdlog::error("{}", error);

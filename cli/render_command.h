@@ -28,7 +28,6 @@ struct RenderCommandOptions {
   // Render knobs given as flags (one per row of renderer/render_knobs.inc): name, value as
   // written, in the order given.
   std::vector<std::pair<std::string, std::string>> knobs;
-  std::optional<int> samples;
   bool stats = false;
   EncodeOptions encode;
 };

@@ -153,13 +153,11 @@ void readKnob(TableReader& t, const RenderKnob& knob, RenderSettings& settings) 
 }
 
 void readRender(TableReader& t, SceneFile& out) {
-  std::vector<std::string> keys{"reference_samples"};
+  std::vector<std::string> keys;
   for (const RenderKnob& knob : renderKnobs()) keys.emplace_back(knob.name);
   t.allow(keys);
   for (const RenderKnob& knob : renderKnobs()) readKnob(t, knob, out.render);
-  t.integer("reference_samples", out.reference.samples_per_axis, 1, 16);
-  out.reference.heaps = out.render.heaps;          // both renderers draw the same heaps
-  out.reference.sea_waves = out.render.sea_waves;  // and the same sea
+  out.reference = referenceSettingsOf(out.render);
   t.finish();
 }
 

@@ -53,6 +53,7 @@ enum class KnobScope {
   kPlanes,          // sky planes or weather layers
   kSea,             // the sea
   kAutomata,        // automaton clouds
+  kAnything,        // every scene
 };
 
 // How `nephele bench` draws a point of a knob's sweep.
@@ -61,6 +62,7 @@ enum class KnobSweep {
   kMultipass,  // a single render with ellipsoid_passes = multipass, the only path it acts in
   kStream,     // a continuous view: the frame after flying into the view for 16 frames
   kModel,      // another model: its error against a reference with the same knob
+  kReference,  // the CPU reference at this value, against the bench's reference, timed on the CPU
 };
 
 struct RenderKnob {

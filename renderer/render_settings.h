@@ -38,6 +38,9 @@ enum class LimbEvaluation {
 
 enum class TileFormat { kRgba8, kFloat };
 
+// The CPU reference's supersampling per pixel axis by default (the knob reference_samples).
+inline constexpr int kReferenceSamples = 4;
+
 // The knobs' fields and defaults come from their rows in render_knobs.inc, which documents
 // each; render_knobs.h reads, checks, documents and sweeps them.
 struct RenderSettings {
@@ -58,11 +61,21 @@ struct RenderSettings {
 
 // The CPU reference (MODEL.md section 7).
 struct ReferenceSettings {
-  int samples_per_axis = 4;        // supersampling grid per pixel
-  int threads = 0;                 // 0: one per hardware thread
-  HeapDrawing heaps{};             // as RenderSettings::heaps
+  int samples_per_axis = kReferenceSamples;  // supersampling grid per pixel
+  int threads = 0;                           // 0: one per hardware thread
+  HeapDrawing heaps{};                       // as RenderSettings::heaps
   int label_divisor = 1;           // depth, cloud depth, object id: one centre ray per N x N block
   int sea_waves = kSeaComponents;  // as RenderSettings::sea_waves
 };
+
+// The reference's settings that a scene's render settings give: its supersampling
+// (reference_samples), and the heaps and sea both renderers draw.
+inline ReferenceSettings referenceSettingsOf(const RenderSettings& render) {
+  ReferenceSettings out;
+  out.samples_per_axis = render.reference_samples;
+  out.heaps = render.heaps;
+  out.sea_waves = render.sea_waves;
+  return out;
+}
 
 }  // namespace nephele

@@ -58,8 +58,8 @@ constexpr float kFloorColour[4] = {0.25f, 0.3f, 0.4f, 0.5f};
 
 class ReferenceBackendRenderer final : public Renderer {
  public:
-  ReferenceBackendRenderer(const ReferenceSettings& reference, const RenderSettings& settings)
-      : Renderer(settings), reference_(reference) {}
+  ReferenceBackendRenderer(int threads, const RenderSettings& settings)
+      : Renderer(settings), threads_(threads) {}
   Frame render(const Scene& scene, const RenderSettings& settings,
                const FrameRequest& request) override {
     return trace(scene, settings, request);
@@ -84,30 +84,28 @@ class ReferenceBackendRenderer final : public Renderer {
   }
   bool lastFrameCancelled() const override { return cancelled_; }
   RendererPlatform platform() const override {
-    const int threads = reference_.threads > 0
-                            ? reference_.threads
-                            : std::max(1, int(std::thread::hardware_concurrency()));
+    const int threads =
+        threads_ > 0 ? threads_ : std::max(1, int(std::thread::hardware_concurrency()));
     return {"reference", "", "cpu, " + std::to_string(threads) + " threads"};
   }
   std::string description() const override {
-    const std::string n = std::to_string(reference_.samples_per_axis);
+    const std::string n = std::to_string(settings_.reference_samples);
     return "reference: " + n + "x" + n + " samples per pixel";
   }
   std::unique_ptr<Renderer> another() const override {
-    return std::make_unique<ReferenceBackendRenderer>(reference_, settings_);
+    return std::make_unique<ReferenceBackendRenderer>(threads_, settings_);
   }
 
  private:
-  // The reference's sampling with what `settings` says both back ends draw alike.
+  // This frame as `settings` asks for it, on the renderer's threads.
   Frame trace(const Scene& scene, const RenderSettings& settings, const FrameRequest& request) {
-    ReferenceSettings drawn = reference_;
-    drawn.heaps = settings.heaps;
-    drawn.sea_waves = settings.sea_waves;
+    ReferenceSettings drawn = referenceSettingsOf(settings);
+    drawn.threads = threads_;
     drawn.label_divisor = settings.channel_divisor;
     return renderReferenceFrame(scene, drawn, request, progress_, cancel_, &cancelled_);
   }
 
-  ReferenceSettings reference_;
+  int threads_;
   ReferenceCancel cancel_;
   bool cancelled_ = false;
   FrameStats stats_;  // stays zero: the reference counts no passes
@@ -117,7 +115,7 @@ class ReferenceBackendRenderer final : public Renderer {
 
 std::unique_ptr<Renderer> createRenderer(const RendererOptions& options, std::string& error) {
   if (options.kind == RendererKind::kReference)
-    return std::make_unique<ReferenceBackendRenderer>(options.reference, options.render);
+    return std::make_unique<ReferenceBackendRenderer>(options.reference_threads, options.render);
   std::shared_ptr<const GlPlatform> platform = createGlPlatform(options.gl_backend, error);
   if (!platform) return nullptr;
   return std::make_unique<GlBackendRenderer>(std::move(platform), options.render);

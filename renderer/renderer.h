@@ -24,9 +24,10 @@ struct RendererOptions {
   GlBackend gl_backend = GlBackend::kAuto;
   // The knobs of the calls that take none (render(scene, request), renderSrgb8(scene)).
   RenderSettings render;
-  // The reference's own: samples and threads. What both back ends draw alike (heaps, sea
-  // waves, the label channels' divisor) comes from each call's RenderSettings.
-  ReferenceSettings reference;
+  // The reference's threads (0: one per hardware thread). The rest of what it draws (its
+  // samples, the heaps, the sea, the label channels' divisor) comes with each call's
+  // RenderSettings.
+  int reference_threads = 0;
 };
 
 // What a renderer runs on, as the benchmarks and the daemon print it.

@@ -38,7 +38,7 @@ class ChannelsTest : public ::testing::TestWithParam<RendererKind>, public Chann
   static std::unique_ptr<Renderer> makeRenderer(RendererKind kind) {
     RendererOptions options;
     options.kind = kind;
-    options.reference.samples_per_axis = 1;  // labels and colour from the centre ray
+    options.render.reference_samples = 1;  // labels and colour from the centre ray
     std::string error;
     auto renderer = createRenderer(options, error);
     EXPECT_NE(renderer, nullptr) << error;
@@ -261,7 +261,7 @@ TEST(ChannelsCompare, GlMatchesReferenceOnEveryChannel) {
   scene.targets = {a, b};
   const FrameRequest all{ChannelSet::all()};
   RendererOptions options;
-  options.reference.samples_per_axis = 1;
+  options.render.reference_samples = 1;
   std::string error;
   const auto gl = createRenderer(options, error);
   ASSERT_NE(gl, nullptr) << error;
@@ -303,8 +303,8 @@ TEST(ChannelsCompare, GlMatchesReferenceOnEveryChannel) {
 TEST(RendererInterface, ReferenceStopsBetweenRowsWhenCancelled) {
   RendererOptions options;
   options.kind = RendererKind::kReference;
-  options.reference.samples_per_axis = 1;
-  options.reference.threads = 1;
+  options.render.reference_samples = 1;
+  options.reference_threads = 1;
   std::string error;
   const auto reference = createRenderer(options, error);
   ASSERT_NE(reference, nullptr) << error;
@@ -334,7 +334,7 @@ TEST(RendererInterface, ReferenceStopsBetweenRowsWhenCancelled) {
 TEST(RendererInterface, ReferenceDrawsEachCallsSettings) {
   RendererOptions options;
   options.kind = RendererKind::kReference;
-  options.reference.samples_per_axis = 1;
+  options.render.reference_samples = 1;
   std::string error;
   const auto reference = createRenderer(options, error);
   ASSERT_NE(reference, nullptr) << error;

@@ -183,7 +183,7 @@ TEST(Recentre, FlightsAcrossTheEarthKeepDistancesAndHeadingsTrue) {
 std::vector<std::uint8_t> rendered(const Scene& scene, const Camera& camera) {
   RendererOptions options;
   options.kind = RendererKind::kReference;
-  options.reference.samples_per_axis = 1;
+  options.render.reference_samples = 1;
   std::string error;
   const auto renderer = createRenderer(options, error);
   EXPECT_NE(renderer, nullptr) << error;
