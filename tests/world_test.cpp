@@ -300,6 +300,30 @@ TEST(World, AWindChangeKeepsCloudsAndLayersWhereTheyAre) {
   EXPECT_NEAR(moved.y, 50.0, 1e-6);
 }
 
+// An automaton cloud too stays where its drift has brought it and rides the new wind, in the
+// world and in a snapshot taken after the change.
+TEST(World, AWindChangeKeepsAutomataWhereTheyAreAndSnapshotsKeepIt) {
+  World world = makeWorld();
+  ASSERT_EQ(world.advance(3.0), "");
+  const glm::dvec3 corner = world.scene().automata[0].corner;
+  ASSERT_EQ(world.setWind({{{0.0, {-20.0, 5.0}}}}), "");
+  EXPECT_NEAR(glm::length(world.scene().automata[0].corner - corner), 0.0, 1e-9);
+  ASSERT_EQ(world.advance(10.0), "");
+  const glm::dvec3 moved = world.scene().automata[0].corner - corner;
+  EXPECT_NEAR(moved.x, -200.0, 1e-6);
+  EXPECT_NEAR(moved.y, 50.0, 1e-6);
+  World restored(Scene{}, WorldDynamics{});
+  ASSERT_EQ(restored.restore(world.snapshot()), "");
+  EXPECT_EQ(restored.hash(), world.hash());
+  EXPECT_EQ(restored.scene().automata[0].corner, world.scene().automata[0].corner);
+  ASSERT_EQ(world.advance(4.5), "");
+  ASSERT_EQ(restored.advance(4.5), "");
+  EXPECT_EQ(restored.scene().automata[0].corner, world.scene().automata[0].corner);
+  EXPECT_EQ(restored.scene().automata[0].to->lattice.density,
+            world.scene().automata[0].to->lattice.density);
+  EXPECT_EQ(restored.hash(), world.hash());
+}
+
 // Every member of two scenes that the world's time or its edits set, compared bit for bit.
 void expectSameScene(const Scene& a, const Scene& b) {
   EXPECT_EQ(a.time_s, b.time_s);

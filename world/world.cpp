@@ -533,6 +533,12 @@ void World::editBase(const std::function<void(Scene& base, WorldDynamics& dynami
   if (base_.sea && !dynamics_.wind.empty() && wind_changes)
     base_.sea->wind = dynamics_.wind.at(0.0);
   foldDrift(-1.0);
+  // The automata ride the new wind from where they are; the specs a restore builds them from
+  // move with them.
+  if (wind_changes)
+    for (std::size_t i = 0; i < automata_.size(); ++i)
+      dynamics_.automata[i].position +=
+          glm::dvec3(automata_[i].setWind(dynamics_.wind, time_ns_), 0.0);
 }
 
 void World::finishEdit() {

@@ -232,6 +232,15 @@ int AutomatonCloud::advanceTo(std::int64_t time_ns, int threads) {
   return ran;
 }
 
+glm::dvec2 AutomatonCloud::setWind(const WindProfile& wind, std::int64_t time_ns) {
+  const glm::dvec2 before = gridWind();
+  wind_ = wind;
+  // view() places the grid at position + gridWind() t: keep that point at t.
+  const glm::dvec2 shift = (before - gridWind()) * (double(time_ns) / kNsPerSecond);
+  moveBy(shift);
+  return shift;
+}
+
 bool AutomatonCloud::setSun(glm::dvec3 to_sun) {
   if (to_sun == to_sun_) return false;
   to_sun_ = to_sun;

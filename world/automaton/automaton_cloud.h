@@ -101,6 +101,10 @@ class AutomatonCloud {
   int advanceTo(std::int64_t time_ns, int threads);
   // Moves the grid by `by` (a re-centred world, World::setSite).
   void moveBy(glm::dvec2 by) { spec_.position += glm::dvec3(by, 0.0); }
+  // The wind changed at time_ns (World::setWind): the grid stays where its drift has brought it
+  // and rides the new wind from there, its layers sheared by it. Returns how far its position
+  // at time 0 moved, which the world's copy of the spec moves too.
+  glm::dvec2 setWind(const WindProfile& wind, std::int64_t time_ns);
   // Recomputes the sunlight when the sun moved; returns whether it did.
   bool setSun(glm::dvec3 to_sun);
   // Replaces both states (snapshots); false if they do not fit the grid.
