@@ -99,7 +99,10 @@ std::vector<T> decoded(const Encoded& encoded, const char* extension, int channe
     ADD_FAILURE() << std::get<std::string>(encoded);
     return {};
   }
-  const std::string path = testing::TempDir() + "encode_test" + extension;
+  // A file of this test's own: ctest runs the tests of this binary side by side.
+  const std::string path = testing::TempDir() + "encode_test_" +
+                           testing::UnitTest::GetInstance()->current_test_info()->name() +
+                           extension;
   std::ofstream(path, std::ios::binary)
       .write(reinterpret_cast<const char*>(bytes->data()), std::streamsize(bytes->size()));
   auto in = OIIO::ImageInput::open(path);

@@ -23,6 +23,7 @@
 #include "world/formulas/sea.h"
 #include "world/formulas/shading.h"
 #include "world/formulas/shadow.h"
+#include "world/formulas/table.h"
 #include "world/formulas/texture.h"
 #include "world/formulas/volume.h"
 
@@ -354,9 +355,20 @@ TEST_F(SharedFormulaTest, SeaOpticsAgree) {
       cases.add("mirroredRay", &f::mirroredRay, 1.0, d, n, f::seaIncidence(toFloat(d), toFloat(n)));
     }
   }
+  // Footprints near and far, steep and grazing (the floor of |sin|), a pixel of 1 mrad.
+  for (double distance : {10.0, 3000.0, 4e4})
+    for (double sin_elev : {-1.0, -0.05, -1e-3, -1e-6, 0.0})
+      cases.add("seaFootprint", &f::seaFootprint,
+                1e-3 * distance / std::sqrt(std::max(std::abs(sin_elev), 1e-4)), distance, sin_elev,
+                1e-3);
   // The sines resolving none, some, the share's limit and more than all of the variance.
   for (double resolved : {0.0, 0.004, 0.02, 0.03, 0.5})
     cases.add("unresolvedSlopeVariance", &f::unresolvedSlopeVariance, 0.03, 0.03, resolved);
+  // Water alone, foam alone, a mirror that hides the body, and the sun low.
+  const glm::dvec3 body(0.002, 0.008, 0.035), sun_colour(1.0, 0.95, 0.85);
+  for (const glm::dvec3& w : {glm::dvec3(0.8, 0.0, 0.02), glm::dvec3(0.8, 1.0, 0.02),
+                              glm::dvec3(0.8, 0.3, 1.0), glm::dvec3(0.05, 0.1, 0.4)})
+    cases.add("seaBodyAndFoam", &f::seaBodyAndFoam, 0.25, w.x, w.y, w.z, body, sun_colour);
   expectAgree(cases);
 }
 
@@ -433,6 +445,9 @@ TEST_F(SharedFormulaTest, RegionsAndTermsAgree) {
   for (double footprint : {0.0, 1e-6, 0.01, 0.06, 0.1, 0.3, 2.0, 1e30})
     for (int removal : {f::kTermFade, f::kTermCut, f::kTermAll})
       cases.add("resolvedTerms", &f::resolvedTerms, 8.0, footprint, 8.0, removal);
+  // Both sums above 0, one or both below (no cloud), and the texture's contrast k.
+  for (const glm::dvec2& s : {glm::dvec2(0.7, 1.3), glm::dvec2(-0.2, 0.9), glm::dvec2(-1.0, -0.5)})
+    for (double k : {0.5, 2.4}) cases.add("textureFromSums", &f::textureFromSums, 4.0, s.x, s.y, k);
   expectAgree(cases);
 }
 
@@ -447,10 +462,10 @@ TEST_F(SharedFormulaTest, FarDeckCoverAgrees) {
     for (double coverage : {0.0, 0.3, 0.92, 1.0, 1.4})
       for (double side_ratio : {0.0, 0.8, 2.5})
         cases.add("farApparentCover", &f::farApparentCover, 1.0, coverage, side_ratio, r);
-  // The table's cell for covers outside [0, 1], at its first, a middle and its last step, and
-  // between steps.
-  for (double cover : {-0.2, 0.0, 0.0625, 0.3, 0.5, 0.96875, 0.999, 1.0, 1.3})
-    cases.add("farTableCell", &f::farTableCell, 1.0, cover);
+  // A table's cell for values outside [0, 1], at its first, a middle and its last step, and
+  // between steps: the far decks' 16 steps and the shadows' 32.
+  for (double x : {-0.2, 0.0, 0.0625, 0.3, 0.5, 0.96875, 0.999, 1.0, 1.3})
+    for (int steps : {f::kFarCoverSteps, 32}) cases.add("tableCell", &f::tableCell, 32.0, x, steps);
   expectAgree(cases);
 }
 

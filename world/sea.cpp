@@ -219,9 +219,8 @@ SeaShading shadeSea(const SeaSurface& surface, const Sea& sea, const SeaSample& 
   out.fresnel = (1.0 - out.foam) * fresnel;
   // Diffuse light on the surface, per pi: the sun's and the sky's (the ground's share in shadow).
   const double diffuse = std::max(sun.z, 0.0) * groundLight(sunlight);
-  out.body_and_foam = diffuse * sun_colour *
-                      ((1.0 - out.foam) * (1.0 - fresnel) * waterBodyColour(sea.clarity) +
-                       out.foam * kFoamReflectance);
+  out.body_and_foam = formulas::seaBodyAndFoam(
+      diffuse, out.foam, fresnel, sun_colour * waterBodyColour(sea.clarity), sun_colour);
   if (sun.z > 0.0 && sunlight > 0.0)
     out.glint =
         (1.0 - out.foam) * sunlight * glintRadiance(d, sun, n, s.unresolved_slope_var) * sun_colour;

@@ -165,11 +165,7 @@ inline double seaPixelAngle(double vfov_deg, int height_px) {
   return 2.0 * std::tan(0.5 * vfov_deg * 3.141592653589793 / 180.0) / std::max(height_px, 1);
 }
 
-// The metres per pixel at distance `distance` along a ray of elevation sin `sin_elev` below the
-// horizon, for `pixel_rad` radians a pixel: distance pixel / sqrt(|sin|), the geometric mean of
-// the footprint's two sides.
-inline double seaFootprint(double distance, double sin_elev, double pixel_rad) {
-  return distance * pixel_rad / std::sqrt(std::max(std::abs(sin_elev), 1e-4));
-}
+// The metres per pixel along a ray below the horizon (world/formulas/sea.h).
+using formulas::seaFootprint;
 
 }  // namespace nephele

@@ -97,8 +97,8 @@ std::string SkyPassLayout::key() const {
 
 std::string formulaSource() {
   using namespace glsl::formulas;
-  return std::string(kPrelude) + kAir + kShading + kSea + kEllipsoid + kHeap + kFarDeck + kRegion +
-         kTexture + kShadow + kVolume;
+  return std::string(kPrelude) + kTable + kAir + kShading + kSea + kEllipsoid + kHeap + kFarDeck +
+         kRegion + kTexture + kShadow + kVolume;
 }
 
 std::string viewShaderSource() {

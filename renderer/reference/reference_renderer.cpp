@@ -373,8 +373,7 @@ class ReferenceTracer {
     SeaView view;
     view.shading = shadeSea(*sea_, *scene_.sea, s, direction, sun_, scene_.sun.colour,
                             sunlight_.at({p.x, p.y, 0.0}));
-    const glm::dvec3 n = glm::normalize(glm::dvec3(-s.slope.x, -s.slope.y, 1.0));
-    view.cos_incidence = std::clamp(-glm::dot(direction, n), 0.0, 1.0);
+    view.cos_incidence = formulas::seaIncidence(direction, formulas::seaNormal(s.slope));
     std::vector<Surface> hits;
     const glm::dvec3 mirrored = glm::dvec3(probe_->trace(view.shading.reflect_dir, hits));
     view.colour = view.shading.body_and_foam + view.shading.glint + view.shading.fresnel * mirrored;

@@ -12,6 +12,7 @@
 #include "world/counter_random.h"
 #include "world/formations/cloud_field.h"
 #include "world/formulas/ellipsoid.h"
+#include "world/formulas/table.h"
 #include "world/scene.h"
 #include "world/shading.h"
 #include "world/textures/solid_texture.h"
@@ -72,10 +73,9 @@ ShadowTable meanOpacityTable(const EllipsoidCloud& cloud) {
 }
 
 double meanOpacity(const ShadowTable& table, double g) {
-  const double x = std::clamp(g, 0.0, 1.0) * (kShadowTableSize - 1);
-  const int i = std::min(int(x), kShadowTableSize - 2);
-  const double f = x - i;
-  return (1.0 - f) * table[std::size_t(i)] + f * table[std::size_t(i) + 1];
+  const glm::dvec2 cell = formulas::tableCell(g, kShadowTableSize - 1);
+  const std::size_t i = std::size_t(cell.x);
+  return (1.0 - cell.y) * table[i] + cell.y * table[i + 1];
 }
 
 double casterSunlight(const ShadowCaster& caster, const ShadowTable& table, glm::dvec3 p,

@@ -8,6 +8,7 @@
 #include "world/counter_random.h"
 #include "world/formulas/far_deck.h"
 #include "world/formulas/region.h"
+#include "world/formulas/table.h"
 #include "world/limits.h"
 
 namespace nephele {
@@ -56,7 +57,7 @@ double farApparentCover(const FarCover& far, glm::dvec3 ray) {
 }
 
 double farThreshold(const FarCover& far, glm::dvec3 ray) {
-  const glm::dvec2 cell = formulas::farTableCell(farApparentCover(far, ray));
+  const glm::dvec2 cell = formulas::tableCell(farApparentCover(far, ray), FarCover::kSteps);
   const int k = int(cell.x);
   return glm::mix(far.threshold[k], far.threshold[k + 1], cell.y);
 }

@@ -1,5 +1,5 @@
 // A far deck standing for a field's heaps (MODEL.md section 11): the cover it shows along a
-// view ray and where its threshold table is read for it. Shared by world/formations/region.cpp
+// view ray, for which its threshold table is read. Shared by world/formations/region.cpp
 // (farApparentCover, farThreshold) and the GL renderer's
 // renderer/gl/shaders/sky/layers.glsl (layerThreshold; see prelude.h). Its light is the
 // heaps' mean light, computed once on the CPU for both renderers (lightFarDeck,
@@ -21,16 +21,8 @@ FORMULA real farApparentCover(real coverage, real side_ratio, vec3 r) {
 }
 
 // A far deck's threshold table holds T1 at apparent cover 0, 1 / kFarCoverSteps, ..., 1
-// (FarCover::threshold, filled by thresholdForCoverage).
+// (FarCover::threshold, filled by thresholdForCoverage), read at tableCell (table.h).
 CONSTANT int kFarCoverSteps = 16;
-
-// The cell of that table where apparent cover `cover` falls and the place in it, (k, f): the
-// threshold is mix(t[k], t[k + 1], f), k at most kFarCoverSteps - 1.
-FORMULA vec2 farTableCell(real cover) {
-  real x = clamp(cover, 0.0, 1.0) * real(kFarCoverSteps);
-  real k = min(floor(x), real(kFarCoverSteps - 1));
-  return vec2(k, x - k);
-}
 
 #ifdef __cplusplus
 }  // namespace nephele::formulas

@@ -39,6 +39,14 @@ FORMULA vec3 mirroredRay(vec3 d, vec3 n, real cos_i) {
   return normalize(r);
 }
 
+// The light the sea sends back from below its surface and from its foam, lit by `diffuse` (the
+// sun's and sky's light on a level surface, per pi): the water body's reflectance `body` where
+// neither foam nor the Fresnel mirror covers it, foam's kFoamReflectance of `foam_colour` where
+// foam does. Colours in the caller's units (times the sun's colour).
+FORMULA vec3 seaBodyAndFoam(real diffuse, real foam, real fresnel, vec3 body, vec3 foam_colour) {
+  return diffuse * ((1.0 - foam) * (1.0 - fresnel) * body + foam * kFoamReflectance * foam_colour);
+}
+
 // Unpolarised Fresnel reflectance of a dielectric of index n from air (Born and Wolf), for the
 // cosine of the incidence angle.
 FORMULA real fresnelWater(real cos_incidence, real n) {
@@ -75,6 +83,13 @@ FORMULA real glintRadiance(vec3 d, vec3 sun, vec3 n, real slope_var) {
   real mu_n2 = mu_n * mu_n, tan2 = (1.0 - mu_n2) / mu_n2;
   return fresnelWater(dot(v, h), 1.34) * exp(-tan2 / slope_var) /
          (4.0 * slope_var * max(mu_v, 1e-2) * mu_n2 * mu_n2);
+}
+
+// The metres per pixel at `distance` along a ray of elevation sine `sin_elev` below the horizon,
+// `pixel_rad` radians a pixel: distance pixel / sqrt(|sin|), the geometric mean of the
+// footprint's two sides.
+FORMULA real seaFootprint(real distance, real sin_elev, real pixel_rad) {
+  return distance * pixel_rad / sqrt(max(abs(sin_elev), 1e-4));
 }
 
 // A sine's weight for a pixel's footprint f (MODEL.md section 18, filtering): 1 while its

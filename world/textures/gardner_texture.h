@@ -8,6 +8,8 @@
 
 #include <glm/glm.hpp>
 
+#include "world/formulas/texture.h"
+
 namespace nephele {
 
 struct GardnerTextureParams {
@@ -45,10 +47,8 @@ enum class TermFilter {
   kNone,  // keep every term (aliases; for measurement)
 };
 
-// Gardner's T from the two sums and k (MODEL.md section 2): k max(SX, 0) max(SY, 0).
-inline double textureFromSums(double sx, double sy, double k) {
-  return k * std::max(sx, 0.0) * std::max(sy, 0.0);
-}
+// Gardner's T from the two sums and k (MODEL.md section 2; world/formulas/texture.h).
+using formulas::textureFromSums;
 
 class GardnerTexture {
  public:

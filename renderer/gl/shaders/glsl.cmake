@@ -56,6 +56,7 @@ endfunction()
 set(NEPHELE_FORMULA_DIR ${PROJECT_SOURCE_DIR}/world/formulas)
 nephele_embed_glsl(nephele_renderer formulas_glsl.h formulas
   kPrelude ${NEPHELE_FORMULA_DIR}/prelude.h  # real, FORMULA
+  kTable ${NEPHELE_FORMULA_DIR}/table.h      # a table's cell
   kAir ${NEPHELE_FORMULA_DIR}/air.h          # slabs, haze, shafts
   kShading ${NEPHELE_FORMULA_DIR}/shading.h  # Gardner eq. 8, 9, 11, far heaps' diffuse
   kSea ${NEPHELE_FORMULA_DIR}/sea.h          # Fresnel, foam, glint

@@ -77,11 +77,11 @@ float solidValue(vec3 p, vec3 dpdx, vec3 dpdy) {
   int whole = int(count);
   float sx = u_t0, sy = u_t0;
   for (int j = 0; j < whole; ++j) addSolidTerm(j, p, sx, sy);
-  float t = u_k * max(sx, 0.0) * max(sy, 0.0);
+  float t = textureFromSums(sx, sy, u_k);
   float fraction = count - float(whole);
   if (fraction > 0.0) {
     addSolidTerm(whole, p, sx, sy);
-    t = mix(t, u_k * max(sx, 0.0) * max(sy, 0.0), fraction);
+    t = mix(t, textureFromSums(sx, sy, u_k), fraction);
   }
   return t;
 }
@@ -99,7 +99,7 @@ float solidValue(vec3 p, vec3 dpdx, vec3 dpdy) {
            textureGrad(u_volume, u_tex_origin + p * u_inv_period, dpdx * u_inv_period,
                        dpdy * u_inv_period).rg +
            textureGrad(u_volume_fine, u_fine_origin + p * fine, dpdx * fine, dpdy * fine).rg;
-  return u_k * max(s.x, 0.0) * max(s.y, 0.0);
+  return textureFromSums(s.x, s.y, u_k);
 }
 #else
 // A periodic 3D texture: Perlin noise with ordinary mipmaps.

@@ -20,10 +20,10 @@ void main() {
   float chord = unitSphereChord(o, w);
   float light = 1.0;
   if (chord > 0.0) {
-    float x = clamp(sunRayLimb(o, w), 0.0, 1.0) * float(kTableSize - 1);
-    int i = min(int(x), kTableSize - 2), row = int(w2.w);
+    vec2 cell = tableCell(sunRayLimb(o, w), kTableSize - 1);
+    int i = int(cell.x), row = int(w2.w);
     float opacity = mix(texelFetch(u_tables, ivec2(i, row), 0).r,
-                        texelFetch(u_tables, ivec2(i + 1, row), 0).r, x - float(i));
+                        texelFetch(u_tables, ivec2(i + 1, row), 0).r, cell.y);
     light = lobeSunlight(opacity, w1.w * chord, kDiffuseAsymmetry);
   }
   o_light = vec4(light);

@@ -209,7 +209,7 @@ vec3 probeRadiance(vec3 r) {
 vec3 seaColour(vec3 d) {
   float distance = u_camera_z / -d.z;
   vec2 p = d.xy * distance;
-  float footprint = distance * u_sea.w / sqrt(max(abs(d.z), 1e-4));
+  float footprint = seaFootprint(distance, d.z, u_sea.w);
   float resolved_slope = 0.0;
   vec2 slope = vec2(0.0);
   for (int i = 0; i < u_waves; ++i) {
@@ -233,8 +233,7 @@ vec3 seaColour(vec3 d) {
   float fresnel = fresnelWater(cos_i, 1.34);
   float sun = groundSunlight(d);
   float diffuse = max(u_sea_sun.z, 0.0) * groundLight(sun);
-  vec3 colour = diffuse * ((1.0 - foam) * (1.0 - fresnel) * u_sea_body +
-                           foam * kFoamReflectance * u_sun_colour);
+  vec3 colour = seaBodyAndFoam(diffuse, foam, fresnel, u_sea_body, u_sun_colour);
   if (u_sea_sun.z > 0.0 && sun > 0.0)
     colour += (1.0 - foam) * sun * glintRadiance(d, u_sea_sun, n, slope_var) * u_sun_colour;
   return colour + (1.0 - foam) * fresnel * probeRadiance(r);

@@ -106,11 +106,11 @@ float truncatedValue(int i, vec2 p, float count) {
   int whole = int(count);
   float sx = u_t0[i], sy = u_t0[i];
   for (int j = 0; j < whole; ++j) addTerm(i, j, p, sx, sy);
-  float t = u_k[i] * max(sx, 0.0) * max(sy, 0.0);
+  float t = textureFromSums(sx, sy, u_k[i]);
   float fraction = count - float(whole);
   if (fraction > 0.0) {
     addTerm(i, whole, p, sx, sy);
-    t = mix(t, u_k[i] * max(sx, 0.0) * max(sy, 0.0), fraction);
+    t = mix(t, textureFromSums(sx, sy, u_k[i]), fraction);
   }
   return t;
 }
@@ -158,7 +158,7 @@ float layerThreshold(int i, vec3 r, vec2 p) {
   float t1 = u_threshold[i];
   if (u_far[i].y > 0.0) {
     float cover = farApparentCover(u_far[i].x, u_far[i].y, r);  // world/formulas/far_deck.h
-    vec2 cell = farTableCell(cover);
+    vec2 cell = tableCell(cover, kFarCoverSteps);
     int k = (kFarCoverSteps + 1) * i + int(cell.x);
     t1 = mix(u_far_threshold[k], u_far_threshold[k + 1], cell.y);
   }
@@ -194,7 +194,11 @@ void composite(int i, vec3 r, LayerHit hit, float t1, float it, inout vec3 colou
 #endif
   float diffuse = max(n_dot_l, 0.0);
 #ifdef REGIONS
-  if (u_far[i].y > 0.0) diffuse = sphereDiffuse(dot(u_to_sun, -normalize(r)));
+  // A far deck stands for heaps: lit as their mean, with no highlight (as the reference).
+  if (u_far[i].y > 0.0) {
+    diffuse = sphereDiffuse(dot(u_to_sun, -normalize(r)));
+    highlight = 0.0;
+  }
 #endif
   vec3 surface = gardnerIntensity(u_shading[i], diffuse, highlight, it) * u_colour[i];
 #if defined(PLANE_SHADOWS) || defined(SHADOWS)
