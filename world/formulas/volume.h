@@ -1,6 +1,8 @@
-// Single scattering in an automaton cloud (MODEL.md section 6): the phase functions and the
-// light a point scatters towards the viewer. Shared by world/automaton/cloud_density.h and the
-// GL renderer's volume pass (renderer/gl/shaders/automaton/volume_pass.glsl; see prelude.h).
+// Scattering in clouds (MODEL.md sections 6 and 14): the phase functions, the light a point of
+// an automaton cloud scatters towards the viewer and a segment's transmittance, and the sunbeam
+// a heap's skin scatters forward. Shared by world/automaton/cloud_density.h,
+// world/formations/heap_light.cpp and the GL renderer's volume pass and ellipsoid shader
+// (renderer/gl/shaders/automaton/volume_pass.glsl, ellipsoid/cloud.glsl; see prelude.h).
 #ifdef __cplusplus
 #pragma once
 #include "world/formulas/prelude.h"

@@ -64,9 +64,9 @@ nephele_embed_glsl(nephele_renderer formulas_glsl.h formulas
   kHeap ${NEPHELE_FORMULA_DIR}/heap.h            # heap light, two-stream transmittance
   kFarDeck ${NEPHELE_FORMULA_DIR}/far_deck.h     # a far deck's apparent cover
   kRegion ${NEPHELE_FORMULA_DIR}/region.h        # a region's bands and threshold
-  kTexture ${NEPHELE_FORMULA_DIR}/texture.h      # the terms a footprint resolves
-  kShadow ${NEPHELE_FORMULA_DIR}/shadow.h        # a lobe's shadow, the ground's light
-  kVolume ${NEPHELE_FORMULA_DIR}/volume.h)       # phase functions, single scattering
+  kTexture ${NEPHELE_FORMULA_DIR}/texture.h      # the terms a footprint resolves, T from sums
+  kShadow ${NEPHELE_FORMULA_DIR}/shadow.h        # a lobe's shadow, ground and target light
+  kVolume ${NEPHELE_FORMULA_DIR}/volume.h)       # phase functions, scattering
 nephele_embed_glsl(nephele_renderer sky_glsl.h sky
   kCommon sky/common.glsl             # the view, output, air, background and targets
   kLayers sky/layers.glsl             # textured cloud layers
