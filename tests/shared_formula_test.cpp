@@ -207,6 +207,10 @@ TEST_F(SharedFormulaTest, SlabsAgree) {
           cases.add("slabPath", &f::slabPath, floor, slab, z0, dz, distance);
         }
   }
+  // The clear sky from below the horizon to the zenith.
+  for (double up : {-0.4, 0.0, 1e-6, 0.2, 1.0})
+    cases.add("skyGradient", &f::skyGradient, 1.0, glm::dvec3(0.7, 0.75, 0.8),
+              glm::dvec3(0.2, 0.35, 0.7), up);
   expectAgree(cases);
 }
 
@@ -318,6 +322,11 @@ TEST_F(SharedFormulaTest, ShadingAgrees) {
   // llvmpipe's acos is good to about 2e-4 radians, which moves the mean by up to 1e-4.
   for (double c : {-1.5, -1.0, -0.6, 0.0, 0.3, 0.999, 1.0, 1.2})
     cases.add("sphereDiffuse", &f::sphereDiffuse, 10.0, c);
+  // Normals facing the eye, away from it and across the ray.
+  for (const glm::dvec3& ray : {glm::dvec3(0.0, 1.0, 0.0), glm::dvec3(-300.0, 50.0, -20.0)})
+    for (const glm::dvec3& n :
+         {glm::dvec3(0.0, -1.0, 0.0), glm::dvec3(0.6, 0.8, 0.0), glm::dvec3(0.0, 0.0, 1.0)})
+      cases.add("facingViewer", &f::facingViewer, 1.0, n, ray);
   expectAgree(cases);
 }
 
@@ -387,6 +396,16 @@ TEST_F(SharedFormulaTest, ShadowsAgree) {
   for (double opacity : {0.0, 0.3, 1.0})
     for (double depth : {0.0, 1e-6, 2.0, 1e4, 1e30})
       cases.add("lobeSunlight", &f::lobeSunlight, 1.0, opacity, depth, f::kDiffuseAsymmetry);
+  // The sun's ray from a lobe's centre to the ground and from the ground up to a plane, the sun
+  // high and low (the vector of any length).
+  for (const glm::dvec3& to_sun : {glm::dvec3(0.3, -0.2, 0.93), glm::dvec3(2.0, 1.0, 0.05)})
+    for (const glm::dvec4& p_at :
+         {glm::dvec4(1200.0, -800.0, 1500.0, 0.0), glm::dvec4(-50.0, 30.0, 0.0, 4000.0)}) {
+      const double reach =
+          std::abs(p_at.w - p_at.z) * glm::length(glm::dvec2(to_sun.x, to_sun.y)) / to_sun.z +
+          2000.0;
+      cases.add("sunCrossing", &f::sunCrossing, reach, glm::dvec3(p_at), p_at.w, to_sun);
+    }
   // Targets in sun and shade, facing the sun, grazing and turned away.
   for (double sunlight : {0.0, 0.4, 1.0})
     for (double n_dot_l : {-0.5, 0.0, 0.3, 1.0})
@@ -419,6 +438,10 @@ TEST_F(SharedFormulaTest, VolumeAgrees) {
                                 glm::dvec2(3.0, 5.0), glm::dvec2(1e6, 1e6)})
     for (double ds : {0.0, 25.0, 400.0})
       cases.add("segmentTransmittance", &f::segmentTransmittance, 1.0, rho.x, rho.y, ds, 16.33e-3);
+  // A march's step, early and late, clear and opaque.
+  for (double transmittance : {1.0, 0.3})
+    for (double segment : {1.0, 0.6, 0.0})
+      cases.add("stepScattered", &f::stepScattered, 2.0, transmittance, segment, 0.8, 1.7);
   expectAgree(cases);
 }
 

@@ -27,7 +27,7 @@ double heapLitIntensity(const ShadingParams& shading, double sun, double sky, do
 DiffuseHighlight diffuseHighlight(const ShadingParams& shading, glm::dvec3 normal,
                                   glm::dvec3 to_sun, glm::dvec3 to_viewer, bool turn) {
   glm::dvec3 n = glm::normalize(normal);
-  if (turn && glm::dot(n, to_viewer) < 0.0) n = -n;
+  if (turn) n = formulas::facingViewer(n, -to_viewer);
   const double n_dot_l = glm::dot(n, to_sun);
   DiffuseHighlight out{std::max(0.0, n_dot_l), 0.0, n_dot_l};
   if (n_dot_l > 0.0 && shading.specular > 0.0)

@@ -5,12 +5,14 @@
 #include <limits>
 #include <numbers>
 
+#include "world/formulas/air.h"
+
 namespace nephele {
 
 glm::dvec3 skyBackground(const Sky& sky, glm::dvec3 direction) {
   const glm::dvec3 d = glm::normalize(direction);
   if (d.z < 0.0) return sky.ground;
-  return sky.horizon + (sky.zenith - sky.horizon) * std::sqrt(d.z);
+  return formulas::skyGradient(sky.horizon, sky.zenith, d.z);
 }
 
 glm::dvec3 sunDirection(const Sun& sun) {

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "world/formations/ellipsoid.h"
+#include "world/formulas/shading.h"
 #include "world/formulas/shadow.h"
 
 namespace nephele {
@@ -53,7 +54,7 @@ std::optional<double> intersectTriangle(glm::dvec3 o, glm::dvec3 d, glm::dvec3 a
 
 glm::dvec3 targetRadiance(const Target& target, glm::dvec3 normal, glm::dvec3 to_sun,
                           glm::dvec3 to_viewer, const Sun& sun, double sunlight) {
-  if (glm::dot(normal, to_viewer) < 0.0) normal = -normal;
+  normal = formulas::facingViewer(normal, -to_viewer);
   return target.colour * sun.colour * formulas::targetLight(sunlight, glm::dot(normal, to_sun));
 }
 

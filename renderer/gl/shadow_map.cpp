@@ -16,7 +16,7 @@ namespace {
 // Caster i is texels 4i to 4i + 3 of u_casters: its centre from the map's centre (x, y) and
 // its altitude (z), its reach (w); then the rows of W (xyz), with its extinction (row 1's w)
 // and its table's row (row 2's w).
-using glsl::shadow_map::kVertex;  // shaders/shadow_map/footprint.vert
+using glsl::shadow_map::kVertex;  // shaders/shadow_map/footprint_vertex.glsl
 
 // casterSunlight (world/formations/cloud_shadow.cpp) at the texel's ground point.
 using glsl::shadow_map::kFragment;  // shaders/shadow_map/sunlight.glsl
@@ -87,6 +87,10 @@ void ShadowMap::prepare(const CloudShadows& shadows, glm::dvec3 camera, int size
   key_ = key;
 }
 
+std::string ShadowMap::vertexSource() {
+  return "#version 450 core\n" + formulaSource() + kVertex;
+}
+
 std::string ShadowMap::fragmentSource() {
   return "#version 450 core\nconst int kTableSize = " + std::to_string(kShadowTableSize) + ";\n" +
          formulaSource() + kFragment;
@@ -98,7 +102,7 @@ void ShadowMap::draw(const CloudShadows& shadows, const std::vector<glm::vec4>& 
   StageClock clock(stats.times.cpu(CpuStage::kUploads));
   if (!program_) {
     std::string error;
-    program_ = createProgram(gl_, kVertex, fragmentSource(), error);
+    program_ = createProgram(gl_, vertexSource(), fragmentSource(), error);
     NEPHELE_CHECK(program_, "shadow map program: " << error);
     vertex_array_ = createVertexArray(gl_);
     framebuffer_ = createFramebuffer(gl_);

@@ -34,7 +34,9 @@ class ShadowMap {
   // and u_shadow_floor (the casters' lowest point above the camera, CloudShadows::floor).
   void bind(GLuint program, GLuint unit, glm::dvec3 camera) const;
   int draws() const { return draws_; }  // maps drawn since construction
-  // The map's fragment stage: its table size, the shared formulas and sunlight.glsl.
+  // The map's stages: the shared formulas, then footprint_vertex.glsl; the table size, the
+  // formulas, then sunlight.glsl.
+  static std::string vertexSource();
   static std::string fragmentSource();
 
  private:

@@ -275,7 +275,7 @@ class ReferenceTracer {
                                             entry.view.limb(direction), cloud.transition);
     // Turned towards the viewer, then bent towards the heap's (MODEL.md section 14).
     glm::dvec3 normal = entry.view.normalAt(direction, s);
-    if (glm::dot(normal, direction) > 0.0) normal = -normal;
+    normal = formulas::facingViewer(normal, direction);
     normal = heapLitNormal(entry.envelope, p, normal);
     // The heap's own light, and the sunlight the other clouds above let through (MODEL.md
     // sections 14 and 16).
@@ -330,8 +330,7 @@ class ReferenceTracer {
       const double segment = segmentTransmittance(rho_a, rho_b, ds);
       profile.emplace_back(enter + i * ds, transmittance * segment);
       // Source constant over the step (the mean of its ends); exact attenuation within it.
-      const double source = 0.5 * (lit_a + lit_b);
-      radiance += transmittance * (1.0 - segment) * source * light;
+      radiance += formulas::stepScattered(transmittance, segment, lit_a, lit_b) * light;
       transmittance *= segment;
       rho_a = rho_b;
       lit_a = lit_b;

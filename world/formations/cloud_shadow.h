@@ -52,10 +52,8 @@ inline constexpr double kMinShadowElevationDeg = 1.0;
 // than the heaps' beyond it.
 inline constexpr int kMaxCastingPlanes = 8;
 std::vector<std::size_t> castingPlanes(const Scene& scene);
-// Where the sun's ray through p crosses the plane Z = altitude (above p; to_sun rising).
-inline glm::dvec2 sunCrossing(glm::dvec3 p, double altitude, glm::dvec3 to_sun) {
-  return glm::dvec2(p) + ((altitude - p.z) / to_sun.z) * glm::dvec2(to_sun);
-}
+// Where the sun's ray through p crosses the plane Z = altitude (world/formulas/shadow.h).
+using formulas::sunCrossing;
 
 // How far from the camera's ground point shadows are drawn: 24 km, doubled until it is at
 // least 4 times the camera's height (a high camera sees the ground farther out), at most 64

@@ -112,6 +112,12 @@ FORMULA vec3 airOver(vec3 colour, vec3 weighted, real tau) {
   return mix(weighted / tau, colour, exp(-tau));
 }
 
+// The clear sky's colour at elevation sine `up` (MODEL.md section 5): from the horizon's colour
+// to the zenith's as sqrt(up), the horizon's at and below level.
+FORMULA vec3 skyGradient(vec3 horizon, vec3 zenith, real up) {
+  return horizon + (zenith - horizon) * sqrt(max(up, 0.0));
+}
+
 #ifdef __cplusplus
 }  // namespace nephele::formulas
 #endif

@@ -16,6 +16,12 @@ FORMULA real gardnerIntensity(vec4 shading, real diffuse, real highlight, real i
   return (1.0 - a) * ((1.0 - t) * ((1.0 - s) * diffuse + s * highlight) + t * it) + a;
 }
 
+// A surface normal turned towards the viewer: -n where n faces along the view ray `ray` (from
+// the eye to the surface, any length), else n.
+FORMULA vec3 facingViewer(vec3 n, vec3 ray) {
+  return dot(n, ray) > 0.0 ? -n : n;
+}
+
 // Phong's highlight Is = max(0, R.V)^e, R the unit `to_sun` mirrored about the unit normal n
 // (n_dot_l = n . to_sun, above 0), V the unit `to_viewer`.
 FORMULA real phongHighlight(vec3 n, real n_dot_l, vec3 to_sun, vec3 to_viewer, real e) {

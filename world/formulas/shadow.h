@@ -22,6 +22,12 @@ FORMULA real groundLight(real sunlight) {
   return kGroundSkyShare + (1.0 - kGroundSkyShare) * sunlight;
 }
 
+// Where the sun's ray through p crosses the plane Z = altitude (to_sun rising, unit or not):
+// p's ground point for altitude 0 below it, a plane's point above it.
+FORMULA vec2 sunCrossing(vec3 p, real altitude, vec3 to_sun) {
+  return vec2(p.x, p.y) + ((altitude - p.z) / to_sun.z) * vec2(to_sun.x, to_sun.y);
+}
+
 // The limb value g = 1 - |o_perp|^2 of the ray o + s w through a lobe's unit sphere (o the
 // point, w the direction towards the sun in the lobe's unit-sphere space): the limb function of
 // an eye at infinity, 1 through the centre, 0 on the outline, below 0 where the ray misses.

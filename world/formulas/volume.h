@@ -38,6 +38,13 @@ FORMULA real segmentTransmittance(real rho_a, real rho_b, real length, real exti
   return exp(-extinction * 0.5 * (rho_a + rho_b) * length);
 }
 
+// What a step of a march adds to the light scattered towards the eye, per unit of the light's
+// colour: the transmittance before it times the step's opacity 1 - segment times its source,
+// held at the mean of the step's ends (MODEL.md section 6).
+FORMULA real stepScattered(real transmittance, real segment, real source_a, real source_b) {
+  return transmittance * (1.0 - segment) * (0.5 * (source_a + source_b));
+}
+
 // The light a point scatters towards the viewer, per unit of the sun's: the unscattered
 // sunlight `sun_direct` through the phase function, the rest of the sunlight there,
 // `sun_diffuse` less sun_direct, scattered evenly, and the sky light `ambient` x `sky`. The

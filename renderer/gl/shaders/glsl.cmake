@@ -92,7 +92,7 @@ nephele_embed_glsl(nephele_renderer automaton_glsl.h automaton
 nephele_embed_glsl(nephele_renderer floor_glsl.h floor_pass
   kFloorFragment floor.frag)
 nephele_embed_glsl(nephele_renderer shadow_map_glsl.h shadow_map
-  kVertex shadow_map/footprint.vert
+  kVertex shadow_map/footprint_vertex.glsl
   kFragment shadow_map/sunlight.glsl)
 nephele_embed_glsl(nephele_renderer target_glsl.h target
   kVertex target/mesh.vert

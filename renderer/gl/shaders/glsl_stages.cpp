@@ -7,7 +7,7 @@
 //   glsl_stages VALIDATOR DIRECTORY
 //
 // The sky, clipmap and ellipsoid stages come from the renderer's own source functions
-// (sky_shaders.h, ellipsoid_shaders.h) and the shadow map's from ShadowMap::fragmentSource. The
+// (sky_shaders.h, ellipsoid_shaders.h) and the shadow map's from ShadowMap. The
 // automaton, target and floor programs are assembled inside their renderers' classes; here
 // their few prefix lines are written out again, next to the pieces those classes join
 // (automaton_renderer.cpp, target_renderer.cpp, gl_renderer.cpp).
@@ -22,7 +22,6 @@
 #include "renderer/gl/ellipsoid_shaders.h"
 #include "renderer/gl/shaders/automaton_glsl.h"
 #include "renderer/gl/shaders/floor_glsl.h"
-#include "renderer/gl/shaders/shadow_map_glsl.h"
 #include "renderer/gl/shaders/target_glsl.h"
 #include "renderer/gl/shadow_map.h"
 #include "renderer/gl/sky_shaders.h"
@@ -140,7 +139,7 @@ void addOthers(Stages& stages) {
                    glsl::automaton::kVolumePass);
   }
   // ShadowMap::prepare.
-  stages.add("shadow_map", true, glsl::shadow_map::kVertex);
+  stages.add("shadow_map", true, ShadowMap::vertexSource());
   stages.add("shadow_map", false, ShadowMap::fragmentSource());
   // TargetRenderer::program.
   stages.add("target", true, glsl::target::kVertex);

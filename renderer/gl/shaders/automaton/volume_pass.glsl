@@ -60,8 +60,8 @@ void main() {
     // Exact attenuation over the step for density linear along it (MODEL.md section 6), with the source
     // held at the mean of the step's ends, as the reference does.
     float segment = segmentTransmittance(a.x, b.x, ds, u_extinction);
-    float source = 0.5 * (scatteredAt(scattering, a) + scatteredAt(scattering, b));
-    radiance += transmittance * (1.0 - segment) * source * u_light;
+    radiance += stepScattered(transmittance, segment, scatteredAt(scattering, a),
+                              scatteredAt(scattering, b)) * u_light;
     transmittance *= segment;
     a = b;
   }

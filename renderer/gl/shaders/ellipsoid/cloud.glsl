@@ -160,7 +160,7 @@ float opacityFromExcess(float x) { return 1.0 - translucence(x, u_thresholds.z);
 vec4 ellipsoidSurface(int i, vec3 r, float s) {
   vec3 p = s * r;
   vec3 n = normalize(gradientFromUnit(i, record(i, 3).xyz + s * toUnit(i, r)));
-  if (dot(n, r) > 0.0) n = -n;  // turned towards the viewer
+  n = facingViewer(n, r);
   // Ray differentials on the tangent plane: the hit moves by s (dr - r (n.dr) / (n.r)).
   vec3 drx = u_right * (2.0 / u_viewport.x), dry = u_up * (2.0 / u_viewport.y);
   float n_dot_r = min(dot(n, r), -1e-4 * length(r));

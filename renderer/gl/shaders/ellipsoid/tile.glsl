@@ -13,8 +13,8 @@ void main() {
   o_colour = vec4(0.0, 0.0, 0.0, (u_thresholds.y - u_thresholds.x) * (1.0 - limbG(u_index, p)));
 #else
   vec3 n = normalize(gradientFromUnit(u_index, v_unit));
-  if (dot(n, p) > 0.0) n = -n;
-  float excess = it - u_thresholds.x - (u_thresholds.y - u_thresholds.x) * (1.0 - limbG(u_index, p));
+  n = facingViewer(n, p);
+  float excess = limbExcess(it, u_thresholds.x, u_thresholds.y, limbG(u_index, p));
   o_colour = vec4(surfaceColour(u_index, n, p, p, it, 1.0 - opacityFromExcess(excess), length(p)), 0.0);
 #endif
 }

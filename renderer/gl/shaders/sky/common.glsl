@@ -245,7 +245,7 @@ vec3 background(vec3 r) {
   // The ground's share of the pixel: r.z is linear across the image, so the horizon is a
   // straight edge and its box-filtered coverage is exact.
   float ground = clamp(0.5 - r.z / u_horizon_slope, 0.0, 1.0);
-  vec3 sky = u_horizon + (u_zenith - u_horizon) * sqrt(max(d.z, 0.0));  // MODEL.md section 5
+  vec3 sky = skyGradient(u_horizon, u_zenith, d.z);
 #ifdef SEA
   vec3 below = d.z < 0.0 ? seaColour(d) : u_horizon;
 #else

@@ -12,7 +12,7 @@ in vec3 v_body;
 void main() {
   vec3 n = u_smooth != 0 ? u_normal_matrix * v_body : cross(dFdx(v_position), dFdy(v_position));
   n = normalize(n);
-  if (dot(n, v_position) > 0.0) n = -n;
+  n = facingViewer(n, v_position);
   vec3 colour = u_albedo * targetLight(u_sunlight, dot(n, u_to_sun));
   float distance = length(v_position);
   o_colour = vec4(applyAir(colour, v_position / distance, distance), 1.0);
