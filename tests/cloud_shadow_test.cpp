@@ -133,7 +133,7 @@ TEST(CloudShadowTest, TheLowestPlanesCastWhileTheSunIsUp) {
   EXPECT_TRUE(castingPlanes(scene).empty());
   // From a point 1 km under a plane, with the sun 45 degrees up in the east, 1 km east.
   const glm::dvec2 q =
-      sunCrossing({10.0, 20.0, 500.0}, 1500.0, glm::normalize(glm::dvec3(1.0, 0.0, 1.0)));
+      planeCrossing({10.0, 20.0, 500.0}, 1500.0, glm::normalize(glm::dvec3(1.0, 0.0, 1.0)));
   EXPECT_NEAR(q.x, 1010.0, 1e-9);
   EXPECT_NEAR(q.y, 20.0, 1e-9);
 }

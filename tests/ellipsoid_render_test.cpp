@@ -217,7 +217,7 @@ TEST_F(EllipsoidRenderTest, CloudsShadowTheCloudsAndTargetsBelowThem) {
   const glm::dvec3 to_sun = sunDirection(lit.sun);
   // The box where the sun's ray through the cumulus's middle lands.
   Target box;
-  box.centre = glm::dvec3(sunCrossing({0.0, 0.0, 1400.0}, 0.0, to_sun), 30.0);
+  box.centre = glm::dvec3(planeCrossing({0.0, 0.0, 1400.0}, 0.0, to_sun), 30.0);
   box.size = {200.0, 200.0, 30.0};
   lit.targets.push_back(box);
   Scene shadowed = lit;
@@ -226,7 +226,7 @@ TEST_F(EllipsoidRenderTest, CloudsShadowTheCloudsAndTargetsBelowThem) {
   EllipsoidCloud slab = lit.clouds[0];
   slab.name = "slab";
   slab.ellipsoids = {{{1500.0, 1500.0, 200.0},
-                      glm::dvec3(sunCrossing({0.0, 0.0, 1400.0}, 3400.0, to_sun), 3400.0),
+                      glm::dvec3(planeCrossing({0.0, 0.0, 1400.0}, 3400.0, to_sun), 3400.0),
                       {}}};
   shadowed.clouds.push_back(slab);
   RenderSettings exact;

@@ -404,7 +404,7 @@ TEST_F(SharedFormulaTest, ShadowsAgree) {
       const double reach =
           std::abs(p_at.w - p_at.z) * glm::length(glm::dvec2(to_sun.x, to_sun.y)) / to_sun.z +
           2000.0;
-      cases.add("sunCrossing", &f::sunCrossing, reach, glm::dvec3(p_at), p_at.w, to_sun);
+      cases.add("planeCrossing", &f::planeCrossing, reach, glm::dvec3(p_at), p_at.w, to_sun);
     }
   // Targets in sun and shade, facing the sun, grazing and turned away.
   for (double sunlight : {0.0, 0.4, 1.0})

@@ -44,9 +44,9 @@ std::string casterFunction(int caster, int slot, LayerKind kind) {
   const std::string c = std::to_string(caster), i = std::to_string(slot);
   return "float casterSunlight" + c + "(LayerHit hit, float height) {\n" +
          "  float rise = u_height[" + i + "] - height;\n" + "  if (!(rise > 0.0)) return 1.0;\n" +
-         "  hit.p += (rise / u_to_sun.z) * u_to_sun.xy;\n" + "  float t1 = layerThreshold(" + i +
-         ", u_to_sun, hit.p);\n" + "  if (t1 >= 1.0) return 1.0;\n" +
-         "  float penumbra = 0.0093 * rise / u_to_sun.z;\n" +
+         "  hit.p = planeCrossing(vec3(hit.p, height), u_height[" + i + "], u_to_sun);\n" +
+         "  float t1 = layerThreshold(" + i + ", u_to_sun, hit.p);\n" +
+         "  if (t1 >= 1.0) return 1.0;\n" + "  float penumbra = 0.0093 * rise / u_to_sun.z;\n" +
          "  if (length(hit.dpdx) < penumbra) hit.dpdx = vec2(penumbra, 0.0);\n" +
          "  if (length(hit.dpdy) < penumbra) hit.dpdy = vec2(0.0, penumbra);\n" +
          "  return translucence(" + slotValue(slot, kind, "hit") + " - t1, u_transition[" + i +

@@ -148,8 +148,8 @@ class ReferenceTracer {
       } else {
         colour = skyBackground(scene_.sky, direction);
         if (direction.z < 0.0 && !sunlight_.empty()) {
-          const glm::dvec3 ground = eye + (eye.z / -direction.z) * direction;
-          colour *= groundLight(sunlight_.at({ground.x, ground.y, 0.0}));
+          const glm::dvec2 ground = formulas::planeCrossing(eye, 0.0, direction);
+          colour *= groundLight(sunlight_.at({ground, 0.0}));
         }
       }
     }

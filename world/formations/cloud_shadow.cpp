@@ -178,8 +178,7 @@ void CloudShadows::footprintCells(const ShadowCaster& caster, glm::ivec2& c0,
 void CloudShadows::footprint(const ShadowCaster& caster, glm::dvec2& lo, glm::dvec2& hi) const {
   // The bounding sphere's shadow on Z = 0 is an ellipse about the centre's shadow with semi-axes
   // reach and reach / sin(elevation); the square of half side reach / to_sun.z holds it.
-  const glm::dvec2 centre =
-      glm::dvec2(caster.centre) - caster.centre.z / to_sun_.z * glm::dvec2(to_sun_);
+  const glm::dvec2 centre = planeCrossing(caster.centre, 0.0, to_sun_);
   const double half = caster.reach / to_sun_.z;
   lo = centre - half;
   hi = centre + half;
@@ -188,7 +187,7 @@ void CloudShadows::footprint(const ShadowCaster& caster, glm::dvec2& lo, glm::dv
 double CloudShadows::sunlightAt(glm::dvec3 p, const HeapEnvelope* own) const {
   if (casters_.empty() || first_.empty()) return 1.0;
   // Every point of the sun's line through p lands on the ground where p's does.
-  const glm::dvec2 ground = sunCrossing(p, 0.0, to_sun_);
+  const glm::dvec2 ground = planeCrossing(p, 0.0, to_sun_);
   if (!(ground.x >= lo_.x && ground.y >= lo_.y && ground.x <= hi_.x && ground.y <= hi_.y))
     return 1.0;
   const glm::ivec2 c =
@@ -214,7 +213,7 @@ double PlaneShadows::sunlight(glm::dvec3 p, double top) const {
   for (const Plane& plane : planes_) {
     const CloudLayer& layer = *plane.layer;
     if (!(layer.altitude_m > p.z) || !(layer.altitude_m > top)) continue;
-    const glm::dvec2 q = sunCrossing(p, layer.altitude_m, to_sun_);
+    const glm::dvec2 q = planeCrossing(p, layer.altitude_m, to_sun_);
     const double t1 = layerThreshold(layer, q, to_sun_, time_s_, eye_);
     if (t1 >= 1.0) continue;
     light *= skyPlaneTranslucence(plane.texture.value(q, time_s_), t1, layer.transition);

@@ -52,8 +52,9 @@ inline constexpr double kMinShadowElevationDeg = 1.0;
 // than the heaps' beyond it.
 inline constexpr int kMaxCastingPlanes = 8;
 std::vector<std::size_t> castingPlanes(const Scene& scene);
-// Where the sun's ray through p crosses the plane Z = altitude (world/formulas/shadow.h).
-using formulas::sunCrossing;
+// Where the line through p along a direction crosses the plane Z = altitude
+// (world/formulas/shadow.h).
+using formulas::planeCrossing;
 
 // How far from the camera's ground point shadows are drawn: 24 km, doubled until it is at
 // least 4 times the camera's height (a high camera sees the ground farther out), at most 64

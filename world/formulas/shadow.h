@@ -22,10 +22,11 @@ FORMULA real groundLight(real sunlight) {
   return kGroundSkyShare + (1.0 - kGroundSkyShare) * sunlight;
 }
 
-// Where the sun's ray through p crosses the plane Z = altitude (to_sun rising, unit or not):
-// p's ground point for altitude 0 below it, a plane's point above it.
-FORMULA vec2 sunCrossing(vec3 p, real altitude, vec3 to_sun) {
-  return vec2(p.x, p.y) + ((altitude - p.z) / to_sun.z) * vec2(to_sun.x, to_sun.y);
+// Where the line through p along `direction` (unit or not, not level) crosses the plane
+// Z = altitude: the sun's ray's ground point or a plane's point above it, or a view ray's
+// ground point.
+FORMULA vec2 planeCrossing(vec3 p, real altitude, vec3 direction) {
+  return vec2(p.x, p.y) + ((altitude - p.z) / direction.z) * vec2(direction.x, direction.y);
 }
 
 // The limb value g = 1 - |o_perp|^2 of the ray o + s w through a lobe's unit sphere (o the

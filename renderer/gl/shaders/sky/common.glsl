@@ -163,7 +163,7 @@ float g_planes_sun = 1.0;
 float groundSunlight(vec3 d) {
   float sun = g_planes_sun;
 #ifdef SHADOWS
-  sun *= mapSunlight(d.xy * (u_camera_z / -d.z));
+  sun *= mapSunlight(planeCrossing(vec3(0.0, 0.0, u_camera_z), 0.0, d));
 #endif
   return sun;
 }

@@ -210,7 +210,7 @@ void composite(int i, vec3 r, LayerHit hit, float t1, float it, inout vec3 colou
   // A plane under every heap takes the heaps' shadow where the sun's ray through it lands
   // (MODEL.md section 16, "planes under heaps").
   if (u_height[i] <= u_shadow_floor)
-    sun *= mapSunlight(sunCrossing(vec3(hit.p, u_height[i]), -u_camera_z, u_to_sun));
+    sun *= mapSunlight(planeCrossing(vec3(hit.p, u_height[i]), -u_camera_z, u_to_sun));
 #endif
   surface *= groundLight(sun);
 #endif
