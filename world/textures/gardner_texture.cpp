@@ -111,7 +111,7 @@ double GardnerTexture::evaluate(glm::dvec3 p, bool solid, double term_count) con
   if (fraction == 0.0 || whole >= n) return t_whole;
 
   addTerm(whole, p, solid, sx, sy);
-  return (1.0 - fraction) * t_whole + fraction * textureFromSums(sx, sy, k_);
+  return glm::mix(t_whole, textureFromSums(sx, sy, k_), fraction);  // as the GPU blends them
 }
 
 double GardnerTexture::termCountForFootprint(double footprint_periods, TermFilter filter) const {
