@@ -210,6 +210,9 @@ void Engine::renderTrigger() {
     return;
   }
   renderView(view, image, *frame);
+  // The frame counter it moved, published before the encoder can write the file and clear the
+  // coil: a host that sees the coil at 0 reads the new count.
+  publishReadings();
   const std::string extension = config_.output_format == ImageFormat::kPng    ? ".png"
                                 : config_.output_format == ImageFormat::kJpeg ? ".jpg"
                                                                               : ".exr";

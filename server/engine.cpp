@@ -250,12 +250,7 @@ void Engine::executeBatch(Job& job) {
   // (a CIGI frame that re-centred the world: its site).
   publish();
   job.done(std::nullopt);
-  if (job.render) {
-    renderTrigger();  // the render coil reads 1 until the file is written
-    // The frame counter it moved, published before the encoder writes the file and clears the
-    // coil: a host that sees the coil at 0 reads the new count.
-    publishReadings();
-  }
+  if (job.render) renderTrigger();  // the render coil reads 1 until the file is written
 }
 
 void Engine::publish() {
