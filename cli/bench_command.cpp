@@ -632,7 +632,7 @@ SceneResult measureScene(Renderer& renderer, BenchScene& bench_scene, const Benc
   result.what = bench_scene.what;
   // The scene's own reference settings at the sweep's supersampling, with every lobe of
   // every heap in range, so that the heaps' level of detail is measured, not shared.
-  ReferenceSettings reference_settings = bench_scene.file.reference;
+  ReferenceSettings reference_settings = bench_scene.file.reference();
   reference_settings.samples_per_axis = run.samples;
   reference_settings.heaps.detail_px = 0.0;
   const auto ref_start = Clock::now();

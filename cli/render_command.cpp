@@ -60,7 +60,6 @@ std::string applyKnobOverrides(const RenderCommandOptions& o, SceneFile& file) {
     if (std::string e = knobError(knob, value); !e.empty()) return e;
     knob.set(file.render, value);
   }
-  file.reference = referenceSettingsOf(file.render);
   return "";
 }
 

@@ -157,7 +157,6 @@ void readRender(TableReader& t, SceneFile& out) {
   for (const RenderKnob& knob : renderKnobs()) keys.emplace_back(knob.name);
   t.allow(keys);
   for (const RenderKnob& knob : renderKnobs()) readKnob(t, knob, out.render);
-  out.reference = referenceSettingsOf(out.render);
   t.finish();
 }
 

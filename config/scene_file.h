@@ -19,7 +19,8 @@ struct SceneFile {
   Scene scene;
   WorldDynamics dynamics;  // wind, development schedules, automaton clouds
   RenderSettings render;
-  ReferenceSettings reference;
+  // The CPU reference's settings, from `render` (its supersampling, the heaps and the sea).
+  ReferenceSettings reference() const { return referenceSettingsOf(render); }
 };
 
 // Names of an automaton cloud's phase functions in enum order. The render knobs' names are

@@ -68,13 +68,14 @@ struct ReferenceSettings {
   int sea_waves = kSeaComponents;  // as RenderSettings::sea_waves
 };
 
-// The reference's settings that a scene's render settings give: its supersampling
-// (reference_samples), and the heaps and sea both renderers draw.
+// The reference's settings that render settings give: its supersampling (reference_samples),
+// the heaps and sea both renderers draw, and the label channels' divisor.
 inline ReferenceSettings referenceSettingsOf(const RenderSettings& render) {
   ReferenceSettings out;
   out.samples_per_axis = render.reference_samples;
   out.heaps = render.heaps;
   out.sea_waves = render.sea_waves;
+  out.label_divisor = render.channel_divisor;
   return out;
 }
 

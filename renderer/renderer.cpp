@@ -101,7 +101,6 @@ class ReferenceBackendRenderer final : public Renderer {
   Frame trace(const Scene& scene, const RenderSettings& settings, const FrameRequest& request) {
     ReferenceSettings drawn = referenceSettingsOf(settings);
     drawn.threads = threads_;
-    drawn.label_divisor = settings.channel_divisor;
     return renderReferenceFrame(scene, drawn, request, progress_, cancel_, &cancelled_);
   }
 

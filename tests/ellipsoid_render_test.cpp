@@ -58,7 +58,7 @@ TEST_F(EllipsoidRenderTest, PresetsMatchReference) {
   for (const char* name :
        {"cumulus", "gardner_trio", "intersecting_pair", "inside_cloud", "cumulus_target"}) {
     const SceneFile file = preset(name);
-    const FloatImage reference = renderReference(file.scene, file.reference);
+    const FloatImage reference = renderReference(file.scene, file.reference());
     expectClose(renderer_->renderFloat(file.scene, file.render), reference, 33.0, 0.45,
                 std::string("ellipsoid_preset_") + name);
   }
@@ -68,7 +68,7 @@ TEST_F(EllipsoidRenderTest, PresetsMatchReference) {
 // 8-bit tiles) are the loosest. Their measured errors are in the README.
 TEST_F(EllipsoidRenderTest, KnobsMatchReference) {
   const SceneFile file = preset("cumulus");
-  const FloatImage reference = renderReference(file.scene, file.reference);
+  const FloatImage reference = renderReference(file.scene, file.reference());
   struct Case {
     const char* name;
     void (*edit)(RenderSettings&);
@@ -168,7 +168,7 @@ TEST_F(EllipsoidRenderTest, HeapLightMatchesReference) {
   file.scene.sun.elevation_deg = 10.0;
   for (double azimuth : {90.0, 0.0}) {
     file.scene.sun.azimuth_deg = azimuth;
-    const FloatImage reference = renderReference(file.scene, file.reference);
+    const FloatImage reference = renderReference(file.scene, file.reference());
     const std::string name = "heap_light_" + std::to_string(int(azimuth));
     // Against the 4x4 reference: 31.9 dB measured with the sun behind (the silver lining's
     // texture detail, and the heap light varying across each lobe, which GL samples once per
@@ -558,8 +558,8 @@ TEST_F(EllipsoidRenderTest, BakedTextureKeepsItsDetailMagnified) {
   const SceneFile close_up = preset("cumulus_target");
   const Scene near_lobe = cloudScene({{{60.0, 60.0, 60.0}, {-50.0, 200.0, 1000.0}, {}}},
                                      lookingNorth({0.0, 0.0, 1000.0}));
-  const std::pair<const Scene*, ReferenceSettings> cases[] = {{&close_up.scene, close_up.reference},
-                                                              {&near_lobe, {4, 0}}};
+  const std::pair<const Scene*, ReferenceSettings> cases[] = {
+      {&close_up.scene, close_up.reference()}, {&near_lobe, {4, 0}}};
   for (const auto& [scene, reference_settings] : cases) {
     RenderSettings baked, procedural;
     baked.texture_evaluation = TextureEvaluation::kBaked;
@@ -575,7 +575,7 @@ TEST_F(EllipsoidRenderTest, BakedTextureKeepsItsDetailMagnified) {
                 1e-6, "auto_is_baked");
   }
   expectClose(renderer_->renderFloat(close_up.scene, close_up.render),
-              renderReference(close_up.scene, close_up.reference), 45.0, 0.3, "close_up_auto");
+              renderReference(close_up.scene, close_up.reference()), 45.0, 0.3, "close_up_auto");
 }
 
 // The three ellipsoid pass structures, for the defect tests below.

@@ -19,7 +19,7 @@ namespace {
 TEST_F(GlRenderTest, PresetsMatchReference) {
   for (const char* name : {"cirrus", "stratus", "overcast", "ground_fog"}) {
     const SceneFile file = preset(name);
-    const FloatImage reference = renderReference(file.scene, file.reference);
+    const FloatImage reference = renderReference(file.scene, file.reference());
     expectClose(renderer_->renderFloat(file.scene, file.render), reference, 38.0, 0.25,
                 std::string("preset_") + name);
   }
@@ -27,7 +27,7 @@ TEST_F(GlRenderTest, PresetsMatchReference) {
 
 TEST_F(GlRenderTest, KnobsMatchReference) {
   const SceneFile file = preset("cirrus");
-  const FloatImage reference = renderReference(file.scene, file.reference);
+  const FloatImage reference = renderReference(file.scene, file.reference());
   RenderSettings procedural = file.render;
   procedural.texture_evaluation = TextureEvaluation::kProcedural;
   expectClose(renderer_->renderFloat(file.scene, procedural), reference, 38.0, 0.25, "procedural");
@@ -158,7 +158,7 @@ TEST_F(GlRenderTest, ClipmapMatchesReference) {
     sines.texture_evaluation = TextureEvaluation::kProcedural;
     const FloatImage a = renderer_->renderFloat(file.scene, clipmap);
     EXPECT_GT(renderer_->lastFrameStats().layer_texels_baked, 0) << c.preset;
-    const FloatImage reference = renderReference(file.scene, file.reference);
+    const FloatImage reference = renderReference(file.scene, file.reference());
     const FloatImage b = renderer_->renderFloat(file.scene, sines);
     const std::string name = std::string("clipmap_") + c.preset;
     std::printf(
@@ -493,7 +493,7 @@ TEST_F(GlRenderTest, LayersAboveAndBelowTheCamera) {
   high.texture.seed = 5;
   file.scene.layers.push_back(high);
   expectClose(renderer_->renderFloat(file.scene, file.render),
-              renderReference(file.scene, file.reference), 29.0, 0.3, "deck");
+              renderReference(file.scene, file.reference()), 29.0, 0.3, "deck");
   for (double pitch : {-50.0, 50.0}) {
     file.scene.camera.orientation.pitch_deg = pitch;
     expectPointSampledEqual(*renderer_, file.scene, "deck_point");
@@ -508,7 +508,7 @@ TEST_F(GlRenderTest, NoiseSourcesMatchReference) {
     layer.texture.table.tile_size_m = {6000.0, 6000.0};
     layer.threshold = 0.4;
     layer.transition = 0.3;
-    const FloatImage reference = renderReference(file.scene, file.reference);
+    const FloatImage reference = renderReference(file.scene, file.reference());
     expectClose(renderer_->renderFloat(file.scene, file.render), reference, 38.0, 0.25,
                 std::string(textureSourceName(source)));
   }
@@ -519,7 +519,7 @@ TEST_F(GlRenderTest, NoiseSourcesMatchReference) {
 TEST_F(GlRenderTest, HardThresholdMatchesReference) {
   SceneFile file = preset("cirrus");
   file.scene.layers[0].transition = 0.0;
-  const FloatImage reference = renderReference(file.scene, file.reference);
+  const FloatImage reference = renderReference(file.scene, file.reference());
   expectClose(renderer_->renderFloat(file.scene, file.render), reference, 26.0, 0.6, "hard");
 }
 

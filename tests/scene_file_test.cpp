@@ -103,12 +103,12 @@ roughness = 0.5
   EXPECT_EQ(f.scene.haze->scale_height_m, 900);
   EXPECT_EQ(f.render.heaps.range_m, 9000);
   EXPECT_EQ(f.render.heaps.detail_px, 12);
-  EXPECT_EQ(f.reference.heaps.detail_px, 12);  // both renderers draw the same heaps
+  EXPECT_EQ(f.reference().heaps.detail_px, 12);  // both renderers draw the same heaps
   EXPECT_EQ(f.render.texture_evaluation, TextureEvaluation::kProcedural);
   EXPECT_EQ(f.render.term_filter, TermFilter::kCut);
   EXPECT_EQ(f.render.sky_passes, SkyPasses::kMultipass);
   EXPECT_EQ(f.render.bake_texels_per_cycle, 8);
-  EXPECT_EQ(f.reference.samples_per_axis, 3);
+  EXPECT_EQ(f.reference().samples_per_axis, 3);
   ASSERT_EQ(f.scene.layers.size(), 2u);
   const CloudLayer& a = f.scene.layers[0];
   EXPECT_EQ(a.transition, 0.0);

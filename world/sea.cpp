@@ -14,8 +14,6 @@ constexpr double kG = 9.81;
 constexpr double kPi = std::numbers::pi;
 // The shortest wave drawn: shorter ones are capillary-gravity ripples, left to Cox-Munk.
 constexpr double kShortestWave = 0.5;
-// The drawn waves take at most this share of Cox-Munk's slope variance; the rest stays
-// unresolved at every distance, so no pixel is a perfect mirror.
 
 // The omnidirectional frequency spectrum S(omega), m^2 s (MODEL.md section 18): JONSWAP for a
 // fetch-limited sea, Pierson-Moskowitz when the fetch is long enough to be fully developed.
@@ -211,6 +209,7 @@ SeaShading shadeSea(const SeaSurface& surface, const Sea& sea, const SeaSample& 
   SeaShading out;
   const glm::dvec3 n = formulas::seaNormal(s.slope);
   const double cos_i = formulas::seaIncidence(d, n);
+  out.cos_incidence = cos_i;
   out.reflect_dir = formulas::mirroredRay(d, n, cos_i);
   out.foam =
       foamShare(surface.whitecapFraction(), surface.foamSteepness(), glm::dot(s.slope, s.slope),

@@ -145,6 +145,7 @@ struct SeaShading {
   glm::dvec3 body_and_foam{0.0};          // water colour and foam, lit (times sunlight share)
   glm::dvec3 glint{0.0};                  // sun glint (times sunlight share)
   double foam = 0.0;                      // foam share
+  double cos_incidence = 1.0;             // of the ray on the resolved surface's facet
 };
 // `sunlight`: the share of the sun reaching the point (cloud shadows), `sun` unit towards it.
 SeaShading shadeSea(const SeaSurface& surface, const Sea& sea, const SeaSample& s, glm::dvec3 d,

@@ -7,7 +7,6 @@
 #include "renderer/gl/gl_platform.h"
 #include "renderer/gl/shaders/shadow_map_glsl.h"
 #include "renderer/gl/sky_shaders.h"
-#include "world/automaton/cloud_density.h"
 #include "world/check.h"
 
 namespace nephele {

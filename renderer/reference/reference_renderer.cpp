@@ -68,8 +68,7 @@ double luminance(glm::dvec3 c) {
 // The sea where a ray meets it (MODEL.md section 18).
 struct SeaView {
   SeaShading shading;
-  double cos_incidence = 1.0;  // on the resolved surface
-  glm::dvec3 colour{0.0};      // its radiance, before the air
+  glm::dvec3 colour{0.0};  // its radiance, before the air
 };
 
 struct EllipsoidEntry {
@@ -225,7 +224,7 @@ class ReferenceTracer {
     if (object_id > 0) {
       radiance = bandRadiance(model, targetTemperature(model, object_id - 1));
     } else if (sea) {  // emissivity 1 - F by the angle on the resolved waves, the sky mirrored
-      const double e = seaEmissivity(sea->cos_incidence);
+      const double e = seaEmissivity(sea->shading.cos_incidence);
       const double mirrored = std::asin(std::clamp(sea->shading.reflect_dir.z, 0.0, 1.0));
       radiance = e * bandRadiance(model, scene_.sea->temperature_c + 273.15) +
                  (1.0 - e) * clearSkyRadiance(model, mirrored, 0.0);
@@ -372,7 +371,6 @@ class ReferenceTracer {
     SeaView view;
     view.shading = shadeSea(*sea_, *scene_.sea, s, direction, sun_, scene_.sun.colour,
                             sunlight_.at({p.x, p.y, 0.0}));
-    view.cos_incidence = formulas::seaIncidence(direction, formulas::seaNormal(s.slope));
     std::vector<Surface> hits;
     const glm::dvec3 mirrored = glm::dvec3(probe_->trace(view.shading.reflect_dir, hits));
     view.colour = view.shading.body_and_foam + view.shading.glint + view.shading.fresnel * mirrored;

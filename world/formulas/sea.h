@@ -9,8 +9,8 @@ namespace nephele::formulas {
 
 // The effective reflectance of whitecap foam (Koepke 1984).
 CONSTANT real kFoamReflectance = 0.22;
-// The share of the sea's slope variance the drawn sines may take (SeaSurface); at least the
-// rest is left to the glint's slope variance.
+// The share of the sea's slope variance the drawn sines may take (SeaSurface); the rest stays
+// unresolved at every distance, for the glint, so that no pixel is a perfect mirror.
 CONSTANT real kResolvedSlopeShare = 0.8;
 
 // The slope variance the glint spreads over, for the sea's total and the share the drawn sines

@@ -116,9 +116,9 @@ double GardnerTexture::evaluate(glm::dvec3 p, bool solid, double term_count) con
 
 double GardnerTexture::termCountForFootprint(double footprint_periods, TermFilter filter) const {
   const int n = params_.terms;
-  if (filter == TermFilter::kNone) return n;
-  if (!(footprint_periods > 0.0)) return n;           // zero footprint: every term resolves
-  if (!std::isfinite(footprint_periods)) return 0.0;  // infinite footprint: nothing resolves
+  // A zero or negative footprint resolves every term, an infinite one none (the formula's own
+  // floor and log); one not known (NaN) every term.
+  if (std::isnan(footprint_periods)) return n;
   static_assert(int(TermFilter::kFade) == formulas::kTermFade &&
                 int(TermFilter::kCut) == formulas::kTermCut &&
                 int(TermFilter::kNone) == formulas::kTermAll);
