@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 
+#include "world/limits.h"
+
 namespace nephele {
 namespace {
 
@@ -63,8 +65,15 @@ Camera seaProbeCamera(const Camera& view, double scale) {
   const double half =
       std::atan(std::tan(0.5 * glm::radians(view.vfov_deg)) * std::sqrt(1.0 + aspect * aspect));
   probe.vfov_deg = std::min(2.0 * glm::degrees(half) + 2.0 * kProbeMarginDeg, 160.0);
-  probe.width = std::max(32, int(std::lround(view.width * scale)));
-  probe.height = std::max(32, int(std::lround(probe.width / aspect)));
+  // At least 32 pixels a side and at most a view's largest. The probe keeps the view's aspect,
+  // except where its least width was imposed: a view 1 pixel wide and 16,384 high would
+  // otherwise ask for a probe 32 x 524,288 (found by the live fuzz), so its height follows the
+  // view's own at this scale (a probe wider than needed still holds the view's diagonal).
+  const auto side = [](double pixels) {
+    return std::clamp(int(std::lround(pixels)), 32, Limits::kMaxImageSide);
+  };
+  probe.width = side(view.width * scale);
+  probe.height = view.width * scale < 32.0 ? side(view.height * scale) : side(probe.width / aspect);
   return probe;
 }
 

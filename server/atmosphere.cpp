@@ -180,13 +180,35 @@ nlohmann::json engine_detail::siteJson(const World& world) {
               {"content_origin", {o.x, o.y}}};
 }
 
+Site engine_detail::siteAfter(const World& world, const command::SetSite& c) {
+  Site site{*c.latitude, *c.longitude, 0.0};
+  if (const std::optional<Site>& before = world.base().site)
+    site = recentred(*before, site.latitude_deg, site.longitude_deg).to;
+  if (c.grid) site.grid_deg = *c.grid;
+  return site;
+}
+
+std::optional<ProtocolError> Engine::siteError(const command::SetSite& c) const {
+  if (!c.latitude) return std::nullopt;
+  const Site site = siteAfter(*world_, c);
+  if (std::string error = world_->setSiteError(site); !error.empty()) return badField(error);
+  // The views move with the world: none may be carried beyond where set_view places one.
+  const glm::dvec3 shift(world_->recentreShift(site), 0.0);
+  for (const ViewConfig& v : views_.all()) {
+    const glm::dvec3 to = v.camera.position - shift;
+    if (std::string e = placementError("view " + v.name, to.x, to.y, to.z); !e.empty())
+      return badField("site: the re-centring moves the world by " +
+                      formatNumber(glm::length(shift)) + " m, which would carry " + e +
+                      "; nothing changed");
+  }
+  return std::nullopt;
+}
+
 Outcome Engine::setSite(const command::SetSite& c) {
   World& world = *world_;
   if (c.latitude) {
-    const std::optional<Site> before = world.base().site;
-    Site site{*c.latitude, *c.longitude, 0.0};
-    if (before) site = recentred(*before, site.latitude_deg, site.longitude_deg).to;
-    if (c.grid) site.grid_deg = *c.grid;
+    if (auto error = siteError(c)) return *error;
+    const Site site = siteAfter(world, c);
     const glm::dvec2 origin = world.base().content_origin;
     bool changed = false;
     if (std::string error = world.setSite(site, &changed); !error.empty()) return badField(error);

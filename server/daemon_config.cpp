@@ -100,9 +100,11 @@ void readSocket(TableReader& t, DaemonConfig& out) {
     s->integer("max_clients", out.max_clients, 1, DaemonLimits::kMaxClients);
     s->integer("max_subscriptions", out.max_subscriptions, 0, 4096);
     s->integer("max_queue", out.max_queue, 1, 65536);
-    int pixels_m = int(out.max_image_pixels >> 20);
-    s->integer("max_image_pixels", pixels_m, 1, 256);  // in mebipixels
-    out.max_image_pixels = std::int64_t(pixels_m) << 20;
+    // In mebipixels; a fraction bounds a small machine's frames tighter (the live fuzz runs
+    // under 0.25, so that a lockstep tick's renders fit its 5 s reply bound on two cores).
+    double pixels_m = double(out.max_image_pixels) / double(1 << 20);
+    s->number("max_image_pixels", pixels_m, 0.01, 256.0);
+    out.max_image_pixels = std::int64_t(pixels_m * double(1 << 20));
     int pending_mb = int(out.max_pending_bytes >> 20);
     s->integer("max_pending_mb", pending_mb, 1, 4096);
     out.max_pending_bytes = std::size_t(pending_mb) << 20;
@@ -218,10 +220,12 @@ void readStreams(TableReader& t, DaemonConfig& out) {
 
 void readSnapshot(TableReader& t, DaemonConfig& out) {
   if (auto s = t.table("snapshot")) {
-    s->allow({"path", "interval", "restore", "directory"});
+    s->allow({"path", "interval", "restore", "directory", "on_error"});
     s->string("path", out.snapshot_path);
     s->number("interval", out.snapshot_interval_s, 0.0, 86400.0);
     s->boolean("restore", out.restore_on_start);
+    out.snapshot_on_error = DaemonConfig::SnapshotOnError(
+        s->choice("on_error", {"exit", "start_fresh"}, int(out.snapshot_on_error)));
     s->string("directory", out.snapshot_directory);
     s->finish();
   }

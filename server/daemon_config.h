@@ -90,6 +90,9 @@ struct DaemonConfig {
   std::string snapshot_path;          // empty: no snapshots
   double snapshot_interval_s = 60.0;  // 0: only at shutdown
   bool restore_on_start = true;
+  // A snapshot at start that does not read: exit naming the file and the field (the default),
+  // or move it aside (PATH.rejected) and start from the scene (`on_error = "start_fresh"`).
+  enum class SnapshotOnError { kExit, kStartFresh } snapshot_on_error = SnapshotOnError::kExit;
   std::string snapshot_directory;  // for the snapshot/restore requests; empty: beside the path
   // Where named snapshots go: snapshot_directory, else the snapshot path's directory.
   std::string snapshotDirectory() const {

@@ -45,19 +45,22 @@ std::optional<Outcome> Engine::renderRequest(const command::Render& c, Job& job)
   };
   std::vector<Part> parts;
   bool all_raw = true;
+  const auto rendering = Clock::now();
   for (const ViewConfig& v : views) {
     Part part{std::make_shared<RenderedView>(), c.image.value_or(v.image)};
     renderView(v, part.image, *part.frame);
     all_raw = all_raw && part.image.format == ImageFormat::kRaw && !part.image.floatPlanes();
     parts.push_back(std::move(part));
   }
+  if (job.trace) job.trace->render_ms = msSince(rendering);
   auto send = [parts, id = job.request.id, reply = job.reply, options = config_.encode,
-               telemetry = &telemetry_]() {
+               telemetry = &telemetry_, trace = job.trace]() {
     std::vector<SharedReply> replies;
     for (std::size_t i = 0; i < parts.size(); ++i) {
       const auto t0 = Clock::now();
       auto encoded = encodeView(*parts[i].frame, parts[i].image, options);
       telemetry->noteEncode(msSince(t0));
+      if (trace) trace->encode_ms += msSince(t0);
       if (auto* e = std::get_if<std::string>(&encoded)) {
         reply(makeReply(errorReply(id, {ErrorCode::kFailed, *e})));
         return;
@@ -74,6 +77,7 @@ std::optional<Outcome> Engine::renderRequest(const command::Render& c, Job& job)
     reply(chainReplies(std::move(replies)));
   };
   publish();  // before the reply can go: a client's next stats is answered from it
+  if (job.trace) job.trace->applied = Clock::now();  // before the encoder has the trace
   if (all_raw)
     send();  // nothing to encode: packing is a copy
   else
@@ -85,12 +89,14 @@ void Engine::deliverFrames(Delivery which, const std::string& view_name) {
   views_.dropGone();
   // The subscriptions that are due, grouped by view and by image request: one render per view
   // (and per kind of pixel), one encoding per request.
-  for (auto& [name, subs] : views_.due(which, view_name, clock_.ticks(), Clock::now())) {
+  const Clock::time_point now = Clock::now();
+  bool rendered = false;
+  for (auto& [name, due] : views_.due(which, view_name, clock_.ticks(), now)) {
     const ViewConfig* view = views_.find(name);
     if (!view) continue;
     std::shared_ptr<RenderedView> frames[2];  // 8-bit and linear
     std::vector<std::pair<ImageRequest, std::vector<Subscription*>>> groups;
-    for (Subscription* sub : subs) {
+    for (Subscription* sub : due) {
       auto it = std::find_if(groups.begin(), groups.end(),
                              [&](const auto& g) { return g.first == sub->image; });
       if (it == groups.end())
@@ -98,10 +104,18 @@ void Engine::deliverFrames(Delivery which, const std::string& view_name) {
       else
         it->second.push_back(sub);
     }
-    for (auto& [image, members] : groups) {
+    for (auto& [image, candidates] : groups) {
       const bool linear = image.format == ImageFormat::kExr;
       std::shared_ptr<RenderedView> planes;  // ground-truth channels: rendered for this group
       std::shared_ptr<RenderedView>& frame = image.floatPlanes() ? planes : frames[linear ? 1 : 0];
+      // Realtime frames yield to requests: once one render is done, requests waiting are
+      // served before the next, so that none waits behind a whole round of subscriptions. The
+      // subscriptions not served stay due, the most overdue first (docs/RELIABILITY.md).
+      // Lockstep's frames are the tick's and are all rendered.
+      if (which == Delivery::kDue && rendered && !frame && queue_.depth() > 0) return;
+      const std::vector<Subscription*> members =
+          views_.take(candidates, which, clock_.ticks(), now);
+      if (members.empty()) continue;
       if (!frame) {
         if (auto error = platformLimit(*view, image)) {
           spdlog::error("event=frame_skipped view={} error=\"{}\"", view->name, error->message);
@@ -110,6 +124,7 @@ void Engine::deliverFrames(Delivery which, const std::string& view_name) {
         }
         frame = std::make_shared<RenderedView>();
         renderView(*view, image, *frame, /*continuous=*/true);
+        rendered = true;
       }
       sendToSubscribers(frame, image, members);
     }

@@ -54,6 +54,7 @@ std::optional<ProtocolError> Engine::check(const Command& command) const {
   }
   if (const auto* c = std::get_if<command::SetTime>(&command); c && c->advance)
     return checkAdvance(*c->advance);
+  if (const auto* c = std::get_if<command::SetSite>(&command)) return siteError(*c);
   if (const auto* c = std::get_if<command::SetSea>(&command))  // the trains it would hold
     if (auto sea = seaAfter(world_->base().sea, *c, surfaceWind(*world_));
         std::holds_alternative<ProtocolError>(sea))
@@ -253,7 +254,7 @@ struct Engine::Handlers {
     if (config_.snapshotDirectory().empty()) return noSnapshotDirectory();
     std::error_code ec;
     std::filesystem::create_directories(config_.snapshotDirectory(), ec);
-    if (std::string e = engine.writeSnapshot(snapshotPath(c.name)); !e.empty())
+    if (std::string e = engine.saveSnapshot(snapshotPath(c.name), "request"); !e.empty())
       return ProtocolError{ErrorCode::kFailed, e};
     return json{{"name", c.name}, {"time", world.timeSeconds()}, {"hash", hexHash(world.hash())}};
   }

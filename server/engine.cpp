@@ -52,8 +52,11 @@ Telemetry::Live Engine::live() const {
   return {queue_.depth(), renders_->encoderDepth()};
 }
 
-bool Engine::submit(Request request, std::int64_t client, PushSink push, ReplySink done) {
+bool Engine::submit(Request request, std::int64_t client, PushSink push, ReplySink done,
+                    std::shared_ptr<RequestTrace> trace) {
   Job job;
+  job.trace = std::move(trace);
+  if (job.trace) job.queued = job.trace->queued;
   job.request = std::move(request);
   job.client = client;
   job.push = std::move(push);
@@ -84,11 +87,26 @@ std::string Engine::openWorld() {
   if (config_.site) world_->setSite({config_.site->latitude_deg, config_.site->longitude_deg, 0.0});
   const std::string& snapshot = config_.snapshot_path;
   if (config_.restore_on_start && !snapshot.empty() && std::filesystem::exists(snapshot)) {
-    if (std::string e = restoreSnapshot(snapshot); !e.empty())
-      return e + " (move the file away to start from the scene instead)";
-    spdlog::info("event=restored snapshot={} time={:.3f} ticks={} frames={} hash={}", snapshot,
+    if (std::string e = restoreSnapshot(snapshot); !e.empty()) {
+      if (config_.snapshot_on_error != DaemonConfig::SnapshotOnError::kStartFresh)
+        return e +
+               " (move the file away, or set [snapshot] on_error = \"start_fresh\", to start "
+               "from the scene instead)";
+      // Kept for whoever looks into it; the next snapshot takes the path. A restore that fails
+      // changes nothing, so the world is still the scene's.
+      std::error_code ec;
+      for (const std::string& file : {snapshot, daemonStatePath(snapshot)})
+        if (std::filesystem::exists(file, ec))
+          std::filesystem::rename(file, file + ".rejected", ec);
+      spdlog::error("event=snapshot_rejected path={} moved_to={}.rejected error=\"{}\" "
+                    "action=start_fresh",
+                    snapshot, snapshot, e);
+      telemetry_.noteSnapshotFailed();
+    } else {
+      spdlog::info("event=restored snapshot={} time={:.3f} ticks={} frames={} hash={}", snapshot,
                  world_->timeSeconds(), clock_.ticks(), telemetry_.frames(),
-                 hexHash(world_->hash()));
+                   hexHash(world_->hash()));
+    }
   }
   for (const command::Stream& stream : config_.streams) {
     const Outcome started = startStream(stream);
@@ -124,8 +142,14 @@ void Engine::run(std::promise<std::string>& started) {
                                  : std::string(commandName(job.request.command)),
                              job.client);
         try {
+          const auto t0 = Clock::now();
+          if (job.trace) job.trace->started = t0;
           execute(job);
           telemetry_.noteRequestDone(job.queued);
+          telemetry_.noteBusy(job.kind == Job::Kind::kBatch
+                                  ? "modbus write"
+                                  : std::string(commandName(job.request.command)),
+                              t0);
           continue;
         } catch (const RenderCancelled&) {
           stopping = true;  // stop() cancelled its render: answered as the queued ones
@@ -138,12 +162,16 @@ void Engine::run(std::promise<std::string>& started) {
     telemetry_.setInHand("", 0);
     if (stopping) break;
     try {
+      auto t0 = Clock::now();
       telemetry_.setInHand("ticks", 0);
       realtimeTicks();
+      telemetry_.noteBusy("ticks", t0);
       // Realtime: subscriptions at their rate. Lockstep: a new subscription's first frame
       // (the ticks themselves deliver in advance()).
+      t0 = Clock::now();
       telemetry_.setInHand("frames", 0);
       deliverFrames(clock_.lockstep() ? Delivery::kEveryTick : Delivery::kDue, "");
+      telemetry_.noteBusy("frames", t0);
     } catch (const RenderCancelled&) {
       telemetry_.setInHand("", 0);
       break;  // stopping: the frames in hand are not sent
@@ -151,13 +179,18 @@ void Engine::run(std::promise<std::string>& started) {
     telemetry_.setInHand("", 0);
     if (config_.snapshot_interval_s > 0.0 && !config_.snapshot_path.empty() &&
         Clock::now() >= next_snapshot_) {
-      saveSnapshot(config_.snapshot_path, "periodic");
+      const auto t0 = Clock::now();
+      if (!saveSnapshot(config_.snapshot_path, "periodic").empty())
+        telemetry_.noteError(ErrorCode::kFailed);
+      telemetry_.noteBusy("snapshot", t0);
       next_snapshot_ = Clock::now() + secondsToDuration(config_.snapshot_interval_s);
     }
+    const auto t0 = Clock::now();
     publish();
+    telemetry_.noteBusy("publish", t0);
   }
   if (!config_.snapshot_path.empty())
-    shutdown_saved_ = saveSnapshot(config_.snapshot_path, "shutdown");
+    shutdown_saved_ = saveSnapshot(config_.snapshot_path, "shutdown").empty();
   views_.clear();
   renders_->close();  // GL objects go while their context is current
 }
@@ -222,6 +255,7 @@ void Engine::execute(Job& job) {
   // So that a register read, or a stats or hello answered at once (answerAtOnce), right after
   // the reply sees the change.
   publish();
+  if (job.trace) job.trace->applied = Clock::now();  // before the reply hands the trace on
   if (const auto* error = std::get_if<ProtocolError>(&*outcome)) {
     telemetry_.noteError(error->code);
     job.reply(makeReply(errorReply(job.request.id, *error)));

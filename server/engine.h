@@ -55,7 +55,9 @@ class Engine {
   bool stopping() const { return queue_.stopping(); }
 
   // Queues work; each returns false (and queues nothing) when the queue is full.
-  bool submit(Request request, std::int64_t client, PushSink push, ReplySink done);
+  // `trace` (if given) is stamped as the request passes the world thread and the encoder.
+  bool submit(Request request, std::int64_t client, PushSink push, ReplySink done,
+              std::shared_ptr<RequestTrace> trace = nullptr);
   // A Modbus write: every command is checked before any is applied; with `render` (the
   // render coil) the Modbus view is then rendered into the output directory and pushed to
   // the view's subscribers. `done` hears the outcome once the commands are applied and the
@@ -114,12 +116,16 @@ class Engine {
   Outcome setHaze(const command::SetHaze& c);
   Outcome setSea(const command::SetSea& c);
   Outcome setSite(const command::SetSite& c);
+  // What a set_site would refuse: a site out of range, or a re-centring that would carry a
+  // target or a view beyond the range their readers accept (placementError).
+  std::optional<ProtocolError> siteError(const command::SetSite& c) const;
   void setMode(TickMode mode);
   // Snapshots: the World's file and the daemon's state beside it (snapshots.cpp).
   nlohmann::json daemonState() const;
   std::string writeSnapshot(const std::string& path);
   std::string restoreSnapshot(const std::string& path);
-  bool saveSnapshot(const std::string& path, const char* why);
+  // Writes a snapshot (writeSnapshot), logging and counting a failure; "" or the error.
+  std::string saveSnapshot(const std::string& path, const char* why);
   // Time: one tick (lockstep, or set_time advance) and the realtime ticks due (engine.cpp).
   std::optional<ProtocolError> checkAdvance(double dt_s) const;
   void advance(double dt_s);

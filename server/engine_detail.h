@@ -86,6 +86,14 @@ std::variant<std::optional<Sea>, ProtocolError> seaAfter(const std::optional<Sea
 json seaJson(const std::optional<Sea>& sea);
 // Where the world's database lies on the Earth (set_site's reply, stats' "site").
 json siteJson(const World& world);
+// The site a set_site with a position asks for, from where the world is placed now: a placed
+// world re-centres and keeps its grid unless one is given (MODEL.md section 13).
+Site siteAfter(const World& world, const command::SetSite& c);
+
+// Beside a snapshot at PATH, the daemon's part of it (snapshots.cpp).
+inline std::string daemonStatePath(const std::string& snapshot) {
+  return snapshot + ".daemon.json";
+}
 
 }  // namespace engine_detail
 }  // namespace nephele

@@ -13,6 +13,7 @@
 
 #include "protocol/messages.h"
 #include "server/reply.h"
+#include "server/telemetry.h"
 
 namespace nephele {
 
@@ -28,6 +29,7 @@ struct Job {
   bool render = false;  // a batch with the render coil
   std::shared_ptr<BatchTicket> ticket;
   DoneSink done;
+  std::shared_ptr<RequestTrace> trace;  // a socket request's stage times, or null
 };
 
 class RequestQueue {

@@ -108,18 +108,19 @@ class Connection : public std::enable_shared_from_this<Connection> {
     });
   }
 
-  // Queues a reply or frame for writing.
-  void send(SharedReply reply) {
+  // Queues a reply or frame for writing; a request's `trace` is noted once it is written.
+  void send(SharedReply reply, std::shared_ptr<RequestTrace> trace = nullptr) {
     if (closed_) return;
     pending_bytes_ += reply->size();
-    out_.push_back(std::move(reply));
+    out_.push_back({std::move(reply), std::move(trace)});
     if (!writing_) write();
   }
 
   // A request's reply, from the world thread or the encoder.
-  void reply(const nlohmann::json& id, SharedReply r) {
+  void reply(const nlohmann::json& id, SharedReply r, std::shared_ptr<RequestTrace> trace) {
     --in_flight_;
     if (closed_) return;
+    trace->replied = Clock::now();
     if (r->body && pending_bytes_ > 0 &&
         pending_bytes_ + r->size() > engine_.config().max_pending_bytes) {
       engine_.telemetry().noteError(ErrorCode::kBusy);
@@ -129,7 +130,7 @@ class Connection : public std::enable_shared_from_this<Connection> {
                                      std::to_string(engine_.config().max_pending_bytes >> 20) +
                                      " MiB); the image was not sent; read first, then ask again"}));
     }
-    send(std::move(r));
+    send(std::move(r), std::move(trace));
     resume();
   }
 
@@ -289,9 +290,12 @@ class Connection : public std::enable_shared_from_this<Connection> {
       }
     std::weak_ptr<Connection> weak = weak_from_this();
     asio::io_context& io = static_cast<asio::io_context&>(socket_.get_executor().context());
-    auto reply = [weak, &io, id](SharedReply r) {
-      asio::post(io, [weak, id, r = std::move(r)] {
-        if (auto c = weak.lock()) c->reply(id, r);
+    auto trace = std::make_shared<RequestTrace>();
+    trace->command = commandName(request.command);
+    trace->client = id_;
+    auto reply = [weak, &io, id, trace](SharedReply r) {
+      asio::post(io, [weak, id, r = std::move(r), trace] {
+        if (auto c = weak.lock()) c->reply(id, r, trace);
       });
     };
     auto frames = [weak, &io](SharedReply r) {
@@ -301,7 +305,7 @@ class Connection : public std::enable_shared_from_this<Connection> {
       return true;
     };
     ++in_flight_;
-    if (!engine_.submit(std::move(request), id_, frames, reply)) {
+    if (!engine_.submit(std::move(request), id_, frames, reply, trace)) {
       --in_flight_;
       sendError(
           id, engine_.stopping()
@@ -319,7 +323,7 @@ class Connection : public std::enable_shared_from_this<Connection> {
 
   void write() {
     writing_ = true;
-    const SharedReply& r = out_.front();
+    const SharedReply& r = out_.front().reply;
     std::vector<asio::const_buffer> buffers{asio::buffer(r->header)};
     if (r->body) buffers.push_back(asio::buffer(*r->body));
     for (const SharedReply& then : r->then) {
@@ -328,8 +332,12 @@ class Connection : public std::enable_shared_from_this<Connection> {
     }
     asio::async_write(socket_, buffers,
                       [self = shared_from_this()](std::error_code ec, std::size_t) {
-                        const SharedReply& done = self->out_.front();
-                        self->pending_bytes_ -= done->size();
+                        const Outgoing& done = self->out_.front();
+                        self->pending_bytes_ -= done.reply->size();
+                        if (done.trace && !ec) {
+                          done.trace->written = Clock::now();
+                          self->engine_.telemetry().noteTrace(*done.trace);
+                        }
                         self->out_.pop_front();
                         self->last_activity_ = Clock::now();
                         if (ec) {
@@ -363,7 +371,11 @@ class Connection : public std::enable_shared_from_this<Connection> {
   int in_flight_ = 0;
   Clock::time_point last_activity_;
   std::optional<Clock::time_point> line_started_;
-  std::deque<SharedReply> out_;
+  struct Outgoing {
+    SharedReply reply;
+    std::shared_ptr<RequestTrace> trace;  // a request's, noted when written
+  };
+  std::deque<Outgoing> out_;
   std::size_t pending_bytes_ = 0;
   bool writing_ = false;
   const char* finishing_ = nullptr;  // why the connection is closing once written out

@@ -1,13 +1,28 @@
 #include "server/telemetry.h"
 
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
 #include <sstream>
 #include <vector>
 
 #include "renderer/frame_timing.h"
+#include "server/log_limiter.h"
 
 namespace nephele {
 
 using nlohmann::json;
+
+namespace {
+
+// Slow requests are logged in full while rare, summarised while they flood.
+LogLimiter& slowLog() {
+  static LogLimiter limiter;
+  return limiter;
+}
+
+}  // namespace
 
 void Histogram::add(double seconds) {
   std::size_t i = 0;
@@ -50,6 +65,69 @@ void Telemetry::noteRequestDone(Clock::time_point queued) {
   request_seconds_.add(std::chrono::duration<double>(Clock::now() - queued).count());
 }
 
+json RequestTrace::toJson() const {
+  const auto ms = [](Clock::time_point from, Clock::time_point to) {
+    return std::chrono::duration<double, std::milli>(to - from).count();
+  };
+  return {{"cmd", command},
+          {"client", client},
+          {"total_ms", ms(queued, written)},
+          {"queue_ms", ms(queued, started)},
+          {"world_ms", ms(started, applied)},
+          {"render_ms", render_ms},
+          {"handoff_ms", ms(applied, replied)},
+          {"encode_ms", encode_ms},
+          {"write_ms", ms(replied, written)},
+          {"behind_ms", behind}};
+}
+
+void Telemetry::noteBusy(const std::string& what, Clock::time_point from) {
+  const Clock::time_point to = Clock::now();
+  const double ms = std::chrono::duration<double, std::milli>(to - from).count();
+  if (ms >= 1.0) {  // shorter work cannot account for a slow request
+    std::lock_guard lock(traces_mutex_);
+    spans_.push_back({what, from, to});
+    while (spans_.size() > kSpans) spans_.pop_front();
+  }
+  Busy& b = busy_[what];
+  ++b.count;
+  b.total_ms += ms;
+  b.max_ms = std::max(b.max_ms, ms);
+}
+
+void Telemetry::noteTrace(const RequestTrace& done) {
+  RequestTrace trace = done;
+  const double seconds = trace.totalSeconds();
+  const std::int64_t second =
+      std::chrono::duration_cast<std::chrono::seconds>(trace.written - started_).count();
+  {
+    std::lock_guard lock(traces_mutex_);
+    if (seconds > kSlowRequestSeconds)  // what the world thread did while it waited
+      for (const Span& span : spans_) {
+        const auto from = std::max(span.from, trace.queued), to = std::min(span.to, trace.started);
+        if (from < to) trace.behind[span.what] += std::chrono::duration<double, std::milli>(to - from).count();
+      }
+    if (slowest_.empty() || slowest_.back().second != second)
+      slowest_.push_back({second, trace});
+    else if (seconds > slowest_.back().trace.totalSeconds())
+      slowest_.back().trace = trace;
+    while (slowest_.size() > kSlowestSeconds) slowest_.pop_front();
+    if (seconds > kSlowRequestSeconds) ++slow_requests_;
+  }
+  if (seconds > kSlowRequestSeconds && slowLog().admit("slow_request")) {
+    const json t = trace.toJson();
+    std::string behind;
+    for (const auto& [what, ms] : trace.behind)
+      behind += (behind.empty() ? "" : ",") + what + ":" + std::to_string(std::lround(ms));
+    spdlog::warn(
+        "event=slow_request cmd={} client={} total_ms={:.1f} queue_ms={:.1f} world_ms={:.1f} "
+        "render_ms={:.1f} handoff_ms={:.1f} encode_ms={:.1f} write_ms={:.1f} behind={}",
+        trace.command, trace.client, t["total_ms"].get<double>(), t["queue_ms"].get<double>(),
+        t["world_ms"].get<double>(), trace.render_ms, t["handoff_ms"].get<double>(),
+        trace.encode_ms, t["write_ms"].get<double>(), behind.empty() ? "-" : behind);
+  }
+}
+
 void Telemetry::addRecords(json& stats) const {
   const std::vector<double> history(render_ms_.begin(), render_ms_.end());
   stats["frames"] = frames_;
@@ -58,6 +136,10 @@ void Telemetry::addRecords(json& stats) const {
                         {"p99", percentile(history, 0.99)},
                         {"samples", history.size()}};
   stats["requests"] = requests_;
+  json busy = json::object();
+  for (const auto& [what, b] : busy_)
+    busy[what] = {{"count", b.count}, {"total_ms", b.total_ms}, {"max_ms", b.max_ms}};
+  stats["world_thread"] = std::move(busy);
   stats["histograms"] = {{"render_seconds", render_seconds_.toJson()},
                          {"request_seconds", request_seconds_.toJson()}};
 }
@@ -127,6 +209,19 @@ json Telemetry::stats(const Live& live) const {
   if (out.is_null()) return out;
   out["requests"] = out["requests"].get<std::uint64_t>() + answered_at_once_.load();
   out["errors"] = errors_.load();
+  out["snapshot_failures"] = snapshot_failures_.load();
+  {
+    std::lock_guard lock(traces_mutex_);
+    json slowest = json::array();
+    for (const Slowest& s : slowest_) {
+      json entry = s.trace.toJson();
+      entry["second"] = s.second;
+      slowest.push_back(std::move(entry));
+    }
+    out["slow_requests"] = {{"count", slow_requests_},
+                            {"over_seconds", kSlowRequestSeconds},
+                            {"slowest_per_second", std::move(slowest)}};
+  }
   out["frames_dropped"] = frames_dropped.load();
   out["clients"] = {{"socket", socket_clients.load()}, {"modbus", modbus_clients.load()}};
   out["queue"]["depth"] = live.queue_depth;
@@ -186,6 +281,12 @@ std::string Telemetry::prometheusText(const Live& live) const {
   metric("frames_dropped_total", "counter", "Frames dropped for slow clients.",
          st["frames_dropped"].get<double>());
   metric("errors_total", "counter", "Error replies and failed work.", st["errors"].get<double>());
+  metric("slow_requests_total", "counter",
+         "Socket requests whose reply was written more than 1 s after they were queued.",
+         st["slow_requests"]["count"].get<double>());
+  metric("snapshot_failures_total", "counter",
+         "Snapshots not installed: not written, or would not read back.",
+         st["snapshot_failures"].get<double>());
   metric("world_heartbeat_age_seconds", "gauge",
          "Since the world thread last ran its loop or made progress in a render.",
          st["heartbeat_age"].get<double>());

@@ -31,6 +31,24 @@ struct Histogram {
   nlohmann::json toJson() const;
 };
 
+// Where one socket request's time went, stage by stage, filled in by the threads it passes
+// through in turn (each hands it on through a queue or a post, so no two touch it at once):
+// the transport queues it, the world thread takes it and applies it (rendering, for a render),
+// the encoder encodes its images, and the transport hands the reply over and writes it.
+struct RequestTrace {
+  using Clock = std::chrono::steady_clock;
+  std::string command;
+  std::int64_t client = 0;
+  Clock::time_point queued = Clock::now(), started, applied, replied, written;
+  double render_ms = 0.0;  // the views rendered for it, within applied - started
+  double encode_ms = 0.0;  // its images encoded, within replied - applied
+  // What the world thread did while this request waited in the queue, milliseconds by what it
+  // had in hand (filled in by Telemetry::noteTrace).
+  std::map<std::string, double> behind;
+  double totalSeconds() const { return std::chrono::duration<double>(written - queued).count(); }
+  nlohmann::json toJson() const;  // milliseconds by stage
+};
+
 class Telemetry {
  public:
   using Clock = std::chrono::steady_clock;
@@ -44,6 +62,8 @@ class Telemetry {
   // CIGI messages applied, refused (by reason) and packets ignored.
   void countCigi(const std::string& what);
   void noteEncode(double ms) { last_encode_ms_ = ms; }  // the encoder thread's last image
+  // A snapshot that was not written, or would not read back, and was not installed.
+  void noteSnapshotFailed() { ++snapshot_failures_; }
 
   // The world thread's heartbeat: at the top of its loop and wherever a render could be
   // cancelled. Its age (any thread) is the health check of /healthz and the systemd watchdog.
@@ -58,8 +78,19 @@ class Telemetry {
   double lastRenderMs() const { return last_render_ms_; }
   void noteRequest() { ++requests_; }
   void noteRequestDone(Clock::time_point queued);
+  // A request written out (any thread): the slowest of each second is kept for stats, and one
+  // that took longer than kSlowRequestSeconds is counted and logged with its stages.
+  void noteTrace(const RequestTrace& trace);
+  static constexpr double kSlowRequestSeconds = 1.0;
+  static constexpr std::size_t kSlowestSeconds = 10;  // seconds whose slowest stats lists
   // The render and request figures of the stats reply: render_ms, requests, histograms.
   void addRecords(nlohmann::json& stats) const;
+  // Where the world thread's time went since the start, by what it had in hand (a command's
+  // name, "frames", "ticks", "snapshot", "publish"): stats' world_thread, each with its count,
+  // total and longest milliseconds.
+  // A span is also kept a while, so that a slow request can say what the world thread did
+  // while it waited in the queue (RequestTrace::behind).
+  void noteBusy(const std::string& what, Clock::time_point from);
   // What the world thread has in hand, for stats (empty `what` when idle).
   void setInHand(std::string what, std::int64_t client);
 
@@ -90,13 +121,33 @@ class Telemetry {
   std::deque<double> render_ms_;
   Histogram render_seconds_;   // one view's render
   Histogram request_seconds_;  // a request or batch, from queueing to done
+  struct Busy {
+    std::uint64_t count = 0;
+    double total_ms = 0.0, max_ms = 0.0;
+  };
+  std::map<std::string, Busy> busy_;
 
   // Any thread.
   std::atomic<std::int64_t> heartbeat_ns_{0};
   std::atomic<std::uint64_t> errors_{0};
+  std::atomic<std::uint64_t> snapshot_failures_{0};
   std::atomic<std::uint64_t> answered_at_once_{0};  // requests the control plane answered
   std::atomic<int> last_error_{0};
   std::atomic<double> last_encode_ms_{0.0};
+  mutable std::mutex traces_mutex_;
+  struct Slowest {
+    std::int64_t second = 0;  // since the daemon started
+    RequestTrace trace;
+  };
+  std::deque<Slowest> slowest_;  // one per second that wrote a request, the last kSlowestSeconds
+  struct Span {
+    std::string what;
+    Clock::time_point from, to;
+  };
+  std::deque<Span> spans_;  // the world thread's last kSpans spans of work
+  static constexpr std::size_t kSpans = 4096;
+  std::uint64_t slow_requests_ = 0;
+  const Clock::time_point started_ = Clock::now();
   mutable std::mutex cigi_mutex_;
   std::map<std::string, std::uint64_t> cigi_counts_;
 

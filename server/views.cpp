@@ -102,28 +102,42 @@ Views::Clock::time_point Views::nextDue(Clock::time_point wake) const {
   return wake;
 }
 
-std::map<std::string, std::vector<Subscription*>> Views::due(Delivery which,
-                                                             const std::string& view,
-                                                             std::uint64_t tick,
-                                                             Clock::time_point now) {
+std::vector<std::pair<std::string, std::vector<Subscription*>>> Views::due(
+    Delivery which, const std::string& view, std::uint64_t tick, Clock::time_point now) {
   std::map<std::string, std::vector<Subscription*>> by_view;
+  std::map<std::string, Clock::time_point> since;  // the view's most overdue subscription
   for (Subscription& sub : subscriptions_) {
     const bool due = which == Delivery::kDue         ? now >= sub.next_due
                      : which == Delivery::kEveryTick ? sub.last_tick != tick
                                                      : sub.view == view;
     if (!due) continue;
+    by_view[sub.view].push_back(&sub);
+    auto [at, added] = since.try_emplace(sub.view, sub.next_due);
+    if (!added) at->second = std::min(at->second, sub.next_due);
+  }
+  std::vector<std::pair<std::string, std::vector<Subscription*>>> out(by_view.begin(),
+                                                                      by_view.end());
+  std::stable_sort(out.begin(), out.end(),
+                   [&](const auto& a, const auto& b) { return since[a.first] < since[b.first]; });
+  return out;
+}
+
+std::vector<Subscription*> Views::take(const std::vector<Subscription*>& due, Delivery which,
+                                       std::uint64_t tick, Clock::time_point now) {
+  std::vector<Subscription*> out;
+  for (Subscription* sub : due) {
     if (which == Delivery::kDue) {
-      sub.next_due += sub.period;
-      if (sub.next_due < now) sub.next_due = now + sub.period;  // a slow render: skip, never burst
+      sub->next_due += sub->period;
+      if (sub->next_due < now) sub->next_due = now + sub->period;  // a slow render: skip, never burst
     }
-    sub.last_tick = tick;
-    if (sub.video && sub.video->full()) {
-      sub.video->countDropped();
+    sub->last_tick = tick;
+    if (sub->video && sub->video->full()) {
+      sub->video->countDropped();
       continue;
     }
-    by_view[sub.view].push_back(&sub);
+    out.push_back(sub);
   }
-  return by_view;
+  return out;
 }
 
 int Views::subscriptionsOf(std::int64_t client) const {

@@ -75,10 +75,16 @@ class Views {
   void restartPeriods(Clock::time_point now);
   // The earliest of `wake` and every subscription's next due time.
   Clock::time_point nextDue(Clock::time_point wake) const;
-  // The subscriptions `which` makes due at `now` and `tick`, by view name (their next due time
-  // moved on); a stream whose encoder is still busy drops the frame here, before it is rendered.
-  std::map<std::string, std::vector<Subscription*>> due(Delivery which, const std::string& view,
-                                                        std::uint64_t tick, Clock::time_point now);
+  // The subscriptions `which` makes due at `now` and `tick`, by view, the most overdue view
+  // first; nothing changes until take().
+  std::vector<std::pair<std::string, std::vector<Subscription*>>> due(Delivery which,
+                                                                      const std::string& view,
+                                                                      std::uint64_t tick,
+                                                                      Clock::time_point now);
+  // Serves one view's due subscriptions: their next due time moves on, and those to render are
+  // returned; a stream whose encoder is still busy drops the frame here, before it is rendered.
+  std::vector<Subscription*> take(const std::vector<Subscription*>& due, Delivery which,
+                                  std::uint64_t tick, Clock::time_point now);
 
   // How many subscriptions a socket client holds (any thread).
   int subscriptionsOf(std::int64_t client) const;

@@ -2,6 +2,7 @@
 // them, then its fields' heaps as withFieldClouds adds them; the budget thins the list as
 // withinEllipsoidBudget thins a scene; the sea's probe shares the view's clouds.
 #include "renderer/frame_plan.h"
+#include "world/limits.h"
 
 #include <gtest/gtest.h>
 
@@ -78,6 +79,28 @@ TEST(FramePlan, ABudgetThinsTheListAsItThinsAScene) {
   ASSERT_EQ(plan.view.clouds.size(), within->clouds.size());
   for (std::size_t i = 0; i < within->clouds.size(); ++i)
     EXPECT_TRUE(sameLobes(plan.view.cloud(i), within->clouds[i])) << i;
+}
+
+TEST(FramePlan, TheSeasProbeOfAnyLegalViewIsALegalTarget) {
+  // A view 1 pixel wide and 16,384 high asked the GL for a 32 x 524,288 probe and aborted the
+  // daemon (the live fuzz of issue 62). Every probe stays within 32 to 16,384 a side and holds
+  // about the view's rows at its scale.
+  for (const auto& [width, height] : {std::pair{1, 16384}, {16384, 1}, {1, 1}, {16384, 16384},
+                                      {64, 16384}, {640, 480}})
+    for (double scale : {Limits::kSeaProbeScale.lo, 0.5, Limits::kSeaProbeScale.hi}) {
+      Camera view;
+      view.width = width;
+      view.height = height;
+      view.vfov_deg = 60.0;
+      const Camera probe = seaProbeCamera(view, scale);
+      SCOPED_TRACE(std::to_string(width) + "x" + std::to_string(height) + " at " +
+                   std::to_string(scale));
+      EXPECT_GE(probe.width, 32);
+      EXPECT_GE(probe.height, 32);
+      EXPECT_LE(probe.width, Limits::kMaxImageSide);
+      EXPECT_LE(probe.height, Limits::kMaxImageSide);
+      EXPECT_LE(probe.height, std::max(32.0, std::ceil(height * scale)) + 1.0);
+    }
 }
 
 TEST(FramePlan, TheSeasProbeSharesTheViewsCloudsFromTheSea) {

@@ -205,6 +205,53 @@ TEST(World, SnapshotRestoresBitExactlyAndContinuesIdentically) {
   std::filesystem::remove(path);
 }
 
+TEST(World, ARecentringThatWouldCarryATargetOutOfRangeIsRefusedAndChangesNothing) {
+  // Issue 62: a view or target near the edge of the range its readers accept, then a set_site
+  // whose re-centring (about 111 km north-south) would carry it past the edge.
+  World world = makeWorld();
+  ASSERT_EQ(world.setSite({46.0, 7.0, 0.0}), "");
+  Target edge;
+  edge.name = "edge";
+  edge.centre = {0.0, Limits::kMaxCoordinate - 10000.0, 100.0};
+  ASSERT_EQ(world.addTarget(edge, false, 4), "");
+  const std::uint64_t hash = world.hash();
+  const Site south{45.0, 7.0, 0.0};
+  EXPECT_GT(glm::length(world.recentreShift(south)), 100000.0);
+  EXPECT_THAT(world.setSiteError(south), ::testing::HasSubstr("target edge"));
+  EXPECT_THAT(world.setSite(recentred(*world.base().site, 45.0, 7.0).to),
+              ::testing::HasSubstr("nothing changed"));
+  EXPECT_EQ(world.hash(), hash);
+  // The other way the target moves inward: allowed, and the state saves and reads back.
+  ASSERT_EQ(world.setSite(recentred(*world.base().site, 47.0, 7.0).to), "");
+  const std::vector<std::uint8_t> bytes = world.snapshot();
+  World restored = makeWorld();
+  EXPECT_EQ(restored.restore(bytes), "");
+  EXPECT_EQ(restored.hash(), world.hash());
+}
+
+TEST(World, ASnapshotThatWouldNotReadBackIsNotInstalled) {
+  const std::filesystem::path path =
+      std::filesystem::temp_directory_path() / "nephele_world_test_proven.snapshot";
+  World good = makeWorld();
+  ASSERT_EQ(good.saveSnapshot(path.string()), "");
+  // A world holding what no reader accepts (built directly, past every request's checks): its
+  // snapshot is written, fails to read back, and is not installed.
+  auto [scene, dynamics] = smallWorld();
+  Target far;
+  far.name = "far";
+  far.centre = {2.0 * Limits::kMaxCoordinate, 0.0, 0.0};
+  scene.targets.push_back(far);
+  World bad(scene, dynamics, 1);
+  const std::string error = bad.saveSnapshot(path.string());
+  EXPECT_THAT(error, ::testing::HasSubstr("does not read back"));
+  EXPECT_THAT(error, ::testing::HasSubstr("target far"));
+  EXPECT_FALSE(std::filesystem::exists(path.string() + ".partial"));
+  World restored(Scene{}, WorldDynamics{});
+  ASSERT_EQ(restored.restoreSnapshot(path.string()), "");
+  EXPECT_EQ(restored.hash(), good.hash());  // the previous snapshot stayed
+  std::filesystem::remove(path);
+}
+
 TEST(World, CorruptOrTruncatedSnapshotsAreRefusedAndLeaveTheWorldAsItWas) {
   World source = makeWorld();
   ASSERT_EQ(source.advance(5.0), "");

@@ -9,8 +9,9 @@
 
 namespace nephele {
 
-std::string writeFileAtomically(const std::string& path, std::span<const std::uint8_t> bytes,
-                                const std::string& what) {
+std::string writeFileAtomically(
+    const std::string& path, std::span<const std::uint8_t> bytes, const std::string& what,
+    const std::function<std::string(const std::string& temporary)>& verify) {
   const std::string temporary = path + ".partial";
   const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) return what + ": cannot create '" + temporary + "': " + std::strerror(errno);
@@ -38,6 +39,12 @@ std::string writeFileAtomically(const std::string& path, std::span<const std::ui
     ::unlink(temporary.c_str());
     return error;
   }
+  if (verify)
+    if (std::string error = verify(temporary); !error.empty()) {
+      ::unlink(temporary.c_str());
+      return what + ": '" + path + "' not replaced: what was written does not read back: " +
+             error;
+    }
   if (std::rename(temporary.c_str(), path.c_str()) != 0) {
     const std::string error =
         what + ": cannot move '" + temporary + "' into place: " + std::strerror(errno);

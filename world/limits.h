@@ -43,6 +43,13 @@ inline bool heldExactly(std::int64_t v) {
   return v >= -kMaxExactInteger && v <= kMaxExactInteger;
 }
 
+// Where a host places a camera or a target: each coordinate within Limits::kMaxCoordinate of the
+// origin (a camera's z also at or above the ground). Every reader of positions (requests, scene
+// files and configs, snapshots) and every move of the world under them (set_site's
+// re-centring) keep to it, so that whatever the daemon holds can be saved and read back.
+// Returns "" or "WHAT: (x, y, z) is beyond ... (allowed: ...)".
+inline std::string placementError(std::string_view what, double x, double y, double z);
+
 struct Limits {
   // Camera and image.
   static constexpr int kMaxImageSide = 16384;      // GL_MAX_RENDERBUFFER_SIZE on llvmpipe
@@ -189,6 +196,17 @@ struct Limits {
   // Names of views, clouds, layers, automata, targets and snapshots.
   static constexpr std::size_t kMaxNameLength = 64;
 };
+
+inline std::string placementError(std::string_view what, double x, double y, double z) {
+  const double c = Limits::kMaxCoordinate;
+  if (std::isfinite(x) && std::isfinite(y) && std::isfinite(z) && std::abs(x) <= c &&
+      std::abs(y) <= c && std::abs(z) <= c)
+    return "";
+  return std::string(what) + ": (" + formatNumber(x) + ", " + formatNumber(y) + ", " +
+         formatNumber(z) + ") lies beyond " + formatNumber(c) +
+         " m of the origin (allowed: each coordinate " + formatNumber(-c) + " to " +
+         formatNumber(c) + ")";
+}
 
 // The one name rule, for every name a user gives (scene files, daemon configs, requests):
 // 1 to 64 ASCII letters, digits, '_', '-' or '.', not starting with '.'. A name is thus

@@ -379,13 +379,28 @@ std::string siteError(const Site& site) {
          " (allowed: latitude -90 to 90, longitude -180 to 180, a finite grid north)";
 }
 
+glm::dvec2 World::recentreShift(const Site& site) const {
+  if (!base_.site || *base_.site == site) return glm::dvec2(0.0);
+  return recentred(*base_.site, site.latitude_deg, site.longitude_deg).shift;
+}
+
+std::string World::setSiteError(const Site& site) const {
+  if (std::string e = siteError(site); !e.empty()) return e;
+  const glm::dvec3 by(recentreShift(site), 0.0);
+  for (const Target& t : base_.targets) {  // targets do not drift: base_ holds where they stand
+    const glm::dvec3 to = t.centre - by;
+    if (std::string e = placementError("target " + t.name, to.x, to.y, to.z); !e.empty())
+      return "site: the re-centring moves the world by " + formatNumber(glm::length(by)) +
+             " m, which would carry " + e + "; nothing changed";
+  }
+  return "";
+}
+
 std::string World::setSite(const Site& site, bool* changed) {
   if (changed) *changed = false;
-  if (std::string e = siteError(site); !e.empty()) return e;
+  if (std::string e = setSiteError(site); !e.empty()) return e;
   if (base_.site == site) return "";
-  const glm::dvec2 shift = base_.site
-                               ? recentred(*base_.site, site.latitude_deg, site.longitude_deg).shift
-                               : glm::dvec2(0.0);
+  const glm::dvec2 shift = recentreShift(site);
   editBase([&](Scene& base, WorldDynamics&) {
     base.site = site;
     moveContent(base, shift);

@@ -151,6 +151,12 @@ class World {
   // north other than the one the move implies (recentred()) turns nothing. A site out of
   // range is refused.
   std::string setSite(const Site& site, bool* changed = nullptr);
+  // What setSite(site) would refuse, changing nothing: a site out of range, or a re-centring
+  // that would carry a target beyond the range its readers accept (placementError). The move
+  // itself is recentreShift(site): the new origin in the database as it stands (zero for a
+  // world placed nowhere, or one already there).
+  std::string setSiteError(const Site& site) const;
+  glm::dvec2 recentreShift(const Site& site) const;
   // The wind by altitude (layers, clouds and fields drift on from where they are; the sea
   // takes the wind at altitude 0). A profile worldDynamicsError refuses is refused.
   std::string setWind(const WindProfile& wind);
@@ -190,7 +196,11 @@ class World {
   std::vector<std::uint8_t> snapshot() const;
   std::string restore(std::span<const std::uint8_t> bytes,
                       std::size_t max_ellipsoids = Limits::kMaxWorldEllipsoids);
-  std::string saveSnapshot(const std::string& path) const;
+  // Writes the snapshot beside `path`, reads it back with restoreSnapshot's reader (under
+  // `max_ellipsoids`) and only then renames it over `path`: a file that would not read back is
+  // not installed, and the previous one stays.
+  std::string saveSnapshot(const std::string& path,
+                           std::size_t max_ellipsoids = Limits::kMaxWorldEllipsoids) const;
   std::string restoreSnapshot(const std::string& path,
                               std::size_t max_ellipsoids = Limits::kMaxWorldEllipsoids);
 

@@ -420,6 +420,10 @@ std::string World::restore(std::span<const std::uint8_t> bytes, std::size_t max_
     for (const Ellipsoid& e : cloud.ellipsoids)
       if (std::string error = ellipsoidError(e); !error.empty())
         return "snapshot: cloud " + cloud.name + ": " + error;
+  for (const Target& t : scene.targets)
+    if (std::string e = placementError("target " + t.name, t.centre.x, t.centre.y, t.centre.z);
+        !e.empty())
+      return "snapshot: " + e;
   if (time_ns < 0) return "snapshot: negative time";
 
   World restored(scene, dynamics, threads_, false);
@@ -442,8 +446,13 @@ std::string World::restore(std::span<const std::uint8_t> bytes, std::size_t max_
   return {};
 }
 
-std::string World::saveSnapshot(const std::string& path) const {
-  return writeFileAtomically(path, snapshot(), "snapshot");
+std::string World::saveSnapshot(const std::string& path, std::size_t max_ellipsoids) const {
+  // Proven before it replaces the last one: the file written is read back by restore's own
+  // reader, into a world of its own, and renamed into place only if it reads.
+  return writeFileAtomically(path, snapshot(), "snapshot", [&](const std::string& written) {
+    World probe(Scene{}, WorldDynamics{}, 1, false);
+    return probe.restoreSnapshot(written, max_ellipsoids);
+  });
 }
 
 std::string World::restoreSnapshot(const std::string& path, std::size_t max_ellipsoids) {

@@ -24,6 +24,15 @@ SCENE = os.path.join(SOURCE, "config", "scenes", "cumulus.toml")
 TIMEOUT = 60  # seconds any single wait may take (sanitizer builds are slow)
 
 
+# The live fuzz's daemon (live_fuzz.py): frames of at most 0.25 MiP (about 0.25 s each on two
+# cores under llvmpipe) and 4 subscriptions, so that a lockstep tick, which renders every
+# subscription's frame before anything else runs, fits the fuzz's 5 s reply bound; snapshots only
+# when asked and at shutdown.
+LIVE_FUZZ_DAEMON = dict(socket_keys="max_pending_mb = 4\nmax_image_pixels = 0.25\n"
+                                    "max_subscriptions = 4",
+                        extra="[snapshot]\npath = \"{snapshot}\"\ninterval = 0\n")
+
+
 def wait_until(condition, what, timeout=TIMEOUT):
     """Polls `condition` until it holds; fails the test with `what` after `timeout`."""
     deadline = time.monotonic() + timeout
@@ -709,6 +718,76 @@ class LockstepAndSnapshotTest(DaemonTest):
                 self.assertEqual(error["code"], "failed")
                 self.assertIn(words, error["message"])
         self.assertEqual(c.ok({"cmd": "hash"})["hash"], before["hash"])
+
+    def test_case62_a_recentring_past_the_range_is_refused_and_the_state_restarts(self):
+        """Issue 62: a view at y = 99,990,000 (legal), then set_site 46/7 and 45/7: the second
+        would carry the view to y = 100,101,136, beyond what set_view, configs and snapshots
+        accept. It is refused with bad_field and changes nothing, and the state snapshots,
+        restores and survives a restart. The same holds for a target."""
+        d = self.daemon(name="e", extra='[snapshot]\npath = "{snapshot}"\ninterval = 0')
+        c = d.client()
+        c.ok({"cmd": "set_view", "view": "front", "position": [0, 99990000, 100]})
+        c.ok({"cmd": "set_site", "latitude": 46, "longitude": 7})
+        before = (c.ok({"cmd": "hash"})["hash"], c.ok({"cmd": "get_view", "view": "front"}),
+                  c.ok({"cmd": "set_site"}))
+        error = c.error({"cmd": "set_site", "latitude": 45, "longitude": 7})
+        self.assertEqual(error["code"], "bad_field", error)
+        self.assertIn("view front", error["message"])
+        self.assertIn("nothing changed", error["message"])
+        self.assertEqual((c.ok({"cmd": "hash"})["hash"],
+                          c.ok({"cmd": "get_view", "view": "front"}),
+                          c.ok({"cmd": "set_site"})), before)
+        # A target at the edge likewise (the view moved back inside first).
+        c.ok({"cmd": "set_view", "view": "front", "position": [0, 0, 100]})
+        c.ok({"cmd": "add_target", "target": {"name": "buoy", "shape": "box",
+                                              "centre": [0, 99990000, 0], "size": [2, 2, 2]}})
+        hash_before = c.ok({"cmd": "hash"})["hash"]
+        error = c.error({"cmd": "set_site", "latitude": 45, "longitude": 7})
+        self.assertEqual(error["code"], "bad_field", error)
+        self.assertIn("target buoy", error["message"])
+        self.assertEqual(c.ok({"cmd": "hash"})["hash"], hash_before)
+        # Northwards everything moves inward: accepted, saved, restored and restarted.
+        moved = c.ok({"cmd": "set_site", "latitude": 47, "longitude": 7})
+        self.assertTrue(moved["placed"])
+        saved = c.ok({"cmd": "snapshot", "name": "edge"})
+        self.assertEqual(c.ok({"cmd": "restore", "name": "edge"})["hash"], saved["hash"])
+        view = c.ok({"cmd": "get_view", "view": "front"})
+        self.assertEqual(d.stop(), 0)
+        d.start()
+        c = d.client()
+        self.assertEqual(c.ok({"cmd": "hash"})["hash"], saved["hash"])
+        self.assertEqual(c.ok({"cmd": "get_view", "view": "front"}), view)
+
+    def test_case62_a_snapshot_that_does_not_read_at_start_exits_or_starts_fresh(self):
+        """Issue 62: a shutdown snapshot that does not read stops the next start, naming the
+        file and the field, unless [snapshot] on_error = "start_fresh": then the daemon moves
+        it aside (PATH.rejected), logs and counts it, and starts from the scene."""
+        extra = '[snapshot]\npath = "{snapshot}"\ninterval = 0\n'
+        d = self.daemon(name="bad", extra=extra)
+        fresh = d.client().ok({"cmd": "hash"})["hash"]
+        self.assertEqual(d.stop(), 0)
+        side = d.snapshot + ".daemon.json"
+        with open(side) as f:
+            state = json.load(f)
+        state["requests"][0]["position"] = [0, 100101136, 100]  # as the old daemon wrote it
+        with open(side, "w") as f:
+            json.dump(state, f)
+        with self.assertRaises(AssertionError) as refused:
+            d.start()
+        self.assertIn(side, str(refused.exception))
+        self.assertIn("position", str(refused.exception))
+        self.assertIn("start_fresh", str(refused.exception))
+        d.stop()
+        with open(d.config, "a") as f:
+            f.write('on_error = "start_fresh"\n')  # the [snapshot] table is the config's last
+        d.start()
+        c = d.client()
+        self.assertEqual(c.ok({"cmd": "hash"})["hash"], fresh)
+        self.assertEqual(c.ok({"cmd": "stats"})["snapshot_failures"], 1)
+        self.assertIn("event=snapshot_rejected", d.log_text())
+        self.assertTrue(os.path.exists(side + ".rejected"))
+        self.assertTrue(os.path.exists(d.snapshot + ".rejected"))
+        self.assertFalse(os.path.exists(d.snapshot))
 
     def test_a_scene_may_start_later_than_one_advance_reaches(self):
         # A scene's time may be up to 1e9 s; one World advance is at most 1e7 s. The daemon
@@ -1653,118 +1732,31 @@ class AbuseTest(DaemonTest):
 
 
     def test_live_fuzz_of_every_command_leaves_the_daemon_answering(self):
-        """Random mixes of valid and broken requests of every command over three connections,
-        restore of directories, FIFOs and sparse files included. NEPHELE_LIVE_FUZZ sets the
-        number of requests (default 1500, a few seconds)."""
-        import random
-        total = int(os.environ.get("NEPHELE_LIVE_FUZZ", "1500"))
-        d = self.daemon(socket_keys="max_pending_mb = 4", extra="[snapshot]\n"
-                        "path = \"{snapshot}\"\ninterval = 0\n")
-        snaps = os.path.dirname(d.snapshot)
-        os.makedirs(snaps, exist_ok=True)
-        os.mkdir(os.path.join(snaps, "dir.snap"))
-        os.mkfifo(os.path.join(snaps, "fifo.snap"))
-        with open(os.path.join(snaps, "sparse.snap"), "wb") as f:
-            f.truncate(1 << 30)
-        with open(os.path.join(snaps, "junk.snap"), "wb") as f:
-            f.write(b"NEPHSNAP" + bytes(range(256)) * 4)
-        rng = random.Random(12)
-        names = ["a", "b", "dir", "fifo", "sparse", "junk", "x" * 70, "a b", "../etc"]
-        values = [0, -1, 1e308, -1e308, 0.5, 12, 1e7, 3600.1, "x", None, True, [], {}, [1, 2, 3]]
-        # The edges of int64 and binary64 (issue 26: 2^53 + 1 in an add_target centre aborted
-        # the daemon), integers where floats are read and the reverse.
-        edges = [2**53 + 1, -(2**53 + 1), 2**63, 2**63 - 1, -(2**63), 2**64, -0.0, 5e-324,
-                 1.7976931348623157e308, 1.0, 1]
+        """tests/daemon/live_fuzz.py: every command of protocol/commands.inc with the fields
+        and ranges its reader names, over three connections, among snapshot files that are a
+        directory, a FIFO, a sparse file and junk. One well-formed reply per request, each
+        within 5 s; snapshot round trips give back their hash; a restart restores the shutdown
+        snapshot. NEPHELE_LIVE_FUZZ sets the seconds (default 20)."""
+        import live_fuzz
+        seconds = float(os.environ.get("NEPHELE_LIVE_FUZZ", "20"))
 
-        def value():
-            return rng.choice(values + edges + [rng.uniform(-1e4, 1e4), rng.randint(-5, 70000)])
+        def daemon():
+            d = self.daemon(**LIVE_FUZZ_DAEMON)
+            snaps = os.path.dirname(d.snapshot)
+            os.makedirs(snaps, exist_ok=True)
+            os.mkdir(os.path.join(snaps, "dir.snap"))
+            os.mkfifo(os.path.join(snaps, "fifo.snap"))
+            with open(os.path.join(snaps, "sparse.snap"), "wb") as f:
+                f.truncate(1 << 30)
+            with open(os.path.join(snaps, "junk.snap"), "wb") as f:
+                f.write(b"NEPHSNAP" + bytes(range(256)) * 4)
+            return d
 
-        def number(sensible):
-            return sensible if rng.random() < 0.7 else rng.choice(edges + values)
-
-        def request():
-            cmd = rng.choice(["hello", "get_view", "set_view", "set_weather", "set_wind",
-                              "set_sun", "set_sea", "set_time", "add_cloud", "change_cloud",
-                              "remove_cloud", "add_target", "move_target", "tick", "render",
-                              "subscribe", "unsubscribe",
-                              "snapshot", "restore", "stats", "hash", "nonsense"])
-            r = {"cmd": cmd}
-            keys = {"get_view": ["view"], "set_view": ["view", "heading", "width", "height",
-                                                         "vfov", "position", "format"],
-                    "set_weather": ["layer", "type", "base", "thickness", "coverage", "wind"],
-                    "set_wind": ["velocity"], "set_sun": ["azimuth", "elevation"],
-                    "set_sea": ["enabled", "fetch", "temperature", "clarity", "whitecaps", "seed",
-                                "waves"],
-                    "set_time": ["advance", "paused", "time_scale"],
-                    "change_cloud": ["name", "move", "threshold"], "remove_cloud": ["name"],
-                    "move_target": ["name", "centre", "heading", "pitch"],
-                    "tick": ["dt"], "render": ["view", "format", "channels"],
-                    "subscribe": ["view", "rate"], "unsubscribe": ["subscription"],
-                    "snapshot": ["name"], "restore": ["name"]}.get(cmd, [])
-            for k in keys:
-                if rng.random() < 0.8:
-                    r[k] = value()
-            # Mostly sensible values, so that valid requests run too.
-            if "view" in r and rng.random() < 0.7:
-                r["view"] = rng.choice(["front", "left"])
-            if "name" in r and rng.random() < 0.8:
-                r["name"] = rng.choice(names)
-            if "layer" in r and rng.random() < 0.7:
-                r.update(layer=rng.randint(1, 3), type=rng.randint(0, 10), base=1500,
-                         thickness=500, coverage=rng.uniform(0, 100))
-            if "dt" in r and rng.random() < 0.7:
-                r["dt"] = rng.uniform(0, 2)
-            if cmd == "add_cloud" and rng.random() < 0.5:
-                r["cloud"] = {"name": rng.choice(names),
-                              "cumulus": {"base": [0, 0, number(900)],
-                                          "width": number(rng.uniform(-10, 900)),
-                                          "count": number(8), "seed": number(3)}}
-            elif cmd == "add_cloud":
-                r["cloud"] = {"name": rng.choice(names), "threshold": number(0.5),
-                              "ellipsoid": [{"centre": [number(0), 0, number(1000)],
-                                             "radii": [number(300), 200, number(150)]}]}
-            if cmd == "add_target":
-                r["target"] = {"name": rng.choice(names), "shape": "box",
-                               "centre": [number(0), number(10), number(1000)],
-                               "size": [number(5), 5, number(5)], "heading": number(10)}
-            if cmd == "set_view":
-                r.update(width=rng.randint(1, 96), height=rng.randint(1, 96))
-            if cmd == "set_sea" and rng.random() < 0.7:
-                r.pop("enabled", None)
-                r["waves"] = [{"id": number(rng.randint(0, 12)), "height": number(1.5),
-                               "wavelength": number(80), "direction": value()}
-                              for _ in range(rng.randint(1, 3))]
-            if cmd == "subscribe":
-                r["rate"] = rng.choice([0.5, 60, 0, -1, "x"])
-            line = json.dumps(r)
-            if rng.random() < 0.1:  # broken bytes: truncation, garbage, BOM, NUL
-                line = rng.choice([line[:rng.randint(0, len(line))], "\ufeff" + line,
-                                   line + "\0", line + "}", "{" * 40, "[]"])
-            return line.encode("utf-8", "replace") + b"\n"
-
-        conns = [d.client() for _ in range(3)]
-        for c in conns:
-            c.sock.settimeout(TIMEOUT)
-        sent = 0
-        while sent < total:
-            for c in conns:
-                batch = b"".join(request() for _ in range(10))
-                c.sock.sendall(batch)
-                sent += 10
-            # Drain what has come back so far without waiting for every reply.
-            for c in conns:
-                c.sock.setblocking(False)
-                try:
-                    while c.sock.recv(1 << 20):
-                        pass
-                except (BlockingIOError, ConnectionResetError):
-                    pass
-                c.sock.setblocking(True)
-                c.sock.settimeout(TIMEOUT)
-        self.assertIsNone(d.proc.poll(), "the daemon died")
-        fresh = d.client()
-        fresh.ok({"cmd": "hello"})
-        fresh.ok({"cmd": "hash"})
+        d, figures = live_fuzz.run(daemon, SOURCE, seconds, seed=12)
+        print(f"live fuzz: {figures['requests']} requests, {figures['round_trips']} round "
+              f"trips, slowest reply {figures['max_reply_s']:.2f} s ({figures['slowest']})")
+        self.assertGreater(figures["round_trips"], 0)
+        self.assertEqual(figures["snapshot_failures"], 0)
         self.assertEqual(d.stop(), 0, d.log_text()[-2000:])
 
     def test_case18_modbus_clients_that_drop_mid_frame_free_their_slots_at_once(self):
