@@ -101,7 +101,7 @@ void readSocket(TableReader& t, DaemonConfig& out) {
     s->integer("max_subscriptions", out.max_subscriptions, 0, 4096);
     s->integer("max_queue", out.max_queue, 1, 65536);
     // In mebipixels; a fraction bounds a small machine's frames tighter (the live fuzz runs
-    // under 0.25, so that a lockstep tick's renders fit its 5 s reply bound on two cores).
+    // under 0.0625, so that a lockstep tick's renders fit its 5 s reply bound on two cores).
     double pixels_m = double(out.max_image_pixels) / double(1 << 20);
     s->number("max_image_pixels", pixels_m, 0.01, 256.0);
     out.max_image_pixels = std::int64_t(pixels_m * double(1 << 20));

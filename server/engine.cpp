@@ -85,29 +85,7 @@ std::string Engine::openWorld() {
   if (std::string e = world_->advanceInPieces(config_.scene.scene.time_s); !e.empty())
     return "scene time: " + e;
   if (config_.site) world_->setSite({config_.site->latitude_deg, config_.site->longitude_deg, 0.0});
-  const std::string& snapshot = config_.snapshot_path;
-  if (config_.restore_on_start && !snapshot.empty() && std::filesystem::exists(snapshot)) {
-    if (std::string e = restoreSnapshot(snapshot); !e.empty()) {
-      if (config_.snapshot_on_error != DaemonConfig::SnapshotOnError::kStartFresh)
-        return e +
-               " (move the file away, or set [snapshot] on_error = \"start_fresh\", to start "
-               "from the scene instead)";
-      // Kept for whoever looks into it; the next snapshot takes the path. A restore that fails
-      // changes nothing, so the world is still the scene's.
-      std::error_code ec;
-      for (const std::string& file : {snapshot, daemonStatePath(snapshot)})
-        if (std::filesystem::exists(file, ec))
-          std::filesystem::rename(file, file + ".rejected", ec);
-      spdlog::error("event=snapshot_rejected path={} moved_to={}.rejected error=\"{}\" "
-                    "action=start_fresh",
-                    snapshot, snapshot, e);
-      telemetry_.noteSnapshotFailed();
-    } else {
-      spdlog::info("event=restored snapshot={} time={:.3f} ticks={} frames={} hash={}", snapshot,
-                 world_->timeSeconds(), clock_.ticks(), telemetry_.frames(),
-                   hexHash(world_->hash()));
-    }
-  }
+  if (std::string e = restoreAtStart(); !e.empty()) return e;
   for (const command::Stream& stream : config_.streams) {
     const Outcome started = startStream(stream);
     if (const auto* e = std::get_if<ProtocolError>(&started))
@@ -116,6 +94,32 @@ std::string Engine::openWorld() {
   spdlog::info("event=world_ready gl=\"{}\" backend={} views={} mode={} tick_rate={}",
                renders_->glName(), renders_->backendName(), views_.all().size(),
                modeName(clock_.mode()), config_.tick_rate_hz);
+  return "";
+}
+
+std::string Engine::restoreAtStart() {
+  const std::string& snapshot = config_.snapshot_path;
+  if (!config_.restore_on_start || snapshot.empty() || !std::filesystem::exists(snapshot))
+    return "";
+  const std::string e = restoreSnapshot(snapshot);
+  if (e.empty()) {
+    spdlog::info("event=restored snapshot={} time={:.3f} ticks={} frames={} hash={}", snapshot,
+                 world_->timeSeconds(), clock_.ticks(), telemetry_.frames(),
+                 hexHash(world_->hash()));
+    return "";
+  }
+  if (config_.snapshot_on_error != DaemonConfig::SnapshotOnError::kStartFresh)
+    return e + " (move the file away, or set [snapshot] on_error = \"start_fresh\", to start from "
+               "the scene instead)";
+  // Kept for whoever looks into it; the next snapshot takes the path. A restore that fails
+  // changes nothing, so the world is still the scene's.
+  std::error_code ec;
+  for (const std::string& file : {snapshot, daemonStatePath(snapshot)})
+    if (std::filesystem::exists(file, ec)) std::filesystem::rename(file, file + ".rejected", ec);
+  spdlog::error("event=snapshot_rejected path={} moved_to={}.rejected error=\"{}\" "
+                "action=start_fresh",
+                snapshot, snapshot, e);
+  telemetry_.noteSnapshotFailed();
   return "";
 }
 
@@ -137,19 +141,16 @@ void Engine::run(std::promise<std::string>& started) {
     views_.dropClients(taken.gone);
     for (Job& job : taken.jobs) {
       if (!stopping) {
-        telemetry_.setInHand(job.kind == Job::Kind::kBatch
-                                 ? "modbus write"
-                                 : std::string(commandName(job.request.command)),
-                             job.client);
+        const std::string what = job.kind == Job::Kind::kBatch
+                                     ? "modbus write"
+                                     : std::string(commandName(job.request.command));
+        telemetry_.setInHand(what, job.client);
         try {
           const auto t0 = Clock::now();
           if (job.trace) job.trace->started = t0;
           execute(job);
           telemetry_.noteRequestDone(job.queued);
-          telemetry_.noteBusy(job.kind == Job::Kind::kBatch
-                                  ? "modbus write"
-                                  : std::string(commandName(job.request.command)),
-                              t0);
+          telemetry_.noteBusy(what, t0);
           continue;
         } catch (const RenderCancelled&) {
           stopping = true;  // stop() cancelled its render: answered as the queued ones

@@ -102,6 +102,9 @@ class Engine {
   Telemetry::Live live() const;
   void run(std::promise<std::string>& started);
   std::string openWorld();
+  // The configured snapshot restored at start, if there is one; "" or why the daemon cannot
+  // start ([snapshot] on_error).
+  std::string restoreAtStart();
   void execute(Job& job);
   void executeBatch(Job& job);
   // A request's result (or error); render and snapshot replies may come later from the

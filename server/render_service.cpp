@@ -1,11 +1,15 @@
 #include "server/render_service.h"
 
+#include <spdlog/spdlog.h>
+
+
 #include <condition_variable>
 #include <deque>
 #include <mutex>
 #include <thread>
 
 #include "renderer/renderer.h"
+#include "server/log_limiter.h"
 #include "server/telemetry.h"
 #include "world/limits.h"
 #include "world/world.h"
@@ -141,6 +145,12 @@ std::string RenderService::backendName() const {
 
 namespace {
 
+// Frames slower than a second are logged with their stages, in full while rare.
+LogLimiter& slowFrameLog() {
+  static LogLimiter limiter;
+  return limiter;
+}
+
 // The camera a view is rendered with: an off-axis view renders the centred view that holds it.
 Camera renderedCamera(const ViewConfig& view) {
   return view.frustum ? offAxisView(view.camera, *view.frustum).render : view.camera;
@@ -212,8 +222,19 @@ void RenderService::render(const World& world, const ViewConfig& view, const Ima
     info.cy = o.cy;
   }
   if (channels.pixels == Channels::Pixels::kPlanes && off_axis) frame.info = info;
-  telemetry_.noteRender(
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  telemetry_.noteRender(ms);
+  if (ms > 1000.0 && slowFrameLog().admit("slow_frame")) {  // where a slow frame's time went
+    std::string stages;
+    for (const auto& [stage, stage_ms] : renderer_->lastFrameStats().times.fields())
+      if (stage_ms >= 1.0)
+        stages += (stages.empty() ? "" : ",") + std::string(stage) + ":" +
+                  std::to_string(std::lround(stage_ms));
+    spdlog::warn("event=slow_frame view={} width={} height={} pixels={} ms={:.0f} stages={}",
+                 view.name, scene.camera.width, scene.camera.height, int(channels.pixels), ms,
+                 stages.empty() ? "-" : stages);
+  }
   out.meta = {{"view", view.name},           {"width", info.width}, {"height", info.height},
               {"time", world.timeSeconds()}, {"tick", tick},        {"frame", telemetry_.frames()},
               {"camera", cameraJson(info)}};

@@ -96,6 +96,7 @@ void Telemetry::noteBusy(const std::string& what, Clock::time_point from) {
 }
 
 void Telemetry::noteTrace(const RequestTrace& done) {
+  if (done.started == Clock::time_point{}) return;  // refused at shutdown, never applied
   RequestTrace trace = done;
   const double seconds = trace.totalSeconds();
   const std::int64_t second =

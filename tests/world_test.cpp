@@ -221,11 +221,46 @@ TEST(World, ARecentringThatWouldCarryATargetOutOfRangeIsRefusedAndChangesNothing
   EXPECT_THAT(world.setSite(recentred(*world.base().site, 45.0, 7.0).to),
               ::testing::HasSubstr("nothing changed"));
   EXPECT_EQ(world.hash(), hash);
+  // A weather layer's macrocluster likewise.
+  World clustered = makeWorld();
+  ASSERT_EQ(clustered.setSite({46.0, 7.0, 0.0}), "");
+  WeatherLayer patch = typicalWeatherLayer(CloudType::kStratus, 0.6);
+  patch.region.centre = {0.0, Limits::kMaxCoordinate - 10000.0};
+  patch.region.half_size = {5000.0, 5000.0};
+  ASSERT_EQ(clustered.setWeather({2, std::nullopt}, patch), "");
+  EXPECT_THAT(clustered.setSiteError(south), ::testing::HasSubstr("weather layer 2"));
   // The other way the target moves inward: allowed, and the state saves and reads back.
   ASSERT_EQ(world.setSite(recentred(*world.base().site, 47.0, 7.0).to), "");
   const std::vector<std::uint8_t> bytes = world.snapshot();
   World restored = makeWorld();
   EXPECT_EQ(restored.restore(bytes), "");
+  EXPECT_EQ(restored.hash(), world.hash());
+}
+
+TEST(World, AMacroclusterCarriedFarByTheWindSavesAndReadsBack) {
+  // Issue 62's live fuzz: a weather layer with a macrocluster, set again after 1e7 s of a
+  // 150 m/s wind, holds its field's and layer's regions 1.5e9 m out in their drifting frames;
+  // the snapshot reader refused them as if a host had placed them there.
+  auto [scene, dynamics] = smallWorld();
+  dynamics.automata.clear();  // a day of automaton steps is not what this test is about
+  World world(scene, dynamics, 1);
+  ASSERT_EQ(world.setWind({{{0.0, {150.0, 0.0}}}}), "");
+  for (CloudType type : {CloudType::kCumulus, CloudType::kStratus}) {
+    WeatherLayer w = typicalWeatherLayer(type, 0.5);
+    w.region.centre = {1000.0, -2000.0};
+    w.region.half_size = {20000.0, 20000.0};
+    const WeatherKey key{type == CloudType::kCumulus ? 1 : 2, std::nullopt};
+    ASSERT_EQ(world.setWeather(key, w), "");
+  }
+  ASSERT_EQ(world.advance(Limits::kMaxAdvance), "");
+  for (CloudType type : {CloudType::kCumulus, CloudType::kStratus}) {
+    WeatherLayer w = typicalWeatherLayer(type, 0.6);
+    w.region.centre = {1000.0, -2000.0};
+    w.region.half_size = {20000.0, 20000.0};
+    ASSERT_EQ(world.setWeather({type == CloudType::kCumulus ? 1 : 2, std::nullopt}, w), "");
+  }
+  World restored(Scene{}, WorldDynamics{});
+  EXPECT_EQ(restored.restore(world.snapshot()), "");
   EXPECT_EQ(restored.hash(), world.hash());
 }
 

@@ -387,11 +387,23 @@ glm::dvec2 World::recentreShift(const Site& site) const {
 std::string World::setSiteError(const Site& site) const {
   if (std::string e = siteError(site); !e.empty()) return e;
   const glm::dvec3 by(recentreShift(site), 0.0);
+  const auto refused = [&](const std::string& e) {
+    return "site: the re-centring moves the world by " + formatNumber(glm::length(by)) +
+           " m, which would carry " + e + "; nothing changed";
+  };
   for (const Target& t : base_.targets) {  // targets do not drift: base_ holds where they stand
     const glm::dvec3 to = t.centre - by;
     if (std::string e = placementError("target " + t.name, to.x, to.y, to.z); !e.empty())
-      return "site: the re-centring moves the world by " + formatNumber(glm::length(by)) +
-             " m, which would carry " + e + "; nothing changed";
+      return refused(e);
+  }
+  // A weather layer's macrocluster moves with the content (moveContent), within the range
+  // set_weather and the snapshot reader accept.
+  for (const auto& [key, weather] : base_.weather) {
+    if (weather.region.everywhere()) continue;
+    WeatherLayer moved = weather;
+    moved.region.centre -= glm::dvec2(by);
+    if (std::string e = weatherLayerError(moved); !e.empty())
+      return refused("weather layer " + std::to_string(key.layer) + "'s " + e);
   }
   return "";
 }

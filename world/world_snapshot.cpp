@@ -7,6 +7,7 @@
 
 #include <bit>
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <iterator>
@@ -195,12 +196,21 @@ template <class A>
 void io(A& a, ClusterVariation& v) {
   io(a, v.spacing_m), io(a, v.amount);
 }
+// A layer's or field's region lies in the frame its texture or heaps drift in, which the wind
+// carries without bound (MODEL.md section 11): its centre there may be any finite number, and
+// the rest of the region is checked as a request's is.
+Region checkedInDriftingFrame(Region r) {
+  if (std::isfinite(r.centre.x) && std::isfinite(r.centre.y)) r.centre = glm::dvec2(0.0);
+  return r;
+}
+
 template <class A>
 void io(A& a, CloudLayer& l) {
   io(a, l.name), io(a, l.altitude_m), io(a, l.colour), io(a, l.threshold), io(a, l.transition);
   io(a, l.shading), io(a, l.texture), io(a, l.region);
   io(a, l.in_layer.top_m), io(a, l.in_layer.band_m), io(a, l.in_layer.visibility_m);
-  if (std::string e = regionError(l.region); !e.empty()) a.fail("layer " + l.name + ": " + e);
+  if (std::string e = regionError(checkedInDriftingFrame(l.region)); !e.empty())
+    a.fail("layer " + l.name + ": " + e);
 }
 template <class A>
 void io(A& a, SolidTextureSpec& t) {
@@ -248,7 +258,8 @@ void io(A& a, CloudField& f) {
   io(a, f.region), io(a, f.clusters);
   if (f.type != CloudType::kCumulus && f.type != CloudType::kCumulonimbus)
     a.fail("field " + f.name + ": not a convective cloud type");
-  const WeatherLayer w{f.type, f.base_m, f.thickness_m, f.coverage, {}, f.region, f.clusters};
+  const WeatherLayer w{f.type,     f.base_m, f.thickness_m, f.coverage, {}, checkedInDriftingFrame(f.region),
+                       f.clusters};
   if (std::string e = weatherLayerError(w); !e.empty()) a.fail("field " + f.name + ": " + e);
 }
 // The weather layers as set: their clouds are written with the rest of the scene.
