@@ -109,16 +109,18 @@ std::string Engine::restoreAtStart() {
     return "";
   }
   if (config_.snapshot_on_error != DaemonConfig::SnapshotOnError::kStartFresh)
-    return e + " (move the file away, or set [snapshot] on_error = \"start_fresh\", to start from "
-               "the scene instead)";
+    return e +
+           " (move the file away, or set [snapshot] on_error = \"start_fresh\", to start from "
+           "the scene instead)";
   // Kept for whoever looks into it; the next snapshot takes the path. A restore that fails
   // changes nothing, so the world is still the scene's.
   std::error_code ec;
   for (const std::string& file : {snapshot, daemonStatePath(snapshot)})
     if (std::filesystem::exists(file, ec)) std::filesystem::rename(file, file + ".rejected", ec);
-  spdlog::error("event=snapshot_rejected path={} moved_to={}.rejected error=\"{}\" "
-                "action=start_fresh",
-                snapshot, snapshot, e);
+  spdlog::error(
+      "event=snapshot_rejected path={} moved_to={}.rejected error=\"{}\" "
+      "action=start_fresh",
+      snapshot, snapshot, e);
   telemetry_.noteSnapshotFailed();
   return "";
 }

@@ -2,7 +2,6 @@
 
 #include <spdlog/spdlog.h>
 
-
 #include <condition_variable>
 #include <deque>
 #include <mutex>

@@ -106,7 +106,8 @@ void Telemetry::noteTrace(const RequestTrace& done) {
     if (seconds > kSlowRequestSeconds)  // what the world thread did while it waited
       for (const Span& span : spans_) {
         const auto from = std::max(span.from, trace.queued), to = std::min(span.to, trace.started);
-        if (from < to) trace.behind[span.what] += std::chrono::duration<double, std::milli>(to - from).count();
+        if (from < to)
+          trace.behind[span.what] += std::chrono::duration<double, std::milli>(to - from).count();
       }
     if (slowest_.empty() || slowest_.back().second != second)
       slowest_.push_back({second, trace});

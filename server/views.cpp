@@ -102,8 +102,10 @@ Views::Clock::time_point Views::nextDue(Clock::time_point wake) const {
   return wake;
 }
 
-std::vector<std::pair<std::string, std::vector<Subscription*>>> Views::due(
-    Delivery which, const std::string& view, std::uint64_t tick, Clock::time_point now) {
+std::vector<std::pair<std::string, std::vector<Subscription*>>> Views::due(Delivery which,
+                                                                           const std::string& view,
+                                                                           std::uint64_t tick,
+                                                                           Clock::time_point now) {
   std::map<std::string, std::vector<Subscription*>> by_view;
   std::map<std::string, Clock::time_point> since;  // the view's most overdue subscription
   for (Subscription& sub : subscriptions_) {
@@ -128,7 +130,8 @@ std::vector<Subscription*> Views::take(const std::vector<Subscription*>& due, De
   for (Subscription* sub : due) {
     if (which == Delivery::kDue) {
       sub->next_due += sub->period;
-      if (sub->next_due < now) sub->next_due = now + sub->period;  // a slow render: skip, never burst
+      if (sub->next_due < now)
+        sub->next_due = now + sub->period;  // a slow render: skip, never burst
     }
     sub->last_tick = tick;
     if (sub->video && sub->video->full()) {

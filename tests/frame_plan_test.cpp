@@ -85,8 +85,8 @@ TEST(FramePlan, TheSeasProbeOfAnyLegalViewIsALegalTarget) {
   // A view 1 pixel wide and 16,384 high asked the GL for a 32 x 524,288 probe and aborted the
   // daemon (the live fuzz of issue 62). Every probe stays within 32 to 16,384 a side and holds
   // about the view's rows at its scale.
-  for (const auto& [width, height] : {std::pair{1, 16384}, {16384, 1}, {1, 1}, {16384, 16384},
-                                      {64, 16384}, {640, 480}})
+  for (const auto& [width, height] :
+       {std::pair{1, 16384}, {16384, 1}, {1, 1}, {16384, 16384}, {64, 16384}, {640, 480}})
     for (double scale : {Limits::kSeaProbeScale.lo, 0.5, Limits::kSeaProbeScale.hi}) {
       Camera view;
       view.width = width;

@@ -42,8 +42,7 @@ std::string writeFileAtomically(
   if (verify)
     if (std::string error = verify(temporary); !error.empty()) {
       ::unlink(temporary.c_str());
-      return what + ": '" + path + "' not replaced: what was written does not read back: " +
-             error;
+      return what + ": '" + path + "' not replaced: what was written does not read back: " + error;
     }
   if (std::rename(temporary.c_str(), path.c_str()) != 0) {
     const std::string error =

@@ -258,7 +258,8 @@ void io(A& a, CloudField& f) {
   io(a, f.region), io(a, f.clusters);
   if (f.type != CloudType::kCumulus && f.type != CloudType::kCumulonimbus)
     a.fail("field " + f.name + ": not a convective cloud type");
-  const WeatherLayer w{f.type,     f.base_m, f.thickness_m, f.coverage, {}, checkedInDriftingFrame(f.region),
+  const WeatherLayer w{f.type,     f.base_m, f.thickness_m,
+                       f.coverage, {},       checkedInDriftingFrame(f.region),
                        f.clusters};
   if (std::string e = weatherLayerError(w); !e.empty()) a.fail("field " + f.name + ": " + e);
 }

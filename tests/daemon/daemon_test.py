@@ -1758,7 +1758,9 @@ class AbuseTest(DaemonTest):
         print(f"live fuzz: {figures['requests']} requests, {figures['round_trips']} round "
               f"trips, slowest reply {figures['max_reply_s']:.2f} s ({figures['slowest']})")
         self.assertGreater(figures["round_trips"], 0)
-        self.assertEqual(figures["snapshot_failures"], 0)
+        # Snapshots named like the directory and the FIFO fail to be written, and are counted;
+        # none may fail to read back what was written.
+        self.assertNotIn("does not read back", d.log_text())
         self.assertEqual(d.stop(), 0, d.log_text()[-2000:])
 
     def test_case18_modbus_clients_that_drop_mid_frame_free_their_slots_at_once(self):

@@ -28,21 +28,29 @@ std::string automatonCloudError(const AutomatonCloudSpec& s) {
     else if (std::string e = scheduleError(schedule, 0.0, 1.0); !e.empty())
       out << key << " schedule: " << e;
   };
-  const int kMaxSide = 1024;
+  // The ranges of world/limits.h, which the scene reader uses too.
+  const int kMaxSide = Limits::kMaxCellsPerAxis;
   if (s.cells.nx < 1 || s.cells.ny < 1 || s.cells.nz < 1 || s.cells.nx > kMaxSide ||
       s.cells.ny > kMaxSide || s.cells.nz > kMaxSide)
     out << "cells: " << s.cells.nx << "x" << s.cells.ny << "x" << s.cells.nz << " (allowed: 1 to "
         << kMaxSide << " per axis)";
-  else if (s.cells.cells() > (std::int64_t(1) << 24))
-    out << "cells: " << s.cells.cells() << " cells (allowed: at most 16777216)";
-  else if (!(s.cell_size_m >= 0.01 && s.cell_size_m <= 1.0e4))
-    out << "cell_size: " << s.cell_size_m << " (allowed: 0.01 to 10000 m)";
-  else if (!(s.step_interval_s >= 1e-3 && s.step_interval_s <= 3600.0))
-    out << "step_interval: " << s.step_interval_s << " (allowed: 0.001 to 3600 s)";
-  else if (s.warmup_steps < 0 || s.warmup_steps > 100000)
-    out << "warmup_steps: " << s.warmup_steps << " (allowed: 0 to 100000)";
-  else if (s.samples_per_cell < 1 || s.samples_per_cell > 8)
-    out << "samples_per_cell: " << s.samples_per_cell << " (allowed: 1 to 8)";
+  else if (s.cells.cells() > Limits::kMaxCells)
+    out << "cells: " << s.cells.cells() << " cells (allowed: at most " << Limits::kMaxCells << ")";
+  else if (!Limits::kCellSize.contains(s.cell_size_m))
+    out << "cell_size: " << s.cell_size_m << " (allowed: " << Limits::kCellSize.lo << " to "
+        << Limits::kCellSize.hi << " m)";
+  else if (!Limits::kStepInterval.contains(s.step_interval_s))
+    out << "step_interval: " << s.step_interval_s << " (allowed: " << Limits::kStepInterval.lo
+        << " to " << Limits::kStepInterval.hi << " s)";
+  else if (s.warmup_steps < 0 || s.warmup_steps > Limits::kMaxWarmupSteps)
+    out << "warmup_steps: " << s.warmup_steps << " (allowed: 0 to " << Limits::kMaxWarmupSteps
+        << ")";
+  else if (s.samples_per_cell < 1 || s.samples_per_cell > Limits::kMaxSamplesPerCell)
+    out << "samples_per_cell: " << s.samples_per_cell << " (allowed: 1 to "
+        << Limits::kMaxSamplesPerCell << ")";
+  else if (!std::isfinite(s.position.x) || !std::isfinite(s.position.y) ||
+           !std::isfinite(s.position.z))
+    out << "position: not finite (allowed: finite metres)";
   else if (!(s.ambient >= 0.0 && s.ambient <= 1.0))
     out << "ambient: " << s.ambient << " (allowed: 0 to 1)";
   else if (!(s.phase_u >= 0.0 && s.phase_u <= 1.0))
