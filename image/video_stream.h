@@ -37,15 +37,27 @@ struct VideoStreamLimits {
   static constexpr double kMinRate = 0.5, kMaxRate = 60.0;
   static constexpr int kMaxKeyframeInterval = 600;
 };
-// What is wrong with the address's transport or the encoder's name, or empty.
+// What is wrong with the address (its transport, a host, a port 1 to 65535) or the encoder's
+// name, or empty: an address FFmpeg would open without a port, or with one it wraps
+// (udp://host:99999 sends to 34463), is refused here rather than streaming nowhere.
 inline std::string videoStreamSettingsError(const VideoStreamSettings& settings) {
   const std::string& address = settings.address;
   const std::size_t colon = address.find("://");
   const std::string scheme = address.substr(0, colon);
+  const std::string allowed =
+      " (allowed: udp://host:port for MPEG-TS over UDP, srt://host:port for MPEG-TS over SRT, "
+      "rtp://host:port for RTP; port 1 to 65535)";
   if (colon == std::string::npos || (scheme != "udp" && scheme != "srt" && scheme != "rtp"))
-    return "address: \"" + address +
-           "\" (allowed: udp://host:port for MPEG-TS over UDP, srt://host:port for MPEG-TS over "
-           "SRT, rtp://host:port for RTP)";
+    return "address: \"" + address + "\"" + allowed;
+  const std::string rest = address.substr(colon + 3);
+  const std::string host_port = rest.substr(0, rest.find('?'));  // FFmpeg's options may follow
+  const std::size_t port_at = host_port.rfind(':');
+  const std::string host = port_at == std::string::npos ? "" : host_port.substr(0, port_at);
+  const std::string port = port_at == std::string::npos ? "" : host_port.substr(port_at + 1);
+  const bool digits = !port.empty() && port.size() <= 5 &&
+                      port.find_first_not_of("0123456789") == std::string::npos;
+  if (host.empty() || host == "[]" || !digits || std::stoi(port) < 1 || std::stoi(port) > 65535)
+    return "address: \"" + address + "\" needs a host and a port" + allowed;
   if (settings.encoder != "auto" && settings.encoder != "libx264" &&
       settings.encoder != "h264_nvenc")
     return "encoder: \"" + settings.encoder + "\" (allowed: auto, libx264, h264_nvenc)";

@@ -227,9 +227,10 @@ void RenderService::render(const World& world, const ViewConfig& view, const Ima
   if (ms > 1000.0 && slowFrameLog().admit("slow_frame")) {  // where a slow frame's time went
     std::string stages;
     for (const auto& [stage, stage_ms] : renderer_->lastFrameStats().times.fields())
-      if (stage_ms >= 1.0)
-        stages += (stages.empty() ? "" : ",") + std::string(stage) + ":" +
-                  std::to_string(std::lround(stage_ms));
+      if (stage_ms >= 1.0) {
+        if (!stages.empty()) stages += ',';
+        stages.append(stage).append(":").append(std::to_string(std::lround(stage_ms)));
+      }
     spdlog::warn("event=slow_frame view={} width={} height={} pixels={} ms={:.0f} stages={}",
                  view.name, scene.camera.width, scene.camera.height, int(channels.pixels), ms,
                  stages.empty() ? "-" : stages);

@@ -119,8 +119,10 @@ void Telemetry::noteTrace(const RequestTrace& done) {
   if (seconds > kSlowRequestSeconds && slowLog().admit("slow_request")) {
     const json t = trace.toJson();
     std::string behind;
-    for (const auto& [what, ms] : trace.behind)
-      behind += (behind.empty() ? "" : ",") + what + ":" + std::to_string(std::lround(ms));
+    for (const auto& [what, ms] : trace.behind) {
+      if (!behind.empty()) behind += ',';
+      behind.append(what).append(":").append(std::to_string(std::lround(ms)));
+    }
     spdlog::warn(
         "event=slow_request cmd={} client={} total_ms={:.1f} queue_ms={:.1f} world_ms={:.1f} "
         "render_ms={:.1f} handoff_ms={:.1f} encode_ms={:.1f} write_ms={:.1f} behind={}",

@@ -138,6 +138,15 @@ class StreamTest(DaemonTest):
         c = d.client()
         for request, code, text in [
             ({"view": "front", "address": "http://127.0.0.1:1"}, "bad_field", "address"),
+            # No port, a port that is no number, negative, 0 or beyond 65535, no host: each
+            # was accepted and then streamed nowhere, or to the port it wrapped to (issue 62's
+            # live fuzz; issue 65).
+            ({"view": "front", "address": "udp://127.0.0.1"}, "bad_field", "port"),
+            ({"view": "front", "address": "udp://127.0.0.1:abc"}, "bad_field", "port"),
+            ({"view": "front", "address": "udp://127.0.0.1:-5"}, "bad_field", "port"),
+            ({"view": "front", "address": "rtp://127.0.0.1:0"}, "bad_field", "port"),
+            ({"view": "front", "address": "udp://127.0.0.1:99999"}, "bad_field", "port"),
+            ({"view": "front", "address": "udp://:5000"}, "bad_field", "host"),
             ({"view": "front", "address": "udp://127.0.0.1:9", "encoder": "mpeg2"}, "bad_field",
              "encoder"),
             ({"view": "front", "address": "udp://127.0.0.1:9", "bitrate": 50}, "bad_field",
