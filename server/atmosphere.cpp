@@ -197,9 +197,7 @@ std::optional<ProtocolError> Engine::siteError(const command::SetSite& c) const 
   for (const ViewConfig& v : views_.all()) {
     const glm::dvec3 to = v.camera.position - shift;
     if (std::string e = placementError("view " + v.name, to.x, to.y, to.z); !e.empty())
-      return badField("site: the re-centring moves the world by " +
-                      formatNumber(glm::length(shift)) + " m, which would carry " + e +
-                      "; nothing changed");
+      return badField(recentringRefusal(glm::dvec2(shift), e));
   }
   return std::nullopt;
 }

@@ -379,6 +379,11 @@ std::string siteError(const Site& site) {
          " (allowed: latitude -90 to 90, longitude -180 to 180, a finite grid north)";
 }
 
+std::string recentringRefusal(glm::dvec2 shift, const std::string& error) {
+  return "site: the re-centring moves the world by " + formatNumber(glm::length(shift)) +
+         " m, which would carry " + error + "; nothing changed";
+}
+
 glm::dvec2 World::recentreShift(const Site& site) const {
   if (!base_.site || *base_.site == site) return glm::dvec2(0.0);
   return recentred(*base_.site, site.latitude_deg, site.longitude_deg).shift;
@@ -387,10 +392,7 @@ glm::dvec2 World::recentreShift(const Site& site) const {
 std::string World::setSiteError(const Site& site) const {
   if (std::string e = siteError(site); !e.empty()) return e;
   const glm::dvec3 by(recentreShift(site), 0.0);
-  const auto refused = [&](const std::string& e) {
-    return "site: the re-centring moves the world by " + formatNumber(glm::length(by)) +
-           " m, which would carry " + e + "; nothing changed";
-  };
+  const auto refused = [&](const std::string& e) { return recentringRefusal(glm::dvec2(by), e); };
   for (const Target& t : base_.targets) {  // targets do not drift: base_ holds where they stand
     const glm::dvec3 to = t.centre - by;
     if (std::string e = placementError("target " + t.name, to.x, to.y, to.z); !e.empty())

@@ -91,6 +91,10 @@ std::string seaError(const Sea& sea);
 // north that is not a finite number), or empty: the one check of a site, shared by set_site
 // and snapshots.
 std::string siteError(const Site& site);
+// The refusal of a re-centring by `shift` that would carry something out of range (`error`
+// names it and the range): set_site's one wording, for the world's content and the daemon's
+// views alike.
+std::string recentringRefusal(glm::dvec2 shift, const std::string& error);
 
 class World {
  public:
