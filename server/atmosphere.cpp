@@ -193,11 +193,11 @@ std::optional<ProtocolError> Engine::siteError(const command::SetSite& c) const 
   const Site site = siteAfter(*world_, c);
   if (std::string error = world_->setSiteError(site); !error.empty()) return badField(error);
   // The views move with the world: none may be carried beyond where set_view places one.
-  const glm::dvec3 shift(world_->recentreShift(site), 0.0);
+  const glm::dvec2 shift = world_->recentreShift(site);
   for (const ViewConfig& v : views_.all()) {
-    const glm::dvec3 to = v.camera.position - shift;
+    const glm::dvec3 to = v.camera.position - glm::dvec3(shift, 0.0);
     if (std::string e = placementError("view " + v.name, to.x, to.y, to.z); !e.empty())
-      return badField(recentringRefusal(glm::dvec2(shift), e));
+      return badField(recentringRefusal(shift, e));
   }
   return std::nullopt;
 }

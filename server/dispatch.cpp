@@ -252,8 +252,7 @@ struct Engine::Handlers {
   std::optional<Outcome> operator()(const Unstream& c) const { return engine.stopStream(c); }
   std::optional<Outcome> operator()(const Snapshot& c) const {
     if (config_.snapshotDirectory().empty()) return noSnapshotDirectory();
-    std::error_code ec;
-    std::filesystem::create_directories(config_.snapshotDirectory(), ec);
+    // saveSnapshot makes the snapshot directory when it is missing.
     if (std::string e = engine.saveSnapshot(snapshotPath(c.name), "request"); !e.empty())
       return ProtocolError{ErrorCode::kFailed, e};
     return json{{"name", c.name}, {"time", world.timeSeconds()}, {"hash", hexHash(world.hash())}};

@@ -43,13 +43,6 @@ inline bool heldExactly(std::int64_t v) {
   return v >= -kMaxExactInteger && v <= kMaxExactInteger;
 }
 
-// Where a host places a camera or a target: each coordinate within Limits::kMaxCoordinate of the
-// origin (a camera's z also at or above the ground). Every reader of positions (requests, scene
-// files and configs, snapshots) and every move of the world under them (set_site's
-// re-centring) keep to it, so that whatever the daemon holds can be saved and read back.
-// Returns "" or "WHAT: (x, y, z) is beyond ... (allowed: ...)".
-inline std::string placementError(std::string_view what, double x, double y, double z);
-
 struct Limits {
   // Camera and image.
   static constexpr int kMaxImageSide = 16384;      // GL_MAX_RENDERBUFFER_SIZE on llvmpipe
@@ -197,6 +190,11 @@ struct Limits {
   static constexpr std::size_t kMaxNameLength = 64;
 };
 
+// Where a host places a camera or a target: each coordinate within Limits::kMaxCoordinate of the
+// origin (a camera's readers also keep its z at or above the ground). Every reader of positions
+// (requests, scene files and configs, snapshots) and every move of the world under them
+// (set_site's re-centring) keep to it, so that whatever the daemon holds can be saved and read
+// back. Returns "" or "WHAT: (x, y, z) lies beyond ... (allowed: ...)".
 inline std::string placementError(std::string_view what, double x, double y, double z) {
   const double c = Limits::kMaxCoordinate;
   if (std::isfinite(x) && std::isfinite(y) && std::isfinite(z) && std::abs(x) <= c &&

@@ -391,8 +391,9 @@ glm::dvec2 World::recentreShift(const Site& site) const {
 
 std::string World::setSiteError(const Site& site) const {
   if (std::string e = siteError(site); !e.empty()) return e;
-  const glm::dvec3 by(recentreShift(site), 0.0);
-  const auto refused = [&](const std::string& e) { return recentringRefusal(glm::dvec2(by), e); };
+  const glm::dvec2 shift = recentreShift(site);
+  const glm::dvec3 by(shift, 0.0);
+  const auto refused = [&](const std::string& e) { return recentringRefusal(shift, e); };
   for (const Target& t : base_.targets) {  // targets do not drift: base_ holds where they stand
     const glm::dvec3 to = t.centre - by;
     if (std::string e = placementError("target " + t.name, to.x, to.y, to.z); !e.empty())
@@ -403,7 +404,7 @@ std::string World::setSiteError(const Site& site) const {
   for (const auto& [key, weather] : base_.weather) {
     if (weather.region.everywhere()) continue;
     WeatherLayer moved = weather;
-    moved.region.centre -= glm::dvec2(by);
+    moved.region.centre -= shift;
     if (std::string e = weatherLayerError(moved); !e.empty())
       return refused("weather layer " + std::to_string(key.layer) + "'s " + e);
   }

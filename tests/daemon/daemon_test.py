@@ -123,6 +123,17 @@ directory = "{frames or os.path.join(workdir, name + "-frames")}"
             return f.read()
 
 
+def read_message(file):
+    """One reply or event from a connection's file: (header, image bytes or None)."""
+    line = file.readline()
+    if not line:
+        raise ConnectionError("connection closed")
+    header = json.loads(line)
+    image = (header.get("result") or {}).get("image") or header.get("image")
+    body = file.read(image["bytes"]) if isinstance(image, dict) and "bytes" in image else None
+    return header, body
+
+
 class Client:
     def __init__(self, port, receive_buffer=None):
         """`receive_buffer` (bytes) caps what the kernel holds unread for this client."""
@@ -148,13 +159,7 @@ class Client:
 
     def read(self):
         """One reply or event: (header, body bytes or None)."""
-        line = self.file.readline()
-        if not line:
-            raise ConnectionError("connection closed")
-        header = json.loads(line)
-        image = (header.get("result") or {}).get("image") or header.get("image")
-        body = self.file.read(image["bytes"]) if image else None
-        return header, body
+        return read_message(self.file)
 
     def request(self, obj):
         sent = self.send(obj)

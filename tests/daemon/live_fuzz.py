@@ -33,9 +33,13 @@ import os
 import random
 import re
 import socket
+import sys
 import threading
 import time
 import tomllib
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import daemon_test  # noqa: E402  (the harness: its reader of replies and its Daemon)
 
 PROBE = "zz_probe"
 REPLY_BOUND = 5.0 * float(os.environ.get("NEPHELE_TIME_FACTOR", "1"))
@@ -84,22 +88,11 @@ class Connection:
     def send_line(self, line):
         self.sock.sendall(line)
 
-    def read(self):
-        """One reply or event: its header, with any image bytes read past."""
-        line = self.file.readline()
-        if not line:
-            raise ConnectionError("connection closed")
-        header = json.loads(line)
-        image = (header.get("result") or {}).get("image") or header.get("image")
-        if isinstance(image, dict) and "bytes" in image:
-            self.file.read(image["bytes"])
-        return header
-
     def reply(self):
         """The next reply, past any subscription events; a render of several views is one reply
         (its last part)."""
         while True:
-            header = self.read()
+            header, _ = daemon_test.read_message(self.file)
             if "event" in header:
                 continue
             image = (header.get("result") or {}).get("image") or {}
@@ -530,10 +523,7 @@ def run(daemon_factory, source, seconds, seed=5, connections=3, log=print):
 
 
 def main():
-    import sys
     import tempfile
-    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-    import daemon_test
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--seconds", type=float, default=60)
     parser.add_argument("--seed", type=int, default=5)
