@@ -1,6 +1,7 @@
 #include "renderer/frame_plan.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 
@@ -88,7 +89,17 @@ bool viewShowsSea(const Camera& camera) {
   return below;
 }
 
-FramePlan::FramePlan(const Scene& scene, const FramePlanRequest& request) {
+namespace {
+std::atomic<std::uint64_t> plans_made{0};
+}  // namespace
+
+std::uint64_t framePlansMade() {
+  return plans_made.load(std::memory_order_relaxed);
+}
+
+FramePlan::FramePlan(const Scene& scene, const FramePlanRequest& request)
+    : sea_probe_kind(request.sea_probe) {
+  plans_made.fetch_add(1, std::memory_order_relaxed);
   // Fields of heaps become the clouds around this camera (MODEL.md section 10): the scene's
   // own clouds first, then the heaps, as withFieldClouds lists them.
   view.scene = &scene;
@@ -129,13 +140,14 @@ FramePlan::FramePlan(const Scene& scene, const FramePlanRequest& request) {
     addElapsed(shadows_ms, start);
   }
   if (!scene.sea) return;
+  Camera eye = scene.camera;
+  eye.position.z = 0.0;
   if (request.sea_probe == SeaProbe::kView) {
     if (viewShowsSea(scene.camera))
       sea_probe =
           seaProbeView(view, seaProbeCamera(scene.camera, request.sea_probe_scale), request.cull);
+    if (request.sea_eye) sea_eye = seaProbeView(view, eye, request.cull);
   } else {
-    Camera eye = scene.camera;
-    eye.position.z = 0.0;
     sea_probe = seaProbeView(view, eye, request.cull);
   }
 }

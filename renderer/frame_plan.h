@@ -5,6 +5,7 @@
 // the clouds, section 16) and borrows the rest from the scene, which must outlive it. The GL
 // renderer draws a plan in its passes, and the sea's probe (section 18) as a second view of it;
 // the reference traces the same views.
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -42,6 +43,9 @@ struct FramePlanRequest {
   // The work budget (RenderSettings::ellipsoid_budget and ellipsoid_overdraw; 0: none).
   double ellipsoid_budget = 0.0, ellipsoid_overdraw = 0.0;
   SeaProbe sea_probe = SeaProbe::kEyeAtSea;
+  // With kView, the tracer's probe too (FramePlan::sea_eye): a rasteriser whose label channels
+  // the CPU traces from the same plan.
+  bool sea_eye = false;
   double sea_probe_scale = 0.5;  // kView: of the view's resolution
   bool cull = false;             // list each view's clouds in view
   bool heap_shadows = false;     // the fields' and clouds' shadows (CloudShadows, with lookups)
@@ -67,10 +71,21 @@ struct FramePlan {
   bool thinned = false;  // the budget thinned the clouds: the views are within it
   ViewPlan view;
   std::optional<ViewPlan> sea_probe;
+  std::optional<ViewPlan> sea_eye;  // FramePlanRequest::sea_eye
+  SeaProbe sea_probe_kind = SeaProbe::kEyeAtSea;
   std::optional<CloudShadows> heap_shadows;
   PlaneShadows plane_shadows;
   // How long its stages took.
   double heaps_ms = 0.0, budget_ms = 0.0, shadows_ms = 0.0;
+
+  // The probe a tracer mirrors the sea's rays in (kEyeAtSea), or null.
+  const ViewPlan* tracedSeaProbe() const {
+    if (sea_eye) return &*sea_eye;
+    return sea_probe && sea_probe_kind == SeaProbe::kEyeAtSea ? &*sea_probe : nullptr;
+  }
 };
+
+// Plans made in this process: a frame makes one, whatever channels it draws (tests count them).
+std::uint64_t framePlansMade();
 
 }  // namespace nephele

@@ -23,7 +23,8 @@ std::vector<std::pair<const char*, int>> FrameStats::fields() const {
           {"layer_terms", layer_terms},
           {"layer_terms_total", layer_terms_total},
           {"volume_uploads", volume_uploads},
-          {"layer_texels_baked", layer_texels_baked}};
+          {"layer_texels_baked", layer_texels_baked},
+          {"programs_compiled", programs_compiled}};
 }
 
 double FrameTimes::gpuTotal() const {

@@ -104,6 +104,9 @@ struct FrameStats {
   // Layer texels evaluated into clipmaps (MODEL.md section 2): every ring when a clipmap is
   // new, then only the strips the camera uncovers.
   int layer_texels_baked = 0;
+  // Shader programs compiled for this frame: those of a pass first drawn. A daemon that
+  // prewarmed ([world] prewarm) compiles none at a weather change.
+  int programs_compiled = 0;
   FrameTimes times;
 
   int passes() const {

@@ -120,9 +120,10 @@ std::unique_ptr<Renderer> createRenderer(const RendererOptions& options, std::st
   return std::make_unique<GlBackendRenderer>(std::move(platform), options.render);
 }
 
-void dimVisibilityByPrecipitation(Frame& frame, const Scene& scene, const HeapDrawing& heaps) {
+void dimVisibilityByPrecipitation(Frame& frame, const ViewPlan& view) {
+  const Scene& scene = *view.scene;
   if (frame.visibility.empty() || !hasPrecipitation(scene)) return;
-  const PrecipitationMedia media = precipitationMedia(scene, heaps);
+  const PrecipitationMedia media = precipitationMedia(scene);
   if (media.empty()) return;
   const Camera& camera = scene.camera;
   const ViewBasis basis = viewBasis(camera);

@@ -10,6 +10,7 @@
 
 #include "renderer/encode.h"
 #include "renderer/frame.h"
+#include "renderer/frame_plan.h"
 #include "renderer/frame_stats.h"
 #include "renderer/gl/gl_platform.h"
 #include "renderer/render_settings.h"
@@ -105,10 +106,11 @@ class Renderer {
 // Null and `error` set when the back end cannot start (no GL platform).
 std::unique_ptr<Renderer> createRenderer(const RendererOptions& options, std::string& error);
 
-// The visibility channel times the scene's precipitation's transmittance (MODEL.md section 17)
-// on each pixel's centre ray up to its first opaque surface, the ground or a target: a target
-// behind rain is less visible; the shafts under heaps are those of `heaps`' range, as drawn.
-// Nothing without precipitation or without the channel.
-void dimVisibilityByPrecipitation(Frame& frame, const Scene& scene, const HeapDrawing& heaps);
+// The visibility channel times the precipitation's transmittance (MODEL.md section 17) on each
+// pixel's centre ray up to its first opaque surface, the ground or a target: a target behind
+// rain is less visible. The slabs and shafts are the frame plan's (`view`, whose scene holds the
+// shafts under the heaps it drew), as the colour drew them. Nothing without precipitation or
+// without the channel.
+void dimVisibilityByPrecipitation(Frame& frame, const ViewPlan& view);
 
 }  // namespace nephele

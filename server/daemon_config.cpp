@@ -61,13 +61,14 @@ void readSceneKey(TableReader& t, const std::string& file, DaemonConfig& out) {
 // [world], and the scene's clouds checked against its ellipsoid budget.
 void readWorld(TableReader& t, DaemonConfig& out) {
   if (auto w = t.table("world")) {
-    w->allow({"mode", "tick_rate", "time_scale", "threads", "max_ellipsoids"});
+    w->allow({"mode", "tick_rate", "time_scale", "threads", "max_ellipsoids", "prewarm"});
     out.mode = TickMode(w->choice("mode", {"realtime", "lockstep"}, int(out.mode)));
     w->number("tick_rate", out.tick_rate_hz, DaemonLimits::kMinTickRate,
               DaemonLimits::kMaxTickRate);
     w->number("time_scale", out.time_scale, 0.0, ProtocolLimits::kMaxTimeScale);
     w->integer("threads", out.world_threads, 1, 64);
     w->integer("max_ellipsoids", out.max_ellipsoids, 1, Limits::kMaxWorldEllipsoids);
+    w->boolean("prewarm", out.prewarm);
     w->finish();
   }
   if (const std::size_t n = ellipsoidCount(out.scene.scene); n > std::size_t(out.max_ellipsoids))

@@ -86,6 +86,7 @@ std::string Engine::openWorld() {
     return "scene time: " + e;
   if (config_.site) world_->setSite({config_.site->latitude_deg, config_.site->longitude_deg, 0.0});
   if (std::string e = restoreAtStart(); !e.empty()) return e;
+  if (config_.prewarm) renders_->prewarm(views_.all());
   for (const command::Stream& stream : config_.streams) {
     const Outcome started = startStream(stream);
     if (const auto* e = std::get_if<ProtocolError>(&started))

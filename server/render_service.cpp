@@ -10,6 +10,7 @@
 #include "renderer/renderer.h"
 #include "server/log_limiter.h"
 #include "server/telemetry.h"
+#include "world/formations/weather.h"
 #include "world/limits.h"
 #include "world/world.h"
 
@@ -140,6 +141,71 @@ std::string RenderService::glName() const {
 
 std::string RenderService::backendName() const {
   return renderer_->platform().backend;
+}
+
+namespace {
+
+// A side of a prewarm frame: a few pixels, such that the side and its halvings to 1/32 (rounded
+// up: the passes' reduced targets and bins) are powers of two exactly where the view's are.
+// llvmpipe generates a shader's code anew for a texture that is a power of two where the last
+// was not.
+int prewarmSide(int side) {
+  auto pattern = [](int n) {
+    unsigned bits = 0;
+    for (int k = 0; k < 6; ++k) {
+      const int halved = (n + (1 << k) - 1) >> k;
+      bits |= unsigned((halved & (halved - 1)) == 0) << k;
+    }
+    return bits;
+  };
+  for (int small = 48; small < side && small <= 512; ++small)
+    if (pattern(small) == pattern(side)) return small;
+  return side;
+}
+
+}  // namespace
+
+int RenderService::prewarm(const std::vector<ViewConfig>& views) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const RenderSettings& settings = config_.scene.render;
+  int frames = 0, programs = 0;
+  // Each sky a new continuous view, whose second frame reuses its first, then a single render.
+  auto draw = [&](const World& world, const Camera& camera, const std::string& view) {
+    const Scene& scene = world.seenFrom(camera);
+    for (int continuous : {1, 1, 0}) {
+      renderer_->setContinuousView(continuous ? "prewarm " + view : std::string());
+      renderer_->renderSrgb8(scene, settings);
+      programs += renderer_->lastFrameStats().programs_compiled;
+      ++frames;
+    }
+  };
+  const Scene& base = config_.scene.scene;
+  std::vector<std::optional<Haze>> airs{base.haze};
+  if (!base.haze && !base.fog) airs.push_back(Haze{});
+  for (const std::optional<Haze>& haze : airs)
+    for (int type = 0; type < kCloudTypeCount; ++type) {
+      World world(base, config_.scene.dynamics);
+      world.setHaze(haze);
+      const WeatherLayer layer = typicalWeatherLayer(CloudType(type), 0.5);
+      if (type > 0 && !world.setWeather({}, layer).empty()) continue;
+      const double top = layer.base_m + layer.thickness_m;
+      for (const ViewConfig& view : views)
+        for (const auto& [z, pitch] :
+             {std::pair{2.0, 15.0}, {0.5 * (layer.base_m + top), 0.0}, {top + 1000.0, -20.0}}) {
+          Camera camera = view.camera;  // its lens, at a few pixels
+          camera.width = prewarmSide(camera.width);
+          camera.height = prewarmSide(camera.height);
+          camera.position.z = z;
+          camera.orientation.pitch_deg = pitch;
+          draw(world, camera, view.name + "/" + std::to_string(type) + "/" + std::to_string(z));
+          if (type == 0) break;  // a clear sky looks the same from any height
+        }
+    }
+  renderer_->setContinuousView(std::string());
+  spdlog::info(
+      "event=prewarm frames={} programs={} ms={:.0f}", frames, programs,
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  return programs;
 }
 
 namespace {

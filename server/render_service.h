@@ -65,6 +65,14 @@ class RenderService {
   std::string glName() const;
   std::string backendName() const;
 
+  // World thread, before the daemon says ready: every view drawn small once per genus as the
+  // scene's one weather layer, from below, inside and above it, as a subscription's first two
+  // frames and as a single render, with the scene's air and again with haze where it has
+  // none. The programs those frames use are compiled, and llvmpipe's code for them generated,
+  // so that a weather change compiles nothing (docs/ACCURACY.md, "Frame budget"). Returns the
+  // programs compiled; logs event=prewarm.
+  int prewarm(const std::vector<ViewConfig>& views);
+
   // The configured pixel limit, on the centred view an off-axis view is cut from.
   std::optional<ProtocolError> pixelLimit(const ViewConfig& view) const;
   // Whether this GL can allocate the target `view` needs for `image` (a size within the

@@ -25,6 +25,10 @@ TEST(DaemonConfig, DefaultsAndTheExample) {
   EXPECT_EQ(c.modbus_timeouts.request_s, 2.0);
   EXPECT_EQ(c.max_ellipsoids, defaultMaxEllipsoids());
   EXPECT_GE(c.max_ellipsoids, 65536);
+  EXPECT_TRUE(c.prewarm);
+  DaemonConfig cold;
+  ASSERT_EQ(parseDaemonConfig(kScene + "[world]\nprewarm = false\n", "t.toml", cold), "");
+  EXPECT_FALSE(cold.prewarm);
 
   DaemonConfig example;
   ASSERT_EQ(loadDaemonConfig(std::string(NEPHELE_SOURCE_DIR) + "/deploy/nephele.toml", example),
@@ -79,6 +83,7 @@ TEST(DaemonConfig, ErrorsNameTheKey) {
       {kScene + "[[view]]\nname = \"front view\"\n", "is not a name"},
       {"scene = \"/tmp\"\n", "not a regular file"},
       {kScene + "[world]\nmax_ellipsoids = 0\n", "world.max_ellipsoids"},
+      {kScene + "[world]\nprewarm = 1\n", "world.prewarm"},
       // The world budget holds for the scene too: cumulus.toml's heap has 27 lobes.
       {"scene = \"" + std::string(NEPHELE_SOURCE_DIR) +
            "/config/scenes/cumulus.toml\"\n[world]\nmax_ellipsoids = 26\n",

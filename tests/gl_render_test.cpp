@@ -171,9 +171,12 @@ TEST_F(GlRenderTest, ClipmapMatchesReference) {
 }
 
 // A clipmap carried along a flight by strips (a toroidal update: only the texels the camera
-// uncovers are evaluated) holds what a clipmap filled at the end of the flight holds. `auto`
-// waits a frame before filling anything, then fills a frame's pixels of texels a frame and
-// reads the sines until the clipmap is whole, when it draws what `baked` draws.
+// uncovers are evaluated) holds what a clipmap filled at the end of the flight holds. `auto`:
+// a single render notes the clipmap and reads the sines; a second render from the same place
+// fills the coarsest ring whole, then a frame's pixels of texels a frame, coarsest first, and
+// reads the sines until the clipmap is whole, when it draws what `baked` draws. A continuous
+// view fills from its first frame and reads the rings filled so far, compiling no program on
+// the way.
 TEST_F(GlRenderTest, ClipmapFollowsTheCameraByStrips) {
   SceneFile file = preset("genus_stratocumulus", 160, 120);
   file.scene.camera.orientation = {80.0, 20.0, 0.0};  // ahead, where the strips are filled
@@ -199,15 +202,26 @@ TEST_F(GlRenderTest, ClipmapFollowsTheCameraByStrips) {
   ASSERT_EQ(automatic.texture_evaluation, TextureEvaluation::kAuto);
   waiting.renderFloat(scene, automatic);
   EXPECT_EQ(waiting.lastFrameStats().layer_texels_baked, 0);
+  const int ring = LayerClipmaps::sizeFor(120) * LayerClipmaps::sizeFor(120);
   int frames = 1;
   while (frames < 100) {
     waiting.renderFloat(scene, automatic);
     ++frames;
-    if (frames > 2 && waiting.lastFrameStats().layer_texels_baked == 0) break;
-    EXPECT_LE(waiting.lastFrameStats().layer_texels_baked, 2 * 160 * 120);
+    const FrameStats& stats = waiting.lastFrameStats();
+    if (frames > 2 && stats.layer_texels_baked == 0) break;
+    EXPECT_LE(stats.layer_texels_baked, frames == 2 ? 2 * ring : 2 * 160 * 120) << frames;
   }
   EXPECT_LT(frames, 100);
   expectClose(waiting.renderFloat(scene, automatic), carried, 60.0, 0.01, "clipmap_auto");
+  GlRenderer streaming(*platform_);
+  streaming.setContinuousView("flight");
+  streaming.renderFloat(scene, automatic);
+  EXPECT_GE(streaming.lastFrameStats().layer_texels_baked, ring);
+  for (int frame = 0; frame < 6; ++frame) {
+    streaming.renderFloat(scene, automatic);
+    EXPECT_GT(streaming.lastFrameStats().layer_texels_baked, 0) << frame;
+    EXPECT_EQ(streaming.lastFrameStats().programs_compiled, 0) << frame;
+  }
 }
 
 // A layer bounded by a region (a turned rectangle with an edge band, one side of a front;
@@ -448,6 +462,27 @@ TEST_F(GlRenderTest, RainShaftsEqualOneSampleReference) {
         dimmed += tau > 0.1;
       }
     EXPECT_GT(dimmed, 0);
+  }
+}
+
+// Issue 63, item 1: a frame is planned once whatever channels it draws. The GL's colour passes,
+// its visibility's rain and the labels it traces on the CPU read one FramePlan, so labels see
+// the clouds, heaps and shafts the colour drew; the reference plans once too.
+TEST_F(GlRenderTest, AFrameIsPlannedOnce) {
+  for (const char* name : {"storm", "sea_search"}) {
+    const SceneFile file = preset(name, 96, 64);
+    FrameRequest request;
+    request.channels = {Channel::kColour,     Channel::kCoverage, Channel::kVisibility,
+                        Channel::kCloudDepth, Channel::kLwir,     Channel::kGlint,
+                        Channel::kDepth,      Channel::kObjectId};
+    const std::uint64_t before = framePlansMade();
+    const Frame gl = renderer_->renderFrame(file.scene, pointSampled(), request);
+    EXPECT_EQ(framePlansMade() - before, 1u) << name;
+    EXPECT_EQ(gl.cloud_depth.size(), std::size_t(96 * 64)) << name;
+    const std::uint64_t between = framePlansMade();
+    const Frame reference = renderReferenceFrame(file.scene, {1, 0}, request);
+    EXPECT_EQ(framePlansMade() - between, 1u) << name;
+    EXPECT_EQ(reference.lwir.size(), std::size_t(96 * 64)) << name;
   }
 }
 

@@ -1,7 +1,7 @@
 #include "renderer/gl/gl_objects.h"
 
+#include <atomic>
 #include <cmath>
-
 #include <vector>
 
 namespace nephele {
@@ -147,8 +147,17 @@ GlObject compileShader(const GlApi& gl, GLenum stage, const std::string& source,
 
 }  // namespace
 
+namespace {
+std::atomic<std::uint64_t> programs_linked{0};
+}  // namespace
+
+std::uint64_t programsLinked() {
+  return programs_linked.load(std::memory_order_relaxed);
+}
+
 GlObject createProgram(const GlApi& gl, const std::string& vertex_source,
                        const std::string& fragment_source, std::string& error) {
+  programs_linked.fetch_add(1, std::memory_order_relaxed);
   GlObject vertex = compileShader(gl, GL_VERTEX_SHADER, vertex_source, error);
   if (!vertex) return {};
   GlObject fragment = compileShader(gl, GL_FRAGMENT_SHADER, fragment_source, error);

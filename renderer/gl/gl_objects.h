@@ -96,5 +96,7 @@ void keepMostRecent(Map& cache, std::size_t keep, std::uint64_t frame) {
 // puts the driver's log in `error`.
 GlObject createProgram(const GlApi& gl, const std::string& vertex_source,
                        const std::string& fragment_source, std::string& error);
+// Programs createProgram has linked in this process (FrameStats::programs_compiled).
+std::uint64_t programsLinked();
 
 }  // namespace nephele

@@ -264,7 +264,10 @@ void GlRenderer::finishAndRead(int w, int h, GLenum type, void* out) {
 
 FloatImage GlRenderer::renderFloat(const Scene& scene, const RenderSettings& settings) {
   drawFrame(scene, settings, TargetFormat::kFloat);
-  const int w = scene.camera.width, h = scene.camera.height;
+  return readFloat(scene.camera.width, scene.camera.height);
+}
+
+FloatImage GlRenderer::readFloat(int w, int h) {
   FloatImage image{w, h, std::vector<float>(std::size_t(w) * h * 4)};
   finishAndRead(w, h, GL_FLOAT, image.rgba.data());
   // GL rows run bottom-up; FloatImage rows run top-down.
@@ -284,10 +287,20 @@ Frame GlRenderer::renderFrame(const Scene& scene, const RenderSettings& settings
   const ChannelSet& asked = request.channels;
   Frame frame = frameFor(camera, scene.time_s, request);
   const bool composite = compositeAsked(asked);
-  if (composite) frame.colour = renderFloat(scene, settings);
+  const bool traced =
+      asked.has(Channel::kCloudDepth) || asked.has(Channel::kLwir) || asked.has(Channel::kGlint);
+  // One plan for every channel: the colour's passes, the visibility's rain and the traced labels
+  // see the same clouds, heaps and shafts.
+  std::unique_ptr<FramePlan> plan;
+  if (composite) {
+    plan = drawFrame(scene, settings, TargetFormat::kFloat, traced);
+    frame.colour = readFloat(w, h);
+  } else if (traced || asked.has(Channel::kVisibility)) {
+    plan = std::make_unique<FramePlan>(scene, planRequest(settings, traced));
+  }
   if (asked.has(Channel::kVisibility)) {
     frame.visibilityFromCoverage();
-    dimVisibilityByPrecipitation(frame, scene, settings.heaps);
+    dimVisibilityByPrecipitation(frame, plan->view);
   }
   // The channels beyond the composite are read back and converted on the CPU.
   StageClock channels(stats_.times.readback_ms);
@@ -318,17 +331,16 @@ Frame GlRenderer::renderFrame(const Scene& scene, const RenderSettings& settings
                                                                     : 0.0f;
       }
   }
-  if (asked.has(Channel::kCloudDepth) || asked.has(Channel::kLwir) || asked.has(Channel::kGlint)) {
+  if (traced) {
     ReferenceSettings trace;
     trace.samples_per_axis = 1;
-    trace.heaps = settings.heaps;
     trace.sea_waves = settings.sea_waves;
     trace.label_divisor = settings.channel_divisor;
-    FrameRequest traced = request;
-    traced.channels = {};
+    FrameRequest traced_request = request;
+    traced_request.channels = {};
     for (Channel c : {Channel::kCloudDepth, Channel::kLwir, Channel::kGlint})
-      if (asked.has(c)) traced.channels.add(c);
-    Frame cpu = renderReferenceFrame(scene, trace, traced);
+      if (asked.has(c)) traced_request.channels.add(c);
+    Frame cpu = renderReferenceFrame(*plan, trace, traced_request);
     frame.cloud_depth = std::move(cpu.cloud_depth);
     frame.lwir = std::move(cpu.lwir);
     frame.glint = std::move(cpu.glint);
@@ -525,6 +537,7 @@ void GlRenderer::setSlotUniforms(GLuint p, int slot, int unit, const LayerSlot& 
     gl_.ProgramUniform1f(p, location("u_clip_size", slot), float(c.size));
     gl_.ProgramUniform1f(p, location("u_clip_rings", slot), float(c.rings));
     gl_.ProgramUniform1f(p, location("u_clip_constant", slot), float(c.constant));
+    gl_.ProgramUniform1f(p, location("u_clip_finest", slot), float(c.finest));
   }
   if (entry.kind != LayerKind::kProceduralGardner) {
     gl_.BindTextureUnit(GLuint(unit), entry.kind == LayerKind::kClipmapGardner
@@ -538,9 +551,11 @@ void GlRenderer::setSlotUniforms(GLuint p, int slot, int unit, const LayerSlot& 
 void GlRenderer::drawSkyPass(const Scene& scene, const RenderSettings& settings,
                              const SkyPassLayout& drawn, const std::vector<LayerSlot>& slots,
                              const std::vector<glm::vec2>& polygon) {
-  // The casting planes above the lowest plane the pass draws (the ground with the background).
+  // The casting planes above the lowest plane the pass draws (the ground, where the background
+  // reaches below the horizon).
   SkyPassLayout layout = drawn;
-  double lowest = layout.background ? 0.0 : std::numeric_limits<double>::infinity();
+  layout.ground = layout.ground && layout.background;
+  double lowest = layout.ground ? 0.0 : std::numeric_limits<double>::infinity();
   for (const LayerSlot& slot : slots) lowest = std::min(lowest, slot.layer->altitude_m);
   std::vector<const LayerSlot*> casting;
   for (const LayerSlot& caster : casters_)
@@ -548,6 +563,11 @@ void GlRenderer::drawSkyPass(const Scene& scene, const RenderSettings& settings,
       casting.push_back(&caster);
       layout.casters.push_back(caster.kind);
     }
+  for (const LayerSlot& slot : slots)
+    layout.shaded_by.push_back(
+        int(std::count_if(casting.begin(), casting.end(), [&](const LayerSlot* c) {
+          return c->layer->altitude_m > slot.layer->altitude_m;
+        })));
   const GLuint p = program(layout);
   gl_.UseProgram(p);
   const Camera& camera = scene.camera;
@@ -650,6 +670,7 @@ void GlRenderer::drawFusedSky(const Scene& scene, const RenderSettings& settings
       if (area.empty() || (!background && slots.empty())) return;
       SkyPassLayout layout = base;
       layout.background = background;
+      layout.ground = side == &below;  // the pass above the horizon holds no ground
       for (const LayerSlot& slot : slots)
         (side == &above ? layout.above : layout.below).push_back(slot.kind);
       drawSkyPass(scene, settings, layout, slots, area);
@@ -663,20 +684,27 @@ void GlRenderer::drawFusedSky(const Scene& scene, const RenderSettings& settings
   }
 }
 
-void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
-                           TargetFormat format) {
-  const auto start = std::chrono::steady_clock::now();
-  timer_.beginFrame();
+FramePlanRequest GlRenderer::planRequest(const RenderSettings& settings, bool sea_eye) {
   FramePlanRequest request;
   request.heaps = settings.heaps;
   request.ellipsoid_budget = settings.ellipsoid_budget;
   request.ellipsoid_overdraw = settings.ellipsoid_overdraw;
   request.sea_probe = SeaProbe::kView;
+  request.sea_eye = sea_eye;
   request.sea_probe_scale = settings.sea_probe_scale;
   request.cull = true;
   request.heap_shadows = settings.shadow_map_size > 0;
   request.plane_shadows = settings.plane_shadows;
-  const FramePlan plan(scene, request);
+  return request;
+}
+
+std::unique_ptr<FramePlan> GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
+                                                 TargetFormat format, bool sea_eye) {
+  const auto start = std::chrono::steady_clock::now();
+  const std::uint64_t linked = programsLinked();
+  timer_.beginFrame();
+  auto owned = std::make_unique<FramePlan>(scene, planRequest(settings, sea_eye));
+  const FramePlan& plan = *owned;
   RenderSettings rest = settings;
   if (plan.thinned)
     rest.ellipsoid_budget = rest.ellipsoid_overdraw = 0.0;  // the plan's clouds are within it
@@ -697,6 +725,7 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
   sunlight_ = {};  // it points into the plan
   sea_probe_ = false;
   timer_.enter(-1);
+  stats_.programs_compiled = int(programsLinked() - linked);
   t.submit_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count() -
       timer_.waitedMs();
@@ -705,6 +734,7 @@ void GlRenderer::drawFrame(const Scene& scene, const RenderSettings& settings,
   for (std::size_t i = 0; i < t.cpu_ms.size(); ++i)
     if (i != std::size_t(CpuStage::kScene)) staged += t.cpu_ms[i];
   t.cpu(CpuStage::kScene) = std::max(0.0, t.submit_ms - staged);
+  return owned;
 }
 
 void GlRenderer::drawSeaProbe(const FramePlan& plan, const RenderSettings& settings) {
@@ -894,40 +924,48 @@ GlRenderer::LayerSides GlRenderer::layerSides(const ViewPlan& view,
 void GlRenderer::prepareClipmaps(const ViewPlan& view, const RenderSettings& settings,
                                  LayerSides& sides) {
   // The clipmaps of the layers that read one, brought to this camera before any pass. `auto`
-  // fills a layer's clipmap over the frames after the first that draws it from here, about a
-  // frame's pixels of texels each, and reads the sines until it is whole (a single render never
-  // pays for one); `baked` fills it at once.
+  // fills a layer's clipmap coarsest ring first, the coarsest whole and then about a frame's
+  // pixels of texels a frame: a continuous view from its first frame, reading the rings filled so
+  // far; other renders from the second render from the same place, reading the sines until it
+  // is complete (so a single render never pays for one). `baked` fills it at once.
   const Camera& camera = view.camera();
   bool baked = false;
-  const bool wait = settings.texture_evaluation == TextureEvaluation::kAuto;
-  const std::int64_t budget =
-      wait ? std::int64_t(camera.width) * camera.height : std::numeric_limits<std::int64_t>::max();
+  const bool continuous = !continuous_view_.empty();
+  const bool wait = settings.texture_evaluation == TextureEvaluation::kAuto && !continuous;
+  const std::int64_t budget = settings.texture_evaluation == TextureEvaluation::kAuto
+                                  ? std::int64_t(camera.width) * camera.height
+                                  : std::numeric_limits<std::int64_t>::max();
+  auto prepare = [&](LayerSlot& slot) {
+    const LayerTexture& t = *slot.texture->source;
+    const glm::dvec2 eye =
+        glm::dvec2(camera.position) - t.driftOffset(view.scene->time_s, slot.layer->texture);
+    GpuPassScope pass(timer_, GpuPass::kClipmaps);
+    StageClock clock(stats_.times.cpu(CpuStage::kUploads));
+    slot.clipmap = clipmaps_.prepare(slot.texture->key, *t.gardner(), eye,
+                                     LayerClipmaps::sizeFor(camera.height), budget, wait, stats_);
+    if (!(continuous ? slot.clipmap.usable() : slot.clipmap.complete()))
+      slot.kind = LayerKind::kProceduralGardner;
+    baked = true;
+  };
   for (std::vector<LayerSlot>* side : {&sides.above, &sides.below})
     for (LayerSlot& slot : *side)
-      if (slot.kind == LayerKind::kClipmapGardner) {
-        const LayerTexture& t = *slot.texture->source;
-        const glm::dvec2 eye =
-            glm::dvec2(camera.position) - t.driftOffset(view.scene->time_s, slot.layer->texture);
-        GpuPassScope pass(timer_, GpuPass::kClipmaps);
-        StageClock clock(stats_.times.cpu(CpuStage::kUploads));
-        slot.clipmap =
-            clipmaps_.prepare(slot.texture->key, *t.gardner(), eye,
-                              LayerClipmaps::sizeFor(camera.height), budget, wait, stats_);
-        if (!slot.clipmap.complete) slot.kind = LayerKind::kProceduralGardner;
-        baked = true;
-      }
+      if (slot.kind == LayerKind::kClipmapGardner) prepare(slot);
+  // A casting plane reads the clipmap its drawn slot filled. One left out of the passes (behind
+  // a full deck) fills its own: its sines for every receiving pixel cost three times the sky.
+  for (LayerSlot& caster : casters_) {
+    if (caster.kind != LayerKind::kClipmapGardner) continue;
+    const LayerSlot* drawn = nullptr;
+    for (const std::vector<LayerSlot>* side : {&sides.above, &sides.below})
+      for (const LayerSlot& slot : *side)
+        if (slot.layer == caster.layer) drawn = &slot;
+    if (drawn)
+      caster = *drawn;
+    else
+      prepare(caster);
+  }
   if (baked) {
     gl_.BindFramebuffer(GL_FRAMEBUFFER, framebuffer_.get());
     gl_.Viewport(0, 0, camera.width, camera.height);
-  }
-  // A casting plane reads the clipmap its drawn slot filled, or, left out of the passes, its
-  // sines.
-  for (LayerSlot& caster : casters_) {
-    if (caster.kind != LayerKind::kClipmapGardner) continue;
-    caster.kind = LayerKind::kProceduralGardner;
-    for (const std::vector<LayerSlot>* side : {&sides.above, &sides.below})
-      for (const LayerSlot& slot : *side)
-        if (slot.layer == caster.layer) caster = slot;
   }
 }
 

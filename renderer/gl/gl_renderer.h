@@ -111,9 +111,14 @@ class GlRenderer {
     AltitudeBand window;
   };
 
-  // The frame's plan (renderer/frame_plan.h), then its views drawn: the sea's probe, then the
-  // view; its CPU stages and GPU passes timed into stats_.times.
-  void drawFrame(const Scene& scene, const RenderSettings& settings, TargetFormat format);
+  // The frame's plan (renderer/frame_plan.h; returned, for the channels the CPU adds from the
+  // same plan, with the tracer's sea probe when `sea_eye`), then its views drawn: the sea's
+  // probe, then the view; its CPU stages and GPU passes timed into stats_.times.
+  static FramePlanRequest planRequest(const RenderSettings& settings, bool sea_eye);
+  std::unique_ptr<FramePlan> drawFrame(const Scene& scene, const RenderSettings& settings,
+                                       TargetFormat format, bool sea_eye = false);
+  // The drawn float target, top row first.
+  FloatImage readFloat(int width, int height);
   // What the sea mirrors, drawn into sea_probe_texture_ before a view that shows the sea
   // (MODEL.md section 18); the sky pass's sea uniforms read it.
   void drawSeaProbe(const FramePlan& plan, const RenderSettings& settings);

@@ -195,13 +195,14 @@ const ClipmapView& LayerClipmaps::prepare(const std::string& key, const GardnerT
       int& rows = c.rows[std::size_t(ring)];
       if (rows == size) continue;
       bind();
-      const int more = int(std::clamp<std::int64_t>(budget / size, 1, size - rows));
+      const std::int64_t whole = ring == c.rings - 1 ? size : 1;  // the coarsest ring at once
+      const int more = int(std::clamp<std::int64_t>(budget / size, whole, size - rows));
       bake(c, g, ring, {0, rows, size, rows + more});
       rows += more;
       budget -= std::int64_t(more) * size;
     }
-  c.view.complete =
-      std::all_of(c.rows.begin(), c.rows.end(), [&](int rows) { return rows == size; });
+  c.view.finest = c.rings;
+  while (c.view.finest > 0 && c.rows[std::size_t(c.view.finest - 1)] == size) --c.view.finest;
   stats.layer_texels_baked += int(texels_baked_ - before);
   c.view.texture = c.texture.get();
   c.view.size = size;

@@ -36,7 +36,13 @@ struct ClipmapView {
   glm::dvec2 texel_m{0.0};        // ring 0's texel, metres along X and Y
   std::vector<glm::vec2> offset;  // per ring: the camera's lattice coordinate modulo N
   double constant = 0.0;          // T with no term
-  bool complete = false;          // every ring holds every texel; until then, read the sines
+  // The finest ring from which every coarser ring holds every texel (rings: none yet). The sky
+  // pass reads no finer ring: a continuous view's clipmap being filled shows the coarse terms
+  // first, as a streamed texture shows its coarse mip levels, and no frame switches to another
+  // program; other renders read the sines until it is complete.
+  int finest = 0;
+  bool usable() const { return finest < rings; }
+  bool complete() const { return finest == 0; }
 };
 
 class LayerClipmaps {
@@ -50,6 +56,8 @@ class LayerClipmaps {
   // the frames that follow, so that no frame pays for all of it; the view says when it is
   // complete). A clipmap first asked for is only noted, with nothing evaluated, when `wait` is
   // set: a view that is not drawn again (a single render, a dataset's sample) never pays for one.
+  // Otherwise the coarsest ring is filled whole at once, so the clipmap is usable from its first
+  // frame (that ring holds one term a texel, a fraction of a frame's sines).
   // The caller restores its framebuffer, viewport and program afterwards.
   const ClipmapView& prepare(const std::string& key, const GardnerTexture& g, glm::dvec2 eye,
                              int size, std::int64_t budget, bool wait, FrameStats& stats);

@@ -53,7 +53,15 @@ std::string casterFunction(int caster, int slot, LayerKind kind) {
          "]);\n}\n";
 }
 
-std::string slotStatement(int slot, LayerKind kind) {
+// The sunlight the `n` highest casters of `total` let through to a point of the plane `height`
+// (planesSunlightN, skySlots); 1 with none.
+std::string planesSunlight(int n, int total) {
+  return n == 0 ? std::string("1.0")
+                : "planesSunlight" + std::to_string(n) + "of" + std::to_string(total) +
+                      "(hit, height)";
+}
+
+std::string slotStatement(int slot, LayerKind kind, int shaded_by, int casters) {
   const std::string i = std::to_string(slot);
   const std::string value = slotValue(slot, kind, "hit");
   // Behind a surface that is opaque to within 1/1024 nothing more is evaluated (what the
@@ -63,8 +71,9 @@ std::string slotStatement(int slot, LayerKind kind) {
   // costs its threshold only.
   return "    if (transmittance > kClear) { LayerHit hit = hitLayer(" + i +
          ", r); float t1 = inFront(hit.distance) ? layerThreshold(" + i +
-         ", r, hit.p) : 1.0; if (t1 < 1.0) composite(" + i + ", r, hit, t1, " + value +
-         ", colour, transmittance); }\n";
+         ", r, hit.p) : 1.0; if (t1 < 1.0) { float height = u_height[" + i + "]; composite(" + i +
+         ", r, hit, t1, " + value + ", " + planesSunlight(shaded_by, casters) +
+         ", colour, transmittance); } }\n";
 }
 
 // kCommon after the constants it takes from C++ and the formulas it shares with the CPU
@@ -90,8 +99,11 @@ std::string SkyPassLayout::key() const {
   k += regions ? 'r' : '-';
   k += shadows ? 'h' : '-';
   k += sea ? 'w' : '-';
+  k += ground ? 'g' : '-';
   k += '/';
   for (LayerKind kind : casters) k += char('a' + int(kind));
+  k += '/';
+  for (int n : shaded_by) k += char('0' + n);
   return k;
 }
 
@@ -168,21 +180,32 @@ std::string skySlots(const SkyPassLayout& layout) {
       if (kind == LayerKind::kBakedGardner || kind == LayerKind::kTable)
         s += "uniform sampler2D" + name;
     }
-  if (!layout.casters.empty()) {
+  // planesSunlightNofK: the product over the N highest of the K casters, for a plane that
+  // only they lie above; the ground reads all K.
+  const int total = int(layout.casters.size());
+  for (int c = 0; c < total; ++c)
+    s += casterFunction(c, layout.slots() + c, layout.casters[std::size_t(c)]);
+  for (int n = 1; n <= total; ++n) {
     std::string product = "1.0";
-    for (std::size_t c = 0; c < layout.casters.size(); ++c) {
-      s += casterFunction(int(c), layout.slots() + int(c), layout.casters[c]);
+    for (int c = total - n; c < total; ++c)
       product += " * casterSunlight" + std::to_string(c) + "(hit, height)";
-    }
-    s += "float planesSunlight(LayerHit hit, float height) { return " + product + "; }\n";
+    s += "float planesSunlight" + std::to_string(n) + "of" + std::to_string(total) +
+         "(LayerHit hit, float height) { return " + product + "; }\n";
   }
 
   return s;
 }
 
+// Casters above slot `slot`'s plane; all of them where the layout does not say.
+int shadedBy(const SkyPassLayout& layout, int slot) {
+  return std::size_t(slot) < layout.shaded_by.size() ? layout.shaded_by[std::size_t(slot)]
+                                                     : int(layout.casters.size());
+}
+
 // main(): the slots nearest first on the side the ray looks to, then the background.
 std::string skyMain(const SkyPassLayout& layout) {
   std::string s;
+  const int total = int(layout.casters.size());
   s += "const float kClear = 1.0 / 1024.0;\n";
   s += "void main() {\n  vec3 r = viewRay();\n";
   if (layout.targets) {
@@ -198,19 +221,22 @@ std::string skyMain(const SkyPassLayout& layout) {
   if (above > 0) {
     s += "  if (r.z > 0.0) {\n";
     for (int slot = above - 1; slot >= 0; --slot)
-      s += slotStatement(slot, layout.above[std::size_t(slot)]);
+      s += slotStatement(slot, layout.above[std::size_t(slot)], shadedBy(layout, slot), total);
     s += "  }\n";
   }
   if (!layout.below.empty()) {
     s += "  if (r.z < 0.0) {\n";
     for (int k = int(layout.below.size()) - 1; k >= 0; --k)
-      s += slotStatement(above + k, layout.below[std::size_t(k)]);
+      s += slotStatement(above + k, layout.below[std::size_t(k)], shadedBy(layout, above + k),
+                         total);
     s += "  }\n";
   }
   if (layout.background) {
-    if (!layout.casters.empty())  // the ground, where the layers in front let it show
+    if (layout.ground && total > 0)  // the ground, where the layers in front let it show
       s += "  if (r.z < 0.0 && transmittance > kClear) g_planes_sun = "
-           "planesSunlight(hitPlane(-u_camera_z, r), -u_camera_z);\n";
+           "planesSunlight" +
+           std::to_string(total) + "of" + std::to_string(total) +
+           "(hitPlane(-u_camera_z, r), -u_camera_z);\n";
     s += "  vec3 behind = background(r);\n";
     if (layout.targets) s += "  if (target_distance < kFar) behind = targetColour();\n";
     s += "  colour += transmittance * behind;\n";

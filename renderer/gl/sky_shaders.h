@@ -35,9 +35,14 @@ struct SkyPassLayout {
   bool regions = false;  // some layer lies in a bounded region (region.h)
   bool shadows = false;  // the ground takes the clouds' shadows from the shadow map
   bool sea = false;      // the sea in place of the ground (MODEL.md section 18)
+  bool ground = true;    // with the background: the pass's area reaches below the horizon
   // Layers whose shadows fall on the ground and the slots' planes (MODEL.md section 16, "sky
   // planes"), as slots slots() onwards: every layer of the frame while the sun is up.
   std::vector<LayerKind> casters;
+  // Per slot, how many casters lie above its plane: the last ones of `casters`, which run from
+  // the lowest up. A slot reads only those (llvmpipe runs every branch a pixel group meets, so
+  // a caster skipped at run time still costs its texture read).
+  std::vector<int> shaded_by;
 
   int slots() const { return int(above.size() + below.size()); }
   std::string key() const;

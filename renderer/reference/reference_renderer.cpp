@@ -493,6 +493,17 @@ void traceRows(const PixelWork& w, RowQueue& rows, Frame& frame, bool calling_th
 Frame renderReferenceFrame(const Scene& scene, const ReferenceSettings& settings,
                            const FrameRequest& request, const std::function<void(double)>& progress,
                            const ReferenceCancel& cancel, bool* cancelled) {
+  FramePlanRequest plan_request;
+  plan_request.heaps = settings.heaps;
+  plan_request.heap_shadows = true;
+  const FramePlan plan(scene, plan_request);
+  return renderReferenceFrame(plan, settings, request, progress, cancel, cancelled);
+}
+
+Frame renderReferenceFrame(const FramePlan& plan, const ReferenceSettings& settings,
+                           const FrameRequest& request, const std::function<void(double)>& progress,
+                           const ReferenceCancel& cancel, bool* cancelled) {
+  const Scene& scene = *plan.view.scene;
   const Camera& camera = scene.camera;
   const std::size_t pixels = std::size_t(camera.width) * camera.height;
   const ChannelSet& asked = request.channels;
@@ -509,12 +520,9 @@ Frame renderReferenceFrame(const Scene& scene, const ReferenceSettings& settings
   if (infrared) frame.lwir.resize(pixels);
   if (asked.has(Channel::kGlint)) frame.glint.resize(pixels);
 
-  FramePlanRequest plan_request;
-  plan_request.heaps = settings.heaps;
-  plan_request.heap_shadows = true;
-  const FramePlan plan(scene, plan_request);
-  const ReferenceTracer tracer(plan.view, plan.sea_probe ? &*plan.sea_probe : nullptr,
-                               &*plan.heap_shadows, settings.sea_waves);
+  const ReferenceTracer tracer(plan.view, plan.tracedSeaProbe(),
+                               plan.heap_shadows ? &*plan.heap_shadows : nullptr,
+                               settings.sea_waves);
   const PixelWork work{tracer,
                        camera,
                        viewBasis(camera),
@@ -535,7 +543,7 @@ Frame renderReferenceFrame(const Scene& scene, const ReferenceSettings& settings
   if (cancelled) *cancelled = stopped;
   if (asked.has(Channel::kVisibility) && !stopped) {
     frame.visibilityFromCoverage();
-    dimVisibilityByPrecipitation(frame, scene, settings.heaps);
+    dimVisibilityByPrecipitation(frame, plan.view);
   }
   return frame;
 }
@@ -560,7 +568,7 @@ struct CloudProbe::State {
   State(const Scene& s, const HeapDrawing& heaps)
       : scene(withoutTargets(s)),
         plan(scene, drawingHeaps(heaps)),
-        tracer(plan.view, plan.sea_probe ? &*plan.sea_probe : nullptr, nullptr) {}
+        tracer(plan.view, plan.tracedSeaProbe(), nullptr) {}
 };
 
 CloudProbe::CloudProbe(const Scene& scene, const HeapDrawing& heaps)

@@ -8,6 +8,7 @@
 
 #include "image/image.h"
 #include "renderer/frame.h"
+#include "renderer/frame_plan.h"
 #include "renderer/render_settings.h"
 #include "world/scene.h"
 
@@ -30,6 +31,12 @@ struct ReferenceCancel {
 // pixel's centre ray, where a rasteriser samples them. `cancelled`, when given, is set to
 // whether `cancel` stopped the frame before its last row (its channels then incomplete).
 Frame renderReferenceFrame(const Scene& scene, const ReferenceSettings& settings,
+                           const FrameRequest& request,
+                           const std::function<void(double)>& progress = {},
+                           const ReferenceCancel& cancel = {}, bool* cancelled = nullptr);
+// The same of a frame planned already (the GL's label channels: one plan a frame), its clouds
+// and heaps, shadows and rain shafts as `plan` holds them; settings.heaps is not read.
+Frame renderReferenceFrame(const FramePlan& plan, const ReferenceSettings& settings,
                            const FrameRequest& request,
                            const std::function<void(double)>& progress = {},
                            const ReferenceCancel& cancel = {}, bool* cancelled = nullptr);

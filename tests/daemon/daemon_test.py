@@ -22,6 +22,7 @@ BINARY = os.environ.get("NEPHELE_BINARY", "build/nephele")
 SOURCE = os.environ.get("NEPHELE_SOURCE_DIR", ".")
 SCENE = os.path.join(SOURCE, "config", "scenes", "cumulus.toml")
 TIMEOUT = 60  # seconds any single wait may take (sanitizer builds are slow)
+TIME_FACTOR = float(os.environ.get("NEPHELE_TIME_FACTOR", "1"))  # 10 under the sanitizers
 
 
 # The live fuzz's daemon (live_fuzz.py): frames of at most 65,536 pixels and 2 subscriptions.
@@ -29,9 +30,11 @@ TIMEOUT = 60  # seconds any single wait may take (sanitizer builds are slow)
 # 4 us a pixel, and the label channels traced on the CPU (cloud_depth, lwir, glint) about 20, so
 # 0.25 MiP took 5.6 s. A lockstep tick renders every subscription's frame before anything else
 # runs; these limits keep it, and every other reply, within the fuzz's 5 s bound. Snapshots only
-# when asked and at shutdown.
+# when asked and at shutdown. It prewarms, as a cockpit's daemon does, but under the
+# sanitizers, whose bounds are ten times wider and whose prewarm would take minutes.
 LIVE_FUZZ_DAEMON = dict(socket_keys="max_pending_mb = 4\nmax_image_pixels = 0.0625\n"
                                     "max_subscriptions = 2",
+                        world_keys="prewarm = " + ("true" if TIME_FACTOR == 1 else "false"),
                         extra="[snapshot]\npath = \"{snapshot}\"\ninterval = 0\n")
 
 
@@ -53,7 +56,11 @@ class Daemon:
                  socket_keys="", modbus_keys="", scene=SCENE, frames=None, env=None,
                  world_keys=""):
         """`extra` is appended to the config ({snapshot} becomes this daemon's snapshot
-        path); `world_keys`, `socket_keys` and `modbus_keys` go into those tables."""
+        path); `world_keys`, `socket_keys` and `modbus_keys` go into those tables. A test
+        daemon starts without [world] prewarm unless world_keys sets it: most tests do not
+        time frames, and the prewarm's seconds would repeat at every start."""
+        if "prewarm" not in world_keys:
+            world_keys += "\nprewarm = false"
         self.workdir = workdir
         self.env = dict(os.environ, **(env or {}))
         self.config = os.path.join(workdir, name + ".toml")
@@ -1141,6 +1148,33 @@ class HostStateTest(DaemonTest):
         self.assertEqual(regs, [2])  # altostratus, in layer 2's type register
         with open(d.snapshot + ".daemon.json") as f:
             self.assertEqual(json.load(f)["ticks"], 3)
+
+
+    def test_prewarm_leaves_a_weather_change_nothing_to_compile(self):
+        """Issue 63, item 6: with [world] prewarm (the default) every shader program a genus
+        asks for is compiled before the daemon says ready, so the first frames after weather
+        changes compile none (stats last_frame.programs_compiled); without it they compile
+        some, which is what the count is there to tell."""
+        if TIME_FACTOR != 1:
+            self.skipTest("a sanitizer build's prewarm takes minutes; the release run checks it")
+        compiled = {}
+        for prewarm in ("true", "false"):
+            d = self.daemon(world_keys=f"prewarm = {prewarm}", name="prewarm-" + prewarm)
+            c = d.client()
+            c.ok({"cmd": "render", "view": "front", "format": "raw"})
+            compiled[prewarm] = 0
+            for genus, base, thickness in ((7, 1200, 1500), (10, 500, 400), (1, 3000, 600)):
+                c.ok({"cmd": "set_weather", "layer": 1, "type": genus, "base": base,
+                      "thickness": thickness, "coverage": 60})
+                for view in ("front", "left"):
+                    c.ok({"cmd": "render", "view": view, "format": "raw"})
+                    compiled[prewarm] += c.ok({"cmd": "stats"})["last_frame"][
+                        "programs_compiled"]
+            d.stop()
+            if prewarm == "true":
+                self.assertIn("event=prewarm", open(d.log_path).read())
+        self.assertEqual(compiled["true"], 0, compiled)
+        self.assertGreater(compiled["false"], 0, compiled)
 
 
 class ModbusTest(DaemonTest):

@@ -25,6 +25,7 @@ def write_config(directory: str, socket_keys: str = "") -> Path:
 [world]
 mode = "lockstep"
 tick_rate = 30
+prewarm = false
 [[view]]
 name = "front"
 width = 64

@@ -132,12 +132,13 @@ uniform vec2 u_clip_offset[kSlots * kRings];
 uniform float u_clip_size[kSlots];      // N
 uniform float u_clip_rings[kSlots];     // n: ring n and beyond hold T with no term
 uniform float u_clip_constant[kSlots];  // that T, k T0^2
+uniform float u_clip_finest[kSlots];    // the finest ring filled, with all coarser ones
 
 float clipmapValue(sampler2DArray rings, int i, LayerHit hit) {
   float n = u_clip_rings[i], size = u_clip_size[i];
   vec2 q = hit.p / u_clip_texel[i];  // ring 0 texels from the camera
   float reach = log2(max(max(abs(q.x), abs(q.y)), 1.0) / (0.25 * size - 1.0));
-  float level = clamp(max(u_terms[i] - termCount(i, hit), reach), 0.0, n);
+  float level = clamp(max(max(u_terms[i] - termCount(i, hit), reach), u_clip_finest[i]), 0.0, n);
   float l = min(floor(level), n - 1.0);
   int k = int(l);
   float scale = exp2(-l);
@@ -172,18 +173,13 @@ float layerThreshold(int i, vec3 r, vec2 p) {
 float layerThreshold(int i, vec3 r, vec2 p) { return u_threshold[i]; }
 #endif
 
-#ifdef PLANE_SHADOWS
-// The share of the sunlight the sky planes above a point let through (MODEL.md section 16,
-// "sky planes"), the point `hit` on the plane `height` metres above the camera; generated
-// with the casting slots (skyFragmentSource).
-float planesSunlight(LayerHit hit, float height);
-#endif
-
 // Slot i's surface under what lies in front of it: layers are composited nearest first, so
 // `colour` holds the premultiplied sum of the surfaces in front and `transmittance` what they
-// let through ("over" summed front to back, the same sum as back to front).
-void composite(int i, vec3 r, LayerHit hit, float t1, float it, inout vec3 colour,
-               inout float transmittance) {
+// let through ("over" summed front to back, the same sum as back to front). `planes_sun` is the
+// share of the sunlight the sky planes above it let through (MODEL.md section 16, "sky
+// planes"; generated per slot with the casters above it, skyFragmentSource).
+void composite(int i, vec3 r, LayerHit hit, float t1, float it, float planes_sun,
+               inout vec3 colour, inout float transmittance) {
   float tr = translucence(it - t1, u_transition[i]);  // Gardner eq. 9
   if (tr >= 1.0) return;                                // clear here: nothing to add
   vec3 normal = vec3(0.0, 0.0, u_height[i] > 0.0 ? -1.0 : 1.0);  // turned towards the viewer
@@ -204,7 +200,7 @@ void composite(int i, vec3 r, LayerHit hit, float t1, float it, inout vec3 colou
 #if defined(PLANE_SHADOWS) || defined(SHADOWS)
   float sun = 1.0;
 #ifdef PLANE_SHADOWS
-  sun = planesSunlight(hit, u_height[i]);
+  sun = planes_sun;
 #endif
 #ifdef SHADOWS
   // A plane under every heap takes the heaps' shadow where the sun's ray through it lands
