@@ -146,7 +146,7 @@ FramePlan::FramePlan(const Scene& scene, const FramePlanRequest& request)
     if (viewShowsSea(scene.camera))
       sea_probe =
           seaProbeView(view, seaProbeCamera(scene.camera, request.sea_probe_scale), request.cull);
-    if (request.sea_eye) sea_eye = seaProbeView(view, eye, request.cull);
+    if (request.sea_eye) sea_eye = seaProbeView(view, eye, false);  // a tracer reads every cloud
   } else {
     sea_probe = seaProbeView(view, eye, request.cull);
   }

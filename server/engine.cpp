@@ -86,7 +86,6 @@ std::string Engine::openWorld() {
     return "scene time: " + e;
   if (config_.site) world_->setSite({config_.site->latitude_deg, config_.site->longitude_deg, 0.0});
   if (std::string e = restoreAtStart(); !e.empty()) return e;
-  if (config_.prewarm) renders_->prewarm(views_.all());
   for (const command::Stream& stream : config_.streams) {
     const Outcome started = startStream(stream);
     if (const auto* e = std::get_if<ProtocolError>(&started))
@@ -133,6 +132,7 @@ void Engine::run(std::promise<std::string>& started) {
     return;
   }
   clock_.start(Clock::now());
+  prewarming_ = config_.prewarm;
   next_snapshot_ = Clock::now() + secondsToDuration(config_.snapshot_interval_s);
   publish();
   started.set_value("");
@@ -189,9 +189,13 @@ void Engine::run(std::promise<std::string>& started) {
       telemetry_.noteBusy("snapshot", t0);
       next_snapshot_ = Clock::now() + secondsToDuration(config_.snapshot_interval_s);
     }
-    const auto t0 = Clock::now();
+    auto t0 = Clock::now();
     publish();
     telemetry_.noteBusy("publish", t0);
+    // The prewarm a step at a time, between what the world thread has to do.
+    t0 = Clock::now();
+    if (prewarming_) prewarming_ = renders_->prewarmStep(views_.all());
+    telemetry_.noteBusy("prewarm", t0);
   }
   if (!config_.snapshot_path.empty())
     shutdown_saved_ = saveSnapshot(config_.snapshot_path, "shutdown").empty();
@@ -200,6 +204,7 @@ void Engine::run(std::promise<std::string>& started) {
 }
 
 Engine::Clock::time_point Engine::nextWake() const {
+  if (prewarming_) return Clock::now();  // its next step, after what is queued
   const Clock::time_point wake = Clock::now() + std::chrono::milliseconds(500);
   if (clock_.lockstep()) return wake;
   // The IG's frames go on while paused.

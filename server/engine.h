@@ -165,6 +165,7 @@ class Engine {
   Clock::time_point next_snapshot_;
   std::atomic<bool> trigger_pending_{false};
   bool shutdown_saved_ = true;
+  bool prewarming_ = false;  // [world] prewarm steps left (RenderService::prewarmStep)
   std::thread thread_;
 };
 

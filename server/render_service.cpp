@@ -165,47 +165,71 @@ int prewarmSide(int side) {
 
 }  // namespace
 
-int RenderService::prewarm(const std::vector<ViewConfig>& views) {
-  const auto t0 = std::chrono::steady_clock::now();
-  const RenderSettings& settings = config_.scene.render;
+// The catalogue: per air (the scene's, and haze and fog where it has neither), per genus as the
+// one weather layer (none first), per view, the camera below, inside and above the layer.
+struct RenderService::Prewarm {
+  std::vector<std::optional<Haze>> hazes;
+  std::vector<std::optional<Fog>> fogs;
+  std::size_t step = 0, steps = 0;
+  std::unique_ptr<World> world;  // of the step's air and genus
+  std::size_t world_of = std::size_t(-1);
   int frames = 0, programs = 0;
-  // Each sky a new continuous view, whose second frame reuses its first, then a single render.
-  auto draw = [&](const World& world, const Camera& camera, const std::string& view) {
-    const Scene& scene = world.seenFrom(camera);
-    for (int continuous : {1, 1, 0}) {
-      renderer_->setContinuousView(continuous ? "prewarm " + view : std::string());
-      renderer_->renderSrgb8(scene, settings);
-      programs += renderer_->lastFrameStats().programs_compiled;
-      ++frames;
-    }
-  };
+  double ms = 0.0;
+};
+
+bool RenderService::prewarmStep(const std::vector<ViewConfig>& views) {
   const Scene& base = config_.scene.scene;
-  std::vector<std::optional<Haze>> airs{base.haze};
-  if (!base.haze && !base.fog) airs.push_back(Haze{});
-  for (const std::optional<Haze>& haze : airs)
-    for (int type = 0; type < kCloudTypeCount; ++type) {
-      World world(base, config_.scene.dynamics);
-      world.setHaze(haze);
-      const WeatherLayer layer = typicalWeatherLayer(CloudType(type), 0.5);
-      if (type > 0 && !world.setWeather({}, layer).empty()) continue;
-      const double top = layer.base_m + layer.thickness_m;
-      for (const ViewConfig& view : views)
-        for (const auto& [z, pitch] :
-             {std::pair{2.0, 15.0}, {0.5 * (layer.base_m + top), 0.0}, {top + 1000.0, -20.0}}) {
-          Camera camera = view.camera;  // its lens, at a few pixels
-          camera.width = prewarmSide(camera.width);
-          camera.height = prewarmSide(camera.height);
-          camera.position.z = z;
-          camera.orientation.pitch_deg = pitch;
-          draw(world, camera, view.name + "/" + std::to_string(type) + "/" + std::to_string(z));
-          if (type == 0) break;  // a clear sky looks the same from any height
-        }
-    }
+  if (!prewarm_) {
+    prewarm_ = std::make_unique<Prewarm>();
+    Prewarm& p = *prewarm_;
+    p.hazes = {base.haze};
+    p.fogs = {base.fog};
+    if (!base.haze) p.hazes.push_back(Haze{}), p.fogs.push_back(base.fog);
+    if (!base.fog) p.hazes.push_back(base.haze), p.fogs.push_back(Fog{});
+    p.steps = p.hazes.size() * kCloudTypeCount * views.size() * 3;
+    spdlog::info("event=prewarm_started steps={}", p.steps);
+  }
+  Prewarm& p = *prewarm_;
+  if (p.step >= p.steps) return false;
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::size_t position = p.step % 3, view_index = p.step / 3 % views.size();
+  const std::size_t sky = p.step / 3 / views.size();  // air * kCloudTypeCount + genus
+  const int type = int(sky % kCloudTypeCount);
+  ++p.step;
+  const WeatherLayer layer = typicalWeatherLayer(CloudType(type), 0.5);
+  if (p.world_of != sky) {
+    p.world = std::make_unique<World>(base, config_.scene.dynamics);
+    p.world->setHaze(p.hazes[sky / kCloudTypeCount]);
+    p.world->setFog(p.fogs[sky / kCloudTypeCount]);
+    if (type > 0) p.world->setWeather({}, layer);
+    p.world_of = sky;
+  }
+  if (type == 0 && position > 0) return true;  // a clear sky looks the same from any height
+  const double top = layer.base_m + layer.thickness_m;
+  const std::pair<double, double> poses[] = {
+      {2.0, 15.0}, {0.5 * (layer.base_m + top), 0.0}, {top + 1000.0, -20.0}};
+  const ViewConfig& view = views[view_index];
+  Camera camera = view.camera;  // its lens, at a few pixels
+  camera.width = prewarmSide(camera.width);
+  camera.height = prewarmSide(camera.height);
+  camera.position.z = poses[position].first;
+  camera.orientation.pitch_deg = poses[position].second;
+  const Scene& scene = p.world->seenFrom(camera);
+  // A new continuous view, whose second frame reuses its first, then a single render.
+  const std::string name = "prewarm " + view.name + "/" + std::to_string(p.step);
+  for (int continuous : {1, 1, 0}) {
+    renderer_->setContinuousView(continuous ? name : std::string());
+    renderer_->renderSrgb8(scene, config_.scene.render);
+    p.programs += renderer_->lastFrameStats().programs_compiled;
+    ++p.frames;
+  }
   renderer_->setContinuousView(std::string());
-  spdlog::info(
-      "event=prewarm frames={} programs={} ms={:.0f}", frames, programs,
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-  return programs;
+  p.ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  if (p.step == p.steps) {
+    spdlog::info("event=prewarm frames={} programs={} ms={:.0f}", p.frames, p.programs, p.ms);
+    p.world.reset();
+  }
+  return p.step < p.steps;
 }
 
 namespace {

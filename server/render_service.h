@@ -65,13 +65,14 @@ class RenderService {
   std::string glName() const;
   std::string backendName() const;
 
-  // World thread, before the daemon says ready: every view drawn small once per genus as the
-  // scene's one weather layer, from below, inside and above it, as a subscription's first two
-  // frames and as a single render, with the scene's air and again with haze where it has
-  // none. The programs those frames use are compiled, and llvmpipe's code for them generated,
-  // so that a weather change compiles nothing (docs/ACCURACY.md, "Frame budget"). Returns the
-  // programs compiled; logs event=prewarm.
-  int prewarm(const std::vector<ViewConfig>& views);
+  // World thread, while it has nothing else to do ([world] prewarm): one step of drawing every
+  // view small once per genus as the scene's one weather layer, from below, inside and above
+  // it, as a subscription's first two frames and as a single render, with the scene's air and
+  // again with haze and with fog where it has none. The programs those frames use are compiled,
+  // and llvmpipe's code for them generated, so that a weather change compiles nothing
+  // (docs/ACCURACY.md, "Frame budget"). False once every step is done; logs
+  // event=prewarm_started and event=prewarm.
+  bool prewarmStep(const std::vector<ViewConfig>& views);
 
   // The configured pixel limit, on the centred view an off-axis view is cut from.
   std::optional<ProtocolError> pixelLimit(const ViewConfig& view) const;
@@ -95,11 +96,13 @@ class RenderService {
 
  private:
   class Encoder;
+  struct Prewarm;
 
   const DaemonConfig& config_;
   Telemetry& telemetry_;
   std::unique_ptr<Renderer> renderer_;
   std::unique_ptr<Encoder> encoder_;
+  std::unique_ptr<Prewarm> prewarm_;
   std::atomic<bool> cancel_{false};
 };
 

@@ -103,10 +103,20 @@ std::vector<RainShaft> rainShaftsInView(const Scene& scene, const HeapDrawing& h
 }
 
 bool hasPrecipitation(const Scene& scene) {
+  return hasPrecipitationSlabs(scene) || hasPrecipitationShafts(scene);
+}
+
+bool hasPrecipitationSlabs(const Scene& scene) {
+  for (const auto& [key, w] : scene.weather)  // precipitationMedia's slabs
+    if (precipitationExtinction(w.precipitation) > 0.0 && !key.region && !genus(w.type).heaps)
+      return true;
+  return false;
+}
+
+bool hasPrecipitationShafts(const Scene& scene) {
   if (!scene.rain_shafts.empty()) return true;
   for (const auto& [key, w] : scene.weather)
-    if (precipitationExtinction(w.precipitation) > 0.0 && (!key.region || genus(w.type).heaps))
-      return true;
+    if (precipitationExtinction(w.precipitation) > 0.0 && genus(w.type).heaps) return true;
   return false;
 }
 

@@ -76,5 +76,9 @@ std::vector<RainShaft> rainShaftsInView(const Scene& scene, const HeapDrawing& h
 
 // Whether the scene has any precipitation to draw (without walking its fields' tiles).
 bool hasPrecipitation(const Scene& scene);
+// Which of its media precipitationMedia may give (without walking the fields' tiles): slabs of
+// stratiform layers, shafts under heaps.
+bool hasPrecipitationSlabs(const Scene& scene);
+bool hasPrecipitationShafts(const Scene& scene);
 
 }  // namespace nephele

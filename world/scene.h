@@ -138,10 +138,23 @@ std::optional<Fog> inLayerVeil(const Scene& scene);
 // Whether the camera is in a layer's slab or band (where inLayerVeil may give a veil).
 bool eyeInLayer(const Scene& scene);
 
-// Whether anything lies in the air between the eye and a surface (fog, haze, a layer's veil,
-// precipitation).
+// The media in the air between the eye and a surface (MODEL.md sections 5 and 17), a bit each:
+// a GL pass compiles only those its scene holds (renderer/gl/sky_shaders.h, airDefines).
+enum AirMedium : unsigned {
+  kAirFog = 1,
+  kAirVeil = 2,  // the in-layer veil (inLayerVeil)
+  kAirHaze = 4,
+  kAirSlabs = 8,    // precipitation slabs under stratiform layers
+  kAirShafts = 16,  // rain shafts under heaps
+};
+inline unsigned airMedia(const Scene& scene) {
+  return (scene.fog ? kAirFog : 0u) | (eyeInLayer(scene) ? kAirVeil : 0u) |
+         (scene.haze ? kAirHaze : 0u) | (hasPrecipitationSlabs(scene) ? kAirSlabs : 0u) |
+         (hasPrecipitationShafts(scene) ? kAirShafts : 0u);
+}
+// Whether anything lies in the air between the eye and a surface.
 inline bool sceneHasAir(const Scene& scene) {
-  return scene.fog || scene.haze || eyeInLayer(scene) || hasPrecipitation(scene);
+  return airMedia(scene) != 0;
 }
 
 // What a scene's fields make for its camera (MODEL.md sections 10, 11 and 17): their heaps within

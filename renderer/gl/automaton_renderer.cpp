@@ -57,9 +57,8 @@ void AutomatonRenderer::endFrame() {
   std::erase_if(volumes_, [](const auto& entry) { return !entry.second.used; });
 }
 
-GLuint AutomatonRenderer::program(bool air, bool targets, PhaseFunction phase) {
-  std::string defines;
-  if (air) defines += "#define AIR\n";
+GLuint AutomatonRenderer::program(unsigned air, bool targets, PhaseFunction phase) {
+  std::string defines = airDefines(air);
   if (targets) defines += "#define TARGETS\n";
   if (phase == PhaseFunction::kCornetteShanks) defines += "#define CORNETTE_SHANKS\n";
   auto found = programs_.find(defines);
@@ -134,7 +133,7 @@ void AutomatonRenderer::drawCloud(const Scene& scene, std::size_t index,
   const std::vector<glm::vec2> polygon = screenRectangle(scene.camera, box_lo, box_hi);
   if (polygon.empty()) return;
   const Volume& v = volume(scene, index);
-  const GLuint p = program(sceneHasAir(scene), targets_drawn, cloud.phase);
+  const GLuint p = program(airMedia(scene), targets_drawn, cloud.phase);
   gl_.UseProgram(p);
   setViewUniforms(gl_, p, scene.camera, scene, band);
   const glm::dvec3 eye = scene.camera.position;

@@ -39,7 +39,7 @@ class AutomatonRenderer {
     bool used = false;
   };
 
-  GLuint program(bool air, bool targets, PhaseFunction phase);
+  GLuint program(unsigned air, bool targets, PhaseFunction phase);
   Volume& volume(const Scene& scene, std::size_t index);
 
   const GlApi& gl_;

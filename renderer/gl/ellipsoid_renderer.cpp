@@ -705,7 +705,7 @@ EllipsoidPassLayout EllipsoidRenderer::batchLayout(const Scene& scene, const Ell
                      : SolidTextureKind::kBakedGardner;
   base.term_filter = settings.term_filter;
   base.spotlight = spotlight;
-  base.air = sceneHasAir(scene);
+  base.air = airMedia(scene);
   base.specular = cloud.shading.specular > 0.0;
   base.targets = targets_drawn;
   if (base.texture != SolidTextureKind::kProcedural) bindTables(texture);

@@ -45,7 +45,7 @@ std::string EllipsoidPassLayout::key() const {
   k += char('0' + int(texture));
   k += char('0' + int(term_filter));
   k += spotlight ? 'l' : '-';
-  k += air ? 'f' : '-';
+  k += char('a' + int(air));
   k += specular ? 's' : '-';
   k += targets ? 't' : '-';
   k += history ? 'h' : '-';
@@ -79,7 +79,7 @@ std::string ellipsoidVertexSource(const EllipsoidPassLayout& layout) {
 
 std::string ellipsoidFragmentSource(const EllipsoidPassLayout& layout) {
   std::string s = "#version 450 core\n";
-  if (layout.air) s += "#define AIR\n";
+  s += airDefines(layout.air);
   if (layout.specular) s += "#define SPECULAR\n";
   if (layout.targets) s += "#define TARGETS\n";
   if (layout.history) s += "#define HISTORY\n";

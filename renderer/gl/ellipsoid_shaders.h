@@ -29,7 +29,7 @@ struct EllipsoidPassLayout {
   SolidTextureKind texture = SolidTextureKind::kBakedGardner;
   TermFilter term_filter = TermFilter::kFade;
   bool spotlight = false;  // g from the projected radial texture instead of the exact form
-  bool air = false;
+  unsigned air = 0;        // the media of the air (airMedia, world/scene.h)
   bool specular = false;
   bool targets = false;
   bool history = false;  // kFusedPerPixel: also written to a continuous view's history

@@ -601,7 +601,7 @@ void GlRenderer::drawSkyGroup(const Scene& scene, const RenderSettings& settings
                               const std::vector<LayerSlot>& above,
                               const std::vector<LayerSlot>& below, bool background, bool targets) {
   SkyPassLayout base;
-  base.air = sceneHasAir(scene);
+  base.air = airMedia(scene);
   base.term_filter = settings.term_filter;
   base.targets = targets;
   base.shadows = shadow_map_.active();

@@ -93,7 +93,7 @@ std::string SkyPassLayout::key() const {
   for (LayerKind kind : below) k += char('a' + int(kind));
   k += '/';
   k += char('0' + int(term_filter));
-  k += air ? 'f' : '-';
+  k += char('a' + int(air));
   k += specular ? 's' : '-';
   k += targets ? 't' : '-';
   k += regions ? 'r' : '-';
@@ -105,6 +105,17 @@ std::string SkyPassLayout::key() const {
   k += '/';
   for (int n : shaded_by) k += char('0' + n);
   return k;
+}
+
+std::string airDefines(unsigned media) {
+  if (media == 0) return "";
+  std::string s = "#define AIR\n#define AIR_MEDIA\n";
+  if (media & kAirFog) s += "#define AIR_FOG\n";
+  if (media & kAirVeil) s += "#define AIR_VEIL\n";
+  if (media & kAirHaze) s += "#define AIR_HAZE\n";
+  if (media & kAirSlabs) s += "#define AIR_SLABS\n";
+  if (media & kAirShafts) s += "#define AIR_SHAFTS\n";
+  return s;
 }
 
 std::string formulaSource() {
@@ -138,7 +149,7 @@ namespace {
 // The pass's defines and constants: what the layout draws, and its slots.
 std::string skyDefines(const SkyPassLayout& layout) {
   std::string s = "#version 450 core\n";
-  if (layout.air) s += "#define AIR\n";
+  s += airDefines(layout.air);
   if (layout.background) s += "#define BACKGROUND\n";
   if (layout.specular) s += "#define SPECULAR\n";
   if (layout.targets) s += "#define TARGETS\n";

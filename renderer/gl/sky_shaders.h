@@ -29,7 +29,7 @@ struct SkyPassLayout {
   std::vector<LayerKind> above;
   std::vector<LayerKind> below;
   TermFilter term_filter = TermFilter::kFade;
-  bool air = false;
+  unsigned air = 0;  // the media of the air (airMedia, world/scene.h)
   bool specular = false;
   bool targets = false;  // opaque targets were drawn first (their colour and distance)
   bool regions = false;  // some layer lies in a bounded region (region.h)
@@ -53,6 +53,9 @@ struct SkyPassLayout {
 // The formulas the GL shares with the CPU reference (world/formulas/, prelude first), as GLSL:
 // every stage that calls one holds them all (the compiler drops what a stage does not call).
 std::string formulaSource();
+// The #defines of a stage that draws the air's `media` (airMedia bits, world/scene.h): AIR and
+// one per medium, so that applyAir holds only those (shaders/sky/common.glsl); none for none.
+std::string airDefines(unsigned media);
 std::string viewShaderSource();
 std::string polygonVertexSource();
 std::string skyFragmentSource(const SkyPassLayout& layout);

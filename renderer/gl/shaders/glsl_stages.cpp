@@ -25,9 +25,13 @@
 #include "renderer/gl/shaders/target_glsl.h"
 #include "renderer/gl/shadow_map.h"
 #include "renderer/gl/sky_shaders.h"
+#include "world/scene.h"
 
 namespace nephele {
 namespace {
+
+// Every medium of the air (airDefines): a stage with air compiles all of them here.
+constexpr unsigned kAllAir = kAirFog | kAirVeil | kAirHaze | kAirSlabs | kAirShafts;
 
 struct Stage {
   std::string name;  // the file name, with the stage's extension
@@ -86,7 +90,7 @@ void addSky(Stages& stages) {
         SkyPassLayout layout = sets[k];
         layout.term_filter = filter;
         layout.background = bits & 1;
-        layout.air = bits & 2;
+        layout.air = (bits & 2) ? kAllAir : 0u;
         layout.specular = bits & 4;
         layout.targets = bits & 8;
         layout.regions = bits & 16;
@@ -115,7 +119,7 @@ void addEllipsoids(Stages& stages) {
             layout.term_filter = filter;
             layout.shading_rate = rate;
             layout.spotlight = bits & 1;
-            layout.air = bits & 2;
+            layout.air = (bits & 2) ? kAllAir : 0u;
             layout.specular = bits & 4;
             layout.targets = bits & 8;
             // The renderer asks for the history with kFusedPerPixel only: kFusedSamples writes

@@ -32,6 +32,14 @@ vec3 viewRay() {
 }
 
 #ifdef AIR
+// A stage compiles the media its scene holds (airDefines, AIR_MEDIA); AIR alone, all of them.
+#ifndef AIR_MEDIA
+#define AIR_FOG
+#define AIR_VEIL
+#define AIR_HAZE
+#define AIR_SLABS
+#define AIR_SHAFTS
+#endif
 // The air between the eye and a surface (MODEL.md section 5): ground fog, the in-layer veil
 // and distance haze; an absent one has zero extinction. Each medium's optical depth and their
 // mixing are the shared formulas' (world/formulas/air.h, pasted ahead of this file), as in
@@ -61,19 +69,30 @@ uniform vec3 u_haze_colour;   // the sky's horizon
 
 vec3 applyAir(vec3 colour, vec3 d, float distance) {
   float z = u_camera_z;
+  vec4 air = vec4(0.0);
+#ifdef AIR_FOG
   float tau_fog = u_fog_sigma > 0.0 ? u_fog_sigma * slabPath(u_fog_slab, z, d.z, distance) : 0.0;
+  air = withMedium(air, tau_fog, u_fog_colour);
+#endif
+#ifdef AIR_VEIL
   float tau_veil =
       u_veil_sigma > 0.0 ? u_veil_sigma * slabPath(u_veil_slab, z, d.z, distance) : 0.0;
-  vec4 air = withMedium(vec4(0.0), tau_fog, u_fog_colour);
   air = withMedium(air, tau_veil, u_veil_colour);
+#endif
+#ifdef AIR_HAZE
   air = withMedium(air, hazeDepth(u_haze_sigma, u_haze_height, z, d.z, distance), u_haze_colour);
+#endif
+#ifdef AIR_SLABS
   for (int i = 0; i < kPrecipitationSlabs; ++i)
     if (u_precip_sigma[i] > 0.0)
       air = withMedium(air, u_precip_sigma[i] * slabPath(u_precip_slab[i], z, d.z, distance),
                        u_precip_colour[i]);
+#endif
+#ifdef AIR_SHAFTS
   for (int i = 0; i < u_shafts; ++i)
     air = withMedium(air, shaftDepth(u_shaft[i], u_shaft_sigma[i], z, d, distance),
                      u_shaft_colour[i]);
+#endif
   return airOver(colour, air.xyz, air.w);
 }
 
