@@ -216,7 +216,8 @@ bool RenderService::prewarmStep(const std::vector<ViewConfig>& views) {
   camera.orientation.pitch_deg = poses[position].second;
   const Scene& scene = p.world->seenFrom(camera);
   // A new continuous view, whose second frame reuses its first, then a single render.
-  const std::string name = "prewarm " + view.name + "/" + std::to_string(p.step);
+  std::string name = "prewarm ";  // appended, not summed: GCC 12 warns -Wrestrict on the sum
+  name.append(view.name).append("/").append(std::to_string(p.step));
   for (int continuous : {1, 1, 0}) {
     renderer_->setContinuousView(continuous ? name : std::string());
     renderer_->renderSrgb8(scene, config_.scene.render);

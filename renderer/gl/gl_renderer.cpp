@@ -951,7 +951,7 @@ void GlRenderer::prepareClipmaps(const ViewPlan& view, const RenderSettings& set
     for (LayerSlot& slot : *side)
       if (slot.kind == LayerKind::kClipmapGardner) prepare(slot);
   // A casting plane reads the clipmap its drawn slot filled. One left out of the passes (behind
-  // a full deck) fills its own: its sines for every receiving pixel cost three times the sky.
+  // a full deck) fills its own rather than sum its sines for every receiving pixel.
   for (LayerSlot& caster : casters_) {
     if (caster.kind != LayerKind::kClipmapGardner) continue;
     const LayerSlot* drawn = nullptr;
