@@ -97,8 +97,7 @@ std::uint64_t framePlansMade() {
   return plans_made.load(std::memory_order_relaxed);
 }
 
-FramePlan::FramePlan(const Scene& scene, const FramePlanRequest& request)
-    : sea_probe_kind(request.sea_probe) {
+FramePlan::FramePlan(const Scene& scene, const FramePlanRequest& request) {
   plans_made.fetch_add(1, std::memory_order_relaxed);
   // Fields of heaps become the clouds around this camera (MODEL.md section 10): the scene's
   // own clouds first, then the heaps, as withFieldClouds lists them.
@@ -140,15 +139,13 @@ FramePlan::FramePlan(const Scene& scene, const FramePlanRequest& request)
     addElapsed(shadows_ms, start);
   }
   if (!scene.sea) return;
-  Camera eye = scene.camera;
-  eye.position.z = 0.0;
-  if (request.sea_probe == SeaProbe::kView) {
-    if (viewShowsSea(scene.camera))
-      sea_probe =
-          seaProbeView(view, seaProbeCamera(scene.camera, request.sea_probe_scale), request.cull);
-    if (request.sea_eye) sea_eye = seaProbeView(view, eye, false);  // a tracer reads every cloud
-  } else {
-    sea_probe = seaProbeView(view, eye, request.cull);
+  if (request.sea_view && viewShowsSea(scene.camera))
+    sea_probe =
+        seaProbeView(view, seaProbeCamera(scene.camera, request.sea_probe_scale), request.cull);
+  if (request.sea_eye) {
+    Camera eye = scene.camera;
+    eye.position.z = 0.0;
+    sea_eye = seaProbeView(view, eye, request.cull);
   }
 }
 

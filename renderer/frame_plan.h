@@ -32,21 +32,17 @@ struct ViewPlan {
   const EllipsoidCloud& cloud(std::size_t i) const { return *clouds[i]; }
 };
 
-// The camera of the sea's probe.
-enum class SeaProbe {
-  kEyeAtSea,  // the view's camera moved down to the sea, for a tracer that mirrors its rays
-  kView,      // a rasteriser's view of what the sea mirrors (seaProbeCamera), when the sea shows
-};
-
 struct FramePlanRequest {
   HeapDrawing heaps;
   // The work budget (RenderSettings::ellipsoid_budget and ellipsoid_overdraw; 0: none).
   double ellipsoid_budget = 0.0, ellipsoid_overdraw = 0.0;
-  SeaProbe sea_probe = SeaProbe::kEyeAtSea;
-  // With kView, the tracer's probe too (FramePlan::sea_eye): a rasteriser whose label channels
-  // the CPU traces from the same plan.
+  // The sea's probes, over a sea (MODEL.md section 18): a rasteriser's view of what the sea
+  // mirrors (FramePlan::sea_probe, seaProbeCamera, when the view shows the sea), and the view's
+  // camera moved down to the sea for a tracer that mirrors its rays (FramePlan::sea_eye; the
+  // GL's label channels traced on the CPU ask for both).
+  bool sea_view = false;
   bool sea_eye = false;
-  double sea_probe_scale = 0.5;  // kView: of the view's resolution
+  double sea_probe_scale = 0.5;  // sea_view: of the view's resolution
   bool cull = false;             // list each view's clouds in view
   bool heap_shadows = false;     // the fields' and clouds' shadows (CloudShadows, with lookups)
   bool plane_shadows = false;    // the casting planes' shadows (PlaneShadows)
@@ -70,19 +66,12 @@ struct FramePlan {
   std::vector<EllipsoidCloud> heaps, kept;
   bool thinned = false;  // the budget thinned the clouds: the views are within it
   ViewPlan view;
-  std::optional<ViewPlan> sea_probe;
-  std::optional<ViewPlan> sea_eye;  // FramePlanRequest::sea_eye
-  SeaProbe sea_probe_kind = SeaProbe::kEyeAtSea;
+  std::optional<ViewPlan> sea_probe;  // FramePlanRequest::sea_view
+  std::optional<ViewPlan> sea_eye;    // FramePlanRequest::sea_eye
   std::optional<CloudShadows> heap_shadows;
   PlaneShadows plane_shadows;
   // How long its stages took.
   double heaps_ms = 0.0, budget_ms = 0.0, shadows_ms = 0.0;
-
-  // The probe a tracer mirrors the sea's rays in (kEyeAtSea), or null.
-  const ViewPlan* tracedSeaProbe() const {
-    if (sea_eye) return &*sea_eye;
-    return sea_probe && sea_probe_kind == SeaProbe::kEyeAtSea ? &*sea_probe : nullptr;
-  }
 };
 
 // Plans made in this process: a frame makes one, whatever channels it draws (tests count them).

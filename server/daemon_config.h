@@ -62,9 +62,9 @@ struct DaemonConfig {
   double tick_rate_hz = 30.0;
   double time_scale = 1.0;
   int world_threads = 1;
-  // Compile the shaders every genus asks for while the world thread is idle after ready
-  // (RenderService::prewarmStep), so that no weather change stalls a frame; false compiles at
-  // each first use.
+  // Compile the shaders every genus asks for after ready, a step after each round of the world
+  // thread's work (RenderService::prewarmStep), so that no weather change stalls a frame; false
+  // compiles at each first use.
   bool prewarm = true;
   // The world budget: ellipsoids its clouds may hold (the scene's, add_cloud's, a restored
   // snapshot's); the default is what a quarter of this machine's memory holds.

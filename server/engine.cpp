@@ -192,10 +192,11 @@ void Engine::run(std::promise<std::string>& started) {
     auto t0 = Clock::now();
     publish();
     telemetry_.noteBusy("publish", t0);
-    // The prewarm a step at a time, between what the world thread has to do.
-    t0 = Clock::now();
-    if (prewarming_) prewarming_ = renders_->prewarmStep(views_.all());
-    telemetry_.noteBusy("prewarm", t0);
+    if (prewarming_) {  // a step after each round of what the world thread has to do
+      t0 = Clock::now();
+      prewarming_ = renders_->prewarmStep(views_.all());
+      telemetry_.noteBusy("prewarm", t0);
+    }
   }
   if (!config_.snapshot_path.empty())
     shutdown_saved_ = saveSnapshot(config_.snapshot_path, "shutdown").empty();

@@ -168,8 +168,11 @@ int prewarmSide(int side) {
 // The catalogue: per air (the scene's, and haze and fog where it has neither), per genus as the
 // one weather layer (none first), per view, the camera below, inside and above the layer.
 struct RenderService::Prewarm {
-  std::vector<std::optional<Haze>> hazes;
-  std::vector<std::optional<Fog>> fogs;
+  struct Air {
+    std::optional<Haze> haze;
+    std::optional<Fog> fog;
+  };
+  std::vector<Air> airs;
   std::size_t step = 0, steps = 0;
   std::unique_ptr<World> world;  // of the step's air and genus
   std::size_t world_of = std::size_t(-1);
@@ -182,11 +185,10 @@ bool RenderService::prewarmStep(const std::vector<ViewConfig>& views) {
   if (!prewarm_) {
     prewarm_ = std::make_unique<Prewarm>();
     Prewarm& p = *prewarm_;
-    p.hazes = {base.haze};
-    p.fogs = {base.fog};
-    if (!base.haze) p.hazes.push_back(Haze{}), p.fogs.push_back(base.fog);
-    if (!base.fog) p.hazes.push_back(base.haze), p.fogs.push_back(Fog{});
-    p.steps = p.hazes.size() * kCloudTypeCount * views.size() * 3;
+    p.airs = {{base.haze, base.fog}};
+    if (!base.haze) p.airs.push_back({Haze{}, base.fog});
+    if (!base.fog) p.airs.push_back({base.haze, Fog{}});
+    p.steps = p.airs.size() * kCloudTypeCount * views.size() * 3;
     spdlog::info("event=prewarm_started steps={}", p.steps);
   }
   Prewarm& p = *prewarm_;
@@ -199,8 +201,9 @@ bool RenderService::prewarmStep(const std::vector<ViewConfig>& views) {
   const WeatherLayer layer = typicalWeatherLayer(CloudType(type), 0.5);
   if (p.world_of != sky) {
     p.world = std::make_unique<World>(base, config_.scene.dynamics);
-    p.world->setHaze(p.hazes[sky / kCloudTypeCount]);
-    p.world->setFog(p.fogs[sky / kCloudTypeCount]);
+    const Prewarm::Air& air = p.airs[sky / kCloudTypeCount];
+    p.world->setHaze(air.haze);
+    p.world->setFog(air.fog);
     if (type > 0) p.world->setWeather({}, layer);
     p.world_of = sky;
   }

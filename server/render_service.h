@@ -65,7 +65,7 @@ class RenderService {
   std::string glName() const;
   std::string backendName() const;
 
-  // World thread, while it has nothing else to do ([world] prewarm): one step of drawing every
+  // World thread, after each round of its work ([world] prewarm): one step of drawing every
   // view small once per genus as the scene's one weather layer, from below, inside and above
   // it, as a subscription's first two frames and as a single render, with the scene's air and
   // again with haze and with fog where it has none. The programs those frames use are compiled,

@@ -110,7 +110,7 @@ TEST(FramePlan, TheSeasProbeSharesTheViewsCloudsFromTheSea) {
   scene.targets.emplace_back();
   scene.camera.orientation.pitch_deg = -10.0;
   FramePlanRequest request;
-  request.sea_probe = SeaProbe::kView;
+  request.sea_view = true;
   request.cull = true;
   const FramePlan plan(scene, request);
   ASSERT_TRUE(plan.sea_probe);
@@ -127,11 +127,12 @@ TEST(FramePlan, TheSeasProbeSharesTheViewsCloudsFromTheSea) {
   scene.camera.orientation.pitch_deg = 60.0;
   EXPECT_FALSE(FramePlan(scene, request).sea_probe);
   // A tracer's probe is the eye moved down to the sea, whatever the view.
-  request.sea_probe = SeaProbe::kEyeAtSea;
+  request.sea_view = false;
+  request.sea_eye = true;
   const FramePlan traced(scene, request);
-  ASSERT_TRUE(traced.sea_probe);
-  EXPECT_EQ(traced.sea_probe->camera().position.z, 0.0);
-  EXPECT_EQ(traced.sea_probe->camera().orientation.pitch_deg, 60.0);
+  ASSERT_TRUE(traced.sea_eye);
+  EXPECT_EQ(traced.sea_eye->camera().position.z, 0.0);
+  EXPECT_EQ(traced.sea_eye->camera().orientation.pitch_deg, 60.0);
 }
 
 }  // namespace

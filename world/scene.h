@@ -147,6 +147,7 @@ enum AirMedium : unsigned {
   kAirSlabs = 8,    // precipitation slabs under stratiform layers
   kAirShafts = 16,  // rain shafts under heaps
 };
+inline constexpr unsigned kEveryAirMedium = kAirFog | kAirVeil | kAirHaze | kAirSlabs | kAirShafts;
 inline unsigned airMedia(const Scene& scene) {
   return (scene.fog ? kAirFog : 0u) | (eyeInLayer(scene) ? kAirVeil : 0u) |
          (scene.haze ? kAirHaze : 0u) | (hasPrecipitationSlabs(scene) ? kAirSlabs : 0u) |

@@ -689,7 +689,7 @@ FramePlanRequest GlRenderer::planRequest(const RenderSettings& settings, bool se
   request.heaps = settings.heaps;
   request.ellipsoid_budget = settings.ellipsoid_budget;
   request.ellipsoid_overdraw = settings.ellipsoid_overdraw;
-  request.sea_probe = SeaProbe::kView;
+  request.sea_view = true;
   request.sea_eye = sea_eye;
   request.sea_probe_scale = settings.sea_probe_scale;
   request.cull = true;

@@ -53,12 +53,15 @@ std::string casterFunction(int caster, int slot, LayerKind kind) {
          "]);\n}\n";
 }
 
-// The sunlight the `n` highest casters of `total` let through to a point of the plane `height`
-// (planesSunlightN, skySlots); 1 with none.
-std::string planesSunlight(int n, int total) {
+// The function of the sunlight the `n` highest casters of `total` let through (skySlots).
+std::string planesSunlightName(int n, int total) {
+  return "planesSunlight" + std::to_string(n) + "of" + std::to_string(total);
+}
+
+// Its value at `hit` on the plane at `height`; 1 with no caster.
+std::string planesSunlight(int n, int total, const std::string& hit, const std::string& height) {
   return n == 0 ? std::string("1.0")
-                : "planesSunlight" + std::to_string(n) + "of" + std::to_string(total) +
-                      "(hit, height)";
+                : planesSunlightName(n, total) + "(" + hit + ", " + height + ")";
 }
 
 std::string slotStatement(int slot, LayerKind kind, int shaded_by, int casters) {
@@ -71,9 +74,9 @@ std::string slotStatement(int slot, LayerKind kind, int shaded_by, int casters) 
   // costs its threshold only.
   return "    if (transmittance > kClear) { LayerHit hit = hitLayer(" + i +
          ", r); float t1 = inFront(hit.distance) ? layerThreshold(" + i +
-         ", r, hit.p) : 1.0; if (t1 < 1.0) { float height = u_height[" + i + "]; composite(" + i +
-         ", r, hit, t1, " + value + ", " + planesSunlight(shaded_by, casters) +
-         ", colour, transmittance); } }\n";
+         ", r, hit.p) : 1.0; if (t1 < 1.0) composite(" + i + ", r, hit, t1, " + value + ", " +
+         planesSunlight(shaded_by, casters, "hit", "u_height[" + i + "]") +
+         ", colour, transmittance); }\n";
 }
 
 // kCommon after the constants it takes from C++ and the formulas it shares with the CPU
@@ -109,7 +112,7 @@ std::string SkyPassLayout::key() const {
 
 std::string airDefines(unsigned media) {
   if (media == 0) return "";
-  std::string s = "#define AIR\n#define AIR_MEDIA\n";
+  std::string s = "#define AIR\n";
   if (media & kAirFog) s += "#define AIR_FOG\n";
   if (media & kAirVeil) s += "#define AIR_VEIL\n";
   if (media & kAirHaze) s += "#define AIR_HAZE\n";
@@ -200,8 +203,8 @@ std::string skySlots(const SkyPassLayout& layout) {
     std::string product = "1.0";
     for (int c = total - n; c < total; ++c)
       product += " * casterSunlight" + std::to_string(c) + "(hit, height)";
-    s += "float planesSunlight" + std::to_string(n) + "of" + std::to_string(total) +
-         "(LayerHit hit, float height) { return " + product + "; }\n";
+    s += "float " + planesSunlightName(n, total) + "(LayerHit hit, float height) { return " +
+         product + "; }\n";
   }
 
   return s;
@@ -244,10 +247,8 @@ std::string skyMain(const SkyPassLayout& layout) {
   }
   if (layout.background) {
     if (layout.ground && total > 0)  // the ground, where the layers in front let it show
-      s += "  if (r.z < 0.0 && transmittance > kClear) g_planes_sun = "
-           "planesSunlight" +
-           std::to_string(total) + "of" + std::to_string(total) +
-           "(hitPlane(-u_camera_z, r), -u_camera_z);\n";
+      s += "  if (r.z < 0.0 && transmittance > kClear) g_planes_sun = " +
+           planesSunlight(total, total, "hitPlane(-u_camera_z, r)", "-u_camera_z") + ";\n";
     s += "  vec3 behind = background(r);\n";
     if (layout.targets) s += "  if (target_distance < kFar) behind = targetColour();\n";
     s += "  colour += transmittance * behind;\n";

@@ -28,8 +28,10 @@ TargetRenderer::~TargetRenderer() = default;
 GLuint TargetRenderer::program() {
   if (program_) return program_.get();
   std::string error;
+  // One program for every scene: targets are few, and their program holds every medium.
   program_ = createProgram(
-      gl_, kVertex, "#version 450 core\n#define AIR\n" + viewShaderSource() + kFragment, error);
+      gl_, kVertex,
+      "#version 450 core\n" + airDefines(kEveryAirMedium) + viewShaderSource() + kFragment, error);
   NEPHELE_CHECK(program_, "target program: " << error);
   return program_.get();
 }

@@ -495,6 +495,7 @@ Frame renderReferenceFrame(const Scene& scene, const ReferenceSettings& settings
                            const ReferenceCancel& cancel, bool* cancelled) {
   FramePlanRequest plan_request;
   plan_request.heaps = settings.heaps;
+  plan_request.sea_eye = true;
   plan_request.heap_shadows = true;
   const FramePlan plan(scene, plan_request);
   return renderReferenceFrame(plan, settings, request, progress, cancel, cancelled);
@@ -520,7 +521,7 @@ Frame renderReferenceFrame(const FramePlan& plan, const ReferenceSettings& setti
   if (infrared) frame.lwir.resize(pixels);
   if (asked.has(Channel::kGlint)) frame.glint.resize(pixels);
 
-  const ReferenceTracer tracer(plan.view, plan.tracedSeaProbe(),
+  const ReferenceTracer tracer(plan.view, plan.sea_eye ? &*plan.sea_eye : nullptr,
                                plan.heap_shadows ? &*plan.heap_shadows : nullptr,
                                settings.sea_waves);
   const PixelWork work{tracer,
@@ -552,6 +553,7 @@ namespace {
 FramePlanRequest drawingHeaps(const HeapDrawing& heaps) {
   FramePlanRequest request;
   request.heaps = heaps;
+  request.sea_eye = true;
   return request;
 }
 Scene withoutTargets(Scene scene) {
@@ -568,7 +570,7 @@ struct CloudProbe::State {
   State(const Scene& s, const HeapDrawing& heaps)
       : scene(withoutTargets(s)),
         plan(scene, drawingHeaps(heaps)),
-        tracer(plan.view, plan.tracedSeaProbe(), nullptr) {}
+        tracer(plan.view, plan.sea_eye ? &*plan.sea_eye : nullptr, nullptr) {}
 };
 
 CloudProbe::CloudProbe(const Scene& scene, const HeapDrawing& heaps)

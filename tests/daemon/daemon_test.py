@@ -1149,10 +1149,9 @@ class HostStateTest(DaemonTest):
         with open(d.snapshot + ".daemon.json") as f:
             self.assertEqual(json.load(f)["ticks"], 3)
 
-
     def test_prewarm_leaves_a_weather_change_nothing_to_compile(self):
         """Issue 63, item 6: with [world] prewarm (the default) the world thread compiles every
-        shader program a genus asks for while it is idle after ready (event=prewarm when done),
+        shader program a genus asks for after ready, between requests (event=prewarm when done),
         so the first frames after weather changes compile none (stats
         last_frame.programs_compiled); without it they compile some, which is what the count is
         there to tell. The daemon answers while it prewarms."""

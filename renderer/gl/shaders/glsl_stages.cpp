@@ -30,9 +30,6 @@
 namespace nephele {
 namespace {
 
-// Every medium of the air (airDefines): a stage with air compiles all of them here.
-constexpr unsigned kAllAir = kAirFog | kAirVeil | kAirHaze | kAirSlabs | kAirShafts;
-
 struct Stage {
   std::string name;  // the file name, with the stage's extension
   std::string source;
@@ -90,7 +87,7 @@ void addSky(Stages& stages) {
         SkyPassLayout layout = sets[k];
         layout.term_filter = filter;
         layout.background = bits & 1;
-        layout.air = (bits & 2) ? kAllAir : 0u;
+        layout.air = (bits & 2) ? kEveryAirMedium : 0u;
         layout.specular = bits & 4;
         layout.targets = bits & 8;
         layout.regions = bits & 16;
@@ -119,7 +116,7 @@ void addEllipsoids(Stages& stages) {
             layout.term_filter = filter;
             layout.shading_rate = rate;
             layout.spotlight = bits & 1;
-            layout.air = (bits & 2) ? kAllAir : 0u;
+            layout.air = (bits & 2) ? kEveryAirMedium : 0u;
             layout.specular = bits & 4;
             layout.targets = bits & 8;
             // The renderer asks for the history with kFusedPerPixel only: kFusedSamples writes
@@ -135,7 +132,7 @@ void addOthers(Stages& stages) {
   // AutomatonRenderer::program: its #defines, MAX_STEPS (kMaxMarchSteps), the view chunk.
   for (int bits = 0; bits < 8; ++bits) {
     std::string defines;
-    if (bits & 1) defines += "#define AIR\n";
+    if (bits & 1) defines += airDefines(kEveryAirMedium);
     if (bits & 2) defines += "#define TARGETS\n";
     if (bits & 4) defines += "#define CORNETTE_SHANKS\n";
     stages.add("automaton_" + std::to_string(bits), false,
@@ -148,7 +145,8 @@ void addOthers(Stages& stages) {
   // TargetRenderer::program.
   stages.add("target", true, glsl::target::kVertex);
   stages.add("target", false,
-             "#version 450 core\n#define AIR\n" + viewShaderSource() + glsl::target::kFragment);
+             "#version 450 core\n" + airDefines(kEveryAirMedium) + viewShaderSource() +
+                 glsl::target::kFragment);
   // GlRenderer::renderFloor.
   stages.add("floor", false, glsl::floor_pass::kFloorFragment);
 }

@@ -32,14 +32,7 @@ vec3 viewRay() {
 }
 
 #ifdef AIR
-// A stage compiles the media its scene holds (airDefines, AIR_MEDIA); AIR alone, all of them.
-#ifndef AIR_MEDIA
-#define AIR_FOG
-#define AIR_VEIL
-#define AIR_HAZE
-#define AIR_SLABS
-#define AIR_SHAFTS
-#endif
+// A stage compiles the media its scene holds, AIR_FOG to AIR_SHAFTS (airDefines).
 // The air between the eye and a surface (MODEL.md section 5): ground fog, the in-layer veil
 // and distance haze; an absent one has zero extinction. Each medium's optical depth and their
 // mixing are the shared formulas' (world/formulas/air.h, pasted ahead of this file), as in
