@@ -40,7 +40,8 @@ void setViewUniforms(const GlApi& gl, GLuint p, const Camera& camera, const Scen
   std::sort(precipitation.begin(), precipitation.end(),
             [](const Fog& a, const Fog& b) { return a.visibility_m < b.visibility_m; });
   for (int i = 0; i < kPrecipitationSlabs; ++i) {
-    const std::string element = "[" + std::to_string(i) + "]";
+    std::string element = "[";  // appended, not summed: GCC 12 warns -Wrestrict on the sum
+    element.append(std::to_string(i)).append("]");
     const bool present = std::size_t(i) < precipitation.size();
     const Fog f = present ? precipitation[std::size_t(i)] : Fog{};
     setUniform3(gl, p, ("u_precip_slab" + element).c_str(), {f.bottom_m, f.top_m, f.band_m});
